@@ -141,3 +141,19 @@ class Scaled(Law):
     def __call__(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         q, qd, qdd = self.law(t)
         return self.offset + self.factor * q, self.factor * qd, self.factor * qdd
+
+
+def law_for(motion, start: float, end: float, drive=None) -> Law:
+    """The law of one coordinate from ``start`` to ``end`` (SI) following the spec's ``motion``
+    section (law, duration, accel_fraction); ``drive`` gives the polynomial law's boundary
+    velocities and accelerations."""
+    T = motion.duration
+    if motion.law == "polynomial":
+        d = drive
+        return Polynomial.from_boundary(
+            (start, d.start_velocity if d else 0.0, d.start_acceleration if d else 0.0),
+            (end, d.end_velocity if d else 0.0, d.end_acceleration if d else 0.0),
+            T,
+        )
+    profile = trapezoidal(motion.accel_fraction) if motion.law == "trapezoidal" else PROFILES[motion.law]
+    return PointToPoint(start, end, T, profile)

@@ -1,0 +1,160 @@
+"""The ``custom`` template: any planar mechanism written as a list of bodies, joints and drivers.
+
+Points on a body are given in the body's frame, either as [x, y] or by the name of one of the
+body's ``points``; on the frame, as global [x, y] or by the name of a ``frame_points`` entry.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal, Union
+
+import numpy as np
+from pydantic import Field
+
+from ..model import FRAME, Body, Driver, Gear, Model, Prismatic, Revolute
+from ..spec_parts import SpecFieldError, Strict
+from ..units import Angle, Inertia, Length, Mass, PositiveLength
+
+Point = Union[str, tuple[Length, Length]]
+
+
+class CustomBody(Strict):
+    """A rigid body with its own frame."""
+
+    name: str = Field(min_length=1, description="unique name; 'frame' is the fixed frame")
+    mass: Mass = Field(description="mass")
+    com: tuple[Length, Length] = Field((0.0, 0.0), description="centre of mass in the body frame")
+    inertia: Inertia = Field(0.0, description="centroidal moment of inertia")
+    points: dict[str, tuple[Length, Length]] = Field({}, description="named points in the body frame")
+    pose: tuple[Length, Length, Angle] = Field(
+        description="approximate pose (x, y, angle) of the body frame at t = 0, refined by assembly"
+    )
+    radius: PositiveLength | None = Field(None, description="draw the body as a disc of this radius (gears)")
+    kind: Literal["link", "gear", "slider", "platform"] = Field("link", description="for drawing and accounting")
+
+
+class RevoluteSpec(Strict):
+    type: Literal["revolute"]
+    name: str = Field(min_length=1)
+    a: str = Field(description="first body (or 'frame')")
+    b: str = Field(description="second body")
+    point_a: Point = Field(description="joint centre on a")
+    point_b: Point = Field((0.0, 0.0), description="joint centre on b")
+
+
+class PrismaticSpec(Strict):
+    type: Literal["prismatic"]
+    name: str = Field(min_length=1)
+    guide: str = Field(description="body carrying the guide (or 'frame')")
+    slider: str = Field(description="sliding body")
+    point_guide: Point = Field(description="a point of the guide's axis")
+    axis: tuple[float, float] = Field(description="direction of the guide in the guide's frame")
+    point_slider: Point = Field((0.0, 0.0), description="the slider's point that stays on the axis")
+    angle: Angle = Field(0.0, description="constant angle of the slider relative to the guide")
+
+
+class GearSpec(Strict):
+    type: Literal["gear"]
+    name: str = Field(min_length=1)
+    a: str = Field(description="driving gear's body")
+    b: str = Field(description="driven gear's body")
+    carrier: str = Field(FRAME, description="body holding both axes ('frame' for fixed axes)")
+    ratio: float = Field(description="(w_b - w_c) / (w_a - w_c); -r_a/r_b for an external mesh")
+
+
+JointSpec = Annotated[Union[RevoluteSpec, PrismaticSpec, GearSpec], Field(discriminator="type")]
+
+
+class DriverSpec(Strict):
+    """An actuated coordinate; its motion is motion.drive[name]."""
+
+    name: str = Field(min_length=1)
+    joint: str | None = Field(None, description="a revolute or prismatic joint to drive")
+    body: str | None = Field(None, description="or a body whose coordinate is driven")
+    coordinate: Literal["x", "y", "angle"] | None = Field(None, description="with body: which coordinate")
+    point: str | None = Field(None, description="with body and x/y: the body's point")
+
+
+class CustomMechanism(Strict):
+    """Explicit bodies, joints and drivers, for mechanisms no template covers."""
+
+    template: Literal["custom"] = Field(description="mechanism template")
+    frame_points: dict[str, tuple[Length, Length]] = Field({}, description="named fixed points")
+    bodies: list[CustomBody] = Field(min_length=1)
+    joints: list[JointSpec] = Field(min_length=1)
+    drivers: list[DriverSpec] = Field(min_length=1)
+
+    def drives(self) -> dict[str, str]:
+        out = {}
+        joints = {j.name: j for j in self.joints}
+        for d in self.drivers:
+            if d.joint is not None:
+                out[d.name] = "length" if isinstance(joints.get(d.joint), PrismaticSpec) else "angle"
+            else:
+                out[d.name] = "angle" if d.coordinate == "angle" else "length"
+        return out
+
+
+def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
+    names = [b.name for b in mech.bodies]
+    root = ("mechanism",)
+    for k, n in enumerate(names):
+        if n == FRAME or names.index(n) != k:
+            raise SpecFieldError(root + ("bodies", k, "name"), f"body name {n!r} is reserved or used twice")
+    bodies = {b.name: b for b in mech.bodies}
+
+    def check_body(name: str, path) -> None:
+        if name != FRAME and name not in bodies:
+            raise SpecFieldError(path, f"unknown body {name!r} (bodies: {', '.join(names)}, frame)")
+
+    def point(body: str, p: Point, path) -> tuple[float, float]:
+        if not isinstance(p, str):
+            return (float(p[0]), float(p[1]))
+        table = mech.frame_points if body == FRAME else bodies[body].points
+        if p not in table:
+            raise SpecFieldError(path, f"{body!r} has no point {p!r} (known: {', '.join(table) or 'none'})")
+        return tuple(table[p])
+
+    joints = []
+    for k, j in enumerate(mech.joints):
+        jp = root + ("joints", k)
+        if isinstance(j, RevoluteSpec):
+            check_body(j.a, jp + ("a",))
+            check_body(j.b, jp + ("b",))
+            joints.append(Revolute(j.name, j.a, j.b, point(j.a, j.point_a, jp + ("point_a",)), point(j.b, j.point_b, jp + ("point_b",))))
+        elif isinstance(j, PrismaticSpec):
+            check_body(j.guide, jp + ("guide",))
+            check_body(j.slider, jp + ("slider",))
+            if np.hypot(*j.axis) == 0:
+                raise SpecFieldError(jp + ("axis",), "the axis must not be zero")
+            joints.append(Prismatic(j.name, j.guide, j.slider, point(j.guide, j.point_guide, jp + ("point_guide",)), tuple(j.axis), point(j.slider, j.point_slider, jp + ("point_slider",)), j.angle))
+        else:
+            for key in ("a", "b", "carrier"):
+                check_body(getattr(j, key), jp + (key,))
+            joints.append(Gear(j.name, j.a, j.b, j.carrier, j.ratio))
+    jnames = {j.name for j in joints}
+    drivers = []
+    for k, d in enumerate(mech.drivers):
+        dp = root + ("drivers", k)
+        if d.joint is not None:
+            if d.joint not in jnames:
+                raise SpecFieldError(dp + ("joint",), f"unknown joint {d.joint!r}")
+            target: tuple = ("joint", d.joint)
+        elif d.body is not None and d.coordinate is not None:
+            check_body(d.body, dp + ("body",))
+            target = (d.coordinate, d.body) + ((d.point,) if d.point else ())
+        else:
+            raise SpecFieldError(dp, "a driver needs either joint, or body and coordinate")
+        drivers.append(Driver(d.name, target, laws[d.name]))
+    model_bodies = tuple(
+        Body(b.name, b.mass, tuple(b.com), b.inertia, dict(b.points), outline=tuple(b.points), radius=b.radius, kind=b.kind)
+        for b in mech.bodies
+    )
+    return Model(
+        name="custom",
+        bodies=model_bodies,
+        joints=tuple(joints),
+        drivers=tuple(drivers),
+        initial={b.name: tuple(b.pose) for b in mech.bodies},
+        frame_points={k: tuple(v) for k, v in mech.frame_points.items()},
+    )

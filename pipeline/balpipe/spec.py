@@ -1,0 +1,107 @@
+"""The spec: one YAML file describing a mechanism, its motion, the balancing method and the
+analysis. ``balpipe schema`` prints its JSON Schema.
+
+Mechanism templates and balancing methods register here: each is a pydantic model with a
+``template`` (``method``) literal that discriminates the union, a builder and a balancer (see
+:mod:`balpipe.registry`).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal, Union
+
+from pydantic import Field
+
+from .balancing.slider_crank import SliderCrankCounterweights
+from .mechanisms.custom import CustomMechanism
+from .mechanisms.slider_crank import SliderCrankMechanism
+from .spec_parts import DriveSpec, Strict
+from .units import Duration, Length, quantity
+
+
+class NoBalancing(Strict):
+    """Analyse the mechanism as given."""
+
+    method: Literal["none"] = Field(description="balancing method")
+
+
+Mechanism = Annotated[
+    Union[SliderCrankMechanism, CustomMechanism],
+    Field(discriminator="template", description="the mechanism: a template with its parameters"),
+]
+Balancing = Annotated[
+    Union[NoBalancing, SliderCrankCounterweights],
+    Field(discriminator="method", description="the balancing method and its design choices"),
+]
+
+
+class Motion(Strict):
+    """Point-to-point motion of the driven coordinates, all on the same law and duration."""
+
+    law: Literal["quintic", "cycloidal", "bang_bang", "trapezoidal", "polynomial"] = Field(
+        "quintic",
+        description="quintic: 3-4-5 polynomial; cycloidal; bang_bang: constant +a then -a; "
+        "trapezoidal: constant acceleration, cruise, deceleration; polynomial: the lowest-degree "
+        "polynomial meeting the drives' boundary velocities and accelerations",
+    )
+    duration: Duration = Field(description="duration of the motion")
+    accel_fraction: float = Field(
+        1 / 3, gt=0, le=0.5, description="trapezoidal law: fraction of the duration spent accelerating"
+    )
+    drive: dict[str, DriveSpec] = Field(
+        description="driven coordinates by name (the template lists them: e.g. crank, slider, "
+        "gripper) with their start and end"
+    )
+
+
+class AnalysisSettings(Strict):
+    """How the motion is sampled and the loads are expressed."""
+
+    samples: int = Field(501, ge=3, le=200_000, description="number of time samples over the motion")
+    gravity: bool = Field(False, description="gravity along -y; most papers work in a horizontal plane")
+    g: Annotated[float, quantity("acceleration", gt=0)] = Field(9.80665, description="gravitational acceleration")
+    moment_point: tuple[Length, Length] = Field((0.0, 0.0), description="point about which shaking moments are taken")
+    balance_tolerance: float = Field(
+        1e-9, gt=0, lt=1,
+        description="a stage counts as balanced when its peak is below this fraction of the unbalanced peak",
+    )
+
+
+class ValidationSpec(Strict):
+    """Settings of the pymunk validation of every stage."""
+
+    enabled: bool = Field(True, description="simulate every stage in pymunk")
+    dt: float | None = Field(None, gt=0, description="time step in s (default chosen per mechanism)")
+    iterations: int | None = Field(None, ge=1, le=10_000, description="solver iterations per step")
+    tolerance: float = Field(0.01, gt=0, le=0.01, description="pass when residuals are below this fraction of the unbalanced peaks (at most 1 %)")
+    reactionless: bool | None = Field(None, description="free-floating frame demonstration (default: on for paper specs)")
+
+
+class Reference(Strict):
+    """A published value to compare with a computed one."""
+
+    name: str = Field(
+        description="a computed parameter's name (e.g. mcp1), or stage.metric for a stage result "
+        "(e.g. unbalanced.max_shaking_force)"
+    )
+    published: float = Field(description="the value printed in the paper, in SI units")
+    unit: str = Field("", description="unit of the value, for display")
+    tolerance: float = Field(0.005, ge=0, description="relative tolerance for 'agrees'")
+    note: str = Field("", description="what the paper says, misprints, how to read it")
+    expect: Literal["agree", "differ"] = Field(
+        "agree", description="'differ' when the published value is known not to reproduce (the note says why)"
+    )
+
+
+class Spec(Strict):
+    """A balancing study: mechanism, motion, method, analysis and references."""
+
+    name: str = Field(min_length=1, description="title of the study")
+    description: str = Field("", description="what the spec reproduces and which values are assumed")
+    paper: str | None = Field(None, description="the paper the spec reproduces, if any")
+    mechanism: Mechanism
+    motion: Motion
+    balancing: Balancing = Field(NoBalancing(method="none"))
+    analysis: AnalysisSettings = Field(AnalysisSettings())
+    validation: ValidationSpec = Field(ValidationSpec())
+    references: list[Reference] = Field([], description="published values to compare with")

@@ -1,0 +1,62 @@
+"""Building blocks shared by the spec sections of every mechanism template and method."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from .units import Inertia, Length, Mass, PositiveLength
+
+
+class SpecFieldError(ValueError):
+    """A semantic error found after schema validation, attached to a field path of the spec.
+
+    ``path`` is a tuple of keys and list indices from the document root, e.g.
+    ``("motion", "drive", "crank", "to")``; the loader turns it into a file line and column.
+    """
+
+    def __init__(self, path: tuple[str | int, ...], message: str):
+        super().__init__(message)
+        self.path = tuple(path)
+        self.message = message
+
+
+class Strict(BaseModel):
+    """Base of every spec section: unknown keys are errors, values are immutable."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+
+
+class LinkSpec(Strict):
+    """A bar-shaped link between its proximal joint (origin of its frame) and distal joint (at
+    ``length`` along its x axis). Mass parameters are those of the bare link."""
+
+    length: PositiveLength = Field(description="distance between the link's two joints")
+    mass: Mass = Field(description="mass of the bare link")
+    com: Length = Field(
+        description="position of the centre of mass along the link, measured from the proximal "
+        "joint towards the distal one (negative: beyond the proximal joint)"
+    )
+    com_offset: Length = Field(0.0, description="offset of the centre of mass normal to the link (left positive)")
+    inertia: Inertia = Field(description="centroidal moment of inertia of the bare link")
+
+
+class BodySpec(Strict):
+    """A rigid body that is not a bar (slider, platform): mass, centre of mass, inertia."""
+
+    mass: Mass = Field(description="mass of the body")
+    com: tuple[Length, Length] = Field((0.0, 0.0), description="centre of mass in the body frame")
+    inertia: Inertia = Field(0.0, description="centroidal moment of inertia")
+
+
+class DriveSpec(Strict):
+    """Start and end of one driven coordinate. The unit depends on the coordinate (an angle for a
+    crank, a length for a slider, a point [x, y] for a gripper); numbers are SI."""
+
+    start: Any = Field(alias="from", description="value at t = 0 (angle, length or [x, y] point)")
+    end: Any = Field(alias="to", description="value at t = duration")
+    start_velocity: float = Field(0.0, description="polynomial law only: velocity at t = 0 (SI)")
+    end_velocity: float = Field(0.0, description="polynomial law only: velocity at the end (SI)")
+    start_acceleration: float = Field(0.0, description="polynomial law only: acceleration at t = 0 (SI)")
+    end_acceleration: float = Field(0.0, description="polynomial law only: acceleration at the end (SI)")
