@@ -19,10 +19,12 @@ from .spec_parts import DriveSpec, SpecFieldError
 
 @dataclass(frozen=True)
 class Template:
-    """``build(mechanism_spec, laws, t) -> Model``; ``laws`` maps drive names to laws."""
+    """``build(mechanism_spec, laws, t) -> Model``; ``laws`` maps drive names to laws.
+    ``figures(study)`` optionally yields extra report figures as (title, svg, caption)."""
 
     build: Callable[..., Model]
     label: str
+    figures: Callable[..., Any] | None = None
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,133 @@
+"""The ``balpipe`` command line: build, check, schema."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+
+from . import __version__
+
+EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # usage errors: exit 2, no traceback
+        self.print_usage(sys.stderr)
+        print(f"balpipe: error: {message}", file=sys.stderr)
+        sys.exit(EXIT_USAGE)
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="balpipe", description="Dynamic balancing of planar mechanisms from YAML specs.")
+    p.add_argument("--version", action="version", version=f"balpipe {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    b = sub.add_parser("build", help="build the report site from specs",
+                       description="Compute, analyse, validate and report every spec; skip unchanged ones.")
+    b.add_argument("paths", nargs="+", metavar="PATH", help="spec files or folders of specs")
+    b.add_argument("-o", "--out", default="reports", metavar="DIR", help="output folder (default: reports)")
+    b.add_argument("-j", "--jobs", type=int, default=1, metavar="N", help="build N specs in parallel")
+    b.add_argument("--no-sim", action="store_true", help="skip the pymunk validation (quick iterations)")
+    b.add_argument("--force", action="store_true", help="rebuild specs even when unchanged")
+    b.add_argument("-q", "--quiet", action="store_true", help="print only errors and the summary")
+    c = sub.add_parser("check", help="validate specs without building",
+                       description="Check specs: schema, units, geometry and balancing feasibility.")
+    c.add_argument("paths", nargs="+", metavar="PATH", help="spec files or folders of specs")
+    s = sub.add_parser("schema", help="print the JSON Schema of a spec", description="Print the spec JSON Schema.")
+    s.add_argument("-o", "--out", metavar="FILE", help="write to FILE instead of stdout")
+    return p
+
+
+def _missing(paths: list[str]) -> list[str]:
+    return [p for p in paths if not Path(p).exists()]
+
+
+def cmd_build(args) -> int:
+    from .build import Options, build
+
+    missing = _missing(args.paths)
+    if missing:
+        print(f"balpipe: error: no such file or folder: {', '.join(missing)}", file=sys.stderr)
+        return EXIT_USAGE
+    if args.jobs < 1:
+        print("balpipe: error: --jobs must be at least 1", file=sys.stderr)
+        return EXIT_USAGE
+    opts = Options(out=Path(args.out), simulate=not args.no_sim, force=args.force)
+
+    def progress(k: int, total: int, o) -> None:
+        if args.quiet and o.status in ("ok",):
+            return
+        tag = "unchanged" if o.skipped else o.status
+        print(f"[{k}/{total}] {o.source}: {tag} ({o.seconds:.2f} s)", file=sys.stderr)
+        if o.status != "ok" and o.message and not o.skipped:
+            print("    " + o.message.replace("\n", "\n    "), file=sys.stderr)
+
+    outcomes = build(args.paths, opts, jobs=args.jobs, progress=progress)
+    if not outcomes:
+        print("balpipe: error: no spec files (*.yaml) found", file=sys.stderr)
+        return EXIT_USAGE
+    n_err = sum(o.spec_error for o in outcomes)
+    n_fail = sum(o.status in ("failed", "crash") for o in outcomes)
+    n_ok = len(outcomes) - n_err - n_fail
+    print(f"balpipe: {n_ok} ok, {n_fail} failed, {n_err} invalid; site: {opts.out / 'index.html'}", file=sys.stderr)
+    if n_fail:
+        return EXIT_FAILED
+    return EXIT_USAGE if n_err else EXIT_OK
+
+
+def cmd_check(args) -> int:
+    from . import registry
+    from .build import find_specs
+    from .loader import SpecErrors, load
+    from .spec_parts import SpecFieldError
+
+    missing = _missing(args.paths)
+    if missing:
+        print(f"balpipe: error: no such file or folder: {', '.join(missing)}", file=sys.stderr)
+        return EXIT_USAGE
+    files = find_specs(args.paths)
+    bad = 0
+    for f in files:
+        try:
+            loaded = load(f)
+            try:
+                registry.balance(loaded.spec)
+            except SpecFieldError as exc:
+                raise loaded.error(exc) from None
+            print(f"{f}: ok")
+        except SpecErrors as exc:
+            bad += 1
+            print(str(exc), file=sys.stderr)
+    print(f"balpipe: {len(files) - bad} valid, {bad} invalid", file=sys.stderr)
+    if not files:
+        return EXIT_USAGE
+    return EXIT_USAGE if bad else EXIT_OK
+
+
+def cmd_schema(args) -> int:
+    from .loader import schema
+
+    text = json.dumps(schema(), indent=2, sort_keys=True) + "\n"
+    if args.out:
+        Path(args.out).write_text(text, encoding="utf-8")
+    else:
+        sys.stdout.write(text)
+    return EXIT_OK
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        return {"build": cmd_build, "check": cmd_check, "schema": cmd_schema}[args.command](args)
+    except KeyboardInterrupt:
+        print("balpipe: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,188 @@
+"""Figures in the style of the papers, as deterministic inline SVG.
+
+Stage styles follow the papers' figures: the unbalanced mechanism solid black, the
+counterweight stage dashed, the fully balanced stage grey. Simulated (pymunk) curves are drawn
+as thin dotted coloured lines over the analytic ones.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.patches import Circle, Polygon  # noqa: E402
+
+from ..model import Model  # noqa: E402
+
+plt.rcParams.update({
+    "svg.hashsalt": "balpipe",
+    "svg.fonttype": "none",
+    "font.family": "DejaVu Sans",
+    "font.size": 9,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+})
+
+STAGE_STYLES = [
+    {"color": "black", "linestyle": "-", "linewidth": 1.4},
+    {"color": "black", "linestyle": "--", "linewidth": 1.4},
+    {"color": "0.6", "linestyle": "-", "linewidth": 2.4},
+    {"color": "tab:blue", "linestyle": "-.", "linewidth": 1.4},
+    {"color": "tab:red", "linestyle": ":", "linewidth": 1.4},
+]
+SIM_COLORS = ["tab:orange", "tab:blue", "tab:green", "tab:purple", "tab:brown"]
+
+
+def style(k: int) -> dict:
+    return STAGE_STYLES[k % len(STAGE_STYLES)]
+
+
+def to_svg(fig, prefix: str) -> str:
+    """Serialise a figure to SVG with no date, and every id prefixed so that several figures can
+    be inlined in one page without clashing."""
+    buf = io.StringIO()
+    fig.savefig(buf, format="svg", metadata={"Date": None, "Creator": None}, bbox_inches="tight")
+    plt.close(fig)
+    svg = buf.getvalue()
+    svg = svg[svg.index("<svg"):]
+    svg = re.sub(r'id="([^"]+)"', lambda m: f'id="{prefix}-{m.group(1)}"', svg)
+    svg = re.sub(r"url\(#([^)]+)\)", lambda m: f"url(#{prefix}-{m.group(1)})", svg)
+    svg = re.sub(r'xlink:href="#([^"]+)"', lambda m: f'xlink:href="#{prefix}-{m.group(1)}"', svg)
+    return svg
+
+
+def loads_figure(stages: list, prefix: str = "loads") -> str:
+    """Fx, Fy, |F| and M over time, every stage on the same axes (paper 000 Fig. 4 style).
+    ``stages``: list of (label, Analysis, simulated or None) with simulated = (t, F, M)."""
+    fig, axes = plt.subplots(2, 2, figsize=(9.0, 5.6), sharex=True)
+    panels = [
+        (axes[0, 0], "Shaking force $F_x$ (N)", lambda F, M: F[:, 0]),
+        (axes[0, 1], "Shaking force $F_y$ (N)", lambda F, M: F[:, 1]),
+        (axes[1, 0], "Shaking force $|F|$ (N)", lambda F, M: np.hypot(F[:, 0], F[:, 1])),
+        (axes[1, 1], "Shaking moment $M$ (N m)", lambda F, M: M),
+    ]
+    for k, (label, an, sim) in enumerate(stages):
+        for ax, title, fn in panels:
+            ax.plot(an.t, fn(an.force, an.moment), label=label, **style(k))
+            if sim is not None:
+                ts, Fs, Ms = sim
+                ax.plot(ts, fn(Fs, Ms), color=SIM_COLORS[k % len(SIM_COLORS)], linestyle=":",
+                        linewidth=1.0, label=f"{label} (pymunk)")
+            ax.set_title(title, fontsize=9)
+    for ax in axes[1]:
+        ax.set_xlabel("time (s)")
+    axes[0, 0].legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    return to_svg(fig, prefix)
+
+
+def efforts_figure(stages: list, prefix: str = "efforts") -> str:
+    """Actuator torque (or force) of every driver, every stage."""
+    names = sorted({n for _, an in stages for n in an.efforts})
+    fig, axes = plt.subplots(1, max(1, len(names)), figsize=(4.6 * max(1, len(names)), 2.8), squeeze=False)
+    for ax, name in zip(axes[0], names):
+        for k, (label, an) in enumerate(stages):
+            if name in an.efforts:
+                ax.plot(an.t, an.efforts[name], label=label, **style(k))
+        ax.set_title(f"Actuator effort: {name} (N m or N)", fontsize=9)
+        ax.set_xlabel("time (s)")
+    axes[0][0].legend(fontsize=7)
+    fig.tight_layout()
+    return to_svg(fig, prefix)
+
+
+def _global_point(pose, p) -> np.ndarray:
+    x, y, th = pose
+    c, s = math.cos(th), math.sin(th)
+    return np.array([x + c * p[0] - s * p[1], y + s * p[0] + c * p[1]])
+
+
+def mechanism_figure(model: Model, analysis, instants: int = 5, prefix: str = "mech",
+                     title: str = "") -> str:
+    """The mechanism drawn at several instants (light to dark), counterweights as discs whose
+    area grows with their mass, gears as circles, and the paths of the link points."""
+    fig, ax = plt.subplots(figsize=(6.0, 4.6))
+    N = len(analysis.t)
+    ks = np.unique(np.linspace(0, N - 1, instants).round().astype(int))
+    poses = analysis.extra["frame_pose"]
+    names = analysis.names
+    max_cw = max([a.mass for b in model.bodies for a in b.attachments] + [1e-12])
+    span = _span(model, poses)
+    # paths of every named point
+    for i, b in enumerate(model.bodies):
+        for pname, p in b.points.items():
+            path = np.array([_global_point(poses[k, i], p) for k in range(0, N, max(1, N // 200))])
+            ax.plot(path[:, 0], path[:, 1], color="tab:blue", linewidth=0.5, alpha=0.5)
+    for n, k in enumerate(ks):
+        alpha = 0.25 + 0.75 * (n + 1) / len(ks)
+        for i, b in enumerate(model.bodies):
+            pose = poses[k, i]
+            if b.radius:
+                ax.add_patch(Circle(_global_point(pose, (0, 0)), b.radius, fill=False, color="tab:green", alpha=alpha, linewidth=1.2))
+                edge = _global_point(pose, (b.radius, 0))
+                centre = _global_point(pose, (0, 0))
+                ax.plot([centre[0], edge[0]], [centre[1], edge[1]], color="tab:green", alpha=alpha, linewidth=0.8)
+            if b.kind == "slider":
+                c = _global_point(pose, (0, 0))
+                w = 0.06 * span
+                ax.add_patch(Polygon([c + d for d in ((-w, -w / 2), (w, -w / 2), (w, w / 2), (-w, w / 2))],
+                                     closed=True, fill=True, facecolor="0.85", edgecolor="black", alpha=alpha))
+            pts = [b.points[p] for p in b.outline]
+            for a in b.attachments:
+                if a.kind == "counterweight":
+                    pts_cw = [b.points[b.outline[0]] if b.outline else (0, 0), a.position]
+                    g = np.array([_global_point(pose, p) for p in pts_cw])
+                    ax.plot(g[:, 0], g[:, 1], color="tab:red", alpha=alpha, linewidth=1.5)
+                    r = 0.035 * span * math.sqrt(a.mass / max_cw)
+                    ax.add_patch(Circle(_global_point(pose, a.position), r, color="tab:red", alpha=0.6 * alpha))
+                elif a.radius:
+                    ax.add_patch(Circle(_global_point(pose, a.position), a.radius, fill=False, color="tab:green", alpha=alpha))
+            if len(pts) >= 2:
+                g = np.array([_global_point(pose, p) for p in pts])
+                ax.plot(g[:, 0], g[:, 1], color="black", alpha=alpha, linewidth=2.2, solid_capstyle="round")
+                ax.plot(g[:, 0], g[:, 1], "o", color="white", markeredgecolor="black", markersize=4, alpha=alpha)
+    for (a, b) in model.guides:
+        ax.plot([a[0], b[0]], [a[1], b[1]], color="0.3", linewidth=1.0, linestyle="-")
+    for name, p in model.frame_points.items():
+        ax.plot(p[0], p[1], marker="^", color="black", markersize=9)
+        ax.annotate(name, p, textcoords="offset points", xytext=(4, -12), fontsize=8)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    if title:
+        ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    return to_svg(fig, prefix)
+
+
+def _span(model: Model, poses: np.ndarray) -> float:
+    xy = poses[:, :, :2].reshape(-1, 2)
+    fp = np.array(list(model.frame_points.values()) or [[0.0, 0.0]])
+    allp = np.vstack([xy, fp])
+    return float(max(np.ptp(allp[:, 0]), np.ptp(allp[:, 1]), 1e-3))
+
+
+def series_figure(t: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel: str, prefix: str,
+                  title: str = "") -> str:
+    """A plain time-series plot: one line per (label, values), stage styles in order."""
+    fig, ax = plt.subplots(figsize=(6.0, 3.0))
+    for k, (label, y) in enumerate(curves):
+        ax.plot(t, y, label=label, **style(k))
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel(ylabel)
+    if title:
+        ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return to_svg(fig, prefix)
+
+
+

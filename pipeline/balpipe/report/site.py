@@ -1,0 +1,53 @@
+"""The site index: every spec of the build with its status and headline numbers."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from .render import environment, num
+
+
+def _entry(out: Path, o) -> dict:
+    page = out / o.slug / "index.html"
+    results = o.results
+    stale = False
+    if results is None and page.exists():
+        stale = True  # the spec failed now; its earlier page is still there
+        try:
+            results = json.loads((out / o.slug / "results.json").read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            results = None
+    e = {
+        "title": (results or {}).get("spec") or Path(o.source).name,
+        "source": o.source,
+        "link": f"{o.slug}/index.html" if page.exists() else None,
+        "status": {"ok": "ok", "failed": "failed", "error": "invalid spec", "crash": "internal error"}.get(o.status, o.status),
+        "stale": stale,
+        "results": results if not stale else None,
+        "errors": o.message if o.status in ("error", "crash", "failed") else "",
+        "error_short": (o.message.splitlines() or [""])[0],
+    }
+    if e["results"]:
+        st = results["stages"]
+        first, last = st[0], st[-1]
+        e["peak_f"] = f"{num(first['max_shaking_force'])} → {num(last['max_shaking_force'])}"
+        e["peak_m"] = f"{num(first['max_shaking_moment'])} → {num(last['max_shaking_moment'])}"
+        e["added_mass"] = f"{num(last['added_mass'])} kg"
+        refs = results.get("references") or []
+        agree = sum(r["status"] == "agrees" for r in refs)
+        e["refs"] = f"{agree}/{len(refs)} reproduced" if refs else "—"
+        val = results.get("validation")
+        if val is None:
+            e["validation"] = '<span class="muted">skipped</span>'
+        else:
+            passed = all(v.get("passed") for v in val.values())
+            e["validation"] = '<span class="badge ok">pass</span>' if passed else '<span class="badge bad">fail</span>'
+    return e
+
+
+def write_site(out: Path, outcomes: list) -> None:
+    entries = [_entry(out, o) for o in sorted(outcomes, key=lambda o: o.source)]
+    n_ok = sum(e["status"] == "ok" for e in entries)
+    html = environment().get_template("index.html").render(entries=entries, n_ok=n_ok, n_failed=len(entries) - n_ok)
+    (out / "index.html").write_text(html, encoding="utf-8")

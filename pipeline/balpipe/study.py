@@ -1,0 +1,176 @@
+"""One spec, end to end in memory: model -> balancing stages -> analysis of every stage ->
+checks and references. No files are written here (see :mod:`balpipe.build`)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from . import registry
+from .balancing.base import BalanceResult, Stage
+from .engine import Analysis, AnalysisError, analyse
+from .spec import Spec
+from .spec_parts import SpecFieldError
+
+
+@dataclass
+class StageResult:
+    stage: Stage
+    analysis: Analysis
+    added_mass: float
+    added_inertia: float
+    validation: Any = None  # balpipe.validate.StageValidation, when simulated
+
+    @property
+    def max_effort(self) -> float:
+        if not self.analysis.efforts:
+            return 0.0
+        return float(max(np.max(np.abs(e)) for e in self.analysis.efforts.values()))
+
+
+@dataclass
+class Study:
+    spec: Spec
+    balance: BalanceResult
+    stages: list[StageResult]
+    references: list[dict]
+    checks: dict
+    problems: list[str] = field(default_factory=list)
+    reactionless: Any = None
+
+    @property
+    def unbalanced(self) -> StageResult:
+        return self.stages[0]
+
+    @property
+    def ok(self) -> bool:
+        return not self.problems
+
+    def extra_figures(self) -> list[tuple[str, str, str]]:
+        """Figures that only the mechanism's template knows how to draw (title, svg, caption)."""
+        hook = registry.TEMPLATES[self.spec.mechanism.template].figures
+        return list(hook(self)) if hook is not None else []
+
+
+def gravity_vector(spec: Spec) -> tuple[float, float]:
+    return (0.0, -spec.analysis.g) if spec.analysis.gravity else (0.0, 0.0)
+
+
+def run_stage_analyses(spec: Spec, result: BalanceResult) -> list[StageResult]:
+    t = registry.time_grid(spec)
+    base = result.stages[0].model
+    out = []
+    for stage in result.stages:
+        try:
+            an = analyse(stage.model, t, gravity_vector(spec), tuple(spec.analysis.moment_point))
+        except AnalysisError as exc:
+            raise SpecFieldError(("motion",), f"stage {stage.name!r}: {exc}") from None
+        out.append(
+            StageResult(
+                stage, an,
+                added_mass=stage.model.total_mass() - base.total_mass(),
+                added_inertia=_total_inertia(stage.model) - _total_inertia(base),
+            )
+        )
+    return out
+
+
+def _total_inertia(model) -> float:
+    """Sum of the declared centroidal inertias of links, attachments and gears (no parallel-axis
+    terms): what a balancing stage adds as rotating inertia (counter-rotations, inertia
+    counterweights)."""
+    return sum(b.inertia + sum(a.inertia for a in b.attachments) for b in model.bodies)
+
+
+def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float) -> dict:
+    F0, M0 = unbalanced.analysis.max_force, unbalanced.analysis.max_moment
+    F, M = sr.analysis.max_force, sr.analysis.max_moment
+    df, dm = sr.analysis.route_difference()
+    return {
+        "name": sr.stage.name,
+        "label": sr.stage.label,
+        "description": sr.stage.description,
+        "balances": sr.stage.balances,
+        "max_shaking_force": F,
+        "max_shaking_moment": M,
+        "force_ratio": F / F0 if F0 > 0 else 0.0,
+        "moment_ratio": M / M0 if M0 > 0 else 0.0,
+        "force_balanced": F <= tol * F0,
+        "moment_balanced": M <= tol * M0,
+        "max_actuator_effort": sr.max_effort,
+        "added_mass": sr.added_mass,
+        "added_inertia": sr.added_inertia,
+        "reactions_vs_momentum_force": df / F0 if F0 > 0 else df,
+        "reactions_vs_momentum_moment": dm / M0 if M0 > 0 else dm,
+    }
+
+
+def _lookup(name: str, balance: BalanceResult, metrics: list[dict]) -> float | None:
+    for p in balance.parameters:
+        if p.name == name:
+            return p.value
+    if "." in name:
+        stage, key = name.split(".", 1)
+        for m in metrics:
+            if m["name"] == stage and isinstance(m.get(key), (int, float)):
+                return float(m[key])
+    return None
+
+
+def compare_references(spec: Spec, balance: BalanceResult, metrics: list[dict]) -> list[dict]:
+    """Published vs computed: 'agrees' within the reference's relative tolerance (and the
+    rounding of the printed digits), 'differs' otherwise, 'unknown' if nothing computes it."""
+    out = []
+    for k, ref in enumerate(spec.references):
+        computed = _lookup(ref.name, balance, metrics)
+        if computed is None:
+            raise SpecFieldError(
+                ("references", k, "name"),
+                f"nothing computes {ref.name!r}; parameters: {', '.join(p.name for p in balance.parameters)}, "
+                "or stage.metric such as unbalanced.max_shaking_force",
+            )
+        rel = abs(computed - ref.published) / abs(ref.published) if ref.published else abs(computed)
+        rounding = 0.5 * 10 ** (-_decimals(ref.published)) / abs(ref.published) if ref.published else 0.0
+        agrees = rel <= max(ref.tolerance, rounding)
+        out.append({
+            "name": ref.name,
+            "published": ref.published,
+            "computed": computed,
+            "unit": ref.unit,
+            "relative_difference": rel,
+            "status": "agrees" if agrees else "differs",
+            "expected": ref.expect,
+            "note": ref.note,
+        })
+    return out
+
+
+def _decimals(x: float) -> int:
+    s = repr(float(x))
+    if "e" in s:
+        return max(0, -int(s.split("e")[1]))
+    frac = s.split(".")[1] if "." in s else ""
+    return 0 if frac == "0" else len(frac)
+
+
+def run(spec: Spec) -> Study:
+    """Balance and analyse every stage; collect checks and problems (no simulation)."""
+    balance = registry.balance(spec)
+    stages = run_stage_analyses(spec, balance)
+    tol = spec.analysis.balance_tolerance
+    metrics = [stage_metrics(s, stages[0], tol) for s in stages]
+    problems = []
+    rvm = max(max(m["reactions_vs_momentum_force"], m["reactions_vs_momentum_moment"]) for m in metrics)
+    if not rvm <= 1e-9 or not math.isfinite(rvm):
+        problems.append(f"reactions and momentum disagree by {rvm:.3g} of the unbalanced peak (limit 1e-9)")
+    for m in metrics:
+        if "force" in m["balances"] and not m["force_balanced"]:
+            problems.append(f"stage {m['name']!r} should cancel the shaking force but keeps {m['force_ratio']:.3g} of it")
+        if "moment" in m["balances"] and not m["moment_balanced"]:
+            problems.append(f"stage {m['name']!r} should cancel the shaking moment but keeps {m['moment_ratio']:.3g} of it")
+    refs = compare_references(spec, balance, metrics)
+    checks = {"reactions_vs_momentum": rvm, "balance_tolerance": tol}
+    return Study(spec, balance, stages, refs, checks, problems)
