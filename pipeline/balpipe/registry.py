@@ -9,9 +9,10 @@ from typing import Any, Callable
 import numpy as np
 
 from . import units
+from .balancing import five_bar as fb_balancing
 from .balancing import slider_crank as sc_balancing
 from .balancing.base import BalanceResult, Stage
-from .mechanisms import custom, slider_crank
+from .mechanisms import custom, five_bar, slider_crank
 from .model import Law, Model
 from .motion import law_for
 from .spec_parts import DriveSpec, SpecFieldError
@@ -39,10 +40,14 @@ class Method:
 TEMPLATES: dict[str, Template] = {
     "slider_crank": Template(slider_crank.build, "slider-crank"),
     "custom": Template(custom.build, "custom mechanism"),
+    "five_bar": Template(five_bar.build, "five-bar (5R), fixed-sequence with gear-coupled inputs"),
 }
 METHODS: dict[str, Method] = {
     "slider_crank_counterweights": Method(
         sc_balancing.balance, ("slider_crank",), "counterweights (+ eq. 20 inertia for Scott-Russell)"
+    ),
+    "five_bar_gear_balancing": Method(
+        fb_balancing.balance, ("five_bar",), "counterweights + counter-rotating gears 5, 6, 7 (eqs. 9-21)"
     ),
 }
 

@@ -12,8 +12,10 @@ from typing import Annotated, Literal, Union
 
 from pydantic import Field
 
+from .balancing.five_bar import FiveBarGearBalancing
 from .balancing.slider_crank import SliderCrankCounterweights
 from .mechanisms.custom import CustomMechanism
+from .mechanisms.five_bar import FiveBarMechanism
 from .mechanisms.slider_crank import SliderCrankMechanism
 from .spec_parts import DriveSpec, Strict
 from .units import Duration, Length, quantity
@@ -26,11 +28,11 @@ class NoBalancing(Strict):
 
 
 Mechanism = Annotated[
-    Union[SliderCrankMechanism, CustomMechanism],
+    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism],
     Field(discriminator="template", description="the mechanism: a template with its parameters"),
 ]
 Balancing = Annotated[
-    Union[NoBalancing, SliderCrankCounterweights],
+    Union[NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing],
     Field(discriminator="method", description="the balancing method and its design choices"),
 ]
 
