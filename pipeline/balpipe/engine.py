@@ -335,6 +335,8 @@ def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray)
 _TOL = 1e-12
 _MAX_ITER = 25
 _COND_LIMIT = 1e11
+_COARSE = 17  # samples followed by continuation before the batched refinement
+_JUMP = 0.2  # rad: a refined angle this far from its interpolated guess may be another branch
 
 
 def _extend(q: np.ndarray) -> np.ndarray:
@@ -432,7 +434,7 @@ def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
             "cannot assemble the mechanism at t = 0: " + str(_fail_position(c, q[0], float(t[0]))).split(": ", 1)[1],
             float(t[0]),
         )
-    coarse_idx = np.unique(np.linspace(0, N - 1, min(N, 65)).round().astype(int))
+    coarse_idx = np.unique(np.linspace(0, N - 1, min(N, _COARSE)).round().astype(int))
     tc = t[coarse_idx]
     qc = np.zeros((len(tc), q.shape[1]))
     vc = np.zeros_like(qc)
@@ -459,7 +461,8 @@ def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
     else:
         guess = np.repeat(qc[:1], N, axis=0)
     qall, ok, _ = _newton(c, guess, t)
-    for k in np.flatnonzero(~ok):  # rare: refine sequentially from the previous sample
+    jumped = np.abs(qall[:, 2::3] - guess[:, 2::3]).max(axis=1) > _JUMP
+    for k in np.flatnonzero(~ok | jumped):  # rare: refine sequentially from the previous sample
         prev = k - 1
         qall[k] = _substep(c, qall[prev], t[prev], t[k])[0]
     _check_regular(c, qall, t)

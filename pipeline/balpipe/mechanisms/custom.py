@@ -80,9 +80,9 @@ class CustomMechanism(Strict):
 
     template: Literal["custom"] = Field(description="mechanism template")
     frame_points: dict[str, tuple[Length, Length]] = Field({}, description="named fixed points")
-    bodies: list[CustomBody] = Field(min_length=1)
-    joints: list[JointSpec] = Field(min_length=1)
-    drivers: list[DriverSpec] = Field(min_length=1)
+    bodies: list[CustomBody] = Field(min_length=1, description="the moving bodies")
+    joints: list[JointSpec] = Field(min_length=1, description="revolute, prismatic and gear joints")
+    drivers: list[DriverSpec] = Field(min_length=1, description="the actuated coordinates")
 
     def drives(self) -> dict[str, str]:
         out = {}

@@ -49,7 +49,7 @@ def to_svg(fig, prefix: str) -> str:
     """Serialise a figure to SVG with no date, and every id prefixed so that several figures can
     be inlined in one page without clashing."""
     buf = io.StringIO()
-    fig.savefig(buf, format="svg", metadata={"Date": None, "Creator": None}, bbox_inches="tight")
+    fig.savefig(buf, format="svg", metadata={"Date": None, "Creator": None})
     plt.close(fig)
     svg = buf.getvalue()
     svg = svg[svg.index("<svg"):]
@@ -64,10 +64,10 @@ def loads_figure(stages: list, prefix: str = "loads") -> str:
     ``stages``: list of (label, Analysis, simulated or None) with simulated = (t, F, M)."""
     fig, axes = plt.subplots(2, 2, figsize=(9.0, 5.6), sharex=True)
     panels = [
-        (axes[0, 0], "Shaking force $F_x$ (N)", lambda F, M: F[:, 0]),
-        (axes[0, 1], "Shaking force $F_y$ (N)", lambda F, M: F[:, 1]),
-        (axes[1, 0], "Shaking force $|F|$ (N)", lambda F, M: np.hypot(F[:, 0], F[:, 1])),
-        (axes[1, 1], "Shaking moment $M$ (N m)", lambda F, M: M),
+        (axes[0, 0], "Shaking force Fx (N)", lambda F, M: F[:, 0]),
+        (axes[0, 1], "Shaking force Fy (N)", lambda F, M: F[:, 1]),
+        (axes[1, 0], "Shaking force |F| (N)", lambda F, M: np.hypot(F[:, 0], F[:, 1])),
+        (axes[1, 1], "Shaking moment M (N m)", lambda F, M: M),
     ]
     for k, (label, an, sim) in enumerate(stages):
         for ax, title, fn in panels:
@@ -118,9 +118,11 @@ def mechanism_figure(model: Model, analysis, instants: int = 5, prefix: str = "m
     span = _span(model, poses)
     # paths of every named point
     for i, b in enumerate(model.bodies):
-        for pname, p in b.points.items():
-            path = np.array([_global_point(poses[k, i], p) for k in range(0, N, max(1, N // 200))])
-            ax.plot(path[:, 0], path[:, 1], color="tab:blue", linewidth=0.5, alpha=0.5)
+        x, y, th = poses[:, i, 0], poses[:, i, 1], poses[:, i, 2]
+        for p in b.points.values():
+            px = x + np.cos(th) * p[0] - np.sin(th) * p[1]
+            py = y + np.sin(th) * p[0] + np.cos(th) * p[1]
+            ax.plot(px, py, color="tab:blue", linewidth=0.5, alpha=0.5)
     for n, k in enumerate(ks):
         alpha = 0.25 + 0.75 * (n + 1) / len(ks)
         for i, b in enumerate(model.bodies):

@@ -1,0 +1,119 @@
+"""The command line as a user meets it: exit codes, messages, the site, determinism."""
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SPECS = ROOT / "specs"
+
+
+def balpipe(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "balpipe", *map(str, args)], capture_output=True, text=True, cwd=cwd)
+
+
+@pytest.fixture
+def work(tmp_path):
+    """A folder with the two slider-crank specs (fast to build)."""
+    d = tmp_path / "specs"
+    d.mkdir()
+    for name in ("scott_russell.yaml", "offset_slider_crank.yaml"):
+        shutil.copy(SPECS / name, d / name)
+    return tmp_path
+
+
+def test_help_for_every_command():
+    for args in (["--help"], ["build", "--help"], ["check", "--help"], ["schema", "--help"]):
+        r = balpipe(*args)
+        assert r.returncode == 0 and "usage: balpipe" in r.stdout
+
+
+def test_usage_errors_exit_2_without_traceback(tmp_path):
+    for args in (["build"], ["frobnicate"], ["build", tmp_path / "nope"], ["build", tmp_path, "-j", "0"]):
+        r = balpipe(*args)
+        assert r.returncode == 2, args
+        assert "Traceback" not in r.stderr
+
+
+def test_build_writes_the_site(work):
+    r = balpipe("build", "specs", "-o", "out", "--no-sim", cwd=work)
+    assert r.returncode == 0, r.stderr
+    out = work / "out"
+    index = (out / "index.html").read_text()
+    assert "scott_russell/index.html" in index and "offset_slider_crank/index.html" in index
+    res = json.loads((out / "scott_russell" / "results.json").read_text())
+    assert res["spec"].startswith("Scott-Russell")
+    assert [s["name"] for s in res["stages"]] == ["unbalanced", "counterweights", "full"]
+    for key in ("max_shaking_force", "max_shaking_moment", "max_actuator_effort", "added_mass"):
+        assert all(key in s for s in res["stages"])
+    assert {p["name"] for p in res["parameters"]} >= {"mcp1", "mcp2", "Icp2"}
+    assert res["checks"]["reactions_vs_momentum"] < 1e-9
+    full = res["stages"][-1]
+    assert full["max_shaking_force"] <= 1e-9 * res["stages"][0]["max_shaking_force"]
+    assert full["max_shaking_moment"] <= 1e-9 * res["stages"][0]["max_shaking_moment"]
+    csv = (out / "scott_russell" / "timeseries.csv").read_text().splitlines()
+    assert csv[0].startswith("t_s,unbalanced.Fx_N") and len(csv) == 1 + 501
+    page = (out / "scott_russell" / "index.html").read_text()
+    assert page.count("<svg") >= 5 and "skipped" in page
+    assert (out / "balpipe.schema.json").exists()
+    # unchanged specs are not rebuilt
+    again = balpipe("build", "specs", "-o", "out", "--no-sim", cwd=work)
+    assert again.returncode == 0 and again.stderr.count("unchanged") == 2
+
+
+def test_output_is_byte_identical(work):
+    assert balpipe("build", "specs", "-o", "a", "--no-sim", cwd=work).returncode == 0
+    assert balpipe("build", "specs", "-o", "b", "--no-sim", "--force", cwd=work).returncode == 0
+    files = sorted(p.relative_to(work / "a") for p in (work / "a").rglob("*") if p.is_file())
+    assert len(files) >= 8
+    for f in files:
+        assert (work / "a" / f).read_bytes() == (work / "b" / f).read_bytes(), f
+
+
+def test_bad_spec_does_not_stop_the_others_nor_damage_its_old_page(work):
+    assert balpipe("build", "specs", "-o", "out", "--no-sim", cwd=work).returncode == 0
+    page = work / "out" / "offset_slider_crank" / "index.html"
+    before = page.read_bytes()
+    spec = work / "specs" / "offset_slider_crank.yaml"
+    spec.write_text(spec.read_text().replace("mass: 600 g", "mass: -600 g"))
+    (work / "specs" / "broken.yaml").write_text("name: broken\nmechanism: {template: slider_crank\n")
+    r = balpipe("build", "specs", "-o", "out", "--no-sim", cwd=work)
+    assert r.returncode == 2
+    assert "Traceback" not in r.stderr
+    assert "specs/offset_slider_crank.yaml:15:" in r.stderr and "mechanism.slider.mass: must be >= 0" in r.stderr
+    assert "specs/broken.yaml:3:1: malformed YAML" in r.stderr
+    assert page.read_bytes() == before  # the earlier page is intact
+    index = (work / "out" / "index.html").read_text()
+    assert index.count("invalid spec") == 2 and "page from an earlier build" in index
+    assert (work / "out" / "scott_russell" / "index.html").exists()
+
+
+def test_a_stage_that_misses_its_claim_fails_the_build(work):
+    spec = work / "specs" / "scott_russell.yaml"
+    spec.write_text(spec.read_text().replace("samples: 501", "samples: 501\n  balance_tolerance: 1.0e-18"))
+    r = balpipe("build", spec, "-o", "out", "--no-sim", cwd=work)
+    assert r.returncode == 1
+    res = json.loads((work / "out" / "scott_russell" / "results.json").read_text())
+    assert res["status"] == "failed" and "should cancel" in res["problems"][0]
+    assert "failed" in (work / "out" / "index.html").read_text()
+
+
+def test_unreachable_geometry_is_a_located_spec_error(work):
+    spec = work / "specs" / "offset_slider_crank.yaml"
+    spec.write_text(spec.read_text().replace("offset: 30 mm", "offset: 250 mm"))
+    r = balpipe("check", spec)
+    assert r.returncode == 2
+    assert "offset_slider_crank.yaml:14:" in r.stderr and "mechanism.coupler.length: the coupler" in r.stderr
+
+
+def test_check_and_schema(work):
+    r = balpipe("check", "specs", cwd=work)
+    assert r.returncode == 0 and r.stdout.count(": ok") == 2
+    r = balpipe("schema")
+    assert r.returncode == 0
+    s = json.loads(r.stdout)
+    assert "mechanism" in s["properties"] and s["additionalProperties"] is False

@@ -1,0 +1,111 @@
+"""Physics invariants of the slider-crank balancing (paper 000, Sec. 3.1), random parameters."""
+
+import math
+
+import numpy as np
+import pytest
+
+from balpipe import registry, study
+from balpipe.engine import analyse
+from balpipe.spec_parts import SpecFieldError
+
+from conftest import slider_crank_spec
+
+LAWS = ["quintic", "cycloidal", "bang_bang", "trapezoidal", "polynomial"]
+
+
+def _stage(st, name):
+    return next(s for s in st.stages if s.stage.name == name)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_counterweights_of_eq15_balance_the_force_for_any_law(seed):
+    rng = np.random.default_rng(seed)
+    spec = slider_crank_spec(rng, law=LAWS[seed % len(LAWS)], gravity=bool(seed % 2))
+    st = study.run(spec)
+    unb, cw = st.stages[0].analysis, _stage(st, "counterweights").analysis
+    # with gravity on, the weight of the moving links stays; the inertial part cancels
+    weight = _stage(st, "counterweights").stage.model.total_mass() * np.array(cw.gravity)
+    assert np.max(np.linalg.norm(cw.force - weight, axis=1)) <= 1e-9 * unb.max_force
+    # the total centre of mass does not move, the linear momentum stays zero
+    assert np.ptp(cw.com, axis=0).max() < 1e-12
+    assert np.abs(cw.momentum).max() < 1e-9 * np.abs(unb.momentum).max()
+    assert st.checks["reactions_vs_momentum"] < 1e-9
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_eq20_cancels_the_moment_of_a_scott_russell_mechanism(seed):
+    rng = np.random.default_rng(100 + seed)
+    spec = slider_crank_spec(rng, scott_russell=True, moment_unknown="coupler_counterweight_inertia")
+    try:
+        st = study.run(spec)
+    except SpecFieldError as exc:  # eq. 20 wants the inertia on the crank for these masses
+        assert "crank_counterweight_inertia" in exc.message
+        data = spec.model_dump(by_alias=True)
+        data["balancing"]["moment_unknown"] = "crank_counterweight_inertia"
+        st = study.run(type(spec).model_validate(data))
+    full = _stage(st, "full").analysis
+    unb = st.stages[0].analysis
+    assert full.max_force <= 1e-9 * unb.max_force
+    assert full.max_moment <= 1e-9 * unb.max_moment
+    # angular momentum constant (zero: the mechanism starts at rest)
+    assert np.abs(full.angular_momentum).max() <= 1e-9 * np.abs(unb.angular_momentum).max()
+    assert st.ok, st.problems
+
+
+def test_general_slider_crank_keeps_a_moment_and_says_why(rng):
+    st = study.run(slider_crank_spec(rng))
+    assert [s.stage.name for s in st.stages] == ["unbalanced", "counterweights"]
+    assert st.stages[1].analysis.max_moment > 0.05 * st.stages[0].analysis.max_moment
+    assert any("counter-rotations" in n for n in st.balance.notes)
+
+
+def test_moment_unknown_on_a_general_slider_crank_is_refused(rng):
+    with pytest.raises(SpecFieldError) as exc:
+        study.run(slider_crank_spec(rng, moment_unknown="crank_counterweight_inertia"))
+    assert exc.value.path == ("balancing", "moment_unknown")
+
+
+@pytest.mark.parametrize("k", [0.5, 3.0])
+def test_scaling_every_mass_and_inertia_scales_loads_and_counterweights(k):
+    a = study.run(slider_crank_spec(np.random.default_rng(7), scott_russell=True,
+                                    moment_unknown="coupler_counterweight_inertia"))
+    b = study.run(slider_crank_spec(np.random.default_rng(7), scott_russell=True, mass_scale=k,
+                                    moment_unknown="coupler_counterweight_inertia"))
+    for pa, pb in zip(a.balance.parameters, b.balance.parameters):
+        expected = pa.value * (k if pa.unit in ("kg", "kg m^2") else 1.0)
+        assert pb.value == pytest.approx(expected, rel=1e-12)
+    ua, ub = a.stages[0].analysis, b.stages[0].analysis
+    assert np.allclose(ub.force, k * ua.force, rtol=1e-9, atol=1e-9 * ua.max_force)
+    assert np.allclose(ub.moment, k * ua.moment, rtol=1e-9, atol=1e-9 * ua.max_moment)
+    assert np.allclose(ub.efforts["crank"], k * ua.efforts["crank"], rtol=1e-9, atol=1e-9)
+
+
+def test_halving_the_duration_multiplies_the_loads_by_four(rng):
+    a = study.run(slider_crank_spec(np.random.default_rng(3), duration=0.4))
+    b = study.run(slider_crank_spec(np.random.default_rng(3), duration=0.2))
+    for sa, sb in zip(a.stages, b.stages):
+        assert np.allclose(sb.analysis.force, 4 * sa.analysis.force, atol=1e-9 * sa.analysis.max_force * 4)
+        assert np.allclose(sb.analysis.moment, 4 * sa.analysis.moment, atol=1e-9 * a.stages[0].analysis.max_moment * 4)
+
+
+def test_moment_point_moves_the_moment_by_p_cross_f(rng):
+    spec = slider_crank_spec(rng)
+    model = registry.balance(spec).stages[0].model
+    t = registry.time_grid(spec)
+    a = analyse(model, t)
+    b = analyse(model, t, moment_point=(0.3, -0.2))
+    expected = a.moment - (0.3 * a.force[:, 1] - (-0.2) * a.force[:, 0])
+    assert np.allclose(b.moment, expected, atol=1e-12 * a.max_moment)
+    assert np.allclose(b.moment_momentum, b.moment, atol=1e-9 * a.max_moment)
+
+
+def test_unreachable_motion_names_the_time_and_the_link():
+    spec = slider_crank_spec(np.random.default_rng(1))
+    data = spec.model_dump(by_alias=True)
+    data["mechanism"]["offset"] = 0.5 * data["mechanism"]["coupler"]["length"]
+    data["mechanism"]["coupler"]["length"] = 1.2 * data["mechanism"]["crank"]["length"]
+    with pytest.raises(SpecFieldError) as exc:
+        study.run(type(spec).model_validate(data))
+    assert exc.value.path == ("mechanism", "coupler", "length")
+    assert "cannot reach the guide at t =" in exc.value.message
