@@ -40,7 +40,7 @@ class Method:
 TEMPLATES: dict[str, Template] = {
     "slider_crank": Template(slider_crank.build, "slider-crank"),
     "custom": Template(custom.build, "custom mechanism"),
-    "five_bar": Template(five_bar.build, "five-bar (5R), fixed-sequence with gear-coupled inputs"),
+    "five_bar": Template(five_bar.build, "five-bar (5R), fixed-sequence with gear-coupled inputs", five_bar.figures),
 }
 METHODS: dict[str, Method] = {
     "slider_crank_counterweights": Method(

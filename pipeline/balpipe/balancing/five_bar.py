@@ -37,11 +37,10 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Literal
 
-import numpy as np
 from pydantic import Field
 
 from ..mechanisms.five_bar import FiveBarMechanism, GearPart, Synthesis
-from ..model import FRAME, Attachment, Body, Gear, Model, Revolute
+from ..model import Attachment, Body, Gear, Model, Revolute
 from ..spec_parts import SpecFieldError, Strict
 from ..units import Inertia, Length, Mass
 from .base import BalanceResult, Parameter, Stage

@@ -130,13 +130,12 @@ def inverse_leg(A, lp: float, ld: float, C, sigma: int) -> np.ndarray:
 def reach_message(leg: int, A, lp: float, ld: float, C, sigma: int) -> str | None:
     """Why leg ``leg`` (1 or 2) cannot reach C, or None."""
     dist = math.hypot(C[0] - A[0], C[1] - A[1])
-    name = f"leg {leg} (A{leg} = ({A[0]:g}, {A[1]:g}), links {leg} and {leg + 2}, working mode sigma{leg} = {sigma:+d})"
+    name = (f"leg {leg} (links {leg} and {leg + 2} from A{leg} = ({A[0]:g}, {A[1]:g})) cannot reach "
+            f"({C[0]:.4g}, {C[1]:.4g}) in working mode sigma{leg} = {sigma:+d} nor in the other")
     if dist >= lp + ld:
-        return (f"{name} cannot reach ({C[0]:g}, {C[1]:g}): |A{leg}C| = {dist:.4g} m exceeds "
-                f"l{leg} + l{leg + 2} = {lp + ld:.4g} m")
+        return f"{name}: |A{leg}C| = {dist:.4g} m is not below |A{leg}B{leg}| + |B{leg}C| = {lp + ld:.4g} m"
     if dist <= abs(lp - ld):
-        return (f"{name} cannot reach ({C[0]:g}, {C[1]:g}): |A{leg}C| = {dist:.4g} m is below "
-                f"|l{leg} - l{leg + 2}| = {abs(lp - ld):.4g} m")
+        return f"{name}: |A{leg}C| = {dist:.4g} m is not above ||A{leg}B{leg}| - |B{leg}C|| = {abs(lp - ld):.4g} m"
     return None
 
 
@@ -314,7 +313,7 @@ def synthesise(mech: FiveBarMechanism, start, end) -> Synthesis:
             to,
             f"with the gear-coupled inputs the distal links cannot close the loop on the way: at "
             f"theta1 = {th1[k]:.4g} rad, theta2 = {th2[k]:.4g} rad, |B1B2| = "
-            f"{float(np.hypot(*(B2 - B1))):.4g} m is outside [|l3 - l4|, l3 + l4] = "
+            f"{float(np.hypot(*(B2 - B1))):.4g} m is outside [||B1C| - |B2C||, |B1C| + |B2C|] = "
             f"[{abs(dl1.length - dl2.length):.4g}, {dl1.length + dl2.length:.4g}] m",
         )
     if assembly_mode(mech, th1f, th2f, end) != asm or math.hypot(*(C[-1] - np.asarray(end))) > 1e-9 * max(1.0, dist):
@@ -474,3 +473,45 @@ __all__ = [
     "synthesise", "inverse_kinematics", "forward_kinematics", "gripper_path", "gripper_path_fk",
     "input_angles",
 ]
+
+
+def figures(study):
+    """Report figures of the template: the gripper path (Fig. 7) and the input angles (Figs. 8-9)."""
+    from ..report.figures import plt, to_svg  # matplotlib only when a report is drawn
+
+    first = study.stages[0]
+    an, model = first.analysis, first.stage.model
+    C = gripper_path(an, model)
+    S, E = C[0], C[-1]
+    fig, ax = plt.subplots(figsize=(5.6, 3.6))
+    ax.plot(C[:, 0], C[:, 1], color="black", linewidth=1.4, label="gripper path")
+    ax.plot([S[0], E[0]], [S[1], E[1]], color="0.6", linestyle="--", linewidth=1.0, label="straight segment")
+    ax.plot([S[0]], [S[1]], "o", color="black", markersize=4)
+    ax.plot([E[0]], [E[1]], "s", color="black", markersize=4)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    dev = float(np.max(segment_distance(C, S, E)))
+    coupled = model.name.startswith("fixed-sequence")
+    yield (
+        "Gripper path (Fig. 7)",
+        to_svg(fig, "fivebar-path"),
+        f"C(t) from the analysis, from ({S[0]:.4g}, {S[1]:.4g}) to ({E[0]:.4g}, {E[1]:.4g}) m; largest "
+        f"distance from the straight segment {1000 * dev:.3g} mm"
+        + (" (the gear-coupled inputs do not keep the gripper on the segment)." if coupled else "."),
+    )
+    th1, th2 = input_angles(an)
+    fig, axes = plt.subplots(1, 2, figsize=(8.4, 2.8))
+    for ax, th, name in ((axes[0], th1, "theta1"), (axes[1], th2, "theta2")):
+        ax.plot(an.t, th, color="black", linewidth=1.4)
+        ax.set_title(f"{name} (rad)", fontsize=9)
+        ax.set_xlabel("time (s)")
+    fig.tight_layout()
+    yield (
+        "Input angles (Figs. 8-9)",
+        to_svg(fig, "fivebar-angles"),
+        "theta1 follows the motion law; theta2 follows it through gears 1', 5, 2' (theta2 - theta2i = "
+        "U21 (theta1 - theta1i))." if coupled else "Both inputs follow the inverse kinematics of the straight path.",
+    )
