@@ -1,0 +1,474 @@
+"""Generic translation of a balpipe :class:`~balpipe.model.Model` into a pymunk 7 space.
+
+Nothing here knows a mechanism: every body, joint and driver of the model is mapped by type.
+:mod:`balpipe.validate` drives the space along the motion and measures the loads.
+
+Bodies
+    One ``pymunk.Body(mass, moment)`` per model body, no shapes (so nothing collides). The
+    pymunk body's origin is the body's centre of mass (``center_of_gravity`` stays (0, 0), set
+    before ``angle``, set before ``position``: see ../shared/reference/PYMUNK.md), so
+    ``body.position`` and ``body.velocity`` are the centre of mass's. Joint points are converted
+    from the model's body frame to offsets from the centre of mass. pymunk needs positive masses
+    and moments: a body whose mass (moment) is zero, such as a massless gear, gets
+    ``mass_floor`` times the largest mass (moment) of the model. That changes the loads by at
+    most that fraction (measured: no visible change at the default 1e-6, see
+    :mod:`balpipe.validate`).
+
+Frame
+    ``space.static_body`` (its local coordinates are global coordinates), or, for the
+    free-floating demonstration, a dynamic base body whose local coordinates are the model's
+    global coordinates at t = 0 and whose centre of gravity is a chosen point.
+
+Joints
+    * Revolute: ``PivotJoint``, ``error_bias = 0`` (a pivot drifts ~1e-4 m with the default).
+    * Prismatic: ``GrooveJoint`` (the guide's line through ``point_guide``, long enough never to
+      be left) plus a ``GearJoint(guide, slider, angle, 1)`` locking the relative rotation. A
+      driven prismatic pair replaces its groove by a ``PivotJoint`` whose anchor on the guide
+      moves along the axis with the law.
+    * Angle relations (gear pairs, the rotation lock, angle drivers) are written, as in the
+      engine, as ``sum_k c_k theta_k = phase (+ law)`` over the bodies involved. The frame drops
+      out when it is static. With one or two moving bodies it is one ``GearJoint``: between two
+      moving bodies whose coefficients do not cancel (a gear pair carried by a static frame),
+      pymunk's GearJoint gives the right motion but does not conserve angular momentum; the
+      missing ``(1 - ratio)`` couple is the one the frame takes, and the momentum measurement
+      of :mod:`balpipe.validate` (the loads on the frame are minus the rate of change of the
+      moving bodies' momenta) includes it by construction. With three moving bodies (a gear
+      pair on a moving carrier, or any gear pair on the free-floating base) no combination of
+      two-body GearJoints can express the constraint (each one relates two absolute angles),
+      so the mesh is modelled as what it is: the two gears turn on pivots of the carrier and
+      touch at the pitch point, where a ``GrooveJoint`` (groove on gear a along the line of
+      centres, anchor on gear b) forbids relative sliding. The groove and anchor are re-placed
+      at the pitch point before every step, so the constraint is exactly
+      ``(w_b - w_c) = ratio (w_a - w_c)`` at velocity level, and the anchor is offset along the
+      tangent by the accumulated angle error so that the position-level relation is restored
+      each step (dead-beat). Every force then acts between two bodies at one point: the mesh
+      couple reaches the carrier through the pivots and momentum is conserved. The gear
+      centres are the points where a revolute joint connects a (b) to the carrier; when there
+      is none, two auxiliary light gear bodies are pinned to the carrier and locked to a and b
+      (ratio 1 GearJoints, which conserve momentum).
+
+Drivers (the dead-beat recipe)
+    Chipmunk moves positions before it solves velocities, so a constraint's target set before
+    the step from t is reached at t + 2 dt. Every driver constraint has ``error_bias = 0`` and
+    its target is set before each step to the law at t + 2 dt.
+
+    * revolute joint or absolute angle: ``GearJoint(a, b, phase, 1)``, phase = law;
+    * prismatic joint: the moving pivot above;
+    * x / y of a body point: a ``GrooveJoint`` on the frame, the vertical (horizontal) line at
+      the law's value, the point as anchor.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pymunk
+
+from .model import FRAME, Driver, Gear, Model, Prismatic, Revolute
+
+__all__ = ["SimModel", "build_space", "assembled_state"]
+
+
+def _rot(th: float, v) -> tuple[float, float]:
+    c, s = math.cos(th), math.sin(th)
+    return (c * v[0] - s * v[1], s * v[0] + c * v[1])
+
+
+def _unrot(th: float, v) -> tuple[float, float]:
+    c, s = math.cos(th), math.sin(th)
+    return (c * v[0] + s * v[1], -s * v[0] + c * v[1])
+
+
+@dataclass
+class _Drive:
+    """A constraint whose target follows a law: ``set(value)`` before each step."""
+
+    name: str
+    driver: Driver
+    kind: str  # "phase", "anchor", "groove"
+    constraint: pymunk.Constraint
+    scale: float = 1.0
+    offset: float = 0.0
+    base_point: tuple[float, float] = (0.0, 0.0)
+    axis: tuple[float, float] = (1.0, 0.0)
+    half_length: float = 1.0
+
+    def set(self, value: float) -> None:
+        c = self.constraint
+        if self.kind == "phase":
+            c.phase = self.offset + self.scale * value
+        elif self.kind == "anchor":
+            c.anchor_a = (
+                self.base_point[0] + self.axis[0] * value,
+                self.base_point[1] + self.axis[1] * value,
+            )
+        else:  # groove: line through axis-coordinate `value`, perpendicular to axis
+            ax, L = self.axis, self.half_length
+            n = (-ax[1], ax[0])
+            p = (self.base_point[0] + ax[0] * value, self.base_point[1] + ax[1] * value)
+            c.groove_a = (p[0] - n[0] * L, p[1] - n[1] * L)
+            c.groove_b = (p[0] + n[0] * L, p[1] + n[1] * L)
+
+
+@dataclass
+class _Mesh:
+    """A gear pair on a moving carrier: a groove re-placed at the pitch point every step."""
+
+    name: str
+    groove: pymunk.GrooveJoint
+    a: pymunk.Body  # the body holding the groove (gear a, or its auxiliary)
+    b: pymunk.Body  # the body holding the anchor (gear b, or its auxiliary)
+    c: pymunk.Body  # carrier
+    ta: pymunk.Body  # bodies whose angles enter the relation
+    tb: pymunk.Body
+    oa: tuple[float, float]  # gear centres in the carrier's local coordinates
+    ob: tuple[float, float]
+    ratio: float
+    phase: float
+    half_length: float
+    auxiliary: bool = False
+
+    def update(self, dt: float) -> None:
+        """Place groove and anchor for the positions the next step will integrate to."""
+
+        def pred(body):
+            # pymunk integrates the centre of gravity: p += v dt, angle += w dt
+            th = body.angle + dt * body.angular_velocity
+            cog = body.center_of_gravity
+            g = body.local_to_world(cog)
+            v = body.velocity
+            o = _rot(th, cog)
+            return g.x + dt * v.x - o[0], g.y + dt * v.y - o[1], th
+
+        xc, yc, thc = pred(self.c)
+        xa, ya, tha = pred(self.a)
+        xb, yb, thb = pred(self.b)
+        tha_r = self.ta.angle + dt * self.ta.angular_velocity
+        thb_r = self.tb.angle + dt * self.tb.angular_velocity
+        wa = _rot(thc, self.oa)
+        wb = _rot(thc, self.ob)
+        wa = (xc + wa[0], yc + wa[1])
+        wb = (xc + wb[0], yc + wb[1])
+        dx, dy = wb[0] - wa[0], wb[1] - wa[1]
+        d = math.hypot(dx, dy)
+        u = (dx / d, dy / d)
+        t = (-u[1], u[0])
+        R = self.ratio
+        p = R * d / (R - 1.0)
+        q = d / (R - 1.0)
+        err = (thb_r - thc) - R * (tha_r - thc) - self.phase
+        P = (wa[0] + p * u[0], wa[1] + p * u[1])
+        anchor = (P[0] + q * err * t[0], P[1] + q * err * t[1])
+        L = self.half_length
+        g1 = _unrot(tha, (P[0] - L * u[0] - xa, P[1] - L * u[1] - ya))
+        g2 = _unrot(tha, (P[0] + L * u[0] - xa, P[1] + L * u[1] - ya))
+        self.groove.groove_a = g1
+        self.groove.groove_b = g2
+        self.groove.anchor_b = _unrot(thb, (anchor[0] - xb, anchor[1] - yb))
+
+
+@dataclass
+class SimModel:
+    """A model built in a pymunk space.
+
+    ``bodies`` are the model's bodies in ``model.bodies`` order (their ``position`` is the centre
+    of mass); ``auxiliary`` holds the light bodies added for meshes without a carrier pivot;
+    ``base`` is the frame (``space.static_body``, or the dynamic base when floating).
+    ``floored`` names the bodies whose mass or moment was raised to the floor.
+    """
+
+    model: Model
+    space: pymunk.Space
+    bodies: list[pymunk.Body]
+    auxiliary: list[pymunk.Body]
+    base: pymunk.Body
+    floating: bool
+    drives: list[_Drive]
+    meshes: list[_Mesh]
+    com_local: list[tuple[float, float]]
+    floored: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def moving(self) -> list[pymunk.Body]:
+        """Every dynamic body of the mechanism (not the base)."""
+        return self.bodies + self.auxiliary
+
+    def prepare(self, targets: dict[str, float], dt: float) -> None:
+        """Set driver targets (law values at t + 2 dt) and re-place meshes before a step."""
+        for d in self.drives:
+            d.set(targets[d.driver.name])
+        for m in self.meshes:
+            m.update(dt)
+
+    def step(self, targets: dict[str, float], dt: float) -> None:
+        self.prepare(targets, dt)
+        self.space.step(dt)
+
+    def state(self) -> np.ndarray:
+        """(nb, 3) centre-of-mass coordinates x, y, theta of the model's bodies."""
+        return np.array([(b.position.x, b.position.y, b.angle) for b in self.bodies])
+
+
+def assembled_state(model: Model, t0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Assembled centre-of-mass pose and velocity (nb, 3) at t0, from the engine."""
+    from .engine import analyse
+
+    a = analyse(model, np.array([t0]))
+    return a.q[0], a.v[0]
+
+
+def _length_scale(model: Model, pose: np.ndarray) -> float:
+    vals = [1e-3]
+    for b in model.bodies:
+        vals += [abs(c) for p in b.points.values() for c in p]
+        vals += [abs(c) for c in b.com]
+    for j in model.joints:
+        if isinstance(j, Revolute):
+            vals += [abs(c) for c in j.point_a + j.point_b]
+        elif isinstance(j, Prismatic):
+            vals += [abs(c) for c in j.point_guide + j.point_slider]
+    vals += list(np.abs(pose[:, :2]).ravel())
+    return float(max(vals))
+
+
+def build_space(
+    model: Model,
+    pose: np.ndarray | None = None,
+    velocity: np.ndarray | None = None,
+    *,
+    gravity: tuple[float, float] = (0.0, 0.0),
+    iterations: int = 30,
+    floating_base: tuple[float, float, tuple[float, float]] | None = None,
+    mass_floor: float = 1e-6,
+    absolute_gears: bool = False,
+    joint_bias: float | None = None,
+    mesh_bias: float | None = 0.0,
+    dt: float = 1e-3,
+) -> SimModel:
+    """Build ``model`` in a new pymunk space.
+
+    ``pose`` and ``velocity`` are (nb, 3) centre-of-mass coordinates and their rates in
+    ``model.bodies`` order (default: the engine's assembly at t = 0, at rest).
+    ``floating_base = (mass, moment, centre_of_gravity)`` makes the frame a free body (used by
+    :func:`balpipe.validate.free_floating`); otherwise the frame is ``space.static_body``.
+    ``absolute_gears = True`` builds every gear pair as a single absolute GearJoint, the trap
+    of PYMUNK.md (kept only to measure it).
+    """
+    if pose is None:
+        pose, v0 = assembled_state(model)
+        velocity = v0 if velocity is None else velocity
+    pose = np.asarray(pose, dtype=float)
+    velocity = np.zeros_like(pose) if velocity is None else np.asarray(velocity, dtype=float)
+    names = [b.name for b in model.bodies]
+    if FRAME in names:
+        raise ValueError(f"'{FRAME}' is reserved for the fixed frame")
+
+    space = pymunk.Space()
+    space.iterations = int(iterations)
+    space.gravity = tuple(float(g) for g in gravity)
+    scale = _length_scale(model, pose)
+    half = 100.0 * scale
+
+    props = [b.mass_properties() for b in model.bodies]
+    m_ref = max([p[0] for p in props] + [0.0]) or 1.0
+    i_ref = max([p[2] for p in props] + [0.0]) or m_ref * scale**2
+    floored: list[str] = []
+    bodies: list[pymunk.Body] = []
+    com_local: list[tuple[float, float]] = []
+    for b, (m, com, inertia), q, v in zip(model.bodies, props, pose, velocity):
+        mm, ii = m, inertia
+        if m <= 0 or inertia <= 0:
+            floored.append(b.name)
+            mm = max(m, mass_floor * m_ref)
+            ii = max(inertia, mass_floor * i_ref)
+        body = pymunk.Body(mm, ii)
+        body.center_of_gravity = (0.0, 0.0)  # first (the origin is the centre of mass)
+        body.angle = float(q[2])  # then the angle
+        body.position = (float(q[0]), float(q[1]))  # then the position
+        body.velocity = (float(v[0]), float(v[1]))
+        body.angular_velocity = float(v[2])
+        space.add(body)
+        bodies.append(body)
+        com_local.append((float(com[0]), float(com[1])))
+
+    if floating_base is None:
+        base = space.static_body
+        floating = False
+    else:
+        bm, bi, cg = floating_base
+        base = pymunk.Body(float(bm), float(bi))
+        base.center_of_gravity = (float(cg[0]), float(cg[1]))
+        base.angle = 0.0
+        base.position = (0.0, 0.0)
+        space.add(base)
+        floating = True
+
+    pb = {FRAME: base, **dict(zip(names, bodies))}
+    com = {FRAME: (0.0, 0.0), **dict(zip(names, com_local))}
+    sim = SimModel(model, space, bodies, [], base, floating, [], [], com_local, floored)
+
+    def local(body: str, p) -> tuple[float, float]:
+        c = com[body]
+        return (float(p[0]) - c[0], float(p[1]) - c[1])
+
+    passive_bias = 0.0 if joint_bias is None or joint_bias >= 1 else (1.0 - joint_bias) ** (1.0 / dt)
+
+    def add(c: pymunk.Constraint, error_bias: float | None = None) -> pymunk.Constraint:
+        c.collide_bodies = False
+        c.error_bias = passive_bias if error_bias is None else error_bias
+        space.add(c)
+        return c
+
+    def is_static(name: str) -> bool:
+        return name == FRAME and not floating
+
+    def angle_joint(coeffs: dict[str, float], phase: float, eb: float | None = None) -> tuple[pymunk.GearJoint, float, float]:
+        """One GearJoint for sum_k c_k theta_k = phase + s(t); returns it with (scale, offset)
+        such that the joint's phase = offset + scale * s."""
+        terms = [(n, k) for n, k in coeffs.items() if k != 0.0 and not is_static(n)]
+        if floating:
+            total = sum(k for _, k in terms)
+            if abs(total) > 1e-12:  # an absolute angle: relative to the base
+                terms.append((FRAME, -total))
+                merged: dict[str, float] = {}
+                for n, k in terms:
+                    merged[n] = merged.get(n, 0.0) + k
+                terms = [(n, k) for n, k in merged.items() if abs(k) > 1e-15]
+        if len(terms) == 1:
+            (n, k), = terms
+            return add(pymunk.GearJoint(base, pb[n], phase / k, 1.0), eb), 1.0 / k, phase / k
+        if len(terms) == 2:
+            (n1, k1), (n2, k2) = terms
+            r = -k2 / k1
+            j = add(pymunk.GearJoint(pb[n1], pb[n2], -phase / k1, r), eb)
+            return j, -1.0 / k1, -phase / k1
+        raise ValueError(f"cannot express {coeffs} with one GearJoint")
+
+    driven: dict[str, Driver] = {}
+    for d in model.drivers:
+        if d.target[0] == "joint":
+            driven[d.target[1]] = d
+
+    init_angle = {FRAME: 0.0, **{n: float(q[2]) for n, q in zip(names, pose)}}
+    for jt in model.joints:
+        if isinstance(jt, Revolute):
+            add(pymunk.PivotJoint(pb[jt.a], pb[jt.b], local(jt.a, jt.point_a), local(jt.b, jt.point_b)))
+        elif isinstance(jt, Prismatic):
+            ax = np.asarray(jt.axis, dtype=float)
+            ax = tuple(ax / np.linalg.norm(ax))
+            pg = local(jt.guide, jt.point_guide)
+            ps = local(jt.slider, jt.point_slider)
+            angle_joint({jt.slider: 1.0, jt.guide: -1.0}, jt.angle)
+            d = driven.get(jt.name)
+            if d is None:
+                g1 = (pg[0] - half * ax[0], pg[1] - half * ax[1])
+                g2 = (pg[0] + half * ax[0], pg[1] + half * ax[1])
+                add(pymunk.GrooveJoint(pb[jt.guide], pb[jt.slider], g1, g2, ps))
+            else:
+                s0 = float(d.law(np.array([0.0]))[0][0])
+                c = add(pymunk.PivotJoint(pb[jt.guide], pb[jt.slider], (pg[0] + ax[0] * s0, pg[1] + ax[1] * s0), ps), 0.0)
+                sim.drives.append(_Drive(d.name, d, "anchor", c, base_point=pg, axis=ax))
+        elif isinstance(jt, Gear):
+            _add_gear(sim, jt, pb, com, init_angle, model, angle_joint, add, is_static, absolute_gears, half, mass_floor, m_ref, i_ref, mesh_bias)
+        else:  # pragma: no cover
+            raise TypeError(jt)
+
+    for d in model.drivers:
+        kind = d.target[0]
+        if kind == "joint":
+            jt = model.joint(d.target[1])
+            if isinstance(jt, Revolute):
+                c, s, o = angle_joint({jt.b: 1.0, jt.a: -1.0}, 0.0, 0.0)
+                sim.drives.append(_Drive(d.name, d, "phase", c, scale=s, offset=o))
+            elif isinstance(jt, Prismatic):
+                pass  # built with the joint
+            else:
+                raise ValueError(f"driver {d.name!r}: a gear pair cannot be driven")
+        elif kind == "angle":
+            c, s, o = angle_joint({d.target[1]: 1.0}, 0.0, 0.0)
+            sim.drives.append(_Drive(d.name, d, "phase", c, scale=s, offset=o))
+        elif kind in ("x", "y"):
+            body = d.target[1]
+            point = model.body(body).point(d.target[2]) if len(d.target) > 2 else (0.0, 0.0)
+            axis = (1.0, 0.0) if kind == "x" else (0.0, 1.0)
+            c = add(pymunk.GrooveJoint(base, pb[body], (0.0, -half), (0.0, half), local(body, point)), 0.0)
+            dr = _Drive(d.name, d, "groove", c, axis=axis, half_length=half)
+            dr.set(float(d.law(np.array([0.0]))[0][0]))
+            sim.drives.append(dr)
+        else:
+            raise ValueError(f"driver {d.name!r}: unknown target {d.target!r}")
+    return sim
+
+
+def _gear_phase(jt: Gear, model: Model) -> float:
+    """The phase exactly as the engine computes it (from the model's initial poses)."""
+    if jt.phase is not None:
+        return float(jt.phase)
+    from .model import pose_of_com
+
+    th = {FRAME: 0.0}
+    for n in (jt.a, jt.b, jt.carrier):
+        if n != FRAME:
+            th[n] = pose_of_com(model.body(n), model.initial[n])[2]
+    return (th[jt.b] - th[jt.carrier]) - jt.ratio * (th[jt.a] - th[jt.carrier])
+
+
+def _add_gear(sim, jt, pb, com, init_angle, model, angle_joint, add, is_static, absolute, half, floor, m_ref, i_ref, mesh_bias):
+    phase = _gear_phase(jt, model)
+    coeffs: dict[str, float] = {}
+    for n, v in ((jt.b, 1.0), (jt.carrier, -1.0), (jt.a, -jt.ratio), (jt.carrier, jt.ratio)):
+        coeffs[n] = coeffs.get(n, 0.0) + v
+    moving = [n for n, k in coeffs.items() if k != 0.0 and not is_static(n)]
+    if absolute and len(moving) == 3:
+        # the trap: theta_b - ratio theta_a = phase + (1 - ratio) theta_c(initial), carrier ignored
+        c0 = init_angle[jt.carrier]
+        angle_joint({jt.b: 1.0, jt.a: -jt.ratio}, phase + (1.0 - jt.ratio) * c0)
+        sim.notes.append(f"gear {jt.name!r}: absolute GearJoint (carrier ignored)")
+        return
+    if len(moving) <= 2:
+        angle_joint(coeffs, phase)
+        return
+    # three moving bodies: a mesh on the carrier
+    def centre(g: str) -> tuple[float, float] | None:
+        for j in model.joints:
+            if isinstance(j, Revolute):
+                if j.a == jt.carrier and j.b == g:
+                    return (j.point_a[0] - com[jt.carrier][0], j.point_a[1] - com[jt.carrier][1])
+                if j.b == jt.carrier and j.a == g:
+                    return (j.point_b[0] - com[jt.carrier][0], j.point_b[1] - com[jt.carrier][1])
+        return None
+
+    oa, ob = centre(jt.a), centre(jt.b)
+    A, B, C = pb[jt.a], pb[jt.b], pb[jt.carrier]
+    auxiliary = False
+    if oa is None or ob is None or math.dist(oa, ob) < 1e-9 * half:
+        # auxiliary light gears pinned to the carrier at virtual centres and locked to a and b
+        auxiliary = True
+        span = half / 100.0
+        oa = (0.0, 0.0)
+        ob = (span, 0.0)
+        aux = []
+        for g, o in ((jt.a, oa), (jt.b, ob)):
+            gb = pb[g]
+            body = pymunk.Body(floor * m_ref, floor * i_ref)
+            body.center_of_gravity = (0.0, 0.0)
+            body.angle = gb.angle
+            w = _rot(C.angle, o)
+            body.position = (C.position.x + w[0], C.position.y + w[1])
+            vc = C.velocity_at_local_point(o)
+            body.velocity = (vc.x, vc.y)
+            body.angular_velocity = gb.angular_velocity
+            sim.space.add(body)
+            sim.auxiliary.append(body)
+            add(pymunk.PivotJoint(C, body, o, (0.0, 0.0)))
+            add(pymunk.GearJoint(gb, body, body.angle - gb.angle, 1.0))
+            aux.append(body)
+        A, B = aux
+        sim.notes.append(f"gear {jt.name!r}: no carrier pivot for its gears, auxiliary gears used")
+    groove = add(pymunk.GrooveJoint(A, B, (0.0, -half), (0.0, half), (0.0, 0.0)), mesh_bias)
+    sim.meshes.append(
+        _Mesh(jt.name, groove, A, B, C, pb[jt.a], pb[jt.b], oa, ob, float(jt.ratio), phase, half, auxiliary)
+    )

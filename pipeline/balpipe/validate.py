@@ -1,0 +1,640 @@
+"""Independent check of a stage's shaking loads with a pymunk simulation of the jointed mechanism.
+
+MEASURED_NUMBERS_PLACEHOLDER
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import pymunk
+
+from .engine import Analysis
+from .model import FRAME, Model, Prismatic, Revolute
+from .pymunk_model import SimModel, build_space
+
+__all__ = [
+    "ValidationSettings",
+    "StageValidation",
+    "FreeFloating",
+    "SimulationRun",
+    "default_settings",
+    "simulate",
+    "validate",
+    "free_floating",
+]
+
+#: default number of steps over the motion (the step is also kept below 0.01 / w_max)
+STEPS_PER_MOTION = 1000
+#: default solver iterations; doubled (up to MAX_ITERATIONS) if a run loses its joints
+ITERATIONS = 100
+MAX_ITERATIONS = 800
+#: tracking error (rad, or m relative to the model's size) above which a run is retried
+HEALTH_LIMIT = 1e-4
+
+
+@dataclass(frozen=True)
+class ValidationSettings:
+    """Numerical settings of the simulation and the pass criterion.
+
+    ``dt``: time step (None: :func:`default_settings`); it is rounded down so that a whole
+    number of steps fits each interval of the analysis grid. ``iterations``: pymunk solver
+    iterations (None: :data:`ITERATIONS`, doubled while a run loses its joints).
+    ``tolerance``: the stage passes when both residuals are at most this fraction of the
+    unbalanced peaks. ``balance_tolerance``: for the loads a stage claims to cancel (``expect``
+    of :func:`validate`), the simulated peak must also be at most this fraction of the
+    unbalanced peak. ``skip_initial_steps``: simulation steps at the start whose samples are
+    excluded from the residuals (none are needed: see the start-up in :func:`simulate`).
+    ``startup_steps``/``startup_iterations``: the first steps run with more solver iterations,
+    because the solver has no previous impulses to start from (warm start).
+    """
+
+    dt: float | None = None
+    iterations: int | None = None
+    tolerance: float = 0.01
+    balance_tolerance: float = 0.01
+    skip_initial_steps: int = 0
+    startup_steps: int = 3
+    startup_iterations: int = 500
+
+
+@dataclass
+class SimulationRun:
+    """Raw simulation output, one sample per step (``t``)."""
+
+    t: np.ndarray
+    force: np.ndarray  # (n, 2) load on the frame
+    moment: np.ndarray  # (n,) about the analysis' moment point
+    poses: np.ndarray  # (n, nb, 3) centre-of-mass coordinates
+    base: np.ndarray  # (n, 3) pose of the frame's origin (zeros when static)
+    driver_error: dict[str, np.ndarray]
+    momentum: np.ndarray  # (n, 3) P_x, P_y, H about the moment point of all dynamic bodies
+    dt: float
+    iterations: int
+    wall: float
+    sim: SimModel
+
+
+@dataclass
+class StageValidation:
+    """The simulation of one stage against its analysis.
+
+    Curves on the analysis grid ``t``: ``force`` (N, 2), ``moment`` (N,) (simulated, same
+    convention as the engine: load of the moving links on the frame, moment about the
+    analysis' moment point); ``force_error`` (N,) = |F_sim - F_analytic|, ``moment_error``.
+    ``measured`` (N,) marks the samples that enter the residuals.
+    Scalars: residuals ``force_residual = max|F_sim - F_analytic| / F0`` and
+    ``moment_residual`` (F0, M0: the unbalanced stage's analytic peaks, also stored);
+    ``force_peak``/``moment_peak``: simulated peaks / F0, M0; ``tracking_error``: max abs
+    error of each driven coordinate (rad or m) and its maximum ``tracking_error_max``;
+    ``pose_error_position`` (m) / ``pose_error_angle`` (rad): largest deviation of the
+    simulated centres of mass from the analysis; ``dt``, ``steps``, ``iterations``, pymunk
+    and Chipmunk versions; ``passed``. ``timing`` (wall-clock seconds) is kept out of
+    :meth:`to_json` so that results files are deterministic.
+    """
+
+    t: np.ndarray
+    force: np.ndarray
+    moment: np.ndarray
+    force_error: np.ndarray
+    moment_error: np.ndarray
+    measured: np.ndarray
+    force_residual: float
+    moment_residual: float
+    force_peak: float
+    moment_peak: float
+    unbalanced_force_peak: float
+    unbalanced_moment_peak: float
+    tracking_error: dict[str, float]
+    tracking_error_max: float
+    pose_error_position: float
+    pose_error_angle: float
+    dt: float
+    steps: int
+    iterations: int
+    tolerance: float
+    balance_tolerance: float
+    expect: tuple[str, ...]
+    passed: bool
+    reasons: list[str]
+    excluded_samples: int
+    extrapolated_samples: int
+    floored_bodies: list[str]
+    notes: list[str]
+    pymunk_version: str = pymunk.version
+    chipmunk_version: str = pymunk.chipmunk_version
+    timing: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def status(self) -> str:
+        return "pass" if self.passed else "fail"
+
+    def to_json(self) -> dict:
+        """Plain, deterministic summary (no curves, no wall-clock times)."""
+        return {
+            "passed": bool(self.passed),
+            "status": self.status,
+            "reasons": "; ".join(self.reasons),
+            "force_residual": float(self.force_residual),
+            "moment_residual": float(self.moment_residual),
+            "force_peak": float(self.force_peak),
+            "moment_peak": float(self.moment_peak),
+            "unbalanced_force_peak": float(self.unbalanced_force_peak),
+            "unbalanced_moment_peak": float(self.unbalanced_moment_peak),
+            "tracking_error": {k: float(v) for k, v in sorted(self.tracking_error.items())},
+            "tracking_error_max": float(self.tracking_error_max),
+            "pose_error_position": float(self.pose_error_position),
+            "pose_error_angle": float(self.pose_error_angle),
+            "dt": float(self.dt),
+            "steps": int(self.steps),
+            "iterations": int(self.iterations),
+            "tolerance": float(self.tolerance),
+            "balance_tolerance": float(self.balance_tolerance),
+            "expect": ",".join(self.expect),
+            "samples": int(len(self.t)),
+            "excluded_samples": int(self.excluded_samples),
+            "extrapolated_samples": int(self.extrapolated_samples),
+            "floored_bodies": ",".join(self.floored_bodies),
+            "notes": "; ".join(self.notes),
+            "pymunk_version": str(self.pymunk_version),
+            "chipmunk_version": str(self.chipmunk_version),
+            "method": "momentum",
+        }
+
+
+@dataclass
+class FreeFloating:
+    """The mechanism on a free base without gravity (reactionless demonstration).
+
+    ``t`` (N,) analysis grid; ``base`` (N, 3): pose (x, y, angle) of the frame's origin, so
+    frame points p are drawn at base[:2] + R(base[2]) p; ``drift`` (N, 2): displacement of the
+    base's centre of gravity; ``rotation`` (N,) = base[:, 2] (rad); ``poses`` (N, nb, 3):
+    global pose of each body's own frame (for drawing, like ``Analysis.pose``);
+    ``max_drift`` (m), ``max_rotation`` (rad); ``momentum_drift``: largest change of the total
+    linear (N s) and angular (N m s) momentum of base + mechanism, which physics keeps at
+    zero (a check of the simulation itself).
+    """
+
+    t: np.ndarray
+    names: list[str]
+    base: np.ndarray
+    drift: np.ndarray
+    rotation: np.ndarray
+    poses: np.ndarray
+    base_mass: float
+    base_inertia: float
+    base_centre: tuple[float, float]
+    max_drift: float
+    max_rotation: float
+    momentum_drift: tuple[float, float]
+    dt: float
+    iterations: int
+    timing: dict[str, float] = field(default_factory=dict)
+
+    def to_json(self) -> dict:
+        return {
+            "base_mass": float(self.base_mass),
+            "base_inertia": float(self.base_inertia),
+            "max_drift": float(self.max_drift),
+            "max_rotation": float(self.max_rotation),
+            "max_rotation_deg": float(math.degrees(self.max_rotation)),
+            "final_drift": float(np.linalg.norm(self.drift[-1])),
+            "final_rotation": float(self.rotation[-1]),
+            "linear_momentum_drift": float(self.momentum_drift[0]),
+            "angular_momentum_drift": float(self.momentum_drift[1]),
+            "dt": float(self.dt),
+            "iterations": int(self.iterations),
+        }
+
+
+# ----------------------------------------------------------------------------------------------
+# Simulation
+
+
+def default_settings(model: Model, analysis: Analysis) -> tuple[float, int]:
+    """Default (dt, iterations) for a model and motion.
+
+    dt = min(T / STEPS_PER_MOTION, 0.01 / w_max) with T the motion's duration and w_max the
+    largest angular speed of any body (pymunk's joints follow straight lines during a step,
+    so their error is ~ (w dt)^2 times the lever arm); iterations = :data:`ITERATIONS`.
+    """
+    T = float(analysis.t[-1] - analysis.t[0])
+    w = float(np.max(np.abs(analysis.v[:, :, 2]))) if analysis.v.size else 0.0
+    dt = T / STEPS_PER_MOTION if T > 0 else 1e-3
+    if w > 0:
+        dt = min(dt, 0.01 / w)
+    return dt, ITERATIONS
+
+
+def _driver_coordinate(model: Model, d, poses: dict[str, tuple[float, float, float]], com: dict) -> float:
+    """The driven coordinate measured on simulated poses (centre-of-mass poses for bodies, the
+    origin's pose for the frame), in the frame's coordinates."""
+
+    def world(body: str, p) -> tuple[float, float]:
+        x, y, th = poses[body]
+        c = com[body]
+        lx, ly = p[0] - c[0], p[1] - c[1]
+        cs, sn = math.cos(th), math.sin(th)
+        return x + cs * lx - sn * ly, y + sn * lx + cs * ly
+
+    kind = d.target[0]
+    th0 = poses[FRAME][2]
+    if kind == "joint":
+        jt = model.joint(d.target[1])
+        if isinstance(jt, Revolute):
+            return poses[jt.b][2] - poses[jt.a][2]
+        if isinstance(jt, Prismatic):
+            ax = np.asarray(jt.axis, dtype=float)
+            ax = ax / np.linalg.norm(ax)
+            thg = poses[jt.guide][2]
+            e = (math.cos(thg) * ax[0] - math.sin(thg) * ax[1], math.sin(thg) * ax[0] + math.cos(thg) * ax[1])
+            ps = world(jt.slider, jt.point_slider)
+            pg = world(jt.guide, jt.point_guide)
+            return (ps[0] - pg[0]) * e[0] + (ps[1] - pg[1]) * e[1]
+        raise ValueError(f"driver {d.name!r}: a gear pair cannot be driven")
+    if kind == "angle":
+        return poses[d.target[1]][2] - th0
+    body = d.target[1]
+    point = model.body(body).point(d.target[2]) if len(d.target) > 2 else (0.0, 0.0)
+    p = world(body, point)
+    rel = (p[0] - poses[FRAME][0], p[1] - poses[FRAME][1])
+    cs, sn = math.cos(th0), math.sin(th0)
+    loc = (cs * rel[0] + sn * rel[1], -sn * rel[0] + cs * rel[1])
+    return loc[0] if kind == "x" else loc[1]
+
+
+def _step_grid(t: np.ndarray, dt_target: float) -> tuple[float, int, np.ndarray | None]:
+    """Step, number of steps and the step index of each analysis sample (None when the grid is
+    not uniform: the samples are then interpolated linearly)."""
+    t0, t1 = float(t[0]), float(t[-1])
+    if len(t) > 1:
+        h = np.diff(t)
+        if np.allclose(h, h[0], rtol=1e-9, atol=0.0):
+            sub = max(1, int(math.ceil(h[0] / dt_target - 1e-9)))
+            return (t1 - t0) / ((len(t) - 1) * sub), (len(t) - 1) * sub, np.arange(len(t)) * sub
+    n = max(1, int(math.ceil((t1 - t0) / dt_target - 1e-9)))
+    return (t1 - t0) / n, n, None
+
+
+def simulate(
+    model: Model,
+    analysis: Analysis,
+    dt: float,
+    iterations: int,
+    *,
+    startup_steps: int = 3,
+    startup_iterations: int = 500,
+    floating_base: tuple[float, float, tuple[float, float]] | None = None,
+    record_poses: bool = True,
+    **build_options,
+) -> SimulationRun:
+    """Simulate ``model`` along ``analysis``' motion and measure the loads on the frame.
+
+    ``dt`` should divide the analysis' duration (see :func:`validate`, which picks it).
+    Start-up: pymunk integrates positions with the velocities of the previous step
+    (symplectic Euler), so its velocities belong half a step after its positions. The run
+    starts one step before t0 at q(t0) - dt v(t0 - dt/2) with the velocity
+    v(t0 - dt/2) = v(t0) - a(t0) dt/2 (the analysis at t0 is the only analytic input), so that
+    the first step lands exactly on q(t0). The loads at step time t_k are
+    F = sum m g - (P_{k+1/2} - P_{k-1/2}) / dt and
+    M = sum (r_k - O) x m g - (H_{k+1/2} - H_{k-1/2}) / dt, central differences of the
+    momenta of every dynamic body of the mechanism, about the analysis' moment point O
+    (H_{k+1/2} = sum m (r_k - O) x v_{k+1/2} + I w_{k+1/2} is exactly the mid-step value, as
+    v x v = 0): second-order accurate where the motion laws are smooth.
+    """
+    t = np.asarray(analysis.t, dtype=float)
+    t0 = float(t[0])
+    n = int(round((float(t[-1]) - t0) / dt))
+    times = t0 + dt * np.arange(n + 1)
+    q0, v0, a0 = analysis.q[0], analysis.v[0], analysis.a[0]
+    vh = v0 - 0.5 * dt * a0
+    qs = q0 - dt * vh
+    gravity = (0.0, 0.0) if floating_base is not None else analysis.gravity
+    sim = build_space(
+        model, qs, vh, gravity=gravity, iterations=iterations, floating_base=floating_base,
+        dt=dt, **build_options,
+    )
+    space = sim.space
+    bodies = sim.moving
+    everything = bodies + ([sim.base] if sim.floating else [])
+    m = np.array([b.mass for b in bodies])
+    g = np.asarray(gravity, dtype=float)
+    O = np.asarray(analysis.moment_point, dtype=float)
+    weight = m.sum() * g
+    names = [b.name for b in model.bodies]
+    com = {FRAME: (0.0, 0.0), **{b.name: b.mass_properties()[1] for b in model.bodies}}
+
+    target_t = times + dt  # the step landing on times[k] starts at times[k] - dt: target t + 2 dt
+    targets = {d.name: np.asarray(d.law(target_t)[0], dtype=float) for d in model.drivers}
+    laws_now = {d.name: np.asarray(d.law(times)[0], dtype=float) for d in model.drivers}
+
+    def momenta(group) -> tuple[float, float, float]:
+        px = py = h = 0.0
+        for b in group:
+            mk = b.mass
+            p = b.local_to_world(b.center_of_gravity)
+            v = b.velocity
+            px += mk * v.x
+            py += mk * v.y
+            h += mk * ((p.x - O[0]) * v.y - (p.y - O[1]) * v.x) + b.moment * b.angular_velocity
+        return px, py, h
+
+    force = np.zeros((n + 1, 2))
+    moment = np.zeros(n + 1)
+    poses = np.zeros((n + 1, len(names), 3)) if record_poses else np.zeros((0, len(names), 3))
+    base = np.zeros((n + 1, 3))
+    total = np.zeros((n + 1, 3))
+    derr = {d.name: np.zeros(n + 1) for d in model.drivers}
+    px0, py0, h0 = momenta(bodies)
+    start = time.perf_counter()
+    for k in range(n + 1):
+        space.iterations = startup_iterations if k < startup_steps else iterations
+        sim.prepare({name: v[k] for name, v in targets.items()}, dt)
+        space.step(dt)
+        px, py, h = momenta(bodies)
+        gm = 0.0
+        if g.any():
+            for b, mk in zip(bodies, m):
+                p = b.position
+                gm += mk * ((p.x - O[0]) * g[1] - (p.y - O[1]) * g[0])
+        force[k, 0] = weight[0] - (px - px0) / dt
+        force[k, 1] = weight[1] - (py - py0) / dt
+        moment[k] = gm - (h - h0) / dt
+        px0, py0, h0 = px, py, h
+        st = {nm: (b.position.x, b.position.y, b.angle) for nm, b in zip(names, sim.bodies)}
+        bo = sim.base.position
+        st[FRAME] = (bo.x, bo.y, sim.base.angle)
+        base[k] = st[FRAME]
+        if sim.floating:
+            total[k] = momenta(everything)
+        if record_poses:
+            poses[k] = [st[nm] for nm in names]
+        for d in model.drivers:
+            derr[d.name][k] = _driver_coordinate(model, d, st, com) - laws_now[d.name][k]
+    wall = time.perf_counter() - start
+    space.iterations = iterations
+    return SimulationRun(times, force, moment, poses, base, derr, total, dt, iterations, wall, sim)
+
+
+# ----------------------------------------------------------------------------------------------
+# Sampling the simulation on the analysis grid
+
+
+def _law_kinds(model: Model, times: np.ndarray) -> list[str]:
+    """Smoothness of the motion at each analysis sample: "smooth", "kink" (a jump of some
+    law's jerk: the central difference straddling it is only first order), "left"/"right"
+    (a jump of some law's acceleration, the law's value at the sample being the left/right
+    limit) or "mixed" (jumps with different sides)."""
+    T = float(times[-1] - times[0]) or 1.0
+    delta = 1e-6 * T
+    kinds = ["smooth"] * len(times)
+    for d in model.drivers:
+        _, _, a_m = d.law(times - delta)
+        _, _, a_0 = d.law(times)
+        _, _, a_p = d.law(times + delta)
+        a_m, a_0, a_p = (np.asarray(x, dtype=float) for x in (a_m, a_0, a_p))
+        scale = float(np.max(np.abs(a_0))) or 1.0
+        # a smooth law changes its acceleration by ~ jerk * delta ~ 1e-6 scale across the
+        # sample, and its jerk by ~ 1e-6 jerk: a thousand times that is a corner
+        dm, dp = a_0 - a_m, a_p - a_0
+        jump = np.maximum(np.abs(dm), np.abs(dp)) > 1e-3 * scale
+        left_ok = np.abs(dm) <= 1e-3 * scale
+        kink = np.abs(dp - dm) > 1e-9 * scale
+        for i in range(len(times)):
+            if jump[i]:
+                side = "left" if left_ok[i] else "right"
+                kinds[i] = side if kinds[i] in ("smooth", "kink", side) else "mixed"
+            elif kink[i] and kinds[i] == "smooth":
+                kinds[i] = "kink"
+    return kinds
+
+
+def _on_grid(run: SimulationRun, analysis: Analysis, idx: np.ndarray | None, kinds: list[str], skip: int):
+    """Simulated loads at the analysis samples. Where a law is not smooth the central
+    difference straddles the corner: the sample is then the linear extrapolation of the
+    simulated loads from the side(s) the law's value belongs to (both sides averaged for a
+    jerk kink), which is second-order again. Returns force, moment, measured mask and counts."""
+    n = len(run.t) - 1
+    N = len(analysis.t)
+    F = np.zeros((N, 2))
+    M = np.zeros(N)
+    measured = np.ones(N, dtype=bool)
+    extrapolated = 0
+    series = np.column_stack([run.force, run.moment])
+    if idx is None:
+        vals = np.column_stack([np.interp(analysis.t, run.t, series[:, c]) for c in range(3)])
+        idx_f = np.searchsorted(run.t, analysis.t).clip(0, n)
+    else:
+        vals = series[idx].copy()
+        idx_f = idx
+    for i, kind in enumerate(kinds):
+        s = int(idx_f[i])
+        if s < skip:
+            measured[i] = False
+        if kind == "smooth":
+            continue
+        left = 2 * series[s - 1] - series[s - 2] if s >= 2 + skip else None
+        right = 2 * series[s + 1] - series[s + 2] if s + 2 <= n else None
+        if kind == "kink":
+            sides = [v for v in (left, right) if v is not None]
+        elif kind == "left":
+            sides = [left] if left is not None else []
+        elif kind == "right":
+            sides = [right] if right is not None else []
+        else:
+            sides = []
+        if sides:
+            vals[i] = np.mean(sides, axis=0)
+            extrapolated += 1
+        else:
+            measured[i] = False
+    F[:] = vals[:, :2]
+    M[:] = vals[:, 2]
+    return F, M, measured, extrapolated
+
+
+# ----------------------------------------------------------------------------------------------
+# Validation
+
+
+def _run_healthy(model, analysis, dt, iterations, settings, scale, **kw) -> tuple[SimulationRun, list[str]]:
+    """Run; if the joints come apart (non-finite loads or a tracking error above
+    HEALTH_LIMIT), double the iterations and run again, up to MAX_ITERATIONS."""
+    notes: list[str] = []
+    it = iterations
+    while True:
+        with np.errstate(all="ignore"):
+            try:
+                run = simulate(
+                    model, analysis, dt, it, startup_steps=settings.startup_steps,
+                    startup_iterations=max(settings.startup_iterations, it), **kw,
+                )
+                bad = not (np.isfinite(run.force).all() and np.isfinite(run.moment).all())
+                err = max([float(np.max(np.abs(e))) / _unit(model, name, scale) for name, e in run.driver_error.items()] + [0.0])
+                bad = bad or not math.isfinite(err) or err > HEALTH_LIMIT
+            except (ZeroDivisionError, ValueError, OverflowError):
+                run, bad = None, True
+        if not bad or it >= MAX_ITERATIONS:
+            if bad:
+                notes.append(f"the simulation lost its joints even at {it} iterations")
+            return run, notes
+        notes.append(f"{it} iterations lost the joints: retried with {2 * it}")
+        it *= 2
+
+
+def _unit(model: Model, driver: str, scale: float) -> float:
+    """Scale of a driven coordinate: 1 rad for angles, the model's size for lengths."""
+    d = next(d for d in model.drivers if d.name == driver)
+    if d.target[0] in ("x", "y"):
+        return scale
+    if d.target[0] == "joint" and isinstance(model.joint(d.target[1]), Prismatic):
+        return scale
+    return 1.0
+
+
+def _model_scale(analysis: Analysis) -> float:
+    r = np.linalg.norm(analysis.q[:, :, :2] - np.asarray(analysis.moment_point), axis=2)
+    return max(float(r.max()) if r.size else 0.0, 1e-3)
+
+
+def validate(
+    model: Model,
+    analysis: Analysis,
+    unbalanced_peaks: tuple[float, float],
+    settings: ValidationSettings | None = None,
+    expect: tuple[str, ...] = (),
+) -> StageValidation:
+    """Simulate ``model`` in pymunk along ``analysis``' motion and compare the loads.
+
+    ``unbalanced_peaks`` = (F0, M0): the unbalanced stage's analytic peak force and moment,
+    the denominators of every relative number. ``expect`` names the loads this stage claims to
+    cancel ("force", "moment"): their simulated peaks must then also be at most
+    ``settings.balance_tolerance`` times F0 (M0). Passes when the residuals are at most
+    ``settings.tolerance`` and every expectation holds.
+    """
+    settings = settings or ValidationSettings()
+    wall0 = time.perf_counter()
+    dt_default, it_default = default_settings(model, analysis)
+    dt_target = settings.dt or dt_default
+    iterations = settings.iterations or it_default
+    dt, nsteps, idx = _step_grid(np.asarray(analysis.t, dtype=float), dt_target)
+    scale = _model_scale(analysis)
+    run, notes = _run_healthy(model, analysis, dt, iterations, settings, scale)
+    F0, M0 = (float(x) for x in unbalanced_peaks)
+    fden = F0 if F0 > 0 else 1.0
+    mden = M0 if M0 > 0 else 1.0
+    if F0 <= 0 or M0 <= 0:
+        notes.append("an unbalanced peak is zero: that residual is absolute")
+    N = len(analysis.t)
+    if run is None:
+        nan = np.full(N, np.nan)
+        return StageValidation(
+            analysis.t, np.full((N, 2), np.nan), nan, nan, nan, np.zeros(N, bool), math.inf, math.inf,
+            math.inf, math.inf, F0, M0, {d.name: math.inf for d in model.drivers}, math.inf, math.inf,
+            math.inf, dt, nsteps, MAX_ITERATIONS, settings.tolerance, settings.balance_tolerance,
+            tuple(expect), False, ["the simulation failed"], N, 0, [], notes,
+            timing={"total_s": time.perf_counter() - wall0},
+        )
+    kinds = _law_kinds(model, np.asarray(analysis.t, dtype=float))
+    F, M, measured, extrapolated = _on_grid(run, analysis, idx, kinds, settings.skip_initial_steps)
+    ferr = np.linalg.norm(F - analysis.force, axis=1)
+    merr = np.abs(M - analysis.moment)
+    fres = float(np.max(ferr[measured])) / fden if measured.any() else math.inf
+    mres = float(np.max(merr[measured])) / mden if measured.any() else math.inf
+    fpk = float(np.max(np.linalg.norm(F[measured], axis=1))) / fden if measured.any() else math.inf
+    mpk = float(np.max(np.abs(M[measured]))) / mden if measured.any() else math.inf
+    track = {k: float(np.max(np.abs(v))) for k, v in run.driver_error.items()}
+    if idx is not None:
+        qs = run.poses[idx]
+    else:
+        qs = np.stack([np.stack([np.interp(analysis.t, run.t, run.poses[:, b, c]) for c in range(3)], -1)
+                       for b in range(run.poses.shape[1])], 1)
+    dpos = float(np.max(np.linalg.norm(qs[:, :, :2] - analysis.q[:, :, :2], axis=2))) if qs.size else 0.0
+    dang = float(np.max(np.abs(qs[:, :, 2] - analysis.q[:, :, 2]))) if qs.size else 0.0
+    reasons = []
+    tol = settings.tolerance
+    if not fres <= tol:
+        reasons.append(f"force residual {fres:.3g} > {tol:g}")
+    if not mres <= tol:
+        reasons.append(f"moment residual {mres:.3g} > {tol:g}")
+    for what, pk in (("force", fpk), ("moment", mpk)):
+        if what in expect and not pk <= settings.balance_tolerance:
+            reasons.append(f"{what} not balanced: simulated peak {pk:.3g} of the unbalanced > {settings.balance_tolerance:g}")
+    notes = notes + list(run.sim.notes)
+    if run.sim.floored:
+        notes.append(
+            "massless bodies simulated with mass/moment floors: " + ", ".join(run.sim.floored)
+        )
+    excluded = int(np.count_nonzero(~measured))
+    return StageValidation(
+        t=np.asarray(analysis.t, dtype=float), force=F, moment=M, force_error=ferr, moment_error=merr,
+        measured=measured, force_residual=fres, moment_residual=mres, force_peak=fpk, moment_peak=mpk,
+        unbalanced_force_peak=F0, unbalanced_moment_peak=M0, tracking_error=track,
+        tracking_error_max=max(track.values(), default=0.0), pose_error_position=dpos,
+        pose_error_angle=dang, dt=run.dt, steps=nsteps, iterations=run.iterations,
+        tolerance=tol, balance_tolerance=settings.balance_tolerance, expect=tuple(expect),
+        passed=not reasons, reasons=reasons, excluded_samples=excluded,
+        extrapolated_samples=extrapolated, floored_bodies=list(run.sim.floored), notes=notes,
+        timing={"simulation_s": run.wall, "total_s": time.perf_counter() - wall0},
+    )
+
+
+# ----------------------------------------------------------------------------------------------
+# Reactionless demonstration
+
+
+def free_floating(
+    model: Model,
+    analysis: Analysis,
+    base_mass: float = 10.0,
+    base_inertia: float | None = None,
+    settings: ValidationSettings | None = None,
+) -> FreeFloating:
+    """The mechanism moving on a free base, without gravity.
+
+    The frame becomes a body of mass ``base_mass`` (default 10 kg) whose centre of gravity is
+    the analysis' moment point, with moment of inertia ``base_inertia`` (default
+    (2/3) base_mass reach^2: a square plate of side 2 reach, reach = the largest distance of a
+    centre of mass from that point during the motion). Every driver and frame joint acts on the
+    base, gear pairs carried by the frame mesh on it. A reactionless stage leaves the base where
+    it is.
+    """
+    settings = settings or ValidationSettings()
+    wall0 = time.perf_counter()
+    reach = _model_scale(analysis)
+    bi = base_inertia if base_inertia is not None else (2.0 / 3.0) * base_mass * reach**2
+    dt_default, it_default = default_settings(model, analysis)
+    dt, nsteps, idx = _step_grid(np.asarray(analysis.t, dtype=float), settings.dt or dt_default)
+    centre = tuple(float(c) for c in analysis.moment_point)
+    run, notes = _run_healthy(
+        model, analysis, dt, settings.iterations or it_default, settings, reach,
+        floating_base=(base_mass, bi, centre),
+    )
+    if run is None:
+        raise RuntimeError("free-floating simulation failed: " + "; ".join(notes))
+    if idx is None:
+        idx = np.searchsorted(run.t, analysis.t).clip(0, len(run.t) - 1)
+    base = run.base[idx]
+    c, s = np.cos(base[:, 2]), np.sin(base[:, 2])
+    cog = np.stack([base[:, 0] + c * centre[0] - s * centre[1], base[:, 1] + s * centre[0] + c * centre[1]], -1)
+    drift = cog - np.asarray(centre)
+    poses = run.poses[idx].copy()
+    for k, b in enumerate(model.bodies):
+        cl = b.mass_properties()[1]
+        th = poses[:, k, 2]
+        poses[:, k, 0] -= np.cos(th) * cl[0] - np.sin(th) * cl[1]
+        poses[:, k, 1] -= np.sin(th) * cl[0] + np.cos(th) * cl[1]
+    mom = run.momentum - run.momentum[0]
+    return FreeFloating(
+        t=np.asarray(analysis.t, dtype=float), names=[b.name for b in model.bodies], base=base,
+        drift=drift, rotation=base[:, 2].copy(), poses=poses, base_mass=float(base_mass),
+        base_inertia=float(bi), base_centre=centre,
+        max_drift=float(np.max(np.linalg.norm(drift, axis=1))),
+        max_rotation=float(np.max(np.abs(base[:, 2]))),
+        momentum_drift=(float(np.max(np.linalg.norm(mom[:, :2], axis=1))), float(np.max(np.abs(mom[:, 2])))),
+        dt=run.dt, iterations=run.iterations,
+        timing={"simulation_s": run.wall, "total_s": time.perf_counter() - wall0},
+    )
