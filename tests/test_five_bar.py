@@ -265,6 +265,13 @@ def test_final_position_in_the_other_assembly_mode():
     assert err.path == ("motion", "drive", "gripper", "to") and "assembly mode" in err.message
 
 
+def test_inputs_turning_opposite_ways_cannot_be_coupled_by_one_idler():
+    data = _paper_data()
+    data["motion"]["drive"]["gripper"]["to"] = [-0.06, 0.55]
+    err = _error(data)
+    assert err.path == ("motion", "drive", "gripper", "to") and "U21 > 0" in err.message
+
+
 def test_coupling_gears_that_do_not_fit():
     data = _paper_data()
     data["mechanism"]["coupling"]["r1p"] = "250 mm"
