@@ -107,6 +107,18 @@ def test_paper_model_structure(paper):
     assert {b.name for b in full.bodies if b.kind == "gear"} == {"gear5", "gear6", "gear7"}
 
 
+def test_gear_kinematics_as_in_the_paper(paper):
+    """w2 = U21 w1, w5 = U51 w1 (U51 = -r1'/r5), w6 = w1 + U63 (w1 - w3), w7 = w2 + U74 (w2 - w4)."""
+    _, _, a, p = paper
+    an = a["full"]
+    w = {n: an.v[:, an.names.index(n), 2] for n in an.names}
+    scale = np.abs(w["link1"]).max()
+    assert np.abs(w["link2"] - p["U21"] * w["link1"]).max() < 1e-10 * scale
+    assert np.abs(w["gear5"] + p["r1p"] / p["r5"] * w["link1"]).max() < 1e-10 * scale
+    assert np.abs(w["gear6"] - (w["link1"] + p["U63"] * (w["link1"] - w["link3"]))).max() < 1e-10 * scale
+    assert np.abs(w["gear7"] - (w["link2"] + p["U74"] * (w["link2"] - w["link4"]))).max() < 1e-10 * scale
+
+
 def test_gripper_path_and_coupled_input(paper):
     spec, result, a, p = paper
     full = result.stages[-1].model
