@@ -127,16 +127,21 @@ def build_one(path: Path, opts: Options) -> Outcome:
                            seconds=time.perf_counter() - start)
     try:
         st = study_mod.run(loaded.spec)
+        extra: dict[str, str] = {}
         if opts.simulate and loaded.spec.validation.enabled:
-            from .validation_stage import simulate_study
+            from .validation_stage import simulate_study, timing, timing_script
 
             simulate_study(st)
+            times = timing(st)
+            extra = {"timing.json": json.dumps(times, indent=2, sort_keys=True) + "\n",
+                     "timing.js": timing_script(times)}
         results = results_dict(st, source, h, simulated=st.stages[0].validation is not None)
         page = render_page(st, results, loaded.text)
         _write_atomic_dir(target, {
             "index.html": page,
             "results.json": dumps(results),
             "timeseries.csv": timeseries_csv(st),
+            **extra,
         })
         status = "ok" if st.ok else "failed"
         return Outcome(source, slug, status, "; ".join(st.problems), results, seconds=time.perf_counter() - start)

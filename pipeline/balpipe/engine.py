@@ -545,8 +545,8 @@ class Analysis:
         return float(np.max(np.abs(self.moment)))
 
     def route_difference(self) -> tuple[float, float]:
-        """max |reactions - momentum| relative to the peak (force, moment); absolute if the peak
-        is below 1e-300."""
+        """Absolute max |reactions - momentum| of the force (N) and of the moment (N m); the
+        study divides them by the unbalanced stage's peaks."""
         df = float(np.max(np.linalg.norm(self.force - self.force_momentum, axis=1)))
         dm = float(np.max(np.abs(self.moment - self.moment_momentum)))
         return df, dm

@@ -188,3 +188,37 @@ def series_figure(t: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel: s
 
 
 
+
+
+def drift_figure(runs: list, prefix: str = "drift") -> str:
+    """Free-floating frame: drift of its centre of mass (mm) and rotation (deg) per stage.
+    ``runs``: (label, t, drift (N, 2) in m, rotation (N,) in rad)."""
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 2.8))
+    for k, (label, t, drift, rot) in enumerate(runs):
+        a1.plot(t, 1000 * np.hypot(drift[:, 0], drift[:, 1]), label=label, **style(k))
+        a2.plot(t, np.degrees(rot), label=label, **style(k))
+    a1.set_title("Drift of the free frame (mm)", fontsize=9)
+    a2.set_title("Rotation of the free frame (deg)", fontsize=9)
+    for a in (a1, a2):
+        a.set_xlabel("time (s)")
+    a1.legend(fontsize=7)
+    fig.tight_layout()
+    return to_svg(fig, prefix)
+
+
+def residual_figure(stages: list, prefix: str = "residuals") -> str:
+    """|F_sim - F_analytic| / F0 and |M_sim - M_analytic| / M0 over time, every stage.
+    ``stages``: (label, t, force_error, moment_error, F0, M0)."""
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 2.8))
+    for k, (label, t, fe, me, F0, M0) in enumerate(stages):
+        c = SIM_COLORS[k % len(SIM_COLORS)]
+        a1.plot(t, fe / F0 if F0 > 0 else fe, color=c, label=label, linewidth=1.0)
+        a2.plot(t, me / M0 if M0 > 0 else me, color=c, label=label, linewidth=1.0)
+    a1.set_title("|F_sim - F_analytic| / unbalanced peak", fontsize=9)
+    a2.set_title("|M_sim - M_analytic| / unbalanced peak", fontsize=9)
+    for a in (a1, a2):
+        a.set_xlabel("time (s)")
+        a.set_yscale("log")
+    a1.legend(fontsize=7)
+    fig.tight_layout()
+    return to_svg(fig, prefix)

@@ -24,19 +24,35 @@ def study_figures(study: Study) -> dict:
     ]
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
     validation = []
+    vals = [s for s in study.stages if s.validation is not None]
+    if vals:
+        F0, M0 = study.unbalanced.analysis.max_force, study.unbalanced.analysis.max_moment
+        validation.append((
+            "Residuals of the simulation",
+            figures.residual_figure([(s.stage.label, s.validation.t, s.validation.force_error,
+                                      s.validation.moment_error, F0, M0) for s in vals]),
+            "Difference between the pymunk simulation and the analytic engine, relative to the unbalanced peaks.",
+        ))
     if study.reactionless is not None:
-        validation = list(study.reactionless.figures())
+        validation += list(study.reactionless.figures())
     return {"loads": loads, "efforts": efforts, "mechanism": mech, "extra": extra, "validation": validation}
 
 
 def render_page(study: Study, results: dict, spec_text: str) -> str:
     spec = study.spec
     validation_rows = []
-    note = ""
     for s in study.stages:
-        if s.validation is not None:
-            validation_rows.append(s.validation.row(s.stage.label))
-            note = s.validation.settings_note()
+        v = s.validation
+        if v is not None:
+            validation_rows.append({
+                "name": s.stage.name, "label": s.stage.label, "force_residual": v.force_residual,
+                "moment_residual": v.moment_residual, "sim_force_ratio": v.force_peak,
+                "sim_moment_ratio": v.moment_peak, "tracking": v.tracking_error_max, "passed": v.passed,
+                "dt": v.dt, "steps": v.steps, "iterations": v.iterations, "tolerance": v.tolerance,
+                "reasons": "; ".join(v.reasons), "notes": "; ".join(v.notes),
+                "excluded": v.excluded_samples, "version": v.pymunk_version,
+            })
+    rl = study.reactionless
     return environment().get_template("spec.html").render(
         r=results,
         paper=spec.paper,
@@ -44,7 +60,8 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
         law=spec.motion.law,
         figures=study_figures(study),
         validation=validation_rows,
-        validation_note=note,
+        reactionless={"base_mass": rl.base_mass, "base_inertia": rl.base_inertia, "rows": rl.rows(),
+                      "player": rl.player()} if rl is not None else None,
         instants=INSTANTS,
         spec_text=spec_text,
     )

@@ -1,0 +1,119 @@
+"""A small self-contained canvas player: the mechanism moving on its free-floating frame.
+
+The page embeds, per stage, the outline of every body (local points) and its pose at about 60
+frames, plus the frame's pose; a few lines of JavaScript draw them side by side. No library, no
+external file: a few kilobytes per page.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+from ..model import Model
+
+FRAMES = 60
+
+
+def _outline(model: Model) -> list[dict]:
+    shapes = []
+    for b in model.bodies:
+        pts = [b.points[p] for p in b.outline] if len(b.outline) >= 2 else []
+        cws = [[round(a.position[0], 5), round(a.position[1], 5), round(a.mass, 4)]
+               for a in b.attachments if a.kind == "counterweight"]
+        shapes.append({
+            "line": [[round(p[0], 5), round(p[1], 5)] for p in pts],
+            "radius": round(b.radius, 5) if b.radius else 0,
+            "slider": b.kind == "slider",
+            "cw": cws,
+        })
+    return shapes
+
+
+def frame_poses(model: Model, com_poses: np.ndarray) -> np.ndarray:
+    """Body-frame poses (n, nb, 3) from centre-of-mass poses (n, nb, 3)."""
+    out = np.array(com_poses, dtype=float, copy=True)
+    for i, b in enumerate(model.bodies):
+        _, c, _ = b.mass_properties()
+        th = out[:, i, 2]
+        out[:, i, 0] -= np.cos(th) * c[0] - np.sin(th) * c[1]
+        out[:, i, 1] -= np.sin(th) * c[0] + np.cos(th) * c[1]
+    return out
+
+
+def player_html(stages: list[dict], element_id: str = "player") -> str:
+    """``stages``: dicts with label, model, t (n,), base (n, 3) frame-origin poses and poses
+    (n, nb, 3) body-frame poses, all in the global frame of the start."""
+    data = []
+    lo = np.array([np.inf, np.inf])
+    hi = -lo
+    for s in stages:
+        n = len(s["t"])
+        ks = np.unique(np.linspace(0, n - 1, min(n, FRAMES)).round().astype(int))
+        poses = s["poses"][ks]
+        base = s["base"][ks]
+        xy = poses[:, :, :2].reshape(-1, 2)
+        lo, hi = np.minimum(lo, xy.min(axis=0)), np.maximum(hi, xy.max(axis=0))
+        fp = [[round(p[0], 5), round(p[1], 5)] for p in s["model"].frame_points.values()]
+        data.append({
+            "label": s["label"],
+            "t": [round(float(v), 5) for v in s["t"][ks]],
+            "base": [[round(float(v), 6) for v in row] for row in base],
+            "poses": [[[round(float(v), 6) for v in body] for body in frame] for frame in poses],
+            "shapes": _outline(s["model"]),
+            "pivots": fp,
+        })
+    pad = 0.15 * float(max(hi - lo)) if np.all(np.isfinite(hi)) else 0.1
+    box = [round(float(lo[0] - pad), 4), round(float(lo[1] - pad), 4), round(float(hi[0] + pad), 4), round(float(hi[1] + pad), 4)]
+    payload = json.dumps({"stages": data, "box": box}, separators=(",", ":"), sort_keys=True)
+    width = 300 * max(1, len(stages))
+    return f"""<canvas id="{element_id}" width="{width}" height="300" style="max-width:100%;border:1px solid #d9dee4"></canvas>
+<script>
+(function() {{
+const D = {payload};
+const cv = document.getElementById("{element_id}"), g = cv.getContext("2d");
+const n = D.stages[0].t.length, W = 300, H = 300, b = D.box;
+const s = Math.min(W / (b[2] - b[0]), (H - 40) / (b[3] - b[1]));
+function P(x, y, k) {{ return [k * W + (x - b[0]) * s, H - 30 - (y - b[1]) * s]; }}
+function T(pose, p) {{ const c = Math.cos(pose[2]), si = Math.sin(pose[2]);
+  return [pose[0] + c * p[0] - si * p[1], pose[1] + si * p[0] + c * p[1]]; }}
+let f = 0;
+function draw() {{
+  g.clearRect(0, 0, cv.width, cv.height);
+  D.stages.forEach((st, k) => {{
+    const i = Math.min(f, st.t.length - 1), base = st.base[i];
+    g.fillStyle = "#e8edf3"; g.strokeStyle = "#8aa4c0";
+    g.beginPath(); st.pivots.forEach((p, j) => {{ const q = P(...T(base, p), k); j ? g.lineTo(...q) : g.moveTo(...q); }});
+    g.closePath(); g.stroke();
+    st.pivots.forEach(p => {{ const q = P(...T(base, p), k); g.fillStyle = "#22303f"; g.fillRect(q[0] - 4, q[1] - 4, 8, 8); }});
+    st.shapes.forEach((sh, j) => {{
+      const pose = st.poses[i][j];
+      if (sh.radius) {{ const c = P(...T(pose, [0, 0]), k); g.strokeStyle = "#2e8b57"; g.beginPath();
+        g.arc(c[0], c[1], sh.radius * s, 0, 2 * Math.PI); g.stroke(); const e = P(...T(pose, [sh.radius, 0]), k);
+        g.beginPath(); g.moveTo(...c); g.lineTo(...e); g.stroke(); }}
+      if (sh.slider) {{ const c = P(...T(pose, [0, 0]), k); g.fillStyle = "#ccc"; g.fillRect(c[0] - 8, c[1] - 5, 16, 10); }}
+      sh.cw.forEach(cw => {{ const c = P(...T(pose, cw), k); g.fillStyle = "rgba(214,39,40,0.6)"; g.beginPath();
+        g.arc(c[0], c[1], 3 + 2 * Math.sqrt(cw[2]), 0, 2 * Math.PI); g.fill(); }});
+      if (sh.line.length > 1) {{ g.strokeStyle = "#111"; g.lineWidth = 3; g.beginPath();
+        sh.line.forEach((p, m) => {{ const q = P(...T(pose, p), k); m ? g.lineTo(...q) : g.moveTo(...q); }}); g.stroke(); g.lineWidth = 1; }}
+    }});
+    g.fillStyle = "#1d232b"; g.font = "12px sans-serif";
+    g.fillText(st.label, k * W + 8, 16);
+    const dx = base[0] * 1000, dy = base[1] * 1000, rot = base[2] * 180 / Math.PI;
+    g.fillText(`t = ${{st.t[i].toFixed(3)}} s  frame: (${{dx.toFixed(2)}}, ${{dy.toFixed(2)}}) mm, ${{rot.toFixed(3)}} deg`, k * W + 8, H - 8);
+  }});
+  f = (f + 1) % (n + 15);
+}}
+draw(); setInterval(draw, 50);
+}})();
+</script>"""
+
+
+def reactionless_summary(t: np.ndarray, base: np.ndarray) -> dict:
+    """Drift (max distance of the frame's origin from its start) and rotation of the frame."""
+    d = np.hypot(base[:, 0] - base[0, 0], base[:, 1] - base[0, 1])
+    rot = np.abs(base[:, 2] - base[0, 2])
+    return {"max_drift_m": float(d.max()), "max_rotation_deg": float(math.degrees(rot.max())),
+            "final_drift_m": float(d[-1]), "final_rotation_deg": float(math.degrees(rot[-1]))}

@@ -1,0 +1,110 @@
+"""The validation stage of the pipeline: every balancing stage simulated in pymunk
+(:mod:`balpipe.validate`), and the optional free-floating-frame demonstration."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from .study import Study
+from .validate import FreeFloating, ValidationSettings, free_floating, validate
+
+
+def settings_for(study: Study) -> ValidationSettings:
+    v = study.spec.validation
+    return ValidationSettings(dt=v.dt, iterations=v.iterations, tolerance=v.tolerance)
+
+
+def reactionless_enabled(study: Study) -> bool:
+    """On by default for the papers' specs (those naming a ``paper``), opt-in otherwise."""
+    flag = study.spec.validation.reactionless
+    return flag if flag is not None else study.spec.paper is not None
+
+
+@dataclass
+class Reactionless:
+    """The free-floating runs of every stage, for the page and results.json."""
+
+    labels: list[str]
+    names: list[str]
+    runs: list[FreeFloating]
+    models: list = field(default_factory=list)
+
+    def to_json(self) -> dict:
+        return {name: run.to_json() for name, run in zip(self.names, self.runs)}
+
+    @property
+    def base_mass(self) -> float:
+        return self.runs[0].base_mass
+
+    @property
+    def base_inertia(self) -> float:
+        return self.runs[0].base_inertia
+
+    def rows(self) -> list[dict]:
+        return [
+            {"label": lab, "max_drift_m": r.max_drift, "max_rotation_deg": math.degrees(r.max_rotation)}
+            for lab, r in zip(self.labels, self.runs)
+        ]
+
+    def figures(self):
+        from .report.figures import drift_figure
+
+        yield (
+            "Frame drift and rotation",
+            drift_figure([(lab, r.t, r.drift, r.rotation) for lab, r in zip(self.labels, self.runs)]),
+            "Displacement of the free frame's centre of mass and its rotation during the motion.",
+        )
+
+    def player(self) -> str:
+        from .report.player import player_html
+
+        return player_html([
+            {"label": lab, "model": m, "t": r.t, "base": r.base, "poses": r.poses}
+            for lab, m, r in zip(self.labels, self.models, self.runs)
+        ])
+
+
+def simulate_study(study: Study) -> None:
+    """Validate every stage; failures become problems of the study (the build exits 1)."""
+    settings = settings_for(study)
+    F0, M0 = study.unbalanced.analysis.max_force, study.unbalanced.analysis.max_moment
+    for s in study.stages:
+        expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
+        s.validation = validate(s.stage.model, s.analysis, (F0, M0), settings, expect)
+        if not s.validation.passed:
+            study.problems.append(
+                f"pymunk validation of stage {s.stage.name!r} fails: {'; '.join(s.validation.reasons)}"
+            )
+    if reactionless_enabled(study):
+        runs = [free_floating(s.stage.model, s.analysis, settings=settings) for s in study.stages]
+        study.reactionless = Reactionless(
+            [s.stage.label for s in study.stages], [s.stage.name for s in study.stages], runs,
+            [s.stage.model for s in study.stages],
+        )
+
+
+def timing(study: Study) -> dict:
+    """Wall-clock seconds of the simulations (kept out of the deterministic files)."""
+    out = {}
+    for s in study.stages:
+        if s.validation is not None:
+            out[s.stage.name] = dict(s.validation.timing)
+    if study.reactionless is not None:
+        for name, r in zip(study.reactionless.names, study.reactionless.runs):
+            out.setdefault(name, {})["reactionless_s"] = float(r.timing.get("total_s", 0.0))
+    return out
+
+
+
+def timing_script(times: dict) -> str:
+    """``timing.js``: fills the page's run-time cells. The only file of a page that changes
+    from one identical build to the next, so the page itself stays byte-identical."""
+    import json
+
+    totals = {k: round(v.get("total_s", 0.0), 4) for k, v in times.items()}
+    return (
+        "(function(){var T=" + json.dumps(totals, sort_keys=True) + ";"
+        "document.querySelectorAll('[data-timing]').forEach(function(e){"
+        "var v=T[e.getAttribute('data-timing')];if(v!=null)e.textContent=v.toFixed(3)+' s';});})();\n"
+    )
