@@ -153,6 +153,8 @@ class _Mesh:
         wb = (xc + wb[0], yc + wb[1])
         dx, dy = wb[0] - wa[0], wb[1] - wa[1]
         d = math.hypot(dx, dy)
+        if not d > 0.0:  # the mechanism came apart
+            raise FloatingPointError(f"gear pair {self.name!r}: its centres coincide")
         u = (dx / d, dy / d)
         t = (-u[1], u[0])
         R = self.ratio
@@ -167,6 +169,33 @@ class _Mesh:
         self.groove.groove_a = g1
         self.groove.groove_b = g2
         self.groove.anchor_b = _unrot(thb, (anchor[0] - xb, anchor[1] - yb))
+
+
+@dataclass
+class _CarriedGear:
+    """A gear pair on a moving carrier as one GearJoint between the gears' absolute angles,
+    theta_b - ratio theta_a = phase + (1 - ratio) theta_c, the carrier's angle entering the
+    phase explicitly: before each step it is set to the carrier's angle extrapolated to the
+    end of the next step (the dead-beat recipe of the drivers, with the carrier's own motion
+    in place of a law). The gears get their mesh couples; the carrier does not get its
+    (1 - ratio) share, which changes only the internal forces of a mechanism whose motion is
+    imposed by its drivers, not its motion, hence not the momentum measurement."""
+
+    name: str
+    joint: pymunk.GearJoint
+    scale: float
+    offset: float
+    carrier: pymunk.Body
+    factor: float  # 1 - ratio
+    w_prev: float | None = None
+
+    def update(self, dt: float) -> None:
+        c = self.carrier
+        w = c.angular_velocity
+        w_next = w if self.w_prev is None else 2.0 * w - self.w_prev
+        self.w_prev = w
+        theta = c.angle + dt * (w + w_next)
+        self.joint.phase = self.offset + self.scale * self.factor * theta
 
 
 @dataclass
@@ -189,6 +218,7 @@ class SimModel:
     meshes: list[_Mesh]
     com_local: list[tuple[float, float]]
     floored: list[str] = field(default_factory=list)
+    carried: list[_CarriedGear] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
 
     @property
@@ -202,6 +232,8 @@ class SimModel:
             d.set(targets[d.driver.name])
         for m in self.meshes:
             m.update(dt)
+        for g in self.carried:
+            g.update(dt)
 
     def step(self, targets: dict[str, float], dt: float) -> None:
         self.prepare(targets, dt)
@@ -243,9 +275,8 @@ def build_space(
     iterations: int = 30,
     floating_base: tuple[float, float, tuple[float, float]] | None = None,
     mass_floor: float = 1e-6,
-    absolute_gears: bool = False,
+    gear_model: str | None = None,
     joint_bias: float | None = None,
-    mesh_bias: float | None = 0.0,
     dt: float = 1e-3,
 ) -> SimModel:
     """Build ``model`` in a new pymunk space.
@@ -254,8 +285,12 @@ def build_space(
     ``model.bodies`` order (default: the engine's assembly at t = 0, at rest).
     ``floating_base = (mass, moment, centre_of_gravity)`` makes the frame a free body (used by
     :func:`balpipe.validate.free_floating`); otherwise the frame is ``space.static_body``.
-    ``absolute_gears = True`` builds every gear pair as a single absolute GearJoint, the trap
-    of PYMUNK.md (kept only to measure it).
+    ``gear_model`` chooses how a gear pair whose two gears and carrier all move is built:
+    ``"explicit"`` (default with a static frame), ``"mesh"`` (default when floating) or
+    ``"absolute"`` (the carrier ignored: PYMUNK.md's trap, kept only to measure it).
+    ``joint_bias``: fraction of a passive joint's position error corrected per step (default
+    1: all of it, dead-beat); drivers and meshes always correct all of it. ``dt`` is the step
+    the space will be stepped with (used to convert ``joint_bias`` into pymunk's error_bias).
     """
     if pose is None:
         pose, v0 = assembled_state(model)
@@ -279,11 +314,10 @@ def build_space(
     bodies: list[pymunk.Body] = []
     com_local: list[tuple[float, float]] = []
     for b, (m, com, inertia), q, v in zip(model.bodies, props, pose, velocity):
-        mm, ii = m, inertia
-        if m <= 0 or inertia <= 0:
+        mm = max(m, mass_floor * m_ref)
+        ii = max(inertia, mass_floor * i_ref)
+        if mm != m or ii != inertia:
             floored.append(b.name)
-            mm = max(m, mass_floor * m_ref)
-            ii = max(inertia, mass_floor * i_ref)
         body = pymunk.Body(mm, ii)
         body.center_of_gravity = (0.0, 0.0)  # first (the origin is the centre of mass)
         body.angle = float(q[2])  # then the angle
@@ -325,11 +359,14 @@ def build_space(
     def is_static(name: str) -> bool:
         return name == FRAME and not floating
 
-    def angle_joint(coeffs: dict[str, float], phase: float, eb: float | None = None) -> tuple[pymunk.GearJoint, float, float]:
+    def angle_joint(
+        coeffs: dict[str, float], phase: float, eb: float | None = None, absolute: bool = False
+    ) -> tuple[pymunk.GearJoint, float, float]:
         """One GearJoint for sum_k c_k theta_k = phase + s(t); returns it with (scale, offset)
-        such that the joint's phase = offset + scale * s."""
+        such that the joint's phase = offset + scale * s. On a floating base, angles whose
+        coefficients do not cancel are measured from the base (unless ``absolute``)."""
         terms = [(n, k) for n, k in coeffs.items() if k != 0.0 and not is_static(n)]
-        if floating:
+        if floating and not absolute:
             total = sum(k for _, k in terms)
             if abs(total) > 1e-12:  # an absolute angle: relative to the base
                 terms.append((FRAME, -total))
@@ -362,17 +399,18 @@ def build_space(
             pg = local(jt.guide, jt.point_guide)
             ps = local(jt.slider, jt.point_slider)
             angle_joint({jt.slider: 1.0, jt.guide: -1.0}, jt.angle)
+            g1 = (pg[0] - half * ax[0], pg[1] - half * ax[1])
+            g2 = (pg[0] + half * ax[0], pg[1] + half * ax[1])
+            add(pymunk.GrooveJoint(pb[jt.guide], pb[jt.slider], g1, g2, ps))
             d = driven.get(jt.name)
-            if d is None:
-                g1 = (pg[0] - half * ax[0], pg[1] - half * ax[1])
-                g2 = (pg[0] + half * ax[0], pg[1] + half * ax[1])
-                add(pymunk.GrooveJoint(pb[jt.guide], pb[jt.slider], g1, g2, ps))
-            else:
-                s0 = float(d.law(np.array([0.0]))[0][0])
-                c = add(pymunk.PivotJoint(pb[jt.guide], pb[jt.slider], (pg[0] + ax[0] * s0, pg[1] + ax[1] * s0), ps), 0.0)
-                sim.drives.append(_Drive(d.name, d, "anchor", c, base_point=pg, axis=ax))
+            if d is not None:
+                # a second groove across the axis, moved along it with the law
+                c = add(pymunk.GrooveJoint(pb[jt.guide], pb[jt.slider], g1, g2, ps), 0.0)
+                dr = _Drive(d.name, d, "groove", c, base_point=pg, axis=ax, half_length=half)
+                dr.set(float(d.law(np.array([0.0]))[0][0]))
+                sim.drives.append(dr)
         elif isinstance(jt, Gear):
-            _add_gear(sim, jt, pb, com, init_angle, model, angle_joint, add, is_static, absolute_gears, half, mass_floor, m_ref, i_ref, mesh_bias)
+            _add_gear(sim, jt, pb, com, init_angle, model, angle_joint, add, is_static, gear_model or ('mesh' if floating else 'explicit'), half, mass_floor, m_ref, i_ref)
         else:  # pragma: no cover
             raise TypeError(jt)
 
@@ -416,21 +454,27 @@ def _gear_phase(jt: Gear, model: Model) -> float:
     return (th[jt.b] - th[jt.carrier]) - jt.ratio * (th[jt.a] - th[jt.carrier])
 
 
-def _add_gear(sim, jt, pb, com, init_angle, model, angle_joint, add, is_static, absolute, half, floor, m_ref, i_ref, mesh_bias):
+def _add_gear(sim, jt, pb, com, init_angle, model, angle_joint, add, is_static, gear_model, half, floor, m_ref, i_ref):
     phase = _gear_phase(jt, model)
     coeffs: dict[str, float] = {}
     for n, v in ((jt.b, 1.0), (jt.carrier, -1.0), (jt.a, -jt.ratio), (jt.carrier, jt.ratio)):
         coeffs[n] = coeffs.get(n, 0.0) + v
     moving = [n for n, k in coeffs.items() if k != 0.0 and not is_static(n)]
-    if absolute and len(moving) == 3:
-        # the trap: theta_b - ratio theta_a = phase + (1 - ratio) theta_c(initial), carrier ignored
-        c0 = init_angle[jt.carrier]
-        angle_joint({jt.b: 1.0, jt.a: -jt.ratio}, phase + (1.0 - jt.ratio) * c0)
-        sim.notes.append(f"gear {jt.name!r}: absolute GearJoint (carrier ignored)")
-        return
     if len(moving) <= 2:
         angle_joint(coeffs, phase)
         return
+    if gear_model == "absolute":
+        # the trap: theta_b - ratio theta_a = phase + (1 - ratio) theta_c(t = 0), carrier ignored
+        c0 = init_angle[jt.carrier]
+        angle_joint({jt.b: 1.0, jt.a: -jt.ratio}, phase + (1.0 - jt.ratio) * c0, absolute=True)
+        sim.notes.append(f"gear {jt.name!r}: absolute GearJoint, carrier ignored")
+        return
+    if gear_model == "explicit":
+        j, scale, offset = angle_joint({jt.b: 1.0, jt.a: -jt.ratio}, phase, 0.0, absolute=True)
+        sim.carried.append(_CarriedGear(jt.name, j, scale, offset, pb[jt.carrier], 1.0 - jt.ratio))
+        return
+    if gear_model != "mesh":
+        raise ValueError(f"unknown gear_model {gear_model!r}")
     # three moving bodies: a mesh on the carrier
     def centre(g: str) -> tuple[float, float] | None:
         for j in model.joints:
@@ -468,7 +512,7 @@ def _add_gear(sim, jt, pb, com, init_angle, model, angle_joint, add, is_static, 
             aux.append(body)
         A, B = aux
         sim.notes.append(f"gear {jt.name!r}: no carrier pivot for its gears, auxiliary gears used")
-    groove = add(pymunk.GrooveJoint(A, B, (0.0, -half), (0.0, half), (0.0, 0.0)), mesh_bias)
+    groove = add(pymunk.GrooveJoint(A, B, (0.0, -half), (0.0, half), (0.0, 0.0)), 0.0)
     sim.meshes.append(
         _Mesh(jt.name, groove, A, B, C, pb[jt.a], pb[jt.b], oa, ob, float(jt.ratio), phase, half, auxiliary)
     )
