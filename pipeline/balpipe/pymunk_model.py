@@ -5,55 +5,66 @@ Nothing here knows a mechanism: every body, joint and driver of the model is map
 
 Bodies
     One ``pymunk.Body(mass, moment)`` per model body, no shapes (so nothing collides). The
-    pymunk body's origin is the body's centre of mass (``center_of_gravity`` stays (0, 0), set
-    before ``angle``, set before ``position``: see ../shared/reference/PYMUNK.md), so
-    ``body.position`` and ``body.velocity`` are the centre of mass's. Joint points are converted
-    from the model's body frame to offsets from the centre of mass. pymunk needs positive masses
-    and moments: a body whose mass (moment) is zero, such as a massless gear, gets
-    ``mass_floor`` times the largest mass (moment) of the model. That changes the loads by at
-    most that fraction (measured: no visible change at the default 1e-6, see
-    :mod:`balpipe.validate`).
+    pymunk body's origin is the body's centre of mass (attachments included): its
+    ``center_of_gravity`` stays (0, 0) and is set before ``angle``, itself set before
+    ``position`` (see ../shared/reference/PYMUNK.md), so ``body.position`` and
+    ``body.velocity`` are the centre of mass's. Joint points are converted from the model's
+    body frame to offsets from the centre of mass. pymunk needs positive masses and moments
+    and its iterative solver stalls on light bodies between heavy ones: every mass (moment)
+    below ``mass_floor`` times the model's largest is raised to it (``SimModel.floored``).
+    :mod:`balpipe.validate` measures the loads with the model's own masses on the simulated
+    motion, which the drivers impose, so the floors only change internal forces there.
 
 Frame
     ``space.static_body`` (its local coordinates are global coordinates), or, for the
     free-floating demonstration, a dynamic base body whose local coordinates are the model's
     global coordinates at t = 0 and whose centre of gravity is a chosen point.
 
-Joints
-    * Revolute: ``PivotJoint``, ``error_bias = 0`` (a pivot drifts ~1e-4 m with the default).
+Joints (every position error corrected in one step: ``error_bias = 0``, unless ``joint_bias``)
+    * Revolute: ``PivotJoint``.
     * Prismatic: ``GrooveJoint`` (the guide's line through ``point_guide``, long enough never to
-      be left) plus a ``GearJoint(guide, slider, angle, 1)`` locking the relative rotation. A
-      driven prismatic pair replaces its groove by a ``PivotJoint`` whose anchor on the guide
-      moves along the axis with the law.
+      be left) plus ``GearJoint(guide, slider, angle, 1)`` locking the relative rotation
+      (a groove alone leaves the slider free to turn).
     * Angle relations (gear pairs, the rotation lock, angle drivers) are written, as in the
-      engine, as ``sum_k c_k theta_k = phase (+ law)`` over the bodies involved. The frame drops
-      out when it is static. With one or two moving bodies it is one ``GearJoint``: between two
-      moving bodies whose coefficients do not cancel (a gear pair carried by a static frame),
-      pymunk's GearJoint gives the right motion but does not conserve angular momentum; the
-      missing ``(1 - ratio)`` couple is the one the frame takes, and the momentum measurement
-      of :mod:`balpipe.validate` (the loads on the frame are minus the rate of change of the
-      moving bodies' momenta) includes it by construction. With three moving bodies (a gear
-      pair on a moving carrier, or any gear pair on the free-floating base) no combination of
-      two-body GearJoints can express the constraint (each one relates two absolute angles),
-      so the mesh is modelled as what it is: the two gears turn on pivots of the carrier and
-      touch at the pitch point, where a ``GrooveJoint`` (groove on gear a along the line of
-      centres, anchor on gear b) forbids relative sliding. The groove and anchor are re-placed
-      at the pitch point before every step, so the constraint is exactly
-      ``(w_b - w_c) = ratio (w_a - w_c)`` at velocity level, and the anchor is offset along the
-      tangent by the accumulated angle error so that the position-level relation is restored
-      each step (dead-beat). Every force then acts between two bodies at one point: the mesh
-      couple reaches the carrier through the pivots and momentum is conserved. The gear
-      centres are the points where a revolute joint connects a (b) to the carrier; when there
-      is none, two auxiliary light gear bodies are pinned to the carrier and locked to a and b
-      (ratio 1 GearJoints, which conserve momentum).
+      engine, ``sum_k c_k theta_k = phase (+ law)``; a static frame drops out (theta = 0), a
+      free base is added to relations whose coefficients do not cancel (an angle driver is
+      then measured from the base). One or two moving bodies: one ``GearJoint``. Between two
+      moving bodies whose coefficients do not cancel (a gear pair carried by a static frame,
+      ratio != 1) pymunk's GearJoint gives the right motion but not the reaction couple
+      (1 - ratio) lambda, which is the frame's: the momentum measurement (minus the rate of
+      change of the moving bodies' momenta) includes it by construction.
+    * Gear pairs whose two gears and carrier all move (planetary gears; every gear pair on a
+      free base): no set of two-body GearJoints can express a relation between three angles,
+      ``gear_model`` chooses:
+
+      - ``"mesh"`` (default): what a gear pair is. Gears a and b turn on pivots of the carrier
+        (the points where revolute joints connect them to it) and touch at the pitch point P
+        of the line of centres, |P - Oa| / |P - Ob| = |ratio|; a ``GrooveJoint`` (groove on a
+        along the line of centres, anchor on b) forbids relative sliding there. Groove and
+        anchor are re-placed at P for the positions the next step integrates to, so the
+        velocity constraint is exactly (w_b - w_c) = ratio (w_a - w_c); the anchor is moved
+        along the tangent by the accumulated angle error times b's pitch radius so that the
+        angle relation itself is restored every step. Every force acts between two bodies at
+        one point: the mesh couple reaches the carrier through the pivots and momentum is
+        conserved, implicitly in the solver. Without such pivots (coaxial gears, or none
+        declared) two auxiliary light gears are pinned to the carrier at virtual centres and
+        locked to a and b by ratio-1 GearJoints. Its convergence degrades when a gear's moment
+        is large next to its mass times its pitch radius squared.
+      - ``"explicit"``: one GearJoint, theta_b - ratio theta_a = phase + (1 - ratio) theta_c,
+        the carrier's angle extrapolated to the end of the next step (``_CarriedGear``). Always
+        converges; the carrier misses its (1 - ratio) couple, harmless for a motion imposed by
+        drivers, but the extrapolation lags where the carrier's acceleration jumps.
+      - ``"absolute"``: the carrier's angle frozen at t = 0: PYMUNK.md's trap, for measurement.
 
 Drivers (the dead-beat recipe)
     Chipmunk moves positions before it solves velocities, so a constraint's target set before
     the step from t is reached at t + 2 dt. Every driver constraint has ``error_bias = 0`` and
-    its target is set before each step to the law at t + 2 dt.
+    its target is set before each step to the law at t + 2 dt (``SimModel.prepare``).
 
     * revolute joint or absolute angle: ``GearJoint(a, b, phase, 1)``, phase = law;
-    * prismatic joint: the moving pivot above;
+    * prismatic joint: a second ``GrooveJoint`` across the axis, moved along it with the law
+      (its force and the guide's act at the same point, so momentum is conserved; a pivot with
+      a moving anchor puts the two ends of its impulse ~ v dt apart);
     * x / y of a body point: a ``GrooveJoint`` on the frame, the vertical (horizontal) line at
       the law's value, the point as anchor.
 """
@@ -87,7 +98,7 @@ class _Drive:
 
     name: str
     driver: Driver
-    kind: str  # "phase", "anchor", "groove"
+    kind: str  # "phase" (a GearJoint's phase) or "groove" (a groove across an axis)
     constraint: pymunk.Constraint
     scale: float = 1.0
     offset: float = 0.0
@@ -99,11 +110,6 @@ class _Drive:
         c = self.constraint
         if self.kind == "phase":
             c.phase = self.offset + self.scale * value
-        elif self.kind == "anchor":
-            c.anchor_a = (
-                self.base_point[0] + self.axis[0] * value,
-                self.base_point[1] + self.axis[1] * value,
-            )
         else:  # groove: line through axis-coordinate `value`, perpendicular to axis
             ax, L = self.axis, self.half_length
             n = (-ax[1], ax[0])
@@ -282,12 +288,13 @@ def build_space(
     """Build ``model`` in a new pymunk space.
 
     ``pose`` and ``velocity`` are (nb, 3) centre-of-mass coordinates and their rates in
-    ``model.bodies`` order (default: the engine's assembly at t = 0, at rest).
+    ``model.bodies`` order (default: the engine's assembly and velocities at t = 0).
     ``floating_base = (mass, moment, centre_of_gravity)`` makes the frame a free body (used by
     :func:`balpipe.validate.free_floating`); otherwise the frame is ``space.static_body``.
     ``gear_model`` chooses how a gear pair whose two gears and carrier all move is built:
-    ``"explicit"`` (default with a static frame), ``"mesh"`` (default when floating) or
-    ``"absolute"`` (the carrier ignored: PYMUNK.md's trap, kept only to measure it).
+    ``"mesh"`` (default), ``"explicit"`` or ``"absolute"`` (see the module's docstring).
+    ``mass_floor``: masses and moments below this fraction of the model's largest are raised
+    to it.
     ``joint_bias``: fraction of a passive joint's position error corrected per step (default
     1: all of it, dead-beat); drivers and meshes always correct all of it. ``dt`` is the step
     the space will be stepped with (used to convert ``joint_bias`` into pymunk's error_bias).
@@ -410,7 +417,7 @@ def build_space(
                 dr.set(float(d.law(np.array([0.0]))[0][0]))
                 sim.drives.append(dr)
         elif isinstance(jt, Gear):
-            _add_gear(sim, jt, pb, com, init_angle, model, angle_joint, add, is_static, gear_model or ('mesh' if floating else 'explicit'), half, mass_floor, m_ref, i_ref)
+            _add_gear(sim, jt, pb, com, init_angle, model, angle_joint, add, is_static, gear_model or 'mesh', half, mass_floor, m_ref, i_ref)
         else:  # pragma: no cover
             raise TypeError(jt)
 
