@@ -3,7 +3,6 @@ type, on models built by hand; plus the cases where it must fail, and the free-f
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 
@@ -254,14 +253,13 @@ def test_planetary_gear_models_and_the_absolute_gear_trap():
     (PYMUNK.md's trap, the carrier ignored) does not: the check can fail."""
     model = planetary()
     a = analyse(model, GRID)
-    O = a.moment_point
     for gear_model, ok in (("mesh", True), ("explicit", True), ("absolute", False)):
         run = simulate(model, a, 5e-4, 400, gear_model=gear_model, mass_floor=0.1)
-        F, M = run.force[::4], run.moment[::4]
+        M = run.moment[::4]  # on the analysis grid; the end samples straddle the laws' corners
         err = np.abs(M[1:-1] - a.moment[1:-1]).max() / a.max_moment
         assert (err < 1e-3) == ok, (gear_model, err)
-        assert np.abs(F[1:-1] - a.force[1:-1]).max() / a.max_force < (1e-3 if ok else np.inf)
-    assert O == (0.0, 0.0)
+        planet = run.poses[::4, 2, 2]
+        assert (np.abs(planet - a.q[:, 2, 2]).max() < 1e-4) == ok  # the trap turns it wrongly
 
 
 def test_massless_gears_use_floors_without_changing_the_loads():

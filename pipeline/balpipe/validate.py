@@ -120,7 +120,7 @@ __all__ = [
 
 #: default number of steps over the motion (the step is also kept below 0.01 / w_max)
 STEPS_PER_MOTION = 1000
-#: default solver iterations; doubled (up to MAX_ITERATIONS) if a run loses its joints
+#: first solver iteration count; doubled (up to MAX_ITERATIONS) until the loads converge
 ITERATIONS = 100
 MAX_ITERATIONS = 3200
 #: deviation from the analysed motion (rad, or relative to the model's size) that makes a run retry
@@ -133,7 +133,9 @@ class ValidationSettings:
 
     ``dt``: time step (None: :func:`default_settings`); it is rounded down so that a whole
     number of steps fits each interval of the analysis grid. ``iterations``: pymunk solver
-    iterations (None: :data:`ITERATIONS`, doubled while a run loses its joints).
+    iterations to start from (None: :data:`ITERATIONS`); they are doubled until two runs'
+    loads differ by at most ``tolerance / 10`` of the unbalanced peaks (see
+    :func:`_run_adaptive`).
     ``tolerance``: the stage passes when both residuals are at most this fraction of the
     unbalanced peaks. ``balance_tolerance``: for the loads a stage claims to cancel (``expect``
     of :func:`validate`), the simulated peak must also be at most this fraction of the
@@ -692,16 +694,6 @@ def _run_adaptive(
     _, run, change, gm = best
     notes.append(f"kept the best converged run ({run.iterations} iterations" + (f", {gm} gears)" if gm else ")"))
     return run, notes, change
-
-
-def _unit(model: Model, driver: str, scale: float) -> float:
-    """Scale of a driven coordinate: 1 rad for angles, the model's size for lengths."""
-    d = next(d for d in model.drivers if d.name == driver)
-    if d.target[0] in ("x", "y"):
-        return scale
-    if d.target[0] == "joint" and isinstance(model.joint(d.target[1]), Prismatic):
-        return scale
-    return 1.0
 
 
 def _model_scale(analysis: Analysis) -> float:
