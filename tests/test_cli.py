@@ -117,3 +117,36 @@ def test_check_and_schema(work):
     assert r.returncode == 0
     s = json.loads(r.stdout)
     assert "mechanism" in s["properties"] and s["additionalProperties"] is False
+
+
+def test_a_counterweight_10_percent_off_fails_validation_visibly(work):
+    """As built with mcp1 10 % heavier than eq. 15's 8.4 kg: the analysis and the pymunk
+    simulation both see the residual force; the page and the index say so; exit 1."""
+    spec = work / "specs" / "offset_slider_crank.yaml"
+    spec.write_text(spec.read_text().replace("coupler_counterweight: -0.15 m",
+                                              "coupler_counterweight: -0.15 m\n  crank_counterweight_mass: 9.24 kg"))
+    r = balpipe("build", spec, "-o", "out", cwd=work)
+    assert r.returncode == 1, r.stderr
+    assert "pymunk validation of stage 'counterweights' fails" in r.stderr
+    res = json.loads((work / "out" / "offset_slider_crank" / "results.json").read_text())
+    v = res["validation"]["counterweights"]
+    assert v["passed"] is False and v["force_peak"] > 0.01
+    assert res["validation"]["unbalanced"]["passed"] is True  # the simulation itself is fine
+    page = (work / "out" / "offset_slider_crank" / "index.html").read_text()
+    assert '<span class="badge bad">fail</span>' in page
+    index = (work / "out" / "index.html").read_text()
+    assert '<span class="badge bad">fail</span>' in index and '<span class="badge bad">failed</span>' in index
+
+
+def test_simulated_build_passes_and_reports_validation(work):
+    r = balpipe("build", work / "specs" / "scott_russell.yaml", "-o", "out", cwd=work)
+    assert r.returncode == 0, r.stderr
+    res = json.loads((work / "out" / "scott_russell" / "results.json").read_text())
+    for name, v in res["validation"].items():
+        assert v["passed"], (name, v["reasons"])
+        assert v["force_residual"] <= 0.01 and v["moment_residual"] <= 0.01
+    rl = res["reactionless"]
+    assert rl["unbalanced"]["max_drift"] > 1e3 * rl["full"]["max_drift"]
+    assert rl["unbalanced"]["max_rotation"] > 1e3 * rl["full"]["max_rotation"]
+    out = work / "out" / "scott_russell"
+    assert "timing.js" in (out / "index.html").read_text() and (out / "timing.json").exists()

@@ -129,3 +129,16 @@ def test_custom_template_matches_the_slider_crank_template():
     assert np.allclose(a.force, b.force, atol=1e-9 * a.max_force)
     assert np.allclose(a.moment, b.moment, atol=1e-9 * a.max_moment)
     assert np.allclose(a.efforts["crank"], b.efforts["crank"], atol=1e-9)
+
+
+def test_absolute_angle_drivers_put_their_reaction_on_the_frame():
+    rng = np.random.default_rng(9)
+    a1, a2 = bar("l1", 0.3, 1.2, rng), bar("l2", 0.25, 0.8, rng)
+    model = Model("2R", (a1, a2),
+                  (Revolute("A", FRAME, "l1", (0.0, 0.0), (0.0, 0.0)), Revolute("B", "l1", "l2", (0.3, 0.0), (0.0, 0.0))),
+                  (Driver("t1", ("angle", "l1"), PointToPoint(0.1, 1.2, 0.5, PROFILES["quintic"])),
+                   Driver("t2", ("angle", "l2"), PointToPoint(0.5, -0.7, 0.5, PROFILES["quintic"]))),
+                  {"l1": (0, 0, 0.1), "l2": (0.3 * math.cos(0.1), 0.3 * math.sin(0.1), 0.5)})
+    an = analyse(model, np.linspace(0, 0.5, 201))
+    df, dm = an.route_difference()
+    assert an.max_moment > 0.1 and dm <= 1e-9 * an.max_moment and df <= 1e-9 * an.max_force

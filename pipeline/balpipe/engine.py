@@ -210,8 +210,8 @@ def _driver_primitive(d: Driver, joints: dict, idx, local, model: Model):
         raise ValueError(f"driver {d.name!r}: a gear pair cannot be driven, drive one of its bodies")
     body = d.target[1]
     b = idx(body, d.name)
-    if kind == "angle":
-        return _Angle(d.name, [(b, 1.0)], 0.0, d.law)
+    if kind == "angle":  # absolute angle: theta_b - theta_frame, so the reaction lands on the frame
+        return _Angle(d.name, [(b, 1.0), (0, -1.0)], 0.0, d.law)
     if kind in ("x", "y"):
         point = model.body(body).point(d.target[2]) if len(d.target) > 2 else (0.0, 0.0)
         axis = np.array([1.0, 0.0]) if kind == "x" else np.array([0.0, 1.0])
@@ -350,11 +350,6 @@ def _check_square(c: Compiled) -> None:
             f"the model has {n} coordinates but {m} constraint equations: "
             + ("add drivers or joints (it can move freely)" if m < n else "it is over-constrained")
         )
-
-
-def _length_scale(c: Compiled) -> float:
-    pts = [np.abs(np.asarray(j.point_a)).max() for j in c.model.joints if isinstance(j, Revolute)]
-    return max([1.0, *pts])
 
 
 def _newton(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER):
@@ -573,7 +568,7 @@ def analyse(
     Jf, J0 = J[:, :, 3:], J[:, :, :3]
     nb = c.nb
     g = np.asarray(gravity, dtype=float)
-    Mdiag = np.repeat(np.stack([c.mass, c.mass, c.inertia], axis=1)[None], 1, axis=0).reshape(1, -1)
+    Mdiag = np.stack([c.mass, c.mass, c.inertia], axis=1).reshape(1, -1)
     Q = np.zeros_like(q)
     Q[:, 0::3] = c.mass * g[0]
     Q[:, 1::3] = c.mass * g[1]

@@ -125,9 +125,12 @@ class Polynomial(Law):
         return cls(tuple(float(c) for c in coeffs), duration)
 
     def __call__(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        """Inside [0, T] the polynomial; outside, held at its end values (at rest)."""
+        t = np.asarray(t, dtype=float)
+        inside = (t >= 0) & (t <= self.duration)
+        tc = np.clip(t, 0.0, self.duration)
         c = np.polynomial.Polynomial(self.coefficients)
-        return c(t), c.deriv(1)(t), c.deriv(2)(t)
+        return c(tc), np.where(inside, c.deriv(1)(tc), 0.0), np.where(inside, c.deriv(2)(tc), 0.0)
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ from pydantic import Field
 from ..mechanisms.slider_crank import SliderCrankMechanism
 from ..model import Attachment, Model
 from ..spec_parts import SpecFieldError, Strict
-from ..units import Length
+from ..units import Length, Mass
 from .base import BalanceResult, Parameter, Stage
 
 
@@ -28,6 +28,12 @@ class SliderCrankCounterweights(Strict):
     coupler_counterweight: Length = Field(
         description="position of counterweight 2 along the coupler from B (rcp2 L2; negative: on "
         "the far side of B from C)"
+    )
+    crank_counterweight_mass: Mass | None = Field(
+        None, description="as built: use this mass instead of eq. 15's (the page then shows what it leaves)"
+    )
+    coupler_counterweight_mass: Mass | None = Field(
+        None, description="as built: use this mass instead of eq. 15's"
     )
     moment_unknown: Literal["crank_counterweight_inertia", "coupler_counterweight_inertia"] | None = Field(
         None,
@@ -74,6 +80,18 @@ def balance(mech: SliderCrankMechanism, method: SliderCrankCounterweights, model
     params = [
         Parameter("mcp2", mcp2, "kg", "eq. 15", "counterweight on the coupler"),
         Parameter("mcp1", mcp1, "kg", "eq. 15", "counterweight on the crank"),
+    ]
+    notes: list[str] = []
+    for attr, name in (("coupler_counterweight_mass", "mcp2"), ("crank_counterweight_mass", "mcp1")):
+        built = getattr(method, attr)
+        if built is not None:
+            params.append(Parameter(f"{name}_built", built, "kg", "spec", f"as built, instead of eq. 15's {name}"))
+            notes.append(f"The spec sets {name} = {built:.6g} kg as built; eq. 15 asks for {(mcp1 if name == 'mcp1' else mcp2):.6g} kg.")
+    if method.crank_counterweight_mass is not None:
+        mcp1 = method.crank_counterweight_mass
+    if method.coupler_counterweight_mass is not None:
+        mcp2 = method.coupler_counterweight_mass
+    params += [
         Parameter("rcp1", c1 / L1, "", "spec", "crank counterweight position / L1"),
         Parameter("rcp2", c2 / L2, "", "spec", "coupler counterweight position / L2"),
     ]
@@ -85,7 +103,6 @@ def balance(mech: SliderCrankMechanism, method: SliderCrankCounterweights, model
         Stage("unbalanced", "unbalanced", model, "the mechanism as given"),
         Stage("counterweights", "counterweights", cw_model, "counterweights of eq. 15", balances="force"),
     ]
-    notes: list[str] = []
     sr = is_scott_russell(mech)
     if not sr:
         notes.append(
