@@ -109,3 +109,25 @@ def test_unreachable_motion_names_the_time_and_the_link():
         study.run(type(spec).model_validate(data))
     assert exc.value.path == ("mechanism", "coupler", "length")
     assert "cannot reach the guide at t =" in exc.value.message
+
+
+def test_scott_russell_spec_counterweights_are_eq15_in_the_papers_form():
+    """specs/scott_russell.yaml: mcp2 = -(m2 r2 + m3) / rcp2, mcp1 = -(m1 r1 + m2 + mcp2 + m3) / rcp1
+    (eq. 15 with r = com / L), and the full stage is balanced to 1e-9."""
+    from pathlib import Path
+
+    from balpipe.loader import load
+
+    spec = load(Path(__file__).resolve().parents[1] / "specs" / "scott_russell.yaml").spec
+    m = spec.mechanism
+    r1, r2 = m.crank.com / m.crank.length, m.coupler.com / m.coupler.length
+    rcp1 = spec.balancing.crank_counterweight / m.crank.length
+    rcp2 = spec.balancing.coupler_counterweight / m.coupler.length
+    mcp2 = -(m.coupler.mass * r2 + m.slider.mass) / rcp2
+    mcp1 = -(m.crank.mass * r1 + m.coupler.mass + mcp2 + m.slider.mass) / rcp1
+    st = study.run(spec)
+    got = {p.name: p.value for p in st.balance.parameters}
+    assert got["mcp2"] == pytest.approx(mcp2, rel=1e-12) and got["mcp1"] == pytest.approx(mcp1, rel=1e-12)
+    full, unb = st.stages[-1].analysis, st.stages[0].analysis
+    assert full.max_force <= 1e-9 * unb.max_force and full.max_moment <= 1e-9 * unb.max_moment
+    assert st.checks["reactions_vs_momentum"] <= 1e-9
