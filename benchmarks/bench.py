@@ -262,8 +262,9 @@ def validation_direct(specs: Path) -> bool:
         except Exception as exc:
             rows.append([_short(str(path)), f"(not analysed: {type(exc).__name__})", *["-"] * 7])
             continue
+        # the settings the build uses (balpipe.validation_stage.settings_for)
         want = {"dt": spec.validation.dt, "iterations": spec.validation.iterations,
-                "tolerance": spec.validation.tolerance, "balance_tolerance": spec.analysis.balance_tolerance}
+                "tolerance": spec.validation.tolerance}
         settings = V.ValidationSettings(**{k: v for k, v in want.items() if k in setting_names})
         reactionless = spec.validation.reactionless
         if reactionless is None:
