@@ -1,6 +1,5 @@
 """Physics invariants of the slider-crank balancing (paper 000, Sec. 3.1), random parameters."""
 
-import math
 
 import numpy as np
 import pytest

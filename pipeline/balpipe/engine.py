@@ -26,7 +26,6 @@ loads are computed twice, independently:
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -433,6 +432,7 @@ def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
     tc = t[coarse_idx]
     qc = np.zeros((len(tc), q.shape[1]))
     vc = np.zeros_like(qc)
+    ac = np.zeros(qc.shape[1])
     qc[0] = q[0]
     for k in range(len(tc)):
         if k > 0:
@@ -483,7 +483,7 @@ def _substep(c: Compiled, q: np.ndarray, ta: float, tb: float, depth: int = 0) -
 
 def _vel_acc_safe(c: Compiled, q: np.ndarray, t: float):
     try:
-        v, a = _vel_acc(c, q[None, :], np.array([t - 0.0]))
+        v, a = _vel_acc(c, q[None, :], np.array([t]))
         return v[0], a[0]
     except np.linalg.LinAlgError:
         return np.zeros_like(q), np.zeros_like(q)
@@ -563,7 +563,7 @@ def analyse(
     t = np.asarray(t, dtype=float)
     q = solve_positions(c, t)
     v, a = _vel_acc(c, q, t)
-    qx, ax = _extend(q), _extend(a)
+    qx = _extend(q)
     J = jacobian(c, qx)
     Jf, J0 = J[:, :, 3:], J[:, :, :3]
     nb = c.nb

@@ -15,7 +15,7 @@ from .balancing.base import BalanceResult, Stage
 from .mechanisms import custom, five_bar, slider_crank
 from .model import Law, Model
 from .motion import law_for
-from .spec_parts import DriveSpec, SpecFieldError
+from .spec_parts import SpecFieldError
 
 
 @dataclass(frozen=True)

@@ -42,9 +42,8 @@ def _link_body(name: str, link: LinkSpec, a: str, b: str) -> Body:
 
 
 def crank_angles(mech: SliderCrankMechanism, slider_x: np.ndarray) -> np.ndarray:
-    """Inverse position: crank angle for slider positions x (relative to A), same branch as the
-    assembly at x[0]... used for slider drives. Returns the crank angle on the upper circle
-    intersection (counter-clockwise from AC)."""
+    """Crank angles for slider positions x (measured from A along the guide), used when the
+    slider is the driven coordinate: B on the counter-clockwise side of AC."""
     L1, L2, a = mech.crank.length, mech.coupler.length, mech.offset
     d = np.hypot(slider_x, a)
     cos_beta = (L1**2 + d**2 - L2**2) / (2 * L1 * d)

@@ -113,7 +113,6 @@ def mechanism_figure(model: Model, analysis, instants: int = 5, prefix: str = "m
     N = len(analysis.t)
     ks = np.unique(np.linspace(0, N - 1, instants).round().astype(int))
     poses = analysis.extra["frame_pose"]
-    names = analysis.names
     max_cw = max([a.mass for b in model.bodies for a in b.attachments] + [1e-12])
     span = _span(model, poses)
     # paths of every named point
