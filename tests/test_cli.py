@@ -149,4 +149,6 @@ def test_simulated_build_passes_and_reports_validation(work):
     assert rl["unbalanced"]["max_drift"] > 1e3 * rl["full"]["max_drift"]
     assert rl["unbalanced"]["max_rotation"] > 1e3 * rl["full"]["max_rotation"]
     out = work / "out" / "scott_russell"
-    assert "timing.js" in (out / "index.html").read_text() and (out / "timing.json").exists()
+    page = (out / "index.html").read_text()
+    assert "timing.js" in page and (out / "timing.json").exists()
+    assert "<canvas" in page and "Reactionless demonstration" in page and "Residuals of the simulation" in page

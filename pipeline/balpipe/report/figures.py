@@ -79,8 +79,10 @@ def loads_figure(stages: list, prefix: str = "loads") -> str:
             ax.set_title(title, fontsize=9)
     for ax in axes[1]:
         ax.set_xlabel("time (s)")
-    axes[0, 0].legend(fontsize=7, loc="best")
-    fig.tight_layout()
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    ncol = min(len(labels), 3)
+    fig.legend(handles, labels, loc="lower center", ncol=ncol, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.04 + 0.035 * math.ceil(len(labels) / ncol), 1, 1))
     return to_svg(fig, prefix)
 
 

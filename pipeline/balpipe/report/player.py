@@ -23,11 +23,14 @@ def _outline(model: Model) -> list[dict]:
         pts = [b.points[p] for p in b.outline] if len(b.outline) >= 2 else []
         cws = [[round(a.position[0], 5), round(a.position[1], 5), round(a.mass, 4)]
                for a in b.attachments if a.kind == "counterweight"]
+        gears = [[round(a.position[0], 5), round(a.position[1], 5), round(a.radius, 5)]
+                 for a in b.attachments if a.radius and a.kind != "counterweight"]
         shapes.append({
             "line": [[round(p[0], 5), round(p[1], 5)] for p in pts],
             "radius": round(b.radius, 5) if b.radius else 0,
             "slider": b.kind == "slider",
             "cw": cws,
+            "gears": gears,
         })
     return shapes
 
@@ -43,6 +46,22 @@ def frame_poses(model: Model, com_poses: np.ndarray) -> np.ndarray:
     return out
 
 
+def _extent_points(model: Model, poses: np.ndarray) -> np.ndarray:
+    """Global positions of every named point, attachment and disc rim over the frames."""
+    out = [poses[:, :, :2].reshape(-1, 2)]
+    for i, b in enumerate(model.bodies):
+        local = list(b.points.values()) + [a.position for a in b.attachments]
+        r = max([b.radius or 0.0] + [(a.radius or 0.0) for a in b.attachments])
+        if r:
+            local += [(r, 0.0), (-r, 0.0), (0.0, r), (0.0, -r)]
+        x, y, th = poses[:, i, 0], poses[:, i, 1], poses[:, i, 2]
+        for px, py in local:
+            out.append(np.stack([x + np.cos(th) * px - np.sin(th) * py, y + np.sin(th) * px + np.cos(th) * py], axis=1))
+    pts = np.vstack(out)
+    fp = np.array(list(model.frame_points.values()) or [[0.0, 0.0]])
+    return np.vstack([pts, fp])
+
+
 def player_html(stages: list[dict], element_id: str = "player") -> str:
     """``stages``: dicts with label, model, t (n,), base (n, 3) frame-origin poses and poses
     (n, nb, 3) body-frame poses, all in the global frame of the start."""
@@ -54,7 +73,7 @@ def player_html(stages: list[dict], element_id: str = "player") -> str:
         ks = np.unique(np.linspace(0, n - 1, min(n, FRAMES)).round().astype(int))
         poses = s["poses"][ks]
         base = s["base"][ks]
-        xy = poses[:, :, :2].reshape(-1, 2)
+        xy = _extent_points(s["model"], poses)
         lo, hi = np.minimum(lo, xy.min(axis=0)), np.maximum(hi, xy.max(axis=0))
         fp = [[round(p[0], 5), round(p[1], 5)] for p in s["model"].frame_points.values()]
         data.append({
@@ -64,6 +83,7 @@ def player_html(stages: list[dict], element_id: str = "player") -> str:
             "poses": [[[round(float(v), 6) for v in body] for body in frame] for frame in poses],
             "shapes": _outline(s["model"]),
             "pivots": fp,
+            "guides": [[[round(a[0], 5), round(a[1], 5)], [round(b[0], 5), round(b[1], 5)]] for a, b in s["model"].guides],
         })
     pad = 0.15 * float(max(hi - lo)) if np.all(np.isfinite(hi)) else 0.1
     box = [round(float(lo[0] - pad), 4), round(float(lo[1] - pad), 4), round(float(hi[0] + pad), 4), round(float(hi[1] + pad), 4)]
@@ -87,6 +107,8 @@ function draw() {{
     g.fillStyle = "#e8edf3"; g.strokeStyle = "#8aa4c0";
     g.beginPath(); st.pivots.forEach((p, j) => {{ const q = P(...T(base, p), k); j ? g.lineTo(...q) : g.moveTo(...q); }});
     g.closePath(); g.stroke();
+    st.guides.forEach(gd => {{ const a = P(...T(base, gd[0]), k), e = P(...T(base, gd[1]), k);
+      g.strokeStyle = "#8aa4c0"; g.beginPath(); g.moveTo(...a); g.lineTo(...e); g.stroke(); }});
     st.pivots.forEach(p => {{ const q = P(...T(base, p), k); g.fillStyle = "#22303f"; g.fillRect(q[0] - 4, q[1] - 4, 8, 8); }});
     st.shapes.forEach((sh, j) => {{
       const pose = st.poses[i][j];
@@ -94,6 +116,8 @@ function draw() {{
         g.arc(c[0], c[1], sh.radius * s, 0, 2 * Math.PI); g.stroke(); const e = P(...T(pose, [sh.radius, 0]), k);
         g.beginPath(); g.moveTo(...c); g.lineTo(...e); g.stroke(); }}
       if (sh.slider) {{ const c = P(...T(pose, [0, 0]), k); g.fillStyle = "#ccc"; g.fillRect(c[0] - 8, c[1] - 5, 16, 10); }}
+      sh.gears.forEach(gr => {{ const c = P(...T(pose, gr), k); g.strokeStyle = "#2e8b57"; g.beginPath();
+        g.arc(c[0], c[1], gr[2] * s, 0, 2 * Math.PI); g.stroke(); }});
       sh.cw.forEach(cw => {{ const c = P(...T(pose, cw), k); g.fillStyle = "rgba(214,39,40,0.6)"; g.beginPath();
         g.arc(c[0], c[1], 3 + 2 * Math.sqrt(cw[2]), 0, 2 * Math.PI); g.fill(); }});
       if (sh.line.length > 1) {{ g.strokeStyle = "#111"; g.lineWidth = 3; g.beginPath();
