@@ -23,19 +23,20 @@ def study_figures(study: Study) -> dict:
         for k, s in enumerate(study.stages)
     ]
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
-    validation = []
+    residuals, drift = [], []
     vals = [s for s in study.stages if s.validation is not None]
     if vals:
         F0, M0 = study.unbalanced.analysis.max_force, study.unbalanced.analysis.max_moment
-        validation.append((
+        residuals.append((
             "Residuals of the simulation",
             figures.residual_figure([(s.stage.label, s.validation.t, s.validation.force_error,
                                       s.validation.moment_error, F0, M0) for s in vals]),
             "Difference between the pymunk simulation and the analytic engine, relative to the unbalanced peaks.",
         ))
     if study.reactionless is not None:
-        validation += list(study.reactionless.figures())
-    return {"loads": loads, "efforts": efforts, "mechanism": mech, "extra": extra, "validation": validation}
+        drift = list(study.reactionless.figures())
+    return {"loads": loads, "efforts": efforts, "mechanism": mech, "extra": extra,
+            "residuals": residuals, "drift": drift}
 
 
 def render_page(study: Study, results: dict, spec_text: str) -> str:
