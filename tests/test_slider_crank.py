@@ -1,5 +1,7 @@
 """Physics invariants of the slider-crank balancing (paper 000, Sec. 3.1), random parameters."""
 
+import math
+
 
 import numpy as np
 import pytest
@@ -130,3 +132,19 @@ def test_scott_russell_spec_counterweights_are_eq15_in_the_papers_form():
     full, unb = st.stages[-1].analysis, st.stages[0].analysis
     assert full.max_force <= 1e-9 * unb.max_force and full.max_moment <= 1e-9 * unb.max_moment
     assert st.checks["reactions_vs_momentum"] <= 1e-9
+
+
+def test_passing_near_the_scott_russell_bifurcation_is_explained():
+    """Crank through 90 deg: C passes through A, where the two branches of the Scott-Russell
+    mechanism meet. The engine keeps the branch but loses accuracy; the study says why."""
+    from pathlib import Path
+
+    from balpipe.loader import load
+
+    spec = load(Path(__file__).resolve().parents[1] / "specs" / "scott_russell.yaml").spec
+    data = spec.model_dump(by_alias=True)
+    data["motion"]["drive"]["crank"]["to"] = math.radians(100)
+    st = study.run(type(spec).model_validate(data))
+    assert st.checks["max_condition_number"] > 1e3
+    assert any("near a singular configuration" in n for n in st.balance.notes)
+    assert all("near a singular configuration" in p for p in st.problems if "should cancel" in p)

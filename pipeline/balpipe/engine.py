@@ -98,6 +98,7 @@ class Compiled:
     driver_rows: dict[str, int]
     joint_rows: dict[str, list[int]]
     q0: np.ndarray  # (3 nb,) initial guess
+    condition: np.ndarray | None = None  # condition numbers of Phi_q along the last motion solved
 
     @property
     def nb(self) -> int:
@@ -396,7 +397,8 @@ def _fail_position(c: Compiled, q: np.ndarray, t: float) -> AnalysisError:
     )
 
 
-def _check_regular(c: Compiled, q: np.ndarray, t: np.ndarray) -> None:
+def _check_regular(c: Compiled, q: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Condition numbers of Phi_q along the motion; a singular configuration is an error."""
     J = jacobian(c, _extend(q))[:, :, 3:]
     s = np.linalg.svd(J, compute_uv=False)
     cond = s[:, 0] / np.maximum(s[:, -1], 1e-300)
@@ -411,6 +413,7 @@ def _check_regular(c: Compiled, q: np.ndarray, t: np.ndarray) -> None:
             float(t[k]),
             c.row_owner[int(np.argmax(np.abs(u[:, -1])))],
         )
+    return cond
 
 
 def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
@@ -460,7 +463,7 @@ def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
     for k in np.flatnonzero(~ok | jumped):  # rare: refine sequentially from the previous sample
         prev = k - 1
         qall[k] = _substep(c, qall[prev], t[prev], t[k])[0]
-    _check_regular(c, qall, t)
+    c.condition = _check_regular(c, qall, t)
     return qall
 
 
@@ -613,5 +616,5 @@ def analyse(
         force_momentum=force_mom, moment_momentum=about_P(moment_mom, force_mom),
         efforts=efforts, reactions=reactions, com=com, momentum=momentum, angular_momentum=ang,
         moment_point=(float(P[0]), float(P[1])), gravity=(float(g[0]), float(g[1])),
-        extra={"frame_pose": frame_pose},
+        extra={"frame_pose": frame_pose, "condition": c.condition},
     )

@@ -55,6 +55,9 @@ class Study:
         return list(hook(self)) if hook is not None else []
 
 
+NEAR_SINGULAR = 1e3  # condition number above which the page warns of lost accuracy
+
+
 def gravity_vector(spec: Spec) -> tuple[float, float]:
     return (0.0, -spec.analysis.g) if spec.analysis.gravity else (0.0, 0.0)
 
@@ -171,6 +174,16 @@ def run(spec: Spec) -> Study:
             problems.append(f"stage {m['name']!r} should cancel the shaking force but keeps {m['force_ratio']:.3g} of it")
         if "moment" in m["balances"] and not m["moment_balanced"]:
             problems.append(f"stage {m['name']!r} should cancel the shaking moment but keeps {m['moment_ratio']:.3g} of it")
+    worst = max(stages, key=lambda s: float(np.max(s.analysis.extra["condition"])))
+    cond = worst.analysis.extra["condition"]
+    k = int(np.argmax(cond))
+    near_singular = float(cond[k]) > NEAR_SINGULAR
+    if near_singular:
+        where = (f"the motion passes near a singular configuration (condition number of the constraint "
+                 f"Jacobian {cond[k]:.3g} at t = {worst.analysis.t[k]:.4g} s): accelerations there lose about "
+                 f"{min(1.0, cond[k] ** 2 * 1e-16):.1g} of their relative accuracy")
+        balance.notes.append(where[0].upper() + where[1:] + ".")
+        problems = [p + f"; {where}" if "should cancel" in p else p for p in problems]
     refs = compare_references(spec, balance, metrics)
-    checks = {"reactions_vs_momentum": rvm, "balance_tolerance": tol}
+    checks = {"reactions_vs_momentum": rvm, "balance_tolerance": tol, "max_condition_number": float(cond[k])}
     return Study(spec, balance, stages, refs, checks, problems)
