@@ -417,3 +417,25 @@ def test_free_floating_reactionless_arm_stays_put():
     ff = free_floating(model, a)
     assert ff.max_drift < 1e-6 and ff.max_rotation < 1e-5
     assert ff.reference_max_drift < 1e-12 and ff.reference_max_rotation < 1e-12
+
+
+def test_trapezoidal_law_corners_between_samples_are_left_out_and_counted():
+    """The trapezoidal law's acceleration jumps at T/3 and 2T/3, between analysis samples: the
+    samples next to them are excluded (and counted); everywhere else the residual is < 1 %."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from conftest import slider_crank_spec
+
+    from balpipe import study
+    from balpipe.validate import ValidationSettings, validate
+
+    spec = slider_crank_spec(np.random.default_rng(5), law="trapezoidal")
+    st = study.run(spec)
+    F0, M0 = st.unbalanced.analysis.max_force, st.unbalanced.analysis.max_moment
+    for s in st.stages:
+        v = validate(s.stage.model, s.analysis, (F0, M0), ValidationSettings())
+        assert v.passed, v.reasons
+        assert 0 < v.excluded_samples <= 16
+        assert v.force_residual < 0.01 and v.moment_residual < 0.01

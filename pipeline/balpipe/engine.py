@@ -542,6 +542,31 @@ class Analysis:
     def max_moment(self) -> float:
         return float(np.max(np.abs(self.moment)))
 
+    def static_load(self) -> tuple[np.ndarray, np.ndarray]:
+        """The part of the shaking loads due to the moving links' weight: the force m g (2,)
+        and its moment (N,) about the moment point, (r_com - P) x m g. Zero without gravity."""
+        W = self.extra["total_mass"] * np.asarray(self.gravity)
+        r = self.com - np.asarray(self.moment_point)
+        return W, r[:, 0] * W[1] - r[:, 1] * W[0]
+
+    @property
+    def inertial_force(self) -> np.ndarray:
+        """Shaking force minus the links' weight: -dP/dt (N, 2)."""
+        return self.force - self.static_load()[0]
+
+    @property
+    def inertial_moment(self) -> np.ndarray:
+        """Shaking moment minus the weight's moment: -dH_P/dt (N,)."""
+        return self.moment - self.static_load()[1]
+
+    @property
+    def max_inertial_force(self) -> float:
+        return float(np.max(np.linalg.norm(self.inertial_force, axis=1)))
+
+    @property
+    def max_inertial_moment(self) -> float:
+        return float(np.max(np.abs(self.inertial_moment)))
+
     def route_difference(self) -> tuple[float, float]:
         """Absolute max |reactions - momentum| of the force (N) and of the moment (N m); the
         study divides them by the unbalanced stage's peaks."""
@@ -616,5 +641,5 @@ def analyse(
         force_momentum=force_mom, moment_momentum=about_P(moment_mom, force_mom),
         efforts=efforts, reactions=reactions, com=com, momentum=momentum, angular_momentum=ang,
         moment_point=(float(P[0]), float(P[1])), gravity=(float(g[0]), float(g[1])),
-        extra={"frame_pose": frame_pose, "condition": c.condition},
+        extra={"frame_pose": frame_pose, "condition": c.condition, "total_mass": float(m.sum())},
     )

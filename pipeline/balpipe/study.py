@@ -89,16 +89,21 @@ def _total_inertia(model) -> float:
 
 
 def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float) -> dict:
-    F0, M0 = unbalanced.analysis.max_force, unbalanced.analysis.max_moment
-    F, M = sr.analysis.max_force, sr.analysis.max_moment
+    """Peaks, ratios and balance of one stage. Ratios and the balance criterion use the inertial
+    part of the loads (the shaking loads less the moving links' weight and its moment, which a
+    force-balanced mechanism keeps constant); without gravity that is the loads themselves."""
+    F0, M0 = unbalanced.analysis.max_inertial_force, unbalanced.analysis.max_inertial_moment
+    F, M = sr.analysis.max_inertial_force, sr.analysis.max_inertial_moment
     df, dm = sr.analysis.route_difference()
     return {
         "name": sr.stage.name,
         "label": sr.stage.label,
         "description": sr.stage.description,
         "balances": sr.stage.balances,
-        "max_shaking_force": F,
-        "max_shaking_moment": M,
+        "max_shaking_force": sr.analysis.max_force,
+        "max_shaking_moment": sr.analysis.max_moment,
+        "max_inertial_force": F,
+        "max_inertial_moment": M,
         "force_ratio": F / F0 if F0 > 0 else 0.0,
         "moment_ratio": M / M0 if M0 > 0 else 0.0,
         "force_balanced": F <= tol * F0,
