@@ -142,3 +142,27 @@ def test_absolute_angle_drivers_put_their_reaction_on_the_frame():
     an = analyse(model, np.linspace(0, 0.5, 201))
     df, dm = an.route_difference()
     assert an.max_moment > 0.1 and dm <= 1e-9 * an.max_moment and df <= 1e-9 * an.max_force
+
+
+def test_joint_reactions_balance_each_body():
+    """Named reactions: the frame pivot of a four-bar crank carries minus the force on the frame
+    from that joint, and Newton's law holds for the slider of a slider-crank."""
+    spec = Spec.model_validate({
+        "name": "sc", "validation": {"enabled": False},
+        "mechanism": {"template": "slider_crank", "offset": 0.02,
+                      "crank": {"length": 0.2, "mass": 1.0, "com": 0.08, "inertia": 0.004},
+                      "coupler": {"length": 0.3, "mass": 0.8, "com": 0.1, "inertia": 0.006},
+                      "slider": {"mass": 0.5}},
+        "motion": {"duration": 0.3, "drive": {"crank": {"from": 0.3, "to": 2.0}}},
+    })
+    model = registry.balance(spec).stages[0].model
+    an = analyse(model, np.linspace(0, 0.3, 101))
+    k = an.names.index("slider")
+    m3 = model.body("slider").mass_properties()[0]
+    RC = np.stack([an.reactions["C"]["Fx"], an.reactions["C"]["Fy"]], axis=1)  # on the slider
+    N = an.reactions["guide"]["N"]  # along the guide's left normal, +y here
+    assert np.allclose(m3 * an.a[:, k, 0], RC[:, 0], atol=1e-9 * np.abs(RC).max())
+    assert np.allclose(0.0, RC[:, 1] + N, atol=1e-9 * np.abs(RC).max())
+    # the frame takes minus the pivot force at A and minus the guide's normal force
+    frame_load = -np.stack([an.reactions["A"]["Fx"], an.reactions["A"]["Fy"] + N], axis=1)
+    assert np.allclose(frame_load, an.force, atol=1e-9 * an.max_force)

@@ -513,7 +513,8 @@ class Analysis:
     (route a), about ``moment_point``; ``force_momentum``/``moment_momentum`` the same from the
     momentum derivative (route b). ``efforts``: actuator torque or force per driver, applied by
     the actuator to the driven body. ``reactions``: constraint loads per joint (the generalized
-    forces of the joint's multipliers), for revolutes the force exerted on body b by body a.
+    forces of the joint's multipliers, see :func:`_joint_reactions`), for revolutes the force
+    exerted on body b by body a.
     """
 
     t: np.ndarray
@@ -526,7 +527,7 @@ class Analysis:
     force_momentum: np.ndarray
     moment_momentum: np.ndarray
     efforts: dict[str, np.ndarray]
-    reactions: dict[str, np.ndarray]
+    reactions: dict[str, dict[str, np.ndarray]]
     com: np.ndarray
     momentum: np.ndarray
     angular_momentum: np.ndarray
@@ -580,6 +581,26 @@ class Analysis:
         return self.extra["frame_pose"][k, i].tolist()
 
 
+def _joint_reactions(model: Model, c: Compiled, lam: np.ndarray) -> dict[str, dict[str, np.ndarray]]:
+    """Loads that each joint transmits, from its multipliers (constraint force = -Phi_q^T lam).
+
+    Revolute: force (Fx, Fy) exerted on body b by body a (Phi = P_a - P_b, so it is +lam).
+    Prismatic: N, the force on the slider along the guide's left normal (-lam of the guide
+    row), and M, the moment on the slider (-lam of the rotation lock). Gear: T, the torque on
+    gear b relative to the carrier (-lam).
+    """
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for jt in model.joints:
+        rows = c.joint_rows[jt.name]
+        if isinstance(jt, Revolute):
+            out[jt.name] = {"Fx": lam[:, rows[0]], "Fy": lam[:, rows[1]]}
+        elif isinstance(jt, Prismatic):
+            out[jt.name] = {"N": -lam[:, rows[1]], "M": -lam[:, rows[0]]}
+        else:
+            out[jt.name] = {"T": -lam[:, rows[0]]}
+    return out
+
+
 def analyse(
     model: Model,
     t: np.ndarray,
@@ -624,11 +645,7 @@ def analyse(
         return M - (P[0] * F[:, 1] - P[1] * F[:, 0])
 
     efforts = {name: -lam[:, row] for name, row in c.driver_rows.items()}
-    reactions = {}
-    for name, rows in c.joint_rows.items():
-        if name in c.driver_rows:
-            continue
-        reactions[name] = lam[:, rows] if len(rows) > 1 else lam[:, rows[0]]
+    reactions = _joint_reactions(model, c, lam)
     # frame poses for drawing: frame origin = com - A(theta) com_local
     frame_pose = np.zeros_like(qb)
     for k, b in enumerate(model.bodies):

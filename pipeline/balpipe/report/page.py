@@ -5,6 +5,7 @@ from __future__ import annotations
 from ..study import Study
 from . import figures
 from .render import environment
+from .results import joint_load_table
 
 INSTANTS = 5
 
@@ -64,5 +65,7 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
         reactionless={"base_mass": rl.base_mass, "base_inertia": rl.base_inertia, "rows": rl.rows(),
                       "player": rl.player()} if rl is not None else None,
         instants=INSTANTS,
+        joint_loads=joint_load_table(study),
+        stage_names=[(s.stage.name, s.stage.label) for s in study.stages],
         spec_text=spec_text,
     )

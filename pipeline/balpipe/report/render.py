@@ -37,6 +37,11 @@ def ratio(x) -> str:
     return f"{x:.2e}"
 
 
+def unit(u: str) -> str:
+    """Display form of a unit: 'kg m^2' -> 'kg m²'."""
+    return (u or "").replace("^2", "²").replace("^3", "³")
+
+
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     folder = resources.files("balpipe.templates")
@@ -48,5 +53,6 @@ def environment() -> jinja2.Environment:
     )
     env.filters["num"] = num
     env.filters["ratio"] = ratio
+    env.filters["unit"] = unit
     env.globals["version"] = __version__
     return env

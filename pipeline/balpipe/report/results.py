@@ -76,9 +76,30 @@ def dumps(results: dict) -> str:
     return json.dumps(results, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
 
 
+def joint_load_table(study: Study) -> list[dict]:
+    """Peak load of every joint in every stage: |F| for revolutes (bearing load), |N| and |M|
+    for prismatic pairs, |T| for gear meshes."""
+    rows: dict[str, dict] = {}
+    for s in study.stages:
+        for j, comps in s.analysis.reactions.items():
+            row = rows.setdefault(j, {"joint": j, "kind": "", "unit": "", "peaks": {}})
+            if "Fx" in comps:
+                row["kind"], row["unit"] = "revolute: |F|", "N"
+                peak = float(np.max(np.hypot(comps["Fx"], comps["Fy"])))
+            elif "N" in comps:
+                row["kind"], row["unit"] = "prismatic: |N| (normal force)", "N"
+                peak = float(np.max(np.abs(comps["N"])))
+            else:
+                row["kind"], row["unit"] = "gear mesh: |T| (torque on the driven gear)", "N m"
+                peak = float(np.max(np.abs(comps["T"])))
+            row["peaks"][s.stage.name] = peak
+    return list(rows.values())
+
+
 def timeseries_csv(study: Study) -> str:
-    """One row per sample: t, then per stage Fx, Fy, |F|, M (about the moment point), and every
-    actuator effort; SI units, 12 significant digits."""
+    """One row per sample: t, then per stage Fx, Fy, |F|, M (about the moment point), every
+    actuator effort and every joint reaction (see :func:`balpipe.engine._joint_reactions`);
+    SI units, 12 significant digits."""
     cols: list[tuple[str, np.ndarray]] = [("t_s", study.unbalanced.analysis.t)]
     for s in study.stages:
         an, n = s.analysis, s.stage.name
@@ -90,6 +111,9 @@ def timeseries_csv(study: Study) -> str:
         ]
         for d in sorted(an.efforts):
             cols.append((f"{n}.effort.{d}", an.efforts[d]))
+        for j in sorted(an.reactions):
+            for comp, values in an.reactions[j].items():
+                cols.append((f"{n}.reaction.{j}.{comp}", values))
     buf = io.StringIO()
     buf.write(",".join(c for c, _ in cols) + "\n")
     data = np.column_stack([v for _, v in cols])
