@@ -44,13 +44,19 @@ class AnalysisError(Exception):
 
 def _perp(v: np.ndarray) -> np.ndarray:
     """Rotate vectors (..., 2) by +90 degrees."""
-    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
+    out = np.empty_like(v)
+    out[..., 0] = -v[..., 1]
+    out[..., 1] = v[..., 0]
+    return out
 
 
 def _rotate(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
     """A(theta) s for theta (N,), s (2,) -> (N, 2)."""
     c, si = np.cos(theta), np.sin(theta)
-    return np.stack([c * s[0] - si * s[1], si * s[0] + c * s[1]], axis=-1)
+    out = np.empty(theta.shape + (2,))
+    out[..., 0] = c * s[0] - si * s[1]
+    out[..., 1] = si * s[0] + c * s[1]
+    return out
 
 
 @dataclass
