@@ -152,3 +152,12 @@ def test_simulated_build_passes_and_reports_validation(work):
     page = (out / "index.html").read_text()
     assert "timing.js" in page and (out / "timing.json").exists()
     assert "<canvas" in page and "Reactionless demonstration" in page and "Residuals of the simulation" in page
+
+
+def test_parallel_build_gives_the_same_site_and_quiet_hides_progress(work):
+    a = balpipe("build", "specs", "-o", "a", "--no-sim", cwd=work)
+    b = balpipe("build", "specs", "-o", "b", "--no-sim", "-j", "2", "-q", cwd=work)
+    assert a.returncode == b.returncode == 0
+    assert "[1/2]" in a.stderr and "[1/2]" not in b.stderr and "2 ok" in b.stderr
+    for f in sorted(p.relative_to(work / "a") for p in (work / "a").rglob("*") if p.is_file()):
+        assert (work / "a" / f).read_bytes() == (work / "b" / f).read_bytes(), f
