@@ -1,4 +1,4 @@
-"""The ``balpipe`` command line: build, check, schema."""
+"""The ``balpipe`` command line: build, check, diff, schema."""
 
 from __future__ import annotations
 
@@ -35,6 +35,16 @@ def _parser() -> argparse.ArgumentParser:
     c = sub.add_parser("check", help="validate specs without building",
                        description="Check specs: schema, units, geometry and balancing feasibility.")
     c.add_argument("paths", nargs="+", metavar="PATH", help="spec files or folders of specs")
+    d = sub.add_parser("diff", help="compare two designs: inputs and results",
+                       description="Compare two specs (files, or REV:PATH for a spec at a git revision): "
+                       "what changed in the inputs and what it did to the parameters, peaks, added mass, "
+                       "references and validation residuals.")
+    d.add_argument("old", metavar="OLD", help="spec file or REV:PATH, e.g. HEAD~1:specs/a.yaml")
+    d.add_argument("new", metavar="NEW", help="spec file or REV:PATH")
+    d.add_argument("-f", "--format", choices=["text", "markdown", "json", "html"], default="text",
+                   help="output format (default: text)")
+    d.add_argument("-o", "--out", metavar="FILE", help="write to FILE instead of stdout")
+    d.add_argument("--no-sim", action="store_true", help="skip the pymunk validation of both designs")
     s = sub.add_parser("schema", help="print the JSON Schema of a spec", description="Print the spec JSON Schema.")
     s.add_argument("-o", "--out", metavar="FILE", help="write to FILE instead of stdout")
     return p
@@ -106,6 +116,25 @@ def cmd_check(args) -> int:
     return EXIT_USAGE if bad else EXIT_OK
 
 
+def cmd_diff(args) -> int:
+    from . import diff
+    from .loader import SpecErrors
+
+    try:
+        a = diff.run_side(args.old, simulate=not args.no_sim)
+        b = diff.run_side(args.new, simulate=not args.no_sim)
+    except SpecErrors as exc:
+        print(str(exc), file=sys.stderr)
+        return EXIT_USAGE
+    data = diff.compare(a, b)
+    text = diff.to_html(data, a, b) if args.format == "html" else diff.RENDERERS[args.format](data)
+    if args.out:
+        Path(args.out).write_text(text, encoding="utf-8")
+    else:
+        sys.stdout.write(text)
+    return EXIT_OK
+
+
 def cmd_schema(args) -> int:
     from .loader import schema
 
@@ -120,7 +149,7 @@ def cmd_schema(args) -> int:
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
-        return {"build": cmd_build, "check": cmd_check, "schema": cmd_schema}[args.command](args)
+        return {"build": cmd_build, "check": cmd_check, "diff": cmd_diff, "schema": cmd_schema}[args.command](args)
     except KeyboardInterrupt:
         print("balpipe: interrupted", file=sys.stderr)
         return 130

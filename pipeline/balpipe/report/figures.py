@@ -223,3 +223,23 @@ def residual_figure(stages: list, prefix: str = "residuals") -> str:
     a1.legend(fontsize=7)
     fig.tight_layout()
     return to_svg(fig, prefix)
+
+
+def overlay_figure(old, new, prefix: str = "overlay") -> str:
+    """One stage of two designs: Fx, Fy, |F| and M over time, old dashed grey, new solid black."""
+    fig, axes = plt.subplots(2, 2, figsize=(9.0, 5.2), sharex=False)
+    panels = [
+        (axes[0, 0], "Shaking force Fx (N)", lambda a: a.force[:, 0]),
+        (axes[0, 1], "Shaking force Fy (N)", lambda a: a.force[:, 1]),
+        (axes[1, 0], "Shaking force |F| (N)", lambda a: np.hypot(a.force[:, 0], a.force[:, 1])),
+        (axes[1, 1], "Shaking moment M (N m)", lambda a: a.moment),
+    ]
+    for ax, title, fn in panels:
+        ax.plot(old.t, fn(old), color="0.55", linestyle="--", linewidth=1.6, label="old")
+        ax.plot(new.t, fn(new), color="black", linestyle="-", linewidth=1.3, label="new")
+        ax.set_title(title, fontsize=9)
+    for ax in axes[1]:
+        ax.set_xlabel("time (s)")
+    axes[0, 0].legend(fontsize=8)
+    fig.tight_layout()
+    return to_svg(fig, prefix)

@@ -1,0 +1,240 @@
+"""``balpipe diff OLD NEW``: what changed between two designs, and what it did to the results.
+
+Each side is a spec file, or ``REV:PATH`` for the spec as it was at a git revision (e.g.
+``HEAD~1:specs/scott_russell.yaml``). Both are run through the same study as ``build`` (and,
+unless ``--no-sim``, the same pymunk validation); the comparison covers the inputs (every
+field of the validated spec, in SI units), the computed parameters, every stage's peaks,
+ratios, added mass and actuator effort, the references and the validation residuals. Output as
+text, Markdown, JSON or a self-contained HTML page with both designs' curves overlaid.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .loader import LoadedSpec, SpecError, SpecErrors, load, load_text
+from .report.results import _clean
+from .spec_parts import SpecFieldError
+from .study import Study, run, stage_metrics
+
+ROUND_OFF = 1e-9  # ratios to the unbalanced peak below this are cancelled loads
+STAGE_KEYS = ("max_shaking_force", "max_shaking_moment", "force_ratio", "moment_ratio",
+              "max_actuator_effort", "added_mass", "added_inertia")
+
+
+@dataclass
+class Side:
+    ref: str
+    loaded: LoadedSpec
+    study: Study
+
+
+def read_side(ref: str) -> LoadedSpec:
+    """A spec file, or REV:PATH read with ``git show REV:./PATH`` (PATH relative to the current
+    folder, or absolute)."""
+    p = Path(ref)
+    if p.exists() or ":" not in ref:
+        return load(p)
+    rev, path = ref.split(":", 1)
+    target = Path(path)
+    cwd = target.parent if target.is_absolute() else Path(".")
+    name = target.name if target.is_absolute() else target.as_posix()
+    try:
+        text = subprocess.run(["git", "show", f"{rev}:./{name}"], cwd=cwd, capture_output=True,
+                              text=True, check=True).stdout
+    except (subprocess.CalledProcessError, OSError) as exc:
+        detail = (getattr(exc, "stderr", "") or str(exc)).strip().splitlines()
+        raise SpecErrors([SpecError(ref, None, None, "", "cannot read it from git: " + (detail[0] if detail else "?"))]) from None
+    spec, node = load_text(text, ref)
+    return LoadedSpec(Path(ref), text, spec, node)
+
+
+def run_side(ref: str, simulate: bool) -> Side:
+    loaded = read_side(ref)
+    try:
+        st = run(loaded.spec)
+        if simulate and loaded.spec.validation.enabled:
+            from .validation_stage import simulate_study
+
+            simulate_study(st)
+    except SpecFieldError as exc:
+        raise loaded.error(exc) from None
+    return Side(ref, loaded, st)
+
+
+def _flatten(obj: Any, prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            out.update(_flatten(v, f"{prefix}.{k}" if prefix else str(k)))
+    elif isinstance(obj, list) and obj and all(isinstance(v, dict) for v in obj):
+        for i, v in enumerate(obj):
+            out.update(_flatten(v, f"{prefix}[{i}]"))
+    else:
+        out[prefix] = obj
+    return out
+
+
+def _change(old: float | None, new: float | None) -> dict:
+    d: dict[str, Any] = {"old": old, "new": new}
+    if isinstance(old, (int, float)) and isinstance(new, (int, float)):
+        d["delta"] = new - old
+        d["relative"] = (new - old) / abs(old) if old else (0.0 if new == old else math.inf)
+    return d
+
+
+def compare(a: Side, b: Side) -> dict:
+    """The differences between two studies, as plain data (the JSON output)."""
+    ia = _flatten(a.loaded.spec.model_dump(mode="json", by_alias=True))
+    ib = _flatten(b.loaded.spec.model_dump(mode="json", by_alias=True))
+    inputs = [
+        {"field": k, "old": ia.get(k), "new": ib.get(k)}
+        for k in sorted(set(ia) | set(ib)) if ia.get(k) != ib.get(k)
+    ]
+    pa = {p.name: p for p in a.study.balance.parameters}
+    pb = {p.name: p for p in b.study.balance.parameters}
+    params = []
+    for name in list(pa) + [n for n in pb if n not in pa]:
+        x, y = pa.get(name), pb.get(name)
+        row = _change(x.value if x else None, y.value if y else None)
+        row.update({"name": name, "unit": (x or y).unit, "source": (x or y).source})
+        params.append(row)
+    tol_a, tol_b = a.loaded.spec.analysis.balance_tolerance, b.loaded.spec.analysis.balance_tolerance
+    ma = {s.stage.name: stage_metrics(s, a.study.unbalanced, tol_a) for s in a.study.stages}
+    mb = {s.stage.name: stage_metrics(s, b.study.unbalanced, tol_b) for s in b.study.stages}
+    stages = []
+    for name in list(ma) + [n for n in mb if n not in ma]:
+        row: dict[str, Any] = {"name": name}
+        for key in STAGE_KEYS:
+            row[key] = _change(ma.get(name, {}).get(key), mb.get(name, {}).get(key))
+        va = next((s.validation for s in a.study.stages if s.stage.name == name), None)
+        vb = next((s.validation for s in b.study.stages if s.stage.name == name), None)
+        if va is not None or vb is not None:
+            row["validation"] = {
+                "force_residual": _change(getattr(va, "force_residual", None), getattr(vb, "force_residual", None)),
+                "moment_residual": _change(getattr(va, "moment_residual", None), getattr(vb, "moment_residual", None)),
+                "passed": {"old": getattr(va, "passed", None), "new": getattr(vb, "passed", None)},
+            }
+        stages.append(row)
+    ra = {r["name"]: r for r in a.study.references}
+    rb = {r["name"]: r for r in b.study.references}
+    refs = [
+        {"name": n, "published": (ra.get(n) or rb.get(n))["published"],
+         "old": ra.get(n, {}).get("computed"), "new": rb.get(n, {}).get("computed"),
+         "old_status": ra.get(n, {}).get("status"), "new_status": rb.get(n, {}).get("status")}
+        for n in list(ra) + [n for n in rb if n not in ra]
+        if ra.get(n, {}).get("computed") != rb.get(n, {}).get("computed") or ra.get(n, {}).get("status") != rb.get(n, {}).get("status")
+    ]
+    return _clean({
+        "old": a.ref, "new": b.ref,
+        "old_spec": a.loaded.spec.name, "new_spec": b.loaded.spec.name,
+        "status": {"old": "ok" if a.study.ok else "failed", "new": "ok" if b.study.ok else "failed"},
+        "inputs": inputs,
+        "parameters": [p for p in params if p["old"] != p["new"]],
+        "stages": stages,
+        "references": refs,
+    })
+
+
+def _fmt(x: Any) -> str:
+    if x is None:
+        return "—"
+    if isinstance(x, bool):
+        return str(x).lower()
+    if isinstance(x, float):
+        return f"{x:.6g}"
+    return str(x)
+
+
+def _rel(d: dict) -> str:
+    r = d.get("relative")
+    if r is None:
+        return ""
+    if r == 0:
+        return "="
+    return f"{100 * r:+.3g} %" if math.isfinite(r) and abs(r) >= 1e-4 else (f"{r:+.2e}" if math.isfinite(r) else "new")
+
+
+def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
+    """Sections as (title, rows, header) for the text and Markdown renderers."""
+    sections = []
+    sections.append(("Inputs", [[d["field"], _fmt(d["old"]), _fmt(d["new"])] for d in data["inputs"]],
+                     ["field", "old", "new"]))
+    sections.append(("Computed parameters", [[p["name"], _fmt(p["old"]), _fmt(p["new"]), _rel(p), p["unit"]] for p in data["parameters"]],
+                     ["parameter", "old", "new", "change", "unit"]))
+    rows = []
+    for s in data["stages"]:
+        # a load cancelled to round-off in both designs is not a change worth a row
+        quiet = {
+            "force": all(isinstance(x, float) and x <= ROUND_OFF for x in (s["force_ratio"]["old"], s["force_ratio"]["new"])),
+            "moment": all(isinstance(x, float) and x <= ROUND_OFF for x in (s["moment_ratio"]["old"], s["moment_ratio"]["new"])),
+        }
+        for key in STAGE_KEYS:
+            d = s[key]
+            if d["old"] == d["new"] or any(quiet[w] and w in key for w in quiet):
+                continue
+            rows.append([s["name"], key, _fmt(d["old"]), _fmt(d["new"]), _rel(d)])
+        v = s.get("validation")
+        if v:
+            for key in ("force_residual", "moment_residual"):
+                d = v[key]
+                if d["old"] != d["new"]:
+                    rows.append([s["name"], f"pymunk {key}", _fmt(d["old"]), _fmt(d["new"]), _rel(d)])
+            if v["passed"]["old"] != v["passed"]["new"]:
+                rows.append([s["name"], "pymunk passed", _fmt(v["passed"]["old"]), _fmt(v["passed"]["new"]), ""])
+    sections.append(("Stages", rows, ["stage", "result", "old", "new", "change"]))
+    sections.append(("References", [[r["name"], _fmt(r["published"]), _fmt(r["old"]), _fmt(r["new"]), f"{r['old_status']} -> {r['new_status']}"] for r in data["references"]],
+                     ["reference", "published", "old", "new", "status"]))
+    return sections
+
+
+def to_text(data: dict) -> str:
+    out = [f"balpipe diff: {data['old']} ({data['status']['old']}) -> {data['new']} ({data['status']['new']})"]
+    for title, rows, header in _rows(data):
+        out.append("")
+        out.append(f"{title}:" if rows else f"{title}: no change")
+        if rows:
+            widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
+            out.append("  " + "  ".join(h.ljust(w) for h, w in zip(header, widths)).rstrip())
+            for r in rows:
+                out.append("  " + "  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip())
+    return "\n".join(out) + "\n"
+
+
+def to_markdown(data: dict) -> str:
+    out = [f"## balpipe diff: `{data['old']}` → `{data['new']}`", "",
+           f"Status: {data['status']['old']} → {data['status']['new']}"]
+    for title, rows, header in _rows(data):
+        out += ["", f"### {title}", ""]
+        if not rows:
+            out.append("No change.")
+            continue
+        out.append("| " + " | ".join(header) + " |")
+        out.append("|" + "---|" * len(header))
+        out += ["| " + " | ".join(c.replace("|", "\\|") for c in r) + " |" for r in rows]
+    return "\n".join(out) + "\n"
+
+
+def to_json(data: dict) -> str:
+    return json.dumps(data, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
+
+
+def to_html(data: dict, a: Side, b: Side) -> str:
+    from .report.figures import overlay_figure
+    from .report.render import environment
+
+    figs = []
+    names_b = {s.stage.name: s for s in b.study.stages}
+    for k, sa in enumerate(a.study.stages):
+        sb = names_b.get(sa.stage.name)
+        if sb is not None:
+            figs.append((sa.stage.label, overlay_figure(sa.analysis, sb.analysis, prefix=f"diff{k}")))
+    return environment().get_template("diff.html").render(d=data, sections=_rows(data), figures=figs)
+
+
+RENDERERS = {"text": to_text, "markdown": to_markdown, "json": to_json}

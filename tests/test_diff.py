@@ -1,0 +1,70 @@
+"""balpipe diff: two designs, their input changes and what they did to the results."""
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def balpipe(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "balpipe", *map(str, args)], capture_output=True, text=True, cwd=cwd)
+
+
+def test_diff_of_two_spec_files_in_every_format(tmp_path):
+    old = tmp_path / "old.yaml"
+    new = tmp_path / "new.yaml"
+    shutil.copy(ROOT / "specs" / "scott_russell.yaml", old)
+    new.write_text(old.read_text().replace("crank_counterweight: -0.1 m", "crank_counterweight: -0.12 m"))
+    r = balpipe("diff", old, new, "--no-sim", "-f", "json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["inputs"] == [{"field": "balancing.crank_counterweight", "old": -0.1, "new": -0.12}]
+    mcp1 = next(p for p in d["parameters"] if p["name"] == "mcp1")
+    # eq. 15: mcp1 scales as 1 / rcp1
+    assert abs(mcp1["new"] - mcp1["old"] * 0.1 / 0.12) < 1e-9
+    full = next(s for s in d["stages"] if s["name"] == "full")
+    assert full["added_mass"]["delta"] < 0
+    text = balpipe("diff", old, new, "--no-sim").stdout
+    assert "balancing.crank_counterweight" in text and "mcp1" in text
+    # loads cancelled to round-off in both designs are not reported as changes
+    assert "force_ratio" not in text
+    md = balpipe("diff", old, new, "--no-sim", "-f", "markdown").stdout
+    assert md.startswith("## balpipe diff") and "| mcp1 |" in md
+    out = tmp_path / "d.html"
+    assert balpipe("diff", old, new, "--no-sim", "-f", "html", "-o", out).returncode == 0
+    html = out.read_text()
+    assert html.count("<svg") == 3 and "Design comparison" in html
+
+
+def test_diff_against_a_git_revision(tmp_path):
+    repo = tmp_path / "repo"
+    (repo / "specs").mkdir(parents=True)
+    spec = repo / "specs" / "sc.yaml"
+    shutil.copy(ROOT / "specs" / "offset_slider_crank.yaml", spec)
+    git = ["git", "-c", "user.name=t", "-c", "user.email=t@t"]
+    subprocess.run(["git", "init", "-q"], cwd=repo, check=True)
+    subprocess.run(git + ["add", "."], cwd=repo, check=True)
+    subprocess.run(git + ["commit", "-qm", "one"], cwd=repo, check=True)
+    spec.write_text(spec.read_text().replace("mass: 600 g", "mass: 700 g"))
+    r = balpipe("diff", "HEAD:specs/sc.yaml", "specs/sc.yaml", "--no-sim", "-f", "json", cwd=repo)
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["inputs"] == [{"field": "mechanism.slider.mass", "old": 0.6, "new": 0.7}]
+    bad = balpipe("diff", "NOPE:specs/sc.yaml", "specs/sc.yaml", cwd=repo)
+    assert bad.returncode == 2 and "cannot read it from git" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_diff_with_simulation_reports_residual_changes(tmp_path):
+    old = ROOT / "specs" / "offset_slider_crank.yaml"
+    new = tmp_path / "new.yaml"
+    new.write_text(old.read_text().replace("coupler_counterweight: -0.15 m",
+                                           "coupler_counterweight: -0.15 m\n  crank_counterweight_mass: 9.24 kg"))
+    r = balpipe("diff", old, new, "-f", "json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    cw = next(s for s in d["stages"] if s["name"] == "counterweights")
+    assert cw["validation"]["passed"] == {"old": True, "new": False}
+    assert d["status"] == {"old": "ok", "new": "failed"}
