@@ -232,6 +232,13 @@ def test_random_five_bars_are_fully_balanced(data):
     for an in a.values():
         df, dm = an.route_difference()
         assert df <= TOL * F0 and dm <= TOL * M0
+    # balanced for any motion: the total centre of mass stays put, the momenta stay zero
+    scale = float(np.abs(a["unbalanced"].com - a["unbalanced"].com[0]).max())
+    for name in ("counterweights", "full"):
+        assert np.abs(a[name].com - a[name].com[0]).max() <= TOL * scale
+        assert np.abs(a[name].momentum).max() <= TOL * np.abs(a["unbalanced"].momentum).max()
+    H0 = np.abs(a["unbalanced"].angular_momentum).max()
+    assert np.abs(a["full"].angular_momentum - a["full"].angular_momentum[0]).max() <= TOL * H0
     # the gripper starts and ends where the spec says
     C = gripper_path(a["full"], result.stages[-1].model)
     drive = data["motion"]["drive"]["gripper"]
