@@ -32,6 +32,8 @@ def ratio(x) -> str:
     x = float(x)
     if x == 0:
         return "0"
+    if abs(x) >= 10:
+        return f"{x:.3g} ×"
     if abs(x) >= 1e-3:
         return f"{100 * x:.3g} %"
     return f"{x:.2e}"
