@@ -36,7 +36,8 @@ def _entry(out: Path, o) -> dict:
         e["added_mass"] = f"{num(last['added_mass'])} kg"
         refs = results.get("references") or []
         agree = sum(r["status"] == "agrees" for r in refs)
-        e["refs"] = f"{agree}/{len(refs)} reproduced" if refs else "—"
+        known = sum(r["status"] != "agrees" and r.get("expected") == "differ" for r in refs)
+        e["refs"] = (f"{agree}/{len(refs)} reproduced" + (f", {known} known not to" if known else "")) if refs else "—"
         val = results.get("validation")
         if val is None:
             e["validation"] = '<span class="muted">skipped</span>'
