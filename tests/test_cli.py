@@ -161,3 +161,14 @@ def test_parallel_build_gives_the_same_site_and_quiet_hides_progress(work):
     assert "[1/2]" in a.stderr and "[1/2]" not in b.stderr and "2 ok" in b.stderr
     for f in sorted(p.relative_to(work / "a") for p in (work / "a").rglob("*") if p.is_file()):
         assert (work / "a" / f).read_bytes() == (work / "b" / f).read_bytes(), f
+
+
+def test_simulated_output_is_byte_identical_but_for_the_timing_files(work):
+    spec = work / "specs" / "scott_russell.yaml"
+    assert balpipe("build", spec, "-o", "a", cwd=work).returncode == 0
+    assert balpipe("build", spec, "-o", "b", "--force", cwd=work).returncode == 0
+    files = sorted(p.relative_to(work / "a") for p in (work / "a").rglob("*") if p.is_file())
+    assert {f.name for f in files} >= {"index.html", "results.json", "timeseries.csv", "timing.json", "timing.js"}
+    for f in files:
+        if not f.name.startswith("timing."):
+            assert (work / "a" / f).read_bytes() == (work / "b" / f).read_bytes(), f
