@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Callable, Literal
+from typing import Literal
 
 import numpy as np
 
@@ -222,10 +222,6 @@ class Model:
     def total_mass(self) -> float:
         return sum(b.mass_properties()[0] for b in self.bodies)
 
-    def total_rotor_inertia(self) -> float:
-        """Sum of the centroidal inertias of gear bodies (the counter-rotations' cost)."""
-        return sum(b.mass_properties()[2] for b in self.bodies if b.kind == "gear")
-
 
 def rot(theta: float) -> np.ndarray:
     c, s = math.cos(theta), math.sin(theta)
@@ -238,6 +234,3 @@ def pose_of_com(body: Body, pose: tuple[float, float, float]) -> tuple[float, fl
     x, y, th = pose
     p = np.array([x, y]) + rot(th) @ np.array(com)
     return float(p[0]), float(p[1]), th
-
-
-LawFactory = Callable[[float, float], Law]

@@ -133,19 +133,6 @@ class Polynomial(Law):
         return c(tc), np.where(inside, c.deriv(1)(tc), 0.0), np.where(inside, c.deriv(2)(tc), 0.0)
 
 
-@dataclass(frozen=True)
-class Scaled(Law):
-    """``offset + factor * law(t)``: a coordinate coupled linearly to another law."""
-
-    law: Law
-    factor: float
-    offset: float = 0.0
-
-    def __call__(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        q, qd, qdd = self.law(t)
-        return self.offset + self.factor * q, self.factor * qd, self.factor * qdd
-
-
 def law_for(motion, start: float, end: float, drive=None) -> Law:
     """The law of one coordinate from ``start`` to ``end`` (SI) following the spec's ``motion``
     section (law, duration, accel_fraction); ``drive`` gives the polynomial law's boundary

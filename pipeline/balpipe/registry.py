@@ -52,14 +52,6 @@ METHODS: dict[str, Method] = {
 }
 
 
-def register_template(name: str, template: Template) -> None:
-    TEMPLATES[name] = template
-
-
-def register_method(name: str, method: Method) -> None:
-    METHODS[name] = method
-
-
 def scalar_laws(motion: Any, dims: dict[str, str]) -> dict[str, Law]:
     """Laws of the scalar drives named in motion.drive, converted with their dimensions."""
     out = {}

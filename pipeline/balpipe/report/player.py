@@ -8,7 +8,6 @@ external file: a few kilobytes per page.
 from __future__ import annotations
 
 import json
-import math
 
 import numpy as np
 
@@ -33,17 +32,6 @@ def _outline(model: Model) -> list[dict]:
             "gears": gears,
         })
     return shapes
-
-
-def frame_poses(model: Model, com_poses: np.ndarray) -> np.ndarray:
-    """Body-frame poses (n, nb, 3) from centre-of-mass poses (n, nb, 3)."""
-    out = np.array(com_poses, dtype=float, copy=True)
-    for i, b in enumerate(model.bodies):
-        _, c, _ = b.mass_properties()
-        th = out[:, i, 2]
-        out[:, i, 0] -= np.cos(th) * c[0] - np.sin(th) * c[1]
-        out[:, i, 1] -= np.sin(th) * c[0] + np.cos(th) * c[1]
-    return out
 
 
 def _extent_points(model: Model, poses: np.ndarray) -> np.ndarray:
@@ -133,11 +121,3 @@ function draw() {{
 draw(); setInterval(draw, 50);
 }})();
 </script>"""
-
-
-def reactionless_summary(t: np.ndarray, base: np.ndarray) -> dict:
-    """Drift (max distance of the frame's origin from its start) and rotation of the frame."""
-    d = np.hypot(base[:, 0] - base[0, 0], base[:, 1] - base[0, 1])
-    rot = np.abs(base[:, 2] - base[0, 2])
-    return {"max_drift_m": float(d.max()), "max_rotation_deg": float(math.degrees(rot.max())),
-            "final_drift_m": float(d[-1]), "final_rotation_deg": float(math.degrees(rot[-1]))}
