@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .meshes import mesh_geometry
 from .model import FRAME, Driver, Gear, Model, Prismatic, Revolute, pose_of_com
 
 
@@ -105,6 +106,7 @@ class Compiled:
     joint_rows: dict[str, list[int]]
     q0: np.ndarray  # (3 nb,) initial guess
     condition: np.ndarray | None = None  # condition numbers of Phi_q along the last motion solved
+    meshes: list = field(default_factory=list)  # _Mesh: gear pairs that pass tooth forces
 
     @property
     def nb(self) -> int:
@@ -193,9 +195,52 @@ def compile_model(model: Model) -> Compiled:
     driver_rows = {n: prim_first_row[k] for n, k in driver_rows.items()}
 
     q0 = np.array([v for n in names for v in init[n]], dtype=float)
-    return Compiled(
+    compiled = Compiled(
         model, names, np.array(mass), np.array(inertia), prims, row_owner, driver_rows, joint_rows, q0
     )
+    compiled.meshes = _compile_meshes(model, idx, local, joint_rows)
+    return compiled
+
+
+@dataclass
+class _Mesh:
+    """A gear pair with pitch radii (see :mod:`balpipe.meshes`), indexed for the engine."""
+
+    name: str
+    row: int  # the gear's constraint row
+    ia: int
+    ib: int
+    ic: int
+    sca: np.ndarray  # bearing centres O_a, O_b on the carrier (relative to its centre of mass)
+    scb: np.ndarray
+    pitch_a: float
+    pitch_b: float
+    side: float
+    external: bool
+    tan_alpha: float
+    rows_a: list[int]  # rows of the bearings' revolute joints
+    rows_b: list[int]
+    sign_a: float  # +1 when the gear is body b of its bearing (its reaction is the force on the gear)
+    sign_b: float
+
+
+def _compile_meshes(model: Model, idx, local, joint_rows: dict[str, list[int]]) -> list[_Mesh]:
+    out = []
+    for jt in model.joints:
+        if not isinstance(jt, Gear):
+            continue
+        geo = mesh_geometry(model, jt)
+        if geo is None:
+            continue
+        ba, bb = geo.bearing_a, geo.bearing_b
+        out.append(_Mesh(
+            jt.name, joint_rows[jt.name][0], idx(jt.a, jt.name), idx(jt.b, jt.name), idx(jt.carrier, jt.name),
+            local(jt.carrier, ba.centre_carrier), local(jt.carrier, bb.centre_carrier),
+            geo.pitch_a, geo.pitch_b, geo.side, geo.external, float(np.tan(geo.pressure_angle)),
+            joint_rows[ba.joint], joint_rows[bb.joint],
+            1.0 if ba.gear_is_b else -1.0, 1.0 if bb.gear_is_b else -1.0,
+        ))
+    return out
 
 
 def _driver_primitive(d: Driver, joints: dict, idx, local, model: Model):
@@ -587,21 +632,81 @@ class Analysis:
         return self.extra["frame_pose"][k, i].tolist()
 
 
-def _joint_reactions(model: Model, c: Compiled, lam: np.ndarray) -> dict[str, dict[str, np.ndarray]]:
+def _tooth_rows(c: Compiled, qx: np.ndarray, J: np.ndarray) -> list[dict[str, np.ndarray]]:
+    """Write each mesh's generalized force as tooth forces at its pitch point (in place in J).
+
+    The gear's angle row is replaced by the rolling condition t . (v_P(b) - v_P(a)) = 0 at the
+    pitch point P = O_a + s r_a u of the bearings' centres O_a, O_b on the carrier (u from O_a
+    to O_b, t = perp(u)): on b the row is (t, (P - r_b) x t), on a (-t, -(P - r_a) x t). Where
+    the bearings are closed it equals -r_b times the angle row plus a combination of the
+    bearings' rows, so the motion, the efforts and the frame loads are unchanged, the mesh's
+    multiplier becomes the tangential tooth force (-lambda t on b) and the bearings' multipliers
+    carry it (Haug, ch. 6: a constraint's reaction is -Phi_q^T lambda for any equivalent
+    choice of rows). Returns the geometry (u, t, P, O_b) per mesh for the reactions.
+    """
+    geo = []
+    for m in c.meshes:
+        rc, thc = _split(qx, m.ic)
+        Oa = rc + _rotate(thc, m.sca)
+        Ob = rc + _rotate(thc, m.scb)
+        d = Ob - Oa
+        u = d / np.linalg.norm(d, axis=1)[:, None]
+        t = _perp(u)
+        P = Oa + (m.side * m.pitch_a) * u
+        J[:, m.row, :] = 0.0
+        for k, sign in ((m.ib, 1.0), (m.ia, -1.0)):
+            rk, _ = _split(qx, k)
+            arm = P - rk
+            J[:, m.row, 3 * k : 3 * k + 2] += sign * t
+            J[:, m.row, 3 * k + 2] += sign * (arm[:, 0] * t[:, 1] - arm[:, 1] * t[:, 0])
+        geo.append({"u": u, "t": t, "P": P, "Ob": Ob})
+    return geo
+
+
+def _radial_tooth_loads(c: Compiled, geo: list[dict[str, np.ndarray]], lam: np.ndarray) -> np.ndarray:
+    """Add each mesh's radial tooth force, |F_t| tan(pressure angle), to its bearings.
+
+    The radial pair (on b: +F_r u for an external mesh, which it pushes apart, -F_r u for an
+    internal one; the opposite on a) acts at P on the line of centres, so it has no moment about
+    either bearing and its forces on the carrier, at O_a and O_b, cancel: the increments of the
+    two bearings' multipliers below are the exact solution of Phi_q^T dlambda = Q_radial, every
+    other multiplier (and so the frame loads and the efforts) unchanged.
+    """
+    for m, g in zip(c.meshes, geo):
+        Fr = np.abs(lam[:, m.row]) * m.tan_alpha
+        on_b = (Fr if m.external else -Fr)[:, None] * g["u"]  # radial tooth force on gear b
+        lam[:, m.rows_b] -= m.sign_b * on_b  # the bearing of b takes it back ...
+        lam[:, m.rows_a] += m.sign_a * on_b  # ... and that of a the opposite one
+    return lam
+
+
+def _joint_reactions(
+    model: Model, c: Compiled, lam: np.ndarray, geo: list[dict[str, np.ndarray]] | None = None
+) -> dict[str, dict[str, np.ndarray]]:
     """Loads that each joint transmits, from its multipliers (constraint force = -Phi_q^T lam).
 
-    Revolute: force (Fx, Fy) exerted on body b by body a (Phi = P_a - P_b, so it is +lam).
-    Prismatic: N, the force on the slider along the guide's left normal (-lam of the guide
-    row), and M, the moment on the slider (-lam of the rotation lock). Gear: T, the torque on
-    gear b relative to the carrier (-lam).
+    Revolute: force (Fx, Fy) exerted on body b by body a (Phi = P_a - P_b, so it is +lam); a
+    gear's bearing includes the tooth force. Prismatic: N, the force on the slider along the
+    guide's left normal (-lam of the guide row), and M, the moment on the slider (-lam of the
+    rotation lock). Gear: T, the torque on gear b relative to the carrier (-lam of the angle
+    row; with pitch radii the moment of the tooth force about b's centre), and with pitch radii
+    Ft = T / r_b, the tangential tooth force on b (positive when it turns b counter-clockwise)
+    and Fr >= 0, the radial one (|Ft| tan(pressure angle)).
     """
     out: dict[str, dict[str, np.ndarray]] = {}
+    tooth = {m.name: (m, g) for m, g in zip(c.meshes, geo or [])}
     for jt in model.joints:
         rows = c.joint_rows[jt.name]
         if isinstance(jt, Revolute):
             out[jt.name] = {"Fx": lam[:, rows[0]], "Fy": lam[:, rows[1]]}
         elif isinstance(jt, Prismatic):
             out[jt.name] = {"N": -lam[:, rows[1]], "M": -lam[:, rows[0]]}
+        elif jt.name in tooth:
+            m, g = tooth[jt.name]
+            F = -lam[:, rows[0]][:, None] * g["t"]  # tangential tooth force on b
+            arm = g["P"] - g["Ob"]
+            T = arm[:, 0] * F[:, 1] - arm[:, 1] * F[:, 0]
+            out[jt.name] = {"T": T, "Ft": T / m.pitch_b, "Fr": np.abs(lam[:, rows[0]]) * m.tan_alpha}
         else:
             out[jt.name] = {"T": -lam[:, rows[0]]}
     return out
@@ -620,6 +725,7 @@ def analyse(
     v, a = _vel_acc(c, q, t)
     qx = _extend(q)
     J = jacobian(c, qx)
+    mesh_geo = _tooth_rows(c, qx, J)  # gear meshes with pitch radii act by tooth forces
     Jf, J0 = J[:, :, 3:], J[:, :, :3]
     nb = c.nb
     g = np.asarray(gravity, dtype=float)
@@ -629,6 +735,7 @@ def analyse(
     Q[:, 1::3] = c.mass * g[1]
     rhs = Q - Mdiag * a
     lam = np.linalg.solve(np.transpose(Jf, (0, 2, 1)), rhs[..., None])[..., 0]
+    lam = _radial_tooth_loads(c, mesh_geo, lam)
     gen0 = -np.einsum("nmk,nm->nk", J0, lam)  # load on the frame: Fx, Fy, M_O
     P = np.asarray(moment_point, dtype=float)
     force = gen0[:, :2]
@@ -651,7 +758,7 @@ def analyse(
         return M - (P[0] * F[:, 1] - P[1] * F[:, 0])
 
     efforts = {name: -lam[:, row] for name, row in c.driver_rows.items()}
-    reactions = _joint_reactions(model, c, lam)
+    reactions = _joint_reactions(model, c, lam, mesh_geo)
     # frame poses for drawing: frame origin = com - A(theta) com_local
     frame_pose = np.zeros_like(qb)
     for k, b in enumerate(model.bodies):

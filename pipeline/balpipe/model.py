@@ -133,7 +133,10 @@ class Gear:
 
     Constraint: (theta_b - theta_c) - ratio (theta_a - theta_c) = phase. An external mesh of
     radii r_a, r_b has ratio = -r_a / r_b; an internal mesh or a belt +r_a / r_b. ``phase``
-    None means "as assembled in the initial pose". ``radius_a``/``radius_b`` are for drawing.
+    None means "as assembled in the initial pose". ``radius_a``/``radius_b`` are the pitch
+    radii: given, the mesh passes its tooth force (tangential from the mesh torque, radial
+    from ``pressure_angle``) between the gears, whose bearings on the carrier then carry it
+    (:mod:`balpipe.meshes`); omitted (a belt), the pair acts as a couple only.
     """
 
     name: str
@@ -144,6 +147,7 @@ class Gear:
     phase: float | None = None
     radius_a: float | None = None
     radius_b: float | None = None
+    pressure_angle: float = math.radians(20.0)
 
 
 Joint = Revolute | Prismatic | Gear
