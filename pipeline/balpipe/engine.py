@@ -663,21 +663,31 @@ def _tooth_rows(c: Compiled, qx: np.ndarray, J: np.ndarray) -> list[dict[str, np
     return geo
 
 
-def _radial_tooth_loads(c: Compiled, geo: list[dict[str, np.ndarray]], lam: np.ndarray) -> np.ndarray:
+def _radial_tooth_loads(
+    c: Compiled, geo: list[dict[str, np.ndarray]], lam: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Add each mesh's radial tooth force, |F_t| tan(pressure angle), to its bearings.
 
     The radial pair (on b: +F_r u for an external mesh, which it pushes apart, -F_r u for an
     internal one; the opposite on a) acts at P on the line of centres, so it has no moment about
     either bearing and its forces on the carrier, at O_a and O_b, cancel: the increments of the
     two bearings' multipliers below are the exact solution of Phi_q^T dlambda = Q_radial, every
-    other multiplier (and so the frame loads and the efforts) unchanged.
+    other multiplier (and so the efforts) unchanged. When a gear is the frame itself (a fixed
+    sun), the radial force its teeth take is an applied load on the frame, not a multiplier:
+    it is returned as (Fx, Fy, M_O) per sample, to add to the frame's load -Phi_q0^T lambda.
     """
+    on_frame = np.zeros((lam.shape[0], 3))
     for m, g in zip(c.meshes, geo):
         Fr = np.abs(lam[:, m.row]) * m.tan_alpha
         on_b = (Fr if m.external else -Fr)[:, None] * g["u"]  # radial tooth force on gear b
         lam[:, m.rows_b] -= m.sign_b * on_b  # the bearing of b takes it back ...
         lam[:, m.rows_a] += m.sign_a * on_b  # ... and that of a the opposite one
-    return lam
+        for k, f in ((m.ia, -on_b), (m.ib, on_b)):
+            if k == 0:
+                P = g["P"]
+                on_frame[:, :2] += f
+                on_frame[:, 2] += P[:, 0] * f[:, 1] - P[:, 1] * f[:, 0]
+    return lam, on_frame
 
 
 def _joint_reactions(
@@ -735,8 +745,8 @@ def analyse(
     Q[:, 1::3] = c.mass * g[1]
     rhs = Q - Mdiag * a
     lam = np.linalg.solve(np.transpose(Jf, (0, 2, 1)), rhs[..., None])[..., 0]
-    lam = _radial_tooth_loads(c, mesh_geo, lam)
-    gen0 = -np.einsum("nmk,nm->nk", J0, lam)  # load on the frame: Fx, Fy, M_O
+    lam, radial_on_frame = _radial_tooth_loads(c, mesh_geo, lam)
+    gen0 = -np.einsum("nmk,nm->nk", J0, lam) + radial_on_frame  # load on the frame: Fx, Fy, M_O
     P = np.asarray(moment_point, dtype=float)
     force = gen0[:, :2]
     moment_O = gen0[:, 2]

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from . import registry
+from . import realisable, registry
 from .balancing.base import BalanceResult, Stage
 from .engine import Analysis, AnalysisError, analyse
 from .spec import Spec
@@ -95,6 +95,7 @@ def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float) -> dict:
     F0, M0 = unbalanced.analysis.max_inertial_force, unbalanced.analysis.max_inertial_moment
     F, M = sr.analysis.max_inertial_force, sr.analysis.max_inertial_moment
     df, dm = sr.analysis.route_difference()
+    not_realisable = realisable.verdict(sr.stage.model)
     return {
         "name": sr.stage.name,
         "label": sr.stage.label,
@@ -113,6 +114,9 @@ def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float) -> dict:
         "added_inertia": sr.added_inertia,
         "reactions_vs_momentum_force": df / F0 if F0 > 0 else df,
         "reactions_vs_momentum_moment": dm / M0 if M0 > 0 else dm,
+        "realisable": not not_realisable,
+        "not_realisable": not_realisable,
+        "not_realisable_parts": realisable.details(sr.stage.model),
     }
 
 

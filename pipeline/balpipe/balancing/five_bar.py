@@ -40,6 +40,7 @@ from typing import Literal
 from pydantic import Field
 
 from ..mechanisms.five_bar import FiveBarMechanism, GearPart, Synthesis
+from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
 from ..model import Attachment, Body, Gear, Model, Revolute
 from ..spec_parts import SpecFieldError, Strict
 from ..units import Inertia, Length, Mass
@@ -74,6 +75,10 @@ class CounterRotation(Strict):
         "changed for it (the paper lists I1' = I2' = 0.4 kg m^2 only there); default: as in "
         "mechanism.coupling",
     )
+    pressure_angle: PressureAngle = Field(
+        DEFAULT_PRESSURE_ANGLE, description="pressure angle of the meshes 3'-6 and 4'-7 (default "
+        "20 deg): radial tooth force = |tangential| tan of it"
+    )
 
 
 class BalancedInertias(Strict):
@@ -96,6 +101,12 @@ class FiveBarGearBalancing(Strict):
         description="the paper's reading of eq. 17: these are the balanced links' centroidal "
         "inertias, realised by giving the counterweights the inertia needed; omitted: point-mass "
         "counterweights on the bare links",
+    )
+    point_mass_stage: bool = Field(
+        False,
+        description="with balanced_inertias: also analyse the complete balancing with point-mass "
+        "counterweights on the bare links (I5, I6, I7 of eqs. 19-21 recomputed for them), a stage "
+        "that can be built",
     )
 
 
@@ -205,6 +216,13 @@ def balance(mech: FiveBarMechanism, method: FiveBarGearBalancing, model: Model) 
                                  "a counterweight on the joint itself cannot balance anything")
     cr = method.counter_rotation
     U = cr.ratio
+    if method.point_mass_stage and method.balanced_inertias is None:
+        raise SpecFieldError(
+            ("balancing", "point_mass_stage"),
+            "the point-mass stage is the alternative to balanced_inertias; without them the full "
+            "stage already has point-mass counterweights",
+        )
+    point_mass_full = None
     params: list[Parameter] = []
     notes: list[str] = []
     P = lambda *a: params.append(Parameter(*a))  # noqa: E731
@@ -279,6 +297,8 @@ def balance(mech: FiveBarMechanism, method: FiveBarGearBalancing, model: Model) 
         for k in ("I5", "I6", "I7"):
             P(f"{k}_point_masses", Ipm[k], "kg m^2", {"I5": "eq. 19", "I6": "eq. 20", "I7": "eq. 21"}[k],
               f"{k} with point-mass counterweights on the bare links (no balanced_inertias)")
+        if method.point_mass_stage:
+            point_mass_full = _full_stage(model, pm_links, Ipm, mech, cr)
         if negative:
             listing = ", ".join(
                 f"link {j}: stated {v[0] + v[1]:.4g} < {v[1]:.4g} kg m^2" for j, v in sorted(negative.items())
@@ -288,29 +308,13 @@ def balance(mech: FiveBarMechanism, method: FiveBarGearBalancing, model: Model) 
                 f"the bare links with point-mass counterweights ({listing}): no real counterweight "
                 "can give them. The model realises the paper's reading with counterweights of "
                 "negative centroidal inertia (Icw parameters); with point-mass counterweights the "
-                f"design needs I5 = {Ipm['I5']:.4g}, I6 = {Ipm['I6']:.4g}, I7 = {Ipm['I7']:.4g} kg m^2."
+                f"design needs I5 = {Ipm['I5']:.4g}, I6 = {Ipm['I6']:.4g}, I7 = {Ipm['I7']:.4g} kg m^2"
+                + (" (the stage 'full, point-mass counterweights')." if method.point_mass_stage else ".")
             )
 
     # full stage: gears 3', 4' on the distal links, planetary gears 6, 7, gear 5 with I5
-    full = model
-    for b in links.values():
-        full = full.replace_body(b)
-    gear5 = full.body("gear5")
-    full = full.replace_body(replace(gear5, inertia=I["I5"] - sum(a.inertia for a in gear5.attachments)))
-    new_bodies, new_joints, init = [], [], {}
-    for j, prox, dist in ((1, "link1", "link3"), (2, "link2", "link4")):
-        lp = (p1, p2)[j - 1]
-        r_planet = lp.length / (1 + U)
-        name = f"gear{j + 5}"
-        A = model.initial[prox]
-        new_bodies.append(Body(name, cr.planet_mass, (0.0, 0.0), I[f"I{j + 5}"], {f"A{j}": (0.0, 0.0)},
-                               radius=r_planet, kind="gear"))
-        init[name] = (A[0], A[1], 0.0)
-        new_joints += [
-            Revolute(f"A{j}-{j + 5}", prox, name, (0.0, 0.0), (0.0, 0.0)),
-            Gear(f"{j + 2}'-{j + 5}", dist, name, prox, -U, None, U * r_planet, r_planet),
-        ]
-    full = full.add(tuple(new_bodies), tuple(new_joints), init)
+    full = _full_stage(model, links, I, mech, cr)
+    gear5 = model.body("gear5")
     if I["I5"] < gear5.inertia:
         notes.append(
             f"Gear 5 as built ({gear5.inertia:.4g} kg m^2) has more inertia than eq. 19 needs "
@@ -329,4 +333,39 @@ def balance(mech: FiveBarMechanism, method: FiveBarGearBalancing, model: Model) 
               "gears 3', 4' on the distal links with the counterweights of eqs. 15-16, planetary gears "
               "6, 7 (eqs. 20-21) and gear 5 with the inertia of eq. 19", balances="force+moment"),
     ]
+    if point_mass_full is not None:
+        stages.append(Stage(
+            "full_point_masses", "full, point-mass counterweights", point_mass_full,
+            "as the full stage, with point-mass counterweights (no inertia of their own) on the bare "
+            "links and gears 5, 6, 7 with the inertias eqs. 19-21 give for them (I5_point_masses, "
+            "I6_point_masses, I7_point_masses)", balances="force+moment",
+        ))
     return BalanceResult(params, stages, notes)
+
+
+def _full_stage(model: Model, links: dict[str, Body], I: dict[str, float], mech: FiveBarMechanism,
+                cr: CounterRotation) -> Model:
+    """The unbalanced model with the counterweighted links (gears 3', 4' on the distal ones), gear
+    5 given the I5 of eq. 19 and the planetary gears 6, 7 (I6, I7 of eqs. 20-21) on axes A1, A2
+    carried by the input links, meshing with gears 3', 4' (r3' + r6 = l1, r4' + r7 = l2)."""
+    (p1, _), (p2, _) = mech.legs()
+    U = cr.ratio
+    full = model
+    for b in links.values():
+        full = full.replace_body(b)
+    gear5 = full.body("gear5")
+    full = full.replace_body(replace(gear5, inertia=I["I5"] - sum(a.inertia for a in gear5.attachments)))
+    new_bodies, new_joints, init = [], [], {}
+    for j, prox, dist in ((1, "link1", "link3"), (2, "link2", "link4")):
+        lp = (p1, p2)[j - 1]
+        r_planet = lp.length / (1 + U)
+        name = f"gear{j + 5}"
+        A = model.initial[prox]
+        new_bodies.append(Body(name, cr.planet_mass, (0.0, 0.0), I[f"I{j + 5}"], {f"A{j}": (0.0, 0.0)},
+                               radius=r_planet, kind="gear"))
+        init[name] = (A[0], A[1], 0.0)
+        new_joints += [
+            Revolute(f"A{j}-{j + 5}", prox, name, (0.0, 0.0), (0.0, 0.0)),
+            Gear(f"{j + 2}'-{j + 5}", dist, name, prox, -U, None, U * r_planet, r_planet, cr.pressure_angle),
+        ]
+    return full.add(tuple(new_bodies), tuple(new_joints), init)

@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from ..meshes import DEFAULT_PRESSURE_ANGLE
 from ..model import FRAME, Attachment, Body, Gear, Model, Revolute, Vec2, rot
 
 
@@ -42,11 +43,15 @@ def carrier_point_global(model: Model, carrier: str, at: Vec2) -> tuple[float, f
 def add_counter_rotation(
     model: Model, name: str, *, carrier: str, at: Vec2, geared_to: str, ratio: float,
     inertia: float, mass: float = 0.0, radius: float | None = None, radius_geared: float | None = None,
+    pressure_angle: float = DEFAULT_PRESSURE_ANGLE,
 ) -> Model:
     """``model`` with a counter-rotating disc ``name`` pivoted on ``carrier`` at its local point
     ``at`` (global on the frame) and geared to ``geared_to`` through a mesh held by ``carrier``:
     w_disc - w_c = ``ratio`` (w_geared - w_c). A disc of ``inertia`` about its centre, centre of
-    mass on the pivot; ``radius``/``radius_geared`` are the pitch radii (drawing, tooth forces).
+    mass on the pivot; ``radius``/``radius_geared`` are the pitch radii: given both, the mesh
+    passes its tooth force (radial part from ``pressure_angle``) to the disc's pivot and to the
+    geared body's bearing on the carrier, which must then be r + r_geared apart (external mesh,
+    ratio < 0) or |r - r_geared| (internal); omitted, the mesh is a couple (:mod:`balpipe.meshes`).
     """
     if not math.isfinite(ratio) or ratio == 0:
         raise ValueError(f"counter-rotation {name!r}: the gear ratio must be finite and non-zero, got {ratio}")
@@ -54,6 +59,7 @@ def add_counter_rotation(
     disc = Body(name, float(mass), (0.0, 0.0), float(inertia), {"axis": (0.0, 0.0)}, radius=radius, kind="gear")
     joints = (
         Revolute(f"{carrier}-{name}", carrier, name, (float(at[0]), float(at[1])), (0.0, 0.0)),
-        Gear(f"{geared_to}-{name}", geared_to, name, carrier, float(ratio), None, radius_geared, radius),
+        Gear(f"{geared_to}-{name}", geared_to, name, carrier, float(ratio), None, radius_geared, radius,
+             float(pressure_angle)),
     )
     return model.add((disc,), joints, {name: (pivot[0], pivot[1], 0.0)})

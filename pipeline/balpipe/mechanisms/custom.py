@@ -11,6 +11,7 @@ from typing import Annotated, Literal, Union
 import numpy as np
 from pydantic import Field
 
+from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle, mesh_geometry
 from ..model import FRAME, Body, Driver, Gear, Model, Prismatic, Revolute
 from ..spec_parts import SpecFieldError, Strict
 from ..units import Angle, Inertia, Length, Mass, PositiveLength
@@ -60,6 +61,17 @@ class GearSpec(Strict):
     b: str = Field(description="driven gear's body")
     carrier: str = Field(FRAME, description="body holding both axes ('frame' for fixed axes)")
     ratio: float = Field(description="(w_b - w_c) / (w_a - w_c); -r_a/r_b for an external mesh")
+    radius_a: PositiveLength | None = Field(
+        None,
+        description="pitch radius of gear a; with radius_b the mesh passes its tooth force between "
+        "the gears' bearings (revolute joints pivoting a and b on the carrier, r_a + r_b apart, "
+        "|r_a - r_b| for an internal mesh); omitted (a belt): the pair acts as a couple only",
+    )
+    radius_b: PositiveLength | None = Field(None, description="pitch radius of gear b")
+    pressure_angle: PressureAngle = Field(
+        DEFAULT_PRESSURE_ANGLE, description="pressure angle (default 20 deg): radial tooth force = "
+        "|tangential| tan(pressure angle)"
+    )
 
 
 JointSpec = Annotated[Union[RevoluteSpec, PrismaticSpec, GearSpec], Field(discriminator="type")]
@@ -131,7 +143,7 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
         else:
             for key in ("a", "b", "carrier"):
                 check_body(getattr(j, key), jp + (key,))
-            joints.append(Gear(j.name, j.a, j.b, j.carrier, j.ratio))
+            joints.append(Gear(j.name, j.a, j.b, j.carrier, j.ratio, None, j.radius_a, j.radius_b, j.pressure_angle))
     jnames = {j.name for j in joints}
     drivers = []
     for k, d in enumerate(mech.drivers):
@@ -150,7 +162,7 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
         Body(b.name, b.mass, tuple(b.com), b.inertia, dict(b.points), outline=tuple(b.points), radius=b.radius, kind=b.kind)
         for b in mech.bodies
     )
-    return Model(
+    model = Model(
         name="custom",
         bodies=model_bodies,
         joints=tuple(joints),
@@ -158,3 +170,11 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
         initial={b.name: tuple(b.pose) for b in mech.bodies},
         frame_points={k: tuple(v) for k, v in mech.frame_points.items()},
     )
+    for k, (j, jt) in enumerate(zip(mech.joints, joints)):
+        if isinstance(jt, Gear):
+            try:
+                mesh_geometry(model, jt)
+            except ValueError as exc:
+                key = "radius_b" if j.radius_a is not None and j.radius_b is None else "radius_a"
+                raise SpecFieldError(root + ("joints", k, key), str(exc)) from None
+    return model

@@ -35,6 +35,7 @@ import numpy as np
 from pydantic import Field
 
 from .. import units
+from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
 from ..model import FRAME, Attachment, Body, Driver, Gear, Law, Model, Revolute
 from ..motion import law_for
 from ..spec_parts import LinkSpec, SpecFieldError, Strict
@@ -59,6 +60,10 @@ class CouplingSpec(Strict):
     gear_2p: GearPart = Field(GearPart(), description="gear 2', fixed on input link 2 at A2")
     gear_5: GearPart = Field(
         GearPart(), description="the idler gear 5 on the frame, as built before moment balancing"
+    )
+    pressure_angle: PressureAngle = Field(
+        DEFAULT_PRESSURE_ANGLE, description="pressure angle of the meshes 1'-5 and 5-2' (default "
+        "20 deg): the radial tooth force that the bearings A1, O5, A2 carry is |tangential| tan of it"
     )
 
 
@@ -397,8 +402,8 @@ def build(mech: FiveBarMechanism, laws: dict, t: np.ndarray) -> Model:
         initial["gear5"] = (O5[0], O5[1], 0.0)
         joints += [
             Revolute("O5", FRAME, "gear5", O5, (0.0, 0.0)),
-            Gear("1'-5", "link1", "gear5", FRAME, -syn.r1p / syn.r5, None, syn.r1p, syn.r5),
-            Gear("5-2'", "gear5", "link2", FRAME, -syn.r5 / syn.r2p, None, syn.r5, syn.r2p),
+            Gear("1'-5", "link1", "gear5", FRAME, -syn.r1p / syn.r5, None, syn.r1p, syn.r5, cp.pressure_angle),
+            Gear("5-2'", "gear5", "link2", FRAME, -syn.r5 / syn.r2p, None, syn.r5, syn.r2p, cp.pressure_angle),
         ]
         frame_points["O5"] = O5
         drivers = (Driver("theta1", ("joint", "A1"), law),)

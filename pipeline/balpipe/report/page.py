@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from .. import realisable
 from ..study import Study
 from . import figures
 from .render import environment
@@ -53,6 +54,7 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
                 "dt": v.dt, "steps": v.steps, "iterations": v.iterations, "tolerance": v.tolerance,
                 "reasons": "; ".join(v.reasons), "notes": "; ".join(v.notes),
                 "excluded": v.excluded_samples, "version": v.pymunk_version,
+                "not_realisable": realisable.verdict(s.stage.model),
             })
     rl = study.reactionless
     return environment().get_template("spec.html").render(

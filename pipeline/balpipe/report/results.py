@@ -77,22 +77,29 @@ def dumps(results: dict) -> str:
 
 
 def joint_load_table(study: Study) -> list[dict]:
-    """Peak load of every joint in every stage: |F| for revolutes (bearing load), |N| and |M|
-    for prismatic pairs, |T| for gear meshes."""
-    rows: dict[str, dict] = {}
+    """Peak load of every joint in every stage: |F| for revolutes (bearing load, tooth forces
+    included), |N| and |M| for prismatic pairs, |T| for gear meshes and, for meshes with pitch
+    radii, the peak tangential |Ft| and radial Fr tooth forces (a row each)."""
+    rows: dict[tuple[str, str], dict] = {}
+
+    def put(joint: str, comp: str, kind: str, unit: str, stage: str, peak: float) -> None:
+        row = rows.setdefault((joint, comp), {"joint": joint, "kind": kind, "unit": unit, "peaks": {}})
+        row["peaks"][stage] = peak
+
     for s in study.stages:
+        n = s.stage.name
         for j, comps in s.analysis.reactions.items():
-            row = rows.setdefault(j, {"joint": j, "kind": "", "unit": "", "peaks": {}})
             if "Fx" in comps:
-                row["kind"], row["unit"] = "revolute: |F|", "N"
-                peak = float(np.max(np.hypot(comps["Fx"], comps["Fy"])))
+                put(j, "F", "revolute: |F|", "N", n, float(np.max(np.hypot(comps["Fx"], comps["Fy"]))))
             elif "N" in comps:
-                row["kind"], row["unit"] = "prismatic: |N| (normal force)", "N"
-                peak = float(np.max(np.abs(comps["N"])))
+                put(j, "N", "prismatic: |N| (normal force)", "N", n, float(np.max(np.abs(comps["N"]))))
+            elif "Ft" in comps:
+                put(j, "T", "gear mesh: |T| (torque on the driven gear)", "N m", n, float(np.max(np.abs(comps["T"]))))
+                put(j, "Ft", "gear mesh: |Ft| (tangential tooth force)", "N", n, float(np.max(np.abs(comps["Ft"]))))
+                put(j, "Fr", "gear mesh: Fr (radial tooth force)", "N", n, float(np.max(comps["Fr"])))
             else:
-                row["kind"], row["unit"] = "gear mesh: |T| (torque on the driven gear)", "N m"
-                peak = float(np.max(np.abs(comps["T"])))
-            row["peaks"][s.stage.name] = peak
+                put(j, "T", "gear pair without pitch radii, a couple only: |T| (torque on the driven gear)",
+                    "N m", n, float(np.max(np.abs(comps["T"]))))
     return list(rows.values())
 
 

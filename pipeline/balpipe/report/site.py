@@ -27,10 +27,12 @@ def _entry(out: Path, o) -> dict:
         "results": results if not stale else None,
         "errors": o.message if o.status in ("error", "crash", "failed") else "",
         "error_short": (o.message.splitlines() or [""])[0],
+        "not_realisable": [],
     }
     if e["results"]:
         st = results["stages"]
         first, last = st[0], st[-1]
+        e["not_realisable"] = [f"{s['label']}: {s['not_realisable']}" for s in st if s.get("realisable") is False]
         e["peak_f"] = f"{num(first['max_shaking_force'])} → {num(last['max_shaking_force'])}"
         e["peak_m"] = f"{num(first['max_shaking_moment'])} → {num(last['max_shaking_moment'])}"
         e["added_mass"] = f"{num(last['added_mass'])} kg"
@@ -50,5 +52,8 @@ def _entry(out: Path, o) -> dict:
 def write_site(out: Path, outcomes: list) -> None:
     entries = [_entry(out, o) for o in sorted(outcomes, key=lambda o: o.source)]
     n_ok = sum(e["status"] == "ok" for e in entries)
-    html = environment().get_template("index.html").render(entries=entries, n_ok=n_ok, n_failed=len(entries) - n_ok)
+    n_flagged = sum(e["status"] == "ok" and bool(e["not_realisable"]) for e in entries)
+    html = environment().get_template("index.html").render(
+        entries=entries, n_ok=n_ok - n_flagged, n_failed=len(entries) - n_ok, n_flagged=n_flagged
+    )
     (out / "index.html").write_text(html, encoding="utf-8")
