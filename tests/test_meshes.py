@@ -127,6 +127,12 @@ def test_couple_only_gears_leave_the_bearings_unloaded(paper):
     old = analyse(couple_only(stages["full"].model), t)
     assert np.max(np.abs(old.reactions["O5"]["Fx"])) < 1e-9
     assert set(old.reactions["1'-5"]) == {"T"}
+    # and the joint-load table says that such a pair is a couple only
+    from types import SimpleNamespace
+
+    study = SimpleNamespace(stages=[SimpleNamespace(stage=SimpleNamespace(name="full"), analysis=old)])
+    kinds = {r["kind"] for r in joint_load_table(study) if r["joint"] == "1'-5"}
+    assert kinds == {"gear pair without pitch radii, a couple only: |T| (torque on the driven gear)"}
 
 
 def test_pressure_angle_is_read_from_the_spec():
