@@ -80,7 +80,7 @@ def topology_figure(study):
             ax.annotate(name, p, textcoords="offset points", xytext=(4, -12), fontsize=7)
         ax.plot(an.com[0, 0], an.com[0, 1], "*", color="tab:purple", markersize=11)
         added = s.added_mass
-        ax.set_title(f"{FIGURE_OF_STAGE[s.stage.name]}: {s.stage.label}\nadded {added:.3g} kg", fontsize=8)
+        ax.set_title(f"{s.stage.label}\nadded {added:.3g} kg", fontsize=8)
         ax.set_aspect("equal")
         ax.tick_params(labelsize=7)
     fig.tight_layout()
