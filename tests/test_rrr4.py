@@ -260,6 +260,9 @@ def test_paper_spec_study():
     assert p["eq17_residual_unbalanced"] > 0.1
     assert p["eq17_residual_leg_by_leg"] < 1e-12 and p["eq17_residual_general"] < 1e-12
     assert sum(p[f"mu5{i}"] for i in (1, 2, 3, 4)) == pytest.approx(1.0)
+    assert p["eq17_conditions"] == 12 and p["eq17_rank"] == 12
+    res = recipe.eq17_residuals(st.spec.mechanism, st.stages[1].stage.model)
+    assert len(res) == 12 and max(abs(r) for _, r in res) < 1e-12
     assert any("Redundant actuation: 4 actuators drive 3" in n for n in st.balance.notes)
     figs = st.extra_figures()
     titles = [f[0] for f in figs]

@@ -398,7 +398,8 @@ def _solve_rect(J: np.ndarray, b: np.ndarray) -> np.ndarray:
     squares solution of a consistent over-determined system (redundant drivers) otherwise."""
     if J.shape[-2] == J.shape[-1]:
         return np.linalg.solve(J, b[..., None])[..., 0]
-    return np.einsum("nij,nj->ni", np.linalg.pinv(J), b)
+    Q, R = np.linalg.qr(J)  # reduced: J = Q R, R (n, n) upper triangular
+    return np.linalg.solve(R, np.einsum("nji,nj->ni", Q, b)[..., None])[..., 0]
 
 
 def _newton(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER):
@@ -669,9 +670,10 @@ def _multipliers(c: Compiled, Jf: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     n, m = A.shape[1], A.shape[2]
     if m == n:
         return np.linalg.solve(A, rhs[..., None])[..., 0]
-    _, _, vt = np.linalg.svd(A)  # full_matrices: rows n.. of vt span the null space of A
-    lam_p = np.einsum("nij,nj->ni", np.linalg.pinv(A), rhs)
-    null = np.transpose(vt[:, n:, :], (0, 2, 1))  # (N, m, r)
+    Q, R = np.linalg.qr(Jf, mode="complete")  # Jf = [Q1 Q2] [R1; 0]: Q2 spans the null space of A
+    y = np.linalg.solve(np.transpose(R[:, :n, :], (0, 2, 1)), rhs[..., None])[..., 0]  # R1^T y = rhs
+    lam_p = np.einsum("nmk,nk->nm", Q[:, :, :n], y)  # the least-norm solution, Q1 R1^-T rhs
+    null = Q[:, :, n:]  # (N, m, r)
     drv = sorted(c.driver_rows.values())
     S_null = null[:, drv, :]  # (N, d, r)
     z = -np.einsum("nij,nj->ni", np.linalg.pinv(S_null), lam_p[:, drv])

@@ -206,6 +206,10 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
                         "independent conditions by the momentum null space: two of the eight only fix how m5 "
                         "is split among the point masses, which a non-rotating platform does not feel."
                     )
+        names = list(mass_parameters(model))
+        params.append(Parameter("eq17_conditions", len(rows), "", "eq. 17", "number of printed general conditions"))
+        params.append(Parameter("eq17_rank", float(np.linalg.matrix_rank(cond.as_matrix(rows, names))), "", "eq. 17",
+                                "independent conditions among them (rank of their coefficient matrix)"))
         for st in stages:
             p = mass_parameters(st.model)
             worst = max(abs(r.residual(p)) / max(r.scale(p), 1e-300) for r in rows)
@@ -217,3 +221,10 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
             "legs (paper 001 takes legs out by giving them zero mass, which keeps them in the kinematics)."
         )
     return BalanceResult(params, stages, notes)
+
+
+def eq17_residuals(mech: RRR4Mechanism, model: Model) -> list[tuple[cond.LinearCondition, float]]:
+    """Eq. 17's twelve conditions for this geometry, each with its residual (kg m) for the mass
+    distribution of ``model`` (a stage of a four-legged n-RRR)."""
+    p = mass_parameters(model)
+    return [(r, r.residual(p)) for r in cond.eq17(geometry(mech))]

@@ -267,10 +267,16 @@ class JointLaw(Law):
 
     def __call__(self, t):
         t = np.atleast_1d(np.asarray(t, dtype=float))
-        pose = tuple(law(t) for law in self.pose)
-        lm = leg_motion(self.leg, *corner_motion(self.mech, self.leg.i, pose), self.ref)
+        key = t.tobytes()
+        cache = self.__dict__.setdefault("_cache", {})  # the engine asks for the same grid often
+        if key not in cache:
+            if len(cache) > 8:
+                cache.clear()
+            pose = tuple(law(t) for law in self.pose)
+            cache[key] = (pose, leg_motion(self.leg, *corner_motion(self.mech, self.leg.i, pose), self.ref))
+        pose, lm = cache[key]
         if self.kind == "A":
-            return lm.th1, lm.w1, lm.a1
+            return lm.th1.copy(), lm.w1.copy(), lm.a1.copy()
         if self.kind == "B":
             return lm.th2 - lm.th1, lm.w2 - lm.w1, lm.a2 - lm.a1
         ph = pose[2]
