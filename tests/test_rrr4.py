@@ -399,3 +399,30 @@ def test_special_kinematics_check_given_geometry():
     data["mechanism"]["kinematics"] = "fig5b"
     with pytest.raises(SpecFieldError, match="kinematics fig5b"):
         registry.unbalanced_model(spec_of(data))
+
+
+def test_redundant_efforts_scale_with_mass_and_duration():
+    """Scaling every mass and inertia by k scales the efforts and shaking force by k; halving the
+    duration multiplies them by 4 (no gravity)."""
+    data, spec, model = regular_random(11)
+    t = registry.time_grid(spec)
+    an = analyse(model, t)
+    heavy = copy.deepcopy(data)
+    k = 2.5
+    heavy["mechanism"]["platform"]["mass"] *= k
+    heavy["mechanism"]["platform"]["inertia"] *= k
+    for leg in heavy["mechanism"]["legs"].values():
+        for key in ("proximal", "distal"):
+            leg[key]["mass"] *= k
+            leg[key]["inertia"] *= k
+    fast = copy.deepcopy(data)
+    fast["motion"]["duration"] /= 2
+    an_k = analyse(registry.unbalanced_model(spec_of(heavy)), t)
+    fspec = spec_of(fast)
+    an_f = analyse(registry.unbalanced_model(fspec), registry.time_grid(fspec))
+    for name in an.efforts:
+        scale = np.abs(an.efforts[name]).max()
+        assert np.abs(an_k.efforts[name] - k * an.efforts[name]).max() <= 1e-9 * k * scale
+        assert np.abs(an_f.efforts[name] - 4 * an.efforts[name]).max() <= 1e-8 * 4 * scale
+    assert np.abs(an_k.force - k * an.force).max() <= 1e-9 * k * an.max_force
+    assert np.abs(an_f.force - 4 * an.force).max() <= 1e-8 * 4 * an.max_force
