@@ -426,3 +426,26 @@ def test_redundant_efforts_scale_with_mass_and_duration():
         assert np.abs(an_f.efforts[name] - 4 * an.efforts[name]).max() <= 1e-8 * 4 * scale
     assert np.abs(an_k.force - k * an.force).max() <= 1e-9 * k * an.max_force
     assert np.abs(an_f.force - 4 * an.force).max() <= 1e-8 * 4 * an.max_force
+
+
+def test_independent_distal_link_gives_fig2b_and_two_need_a_special_platform():
+    """Sec. II.B: with l22 as built, mu52 = -m22 p22 / l22 (eq. 11) and l22 needs no counter-mass;
+    the leg-by-leg design still balances. Two independent links (Fig. 2c) need the combined
+    centre of mass on a line, which this platform does not have: a located error."""
+    data = paper_data()
+    data["balancing"]["independent"] = [22]
+    data["analysis"] = {"samples": 101}
+    st = study.run(spec_of(data))
+    assert st.ok, st.problems
+    lbl = st.stages[1]
+    assert "Fig. 2b" in lbl.stage.label
+    assert lbl.stage.model.body("link22").attachments == ()
+    p = {x.name: x.value for x in st.balance.parameters}
+    assert p["mu52"] == pytest.approx(-0.6 * 0.15 / 0.3)
+    assert sum(p[f"mu5{i}"] for i in (1, 2, 3, 4)) == pytest.approx(1.0)
+    assert lbl.analysis.max_inertial_force <= 1e-9 * st.stages[0].analysis.max_inertial_force
+    assert p["eq17_residual_leg_by_leg"] < 1e-12
+    data["balancing"]["independent"] = [22, 42]
+    with pytest.raises(SpecFieldError, match="cannot be met") as exc:
+        study.run(spec_of(data))
+    assert exc.value.path == ("balancing", "independent")

@@ -55,6 +55,12 @@ class RRR4Balancing(Strict):
         description="mu_5i, the platform's point masses at the C_i of the legs present, in leg order "
         "(eqs. 2-4 must hold); default: the minimum-norm split",
     )
+    independent: list[Literal[12, 22, 32, 42]] = Field(
+        [],
+        description="distal links l_i2 whose centre of mass along the link stays as built (Sec. II.B-D, "
+        "Figs. 2b-d): mu_5i = -m_i2 p_i2 / l_i2 (eq. 11) instead of a counter-mass, the other mu_5i from "
+        "eqs. 2-4",
+    )
     topologies: bool = Field(
         True, description="also build the eq. 17 design (Fig. 4a) and, for fig5a/fig5b kinematics, eq. 19/21's (Fig. 6)"
     )
@@ -63,12 +69,33 @@ class RRR4Balancing(Strict):
 LEG_BY_LEG_LABEL = "leg-by-leg counter-masses (Fig. 2a, eqs. 8-11)"
 
 
-def platform_split(mech: RRR4Mechanism, legs: list[int], given: list[float] | None) -> np.ndarray:
-    """mu_5i (eqs. 2-4): sum mu = m5, sum mu C_i = m5 (p5, q5) in the platform frame."""
+def platform_split(mech: RRR4Mechanism, legs: list[int], given: list[float] | None,
+                   fixed: dict[int, float] | None = None) -> np.ndarray:
+    """mu_5i (eqs. 2-4): sum mu = m5, sum mu C_i = m5 (p5, q5) in the platform frame; ``fixed``
+    holds the mu_5i that independent links set (Sec. II.B-D)."""
     p = mech.platform
     A = np.array([[1.0] * len(legs), [corner(mech, i)[0] for i in legs], [corner(mech, i)[1] for i in legs]])
     b = p.mass * np.array([1.0, p.com[0], p.com[1]])
     scale = max(p.mass * max(p.half_width, p.half_height), 1e-300)
+    if fixed:
+        free = [k for k, i in enumerate(legs) if i not in fixed]
+        mu = np.zeros(len(legs))
+        for k, i in enumerate(legs):
+            mu[k] = fixed.get(i, 0.0)
+        rhs = b - A @ mu
+        if free:
+            mu[free] = np.linalg.lstsq(A[:, free], rhs, rcond=None)[0]
+        r = A @ mu - b
+        if np.max(np.abs(r)) > 1e-9 * max(scale, p.mass):
+            kept = ", ".join(f"l{i}2 (mu5{i} = {fixed[i]:.4g} kg)" for i in sorted(fixed))
+            rest = ", ".join(f"C{legs[k]}" for k in free) or "none"
+            raise SpecFieldError(
+                ("balancing", "independent"),
+                f"with {kept} as built, eqs. 2-4 cannot be met: the platform and those point masses together "
+                f"must have their centre of mass where the remaining joints ({rest}) can hold it "
+                f"(residuals {r[0]:.3g} kg, {r[1]:.3g} kg m, {r[2]:.3g} kg m; paper 001, Sec. II.B-D)",
+            )
+        return mu
     if given is not None:
         path = ("balancing", "platform_split")
         if len(given) != len(legs):
@@ -109,11 +136,21 @@ def leg_by_leg(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> tuple[
     """Eqs. 8-11 with the split of eqs. 2-4."""
     legs = resolve_legs(mech)
     ids = list(legs)
-    mu = platform_split(mech, ids, spec.platform_split)
+    fixed = {}
+    for k, ij in enumerate(spec.independent):
+        i = ij // 10
+        if i not in legs:
+            raise SpecFieldError(("balancing", "independent", k), f"leg {i} is not part of the mechanism")
+        if spec.platform_split is not None:
+            raise SpecFieldError(("balancing", "independent"), "give either independent links or platform_split")
+        m, c, _ = model.body(f"link{i}2").mass_properties()
+        fixed[i] = -m * c[0] / legs[i].l2  # eq. 11 with p_i2 as built
+    mu = platform_split(mech, ids, spec.platform_split, fixed)
     params = [Parameter(f"mu5{i}", float(m), "kg", "eqs. 2-7", f"platform mass lumped at C{i}") for i, m in zip(ids, mu)]
     out = model
     for i, m5i in zip(ids, mu):
         leg = legs[i]
+        # an independent link keeps its p_i2 (-mu l_i2 is its own first moment); q_i2 = 0 still
         out, m2, pos2 = realise(out, f"link{i}2", -m5i * leg.l2, 0.0, spec.counterweights.distal, f"counter-mass {i}2")
         m2_total = out.body(f"link{i}2").mass_properties()[0]
         out, m1, pos1 = realise(out, f"link{i}1", -(m2_total + m5i) * leg.l1, 0.0, spec.counterweights.proximal,
@@ -162,7 +199,11 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
     stages = [Stage("unbalanced", "unbalanced", model, f"the {model.name} as given")]
     lbl, params = leg_by_leg(mech, spec, model)
     base_mass = model.total_mass()
-    stages.append(Stage("leg_by_leg", LEG_BY_LEG_LABEL, lbl,
+    label = LEG_BY_LEG_LABEL
+    if spec.independent:
+        fig = "Fig. 2" + "abcd"[min(len(spec.independent), 3)]
+        label = f"leg-by-leg counter-masses ({fig}, eqs. 8-11; " + ", ".join(f"l{ij}" for ij in spec.independent) + " as built)"
+    stages.append(Stage("leg_by_leg", label, lbl,
                         "each leg's centre of mass on its base pivot, the platform lumped at the C_i (eqs. 2-11)", "force"))
     params.append(Parameter("added_mass_leg_by_leg", lbl.total_mass() - base_mass, "kg", "eqs. 8-11",
                             "counter-masses of the leg-by-leg balancing"))
@@ -202,9 +243,11 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
                                             f"counter-masses of the {fig} design"))
                     notes.append(
                         f"Paper 001 prints eight conditions for the kinematics of Fig. 5 with a translating platform "
-                        f"({eq}); they are sums of eq. 17's rows, sufficient for balance. PAPERS.md finds 6 "
-                        "independent conditions by the momentum null space: two of the eight only fix how m5 "
-                        "is split among the point masses, which a non-rotating platform does not feel."
+                        f"({eq}); they are sums of eq. 17's rows (the table shows them with their residuals) and "
+                        "sufficient for balance: the special stage meets them with counter-masses on fewer links "
+                        "than eq. 17 needs, and the engine finds its shaking force cancelled although eq. 17 does "
+                        "not hold. They need not all be necessary: how many independent conditions this motion "
+                        "class has is the rank of its momentum regressor, not of the printed list."
                     )
         names = list(mass_parameters(model))
         params.append(Parameter("eq17_conditions", len(rows), "", "eq. 17", "number of printed general conditions"))
