@@ -449,3 +449,16 @@ def test_independent_distal_link_gives_fig2b_and_two_need_a_special_platform():
     with pytest.raises(SpecFieldError, match="cannot be met") as exc:
         study.run(spec_of(data))
     assert exc.value.path == ("balancing", "independent")
+
+
+def test_a_leg_turning_half_a_revolution_is_a_located_error():
+    """A 1-RRR whose pivot is inside the circle of C3: a full platform turn sweeps the leg around."""
+    data = drop_legs(paper_data(), (3,))
+    leg = data["mechanism"]["legs"][3]
+    leg["pivot"] = ["0 m", "0 m"]
+    leg["proximal"]["length"], leg["distal"]["length"] = "0.3 m", "0.25 m"
+    data["mechanism"]["actuators"] = ["A3", "B3", "C3"]
+    data["motion"]["drive"]["platform"] = {"from": [0.0, 0.0, "0 deg"], "to": [0.0, 0.0, "360 deg"]}
+    with pytest.raises(SpecFieldError, match="turns by 180 deg or more") as exc:
+        registry.unbalanced_model(spec_of(data))
+    assert exc.value.path == ("motion", "drive", "platform", "to")

@@ -257,7 +257,9 @@ def leg_motion(leg: Leg, C, Cd, Cdd, ref: tuple[float, float] | None = None) -> 
 class JointLaw(Law):
     """The law of an actuated joint, by inverse kinematics of the platform pose's laws.
 
-    ``kind``: "A" (theta_i1), "B" (theta_i2 - theta_i1) or "C" (theta5 - theta_i2)."""
+    ``kind``: "A" (theta_i1), "B" (theta_i2 - theta_i1) or "C" (theta5 - theta_i2). The link
+    angles are taken within 180 deg of their values at t = 0 (``ref``), so that any set of times
+    gives the same branch; :func:`build` checks that the motion stays inside that range."""
 
     mech: RRR4Mechanism
     leg: Leg
@@ -351,10 +353,19 @@ def build(mech: RRR4Mechanism, laws: dict, t: np.ndarray) -> Model:
     t0 = np.zeros(1)
     pose0 = tuple(law(t0) for law in pose_laws)
     bodies, joints, initial, frame_points, refs = [], [], {}, {}, {}
+    tt = np.asarray(t, dtype=float)
+    pose_t = tuple(law(tt) for law in pose_laws)
     for i, leg in legs.items():
         lm = leg_motion(leg, *corner_motion(mech, i, pose0))
         th1, th2 = float(lm.th1[0]), float(lm.th2[0])
         refs[i] = (th1, th2)
+        along = leg_motion(leg, *corner_motion(mech, i, pose_t))
+        for n, th, ref in ((1, along.th1, th1), (2, along.th2, th2)):
+            turn = np.abs(np.unwrap(np.concatenate([[ref], th])) - ref)[1:]
+            if np.any(turn >= np.pi * (1 - 1e-9)):
+                k = int(np.argmax(turn >= np.pi * (1 - 1e-9)))
+                raise SpecFieldError(PLATFORM_PATH + ("to",), f"link l{i}{n} turns by 180 deg or more from its "
+                                     f"initial angle (at t = {tt[k]:.4g} s); split the motion into shorter moves")
         B = (leg.A[0] + leg.l1 * math.cos(th1), leg.A[1] + leg.l1 * math.sin(th1))
         bodies += [link_body(f"link{i}1", leg.proximal, leg.l1, f"A{i}", f"B{i}"),
                    link_body(f"link{i}2", leg.distal, leg.l2, f"B{i}", f"C{i}")]
