@@ -20,7 +20,7 @@ Inverse dynamics solves Phi_q^T lambda = Q - M q'' (M q'' + Phi_q^T lambda = Q).
 
 Redundant actuation (more drivers than degrees of freedom, e.g. a 4-RRR with four base motors):
 the consistent over-determined position, velocity and acceleration equations are solved in least
-squares (Gauss-Newton with the pseudo-inverse, exact for consistent drivers), and the
+squares (Gauss-Newton, least squares by QR, exact for consistent drivers), and the
 multipliers are those whose actuator efforts have the least norm (:func:`_multipliers`). The
 joints alone must not be over-constrained. The shaking
 loads are computed twice, independently:
