@@ -16,7 +16,13 @@ samples:
 
 Position analysis is Newton-Raphson on Phi(q, t) = 0; velocities solve Phi_q q' = nu and
 accelerations Phi_q q'' = gamma (Haug, Computer-Aided Kinematics and Dynamics, ch. 3 and 6).
-Inverse dynamics solves Phi_q^T lambda = Q - M q'' (M q'' + Phi_q^T lambda = Q). The shaking
+Inverse dynamics solves Phi_q^T lambda = Q - M q'' (M q'' + Phi_q^T lambda = Q).
+
+Redundant actuation (more drivers than degrees of freedom, e.g. a 4-RRR with four base motors):
+the consistent over-determined position, velocity and acceleration equations are solved in least
+squares (Gauss-Newton, least squares by QR, exact for consistent drivers), and the
+multipliers are those whose actuator efforts have the least norm (:func:`_multipliers`). The
+joints alone must not be over-constrained. The shaking
 loads are computed twice, independently:
 
 (a) reactions: F_sh, M_sh = -Phi_{q0}^T lambda (all frame joints, actuator reactions and gear
@@ -397,12 +403,50 @@ def _extend(q: np.ndarray) -> np.ndarray:
 
 
 def _check_square(c: Compiled) -> None:
+    """Fewer equations than coordinates is an error; more are allowed when only drivers are
+    redundant (redundant actuation, checked by :func:`_check_redundancy` once assembled)."""
     m, n = len(c.row_owner), 3 * c.nb
-    if m != n:
+    if m < n:
         raise AnalysisError(
-            f"the model has {n} coordinates but {m} constraint equations: "
-            + ("add drivers or joints (it can move freely)" if m < n else "it is over-constrained")
+            f"the model has {n} coordinates but {m} constraint equations: add drivers or joints "
+            "(it can move freely)"
         )
+    if m > n and m - len(c.driver_rows) > n:
+        raise AnalysisError(
+            f"the model has {n} coordinates but its joints alone give {m - len(c.driver_rows)} "
+            "constraint equations: it is over-constrained (only actuators may be redundant)"
+        )
+
+
+def redundancy(c: Compiled) -> int:
+    """Number of redundant actuators: constraint rows beyond the coordinates (0 when square)."""
+    return len(c.row_owner) - 3 * c.nb
+
+
+def _check_redundancy(c: Compiled, q: np.ndarray, t: float) -> None:
+    """With redundant actuation the joints' own rows must be independent (else the multipliers,
+    hence the reactions, are not determined by the minimum-norm efforts)."""
+    if redundancy(c) == 0:
+        return
+    J = jacobian(c, _extend(q[None, :]))[0, :, 3:]
+    drv = set(c.driver_rows.values())
+    rows = [r for r in range(J.shape[0]) if r not in drv]
+    s = np.linalg.svd(J[rows], compute_uv=False)
+    if s[-1] <= 1e-10 * s[0]:
+        raise AnalysisError(
+            f"at t = {t:.6g} s the joints' constraint equations are dependent (condition "
+            f"{s[0] / max(s[-1], 1e-300):.2g}): the mechanism is over-constrained by its joints, "
+            "not only by redundant actuators", t,
+        )
+
+
+def _solve_rect(J: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Solve J x = b for stacks (N, m, n) of full-column-rank J: exact when square, the least-
+    squares solution of a consistent over-determined system (redundant drivers) otherwise."""
+    if J.shape[-2] == J.shape[-1]:
+        return np.linalg.solve(J, b[..., None])[..., 0]
+    Q, R = np.linalg.qr(J)  # reduced: J = Q R, R (n, n) upper triangular
+    return np.linalg.solve(R, np.einsum("nji,nj->ni", Q, b)[..., None])[..., 0]
 
 
 def _newton(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER):
@@ -418,7 +462,7 @@ def _newton(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER
             break
         J = jacobian(c, qx[todo])[:, :, 3:]
         try:
-            dq = np.linalg.solve(J, -phi[todo][..., None])[..., 0]
+            dq = _solve_rect(J, -phi[todo])
         except np.linalg.LinAlgError:
             dq = np.stack([np.linalg.lstsq(Jk, -pk, rcond=None)[0] for Jk, pk in zip(J, phi[todo])])
         q[todo] += dq
@@ -459,12 +503,13 @@ def _check_regular(c: Compiled, q: np.ndarray, t: np.ndarray) -> np.ndarray:
     if bad.size:
         k = int(bad[0])
         u, _, _ = np.linalg.svd(J[k])
+        weak = u[:, J.shape[2] - 1]  # left vector of the smallest of the n singular values
         raise AnalysisError(
             f"singular configuration at t = {t[k]:.6g} s (condition number {cond[k]:.2g}): "
-            f"joints {_worst_rows(c, u[:, -1])} lose their rank (a dead point, a limit of the "
+            f"joints {_worst_rows(c, weak)} lose their rank (a dead point, a limit of the "
             f"workspace or a branch change)",
             float(t[k]),
-            c.row_owner[int(np.argmax(np.abs(u[:, -1])))],
+            c.row_owner[int(np.argmax(np.abs(weak)))],
         )
     return cond
 
@@ -484,6 +529,7 @@ def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
             "cannot assemble the mechanism at t = 0: " + str(_fail_position(c, q[0], float(t[0]))).split(": ", 1)[1],
             float(t[0]),
         )
+    _check_redundancy(c, q[0], float(t[0]))
     coarse_idx = np.unique(np.linspace(0, N - 1, min(N, _COARSE)).round().astype(int))
     tc = t[coarse_idx]
     qc = np.zeros((len(tc), q.shape[1]))
@@ -548,8 +594,8 @@ def _vel_acc_safe(c: Compiled, q: np.ndarray, t: float):
 def _vel_acc(c: Compiled, q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     qx = _extend(q)
     J = jacobian(c, qx)[:, :, 3:]
-    v = np.linalg.solve(J, velocity_rhs(c, t)[..., None])[..., 0]
-    a = np.linalg.solve(J, acceleration_rhs(c, qx, _extend(v), t)[..., None])[..., 0]
+    v = _solve_rect(J, velocity_rhs(c, t))
+    a = _solve_rect(J, acceleration_rhs(c, qx, _extend(v), t))
     return v, a
 
 
@@ -724,6 +770,33 @@ def _joint_reactions(
     return out
 
 
+def _multipliers(c: Compiled, Jf: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Lagrange multipliers from Phi_q^T lambda = Q - M q'' (N samples).
+
+    Square Jacobian: the unique solution. Redundant actuation (r more rows than coordinates):
+    Phi_q^T has an r-dimensional null space, the internal (antagonistic) loads that the
+    actuators can add without moving anything. Of all solutions, lambda_p + N z, the one whose
+    driver rows (the actuator efforts) have the least Euclidean norm is taken: z minimises
+    |S (lambda_p + N z)| with S the driver rows. The joint multipliers follow from the same
+    lambda, so every reaction is consistent with the efforts; the frame load -Phi_q0^T lambda
+    still equals minus the momentum rate, whatever the split (the null space loads every body
+    with zero net force). This is the pseudo-inverse solution tau = (G^T)^+ f of the reduced
+    dynamics G^T tau = f, G the Jacobian of the actuated coordinates.
+    """
+    A = np.transpose(Jf, (0, 2, 1))  # (N, n, m)
+    n, m = A.shape[1], A.shape[2]
+    if m == n:
+        return np.linalg.solve(A, rhs[..., None])[..., 0]
+    Q, R = np.linalg.qr(Jf, mode="complete")  # Jf = [Q1 Q2] [R1; 0]: Q2 spans the null space of A
+    y = np.linalg.solve(np.transpose(R[:, :n, :], (0, 2, 1)), rhs[..., None])[..., 0]  # R1^T y = rhs
+    lam_p = np.einsum("nmk,nk->nm", Q[:, :, :n], y)  # the least-norm solution, Q1 R1^-T rhs
+    null = Q[:, :, n:]  # (N, m, r)
+    drv = sorted(c.driver_rows.values())
+    S_null = null[:, drv, :]  # (N, d, r)
+    z = -np.einsum("nij,nj->ni", np.linalg.pinv(S_null), lam_p[:, drv])
+    return lam_p + np.einsum("nmr,nr->nm", null, z)
+
+
 def analyse(
     model: Model,
     t: np.ndarray,
@@ -746,7 +819,7 @@ def analyse(
     Q[:, 0::3] = c.mass * g[0]
     Q[:, 1::3] = c.mass * g[1]
     rhs = Q - Mdiag * a
-    lam = np.linalg.solve(np.transpose(Jf, (0, 2, 1)), rhs[..., None])[..., 0]
+    lam = _multipliers(c, Jf, rhs)
     lam, radial_on_frame = _radial_tooth_loads(c, mesh_geo, lam)
     gen0 = -np.einsum("nmk,nm->nk", J0, lam) + radial_on_frame  # load on the frame: Fx, Fy, M_O
     P = np.asarray(moment_point, dtype=float)
@@ -783,5 +856,6 @@ def analyse(
         force_momentum=force_mom, moment_momentum=about_P(moment_mom, force_mom),
         efforts=efforts, reactions=reactions, com=com, momentum=momentum, angular_momentum=ang,
         moment_point=(float(P[0]), float(P[1])), gravity=(float(g[0]), float(g[1])),
-        extra={"frame_pose": frame_pose, "condition": c.condition, "total_mass": float(m.sum())},
+        extra={"frame_pose": frame_pose, "condition": c.condition, "total_mass": float(m.sum()),
+               "redundant_actuators": redundancy(c)},
     )

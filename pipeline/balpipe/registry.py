@@ -10,9 +10,10 @@ import numpy as np
 
 from . import units
 from .balancing import five_bar as fb_balancing
+from .balancing import rrr4 as rrr4_balancing
 from .balancing import slider_crank as sc_balancing
 from .balancing.base import BalanceResult, Stage
-from .mechanisms import custom, five_bar, slider_crank
+from .mechanisms import custom, five_bar, rrr4, slider_crank
 from .model import Law, Model
 from .motion import law_for
 from .spec_parts import SpecFieldError
@@ -41,6 +42,7 @@ TEMPLATES: dict[str, Template] = {
     "slider_crank": Template(slider_crank.build, "slider-crank"),
     "custom": Template(custom.build, "custom mechanism"),
     "five_bar": Template(five_bar.build, "five-bar (5R), fixed-sequence with gear-coupled inputs", five_bar.figures),
+    "rrr4": Template(rrr4.build, "planar n-RRR parallel manipulator (4-RRR of paper 001, legs removable)", rrr4.figures),
 }
 METHODS: dict[str, Method] = {
     "slider_crank_counterweights": Method(
@@ -48,6 +50,9 @@ METHODS: dict[str, Method] = {
     ),
     "five_bar_gear_balancing": Method(
         fb_balancing.balance, ("five_bar",), "counterweights + counter-rotating gears 5, 6, 7 (eqs. 9-21)"
+    ),
+    "rrr4_counter_masses": Method(
+        rrr4_balancing.balance, ("rrr4",), "counter-masses: leg by leg (eqs. 8-11), from eq. 17 (Fig. 4a) and eqs. 19/21 (Fig. 6)"
     ),
 }
 

@@ -13,9 +13,11 @@ from typing import Annotated, Literal, Union
 from pydantic import Field
 
 from .balancing.five_bar import FiveBarGearBalancing
+from .balancing.rrr4 import RRR4Balancing
 from .balancing.slider_crank import SliderCrankCounterweights
 from .mechanisms.custom import CustomMechanism
 from .mechanisms.five_bar import FiveBarMechanism
+from .mechanisms.rrr4 import RRR4Mechanism
 from .mechanisms.slider_crank import SliderCrankMechanism
 from .spec_parts import DriveSpec, Strict
 from .units import Duration, Length, quantity
@@ -28,11 +30,11 @@ class NoBalancing(Strict):
 
 
 Mechanism = Annotated[
-    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism],
+    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism, RRR4Mechanism],
     Field(discriminator="template", description="the mechanism: a template with its parameters"),
 ]
 Balancing = Annotated[
-    Union[NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing],
+    Union[NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing, RRR4Balancing],
     Field(discriminator="method", description="the balancing method and its design choices"),
 ]
 

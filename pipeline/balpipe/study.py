@@ -193,6 +193,15 @@ def run(spec: Spec) -> Study:
                  f"{min(1.0, cond[k] ** 2 * 1e-16):.1g} of their relative accuracy")
         balance.notes.append(where[0].upper() + where[1:] + ".")
         problems = [p + f"; {where}" if "should cancel" in p else p for p in problems]
+    redundant = max(int(s.analysis.extra.get("redundant_actuators", 0)) for s in stages)
+    if redundant:
+        n = len(stages[0].stage.model.drivers)
+        balance.notes.append(
+            f"Redundant actuation: {n} actuators drive {n - redundant} degrees of freedom. The efforts are "
+            "the minimum-norm ones (the pseudo-inverse solution: of all efforts that produce the motion, "
+            "the least sum of squares, no internal preload), and the joint reactions follow from the same "
+            "multipliers. The shaking force and moment do not depend on how the actuators share the load."
+        )
     refs = compare_references(spec, balance, metrics)
     checks = {"reactions_vs_momentum": rvm, "balance_tolerance": tol, "max_condition_number": float(cond[k])}
     return Study(spec, balance, stages, refs, checks, problems)

@@ -1,0 +1,118 @@
+"""Report figures of the n-RRR (paper 001): eq. 17's conditions with their residuals per stage,
+and the balance topologies (Figs. 2a, 4a, 6) with their counter-masses drawn."""
+
+from __future__ import annotations
+
+import html
+import math
+
+import numpy as np
+
+from ..balancing import rrr4 as recipe
+from ..balancing import rrr4_conditions as cond
+from ..mechanisms.rrr4 import mass_parameters, resolve_legs
+
+FIGURE_OF_STAGE = {"leg_by_leg": "Fig. 2a", "general": "Fig. 4a", "special": "Fig. 6"}
+TOL = 1e-9
+
+
+def conditions_table(study) -> str | None:
+    """An HTML table: each printed condition and its residual (kg m) for every stage."""
+    mech = study.spec.mechanism
+    if len(resolve_legs(mech)) != 4:
+        return None
+    rows = cond.eq17(recipe.geometry(mech))
+    if mech.kinematics != "general":
+        rows = rows + cond.special(recipe.geometry(mech), mech.kinematics)
+    params = [(s.stage.label, mass_parameters(s.stage.model)) for s in study.stages]
+    head = "".join(f"<th>{html.escape(lbl)}</th>" for lbl, _ in params)
+    body = []
+    for r in rows:
+        cells = []
+        for _, p in params:
+            res, scale = r.residual(p), r.scale(p)
+            ok = abs(res) <= TOL * max(scale, 1e-300)
+            cells.append(f'<td class="num">{res:.3e}{" ✓" if ok else ""}</td>')
+        body.append(f"<tr><td>{html.escape(r.name)}</td><td><code>{html.escape(r.text())}</code></td>{''.join(cells)}</tr>")
+    return (f"<table><tr><th>Condition</th><th>Linear equation (kg m; masses in kg)</th>{head}</tr>"
+            + "".join(body) + "</table>")
+
+
+def topology_figure(study):
+    """The balanced stages at t = 0, one panel each: links, joints, pivots, each link's centre of
+    mass (cross), counter-masses as red discs of area proportional to mass, and the fixed total
+    centre of mass (star)."""
+    from .figures import plt, to_svg
+    from matplotlib.patches import Circle, Polygon
+
+    shown = [s for s in study.stages if s.stage.name in FIGURE_OF_STAGE]
+    if not shown:
+        return None
+    fig, axes = plt.subplots(1, len(shown), figsize=(4.2 * len(shown), 4.2), squeeze=False)
+    max_cw = max([a.mass for s in shown for b in s.stage.model.bodies for a in b.attachments] + [1e-12])
+    for ax, s in zip(axes[0], shown):
+        model, an = s.stage.model, s.analysis
+        poses = an.extra["frame_pose"][0]
+        span = max(np.ptp([p[0] for p in model.frame_points.values()] + [0.0]),
+                   np.ptp([p[1] for p in model.frame_points.values()] + [0.0]), 0.1)
+        for k, b in enumerate(model.bodies):
+            x, y, th = poses[k]
+            R = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+            g = lambda p: np.array([x, y]) + R @ np.asarray(p, dtype=float)  # noqa: E731
+            pts = np.array([g(b.points[n]) for n in b.outline])
+            if b.kind == "platform":
+                ax.add_patch(Polygon(pts[:-1], closed=True, facecolor="0.9", edgecolor="black", linewidth=1.5))
+            else:
+                ax.plot(pts[:, 0], pts[:, 1], color="black", linewidth=2.0, solid_capstyle="round")
+            ax.plot(pts[:, 0], pts[:, 1], "o", color="white", markeredgecolor="black", markersize=4)
+            for a in b.attachments:
+                if a.kind != "counterweight":
+                    continue
+                root = g(b.points[b.outline[0]])
+                pos = g(a.position)
+                ax.plot([root[0], pos[0]], [root[1], pos[1]], color="tab:red", linewidth=1.2)
+                ax.add_patch(Circle(pos, 0.05 * span * math.sqrt(a.mass / max_cw), color="tab:red", alpha=0.6))
+            _, c, _ = b.mass_properties()
+            gc = g(c)
+            ax.plot(gc[0], gc[1], "x", color="tab:blue", markersize=5)
+        for name, p in model.frame_points.items():
+            ax.plot(p[0], p[1], marker="^", color="black", markersize=8)
+            ax.annotate(name, p, textcoords="offset points", xytext=(4, -12), fontsize=7)
+        ax.plot(an.com[0, 0], an.com[0, 1], "*", color="tab:purple", markersize=11)
+        added = s.added_mass
+        ax.set_title(f"{s.stage.label}\nadded {added:.3g} kg", fontsize=8)
+        ax.set_aspect("equal")
+        ax.tick_params(labelsize=7)
+    fig.tight_layout()
+    return to_svg(fig, "rrr4-topology")
+
+
+def figures(study):
+    """(title, html or svg, caption) for the page."""
+    if study.spec.balancing.method != "rrr4_counter_masses":
+        return
+    table = conditions_table(study)
+    if table is not None:
+        mech = study.spec.mechanism
+        n_special = 0 if mech.kinematics == "general" else 8
+        yield (
+            "Force-balance conditions (paper 001, eq. 17" + (", " + cond.SPECIAL_EQ[mech.kinematics] if n_special else "") + ")",
+            table,
+            f"The twelve general conditions of eq. 17" + (f" and the eight of {cond.SPECIAL_EQ[mech.kinematics]} "
+                                                          "(non-rotating platform)" if n_special else "")
+            + " as printed, as linear equations in the named mass parameters (m_ij p_ij and m_ij q_ij: first "
+            "moments of link l_ij in its frame, origin at its proximal joint, x along the link; m5 p5, m5 q5: the "
+            "platform's about its centre). Residual per stage in kg m; ✓ where it is at most 1e-9 of the "
+            "condition's largest term. Count: 12 printed conditions, independent (each holds one dependent "
+            "first moment with coefficient 1).",
+        )
+    svg = topology_figure(study)
+    if svg is not None:
+        yield (
+            "Balance topologies (paper 001, Figs. 2a, 4a, 6)",
+            svg,
+            "Each force-balanced stage at t = 0: links (black), joints (circles), base pivots (triangles), each "
+            "body's centre of mass (blue cross), counter-masses as red discs (area proportional to mass, the "
+            "largest over the panels has the largest disc) on a line from the link's proximal joint, and the "
+            "total centre of mass (purple star), which stays fixed during the motion in every panel.",
+        )
