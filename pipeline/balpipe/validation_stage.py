@@ -68,11 +68,13 @@ class Reactionless:
 def simulate_study(study: Study) -> None:
     """Validate every stage; failures become problems of the study (the build exits 1)."""
     settings = settings_for(study)
-    # relative to the unbalanced inertial peaks (the shaking loads' peaks without gravity)
-    F0, M0 = study.unbalanced.analysis.max_inertial_force, study.unbalanced.analysis.max_inertial_moment
+    # relative to the unbalanced inertial peaks (the shaking loads' peaks without gravity),
+    # floored by the model's gross inertial loads (balpipe.load_reference)
+    ref = study.reference
+    F0, M0 = ref.force_peak, ref.moment_peak
     for s in study.stages:
         expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
-        s.validation = validate(s.stage.model, s.analysis, (F0, M0), settings, expect)
+        s.validation = validate(s.stage.model, s.analysis, (F0, M0), settings, expect, reference=ref)
         if not s.validation.passed:
             study.problems.append(
                 f"pymunk validation of stage {s.stage.name!r} fails: {'; '.join(s.validation.reasons)}"

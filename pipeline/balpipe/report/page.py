@@ -27,12 +27,14 @@ def study_figures(study: Study) -> dict:
     residuals, drift = [], []
     vals = [s for s in study.stages if s.validation is not None]
     if vals:
-        F0, M0 = study.unbalanced.analysis.max_force, study.unbalanced.analysis.max_moment
+        ref = study.reference
+        F0, M0 = ref.force, ref.moment
         residuals.append((
             "Residuals of the simulation",
             figures.residual_figure([(s.stage.label, s.validation.t, s.validation.force_error,
                                       s.validation.moment_error, F0, M0) for s in vals]),
-            "Difference between the pymunk simulation and the analytic engine, relative to the unbalanced peaks.",
+            "Difference between the pymunk simulation and the analytic engine, relative to "
+            + study.reference.describe("force") + " and " + study.reference.describe("moment") + ".",
         ))
     if study.reactionless is not None:
         drift = list(study.reactionless.figures())
@@ -67,5 +69,7 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
         instants=INSTANTS,
         joint_loads=joint_load_table(study),
         stage_names=[(s.stage.name, s.stage.label) for s in study.stages],
+        reference={"force": study.reference.describe("force"), "moment": study.reference.describe("moment"),
+                   "floored": study.reference.floored},
         spec_text=spec_text,
     )

@@ -109,7 +109,9 @@ class StageValidation:
     analysis' moment point); ``force_error`` (N,) = |F_sim - F_analytic|, ``moment_error``.
     ``measured`` (N,) marks the samples that enter the residuals.
     Scalars: residuals ``force_residual = max|F_sim - F_analytic| / F0`` and
-    ``moment_residual`` (F0, M0: the unbalanced stage's analytic peaks, also stored);
+    ``moment_residual`` (F0, M0: the reference loads ``force_reference``/``moment_reference``,
+    the unbalanced stage's analytic peaks or their floor, see :mod:`balpipe.load_reference`;
+    ``reference_basis`` says which; ``unbalanced_force_peak``/``..._moment_peak`` the peaks);
     ``force_peak``/``moment_peak``: simulated inertial peaks (less the links' weight and its
     moment) / F0, M0; ``tracking_error``: max abs
     error of each driven coordinate (rad or m) and its maximum ``tracking_error_max``;
@@ -150,6 +152,9 @@ class StageValidation:
     pymunk_version: str = pymunk.version
     chipmunk_version: str = pymunk.chipmunk_version
     timing: dict[str, float] = field(default_factory=dict)
+    force_reference: float = math.nan
+    moment_reference: float = math.nan
+    reference_basis: str = "force: unbalanced peak; moment: unbalanced peak"
 
     @property
     def status(self) -> str:
@@ -167,6 +172,9 @@ class StageValidation:
             "moment_peak": float(self.moment_peak),
             "unbalanced_force_peak": float(self.unbalanced_force_peak),
             "unbalanced_moment_peak": float(self.unbalanced_moment_peak),
+            "force_reference": float(self.force_reference),
+            "moment_reference": float(self.moment_reference),
+            "reference_basis": self.reference_basis,
             "tracking_error": {k: float(v) for k, v in sorted(self.tracking_error.items())},
             "tracking_error_max": float(self.tracking_error_max),
             "pose_error_position": float(self.pose_error_position),
@@ -260,6 +268,7 @@ def validate(
     unbalanced_peaks: tuple[float, float],
     settings: ValidationSettings | None = None,
     expect: tuple[str, ...] = (),
+    reference=None,
 ) -> StageValidation:
     """Simulate ``model`` in pymunk along ``analysis``' motion and compare the loads.
 
@@ -267,7 +276,9 @@ def validate(
     the denominators of every relative number. ``expect`` names the loads this stage claims to
     cancel ("force", "moment"): their simulated peaks must then also be at most
     ``settings.balance_tolerance`` times F0 (M0). Passes when the residuals are at most
-    ``settings.tolerance`` and every expectation holds.
+    ``settings.tolerance`` and every expectation holds. ``reference``: a
+    :class:`balpipe.load_reference.LoadReference`, whose loads then replace ``unbalanced_peaks``
+    as the denominators (the unbalanced peaks floored by the model's gross inertial loads).
     """
     settings = settings or ValidationSettings()
     wall0 = time.perf_counter()
@@ -277,6 +288,13 @@ def validate(
     dt, nsteps, idx = _step_grid(np.asarray(analysis.t, dtype=float), dt_target)
     scale = _model_scale(analysis)
     F0, M0 = (float(x) for x in unbalanced_peaks)
+    peaks = (F0, M0)
+    basis = "force: unbalanced peak; moment: unbalanced peak"
+    if reference is not None:
+        F0, M0 = float(reference.force), float(reference.moment)
+        peaks = (float(reference.force_peak), float(reference.moment_peak))
+        basis = f"force: {reference.force_basis}; moment: {reference.moment_basis}"
+    refs = {"force_reference": F0, "moment_reference": M0, "reference_basis": basis}
     limit = (
         settings.tolerance / 10.0 * (F0 if F0 > 0 else 1.0),
         settings.tolerance / 10.0 * (M0 if M0 > 0 else 1.0),
@@ -293,10 +311,10 @@ def validate(
         nan = np.full(N, np.nan)
         return StageValidation(
             analysis.t, np.full((N, 2), np.nan), nan, nan, nan, np.zeros(N, bool), math.inf, math.inf,
-            math.inf, math.inf, F0, M0, {d.name: math.inf for d in model.drivers}, math.inf, math.inf,
+            math.inf, math.inf, *peaks, {d.name: math.inf for d in model.drivers}, math.inf, math.inf,
             math.inf, dt, nsteps, MAX_ITERATIONS, settings.tolerance, settings.balance_tolerance,
             tuple(expect), False, ["the simulation failed"], N, 0, [], notes,
-            timing={"total_s": time.perf_counter() - wall0},
+            timing={"total_s": time.perf_counter() - wall0}, **refs,
         )
     kinds = _law_kinds(model, np.asarray(analysis.t, dtype=float))
     F, M, measured, extrapolated = _on_grid(run, analysis, idx, kinds, settings.skip_initial_steps,
@@ -332,12 +350,12 @@ def validate(
     return StageValidation(
         t=np.asarray(analysis.t, dtype=float), force=F, moment=M, force_error=ferr, moment_error=merr,
         measured=measured, force_residual=fres, moment_residual=mres, force_peak=fpk, moment_peak=mpk,
-        unbalanced_force_peak=F0, unbalanced_moment_peak=M0, tracking_error=track,
+        unbalanced_force_peak=peaks[0], unbalanced_moment_peak=peaks[1], tracking_error=track,
         tracking_error_max=max(track.values(), default=0.0), pose_error_position=dpos,
         pose_error_angle=dang, dt=run.dt, steps=nsteps, iterations=run.iterations,
         tolerance=tol, balance_tolerance=settings.balance_tolerance, expect=tuple(expect),
         passed=not reasons, reasons=reasons, excluded_samples=excluded,
         extrapolated_samples=extrapolated, floored_bodies=list(run.sim.floored), notes=notes,
-        timing={"simulation_s": run.wall, "total_s": time.perf_counter() - wall0},
+        timing={"simulation_s": run.wall, "total_s": time.perf_counter() - wall0}, **refs,
     )
 
