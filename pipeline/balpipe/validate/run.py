@@ -85,6 +85,8 @@ def simulate(
     startup_iterations: int = 5000,
     floating_base: tuple[float, float, tuple[float, float]] | None = None,
     record_poses: bool = True,
+    efforts: dict[str, np.ndarray] | None = None,
+    measure_with: Model | None = None,
     **build_options,
 ) -> SimulationRun:
     """Simulate ``model`` along ``analysis``' motion and measure the loads on the frame.
@@ -100,6 +102,12 @@ def simulate(
     momenta of every dynamic body of the mechanism, about the analysis' moment point O
     (H_{k+1/2} = sum m (r_k - O) x v_{k+1/2} + I w_{k+1/2} is exactly the mid-step value, as
     v x v = 0): second-order accurate where the motion laws are smooth.
+
+    ``efforts`` (driver name -> effort at each step time ``t0 + k dt``): a torque-driven run.
+    No driver constraint is built; before the step that lands on t_k, each actuator applies its
+    effort at t_k (pymunk integrates velocities with the forces at the new positions), and
+    the drivers' laws are only compared with (``driver_error``). ``measure_with``: a model with
+    the same bodies whose masses and moments the loads are measured with (default ``model``).
     """
     t = np.asarray(analysis.t, dtype=float)
     t0 = float(t[0])
@@ -111,14 +119,14 @@ def simulate(
     gravity = (0.0, 0.0) if floating_base is not None else analysis.gravity
     sim = build_space(
         model, qs, vh, gravity=gravity, iterations=iterations, floating_base=floating_base,
-        dt=dt, **build_options,
+        dt=dt, drive=efforts is None, **build_options,
     )
     space = sim.space
     bodies = sim.moving
     everything = bodies + ([sim.base] if sim.floating else [])
     # the loads are measured with the model's masses and moments (a massless body simulated
     # with a floor mass, and the light auxiliary gears of meshes, count for nothing)
-    props = [b.mass_properties() for b in model.bodies]
+    props = [b.mass_properties() for b in (measure_with or model).bodies]
     m = np.array([p[0] for p in props] + [0.0] * len(sim.auxiliary))
     inertia = np.array([p[2] for p in props] + [0.0] * len(sim.auxiliary))
     g = np.asarray(gravity, dtype=float)
@@ -158,6 +166,9 @@ def simulate(
     for k in range(n + 1):
         space.iterations = startup_iterations if boost[k] else iterations
         sim.prepare({name: v[k] for name, v in targets.items()}, dt)
+        if efforts is not None:
+            for act in sim.actuators:
+                act.apply(float(efforts[act.name][k]), dt)
         space.step(dt)
         px, py, h = momenta(bodies, m, inertia)
         gm = 0.0

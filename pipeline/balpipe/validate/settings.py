@@ -46,7 +46,9 @@ class ValidationSettings:
     simulated at that floor, so that pymunk's iterative solver converges (a massless idler
     between two gears otherwise stalls it). The loads are measured with the model's own
     masses and moments on the simulated motion, which the drivers impose: the floors change
-    the internal forces only.
+    the internal forces only. ``tracking_tolerance``: the torque-driven run
+    (:mod:`balpipe.validate.torque`) passes when every driven coordinate stays within this
+    fraction of its travel of the planned motion.
     """
 
     dt: float | None = None
@@ -57,6 +59,7 @@ class ValidationSettings:
     startup_steps: int = 10
     startup_iterations: int = 5000
     mass_floor: float = 0.1
+    tracking_tolerance: float = 1e-3
 
 
 

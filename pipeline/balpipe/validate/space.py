@@ -205,6 +205,52 @@ class _CarriedGear:
 
 
 @dataclass
+class _Actuator:
+    """A driver replaced by the force or torque its actuator applies (torque-driven runs).
+
+    The generalized force of a driver's effort e is e times its constraint gradient (the
+    engine's convention, :mod:`balpipe.engine`): a revolute joint (a, b) gets +e on b and -e on
+    a; an absolute angle +e on the body (the reaction is the frame's); a prismatic joint a
+    force e along the guide's axis on the slider at the slider's point and -e on the guide at
+    the same point; an x or y coordinate a force e along that axis at the body's point. Forces
+    are applied for the positions the coming step integrates to (pymunk moves positions
+    before it integrates velocities), so the moment arms are second-order accurate."""
+
+    name: str
+    kind: str  # "torque", "axis" (prismatic) or "fixed_axis" (x / y of a point)
+    body: pymunk.Body  # the driven body (b, the slider, the body)
+    other: pymunk.Body | None = None  # the reacting body (a, the guide), None for the frame
+    point: tuple[float, float] = (0.0, 0.0)  # the slider's / body's point, from its centre of mass
+    axis: tuple[float, float] = (1.0, 0.0)  # in the guide's frame ("axis") or global ("fixed_axis")
+
+    def apply(self, value: float, dt: float) -> None:
+        if self.kind == "torque":
+            self.body.torque += value
+            if self.other is not None:
+                self.other.torque -= value
+            return
+
+        def pred(body: pymunk.Body) -> tuple[float, float, float]:
+            return (body.position.x + dt * body.velocity.x, body.position.y + dt * body.velocity.y,
+                    body.angle + dt * body.angular_velocity)
+
+        x, y, th = pred(self.body)
+        off = _rot(th, self.point)
+        P = (x + off[0], y + off[1])
+        if self.kind == "axis":
+            e = _rot(pred(self.other)[2], self.axis) if self.other is not None else self.axis
+        else:
+            e = self.axis
+        f = (value * e[0], value * e[1])
+        for body, sign in ((self.body, 1.0), (self.other, -1.0)):
+            if body is None or body.body_type != pymunk.Body.DYNAMIC:
+                continue
+            cx, cy, _ = pred(body)
+            body.force = (body.force.x + sign * f[0], body.force.y + sign * f[1])
+            body.torque += sign * ((P[0] - cx) * f[1] - (P[1] - cy) * f[0])
+
+
+@dataclass
 class SimModel:
     """A model built in a pymunk space.
 
@@ -225,6 +271,7 @@ class SimModel:
     com_local: list[tuple[float, float]]
     floored: list[str] = field(default_factory=list)
     carried: list[_CarriedGear] = field(default_factory=list)
+    actuators: list[_Actuator] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
 
     @property
@@ -284,6 +331,7 @@ def build_space(
     gear_model: str | None = None,
     joint_bias: float | None = None,
     dt: float = 1e-3,
+    drive: bool = True,
 ) -> SimModel:
     """Build ``model`` in a new pymunk space.
 
@@ -298,6 +346,8 @@ def build_space(
     ``joint_bias``: fraction of a passive joint's position error corrected per step (default
     1: all of it, dead-beat); drivers and meshes always correct all of it. ``dt`` is the step
     the space will be stepped with (used to convert ``joint_bias`` into pymunk's error_bias).
+    ``drive=False`` builds no driver constraints: each driver becomes an actuator
+    (``SimModel.actuators``, :class:`_Actuator`) that applies a given effort (torque-driven runs).
     """
     if pose is None:
         pose, v0 = assembled_state(model)
@@ -410,7 +460,7 @@ def build_space(
             g2 = (pg[0] + half * ax[0], pg[1] + half * ax[1])
             add(pymunk.GrooveJoint(pb[jt.guide], pb[jt.slider], g1, g2, ps))
             d = driven.get(jt.name)
-            if d is not None:
+            if d is not None and drive:
                 # a second groove across the axis, moved along it with the law
                 c = add(pymunk.GrooveJoint(pb[jt.guide], pb[jt.slider], g1, g2, ps), 0.0)
                 dr = _Drive(d.name, d, "groove", c, base_point=pg, axis=ax, half_length=half)
@@ -422,6 +472,9 @@ def build_space(
             raise TypeError(jt)
 
     for d in model.drivers:
+        if not drive:
+            sim.actuators.append(_actuator(model, d, pb, local))
+            continue
         kind = d.target[0]
         if kind == "joint":
             jt = model.joint(d.target[1])
@@ -446,6 +499,35 @@ def build_space(
         else:
             raise ValueError(f"driver {d.name!r}: unknown target {d.target!r}")
     return sim
+
+
+def _actuator(model: Model, d: Driver, pb: dict, local) -> _Actuator:
+    """The actuator of driver ``d`` (see :class:`_Actuator`)."""
+    kind = d.target[0]
+    frame = pb[FRAME]
+
+    def body(name: str) -> pymunk.Body | None:
+        b = pb[name]
+        return None if b is frame and b.body_type != pymunk.Body.DYNAMIC else b
+
+    if kind == "joint":
+        jt = model.joint(d.target[1])
+        if isinstance(jt, Revolute):
+            return _Actuator(d.name, "torque", pb[jt.b], body(jt.a))
+        if isinstance(jt, Prismatic):
+            ax = np.asarray(jt.axis, dtype=float)
+            ax = ax / np.linalg.norm(ax)
+            return _Actuator(d.name, "axis", pb[jt.slider], body(jt.guide), local(jt.slider, jt.point_slider),
+                             (float(ax[0]), float(ax[1])))
+        raise ValueError(f"driver {d.name!r}: a gear pair cannot be driven")
+    if kind == "angle":
+        return _Actuator(d.name, "torque", pb[d.target[1]], None)
+    if kind in ("x", "y"):
+        name = d.target[1]
+        point = model.body(name).point(d.target[2]) if len(d.target) > 2 else (0.0, 0.0)
+        return _Actuator(d.name, "fixed_axis", pb[name], None, local(name, point),
+                         (1.0, 0.0) if kind == "x" else (0.0, 1.0))
+    raise ValueError(f"driver {d.name!r}: unknown target {d.target!r}")
 
 
 def _gear_phase(jt: Gear, model: Model) -> float:
