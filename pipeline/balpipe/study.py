@@ -24,6 +24,7 @@ class StageResult:
     added_mass: float
     added_inertia: float
     validation: Any = None  # balpipe.validate.StageValidation, when simulated
+    torque: Any = None  # balpipe.validate.torque.TorqueDriven, when simulated
 
     @property
     def max_effort(self) -> float:

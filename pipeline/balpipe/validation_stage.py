@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 from .study import Study
 from .validate import FreeFloating, ValidationSettings, free_floating, validate
+from .validate.torque import torque_driven
 
 
 def settings_for(study: Study) -> ValidationSettings:
@@ -79,6 +80,15 @@ def simulate_study(study: Study) -> None:
             study.problems.append(
                 f"pymunk validation of stage {s.stage.name!r} fails: {'; '.join(s.validation.reasons)}"
             )
+        # the inverse dynamics: the engine's efforts drive the mechanism (same step and solver effort)
+        s.torque = torque_driven(
+            s.stage.model, s.analysis, settings, reference=(ref.force, ref.moment),
+            dt=s.validation.dt, iterations=s.validation.iterations,
+        )
+        if not s.torque.passed:
+            study.problems.append(
+                f"torque-driven run of stage {s.stage.name!r} fails: {'; '.join(s.torque.reasons)}"
+            )
     if reactionless_enabled(study):
         runs = [free_floating(s.stage.model, s.analysis, settings=settings) for s in study.stages]
         study.reactionless = Reactionless(
@@ -93,6 +103,8 @@ def timing(study: Study) -> dict:
     for s in study.stages:
         if s.validation is not None:
             out[s.stage.name] = dict(s.validation.timing)
+        if s.torque is not None:
+            out.setdefault(s.stage.name, {})["torque_driven_s"] = float(s.torque.timing.get("total_s", 0.0))
     if study.reactionless is not None:
         for name, r in zip(study.reactionless.names, study.reactionless.runs):
             out.setdefault(name, {})["reactionless_s"] = float(r.timing.get("total_s", 0.0))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..study import Study
 from . import figures
 from .render import environment
@@ -38,8 +40,19 @@ def study_figures(study: Study) -> dict:
         ))
     if study.reactionless is not None:
         drift = list(study.reactionless.figures())
+    torque = []
+    runs = [s for s in study.stages if s.torque is not None]
+    if runs:
+        curves = [(f"{s.stage.label}: {d}", np.abs(e) / (s.torque.travel[d] or 1.0))
+                  for s in runs for d, e in sorted(s.torque.tracking.items())]
+        torque.append((
+            "Tracking error of the torque-driven run",
+            figures.series_figure(runs[0].torque.t, curves, "|q_sim − q_plan| / travel", prefix="torque"),
+            "Each driven coordinate of the simulation driven by the engine's efforts (no position drive), "
+            "minus its planned motion, relative to its travel.",
+        ))
     return {"loads": loads, "efforts": efforts, "mechanism": mech, "extra": extra,
-            "residuals": residuals, "drift": drift}
+            "residuals": residuals, "drift": drift, "torque": torque}
 
 
 def render_page(study: Study, results: dict, spec_text: str) -> str:
@@ -56,6 +69,17 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
                 "reasons": "; ".join(v.reasons), "notes": "; ".join(v.notes),
                 "excluded": v.excluded_samples, "version": v.pymunk_version,
             })
+    torque_rows = []
+    for s in study.stages:
+        q = s.torque
+        if q is not None:
+            torque_rows.append({
+                "label": s.stage.label, "tracking": q.tracking_error_max, "calibration": q.calibration_error,
+                "resolution": q.resolution, "force_residual": q.force_residual, "moment_residual": q.moment_residual,
+                "dt": q.dt, "steps": q.steps, "iterations": q.iterations, "tolerance": q.tracking_tolerance,
+                "passed": q.passed, "reasons": "; ".join(q.reasons), "notes": "; ".join(q.notes),
+                "per_driver": ", ".join(f"{k} {v:.2g}" for k, v in sorted(q.tracking_error.items())),
+            })
     rl = study.reactionless
     return environment().get_template("spec.html").render(
         r=results,
@@ -64,6 +88,7 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
         law=spec.motion.law,
         figures=study_figures(study),
         validation=validation_rows,
+        torque=torque_rows,
         reactionless={"base_mass": rl.base_mass, "base_inertia": rl.base_inertia, "rows": rl.rows(),
                       "player": rl.player()} if rl is not None else None,
         instants=INSTANTS,
