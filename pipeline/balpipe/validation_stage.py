@@ -8,7 +8,11 @@ from dataclasses import dataclass, field
 
 from .study import Study
 from .validate import FreeFloating, ValidationSettings, free_floating, validate
+from .validate.run import _model_scale
 from .validate.torque import torque_driven
+
+#: mass of the free-floating frame (kg)
+BASE_MASS = 10.0
 
 
 def settings_for(study: Study) -> ValidationSettings:
@@ -44,9 +48,20 @@ class Reactionless:
 
     def rows(self) -> list[dict]:
         return [
-            {"label": lab, "max_drift_m": r.max_drift, "max_rotation_deg": math.degrees(r.max_rotation)}
+            {"label": lab, "max_drift_m": r.max_drift, "max_rotation_deg": math.degrees(r.max_rotation),
+             "method": r.method_label, "base_mass": r.base_mass, "base_inertia": r.base_inertia,
+             "massless_drift_m": r.massless_max_drift if r.small_masses else None,
+             "massless_rotation_deg": math.degrees(r.massless_max_rotation) if r.small_masses else None,
+             "reference_difference_m": r.reference_difference[0],
+             "reference_difference_deg": math.degrees(r.reference_difference[1]),
+             "notes": "; ".join(r.notes)}
             for lab, r in zip(self.labels, self.runs)
         ]
+
+    @property
+    def same_base(self) -> bool:
+        """Every stage ran on the same frame (mass and inertia)."""
+        return len({(r.base_mass, r.base_inertia) for r in self.runs}) == 1
 
     def figures(self):
         from .report.figures import drift_figure
@@ -90,11 +105,20 @@ def simulate_study(study: Study) -> None:
                 f"torque-driven run of stage {s.stage.name!r} fails: {'; '.join(s.torque.reasons)}"
             )
     if reactionless_enabled(study):
-        runs = [free_floating(s.stage.model, s.analysis, settings=settings) for s in study.stages]
-        study.reactionless = Reactionless(
-            [s.stage.label for s in study.stages], [s.stage.name for s in study.stages], runs,
-            [s.stage.model for s in study.stages],
-        )
+        study.reactionless = reactionless_runs(study, settings)
+
+
+def reactionless_runs(study: Study, settings: ValidationSettings | None = None) -> Reactionless:
+    """Every stage on the same free-floating frame: mass BASE_MASS, the inertia of a square
+    plate reaching the farthest centre of mass of any stage."""
+    reach = max(_model_scale(s.analysis) for s in study.stages)
+    base_inertia = (2.0 / 3.0) * BASE_MASS * reach**2
+    runs = [free_floating(s.stage.model, s.analysis, BASE_MASS, base_inertia, settings=settings)
+            for s in study.stages]
+    return Reactionless(
+        [s.stage.label for s in study.stages], [s.stage.name for s in study.stages], runs,
+        [s.stage.model for s in study.stages],
+    )
 
 
 def timing(study: Study) -> dict:

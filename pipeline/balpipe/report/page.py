@@ -90,6 +90,7 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
         validation=validation_rows,
         torque=torque_rows,
         reactionless={"base_mass": rl.base_mass, "base_inertia": rl.base_inertia, "rows": rl.rows(),
+                      "same_base": rl.same_base,
                       "player": rl.player()} if rl is not None else None,
         instants=INSTANTS,
         joint_loads=joint_load_table(study),

@@ -2,6 +2,16 @@
 
 Simulated in pymunk when it holds together, and always compared with the exact conservation
 solution (constant total momentum and angular momentum along the analysed relative motion).
+
+Massless bodies (the paper-004 five-bar's gears) cannot be simulated: pymunk needs a mass, and
+a floor mass as large as the position-driven validation's (0.1 of the heaviest) would move the
+free base. They get a physically small mass instead, ``small_mass`` (default 1 %) of the
+mechanism's total mass, and, if they have no moment of inertia either, that of a disc of their
+drawn radius (or of a tenth of the mechanism's reach). The simulated design is then that of the
+model with those parts; its own conservation solution checks the simulation
+(``reference_difference``), and the massless model's conservation solution
+(``massless_max_drift``/``..._rotation``, ``massless_difference``) shows what the small masses
+change. ``method`` says per stage which it is.
 """
 
 from __future__ import annotations
@@ -13,9 +23,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..engine import Analysis
-from ..model import Model
+from ..model import Attachment, Model
 from .run import _cross, _model_scale, _rotate, _run_adaptive
 from .settings import ValidationSettings, _step_grid, default_settings
+
+#: the small masses tried in turn, times ``small_mass``: the smallest that pymunk holds together
+SMALL_MASS_STEPS = (1.0, 10.0, 100.0)
 
 @dataclass
 class FreeFloating:
@@ -54,6 +67,19 @@ class FreeFloating:
     iterations: int
     notes: list[str] = field(default_factory=list)
     timing: dict[str, float] = field(default_factory=dict)
+    small_masses: dict[str, tuple[float, float]] = field(default_factory=dict)
+    massless_max_drift: float = math.nan
+    massless_max_rotation: float = math.nan
+    massless_difference: tuple[float, float] = (math.nan, math.nan)
+    small_mass_fraction: float = math.nan
+
+    @property
+    def method_label(self) -> str:
+        """What the page shows: a simulation or the conservation solution."""
+        if self.method == "pymunk":
+            return "simulation (pymunk)" + (
+                f", massless bodies given {100 * self.small_mass_fraction:g} % of the total mass" if self.small_masses else "")
+        return "conservation solution (not simulated)"
 
     def to_json(self) -> dict:
         return {
@@ -74,6 +100,13 @@ class FreeFloating:
             "dt": float(self.dt),
             "iterations": int(self.iterations),
             "notes": "; ".join(self.notes),
+            "method_label": self.method_label,
+            "small_masses": {k: {"mass": float(m), "inertia": float(i)} for k, (m, i) in sorted(self.small_masses.items())},
+            "massless_max_drift": float(self.massless_max_drift),
+            "massless_max_rotation": float(self.massless_max_rotation),
+            "massless_difference_drift": float(self.massless_difference[0]),
+            "massless_difference_rotation": float(self.massless_difference[1]),
+            "small_mass_fraction": float(self.small_mass_fraction),
         }
 
 
@@ -109,6 +142,24 @@ def _conservation_solution(model: Model, analysis: Analysis, mb: float, ib: floa
     return phi, origin
 
 
+def with_small_masses(model: Model, fraction: float, reach: float) -> tuple[Model, dict[str, tuple[float, float]]]:
+    """``model`` with every massless body given ``fraction`` of the total mass (a part at its
+    centre of mass); one without a moment of inertia also gets that of a disc of its radius
+    (or of reach / 10). Returns the model and {body: (added mass, added inertia)}."""
+    total = model.total_mass()
+    out, added = model, {}
+    for b in model.bodies:
+        m, com, inertia = b.mass_properties()
+        if m > 0.0:
+            continue
+        dm = fraction * total
+        r = b.radius or 0.1 * reach
+        di = 0.5 * dm * r * r if inertia <= 0.0 else 0.0
+        out = out.replace_body(b.with_attachments(Attachment("small mass", dm, tuple(com), di, kind="part")))
+        added[b.name] = (dm, di)
+    return out, added
+
+
 def free_floating(
     model: Model,
     analysis: Analysis,
@@ -116,6 +167,7 @@ def free_floating(
     base_inertia: float | None = None,
     settings: ValidationSettings | None = None,
     simulate_pymunk: bool = True,
+    small_mass: float | None = 0.01,
 ) -> FreeFloating:
     """The mechanism moving on a free base, without gravity.
 
@@ -128,6 +180,8 @@ def free_floating(
     When the simulation does not hold together (a mesh between gears of large inertia and
     small mass or radius converges slowly in pymunk's solver), or ``simulate_pymunk`` is False,
     the exact conservation solution is returned instead (``method = "momentum"``).
+    ``small_mass``: massless bodies are simulated with this fraction of the total mass (see the
+    module's docstring); None keeps today's fallback, the conservation solution.
     """
     settings = settings or ValidationSettings()
     wall0 = time.perf_counter()
@@ -136,42 +190,74 @@ def free_floating(
     centre = np.asarray(analysis.moment_point, dtype=float)
     names = [b.name for b in model.bodies]
     t = np.asarray(analysis.t, dtype=float)
-    phi_ref, origin_ref = _conservation_solution(model, analysis, float(base_mass), bi, centre)
-    drift_ref = origin_ref + _rotate(phi_ref, np.broadcast_to(centre, origin_ref.shape)) - centre
     notes: list[str] = []
     run = None
     dt, it = 0.0, 0
     massless = [b.name for b in model.bodies if b.mass_properties()[0] <= 0.0]
-    if simulate_pymunk and massless:
+    massless_ref = None
+    small: dict[str, tuple[float, float]] = {}
+    sim_model = model
+    idx = None
+    attempts: list[float | None] = [None]
+    if massless and small_mass and simulate_pymunk:
+        massless_ref = _conservation_solution(model, analysis, float(base_mass), bi, centre)
+        attempts = [float(small_mass) * k for k in SMALL_MASS_STEPS]
+    elif simulate_pymunk and massless:
         simulate_pymunk = False
         notes.append(
             "massless bodies (" + ", ".join(massless) + "): pymunk needs a mass, which would move "
             "the free base; conservation solution used"
         )
+    phi_ref, origin_ref = _conservation_solution(model, analysis, float(base_mass), bi, centre)
+    drift_ref = origin_ref + _rotate(phi_ref, np.broadcast_to(centre, origin_ref.shape)) - centre
     if simulate_pymunk:
         dt_default, it_default = default_settings(model, analysis)
         dt, nsteps, idx = _step_grid(t, settings.dt or dt_default)
         it = settings.iterations or it_default
-        run, notes, _ = _run_adaptive(
-            model, analysis, dt, it, settings, reach, idx, max_iterations=4 * it,
-            floating_base=(float(base_mass), bi, (float(centre[0]), float(centre[1]))),
-        )
-        if run is not None:
-            mom = run.momentum - run.momentum[0]
-            dp = float(np.max(np.linalg.norm(mom[:, :2], axis=1)))
-            dh = float(np.max(np.abs(mom[:, 2])))
-            # gross momenta of the mechanism (sums of magnitudes: a balanced stage nets zero)
-            mk = np.array([b.mass_properties()[0] for b in model.bodies])
-            ik = np.array([b.mass_properties()[2] for b in model.bodies])
-            speed = np.linalg.norm(analysis.v[:, :, :2], axis=2)
-            arm = np.linalg.norm(analysis.q[:, :, :2] - centre, axis=2)
-            p_scale = float(np.max(speed @ mk)) or 1.0
-            h_scale = float(np.max((arm * speed) @ mk + np.abs(analysis.v[:, :, 2]) @ ik)) or 1.0
-            if dh > 1e-3 * h_scale or dp > 1e-3 * p_scale:
-                notes.append(f"the simulation lost {dh:.3g} N m s of angular momentum")
-                run = None
+        failed: list[str] = []
+        for fraction in attempts:
+            sim_model, small = (model, {}) if fraction is None else with_small_masses(model, fraction, reach)
+            run, run_notes, _ = _run_adaptive(
+                sim_model, analysis, dt, it, settings, reach, idx, max_iterations=max(4 * it, 1600),
+                floating_base=(float(base_mass), bi, (float(centre[0]), float(centre[1]))),
+            )
+            if run is not None:
+                mom = run.momentum - run.momentum[0]
+                dp = float(np.max(np.linalg.norm(mom[:, :2], axis=1)))
+                dh = float(np.max(np.abs(mom[:, 2])))
+                # gross momenta of the mechanism (sums of magnitudes: a balanced stage nets zero)
+                mk = np.array([b.mass_properties()[0] for b in sim_model.bodies])
+                ik = np.array([b.mass_properties()[2] for b in sim_model.bodies])
+                speed = np.linalg.norm(analysis.v[:, :, :2], axis=2)
+                arm = np.linalg.norm(analysis.q[:, :, :2] - centre, axis=2)
+                p_scale = float(np.max(speed @ mk)) or 1.0
+                h_scale = float(np.max((arm * speed) @ mk + np.abs(analysis.v[:, :, 2]) @ ik)) or 1.0
+                if dh > 1e-3 * h_scale or dp > 1e-3 * p_scale:
+                    run_notes.append(f"the simulation lost {dh:.3g} N m s of angular momentum")
+                    run = None
+            if run is not None:
+                if fraction is not None:
+                    notes.append(
+                        "massless bodies simulated with a small mass (" + ", ".join(
+                            f"{k} {1000 * m:.3g} g" + (f" and {i:.3g} kg m^2" if i > 0 else "")
+                            for k, (m, i) in small.items()
+                        ) + f", {100 * fraction:g} % of the total mass)"
+                        + (f"; with {', '.join(failed)} of the total mass pymunk did not hold together" if failed else "")
+                    )
+                    phi_ref, origin_ref = _conservation_solution(sim_model, analysis, float(base_mass), bi, centre)
+                    drift_ref = origin_ref + _rotate(phi_ref, np.broadcast_to(centre, origin_ref.shape)) - centre
+                else:
+                    notes += run_notes
+                break
+            if fraction is None:
+                notes += run_notes
+            else:
+                failed.append(f"{100 * fraction:g} %")
         if run is None:
-            notes.append("pymunk did not hold the mechanism together: conservation solution used")
+            sim_model, small, massless_ref = model, {}, None
+            notes.append("pymunk did not hold the mechanism together" + (
+                f" (massless bodies given {', '.join(failed)} of the total mass)" if failed else "")
+                + ": conservation solution used")
     if run is not None:
         if idx is None:
             idx = np.searchsorted(run.t, t).clip(0, len(run.t) - 1)
@@ -187,11 +273,23 @@ def free_floating(
         poses[:, :, 2] = analysis.q[:, :, 2] + phi_ref[:, None]
         method = "momentum"
         momentum_drift = (0.0, 0.0)
-    for k, b in enumerate(model.bodies):  # centre-of-mass poses -> body frame poses
+    for k, b in enumerate(sim_model.bodies):  # centre-of-mass poses -> body frame poses
         cl = np.asarray(b.mass_properties()[1])
         poses[:, k, :2] -= _rotate(poses[:, k, 2], cl)
     drift = base[:, :2] + _rotate(base[:, 2], np.broadcast_to(centre, base[:, :2].shape)) - centre
     rotation = base[:, 2].copy()
+    extra = {}
+    if massless_ref is not None:
+        phi0, origin0 = massless_ref
+        drift0 = origin0 + _rotate(phi0, np.broadcast_to(centre, origin0.shape)) - centre
+        extra = {
+            "small_masses": small,
+            "small_mass_fraction": fraction,
+            "massless_max_drift": float(np.max(np.linalg.norm(drift0, axis=1))),
+            "massless_max_rotation": float(np.max(np.abs(phi0))),
+            "massless_difference": (float(np.max(np.linalg.norm(drift - drift0, axis=1))),
+                                    float(np.max(np.abs(rotation - phi0)))),
+        }
     return FreeFloating(
         t=t, names=names, base=base, drift=drift, rotation=rotation, poses=poses,
         base_mass=float(base_mass), base_inertia=bi, base_centre=(float(centre[0]), float(centre[1])),
@@ -204,4 +302,5 @@ def free_floating(
         ),
         momentum_drift=momentum_drift, dt=dt, iterations=it, notes=notes,
         timing={"total_s": time.perf_counter() - wall0, **({"simulation_s": run.wall} if run is not None else {})},
+        **extra,
     )

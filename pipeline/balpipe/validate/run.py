@@ -87,6 +87,7 @@ def simulate(
     record_poses: bool = True,
     efforts: dict[str, np.ndarray] | None = None,
     measure_with: Model | None = None,
+    abort: tuple[float, float] | None = None,
     **build_options,
 ) -> SimulationRun:
     """Simulate ``model`` along ``analysis``' motion and measure the loads on the frame.
@@ -108,6 +109,9 @@ def simulate(
     effort at t_k (pymunk integrates velocities with the forces at the new positions), and
     the drivers' laws are only compared with (``driver_error``). ``measure_with``: a model with
     the same bodies whose masses and moments the loads are measured with (default ``model``).
+    ``abort`` = (limit, scale): stop with FloatingPointError as soon as a body, in the frame's
+    coordinates, is more than ``limit`` (rad, or ``limit * scale`` m) from the analysed motion
+    at an analysis sample (checked every tenth step): a run that came apart ends early.
     """
     t = np.asarray(analysis.t, dtype=float)
     t0 = float(t[0])
@@ -162,6 +166,11 @@ def simulate(
     total = np.zeros((n + 1, 3))
     derr = {d.name: np.zeros(n + 1) for d in model.drivers}
     px0, py0, h0 = momenta(bodies, m, inertia)
+    check: dict[int, int] = {}
+    if abort is not None:
+        steps = np.rint((t - t0) / dt).astype(int)
+        on = np.abs(t0 + steps * dt - t) <= 1e-9 * max(float(t[-1] - t0), 1e-12)
+        check = {int(k): i for i, k in enumerate(steps) if on[i] and k % 10 == 0}
     start = time.perf_counter()
     for k in range(n + 1):
         space.iterations = startup_iterations if boost[k] else iterations
@@ -190,6 +199,14 @@ def simulate(
             poses[k] = [st[nm] for nm in names]
         for d in model.drivers:
             derr[d.name][k] = _driver_coordinate(model, d, st, com) - laws_now[d.name][k]
+        if k in check:
+            i = check[k]
+            q = np.array([st[nm] for nm in names])
+            rel = _rotate(np.full(len(names), -st[FRAME][2]), q[:, :2] - np.asarray(st[FRAME][:2]))
+            dev_p = float(np.max(np.abs(rel - analysis.q[i, :, :2]))) / abort[1]
+            dev_a = float(np.max(np.abs(q[:, 2] - st[FRAME][2] - analysis.q[i, :, 2])))
+            if not (dev_p <= abort[0] and dev_a <= abort[0]):
+                raise FloatingPointError(f"the simulation came apart at t = {times[k]:.4g} s")
     wall = time.perf_counter() - start
     space.iterations = iterations
     return SimulationRun(times, force, moment, poses, base, derr, total, dt, iterations, wall, sim)
@@ -250,7 +267,7 @@ def _run_adaptive(
             with np.errstate(all="ignore"):
                 try:
                     run = simulate(
-                        model, analysis, dt, it, startup_steps=settings.startup_steps,
+                        model, analysis, dt, it, startup_steps=settings.startup_steps, abort=(10 * HEALTH_LIMIT, scale),
                         startup_iterations=max(settings.startup_iterations, it),
                         **({"gear_model": gm} if gm else {}), **kw,
                     )

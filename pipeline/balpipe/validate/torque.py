@@ -198,8 +198,8 @@ def torque_driven(
         peak = max((float(np.max(np.abs(v))) for v in bare.values()), default=0.0) or 1.0
         share = max(float(np.max(np.abs(efforts[k] - bare[k]))) for k in bare) / peak
         notes.append(
-            "simulated with floor parts (" + ", ".join(floored) + f", {settings.mass_floor:g} of the largest mass "
-            f"and moment); the efforts include their inertial loads, {share:.2g} of the peak effort"
+            "simulated with floor parts (" + ", ".join(floored) + f": {100 * settings.mass_floor:g} % of the largest "
+            f"mass and moment); the efforts include their inertial loads, {100 * share:.2g} % of the peak effort"
         )
     travel = _travel(analytic_model, t)
 
