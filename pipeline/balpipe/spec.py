@@ -65,7 +65,7 @@ class AnalysisSettings(Strict):
     moment_point: tuple[Length, Length] = Field((0.0, 0.0), description="point about which shaking moments are taken")
     balance_tolerance: float = Field(
         1e-9, gt=0, lt=1,
-        description="a stage counts as balanced when its peak is below this fraction of the unbalanced peak",
+        description="a stage counts as balanced when its peak is below this fraction of the reference load (the unbalanced peak, floored by 1 % of the gross inertial load)",
     )
 
 

@@ -48,7 +48,8 @@ Defaults and why (measured with pymunk 7.3.1 on a 2-core machine)
       comes apart at 3200 iterations; 1e-3: 800 iterations; 1e-2 and 0.1: 200, residuals
       4.7e-5 / 5.7e-5 in all converged cases). The motion is imposed by the drivers, so the
       floors change internal forces only, not the measured loads.
-    * tolerance 1 % of the unbalanced peaks; balance_tolerance 1 % for the loads a stage claims
+    * tolerance 1 % of the unbalanced peaks (the reference loads, :mod:`balpipe.load_reference`, when
+      given); balance_tolerance 1 % for the loads a stage claims
       to cancel (``expect``).
 
 Measured residuals (max |sim - analytic| / unbalanced peak) at the defaults, 0.5 s motions,
@@ -339,7 +340,7 @@ def validate(
         reasons.append(f"moment residual {mres:.3g} > {tol:g}")
     for what, pk in (("force", fpk), ("moment", mpk)):
         if what in expect and not pk <= settings.balance_tolerance:
-            reasons.append(f"{what} not balanced: simulated peak {pk:.3g} of the unbalanced > {settings.balance_tolerance:g}")
+            reasons.append(f"{what} not balanced: simulated peak {pk:.3g} of the reference > {settings.balance_tolerance:g}")
     notes = notes + list(run.sim.notes)
     if run.sim.floored:
         notes.append(
