@@ -144,3 +144,25 @@ def test_paper_five_bar_stages_pass():
     r = torque_driven(s.stage.model, analyse(wrong, s.analysis.t), analytic_model=wrong, dt=1e-3, iterations=400,
                       calibrate=False)
     assert not r.passed and r.tracking_error_max > 1e-3
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_random_slider_cranks(seed):
+    """Random slider-cranks (seeded), every balancing stage: the true model follows its plan;
+    the heaviest body 10 % too heavy (mass, inertia and its counterweight), in the analysis
+    only, is caught."""
+    from balpipe import study
+    from conftest import slider_crank_spec
+
+    st = study.run(slider_crank_spec(np.random.default_rng(100 + seed)))
+    for s in st.stages:
+        model = s.stage.model
+        r = torque_driven(model, s.analysis, calibrate=False)
+        assert r.passed and r.tracking_error_max < 2e-4, (seed, s.stage.name, r.reasons)
+    model = st.stages[1].stage.model  # counterweights
+    heavy = max(model.bodies, key=lambda b: b.mass_properties()[0])
+    wrong = model.replace_body(dataclasses.replace(
+        heavy, mass=1.1 * heavy.mass, inertia=1.1 * heavy.inertia,
+        attachments=tuple(dataclasses.replace(a, mass=1.1 * a.mass, inertia=1.1 * a.inertia) for a in heavy.attachments)))
+    r = torque_driven(model, analyse(wrong, st.stages[1].analysis.t), analytic_model=wrong, calibrate=False)
+    assert not r.passed and r.tracking_error_max > 2e-3, (seed, heavy.name, r.tracking_error_max)
