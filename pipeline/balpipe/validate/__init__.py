@@ -25,6 +25,7 @@ from .floating import FreeFloating, free_floating
 from .loads import StageValidation, validate
 from .run import SimulationRun, simulate
 from .settings import ValidationSettings, default_settings
+from .torque import TorqueDriven, torque_driven
 
 __all__ = [
     "ValidationSettings",
@@ -35,4 +36,6 @@ __all__ = [
     "simulate",
     "validate",
     "free_floating",
+    "TorqueDriven",
+    "torque_driven",
 ]
