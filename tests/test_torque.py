@@ -53,6 +53,8 @@ def test_true_model_follows_the_plan(name):
     assert 0.05 < r.calibration_error < 0.3  # efforts 10 % low: ~ 10 % of the travel
     assert r.resolution > 100
     assert r.force_residual < 1e-3 and r.moment_residual < 1e-3  # the simulated loads, too
+    assert abs(r.force_peak - a.max_inertial_force / r.force_reference) < 1e-3
+    assert abs(r.moment_peak - a.max_inertial_moment / r.moment_reference) < 1e-3
     assert set(r.tracking) == {d.name for d in MODELS[name]().drivers}
 
 

@@ -76,6 +76,7 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
             torque_rows.append({
                 "label": s.stage.label, "tracking": q.tracking_error_max, "calibration": q.calibration_error,
                 "resolution": q.resolution, "force_residual": q.force_residual, "moment_residual": q.moment_residual,
+                "force_peak": q.force_peak, "moment_peak": q.moment_peak,
                 "dt": q.dt, "steps": q.steps, "iterations": q.iterations, "tolerance": q.tracking_tolerance,
                 "passed": q.passed, "reasons": "; ".join(q.reasons), "notes": "; ".join(q.notes),
                 "per_driver": ", ".join(f"{k} {v:.2g}" for k, v in sorted(q.tracking_error.items())),

@@ -70,7 +70,8 @@ class TorqueDriven:
     (driver -> max |q_sim - q_plan| / travel), ``travel`` (rad or m), ``tracking_error_max``;
     ``calibration_error``: the same with efforts ``CALIBRATION_FACTOR`` times the engine's;
     ``resolution`` = calibration_error / tracking_error_max; ``force_residual``,
-    ``moment_residual``: max |simulated - analytic| load / the reference loads;
+    ``moment_residual``: max |simulated - analytic| load / the reference loads; ``force_peak``,
+    ``moment_peak``: simulated inertial peaks (less the links' weight and its moment) / the same;
     ``floored_bodies`` and ``floor_effort_share`` (largest effort of the floor parts / peak
     effort).
     """
@@ -88,6 +89,8 @@ class TorqueDriven:
     moment_residual: float
     force_reference: float
     moment_reference: float
+    force_peak: float
+    moment_peak: float
     tracking_tolerance: float
     dt: float
     steps: int
@@ -120,6 +123,8 @@ class TorqueDriven:
             "moment_residual": float(self.moment_residual),
             "force_reference": float(self.force_reference),
             "moment_reference": float(self.moment_reference),
+            "force_peak": float(self.force_peak),
+            "moment_peak": float(self.moment_peak),
             "dt": float(self.dt),
             "steps": int(self.steps),
             "iterations": int(self.iterations),
@@ -235,7 +240,7 @@ def torque_driven(
         reasons.append("the torque-driven simulation came apart")
         return TorqueDriven(
             t, np.full((N, 2), np.nan), nan, {}, {d.name: math.inf for d in model.drivers}, travel, math.inf,
-            calib, 0.0, math.inf, math.inf, F0, M0, settings.tracking_tolerance, dt, nsteps, iterations, floored,
+            calib, 0.0, math.inf, math.inf, F0, M0, math.inf, math.inf, settings.tracking_tolerance, dt, nsteps, iterations, floored,
             share, False, reasons, notes, {"total_s": time.perf_counter() - wall0},
         )
     from .loads import _on_grid  # the same sampling of the loads as the position-driven check
@@ -246,6 +251,9 @@ def torque_driven(
     merr = np.abs(M - analysis.moment)[measured]
     fres = float(np.max(ferr)) / F0 if ferr.size else math.inf
     mres = float(np.max(merr)) / M0 if merr.size else math.inf
+    W, Ms = analysis.static_load()
+    fpk = float(np.max(np.linalg.norm((F - W)[measured], axis=1))) / F0 if measured.any() else math.inf
+    mpk = float(np.max(np.abs((M - Ms)[measured]))) / M0 if measured.any() else math.inf
     tracking = {k: np.asarray(v, dtype=float)[grid] for k, v in main.driver_error.items()}
     rel = {k: float(np.max(np.abs(v))) / (travel[k] or 1.0) for k, v in main.driver_error.items()}
     worst = max(rel.values(), default=0.0)
@@ -261,7 +269,7 @@ def torque_driven(
     return TorqueDriven(
         t=t, force=F, moment=M, tracking=tracking, tracking_error=rel, travel=travel, tracking_error_max=worst,
         calibration_error=calib, resolution=resolution, force_residual=fres, moment_residual=mres,
-        force_reference=F0, moment_reference=M0, tracking_tolerance=tol, dt=dt, steps=nsteps,
+        force_reference=F0, moment_reference=M0, force_peak=fpk, moment_peak=mpk, tracking_tolerance=tol, dt=dt, steps=nsteps,
         iterations=iterations, floored_bodies=floored, floor_effort_share=share, passed=not reasons,
         reasons=reasons, notes=notes + list(main.sim.notes),
         timing={"simulation_s": main.wall, "total_s": time.perf_counter() - wall0},
