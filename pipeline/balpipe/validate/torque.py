@@ -46,6 +46,7 @@ import numpy as np
 
 from ..engine import Analysis, analyse
 from ..model import Attachment, Model
+from .loads import _on_grid  # the same sampling of the loads as the position-driven check
 from .run import SimulationRun, simulate
 from .settings import ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings
 from .space import build_space
@@ -243,8 +244,6 @@ def torque_driven(
             calib, 0.0, math.inf, math.inf, F0, M0, math.inf, math.inf, settings.tracking_tolerance, dt, nsteps, iterations, floored,
             share, False, reasons, notes, {"total_s": time.perf_counter() - wall0},
         )
-    from .loads import _on_grid  # the same sampling of the loads as the position-driven check
-
     kinds = _law_kinds(analytic_model, t)
     F, M, measured, _ = _on_grid(main, analysis, idx, kinds, 0, _jumps(analytic_model, main.t))
     ferr = np.linalg.norm(F - analysis.force, axis=1)[measured]
