@@ -256,11 +256,11 @@ def validation_direct(specs: Path) -> bool:
         try:
             spec = load(path).spec
             if not spec.validation.enabled:
-                rows.append([_short(str(path)), "(validation disabled)", *["-"] * 7])
+                rows.append([_short(str(path)), "(validation disabled)", *["-"] * 8])
                 continue
             st = study_mod.run(spec)
         except Exception as exc:
-            rows.append([_short(str(path)), f"(not analysed: {type(exc).__name__})", *["-"] * 7])
+            rows.append([_short(str(path)), f"(not analysed: {type(exc).__name__})", *["-"] * 8])
             continue
         # the settings the build uses (balpipe.validation_stage.settings_for)
         want = {"dt": spec.validation.dt, "iterations": spec.validation.iterations,
@@ -281,6 +281,7 @@ def validation_direct(specs: Path) -> bool:
                 steps, pym = getattr(v, "steps", "-"), getattr(v, "timing", {}).get("simulation_s")
             except Exception as exc:
                 wall, status, steps, pym = time.perf_counter() - t0, f"error {type(exc).__name__}", "-", None
+                v = None
             ff, stage_total = "-", wall
             if reactionless and hasattr(V, "free_floating"):
                 t1 = time.perf_counter()
@@ -290,14 +291,26 @@ def validation_direct(specs: Path) -> bool:
                 except Exception as exc:
                     ff = f"{time.perf_counter() - t1:.3f} ({type(exc).__name__})"
                 stage_total += time.perf_counter() - t1
+            tq = "-"
+            try:
+                from balpipe.validate.torque import torque_driven
+
+                t2 = time.perf_counter()
+                r = torque_driven(sr.stage.model, sr.analysis, settings, dt=getattr(v, "dt", None),
+                                  iterations=getattr(v, "iterations", None))
+                tq = f"{time.perf_counter() - t2:.3f} ({r.status}, {r.tracking_error_max:.1e})"
+                stage_total += time.perf_counter() - t2
+            except Exception as exc:  # the module may not exist on an older checkout
+                tq = f"({type(exc).__name__})"
             total += stage_total
             rows.append([_short(str(path)), sr.stage.name, len(sr.analysis.t), steps, fmt_s(wall),
-                         fmt_s(pym) if pym is not None else "-", ff, fmt_s(stage_total), status])
-        rows.append([_short(str(path)), "all stages", "", "", "", "", "", fmt_s(total), ""])
+                         fmt_s(pym) if pym is not None else "-", ff, tq, fmt_s(stage_total), status])
+        rows.append([_short(str(path)), "all stages", "", "", "", "", "", "", fmt_s(total), ""])
     table(["spec", "stage", "samples", "steps", "validate s", "of which pymunk s", "free-floating s",
-           "stage s", "validator says"], rows,
+           "torque-driven s (verdict, tracking)", "stage s", "validator says"], rows,
           "direct: balpipe.validate.validate per stage with the spec's settings (one run each; 'free-floating' = "
-          "the reactionless demonstration, run for paper specs; 'stage s' = both):")
+          "the reactionless demonstration, run for paper specs; 'torque-driven' = the inverse-dynamics run and "
+          "its calibration run; 'stage s' = all):")
     return True
 
 

@@ -152,6 +152,14 @@ def test_simulated_build_passes_and_reports_validation(work):
     page = (out / "index.html").read_text()
     assert "timing.js" in page and (out / "timing.json").exists()
     assert "<canvas" in page and "Reactionless demonstration" in page and "Residuals of the simulation" in page
+    # the torque-driven run (issue 7, item 7): every stage follows its plan under the engine's efforts
+    td = res["torque_driven"]
+    assert set(td) == {"unbalanced", "counterweights", "full"}
+    for name, q in td.items():
+        assert q["passed"], (name, q["reasons"])
+        assert q["tracking_error_max"] < 1e-4 and q["resolution"] > 100
+    assert "Torque-driven run" in page and all(v["method"] == "pymunk" for v in rl.values())
+    assert "simulation (pymunk)" in page and "conservation solution" in page
 
 
 def test_parallel_build_gives_the_same_site_and_quiet_hides_progress(work):

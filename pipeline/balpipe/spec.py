@@ -67,7 +67,7 @@ class AnalysisSettings(Strict):
     moment_point: tuple[Length, Length] = Field((0.0, 0.0), description="point about which shaking moments are taken")
     balance_tolerance: float = Field(
         1e-9, gt=0, lt=1,
-        description="a stage counts as balanced when its peak is below this fraction of the unbalanced peak",
+        description="a stage counts as balanced when its peak is below this fraction of the reference load (the unbalanced peak, floored by 1 % of the gross inertial load)",
     )
 
 
@@ -77,7 +77,7 @@ class ValidationSpec(Strict):
     enabled: bool = Field(True, description="simulate every stage in pymunk")
     dt: float | None = Field(None, gt=0, description="time step in s (default chosen per mechanism)")
     iterations: int | None = Field(None, ge=1, le=10_000, description="solver iterations per step")
-    tolerance: float = Field(0.01, gt=0, le=0.01, description="pass when residuals are below this fraction of the unbalanced peaks (at most 1 %)")
+    tolerance: float = Field(0.01, gt=0, le=0.01, description="pass when residuals are below this fraction of the reference loads: the unbalanced peaks, floored by 1 % of the gross inertial load (at most 1 %)")
     reactionless: bool | None = Field(None, description="free-floating frame demonstration (default: on for paper specs)")
 
 

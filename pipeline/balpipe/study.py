@@ -12,6 +12,7 @@ import numpy as np
 from . import realisable, registry
 from .balancing.base import BalanceResult, Stage
 from .engine import Analysis, AnalysisError, analyse
+from .load_reference import LoadReference, load_reference
 from .spec import Spec
 from .spec_parts import SpecFieldError
 
@@ -23,6 +24,7 @@ class StageResult:
     added_mass: float
     added_inertia: float
     validation: Any = None  # balpipe.validate.StageValidation, when simulated
+    torque: Any = None  # balpipe.validate.torque.TorqueDriven, when simulated
 
     @property
     def max_effort(self) -> float:
@@ -48,6 +50,11 @@ class Study:
     @property
     def ok(self) -> bool:
         return not self.problems
+
+    @property
+    def reference(self) -> LoadReference:
+        """The denominators of every relative figure (see :mod:`balpipe.load_reference`)."""
+        return ratio_reference(self.unbalanced)
 
     def extra_figures(self) -> list[tuple[str, str, str]]:
         """Figures that only the mechanism's template knows how to draw (title, svg, caption)."""
@@ -88,11 +95,18 @@ def _total_inertia(model) -> float:
     return sum(b.inertia + sum(a.inertia for a in b.attachments) for b in model.bodies)
 
 
+def ratio_reference(unbalanced: StageResult) -> LoadReference:
+    """The unbalanced stage's inertial peaks, floored by 1 % of its gross inertial loads."""
+    return load_reference(unbalanced.stage.model, unbalanced.analysis)
+
+
 def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float) -> dict:
     """Peaks, ratios and balance of one stage. Ratios and the balance criterion use the inertial
     part of the loads (the shaking loads less the moving links' weight and its moment, which a
-    force-balanced mechanism keeps constant); without gravity that is the loads themselves."""
-    F0, M0 = unbalanced.analysis.max_inertial_force, unbalanced.analysis.max_inertial_moment
+    force-balanced mechanism keeps constant); without gravity that is the loads themselves.
+    They divide by :func:`ratio_reference` (the unbalanced peaks, or their floor)."""
+    ref = ratio_reference(unbalanced)
+    F0, M0 = ref.force, ref.moment
     F, M = sr.analysis.max_inertial_force, sr.analysis.max_inertial_moment
     df, dm = sr.analysis.route_difference()
     not_realisable = realisable.verdict(sr.stage.model)
@@ -177,7 +191,7 @@ def run(spec: Spec) -> Study:
     problems = []
     rvm = max(max(m["reactions_vs_momentum_force"], m["reactions_vs_momentum_moment"]) for m in metrics)
     if not rvm <= 1e-9 or not math.isfinite(rvm):
-        problems.append(f"reactions and momentum disagree by {rvm:.3g} of the unbalanced peak (limit 1e-9)")
+        problems.append(f"reactions and momentum disagree by {rvm:.3g} of the reference load (limit 1e-9)")
     for m in metrics:
         if "force" in m["balances"] and not m["force_balanced"]:
             problems.append(f"stage {m['name']!r} should cancel the shaking force but keeps {m['force_ratio']:.3g} of it")
@@ -203,5 +217,6 @@ def run(spec: Spec) -> Study:
             "multipliers. The shaking force and moment do not depend on how the actuators share the load."
         )
     refs = compare_references(spec, balance, metrics)
-    checks = {"reactions_vs_momentum": rvm, "balance_tolerance": tol, "max_condition_number": float(cond[k])}
+    checks = {"reactions_vs_momentum": rvm, "balance_tolerance": tol, "max_condition_number": float(cond[k]),
+              "reference": ratio_reference(stages[0]).to_json()}
     return Study(spec, balance, stages, refs, checks, problems)

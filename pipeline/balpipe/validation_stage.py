@@ -8,6 +8,11 @@ from dataclasses import dataclass, field
 
 from .study import Study
 from .validate import FreeFloating, ValidationSettings, free_floating, validate
+from .validate.run import _model_scale
+from .validate.torque import torque_driven
+
+#: mass of the free-floating frame (kg)
+BASE_MASS = 10.0
 
 
 def settings_for(study: Study) -> ValidationSettings:
@@ -43,9 +48,20 @@ class Reactionless:
 
     def rows(self) -> list[dict]:
         return [
-            {"label": lab, "max_drift_m": r.max_drift, "max_rotation_deg": math.degrees(r.max_rotation)}
+            {"label": lab, "max_drift_m": r.max_drift, "max_rotation_deg": math.degrees(r.max_rotation),
+             "method": r.method_label, "base_mass": r.base_mass, "base_inertia": r.base_inertia,
+             "massless_drift_m": r.massless_max_drift if r.small_masses else None,
+             "massless_rotation_deg": math.degrees(r.massless_max_rotation) if r.small_masses else None,
+             "reference_difference_m": r.reference_difference[0],
+             "reference_difference_deg": math.degrees(r.reference_difference[1]),
+             "notes": "; ".join(r.notes)}
             for lab, r in zip(self.labels, self.runs)
         ]
+
+    @property
+    def same_base(self) -> bool:
+        """Every stage ran on the same frame (mass and inertia)."""
+        return len({(r.base_mass, r.base_inertia) for r in self.runs}) == 1
 
     def figures(self):
         from .report.figures import drift_figure
@@ -68,21 +84,41 @@ class Reactionless:
 def simulate_study(study: Study) -> None:
     """Validate every stage; failures become problems of the study (the build exits 1)."""
     settings = settings_for(study)
-    # relative to the unbalanced inertial peaks (the shaking loads' peaks without gravity)
-    F0, M0 = study.unbalanced.analysis.max_inertial_force, study.unbalanced.analysis.max_inertial_moment
+    # relative to the unbalanced inertial peaks (the shaking loads' peaks without gravity),
+    # floored by the model's gross inertial loads (balpipe.load_reference)
+    ref = study.reference
+    F0, M0 = ref.force_peak, ref.moment_peak
     for s in study.stages:
         expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
-        s.validation = validate(s.stage.model, s.analysis, (F0, M0), settings, expect)
+        s.validation = validate(s.stage.model, s.analysis, (F0, M0), settings, expect, reference=ref)
         if not s.validation.passed:
             study.problems.append(
                 f"pymunk validation of stage {s.stage.name!r} fails: {'; '.join(s.validation.reasons)}"
             )
-    if reactionless_enabled(study):
-        runs = [free_floating(s.stage.model, s.analysis, settings=settings) for s in study.stages]
-        study.reactionless = Reactionless(
-            [s.stage.label for s in study.stages], [s.stage.name for s in study.stages], runs,
-            [s.stage.model for s in study.stages],
+        # the inverse dynamics: the engine's efforts drive the mechanism (same step and solver effort)
+        s.torque = torque_driven(
+            s.stage.model, s.analysis, settings, reference=(ref.force, ref.moment),
+            dt=s.validation.dt, iterations=s.validation.iterations,
         )
+        if not s.torque.passed:
+            study.problems.append(
+                f"torque-driven run of stage {s.stage.name!r} fails: {'; '.join(s.torque.reasons)}"
+            )
+    if reactionless_enabled(study):
+        study.reactionless = reactionless_runs(study, settings)
+
+
+def reactionless_runs(study: Study, settings: ValidationSettings | None = None) -> Reactionless:
+    """Every stage on the same free-floating frame: mass BASE_MASS, the inertia of a square
+    plate reaching the farthest centre of mass of any stage."""
+    reach = max(_model_scale(s.analysis) for s in study.stages)
+    base_inertia = (2.0 / 3.0) * BASE_MASS * reach**2
+    runs = [free_floating(s.stage.model, s.analysis, BASE_MASS, base_inertia, settings=settings)
+            for s in study.stages]
+    return Reactionless(
+        [s.stage.label for s in study.stages], [s.stage.name for s in study.stages], runs,
+        [s.stage.model for s in study.stages],
+    )
 
 
 def timing(study: Study) -> dict:
@@ -91,6 +127,8 @@ def timing(study: Study) -> dict:
     for s in study.stages:
         if s.validation is not None:
             out[s.stage.name] = dict(s.validation.timing)
+        if s.torque is not None:
+            out.setdefault(s.stage.name, {})["torque_driven_s"] = float(s.torque.timing.get("total_s", 0.0))
     if study.reactionless is not None:
         for name, r in zip(study.reactionless.names, study.reactionless.runs):
             out.setdefault(name, {})["reactionless_s"] = float(r.timing.get("total_s", 0.0))

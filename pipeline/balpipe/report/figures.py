@@ -215,8 +215,8 @@ def residual_figure(stages: list, prefix: str = "residuals") -> str:
         c = SIM_COLORS[k % len(SIM_COLORS)]
         a1.plot(t, fe / F0 if F0 > 0 else fe, color=c, label=label, linewidth=1.0)
         a2.plot(t, me / M0 if M0 > 0 else me, color=c, label=label, linewidth=1.0)
-    a1.set_title("|F_sim - F_analytic| / unbalanced peak", fontsize=9)
-    a2.set_title("|M_sim - M_analytic| / unbalanced peak", fontsize=9)
+    a1.set_title("|F_sim - F_analytic| / reference force", fontsize=9)
+    a2.set_title("|M_sim - M_analytic| / reference moment", fontsize=9)
     for a in (a1, a2):
         a.set_xlabel("time (s)")
         a.set_yscale("log")

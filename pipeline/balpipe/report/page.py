@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from .. import realisable
 from ..study import Study
 from . import figures
@@ -28,17 +30,30 @@ def study_figures(study: Study) -> dict:
     residuals, drift = [], []
     vals = [s for s in study.stages if s.validation is not None]
     if vals:
-        F0, M0 = study.unbalanced.analysis.max_force, study.unbalanced.analysis.max_moment
+        ref = study.reference
+        F0, M0 = ref.force, ref.moment
         residuals.append((
             "Residuals of the simulation",
             figures.residual_figure([(s.stage.label, s.validation.t, s.validation.force_error,
                                       s.validation.moment_error, F0, M0) for s in vals]),
-            "Difference between the pymunk simulation and the analytic engine, relative to the unbalanced peaks.",
+            "Difference between the pymunk simulation and the analytic engine, relative to "
+            + study.reference.describe("force") + " and " + study.reference.describe("moment") + ".",
         ))
     if study.reactionless is not None:
         drift = list(study.reactionless.figures())
+    torque = []
+    runs = [s for s in study.stages if s.torque is not None]
+    if runs:
+        curves = [(f"{s.stage.label}: {d}", np.abs(e) / (s.torque.travel[d] or 1.0))
+                  for s in runs for d, e in sorted(s.torque.tracking.items())]
+        torque.append((
+            "Tracking error of the torque-driven run",
+            figures.series_figure(runs[0].torque.t, curves, "|q_sim − q_plan| / travel", prefix="torque"),
+            "Each driven coordinate of the simulation driven by the engine's efforts (no position drive), "
+            "minus its planned motion, relative to its travel.",
+        ))
     return {"loads": loads, "efforts": efforts, "mechanism": mech, "extra": extra,
-            "residuals": residuals, "drift": drift}
+            "residuals": residuals, "drift": drift, "torque": torque}
 
 
 def render_page(study: Study, results: dict, spec_text: str) -> str:
@@ -56,6 +71,18 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
                 "excluded": v.excluded_samples, "version": v.pymunk_version,
                 "not_realisable": realisable.verdict(s.stage.model),
             })
+    torque_rows = []
+    for s in study.stages:
+        q = s.torque
+        if q is not None:
+            torque_rows.append({
+                "label": s.stage.label, "tracking": q.tracking_error_max, "calibration": q.calibration_error,
+                "resolution": q.resolution, "force_residual": q.force_residual, "moment_residual": q.moment_residual,
+                "force_peak": q.force_peak, "moment_peak": q.moment_peak,
+                "dt": q.dt, "steps": q.steps, "iterations": q.iterations, "tolerance": q.tracking_tolerance,
+                "passed": q.passed, "reasons": "; ".join(q.reasons), "notes": "; ".join(q.notes),
+                "per_driver": ", ".join(f"{k} {v:.2g}" for k, v in sorted(q.tracking_error.items())),
+            })
     rl = study.reactionless
     return environment().get_template("spec.html").render(
         r=results,
@@ -64,10 +91,14 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
         law=spec.motion.law,
         figures=study_figures(study),
         validation=validation_rows,
+        torque=torque_rows,
         reactionless={"base_mass": rl.base_mass, "base_inertia": rl.base_inertia, "rows": rl.rows(),
+                      "same_base": rl.same_base,
                       "player": rl.player()} if rl is not None else None,
         instants=INSTANTS,
         joint_loads=joint_load_table(study),
         stage_names=[(s.stage.name, s.stage.label) for s in study.stages],
+        reference={"force": study.reference.describe("force"), "moment": study.reference.describe("moment"),
+                   "floored": study.reference.floored},
         spec_text=spec_text,
     )

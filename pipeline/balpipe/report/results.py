@@ -68,6 +68,8 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
         "notes": study.balance.notes,
         "validation": validation if simulated else None,
         "reactionless": study.reactionless.to_json() if study.reactionless is not None else None,
+        "torque_driven": {s.stage.name: s.torque.to_json() for s in study.stages if s.torque is not None}
+        if simulated else None,
     }
     return _clean(out)
 

@@ -1,0 +1,41 @@
+"""Independent check of a stage's shaking loads with a pymunk simulation of the jointed mechanism.
+
+One module per job:
+
+* :mod:`.space`: building the simulation (a :class:`~balpipe.model.Model` translated into a
+  pymunk space: bodies, joints, gears, drivers);
+* :mod:`.settings`: numerical settings, the time step and the corners of the motion laws;
+* :mod:`.run`: running it along the analysed motion and recording the loads on the frame;
+* :mod:`.loads`: measuring a stage's loads against the analysis, the verdict (``validate``);
+* :mod:`.floating`: the reactionless demonstration on a free-floating frame;
+* :mod:`.torque`: the torque-driven run, which checks the inverse dynamics (the actuators apply
+  the engine's efforts; pymunk integrates the motion).
+
+Public API
+    ``validate(model, analysis, unbalanced_peaks, settings=None, expect=()) -> StageValidation``
+    ``free_floating(model, analysis, base_mass=10.0, base_inertia=None, settings=None,
+    simulate_pymunk=True) -> FreeFloating``
+    ``torque_driven(model, analysis, ...) -> TorqueDriven``
+    ``ValidationSettings``, ``default_settings(model, analysis)``, and, lower down,
+    ``simulate(model, analysis, dt, iterations, ...) -> SimulationRun`` and
+    :func:`balpipe.validate.space.build_space` (the translation of a model into pymunk).
+"""
+
+from .floating import FreeFloating, free_floating
+from .loads import StageValidation, validate
+from .run import SimulationRun, simulate
+from .settings import ValidationSettings, default_settings
+from .torque import TorqueDriven, torque_driven
+
+__all__ = [
+    "ValidationSettings",
+    "StageValidation",
+    "FreeFloating",
+    "SimulationRun",
+    "default_settings",
+    "simulate",
+    "validate",
+    "free_floating",
+    "TorqueDriven",
+    "torque_driven",
+]

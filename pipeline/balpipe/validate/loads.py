@@ -1,0 +1,362 @@
+"""Measuring a stage's shaking loads in the simulation, against the analysis: ``validate``.
+
+Method
+    The model is built in pymunk by :mod:`balpipe.validate.space` (bodies at their centres of
+    mass, PivotJoint, GrooveJoint + rotation lock, gear pairs, dead-beat drivers) and driven
+    along the analysis' motion laws. The load on the frame is measured from momenta:
+    F = sum m g - dP/dt, M_O = sum (r - O) x m g - dH_O/dt, about the analysis' moment point,
+    with the model's masses and moments on the simulated motion. pymunk's symplectic Euler
+    keeps velocities half a step after positions, so P and H after a step are mid-step values
+    and their central differences give the loads at the step times to second order (PYMUNK.md's
+    first-order errors came from reading those velocities as values at the step time). The run
+    starts one step before t0 at q(t0) - dt v(t0 - dt/2), v(t0 - dt/2) = v(t0) - a(t0) dt/2, so
+    that the first step lands exactly on q(t0); nothing is excluded (``skip_initial_steps`` = 0).
+    At the grid samples where a law has a corner (its jerk jumps, at t0 and T for the quintic
+    and cycloidal laws; its acceleration jumps, for bang-bang and trapezoidal laws) the central
+    difference would straddle it: the sample is the simulated load extrapolated linearly from
+    the side the law's value belongs to (counted in ``extrapolated_samples``). A step of the
+    simulation divides each interval of the analysis grid (non-uniform grids are interpolated).
+
+Gear pairs
+    Carried by the frame: one GearJoint; its missing (1 - ratio) couple is the frame's, which
+    the momentum measurement includes by construction. On a moving carrier (planetary): a
+    mesh, two gears pinned to the carrier touching at the pitch point through a GrooveJoint
+    re-placed every step (implicit and momentum-conserving), falling back to an explicit
+    carrier (one GearJoint whose phase follows the carrier's extrapolated angle) when the mesh
+    does not converge. Measured on the planetary test model (moment residual): mesh 5.5e-5,
+    explicit 2.0e-4 (4.0e-2 with a bang-bang law: the extrapolation lags where the carrier's
+    acceleration jumps); a single absolute GearJoint (PYMUNK.md's trap) comes apart (the
+    planet follows the wrong angle). On the free base the absolute GearJoint changes the total
+    angular momentum by 0.11 N m s (8 % of the arm's peak), the mesh by 3e-7.
+
+Defaults and why (measured with pymunk 7.3.1 on a 2-core machine)
+    * dt = min(T / 1000, 0.01 / w_max), rounded down to divide the grid: the residual is
+      second order, 57 dt^2 / T^2-ish for the 2R arm (T = 0.5 s):
+      dt 2e-3: 9.1e-4, 1e-3: 2.3e-4, 5e-4: 5.7e-5, 2.5e-4: 1.4e-5, 1.25e-4: 3.6e-6;
+      slider-crank dt 1e-3: 4.5e-4, 5e-4: 1.1e-4, 2.5e-4: 2.8e-5.
+    * iterations: 100, doubled until the loads change by at most tolerance / 10 of the
+      unbalanced peaks between two doublings (so at least two runs), up to 3200; a run whose
+      bodies stray more than 1e-3 (rad, or of the model's size) from the analysed motion is
+      redone with more. The first 10 steps, and those after a jump of a law's acceleration,
+      run with 5000 iterations (the solver's warm start is missing or wrong there; with only
+      3 start-up steps at 500 the Scott-Russell "full" stage had a 2 % error at t0). Fixed
+      counts do not fit all: the 2R arm diverges at 10 iterations with dead-beat joints, the
+      Scott-Russell "full" stage needs 3200 (its moment is 2 % off at 400), pymunk's C solver
+      is cheap next to the Python step loop (100 -> 800 iterations costs ~2x).
+    * mass floor 0.1: bodies lighter (of smaller moment) than 0.1 of the heaviest are simulated
+      at that floor. A massless idler between two gears otherwise stalls the solver (floor 1e-6:
+      comes apart at 3200 iterations; 1e-3: 800 iterations; 1e-2 and 0.1: 200, residuals
+      4.7e-5 / 5.7e-5 in all converged cases). The motion is imposed by the drivers, so the
+      floors change internal forces only, not the measured loads.
+    * tolerance 1 % of the unbalanced peaks (the reference loads, :mod:`balpipe.load_reference`, when
+      given); balance_tolerance 1 % for the loads a stage claims
+      to cancel (``expect``).
+
+Measured residuals (max |sim - analytic| / unbalanced peak) at the defaults, 0.5 s motions,
+251 samples, with the wall-clock time of ``validate`` (all runs included)
+    ===========================================  =======  =======  ==========  =====
+    model (tests/test_validate.py)               force    moment   iterations  s
+    ===========================================  =======  =======  ==========  =====
+    2R arm, joint drivers                        5.7e-5   5.5e-5   200         0.13
+    five-bar, gravity on                         7.6e-6   2.9e-5   200         0.23
+    slider-crank (prismatic), crank driven       3.4e-5   5.0e-5   200         0.25
+    slider-crank driven by the slider's x        6.6e-5   1.0e-4   200         0.19
+    rotating guide + prismatic driver            6.0e-5   6.4e-5   200         0.19
+    disc geared to the frame, ratio -1           4.7e-5   5.7e-5   200         0.20
+    planetary gear (carrier: a moving link)      5.7e-5   5.5e-5   200         0.27
+    planetary gear, bang-bang law                1.0e-4   2.8e-4   200         0.30
+    massless idler and disc (floors)             4.7e-5   5.7e-5   200         0.17
+    force-balanced 2R arm (of unbalanced peak)   1.4e-10  1.2e-4   200         0.15
+    reactionless 2R arm (counter-rotations)      2.0e-8   1.8e-5   400         0.51
+    ===========================================  =======  =======  ==========  =====
+    specs/ (stage: force, moment, iterations, s): offset slider-crank unbalanced 7.9e-5,
+    6.1e-5, 200, 0.26; counterweights 3.6e-11, 1.0e-3, 200, 0.25. Paper 004 five-bar
+    unbalanced 2.7e-4, 1.1e-4, 200, 0.23; counterweights 2.2e-6, 9.5e-5, 800, 0.57; full
+    2.6e-6, 3.4e-6, 400, 0.77. Scott-Russell unbalanced 3.3e-5, 5.7e-5, 800, 0.53;
+    counterweights 2.0e-7, 2.6e-4, 800, 0.58; full 5.4e-8, 1.4e-4, 3200, 1.27.
+    Driven coordinates track their laws to 1e-12 rad (revolute, angle) and 1e-7 m (prismatic).
+
+Free-floating frame
+    The frame becomes a free body, no gravity; the mechanism moves relative to it along the
+    analysed motion. pymunk result when it holds together (massless bodies excluded: a floor
+    mass would move the base), else the exact conservation solution (constant total momentum
+    and angular momentum along the analysed relative motion), which is always computed and
+    compared. 2R arm on a 10 kg base: drift 57 mm, rotation 9.6 deg; pymunk and the
+    conservation solution differ by 1.6e-7 m and 6e-7 rad. Force-balanced arm: drift 7e-16 m,
+    still 36 deg of rotation. Reactionless arm: 2e-17 m and 9e-14 rad (conservation solution;
+    its meshes do not converge in pymunk on the free base). 0.1-0.2 s per stage.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import pymunk
+
+from ..engine import Analysis
+from ..model import Model
+from .run import SimulationRun, _model_scale, _relative_poses, _run_adaptive
+from .settings import MAX_ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings
+
+@dataclass
+class StageValidation:
+    """The simulation of one stage against its analysis.
+
+    Curves on the analysis grid ``t``: ``force`` (N, 2), ``moment`` (N,) (simulated, same
+    convention as the engine: load of the moving links on the frame, moment about the
+    analysis' moment point); ``force_error`` (N,) = |F_sim - F_analytic|, ``moment_error``.
+    ``measured`` (N,) marks the samples that enter the residuals.
+    Scalars: residuals ``force_residual = max|F_sim - F_analytic| / F0`` and
+    ``moment_residual`` (F0, M0: the reference loads ``force_reference``/``moment_reference``,
+    the unbalanced stage's analytic peaks or their floor, see :mod:`balpipe.load_reference`;
+    ``reference_basis`` says which; ``unbalanced_force_peak``/``..._moment_peak`` the peaks);
+    ``force_peak``/``moment_peak``: simulated inertial peaks (less the links' weight and its
+    moment) / F0, M0; ``tracking_error``: max abs
+    error of each driven coordinate (rad or m) and its maximum ``tracking_error_max``;
+    ``pose_error_position`` (m) / ``pose_error_angle`` (rad): largest deviation of the
+    simulated centres of mass from the analysis; ``dt``, ``steps``, ``iterations``, pymunk
+    and Chipmunk versions; ``passed``. ``timing`` (wall-clock seconds) is kept out of
+    :meth:`to_json` so that results files are deterministic.
+    """
+
+    t: np.ndarray
+    force: np.ndarray
+    moment: np.ndarray
+    force_error: np.ndarray
+    moment_error: np.ndarray
+    measured: np.ndarray
+    force_residual: float
+    moment_residual: float
+    force_peak: float
+    moment_peak: float
+    unbalanced_force_peak: float
+    unbalanced_moment_peak: float
+    tracking_error: dict[str, float]
+    tracking_error_max: float
+    pose_error_position: float
+    pose_error_angle: float
+    dt: float
+    steps: int
+    iterations: int
+    tolerance: float
+    balance_tolerance: float
+    expect: tuple[str, ...]
+    passed: bool
+    reasons: list[str]
+    excluded_samples: int
+    extrapolated_samples: int
+    floored_bodies: list[str]
+    notes: list[str]
+    pymunk_version: str = pymunk.version
+    chipmunk_version: str = pymunk.chipmunk_version
+    timing: dict[str, float] = field(default_factory=dict)
+    force_reference: float = math.nan
+    moment_reference: float = math.nan
+    reference_basis: str = "force: unbalanced peak; moment: unbalanced peak"
+
+    @property
+    def status(self) -> str:
+        return "pass" if self.passed else "fail"
+
+    def to_json(self) -> dict:
+        """Plain, deterministic summary (no curves, no wall-clock times)."""
+        return {
+            "passed": bool(self.passed),
+            "status": self.status,
+            "reasons": "; ".join(self.reasons),
+            "force_residual": float(self.force_residual),
+            "moment_residual": float(self.moment_residual),
+            "force_peak": float(self.force_peak),
+            "moment_peak": float(self.moment_peak),
+            "unbalanced_force_peak": float(self.unbalanced_force_peak),
+            "unbalanced_moment_peak": float(self.unbalanced_moment_peak),
+            "force_reference": float(self.force_reference),
+            "moment_reference": float(self.moment_reference),
+            "reference_basis": self.reference_basis,
+            "tracking_error": {k: float(v) for k, v in sorted(self.tracking_error.items())},
+            "tracking_error_max": float(self.tracking_error_max),
+            "pose_error_position": float(self.pose_error_position),
+            "pose_error_angle": float(self.pose_error_angle),
+            "dt": float(self.dt),
+            "steps": int(self.steps),
+            "iterations": int(self.iterations),
+            "tolerance": float(self.tolerance),
+            "balance_tolerance": float(self.balance_tolerance),
+            "expect": ",".join(self.expect),
+            "samples": int(len(self.t)),
+            "excluded_samples": int(self.excluded_samples),
+            "extrapolated_samples": int(self.extrapolated_samples),
+            "floored_bodies": ",".join(self.floored_bodies),
+            "notes": "; ".join(self.notes),
+            "pymunk_version": str(self.pymunk_version),
+            "chipmunk_version": str(self.chipmunk_version),
+            "method": "momentum",
+        }
+
+
+
+def _on_grid(run: SimulationRun, analysis: Analysis, idx: np.ndarray | None, kinds: list[str], skip: int,
+             jumps: list[int] = ()):
+    """Simulated loads at the analysis samples. Where a law is not smooth the central
+    difference straddles the corner: the sample is then the linear extrapolation of the
+    simulated loads from the side(s) the law's value belongs to (both sides averaged for a
+    jerk kink), which is second-order again. ``jumps`` are the simulation steps k where a law's
+    acceleration jumps between steps k-1 and k (:func:`_jumps`): a corner that falls between
+    analysis samples spoils the steps around it (the drive aims two steps ahead, the solver
+    settles after it), so a sample within three steps of one is excluded from the residuals
+    (``excluded_samples`` counts them). Returns force, moment, measured mask and counts."""
+    n = len(run.t) - 1
+    N = len(analysis.t)
+    F = np.zeros((N, 2))
+    M = np.zeros(N)
+    measured = np.ones(N, dtype=bool)
+    extrapolated = 0
+    series = np.column_stack([run.force, run.moment])
+    if idx is None:
+        vals = np.column_stack([np.interp(analysis.t, run.t, series[:, c]) for c in range(3)])
+        idx_f = np.searchsorted(run.t, analysis.t).clip(0, n)
+    else:
+        vals = series[idx].copy()
+        idx_f = idx
+    # corners on analysis samples are handled by their kind; the rest fall between samples
+    on_grid = {int(idx_f[i]) + d for i, k in enumerate(kinds) if k in ("left", "right", "mixed") for d in (0, 1)}
+    jump_steps = np.asarray(sorted(set(jumps) - on_grid), dtype=int)
+    for i, kind in enumerate(kinds):
+        s = int(idx_f[i])
+        if s < skip:
+            measured[i] = False
+        if kind == "smooth" and jump_steps.size:
+            # a corner between analysis samples: the drive anticipates it by two steps and the
+            # solver settles after it, so the steps around it cannot be compared with a curve
+            # that jumps there; the sample is left out of the residuals (and counted)
+            if np.any((jump_steps >= s - 3) & (jump_steps <= s + 4)):
+                measured[i] = False
+                continue
+        if kind == "smooth":
+            continue
+        if kind == "kink":  # linear extrapolation from the two nearest steps
+            left = 2 * series[s - 1] - series[s - 2] if s >= 2 + skip else None
+            right = 2 * series[s + 1] - series[s + 2] if s + 2 <= n else None
+        else:  # from the 2nd and 3rd: the first step after an acceleration jump carries an
+            # O(dt) error (the joints' position corrections follow the jump one step late)
+            left = 3 * series[s - 2] - 2 * series[s - 3] if s >= 3 + skip else None
+            right = 3 * series[s + 2] - 2 * series[s + 3] if s + 3 <= n else None
+        if kind == "kink":
+            sides = [v for v in (left, right) if v is not None]
+        elif kind == "left":
+            sides = [left] if left is not None else []
+        elif kind == "right":
+            sides = [right] if right is not None else []
+        else:
+            sides = []
+        if sides:
+            vals[i] = np.mean(sides, axis=0)
+            extrapolated += 1
+        else:
+            measured[i] = False
+    F[:] = vals[:, :2]
+    M[:] = vals[:, 2]
+    return F, M, measured, extrapolated
+
+
+
+def validate(
+    model: Model,
+    analysis: Analysis,
+    unbalanced_peaks: tuple[float, float],
+    settings: ValidationSettings | None = None,
+    expect: tuple[str, ...] = (),
+    reference=None,
+) -> StageValidation:
+    """Simulate ``model`` in pymunk along ``analysis``' motion and compare the loads.
+
+    ``unbalanced_peaks`` = (F0, M0): the unbalanced stage's analytic peak force and moment,
+    the denominators of every relative number. ``expect`` names the loads this stage claims to
+    cancel ("force", "moment"): their simulated peaks must then also be at most
+    ``settings.balance_tolerance`` times F0 (M0). Passes when the residuals are at most
+    ``settings.tolerance`` and every expectation holds. ``reference``: a
+    :class:`balpipe.load_reference.LoadReference`, whose loads then replace ``unbalanced_peaks``
+    as the denominators (the unbalanced peaks floored by the model's gross inertial loads).
+    """
+    settings = settings or ValidationSettings()
+    wall0 = time.perf_counter()
+    dt_default, it_default = default_settings(model, analysis)
+    dt_target = settings.dt or dt_default
+    iterations = settings.iterations or it_default
+    dt, nsteps, idx = _step_grid(np.asarray(analysis.t, dtype=float), dt_target)
+    scale = _model_scale(analysis)
+    F0, M0 = (float(x) for x in unbalanced_peaks)
+    peaks = (F0, M0)
+    basis = "force: unbalanced peak; moment: unbalanced peak"
+    if reference is not None:
+        F0, M0 = float(reference.force), float(reference.moment)
+        peaks = (float(reference.force_peak), float(reference.moment_peak))
+        basis = f"force: {reference.force_basis}; moment: {reference.moment_basis}"
+    refs = {"force_reference": F0, "moment_reference": M0, "reference_basis": basis}
+    limit = (
+        settings.tolerance / 10.0 * (F0 if F0 > 0 else 1.0),
+        settings.tolerance / 10.0 * (M0 if M0 > 0 else 1.0),
+    )
+    run, notes, change = _run_adaptive(
+        model, analysis, dt, iterations, settings, scale, idx, limit=limit, mass_floor=settings.mass_floor
+    )
+    fden = F0 if F0 > 0 else 1.0
+    mden = M0 if M0 > 0 else 1.0
+    if F0 <= 0 or M0 <= 0:
+        notes.append("an unbalanced peak is zero: that residual is absolute")
+    N = len(analysis.t)
+    if run is None:
+        nan = np.full(N, np.nan)
+        return StageValidation(
+            analysis.t, np.full((N, 2), np.nan), nan, nan, nan, np.zeros(N, bool), math.inf, math.inf,
+            math.inf, math.inf, *peaks, {d.name: math.inf for d in model.drivers}, math.inf, math.inf,
+            math.inf, dt, nsteps, MAX_ITERATIONS, settings.tolerance, settings.balance_tolerance,
+            tuple(expect), False, ["the simulation failed"], N, 0, [], notes,
+            timing={"total_s": time.perf_counter() - wall0}, **refs,
+        )
+    kinds = _law_kinds(model, np.asarray(analysis.t, dtype=float))
+    F, M, measured, extrapolated = _on_grid(run, analysis, idx, kinds, settings.skip_initial_steps,
+                                            _jumps(model, run.t))
+    ferr = np.linalg.norm(F - analysis.force, axis=1)
+    merr = np.abs(M - analysis.moment)
+    fres = float(np.max(ferr[measured])) / fden if measured.any() else math.inf
+    mres = float(np.max(merr[measured])) / mden if measured.any() else math.inf
+    # the balance claims concern the inertial part: less the links' weight and its moment
+    W, Ms = analysis.static_load()
+    fpk = float(np.max(np.linalg.norm((F - W)[measured], axis=1))) / fden if measured.any() else math.inf
+    mpk = float(np.max(np.abs((M - Ms)[measured]))) / mden if measured.any() else math.inf
+    track = {k: float(np.max(np.abs(v))) for k, v in run.driver_error.items()}
+    qs = _relative_poses(run, idx, np.asarray(analysis.t, dtype=float))
+    dpos = float(np.max(np.linalg.norm(qs[:, :, :2] - analysis.q[:, :, :2], axis=2))) if qs.size else 0.0
+    dang = float(np.max(np.abs(qs[:, :, 2] - analysis.q[:, :, 2]))) if qs.size else 0.0
+    reasons = []
+    tol = settings.tolerance
+    if not fres <= tol:
+        reasons.append(f"force residual {fres:.3g} > {tol:g}")
+    if not mres <= tol:
+        reasons.append(f"moment residual {mres:.3g} > {tol:g}")
+    for what, pk in (("force", fpk), ("moment", mpk)):
+        if what in expect and not pk <= settings.balance_tolerance:
+            reasons.append(f"{what} not balanced: simulated peak {pk:.3g} of the reference > {settings.balance_tolerance:g}")
+    notes = notes + list(run.sim.notes)
+    if run.sim.floored:
+        notes.append(
+            f"simulated with mass/moment floors ({settings.mass_floor:g} of the largest): "
+            + ", ".join(run.sim.floored)
+        )
+    excluded = int(np.count_nonzero(~measured))
+    return StageValidation(
+        t=np.asarray(analysis.t, dtype=float), force=F, moment=M, force_error=ferr, moment_error=merr,
+        measured=measured, force_residual=fres, moment_residual=mres, force_peak=fpk, moment_peak=mpk,
+        unbalanced_force_peak=peaks[0], unbalanced_moment_peak=peaks[1], tracking_error=track,
+        tracking_error_max=max(track.values(), default=0.0), pose_error_position=dpos,
+        pose_error_angle=dang, dt=run.dt, steps=nsteps, iterations=run.iterations,
+        tolerance=tol, balance_tolerance=settings.balance_tolerance, expect=tuple(expect),
+        passed=not reasons, reasons=reasons, excluded_samples=excluded,
+        extrapolated_samples=extrapolated, floored_bodies=list(run.sim.floored), notes=notes,
+        timing={"simulation_s": run.wall, "total_s": time.perf_counter() - wall0}, **refs,
+    )
+

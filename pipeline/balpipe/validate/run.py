@@ -1,0 +1,323 @@
+"""Running a model in pymunk along the analysed motion and measuring the loads on the frame.
+
+``simulate`` drives the space built by :mod:`balpipe.validate.space` along the analysis' motion
+laws (dead-beat drivers) and records the load on the frame from the simulated momenta;
+``_run_adaptive`` chooses the solver effort (iterations doubled until the loads converge, gear
+models tried in turn). See :mod:`balpipe.validate.loads` for the method and measured accuracy.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..engine import Analysis
+from ..model import FRAME, Gear, Model, Prismatic, Revolute
+from .settings import HEALTH_LIMIT, MAX_ITERATIONS, _jumps
+from .space import SimModel, build_space
+
+@dataclass
+class SimulationRun:
+    """Raw simulation output, one sample per step (``t``)."""
+
+    t: np.ndarray
+    force: np.ndarray  # (n, 2) load on the frame
+    moment: np.ndarray  # (n,) about the analysis' moment point
+    poses: np.ndarray  # (n, nb, 3) centre-of-mass coordinates
+    base: np.ndarray  # (n, 3) pose of the frame's origin (zeros when static)
+    driver_error: dict[str, np.ndarray]
+    momentum: np.ndarray  # (n, 3) P_x, P_y, H about the moment point of all dynamic bodies
+    dt: float
+    iterations: int
+    wall: float
+    sim: SimModel
+
+
+
+def _driver_coordinate(model: Model, d, poses: dict[str, tuple[float, float, float]], com: dict) -> float:
+    """The driven coordinate measured on simulated poses (centre-of-mass poses for bodies, the
+    origin's pose for the frame), in the frame's coordinates."""
+
+    def world(body: str, p) -> tuple[float, float]:
+        x, y, th = poses[body]
+        c = com[body]
+        lx, ly = p[0] - c[0], p[1] - c[1]
+        cs, sn = math.cos(th), math.sin(th)
+        return x + cs * lx - sn * ly, y + sn * lx + cs * ly
+
+    kind = d.target[0]
+    th0 = poses[FRAME][2]
+    if kind == "joint":
+        jt = model.joint(d.target[1])
+        if isinstance(jt, Revolute):
+            return poses[jt.b][2] - poses[jt.a][2]
+        if isinstance(jt, Prismatic):
+            ax = np.asarray(jt.axis, dtype=float)
+            ax = ax / np.linalg.norm(ax)
+            thg = poses[jt.guide][2]
+            e = (math.cos(thg) * ax[0] - math.sin(thg) * ax[1], math.sin(thg) * ax[0] + math.cos(thg) * ax[1])
+            ps = world(jt.slider, jt.point_slider)
+            pg = world(jt.guide, jt.point_guide)
+            return (ps[0] - pg[0]) * e[0] + (ps[1] - pg[1]) * e[1]
+        raise ValueError(f"driver {d.name!r}: a gear pair cannot be driven")
+    if kind == "angle":
+        return poses[d.target[1]][2] - th0
+    body = d.target[1]
+    point = model.body(body).point(d.target[2]) if len(d.target) > 2 else (0.0, 0.0)
+    p = world(body, point)
+    rel = (p[0] - poses[FRAME][0], p[1] - poses[FRAME][1])
+    cs, sn = math.cos(th0), math.sin(th0)
+    loc = (cs * rel[0] + sn * rel[1], -sn * rel[0] + cs * rel[1])
+    return loc[0] if kind == "x" else loc[1]
+
+
+
+def simulate(
+    model: Model,
+    analysis: Analysis,
+    dt: float,
+    iterations: int,
+    *,
+    startup_steps: int = 10,
+    startup_iterations: int = 5000,
+    floating_base: tuple[float, float, tuple[float, float]] | None = None,
+    record_poses: bool = True,
+    efforts: dict[str, np.ndarray] | None = None,
+    measure_with: Model | None = None,
+    abort: tuple[float, float] | None = None,
+    **build_options,
+) -> SimulationRun:
+    """Simulate ``model`` along ``analysis``' motion and measure the loads on the frame.
+
+    ``dt`` should divide the analysis' duration (see :func:`validate`, which picks it).
+    Start-up: pymunk integrates positions with the velocities of the previous step
+    (symplectic Euler), so its velocities belong half a step after its positions. The run
+    starts one step before t0 at q(t0) - dt v(t0 - dt/2) with the velocity
+    v(t0 - dt/2) = v(t0) - a(t0) dt/2 (the analysis at t0 is the only analytic input), so that
+    the first step lands exactly on q(t0). The loads at step time t_k are
+    F = sum m g - (P_{k+1/2} - P_{k-1/2}) / dt and
+    M = sum (r_k - O) x m g - (H_{k+1/2} - H_{k-1/2}) / dt, central differences of the
+    momenta of every dynamic body of the mechanism, about the analysis' moment point O
+    (H_{k+1/2} = sum m (r_k - O) x v_{k+1/2} + I w_{k+1/2} is exactly the mid-step value, as
+    v x v = 0): second-order accurate where the motion laws are smooth.
+
+    ``efforts`` (driver name -> effort at each step time ``t0 + k dt``): a torque-driven run.
+    No driver constraint is built; before the step that lands on t_k, each actuator applies its
+    effort at t_k (pymunk integrates velocities with the forces at the new positions), and
+    the drivers' laws are only compared with (``driver_error``). ``measure_with``: a model with
+    the same bodies whose masses and moments the loads are measured with (default ``model``).
+    ``abort`` = (limit, scale): stop with FloatingPointError as soon as a body, in the frame's
+    coordinates, is more than ``limit`` (rad, or ``limit * scale`` m) from the analysed motion
+    at an analysis sample (checked every tenth step): a run that came apart ends early.
+    """
+    t = np.asarray(analysis.t, dtype=float)
+    t0 = float(t[0])
+    n = int(round((float(t[-1]) - t0) / dt))
+    times = t0 + dt * np.arange(n + 1)
+    q0, v0, a0 = analysis.q[0], analysis.v[0], analysis.a[0]
+    vh = v0 - 0.5 * dt * a0
+    qs = q0 - dt * vh
+    gravity = (0.0, 0.0) if floating_base is not None else analysis.gravity
+    sim = build_space(
+        model, qs, vh, gravity=gravity, iterations=iterations, floating_base=floating_base,
+        dt=dt, drive=efforts is None, **build_options,
+    )
+    space = sim.space
+    bodies = sim.moving
+    everything = bodies + ([sim.base] if sim.floating else [])
+    # the loads are measured with the model's masses and moments (a massless body simulated
+    # with a floor mass, and the light auxiliary gears of meshes, count for nothing)
+    props = [b.mass_properties() for b in (measure_with or model).bodies]
+    m = np.array([p[0] for p in props] + [0.0] * len(sim.auxiliary))
+    inertia = np.array([p[2] for p in props] + [0.0] * len(sim.auxiliary))
+    g = np.asarray(gravity, dtype=float)
+    O = np.asarray(analysis.moment_point, dtype=float)
+    weight = m.sum() * g
+    names = [b.name for b in model.bodies]
+    com = {FRAME: (0.0, 0.0), **{b.name: b.mass_properties()[1] for b in model.bodies}}
+
+    target_t = times + dt  # the step landing on times[k] starts at times[k] - dt: target t + 2 dt
+    targets = {d.name: np.asarray(d.law(target_t)[0], dtype=float) for d in model.drivers}
+    laws_now = {d.name: np.asarray(d.law(times)[0], dtype=float) for d in model.drivers}
+    boost = np.zeros(n + 1, dtype=bool)
+    boost[:startup_steps] = True
+    for k in _jumps(model, target_t):  # the solver restarts where a law's acceleration jumps
+        boost[max(k - 1, 0) : k + startup_steps] = True
+
+    def momenta(group, masses=None, moments=None) -> tuple[float, float, float]:
+        px = py = h = 0.0
+        for i, b in enumerate(group):
+            mk = b.mass if masses is None else masses[i]
+            ik = b.moment if moments is None else moments[i]
+            p = b.local_to_world(b.center_of_gravity)
+            v = b.velocity
+            px += mk * v.x
+            py += mk * v.y
+            h += mk * ((p.x - O[0]) * v.y - (p.y - O[1]) * v.x) + ik * b.angular_velocity
+        return px, py, h
+
+    force = np.zeros((n + 1, 2))
+    moment = np.zeros(n + 1)
+    poses = np.zeros((n + 1, len(names), 3)) if record_poses else np.zeros((0, len(names), 3))
+    base = np.zeros((n + 1, 3))
+    total = np.zeros((n + 1, 3))
+    derr = {d.name: np.zeros(n + 1) for d in model.drivers}
+    px0, py0, h0 = momenta(bodies, m, inertia)
+    check: dict[int, int] = {}
+    if abort is not None:
+        steps = np.rint((t - t0) / dt).astype(int)
+        on = np.abs(t0 + steps * dt - t) <= 1e-9 * max(float(t[-1] - t0), 1e-12)
+        check = {int(k): i for i, k in enumerate(steps) if on[i] and k % 10 == 0}
+    start = time.perf_counter()
+    for k in range(n + 1):
+        space.iterations = startup_iterations if boost[k] else iterations
+        sim.prepare({name: v[k] for name, v in targets.items()}, dt)
+        if efforts is not None:
+            for act in sim.actuators:
+                act.apply(float(efforts[act.name][k]), dt)
+        space.step(dt)
+        px, py, h = momenta(bodies, m, inertia)
+        gm = 0.0
+        if g.any():
+            for b, mk in zip(bodies, m):
+                p = b.position
+                gm += mk * ((p.x - O[0]) * g[1] - (p.y - O[1]) * g[0])
+        force[k, 0] = weight[0] - (px - px0) / dt
+        force[k, 1] = weight[1] - (py - py0) / dt
+        moment[k] = gm - (h - h0) / dt
+        px0, py0, h0 = px, py, h
+        st = {nm: (b.position.x, b.position.y, b.angle) for nm, b in zip(names, sim.bodies)}
+        bo = sim.base.position
+        st[FRAME] = (bo.x, bo.y, sim.base.angle)
+        base[k] = st[FRAME]
+        if sim.floating:
+            total[k] = momenta(everything)
+        if record_poses:
+            poses[k] = [st[nm] for nm in names]
+        for d in model.drivers:
+            derr[d.name][k] = _driver_coordinate(model, d, st, com) - laws_now[d.name][k]
+        if k in check:
+            i = check[k]
+            q = np.array([st[nm] for nm in names])
+            rel = _rotate(np.full(len(names), -st[FRAME][2]), q[:, :2] - np.asarray(st[FRAME][:2]))
+            dev_p = float(np.max(np.abs(rel - analysis.q[i, :, :2]))) / abort[1]
+            dev_a = float(np.max(np.abs(q[:, 2] - st[FRAME][2] - analysis.q[i, :, 2])))
+            if not (dev_p <= abort[0] and dev_a <= abort[0]):
+                raise FloatingPointError(f"the simulation came apart at t = {times[k]:.4g} s")
+    wall = time.perf_counter() - start
+    space.iterations = iterations
+    return SimulationRun(times, force, moment, poses, base, derr, total, dt, iterations, wall, sim)
+
+
+
+def _relative_poses(run: SimulationRun, idx: np.ndarray | None, t: np.ndarray) -> np.ndarray:
+    """Simulated centre-of-mass poses on the analysis grid, in the frame's coordinates."""
+    if idx is None:
+        idx = np.searchsorted(run.t, t).clip(0, len(run.t) - 1)
+    q = run.poses[idx].copy()
+    base = run.base[idx]
+    rel = q[:, :, :2] - base[:, None, :2]
+    q[:, :, :2] = _rotate(-base[:, None, 2], rel)
+    q[:, :, 2] -= base[:, None, 2]
+    return q
+
+
+def _gear_models(model: Model, floating: bool) -> list[str | None]:
+    """Gear models to try: the mesh (implicit, exact), then, with a static frame, the explicit
+    carrier (converges easily, but lags where the carrier's acceleration jumps), for models
+    with a gear pair whose gears and carrier all move."""
+
+    def moving(n: str) -> bool:
+        return n != FRAME or floating
+
+    for j in model.joints:
+        if isinstance(j, Gear) and j.ratio not in (0.0, 1.0):
+            bodies = {j.a, j.b, j.carrier}
+            if len(bodies) == 3 and all(moving(n) for n in bodies):
+                return ["mesh"] if floating else ["mesh", "explicit"]
+    return [None]
+
+
+def _run_adaptive(
+    model, analysis, dt, iterations, settings, scale, idx, limit=None, max_iterations=None, **kw
+) -> tuple[SimulationRun | None, list[str], tuple[float, float]]:
+    """Run with solver iterations doubled until the measured loads stop changing.
+
+    A run "comes apart" when its loads are not finite or a body strays more than
+    HEALTH_LIMIT (rad, or times the model's size) from the analysed motion. With ``limit`` =
+    (force, moment), a run is accepted when it holds together and its loads differ from those
+    of the run with half the iterations by at most ``limit`` at every step (the solver has
+    converged); without, the first run that holds together is accepted. Iterations go up to
+    MAX_ITERATIONS, then the next gear model is tried. This only chooses the solver effort: the
+    verdict is the residual criterion of :func:`validate`. Returns the run (None if none held
+    together), notes and the last change (force, moment) between doublings."""
+    notes: list[str] = []
+    t = np.asarray(analysis.t, dtype=float)
+    floating = kw.get("floating_base") is not None
+    models = [kw.pop("gear_model")] if "gear_model" in kw else _gear_models(model, floating)
+    best: tuple | None = None
+    for gm in models:
+        it = iterations
+        prev = None
+        label = f" ({gm} gears)" if gm else ""
+        while True:
+            with np.errstate(all="ignore"):
+                try:
+                    run = simulate(
+                        model, analysis, dt, it, startup_steps=settings.startup_steps, abort=(10 * HEALTH_LIMIT, scale),
+                        startup_iterations=max(settings.startup_iterations, it),
+                        **({"gear_model": gm} if gm else {}), **kw,
+                    )
+                    q = _relative_poses(run, idx, t)
+                    dpos = float(np.max(np.abs(q[:, :, :2] - analysis.q[:, :, :2]))) / scale
+                    dang = float(np.max(np.abs(q[:, :, 2] - analysis.q[:, :, 2])))
+                    finite = bool(np.isfinite(run.force).all() and np.isfinite(run.moment).all())
+                    healthy = finite and dpos <= HEALTH_LIMIT and dang <= HEALTH_LIMIT
+                except (ZeroDivisionError, ValueError, OverflowError, FloatingPointError):
+                    run, healthy = None, False
+            change = (math.inf, math.inf)
+            if healthy and prev is not None:
+                change = (
+                    float(np.max(np.linalg.norm(run.force - prev.force, axis=1))),
+                    float(np.max(np.abs(run.moment - prev.moment))),
+                )
+            if healthy:
+                if limit is None:
+                    return run, notes, change
+                score = max(change[0] / limit[0], change[1] / limit[1])
+                if score <= 1.0:
+                    if gm != models[0]:
+                        notes.append(f"gear pairs on moving carriers: {gm} model used")
+                    return run, notes, change
+                if best is None or score < best[0]:
+                    best = (score, run, change, gm)
+            if it >= (max_iterations or MAX_ITERATIONS):
+                state = "came apart" if not healthy else "did not converge"
+                notes.append(f"the simulation{label} {state} up to {it} solver iterations")
+                break
+            prev = run if healthy else None
+            it *= 2
+    if best is None:
+        return None, notes, (math.inf, math.inf)
+    _, run, change, gm = best
+    notes.append(f"kept the best converged run ({run.iterations} iterations" + (f", {gm} gears)" if gm else ")"))
+    return run, notes, change
+
+
+def _model_scale(analysis: Analysis) -> float:
+    r = np.linalg.norm(analysis.q[:, :, :2] - np.asarray(analysis.moment_point), axis=2)
+    return max(float(r.max()) if r.size else 0.0, 1e-3)
+
+
+
+def _rotate(phi: np.ndarray, x: np.ndarray) -> np.ndarray:
+    c, s = np.cos(phi), np.sin(phi)
+    return np.stack([c * x[..., 0] - s * x[..., 1], s * x[..., 0] + c * x[..., 1]], -1)
+
+
+def _cross(u: np.ndarray, w: np.ndarray) -> np.ndarray:
+    return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
+

@@ -1,0 +1,136 @@
+"""Numerical settings of the pymunk validation and the time grid of a run.
+
+``ValidationSettings`` (what a spec can change), ``default_settings`` (the step and the first
+solver iteration count for a model and motion, and why: see :mod:`balpipe.validate.loads`),
+and the helpers that place the simulation's steps on the analysis grid and find the corners
+of the motion laws.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..engine import Analysis
+from ..model import Model
+
+#: default number of steps over the motion (the step is also kept below 0.01 / w_max)
+STEPS_PER_MOTION = 1000
+#: first solver iteration count; doubled (up to MAX_ITERATIONS) until the loads converge
+ITERATIONS = 100
+MAX_ITERATIONS = 3200
+#: deviation from the analysed motion (rad, or relative to the model's size) that makes a run retry
+HEALTH_LIMIT = 1e-3
+
+
+@dataclass(frozen=True)
+class ValidationSettings:
+    """Numerical settings of the simulation and the pass criterion.
+
+    ``dt``: time step (None: :func:`default_settings`); it is rounded down so that a whole
+    number of steps fits each interval of the analysis grid. ``iterations``: pymunk solver
+    iterations to start from (None: :data:`ITERATIONS`); they are doubled until two runs'
+    loads differ by at most ``tolerance / 10`` of the unbalanced peaks (see
+    :func:`_run_adaptive`).
+    ``tolerance``: the stage passes when both residuals are at most this fraction of the
+    unbalanced peaks. ``balance_tolerance``: for the loads a stage claims to cancel (``expect``
+    of :func:`validate`), the simulated peak must also be at most this fraction of the
+    unbalanced peak. ``skip_initial_steps``: simulation steps at the start whose samples are
+    excluded from the residuals (none are needed: see the start-up in :func:`simulate`).
+    ``startup_steps``/``startup_iterations``: the first steps, and the steps after a jump of a
+    law's acceleration, run with more solver iterations, because the solver has no previous
+    impulses to start from (warm start) or they are suddenly wrong.
+    ``mass_floor``: bodies lighter (of smaller moment) than this fraction of the heaviest are
+    simulated at that floor, so that pymunk's iterative solver converges (a massless idler
+    between two gears otherwise stalls it). The loads are measured with the model's own
+    masses and moments on the simulated motion, which the drivers impose: the floors change
+    the internal forces only. ``tracking_tolerance``: the torque-driven run
+    (:mod:`balpipe.validate.torque`) passes when every driven coordinate stays within this
+    fraction of its travel of the planned motion.
+    """
+
+    dt: float | None = None
+    iterations: int | None = None
+    tolerance: float = 0.01
+    balance_tolerance: float = 0.01
+    skip_initial_steps: int = 0
+    startup_steps: int = 10
+    startup_iterations: int = 5000
+    mass_floor: float = 0.1
+    tracking_tolerance: float = 1e-3
+
+
+
+def default_settings(model: Model, analysis: Analysis) -> tuple[float, int]:
+    """Default (dt, iterations) for a model and motion.
+
+    dt = min(T / STEPS_PER_MOTION, 0.01 / w_max) with T the motion's duration and w_max the
+    largest angular speed of any body (pymunk's joints follow straight lines during a step,
+    so their error is ~ (w dt)^2 times the lever arm); iterations = :data:`ITERATIONS`.
+    """
+    T = float(analysis.t[-1] - analysis.t[0])
+    w = float(np.max(np.abs(analysis.v[:, :, 2]))) if analysis.v.size else 0.0
+    dt = T / STEPS_PER_MOTION if T > 0 else 1e-3
+    if w > 0:
+        dt = min(dt, 0.01 / w)
+    return dt, ITERATIONS
+
+
+
+def _step_grid(t: np.ndarray, dt_target: float) -> tuple[float, int, np.ndarray | None]:
+    """Step, number of steps and the step index of each analysis sample (None when the grid is
+    not uniform: the samples are then interpolated linearly)."""
+    t0, t1 = float(t[0]), float(t[-1])
+    if len(t) > 1:
+        h = np.diff(t)
+        if np.allclose(h, h[0], rtol=1e-9, atol=0.0):
+            sub = max(1, int(math.ceil(h[0] / dt_target - 1e-9)))
+            return (t1 - t0) / ((len(t) - 1) * sub), (len(t) - 1) * sub, np.arange(len(t)) * sub
+    n = max(1, int(math.ceil((t1 - t0) / dt_target - 1e-9)))
+    return (t1 - t0) / n, n, None
+
+
+def _jumps(model: Model, times: np.ndarray) -> list[int]:
+    """Indices k where some law's acceleration jumps between times[k-1] and times[k]."""
+    out: set[int] = set()
+    for d in model.drivers:
+        a = np.asarray(d.law(times)[2], dtype=float)
+        if len(a) < 3:
+            continue
+        diff = np.abs(np.diff(a))
+        tiny = 1e-9 * (float(np.max(np.abs(a))) or 1.0)
+        out.update(int(k) + 1 for k in np.flatnonzero(diff > 50.0 * float(np.median(diff)) + tiny))
+    return sorted(out)
+
+
+
+def _law_kinds(model: Model, times: np.ndarray) -> list[str]:
+    """Smoothness of the motion at each analysis sample: "smooth", "kink" (a jump of some
+    law's jerk: the central difference straddling it is only first order), "left"/"right"
+    (a jump of some law's acceleration, the law's value at the sample being the left/right
+    limit) or "mixed" (jumps with different sides)."""
+    T = float(times[-1] - times[0]) or 1.0
+    delta = 1e-6 * T
+    kinds = ["smooth"] * len(times)
+    for d in model.drivers:
+        _, _, a_m = d.law(times - delta)
+        _, _, a_0 = d.law(times)
+        _, _, a_p = d.law(times + delta)
+        a_m, a_0, a_p = (np.asarray(x, dtype=float) for x in (a_m, a_0, a_p))
+        scale = float(np.max(np.abs(a_0))) or 1.0
+        # a smooth law changes its acceleration by ~ jerk * delta ~ 1e-6 scale across the
+        # sample, and its jerk by ~ 1e-6 jerk: a thousand times that is a corner
+        dm, dp = a_0 - a_m, a_p - a_0
+        jump = np.maximum(np.abs(dm), np.abs(dp)) > 1e-3 * scale
+        left_ok = np.abs(dm) <= 1e-3 * scale
+        kink = np.abs(dp - dm) > 1e-9 * scale
+        for i in range(len(times)):
+            if jump[i]:
+                side = "left" if left_ok[i] else "right"
+                kinds[i] = side if kinds[i] in ("smooth", "kink", side) else "mixed"
+            elif kink[i] and kinds[i] == "smooth":
+                kinds[i] = "kink"
+    return kinds
+

@@ -1,0 +1,275 @@
+"""The torque-driven run: a check of the inverse dynamics, not only of the kinematics.
+
+Why
+    The position-driven validation (:mod:`.loads`) imposes the motion and measures the loads
+    from the momenta of bodies with the model's own masses: for a mechanism with one degree of
+    freedom per driver it checks the kinematics and the momentum bookkeeping, and a wrong mass
+    in the model goes unnoticed (the simulation uses the same wrong mass). Here the drivers are
+    removed: each actuator applies the effort the engine computed (torque or force, see
+    :class:`balpipe.validate.space._Actuator`), pymunk integrates the dynamics of the jointed
+    mechanism open loop, and the simulated motion is compared with the planned one. Efforts
+    from a model whose masses or inertias differ from the simulated mechanism's accelerate it
+    differently, and the motion drifts away from the plan.
+
+Method
+    The efforts are the engine's, computed on the simulation's own step times (the analysis
+    of the same model on a finer grid; no interpolation). The run starts like the
+    position-driven one (one step before t0, so that the first step lands on q(t0) with the
+    velocity of t0 + dt/2) and uses its time step and converged solver iterations. Bodies that
+    pymunk cannot simulate massless (mass or moment below ``mass_floor`` of the largest) get
+    the floor as a real part of the body: the efforts are computed for the model with those
+    floor parts, so the floors are compensated exactly and their share of the effort is
+    reported (``floor_effort_share``). The loads are measured, as in :mod:`.loads`, from the
+    momenta of the bodies with the model's own masses, along the simulated motion.
+
+Pass criterion and why it is meaningful
+    ``tracking_error`` of a driver = max |q_sim - q_plan| over the motion / its travel
+    |q(T) - q(t0)|. The run passes when the largest is at most ``tracking_tolerance``
+    (default 1e-3). Open-loop integration drifts, so the same run is repeated with every
+    effort 10 % low (what every mass and inertia 10 % low in the analysis gives: the inverse
+    dynamics is linear in them; low rather than high, so that the motion stays inside the
+    planned range: overshooting took the Scott-Russell mechanism through its singular
+    configuration at 90 deg): ``calibration_error`` is the tracking error that such a model
+    error produces, about 0.1 of the travel for a mechanism dominated by inertia (the motion
+    scales with the effort). The verdict needs calibration_error / tracking_error >= 10
+    as well (``resolution``: the check would see a 1 % error of the whole model's inertia).
+    Measured at the defaults (tests/test_torque.py, specs/): see README "Validation".
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..engine import Analysis, analyse
+from ..model import Attachment, Model
+from .loads import _on_grid  # the same sampling of the loads as the position-driven check
+from .run import SimulationRun, simulate
+from .settings import ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings
+from .space import build_space
+
+__all__ = ["TorqueDriven", "torque_driven", "floored_model", "TRACKING_TOLERANCE", "CALIBRATION_FACTOR"]
+
+#: largest tracking error of a driven coordinate, as a fraction of its travel
+TRACKING_TOLERANCE = ValidationSettings.tracking_tolerance
+#: the calibration run's efforts (every mass and inertia of the analysis 10 % low: the motion stays
+#: inside the planned range, away from the workspace limits that overshooting may cross)
+CALIBRATION_FACTOR = 0.9
+#: calibration_error / tracking_error needed: the run must resolve a tenth of that model error
+MIN_RESOLUTION = 10.0
+
+
+@dataclass
+class TorqueDriven:
+    """One stage driven by its actuators' efforts.
+
+    Curves on the analysis grid ``t``: ``force`` (N, 2), ``moment`` (N,): simulated shaking
+    loads; ``tracking`` (driver -> (N,)): q_sim - q_plan (rad or m). Scalars: ``tracking_error``
+    (driver -> max |q_sim - q_plan| / travel), ``travel`` (rad or m), ``tracking_error_max``;
+    ``calibration_error``: the same with efforts ``CALIBRATION_FACTOR`` times the engine's;
+    ``resolution`` = calibration_error / tracking_error_max; ``force_residual``,
+    ``moment_residual``: max |simulated - analytic| load / the reference loads; ``force_peak``,
+    ``moment_peak``: simulated inertial peaks (less the links' weight and its moment) / the same;
+    ``floored_bodies`` and ``floor_effort_share`` (largest effort of the floor parts / peak
+    effort).
+    """
+
+    t: np.ndarray
+    force: np.ndarray
+    moment: np.ndarray
+    tracking: dict[str, np.ndarray]
+    tracking_error: dict[str, float]
+    travel: dict[str, float]
+    tracking_error_max: float
+    calibration_error: float
+    resolution: float
+    force_residual: float
+    moment_residual: float
+    force_reference: float
+    moment_reference: float
+    force_peak: float
+    moment_peak: float
+    tracking_tolerance: float
+    dt: float
+    steps: int
+    iterations: int
+    floored_bodies: list[str]
+    floor_effort_share: float
+    passed: bool
+    reasons: list[str]
+    notes: list[str] = field(default_factory=list)
+    timing: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def status(self) -> str:
+        return "pass" if self.passed else "fail"
+
+    def to_json(self) -> dict:
+        return {
+            "passed": bool(self.passed),
+            "status": self.status,
+            "reasons": "; ".join(self.reasons),
+            "tracking_error": {k: float(v) for k, v in sorted(self.tracking_error.items())},
+            "travel": {k: float(v) for k, v in sorted(self.travel.items())},
+            "tracking_error_max": float(self.tracking_error_max),
+            "tracking_tolerance": float(self.tracking_tolerance),
+            "calibration_factor": float(CALIBRATION_FACTOR),
+            "calibration_error": float(self.calibration_error),
+            "resolution": float(self.resolution),
+            "min_resolution": float(MIN_RESOLUTION),
+            "force_residual": float(self.force_residual),
+            "moment_residual": float(self.moment_residual),
+            "force_reference": float(self.force_reference),
+            "moment_reference": float(self.moment_reference),
+            "force_peak": float(self.force_peak),
+            "moment_peak": float(self.moment_peak),
+            "dt": float(self.dt),
+            "steps": int(self.steps),
+            "iterations": int(self.iterations),
+            "floored_bodies": ",".join(self.floored_bodies),
+            "floor_effort_share": float(self.floor_effort_share),
+            "notes": "; ".join(self.notes),
+        }
+
+
+def floored_model(model: Model, mass_floor: float) -> tuple[Model, list[str]]:
+    """``model`` with the masses and moments pymunk simulates: a body lighter (of smaller
+    moment) than ``mass_floor`` of the largest gets a part at its centre of mass that brings it
+    to the floor (the same rule as :func:`balpipe.validate.space.build_space`)."""
+    probe = build_space(model, np.zeros((len(model.bodies), 3)), mass_floor=mass_floor, drive=False)
+    out = model
+    for b, pb in zip(model.bodies, probe.bodies):
+        m, com, inertia = b.mass_properties()
+        dm, di = pb.mass - m, pb.moment - inertia
+        if dm > 0 or di > 0:
+            part = Attachment("pymunk floor", max(dm, 0.0), tuple(com), max(di, 0.0), kind="part")
+            out = out.replace_body(b.with_attachments(part))
+    return out, list(probe.floored)
+
+
+def _travel(model: Model, t: np.ndarray) -> dict[str, float]:
+    out = {}
+    for d in model.drivers:
+        q = np.asarray(d.law(t)[0], dtype=float)
+        out[d.name] = float(max(abs(q[-1] - q[0]), np.max(np.abs(q - q[0]))))
+    return out
+
+
+def torque_driven(
+    model: Model,
+    analysis: Analysis,
+    settings: ValidationSettings | None = None,
+    *,
+    analytic_model: Model | None = None,
+    reference: tuple[float, float] | None = None,
+    dt: float | None = None,
+    iterations: int | None = None,
+    calibrate: bool = True,
+) -> TorqueDriven:
+    """Drive ``model`` in pymunk by the efforts of ``analytic_model`` (default ``model``) and
+    compare the motion with ``analysis`` (the analysis of ``analytic_model``: the planned
+    motion and loads).
+
+    ``reference`` = (force, moment): the denominators of the load residuals (default the
+    analysis' peaks). ``dt``/``iterations``: those of the position-driven validation (default
+    :func:`default_settings`; ``settings.iterations``). ``calibrate``: also run with the efforts
+    times ``CALIBRATION_FACTOR`` (``calibration_error``; NaN when False).
+    """
+    settings = settings or ValidationSettings()
+    wall0 = time.perf_counter()
+    analytic_model = analytic_model or model
+    t = np.asarray(analysis.t, dtype=float)
+    dt_default, it_default = default_settings(model, analysis)
+    dt, nsteps, idx = _step_grid(t, dt or settings.dt or dt_default)
+    iterations = int(iterations or settings.iterations or it_default or ITERATIONS)
+    n = int(round((float(t[-1]) - float(t[0])) / dt))
+    times = float(t[0]) + dt * np.arange(n + 1)
+    sim_model, floored = floored_model(model, settings.mass_floor)
+    effort_model = sim_model
+    if analytic_model is not model:  # the analytic model with the simulated mechanism's floor parts
+        effort_model = analytic_model
+        for b in sim_model.bodies:
+            extra = [a for a in b.attachments if a.name == "pymunk floor"]
+            if extra:
+                effort_model = effort_model.replace_body(effort_model.body(b.name).with_attachments(*extra))
+    fine = analyse(effort_model, times, analysis.gravity, analysis.moment_point)
+    efforts = {k: np.asarray(v, dtype=float) for k, v in fine.efforts.items()}
+    notes: list[str] = []
+    share = 0.0
+    if floored:
+        bare = analyse(analytic_model, times, analysis.gravity, analysis.moment_point).efforts
+        peak = max((float(np.max(np.abs(v))) for v in bare.values()), default=0.0) or 1.0
+        share = max(float(np.max(np.abs(efforts[k] - bare[k]))) for k in bare) / peak
+        notes.append(
+            "simulated with floor parts (" + ", ".join(floored) + f": {100 * settings.mass_floor:g} % of the largest "
+            f"mass and moment); the efforts include their inertial loads, {100 * share:.2g} % of the peak effort"
+        )
+    travel = _travel(analytic_model, t)
+
+    def run(factor: float) -> SimulationRun | None:
+        with np.errstate(all="ignore"):
+            try:
+                r = simulate(
+                    sim_model, analysis, dt, iterations, startup_steps=settings.startup_steps,
+                    startup_iterations=max(settings.startup_iterations, iterations),
+                    efforts={k: factor * v for k, v in efforts.items()}, measure_with=model,
+                    mass_floor=settings.mass_floor,
+                )
+            except (ZeroDivisionError, ValueError, OverflowError, FloatingPointError):
+                return None
+        ok = np.isfinite(r.force).all() and all(np.isfinite(v).all() for v in r.driver_error.values())
+        return r if ok else None
+
+    def relative_error(r: SimulationRun | None) -> float:
+        if r is None:
+            return math.inf
+        return max((float(np.max(np.abs(e))) / (travel[k] or 1.0) for k, e in r.driver_error.items()), default=0.0)
+
+    main = run(1.0)
+    calib = relative_error(run(CALIBRATION_FACTOR)) if calibrate else math.nan
+    F0, M0 = reference if reference is not None else (analysis.max_inertial_force, analysis.max_inertial_moment)
+    F0 = F0 if F0 > 0 else 1.0
+    M0 = M0 if M0 > 0 else 1.0
+    N = len(t)
+    grid = idx if idx is not None else np.searchsorted(times, t).clip(0, n)
+    reasons: list[str] = []
+    if main is None:
+        nan = np.full(N, np.nan)
+        reasons.append("the torque-driven simulation came apart")
+        return TorqueDriven(
+            t, np.full((N, 2), np.nan), nan, {}, {d.name: math.inf for d in model.drivers}, travel, math.inf,
+            calib, 0.0, math.inf, math.inf, F0, M0, math.inf, math.inf, settings.tracking_tolerance, dt, nsteps, iterations, floored,
+            share, False, reasons, notes, {"total_s": time.perf_counter() - wall0},
+        )
+    kinds = _law_kinds(analytic_model, t)
+    F, M, measured, _ = _on_grid(main, analysis, idx, kinds, 0, _jumps(analytic_model, main.t))
+    ferr = np.linalg.norm(F - analysis.force, axis=1)[measured]
+    merr = np.abs(M - analysis.moment)[measured]
+    fres = float(np.max(ferr)) / F0 if ferr.size else math.inf
+    mres = float(np.max(merr)) / M0 if merr.size else math.inf
+    W, Ms = analysis.static_load()
+    fpk = float(np.max(np.linalg.norm((F - W)[measured], axis=1))) / F0 if measured.any() else math.inf
+    mpk = float(np.max(np.abs((M - Ms)[measured]))) / M0 if measured.any() else math.inf
+    tracking = {k: np.asarray(v, dtype=float)[grid] for k, v in main.driver_error.items()}
+    rel = {k: float(np.max(np.abs(v))) / (travel[k] or 1.0) for k, v in main.driver_error.items()}
+    worst = max(rel.values(), default=0.0)
+    resolution = calib / worst if worst > 0 else math.inf
+    tol = settings.tracking_tolerance
+    if not worst <= tol:
+        reasons.append(f"tracking error {worst:.3g} of the travel > {tol:g}")
+    if calibrate and not resolution >= MIN_RESOLUTION:
+        reasons.append(
+            f"the run does not resolve a model error: efforts times {CALIBRATION_FACTOR:g} give only "
+            f"{resolution:.3g} times its tracking error (< {MIN_RESOLUTION:g})"
+        )
+    return TorqueDriven(
+        t=t, force=F, moment=M, tracking=tracking, tracking_error=rel, travel=travel, tracking_error_max=worst,
+        calibration_error=calib, resolution=resolution, force_residual=fres, moment_residual=mres,
+        force_reference=F0, moment_reference=M0, force_peak=fpk, moment_peak=mpk, tracking_tolerance=tol, dt=dt, steps=nsteps,
+        iterations=iterations, floored_bodies=floored, floor_effort_share=share, passed=not reasons,
+        reasons=reasons, notes=notes + list(main.sim.notes),
+        timing={"simulation_s": main.wall, "total_s": time.perf_counter() - wall0},
+    )

@@ -1,0 +1,93 @@
+"""Issue 7, item 2: relative figures divide by a reference with an absolute floor from the
+model's own scale, so a spec that is already balanced does not fail on noise over noise."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balpipe import loader, study
+from balpipe.engine import analyse
+from balpipe.load_reference import FLOOR_FRACTION, gross_inertial_loads, load_reference
+
+ROOT = Path(__file__).resolve().parents[1]
+FIXTURE = ROOT / "tests" / "fixtures" / "reactionless_arm.yaml"
+
+sys.path.insert(0, str(Path(__file__).parent))
+from conftest import slider_crank_spec  # noqa: E402
+from test_validate import GRID, arm_2r, five_bar, geared_disc, reactionless_arm, slider_crank  # noqa: E402
+
+
+def test_balanced_one_stage_spec_has_no_false_failure():
+    """Failed on the code before the fix: ratios 1.0 and reactions-vs-momentum 5e3 "of the
+    unbalanced peak" (both routes are round-off)."""
+    st = study.run(loader.load(FIXTURE).spec)
+    assert len(st.stages) == 1
+    an = st.unbalanced.analysis
+    assert an.max_force < 1e-12 and an.max_moment < 1e-12  # already balanced: round-off
+    assert st.problems == []
+    m = study.stage_metrics(st.unbalanced, st.unbalanced, 1e-9)
+    assert m["force_ratio"] < 1e-12 and m["moment_ratio"] < 1e-12
+    ref = st.reference
+    assert ref.force_basis == "floor" and ref.moment_basis == "floor"
+    assert ref.force == pytest.approx(FLOOR_FRACTION * ref.force_scale)
+    assert st.checks["reactions_vs_momentum"] < 1e-9
+    assert m["force_balanced"] and m["moment_balanced"]
+    assert st.checks["reference"]["force_basis"] == "floor"
+
+
+def test_balanced_one_stage_spec_builds_with_exit_0(tmp_path):
+    """The acceptance: the whole build, pymunk validation included, exits 0; results.json and
+    the page say which reference the figures are relative to."""
+    r = subprocess.run([sys.executable, "-m", "balpipe", "build", str(FIXTURE), "-o", str(tmp_path / "out")],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    res = json.loads((tmp_path / "out" / "reactionless_arm" / "results.json").read_text())
+    assert res["status"] == "ok" and res["problems"] == []
+    ref = res["checks"]["reference"]
+    assert ref["force_basis"] == "floor" and ref["moment_basis"] == "floor"
+    assert ref["gross_inertial_force"] > 10 and ref["unbalanced_force_peak"] < 1e-12
+    v = res["validation"]["unbalanced"]
+    assert v["passed"] and v["reference_basis"] == "force: floor; moment: floor"
+    assert v["force_reference"] == pytest.approx(ref["force"])
+    page = (tmp_path / "out" / "reactionless_arm" / "index.html").read_text()
+    assert "of the gross inertial force" in page and "already (nearly) balanced" in page
+
+
+@pytest.mark.parametrize("make", [arm_2r, five_bar, slider_crank, geared_disc])
+def test_reference_is_the_unbalanced_peak_for_unbalanced_mechanisms(make):
+    model = make()
+    a = analyse(model, GRID)
+    ref = load_reference(model, a)
+    assert ref.force_basis == ref.moment_basis == "unbalanced peak" and not ref.floored
+    assert ref.force == a.max_inertial_force and ref.moment == a.max_inertial_moment
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_gross_loads_bound_the_shaking_loads_and_scale_with_mass(seed):
+    """|sum m a| <= sum |m a| (and the same for the moment) for random slider-cranks, every
+    stage; scaling every mass and inertia by k scales the gross loads by k."""
+    scales = {}
+    for k in (1.0, 3.0):
+        st = study.run(slider_crank_spec(np.random.default_rng(seed), mass_scale=k))
+        for s in st.stages:
+            sf, sm = gross_inertial_loads(s.stage.model, s.analysis)
+            assert s.analysis.max_inertial_force <= sf * (1 + 1e-12)
+            assert s.analysis.max_inertial_moment <= sm * (1 + 1e-12)
+            scales[k, s.stage.name] = np.array([sf, sm])
+    for (k, name), v in scales.items():
+        np.testing.assert_allclose(v, k * scales[1.0, name], rtol=1e-9)
+
+
+def test_reactionless_arm_model_gets_the_floor():
+    model = reactionless_arm()
+    a = analyse(model, GRID)
+    ref = load_reference(model, a)
+    assert ref.floored and "gross inertial force" in ref.describe("force")
+    sf, sm = gross_inertial_loads(model, a)
+    assert ref.force == pytest.approx(0.01 * sf) and ref.moment == pytest.approx(0.01 * sm)

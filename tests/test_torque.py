@@ -1,0 +1,170 @@
+"""Issue 7, item 7: the torque-driven run checks the inverse dynamics. The actuators apply the
+engine's efforts, pymunk integrates the motion; a 10 % error in one body's inertia or mass in
+the analytic model only (the simulated mechanism keeps the true one) makes the check fail."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balpipe.engine import analyse
+from balpipe.validate import ValidationSettings, simulate
+from balpipe.validate.torque import CALIBRATION_FACTOR, floored_model, torque_driven
+
+sys.path.insert(0, str(Path(__file__).parent))
+from test_validate import (  # noqa: E402
+    GRID, arm_2r, five_bar, gear_train, geared_disc, planetary, rp_arm, slider_crank,
+)
+
+MODELS = {
+    "2R arm": arm_2r,
+    "five-bar (closed chain)": five_bar,
+    "slider-crank (prismatic, 1 DOF)": slider_crank,
+    "slider-crank driven by x": lambda: slider_crank(drive="x"),
+    "prismatic driver on a rotating guide": rp_arm,
+    "disc geared to the frame": geared_disc,
+    "planetary gear": planetary,
+    "massless idler (floors)": gear_train,
+}
+
+
+def run(model, analysis=None, analytic_model=None, gravity=(0.0, 0.0), **kw):
+    a = analysis if analysis is not None else analyse(analytic_model or model, GRID, gravity=gravity)
+    return torque_driven(model, a, analytic_model=analytic_model, dt=5e-4, iterations=200, **kw), a
+
+
+def perturbed(model, body: str, inertia: float = 1.0, mass: float = 1.0):
+    """``model`` with one body's bare inertia (mass) scaled; its attachments unchanged."""
+    b = model.body(body)
+    return model.replace_body(dataclasses.replace(b, inertia=b.inertia * inertia, mass=b.mass * mass))
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_true_model_follows_the_plan(name):
+    r, a = run(MODELS[name]())
+    assert r.passed, r.reasons
+    assert r.tracking_error_max < 1e-4  # of the travel; measured 4e-6 .. 4e-5
+    assert 0.05 < r.calibration_error < 0.3  # efforts 10 % low: ~ 10 % of the travel
+    assert r.resolution > 100
+    assert r.force_residual < 1e-3 and r.moment_residual < 1e-3  # the simulated loads, too
+    assert abs(r.force_peak - a.max_inertial_force / r.force_reference) < 1e-3
+    assert abs(r.moment_peak - a.max_inertial_moment / r.moment_reference) < 1e-3
+    assert set(r.tracking) == {d.name for d in MODELS[name]().drivers}
+
+
+def test_five_bar_with_gravity():
+    model = five_bar()
+    r, a = run(model, gravity=(0.0, -9.81))
+    assert r.passed and r.tracking_error_max < 1e-4, r.reasons
+
+
+@pytest.mark.parametrize("name, body, inertia, mass", [
+    ("2R arm", "l1", 1.1, 1.0),
+    ("2R arm", "l2", 1.0, 1.1),
+    ("five-bar (closed chain)", "d1", 1.1, 1.0),
+    ("slider-crank (prismatic, 1 DOF)", "rod", 1.1, 1.0),
+    ("slider-crank (prismatic, 1 DOF)", "slider", 1.0, 1.1),
+    ("planetary gear", "planet", 1.1, 1.0),
+    ("disc geared to the frame", "disc", 1.1, 1.0),
+])
+def test_ten_percent_error_in_the_analytic_model_fails(name, body, inertia, mass):
+    """The analysis (and its efforts) of a model with one body 10 % off drives the true
+    mechanism: the motion leaves the plan by more than the tolerance, and the check fails.
+    """
+    true = MODELS[name]()
+    wrong = perturbed(true, body, inertia, mass)
+    a_wrong = analyse(wrong, GRID)
+    r, _ = run(true, a_wrong, analytic_model=wrong, calibrate=False)
+    assert not r.passed and r.status == "fail"
+    assert r.tracking_error_max > 3 * ValidationSettings().tracking_tolerance
+    assert any("tracking error" in x for x in r.reasons)
+
+
+def test_efforts_ten_percent_low_move_a_pure_inertia_ten_percent_less():
+    """The calibration, on an arm and a disc geared to it about fixed axes (one inertia): q'' =
+    0.9 q''_plan gives q - q0 = 0.9 (q_plan - q0), an error of 10 % of the travel at the end."""
+    r, _ = run(geared_disc())
+    assert CALIBRATION_FACTOR == 0.9
+    assert r.calibration_error == pytest.approx(1.0 - CALIBRATION_FACTOR, rel=1e-3)
+
+
+def test_floors_are_compensated_in_the_efforts():
+    model = gear_train()
+    sim, floored = floored_model(model, 0.1)
+    assert set(floored) >= {"idler", "disc"}
+    assert sim.body("idler").mass_properties()[0] > 0 and model.body("idler").mass_properties()[0] == 0
+    r, a = run(model)
+    assert r.floor_effort_share > 0.05 and r.passed
+    # without the compensation the run drifts: the floor parts are real inertia in pymunk
+    dt = 5e-4
+    times = dt * np.arange(int(round(GRID[-1] / dt)) + 1)
+    bare = analyse(model, times).efforts
+    raw = simulate(sim, a, dt, 200, efforts=bare, measure_with=model, mass_floor=0.1)
+    err = np.max(np.abs(raw.driver_error["q"])) / 2.0
+    assert err > 10 * r.tracking_error_max and err > 1e-3
+
+
+def test_to_json_is_plain_and_deterministic():
+    j1 = run(planetary())[0].to_json()
+    j2 = run(planetary())[0].to_json()
+    assert json.dumps(j1, sort_keys=True) == json.dumps(j2, sort_keys=True)
+    for key in ("tracking_error", "tracking_error_max", "tracking_tolerance", "calibration_error", "resolution",
+                "force_residual", "moment_residual", "passed", "dt", "iterations"):
+        assert key in j1
+    assert all(math.isfinite(v) for v in j1["tracking_error"].values())
+    assert j1["travel"]["d1"] == pytest.approx(1.5) and j1["travel"]["d2"] == pytest.approx(1.8)
+
+
+def test_tracking_curves_on_the_analysis_grid():
+    r, a = run(arm_2r())
+    assert r.tracking["d1"].shape == (len(GRID),) and r.force.shape == (len(GRID), 2)
+    assert np.max(np.abs(r.tracking["d1"])) == pytest.approx(r.tracking_error["d1"] * 1.5, rel=1e-6)
+
+
+def test_paper_five_bar_stages_pass():
+    """The spec with gear-coupled inputs, a massless idler and planetary gears (one driver, a
+    closed chain): every stage follows its plan; link 3 (with its counterweight) 10 % too heavy,
+    in the analysis only, is caught (tracking error 4.6e-2 of the travel). Link 3's bare
+    centroidal inertia alone (0.01 kg m^2) is too small to matter next to the counterweights."""
+    from balpipe import loader, study
+
+    st = study.run(loader.load(Path(__file__).resolve().parents[1] / "specs" / "paper004_five_bar.yaml").spec)
+    for s in st.stages:
+        r = torque_driven(s.stage.model, s.analysis, dt=1e-3, iterations=400, calibrate=False)
+        assert r.passed and r.tracking_error_max < 1e-4, (s.stage.name, r.reasons)
+    s = st.stages[1]  # counterweights
+    b = s.stage.model.body("link3")
+    wrong = s.stage.model.replace_body(dataclasses.replace(
+        b, mass=1.1 * b.mass, inertia=1.1 * b.inertia,
+        attachments=tuple(dataclasses.replace(a, mass=1.1 * a.mass, inertia=1.1 * a.inertia) for a in b.attachments)))
+    r = torque_driven(s.stage.model, analyse(wrong, s.analysis.t), analytic_model=wrong, dt=1e-3, iterations=400,
+                      calibrate=False)
+    assert not r.passed and r.tracking_error_max > 1e-3
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_random_slider_cranks(seed):
+    """Random slider-cranks (seeded), every balancing stage: the true model follows its plan;
+    the heaviest body 10 % too heavy (mass, inertia and its counterweight), in the analysis
+    only, is caught."""
+    from balpipe import study
+    from conftest import slider_crank_spec
+
+    st = study.run(slider_crank_spec(np.random.default_rng(100 + seed)))
+    for s in st.stages:
+        model = s.stage.model
+        r = torque_driven(model, s.analysis, calibrate=False)
+        assert r.passed and r.tracking_error_max < 2e-4, (seed, s.stage.name, r.reasons)
+    model = st.stages[1].stage.model  # counterweights
+    heavy = max(model.bodies, key=lambda b: b.mass_properties()[0])
+    wrong = model.replace_body(dataclasses.replace(
+        heavy, mass=1.1 * heavy.mass, inertia=1.1 * heavy.inertia,
+        attachments=tuple(dataclasses.replace(a, mass=1.1 * a.mass, inertia=1.1 * a.inertia) for a in heavy.attachments)))
+    r = torque_driven(model, analyse(wrong, st.stages[1].analysis.t), analytic_model=wrong, calibrate=False)
+    assert not r.passed and r.tracking_error_max > 2e-3, (seed, heavy.name, r.tracking_error_max)
