@@ -10,9 +10,10 @@ import numpy as np
 
 from . import units
 from .balancing import five_bar as fb_balancing
+from .balancing import rpr3_idler, rpr3_scott_russell
 from .balancing import slider_crank as sc_balancing
 from .balancing.base import BalanceResult, Stage
-from .mechanisms import custom, five_bar, slider_crank
+from .mechanisms import custom, five_bar, rpr3, slider_crank
 from .model import Law, Model
 from .motion import law_for
 from .spec_parts import SpecFieldError
@@ -41,6 +42,7 @@ TEMPLATES: dict[str, Template] = {
     "slider_crank": Template(slider_crank.build, "slider-crank"),
     "custom": Template(custom.build, "custom mechanism"),
     "five_bar": Template(five_bar.build, "five-bar (5R), fixed-sequence with gear-coupled inputs", five_bar.figures),
+    "rpr3": Template(rpr3.build, "3-RPR parallel manipulator", rpr3.figures),
 }
 METHODS: dict[str, Method] = {
     "slider_crank_counterweights": Method(
@@ -48,6 +50,13 @@ METHODS: dict[str, Method] = {
     ),
     "five_bar_gear_balancing": Method(
         fb_balancing.balance, ("five_bar",), "counterweights + counter-rotating gears 5, 6, 7 (eqs. 9-21)"
+    ),
+    "rpr3_idler_loop": Method(
+        rpr3_idler.balance, ("rpr3",), "idler loop E-F-P, counterweights (eqs. 5a-d), chained counter-rotations (eqs. 9a-d)"
+    ),
+    "rpr3_scott_russell": Method(
+        rpr3_scott_russell.balance, ("rpr3",),
+        "Scott-Russell legs, counterweights (eqs. 30a-d), eq. 30e, one counter-rotation per leg (eq. 30f)",
     ),
 }
 

@@ -13,9 +13,12 @@ from typing import Annotated, Literal, Union
 from pydantic import Field
 
 from .balancing.five_bar import FiveBarGearBalancing
+from .balancing.rpr3_idler import Rpr3IdlerLoop
+from .balancing.rpr3_scott_russell import Rpr3ScottRussell
 from .balancing.slider_crank import SliderCrankCounterweights
 from .mechanisms.custom import CustomMechanism
 from .mechanisms.five_bar import FiveBarMechanism
+from .mechanisms.rpr3 import Rpr3Mechanism
 from .mechanisms.slider_crank import SliderCrankMechanism
 from .spec_parts import DriveSpec, Strict
 from .units import Duration, Length, quantity
@@ -28,11 +31,11 @@ class NoBalancing(Strict):
 
 
 Mechanism = Annotated[
-    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism],
+    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism, Rpr3Mechanism],
     Field(discriminator="template", description="the mechanism: a template with its parameters"),
 ]
 Balancing = Annotated[
-    Union[NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing],
+    Union[NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing, Rpr3IdlerLoop, Rpr3ScottRussell],
     Field(discriminator="method", description="the balancing method and its design choices"),
 ]
 
