@@ -260,17 +260,28 @@ def test_leg_laws_are_exact_derivatives():
         assert np.allclose((qdp - qdm) / (2 * h), qdd, rtol=1e-5, atol=1e-6)
 
 
+def _first_valid(seed: int, **kw) -> tuple[Spec, object]:
+    r = np.random.default_rng(seed)
+    for _ in range(50):
+        spec = Spec.model_validate(random_rpr3(r, **kw))
+        try:
+            return spec, analyse(registry.unbalanced_model(spec), registry.time_grid(spec))
+        except SpecFieldError:
+            continue
+    raise AssertionError("no valid random design")
+
+
 def test_loads_scale_with_mass_and_duration():
-    spec, result = valid(random_idler, np.random.default_rng(11))
-    t = registry.time_grid(spec)
-    base = analyse(result.stages[1].model, t)
-    d = random_idler(np.random.default_rng(11))
-    half = Spec.model_validate({**spec.model_dump(by_alias=True), "motion": {
-        **spec.motion.model_dump(by_alias=True), "duration": spec.motion.duration / 2}})
-    fast = analyse(registry.balance(half).stages[1].model, registry.time_grid(half))
-    assert fast.max_force == pytest.approx(4 * base.max_force, rel=1e-9)
-    assert fast.max_moment == pytest.approx(4 * base.max_moment, rel=1e-9)
-    assert d  # the same seed gives the same design
+    """Scaling every mass and inertia by k scales loads and efforts by k; halving the duration
+    multiplies them by 4."""
+    _, base = _first_valid(11)
+    _, heavy = _first_valid(11, scale=2.5)
+    _, fast = _first_valid(11, duration=0.15)
+    for other, k in ((heavy, 2.5), (fast, 4.0)):
+        assert other.max_force == pytest.approx(k * base.max_force, rel=1e-9)
+        assert other.max_moment == pytest.approx(k * base.max_moment, rel=1e-9)
+        for name, e in base.efforts.items():
+            assert np.max(np.abs(other.efforts[name] - k * e)) <= 1e-9 * np.max(np.abs(k * e))
 
 
 # --------------------------------------------------------------------------------------------
@@ -380,3 +391,13 @@ def test_template_figures_reproduce_fig_4(idler):
     titles = [f[0] for f in figs]
     assert titles[0].startswith("Shaking force and moment, every stage (Fig. 4")
     assert "17.07" in figs[1][1]  # the factor relative to the plain 3-RPR
+
+
+def test_methods_compared_on_the_same_3rpr():
+    s = study.run(load(SPECS / "paper000_rpr3_methods_compared.yaml").spec)
+    assert s.ok
+    title, table, _ = list(s.extra_figures())[2]
+    assert title == "The two methods on the same 3-RPR"
+    rows = table.split("<tr>")[2:]
+    assert rows[0].startswith("<td>Scott-Russell") and "<td>3</td>" in rows[0]
+    assert rows[1].startswith("<td>idler loop") and "<td>6</td>" in rows[1]
