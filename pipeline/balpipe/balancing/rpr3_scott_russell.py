@@ -35,6 +35,7 @@ from ..units import Length
 from .base import BalanceResult, Parameter, Stage
 from .parts import add_counter_rotation, add_counterweight
 from .rpr3_idler import Rpr3IdlerLoop
+from .slider_crank import eq20_lhs
 
 PATH = ("balancing",)
 
@@ -113,8 +114,7 @@ def counterweight_masses(d: LegDesign) -> dict[str, float]:
 def ieq2(d: LegDesign, m: dict[str, float]) -> float:
     """Eq. 28 (= the right-hand side of eq. 30e): I1 + m1 p1^2 + mcp1 c1^2 + (m2 + mcp2) L1^2
     - I2 - m2 p2^2 - mcp2 c2^2, counterweight inertias added to I1 and I2."""
-    return (d.I1 + d.Icp1 + d.m1 * d.p1**2 + m["mcp1"] * d.c1**2 + (d.m2 + m["mcp2"]) * d.L1**2
-            - d.I2 - d.Icp2 - d.m2 * d.p2**2 - m["mcp2"] * d.c2**2)
+    return eq20_lhs(d.I1 + d.Icp1, d.m1, d.p1, m["mcp1"], d.c1, d.L1, d.I2 + d.Icp2, d.m2, d.p2, m["mcp2"], d.c2)
 
 
 def counter_rotation_inertia(d: LegDesign, m: dict[str, float]) -> float:
