@@ -19,7 +19,9 @@ Motion: the platform pose (x, y, phi) on the spec's law. The template drives the
 (prismatic: rho_i; revolute: the cylinder's angle theta_i) on laws obtained from the pose by
 inverse kinematics, with exact first and second derivatives by the chain rule, so the engine
 reports the actuator efforts at those joints: the axial force of each prismatic actuator, or
-the torque of each revolute one.
+the torque of each revolute one. A pose out of the stroke, or a parallel singularity of the
+chosen actuation (prismatic: the three leg lines concurrent, e.g. a platform homothetic to the
+base, as at the paper's start pose phi = 0), is a located error naming the time (and the leg).
 """
 
 from __future__ import annotations
