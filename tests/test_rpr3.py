@@ -401,3 +401,29 @@ def test_methods_compared_on_the_same_3rpr():
     rows = table.split("<tr>")[2:]
     assert rows[0].startswith("<td>Scott-Russell") and "<td>3</td>" in rows[0]
     assert rows[1].startswith("<td>idler loop") and "<td>6</td>" in rows[1]
+
+
+def test_prismatic_equivalent_of_revolute_torques():
+    """The axial forces that the page shows for revolute-actuated specs equal the efforts of the
+    same motion driven at the prismatic pairs."""
+    r = np.random.default_rng(41)
+    for _ in range(50):
+        d = random_rpr3(r, actuation="revolute")
+        try:
+            spec_r = Spec.model_validate(d)
+            model_r = registry.unbalanced_model(spec_r)
+            d["mechanism"]["actuation"] = "prismatic"
+            spec_p = Spec.model_validate(d)
+            model_p = registry.unbalanced_model(spec_p)
+            break
+        except SpecFieldError:
+            continue
+    t = registry.time_grid(spec_r)
+    ar, ap = analyse(model_r, t), analyse(model_p, t)
+    tau = np.stack([ar.efforts[f"theta{i}"] for i in (1, 2, 3)], axis=1)
+    f = rpr3.prismatic_equivalent(spec_r.mechanism, rpr3.pose_of(model_r), t, tau)
+    fp = np.stack([ap.efforts[f"rho{i}"] for i in (1, 2, 3)], axis=1)
+    assert np.max(np.abs(f - fp)) <= 1e-9 * np.max(np.abs(fp))
+    # the shaking loads do not depend on the actuation
+    assert np.max(np.abs(ar.force - ap.force)) <= 1e-9 * ar.max_force
+    assert np.max(np.abs(ar.moment - ap.moment)) <= 1e-9 * ar.max_moment

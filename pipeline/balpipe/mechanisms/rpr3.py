@@ -370,6 +370,8 @@ def figures(study):
         "moving links exert on the base.",
     )
     yield ("Peak loads and the moment factor", _factor_table(study, method), _factor_caption(study, method))
+    if study.spec.mechanism.actuation == "revolute":
+        yield _prismatic_forces_figure(study, plt, to_svg)
     other = getattr(study.spec.balancing, "compare_with", None)
     if other is not None:
         yield ("The two methods on the same 3-RPR", _comparison_table(study, other),
@@ -408,6 +410,46 @@ def _comparison_table(study, other) -> str:
             "<th>added inertia (kg m²)</th><th>peak actuator effort (N m or N)</th><th>peak joint load (N)</th>"
             "<th>peak moment before counter-rotations (N m)</th><th>last stage max |F| / max |M| (N, N m)</th>"
             "</tr></thead><tbody>" + "".join(rows) + "</tbody></table>")
+
+
+def prismatic_equivalent(mech: Rpr3Mechanism, pose: Pose, t: np.ndarray, torques: np.ndarray) -> np.ndarray:
+    """(N, 3) axial forces that prismatic actuators would need for the same motion as revolute
+    actuators exerting ``torques`` (N, 3): both give the same generalised force on the platform
+    (virtual work; the passive joints do none), J_p^T f = J_r^T tau. NaN where J_p is singular."""
+    Jr = leg_jacobian(mech.model_copy(update={"actuation": "revolute"}), pose, t)
+    Jp = leg_jacobian(mech.model_copy(update={"actuation": "prismatic"}), pose, t)
+    Q = np.einsum("nij,ni->nj", Jr, torques)
+    scaled = Jp.copy()
+    scaled[:, :, 2] /= mech.platform_radius
+    s = np.linalg.svd(scaled, compute_uv=False)
+    ok = s[:, 0] / np.maximum(s[:, -1], 1e-300) < SINGULAR
+    out = np.full_like(Q, np.nan)
+    out[ok] = np.linalg.solve(np.transpose(Jp[ok], (0, 2, 1)), Q[ok][..., None])[..., 0]
+    return out
+
+
+def _prismatic_forces_figure(study, plt, to_svg):
+    mech = study.spec.mechanism
+    pose = pose_of(study.unbalanced.stage.model)
+    fig, axes = plt.subplots(1, 3, figsize=(10.5, 2.9), sharey=True)
+    for k, s in enumerate((study.stages[0], study.stages[-1])):
+        an = s.analysis
+        tau = np.stack([an.efforts[f"theta{i}"] for i in (1, 2, 3)], axis=1)
+        f = prismatic_equivalent(mech, pose, an.t, tau)
+        for i, ax in enumerate(axes):
+            ax.semilogy(an.t, np.abs(f[:, i]), color=("black", "0.6")[k], linewidth=(1.3, 2.2)[k], label=s.stage.label)
+            ax.set_title(f"|axial force| of leg {i + 1} (N)", fontsize=9)
+            ax.set_xlabel("time (s)")
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    return (
+        "Axial forces that prismatic actuators would need",
+        to_svg(fig, "rpr3-prismatic"),
+        "The same motion driven by actuators at the prismatic pairs B_i instead of the revolutes A_i: "
+        "J_p^T f = J_r^T tau (the same generalised force on the platform). Where the three leg lines meet "
+        "in one point (a parallel singularity of prismatic actuation, at phi = 0 for a platform homothetic "
+        "to the base) the forces are unbounded; samples there are left out.",
+    )
 
 
 def _factor_table(study, method: str) -> str:
