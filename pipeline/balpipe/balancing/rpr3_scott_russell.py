@@ -29,7 +29,7 @@ import numpy as np
 from pydantic import Field
 
 from ..mechanisms import rpr3
-from ..model import FRAME, Attachment, Body, Model, Revolute
+from ..model import FRAME, Body, Model, Revolute
 from ..spec_parts import LinkSpec, SpecFieldError, Strict
 from ..units import Length
 from .base import BalanceResult, Parameter, Stage
