@@ -396,7 +396,7 @@ def test_template_figures_reproduce_fig_4(idler):
 def test_methods_compared_on_the_same_3rpr():
     s = study.run(load(SPECS / "paper000_rpr3_scott_russell_corrected.yaml").spec)
     assert s.ok
-    title, table, _ = list(s.extra_figures())[2]
+    title, table, _ = list(s.extra_figures())[-1]
     assert title == "The two methods on the same 3-RPR"
     rows = table.split("<tr>")[2:]
     assert rows[0].startswith("<td>Scott-Russell") and "<td>3</td>" in rows[0]
