@@ -10,10 +10,11 @@ import numpy as np
 
 from . import units
 from .balancing import five_bar as fb_balancing
+from .balancing import rpr3_idler, rpr3_scott_russell
 from .balancing import rrr4 as rrr4_balancing
 from .balancing import slider_crank as sc_balancing
 from .balancing.base import BalanceResult, Stage
-from .mechanisms import custom, five_bar, rrr4, slider_crank
+from .mechanisms import custom, five_bar, rpr3, rrr4, slider_crank
 from .model import Law, Model
 from .motion import law_for
 from .spec_parts import SpecFieldError
@@ -43,6 +44,7 @@ TEMPLATES: dict[str, Template] = {
     "custom": Template(custom.build, "custom mechanism"),
     "five_bar": Template(five_bar.build, "five-bar (5R), fixed-sequence with gear-coupled inputs", five_bar.figures),
     "rrr4": Template(rrr4.build, "planar n-RRR parallel manipulator (4-RRR of paper 001, legs removable)", rrr4.figures),
+    "rpr3": Template(rpr3.build, "3-RPR parallel manipulator", rpr3.figures),
 }
 METHODS: dict[str, Method] = {
     "slider_crank_counterweights": Method(
@@ -53,6 +55,13 @@ METHODS: dict[str, Method] = {
     ),
     "rrr4_counter_masses": Method(
         rrr4_balancing.balance, ("rrr4",), "counter-masses: leg by leg (eqs. 8-11), from eq. 17 (Fig. 4a) and eqs. 19/21 (Fig. 6)"
+    ),
+    "rpr3_idler_loop": Method(
+        rpr3_idler.balance, ("rpr3",), "idler loop E-F-P, counterweights (eqs. 5a-d), chained counter-rotations (eqs. 9a-d)"
+    ),
+    "rpr3_scott_russell": Method(
+        rpr3_scott_russell.balance, ("rpr3",),
+        "Scott-Russell legs, counterweights (eqs. 30a-d), eq. 30e, one counter-rotation per leg (eq. 30f)",
     ),
 }
 

@@ -13,10 +13,13 @@ from typing import Annotated, Literal, Union
 from pydantic import Field
 
 from .balancing.five_bar import FiveBarGearBalancing
+from .balancing.rpr3_idler import Rpr3IdlerLoop
+from .balancing.rpr3_scott_russell import Rpr3ScottRussell
 from .balancing.rrr4 import RRR4Balancing
 from .balancing.slider_crank import SliderCrankCounterweights
 from .mechanisms.custom import CustomMechanism
 from .mechanisms.five_bar import FiveBarMechanism
+from .mechanisms.rpr3 import Rpr3Mechanism
 from .mechanisms.rrr4 import RRR4Mechanism
 from .mechanisms.slider_crank import SliderCrankMechanism
 from .spec_parts import DriveSpec, Strict
@@ -30,11 +33,11 @@ class NoBalancing(Strict):
 
 
 Mechanism = Annotated[
-    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism, RRR4Mechanism],
+    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism, RRR4Mechanism, Rpr3Mechanism],
     Field(discriminator="template", description="the mechanism: a template with its parameters"),
 ]
 Balancing = Annotated[
-    Union[NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing, RRR4Balancing],
+    Union[NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing, RRR4Balancing, Rpr3IdlerLoop, Rpr3ScottRussell],
     Field(discriminator="method", description="the balancing method and its design choices"),
 ]
 

@@ -52,6 +52,15 @@ def _counterweight_masses(mech: SliderCrankMechanism, c1: float, c2: float) -> t
     return mcp1, mcp2
 
 
+def eq20_lhs(I1: float, m1: float, p1: float, mcp1: float, c1: float, L1: float,
+             I2: float, m2: float, p2: float, mcp2: float, c2: float) -> float:
+    """Left-hand side of eq. 20 (= eq. 28's Ieq2 and eq. 30e for a 3-RPR leg) in lengths:
+    I1 + m1 p1^2 + mcp1 c1^2 + (m2 + mcp2) L1^2 - I2 - m2 p2^2 - mcp2 c2^2, the coefficient of the
+    crank's rotation relative to the guide in the angular momentum of a force-balanced
+    Scott-Russell mechanism (p: centres of mass, c: counterweights, from A and from B)."""
+    return I1 + m1 * p1**2 + mcp1 * c1**2 + (m2 + mcp2) * L1**2 - I2 - m2 * p2**2 - mcp2 * c2**2
+
+
 def is_scott_russell(mech: SliderCrankMechanism) -> bool:
     """Eq. 19: a = 0 and L1 = L2 (to round-off)."""
     L1, L2 = mech.crank.length, mech.coupler.length
@@ -122,12 +131,8 @@ def balance(mech: SliderCrankMechanism, method: SliderCrankCounterweights, model
         notes.append("Scott-Russell geometry: eq. 20 could cancel the moment too; name moment_unknown to do it.")
         return BalanceResult(params, stages, notes)
     # eq. 20: I1 + (m1 r1^2 + mcp1 rcp1^2 + m2 + mcp2) L1^2 - I2 - (m2 r2^2 + mcp2 rcp2^2) L1^2 = 0
-    m1, m2 = mech.crank.mass, mech.coupler.mass
-    p1, p2 = mech.crank.com, mech.coupler.com
-    lhs = (
-        mech.crank.inertia + m1 * p1**2 + mcp1 * c1**2 + (m2 + mcp2) * L1**2
-        - mech.coupler.inertia - m2 * p2**2 - mcp2 * c2**2
-    )
+    lhs = eq20_lhs(mech.crank.inertia, mech.crank.mass, mech.crank.com, mcp1, c1, L1,
+                   mech.coupler.inertia, mech.coupler.mass, mech.coupler.com, mcp2, c2)
     if method.moment_unknown == "crank_counterweight_inertia":
         needed, on = -lhs, "crank"
     else:

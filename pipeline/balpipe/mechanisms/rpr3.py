@@ -1,0 +1,484 @@
+"""3-RPR planar parallel manipulator template (paper 000, Sec. 2, Fig. 2(a)).
+
+Geometry (the paper's, and ../shared/reference/PAPERS.md's reading): O is the circumcentre of
+the base triangle A1A2A3, x along A1A2; A_i = Rb (cos a_i, sin a_i) with a_i = -150, -30,
+90 deg. The platform's frame has its origin at P, the centroid of C1C2C3, and turns by phi:
+C_i = P + R(phi) Rp (cos a_i, sin a_i) (platform parallel to the base at phi = 0).
+
+Leg i (i = 1, 2, 3): the cylinder (link i1) pivots on the base at A_i; the piston (link i2, of
+length L1 = |B_iC_i|) slides in it along u_i = (C_i - A_i) / |C_i - A_i| and is pinned to the
+platform at C_i. Centres of mass on the leg axis: the cylinder's at A_i + c1 u_i (the paper's
+d_AiS1i = r1 L1 u_i, r1 = 2 in Sec. 2), the piston's at B_i + c2 u_i (= C_i + (r2 - 1) L1 u_i).
+
+Bodies: ``cyl{i}`` (frame origin A_i, x along u_i), ``piston{i}`` (origin C_i, x along u_i,
+points ``B`` = (-L1, 0) and ``C`` = (0, 0)), ``platform`` (origin P, angle phi, points C1..C3
+and ``P``). Joints: revolutes ``A{i}`` (frame-cylinder) and ``C{i}`` (piston-platform), the
+prismatic pair ``B{i}`` (cylinder-piston, coordinate rho_i = |A_iC_i|).
+
+Motion: the platform pose (x, y, phi) on the spec's law. The template drives the actuated joints
+(prismatic: rho_i; revolute: the cylinder's angle theta_i) on laws obtained from the pose by
+inverse kinematics, with exact first and second derivatives by the chain rule, so the engine
+reports the actuator efforts at those joints: the axial force of each prismatic actuator, or
+the torque of each revolute one. A pose out of the stroke, or a parallel singularity of the
+chosen actuation (prismatic: the three leg lines concurrent, e.g. a platform homothetic to the
+base, as at the paper's start pose phi = 0), is a located error naming the time (and the leg).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Literal
+
+import numpy as np
+from pydantic import Field
+
+from ..model import FRAME, Body, Driver, Law, Model, Prismatic, Revolute
+from ..spec_parts import SpecFieldError, Strict
+from ..units import Inertia, Length, Mass, PositiveLength
+
+ANGLES_DEG = (-150.0, -30.0, 90.0)
+DRIVE_PATH = ("motion", "drive")
+
+
+class CylinderSpec(Strict):
+    """Link i1, pivoted on the base at A_i."""
+
+    mass: Mass = Field(description="mass of each cylinder (the paper's m1)")
+    com: Length = Field(
+        description="centre of mass along the leg from A_i towards C_i (the paper's r1 L1; "
+        "negative: beyond A_i)"
+    )
+    inertia: Inertia = Field(description="centroidal inertia of each cylinder (I1)")
+
+
+class PistonSpec(Strict):
+    """Link i2, sliding in the cylinder, pinned to the platform at C_i."""
+
+    length: PositiveLength = Field(description="|B_iC_i|, the paper's L1")
+    mass: Mass = Field(description="mass of each piston (m2)")
+    com: Length = Field(description="centre of mass along the leg from B_i towards C_i (r2 L1)")
+    inertia: Inertia = Field(description="centroidal inertia of each piston (I2)")
+
+
+class PlatformSpec(Strict):
+    """The moving platform; its centre of mass is P, the centroid of C1C2C3."""
+
+    mass: Mass = Field(description="mass mp")
+    inertia: Inertia = Field(description="centroidal inertia Ip")
+
+
+class Rpr3Mechanism(Strict):
+    """3-RPR parallel manipulator: three legs A_i-B_i-C_i between an equilateral base and an
+    equilateral platform (paper 000, Fig. 2)."""
+
+    template: Literal["rpr3"] = Field(description="mechanism template")
+    base_radius: PositiveLength = Field(description="Rb, circumradius of A1A2A3")
+    platform_radius: PositiveLength = Field(description="Rp, circumradius of C1C2C3")
+    cylinder: CylinderSpec
+    piston: PistonSpec
+    platform: PlatformSpec
+    actuation: Literal["prismatic", "revolute"] = Field(
+        "prismatic",
+        description="actuated joint of each leg: the prismatic pair B_i (effort: axial force) or "
+        "the base revolute A_i (effort: torque)",
+    )
+    stroke: tuple[PositiveLength, PositiveLength] | None = Field(
+        None,
+        description="range [min, max] of the leg length |A_iC_i| that the prismatic pair allows; "
+        "default: from the piston's length (B_i may not pass A_i) to unbounded",
+    )
+
+    def drives(self) -> dict[str, str]:
+        """The platform pose: x, y of P and the angle phi."""
+        return {"x": "length", "y": "length", "phi": "angle"}
+
+
+# --------------------------------------------------------------------------------------------
+# Geometry and inverse kinematics
+
+
+def unit(a: float) -> np.ndarray:
+    return np.array([math.cos(a), math.sin(a)])
+
+
+def base_points(Rb: float) -> np.ndarray:
+    """(3, 2) A_i."""
+    return np.array([Rb * unit(math.radians(a)) for a in ANGLES_DEG])
+
+
+def platform_points(Rp: float) -> np.ndarray:
+    """(3, 2) C_i in the platform frame (origin P)."""
+    return np.array([Rp * unit(math.radians(a)) for a in ANGLES_DEG])
+
+
+@dataclass(frozen=True)
+class Pose:
+    """Platform pose laws x(t), y(t), phi(t)."""
+
+    x: Law
+    y: Law
+    phi: Law
+    grid: np.ndarray | None = field(default=None, compare=False, repr=False)  # the analysis' time samples
+
+    def joint_point(self, c: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """C(t), C'(t), C''(t) (N, 2) of the platform point with local coordinates ``c``:
+        C = P + R(phi) c, C' = P' + phi' J R c, C'' = P'' + phi'' J R c - phi'^2 R c."""
+        x, xd, xdd = self.x(t)
+        y, yd, ydd = self.y(t)
+        f, fd, fdd = self.phi(t)
+        cf, sf = np.cos(f), np.sin(f)
+        rc = np.stack([cf * c[0] - sf * c[1], sf * c[0] + cf * c[1]], axis=1)
+        jrc = np.stack([-rc[:, 1], rc[:, 0]], axis=1)
+        P = np.stack([x, y], axis=1)
+        Pd = np.stack([xd, yd], axis=1)
+        Pdd = np.stack([xdd, ydd], axis=1)
+        return P + rc, Pd + fd[:, None] * jrc, Pdd + fdd[:, None] * jrc - (fd**2)[:, None] * rc
+
+
+def leg_coordinates(A: np.ndarray, C, Cd, Cdd) -> dict[str, np.ndarray]:
+    """rho = |C - A| and theta = angle of C - A with their first two time derivatives:
+    rho' = d.d'/rho, rho'' = (d'.d' + d.d'' - rho'^2)/rho, theta' = (d x d')/rho^2,
+    theta'' = (d x d'')/rho^2 - 2 rho' theta'/rho (d = C - A)."""
+    d = C - A
+    rho = np.hypot(d[:, 0], d[:, 1])
+    rhod = (d * Cd).sum(1) / rho
+    rhodd = ((Cd * Cd).sum(1) + (d * Cdd).sum(1) - rhod**2) / rho
+    cross = lambda a, b: a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]  # noqa: E731
+    th = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+    thd = cross(d, Cd) / rho**2
+    thdd = cross(d, Cdd) / rho**2 - 2 * rhod * thd / rho
+    return {"rho": (rho, rhod, rhodd), "theta": (th, thd, thdd)}
+
+
+@dataclass(frozen=True)
+class LegLaw(Law):
+    """The law of leg i's actuated coordinate (``rho`` or ``theta``) from the platform pose by
+    inverse kinematics, exact to second order (chain rule)."""
+
+    pose: Pose
+    A: tuple[float, float]
+    c: tuple[float, float]
+    coordinate: Literal["rho", "theta"]
+
+    def __call__(self, t):
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        C, Cd, Cdd = self.pose.joint_point(np.asarray(self.c), t)
+        return leg_coordinates(np.asarray(self.A), C, Cd, Cdd)[self.coordinate]
+
+
+def pose_laws(laws: dict[str, Law]) -> Pose:
+    missing = [k for k in ("x", "y", "phi") if k not in laws]
+    if missing:
+        raise SpecFieldError(
+            DRIVE_PATH,
+            f"the 3-RPR moves its platform: give motion.drive.x, .y and .phi (missing: {', '.join(missing)}; "
+            "a constant coordinate has equal from and to)",
+        )
+    return Pose(laws["x"], laws["y"], laws["phi"])
+
+
+def leg_lengths(mech: Rpr3Mechanism, pose: Pose, t: np.ndarray) -> np.ndarray:
+    """(N, 3) rho_i(t)."""
+    A, c = base_points(mech.base_radius), platform_points(mech.platform_radius)
+    out = []
+    for i in range(3):
+        C = pose.joint_point(c[i], t)[0]
+        out.append(np.hypot(C[:, 0] - A[i, 0], C[:, 1] - A[i, 1]))
+    return np.stack(out, axis=1)
+
+
+def check_workspace(mech: Rpr3Mechanism, pose: Pose, t: np.ndarray) -> np.ndarray:
+    """rho_i(t), or a located error naming the first time and leg outside the stroke."""
+    rho = leg_lengths(mech, pose, t)
+    lo, hi = mech.stroke if mech.stroke is not None else (mech.piston.length, math.inf)
+    bad = (rho <= lo) | (rho >= hi)
+    if np.any(bad):
+        k = int(np.argmax(bad.any(axis=1)))
+        i = int(np.argmax(bad[k]))
+        x, y, f = (float(law(t[k:k + 1])[0][0]) for law in (pose.x, pose.y, pose.phi))
+        limit = (f"shorter than its minimum {lo:.4g} m" + ("" if mech.stroke else " (the piston's length: B_i would pass A_i)")
+                 if rho[k, i] <= lo else f"longer than its maximum {hi:.4g} m")
+        raise SpecFieldError(
+            DRIVE_PATH,
+            f"the platform pose at t = {t[k]:.4g} s (x = {x:.4g} m, y = {y:.4g} m, phi = "
+            f"{math.degrees(f):.4g} deg) is outside the workspace: leg {i + 1} (A{i + 1}C{i + 1}) would be "
+            f"{rho[k, i]:.4g} m, {limit}",
+        )
+    return rho
+
+
+def leg_jacobian(mech: Rpr3Mechanism, pose: Pose, t: np.ndarray) -> np.ndarray:
+    """(N, 3, 3) J with q' = J (x', y', phi') for the actuated coordinates q: rows
+    [u_i, (R c_i) x u_i] for rho_i (prismatic) and [n_i, (R c_i) x n_i] / rho_i for theta_i
+    (revolute), u_i the leg's direction, n_i its left normal."""
+    A, c = base_points(mech.base_radius), platform_points(mech.platform_radius)
+    f = pose.phi(t)[0]
+    cf, sf = np.cos(f), np.sin(f)
+    rows = []
+    for i in range(3):
+        rc = np.stack([cf * c[i, 0] - sf * c[i, 1], sf * c[i, 0] + cf * c[i, 1]], axis=1)
+        C = pose.joint_point(c[i], t)[0]
+        d = C - A[i]
+        rho = np.hypot(d[:, 0], d[:, 1])
+        u = d / rho[:, None]
+        v = u if mech.actuation == "prismatic" else np.stack([-u[:, 1], u[:, 0]], axis=1) / rho[:, None]
+        rows.append(np.stack([v[:, 0], v[:, 1], rc[:, 0] * v[:, 1] - rc[:, 1] * v[:, 0]], axis=1))
+    return np.stack(rows, axis=1)
+
+
+SINGULAR = 1e10  # condition number of the (dimensionless) leg Jacobian taken as a parallel singularity
+
+
+def check_regular(mech: Rpr3Mechanism, pose: Pose, t: np.ndarray) -> np.ndarray:
+    """Condition numbers of the leg Jacobian (rotation column scaled by Rp), or a located error
+    where the actuated joints cannot control the platform (a parallel singularity: with
+    prismatic actuation the three leg lines meet in one point, e.g. a platform homothetic to the
+    base at phi = 0)."""
+    J = leg_jacobian(mech, pose, t)
+    J[:, :, 2] /= mech.platform_radius
+    s = np.linalg.svd(J, compute_uv=False)
+    cond = s[:, 0] / np.maximum(s[:, -1], 1e-300)
+    bad = ~(cond < SINGULAR)
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        x, y, f = (float(law(t[k:k + 1])[0][0]) for law in (pose.x, pose.y, pose.phi))
+        what = ("the three leg lines A_iC_i meet in one point" if mech.actuation == "prismatic"
+                else "the normals to the legs at C_i meet in one point")
+        raise SpecFieldError(
+            ("mechanism", "actuation"),
+            f"{mech.actuation} actuation is singular at t = {t[k]:.4g} s (x = {x:.4g} m, y = {y:.4g} m, "
+            f"phi = {math.degrees(f):.4g} deg): {what}, so the actuators cannot control the platform "
+            f"there (condition number {cond[k]:.2g}) and their efforts are unbounded; choose the other "
+            "actuation or a motion away from this pose",
+        )
+    return cond
+
+
+# --------------------------------------------------------------------------------------------
+# Model
+
+
+def build(mech: Rpr3Mechanism, laws: dict[str, Law], t: np.ndarray) -> Model:
+    """The plain 3-RPR (Fig. 2(a)) driven at its actuated joints."""
+    pose = replace(pose_laws(laws), grid=np.asarray(t, dtype=float))
+    check_workspace(mech, pose, t)
+    check_regular(mech, pose, t)
+    A, c = base_points(mech.base_radius), platform_points(mech.platform_radius)
+    L, cyl, pis, pl = mech.piston.length, mech.cylinder, mech.piston, mech.platform
+    t0 = np.zeros(1)
+    x0, y0, f0 = (float(law(t0)[0][0]) for law in (pose.x, pose.y, pose.phi))
+    platform = Body(
+        "platform", pl.mass, (0.0, 0.0), pl.inertia,
+        {"P": (0.0, 0.0), **{f"C{i + 1}": (float(c[i, 0]), float(c[i, 1])) for i in range(3)}},
+        outline=("C1", "C2", "C3", "C1"), kind="platform",
+    )
+    bodies, joints, drivers = [], [], []
+    initial = {"platform": (x0, y0, f0)}
+    for i in range(3):
+        n = i + 1
+        C, Cd, Cdd = pose.joint_point(c[i], t0)
+        lc = leg_coordinates(A[i], C, Cd, Cdd)
+        th0 = float(lc["theta"][0][0])
+        bodies += [
+            Body(f"cyl{n}", cyl.mass, (cyl.com, 0.0), cyl.inertia, {"A": (0.0, 0.0), "tip": (max(cyl.com, L), 0.0)},
+                 outline=("A", "tip")),
+            Body(f"piston{n}", pis.mass, (pis.com - L, 0.0), pis.inertia, {"B": (-L, 0.0), "C": (0.0, 0.0)},
+                 outline=("B", "C"), kind="slider"),
+        ]
+        initial[f"cyl{n}"] = (float(A[i, 0]), float(A[i, 1]), th0)
+        initial[f"piston{n}"] = (float(C[0, 0]), float(C[0, 1]), th0)
+        joints += [
+            Revolute(f"A{n}", FRAME, f"cyl{n}", (float(A[i, 0]), float(A[i, 1])), (0.0, 0.0)),
+            Prismatic(f"B{n}", f"cyl{n}", f"piston{n}", (0.0, 0.0), (1.0, 0.0)),
+            Revolute(f"C{n}", f"piston{n}", "platform", (0.0, 0.0), (float(c[i, 0]), float(c[i, 1]))),
+        ]
+        coordinate = "rho" if mech.actuation == "prismatic" else "theta"
+        law = LegLaw(pose, (float(A[i, 0]), float(A[i, 1])), (float(c[i, 0]), float(c[i, 1])), coordinate)
+        drivers.append(Driver(f"{coordinate}{n}", ("joint", f"B{n}" if coordinate == "rho" else f"A{n}"), law))
+    return Model(
+        name="3-RPR",
+        bodies=tuple(bodies) + (platform,),
+        joints=tuple(joints),
+        drivers=tuple(drivers),
+        initial=initial,
+        frame_points={f"A{i + 1}": (float(A[i, 0]), float(A[i, 1])) for i in range(3)},
+    )
+
+
+def sample_times(model: Model) -> np.ndarray:
+    """The analysis' time samples the template checked the motion on."""
+    return pose_of(model).grid
+
+
+def pose_of(model: Model) -> Pose:
+    """The platform pose laws carried by a 3-RPR model's drivers."""
+    for d in model.drivers:
+        if isinstance(d.law, LegLaw):
+            return d.law.pose
+    raise ValueError(f"model {model.name!r} is not driven through a 3-RPR platform pose")
+
+
+# --------------------------------------------------------------------------------------------
+# Report figures (the template's hook)
+
+PAPER_FIGURES = {"rpr3_idler_loop": "Fig. 4", "rpr3_scott_russell": "Fig. 8"}
+ADDED_LINKAGE = {"rpr3_idler_loop": "idler_loop", "rpr3_scott_russell": "scott_russell"}
+
+
+def _stage(study, name: str):
+    for s in study.stages:
+        if s.stage.name == name:
+            return s
+    return None
+
+
+def figures(study):
+    """The paper's shaking force x, y and moment figure with its line styles (Fig. 4 for the idler
+    loop, Fig. 8 for the Scott-Russell legs: unbalanced solid, counterweights dashed,
+    counter-rotations grey; the added-linkage stage, which the paper does not plot, dotted), and
+    a table of the peaks and of the factor by which the counterweights raise the peak moment."""
+    from ..report.figures import plt, to_svg  # matplotlib only when a report is drawn
+
+    method = study.spec.balancing.method
+    styles = {
+        "unbalanced": {"color": "black", "linestyle": "-", "linewidth": 1.3},
+        ADDED_LINKAGE.get(method, ""): {"color": "tab:blue", "linestyle": ":", "linewidth": 1.2},
+        "counterweights": {"color": "black", "linestyle": "--", "linewidth": 1.3},
+        "counter_rotations": {"color": "0.6", "linestyle": "-", "linewidth": 2.4},
+    }
+    fig, axes = plt.subplots(1, 3, figsize=(10.5, 3.2))
+    panels = (("(a) shaking force along x (N)", lambda a: a.force[:, 0]),
+              ("(b) shaking force along y (N)", lambda a: a.force[:, 1]),
+              ("(c) shaking moment about O (N m)", lambda a: a.moment))
+    for ax, (title, fn) in zip(axes, panels):
+        for s in study.stages:
+            st = styles.get(s.stage.name, {"color": "tab:red", "linestyle": "-.", "linewidth": 1.0})
+            ax.plot(s.analysis.t, fn(s.analysis), label=s.stage.label, **st)
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("time (s)")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
+    number = PAPER_FIGURES.get(method, "")
+    yield (
+        f"Shaking force and moment, every stage ({number} of paper 000)" if number else "Shaking force and moment",
+        to_svg(fig, "rpr3-loads"),
+        "The paper's line styles: before (solid) and after (dashed) the counterweights, after the "
+        "counter-rotations (grey); the stage with the added linkage but no counterweights, which the "
+        "paper does not plot, is dotted. Moments about O, the base's circumcentre; loads that the "
+        "moving links exert on the base.",
+    )
+    yield ("Peak loads and the moment factor", _factor_table(study, method), _factor_caption(study, method))
+    if study.spec.mechanism.actuation == "revolute":
+        yield _prismatic_forces_figure(study, plt, to_svg)
+    other = getattr(study.spec.balancing, "compare_with", None)
+    if other is not None:
+        yield ("The two methods on the same 3-RPR", _comparison_table(study, other),
+               "Both methods' stages analysed on the spec's 3-RPR and motion. Added mass and inertia: over the "
+               "unbalanced 3-RPR (links, counterweights and counter-rotations); peak joint load: the largest "
+               "force that a revolute joint carries; peak moment before the counter-rotations: the "
+               "counterweights stage's.")
+
+
+def _method_row(label: str, stages: list, analyses: list) -> str:
+    base = stages[0].model
+    last, an_last = stages[-1], analyses[-1]
+    cw_an = next(a for s, a in zip(stages, analyses) if s.name == "counterweights")
+    inert = lambda m: sum(b.inertia + sum(a.inertia for a in b.attachments) for b in m.bodies)  # noqa: E731
+    discs = sum(1 for b in last.model.bodies if b.kind == "gear")
+    effort = max(float(np.max(np.abs(e))) for e in an_last.efforts.values())
+    loads = [float(np.max(np.hypot(r["Fx"], r["Fy"]))) for r in an_last.reactions.values() if "Fx" in r]
+    return (f"<tr><td>{label}</td><td>{discs}</td><td>{last.model.total_mass() - base.total_mass():.4g}</td>"
+            f"<td>{inert(last.model) - inert(base):.4g}</td><td>{effort:.4g}</td><td>{max(loads):.4g}</td>"
+            f"<td>{cw_an.max_moment:.4g}</td><td>{an_last.max_force:.3g} / {an_last.max_moment:.3g}</td></tr>")
+
+
+def _comparison_table(study, other) -> str:
+    from .. import registry  # the registry imports this module
+    from ..engine import analyse
+
+    spec = study.spec
+    t = registry.time_grid(spec)
+    stages = registry.METHODS[other.method].balance(spec.mechanism, other, study.unbalanced.stage.model).stages
+    analyses = [analyse(s.model, t, (0.0, -spec.analysis.g) if spec.analysis.gravity else (0.0, 0.0),
+                        tuple(spec.analysis.moment_point)) for s in stages]
+    own = [s.stage for s in study.stages]
+    rows = [_method_row(registry.METHODS[spec.balancing.method].label, own, [s.analysis for s in study.stages]),
+            _method_row(registry.METHODS[other.method].label, stages, analyses)]
+    return ("<table><thead><tr><th>method</th><th>counter-rotations</th><th>added mass (kg)</th>"
+            "<th>added inertia (kg m²)</th><th>peak actuator effort (N m or N)</th><th>peak joint load (N)</th>"
+            "<th>peak moment before counter-rotations (N m)</th><th>last stage max |F| / max |M| (N, N m)</th>"
+            "</tr></thead><tbody>" + "".join(rows) + "</tbody></table>")
+
+
+def prismatic_equivalent(mech: Rpr3Mechanism, pose: Pose, t: np.ndarray, torques: np.ndarray) -> np.ndarray:
+    """(N, 3) axial forces that prismatic actuators would need for the same motion as revolute
+    actuators exerting ``torques`` (N, 3): both give the same generalised force on the platform
+    (virtual work; the passive joints do none), J_p^T f = J_r^T tau. NaN where J_p is singular."""
+    Jr = leg_jacobian(mech.model_copy(update={"actuation": "revolute"}), pose, t)
+    Jp = leg_jacobian(mech.model_copy(update={"actuation": "prismatic"}), pose, t)
+    Q = np.einsum("nij,ni->nj", Jr, torques)
+    scaled = Jp.copy()
+    scaled[:, :, 2] /= mech.platform_radius
+    s = np.linalg.svd(scaled, compute_uv=False)
+    ok = s[:, 0] / np.maximum(s[:, -1], 1e-300) < SINGULAR
+    out = np.full_like(Q, np.nan)
+    out[ok] = np.linalg.solve(np.transpose(Jp[ok], (0, 2, 1)), Q[ok][..., None])[..., 0]
+    return out
+
+
+def _prismatic_forces_figure(study, plt, to_svg):
+    mech = study.spec.mechanism
+    pose = pose_of(study.unbalanced.stage.model)
+    fig, axes = plt.subplots(1, 3, figsize=(10.5, 2.9), sharey=True)
+    for k, s in enumerate((study.stages[0], study.stages[-1])):
+        an = s.analysis
+        tau = np.stack([an.efforts[f"theta{i}"] for i in (1, 2, 3)], axis=1)
+        f = prismatic_equivalent(mech, pose, an.t, tau)
+        for i, ax in enumerate(axes):
+            ax.semilogy(an.t, np.abs(f[:, i]), color=("black", "0.6")[k], linewidth=(1.3, 2.2)[k], label=s.stage.label)
+            ax.set_title(f"|axial force| of leg {i + 1} (N)", fontsize=9)
+            ax.set_xlabel("time (s)")
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    return (
+        "Axial forces that prismatic actuators would need",
+        to_svg(fig, "rpr3-prismatic"),
+        "The same motion driven by actuators at the prismatic pairs B_i instead of the revolutes A_i: "
+        "J_p^T f = J_r^T tau (the same generalised force on the platform). Where the three leg lines meet "
+        "in one point (a parallel singularity of prismatic actuation, at phi = 0 for a platform homothetic "
+        "to the base) the forces are unbounded; samples there are left out.",
+    )
+
+
+def _factor_table(study, method: str) -> str:
+    rows = []
+    for s in study.stages:
+        an = s.analysis
+        rows.append(
+            f"<tr><td>{s.stage.label}</td><td>{an.max_force:.6g}</td><td>{an.max_moment:.6g}</td>"
+            f"<td>{s.max_effort:.6g}</td><td>{s.added_mass:.6g}</td><td>{s.added_inertia:.6g}</td></tr>"
+        )
+    head = ("<table><thead><tr><th>stage</th><th>max |F| (N)</th><th>max |M| (N m)</th>"
+            "<th>peak actuator effort (N m or N)</th><th>added mass (kg)</th><th>added inertia (kg m²)</th>"
+            "</tr></thead><tbody>")
+    out = head + "".join(rows) + "</tbody></table>"
+    cw, un, added = _stage(study, "counterweights"), study.unbalanced, _stage(study, ADDED_LINKAGE.get(method, ""))
+    if cw is not None:
+        out += "<table><thead><tr><th>peak moment with counterweights relative to</th><th>factor</th></tr></thead><tbody>"
+        for ref in (un, added):
+            if ref is not None and ref.analysis.max_moment > 0:
+                out += (f"<tr><td>{ref.stage.label} ({ref.analysis.max_moment:.6g} N m)</td>"
+                        f"<td>{cw.analysis.max_moment / ref.analysis.max_moment:.4g}</td></tr>")
+        out += "</tbody></table>"
+    return out
+
+
+def _factor_caption(study, method: str) -> str:
+    paper = {"rpr3_idler_loop": 17, "rpr3_scott_russell": 28}.get(method)
+    text = ("Peaks over the motion of every stage. The factor is the counterweights stage's peak shaking "
+            "moment divided by the reference stage's")
+    if paper:
+        text += f"; the paper reports {paper} (the reference `counterweights.moment_ratio` compares it with the unbalanced 3-RPR)."
+    return text + "."
