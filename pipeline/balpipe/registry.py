@@ -9,10 +9,12 @@ from typing import Any, Callable
 import numpy as np
 
 from . import units
+from .balancing import com_planning
+from .balancing import decoupling
 from .balancing import five_bar as fb_balancing
 from .balancing import slider_crank as sc_balancing
 from .balancing.base import BalanceResult, Stage
-from .mechanisms import custom, five_bar, slider_crank
+from .mechanisms import custom, five_bar, serial_arm, slider_crank
 from .model import Law, Model
 from .motion import law_for
 from .spec_parts import SpecFieldError
@@ -35,12 +37,14 @@ class Method:
     balance: Callable[..., BalanceResult]
     templates: tuple[str, ...]
     label: str
+    uses_spec: bool = False  # balance(..., spec): the method also reads the motion and analysis settings
 
 
 TEMPLATES: dict[str, Template] = {
     "slider_crank": Template(slider_crank.build, "slider-crank"),
     "custom": Template(custom.build, "custom mechanism"),
     "five_bar": Template(five_bar.build, "five-bar (5R), fixed-sequence with gear-coupled inputs", five_bar.figures),
+    "serial_arm": Template(serial_arm.build, "serial nR arm"),
 }
 METHODS: dict[str, Method] = {
     "slider_crank_counterweights": Method(
@@ -48,6 +52,12 @@ METHODS: dict[str, Method] = {
     ),
     "five_bar_gear_balancing": Method(
         fb_balancing.balance, ("five_bar",), "counterweights + counter-rotating gears 5, 6, 7 (eqs. 9-21)"
+    ),
+    "gear_decoupling": Method(
+        decoupling.balance, ("serial_arm",), "decoupling by gears 1'-2' and mass redistribution, counter-rotating gear 3 (paper 002)"
+    ),
+    "com_motion_planning": Method(
+        com_planning.balance, ("serial_arm",), "centre-of-mass motion planning, phi optimised (paper 003)", uses_spec=True
     ),
 }
 
@@ -95,4 +105,6 @@ def balance(spec: Any) -> BalanceResult:
             ("balancing", "method"),
             f"method {name!r} applies to {', '.join(method.templates)}, not to {spec.mechanism.template!r}",
         )
+    if method.uses_spec:
+        return method.balance(spec.mechanism, spec.balancing, model, spec)
     return method.balance(spec.mechanism, spec.balancing, model)

@@ -12,10 +12,13 @@ from typing import Annotated, Literal, Union
 
 from pydantic import Field
 
+from .balancing.com_planning import ComMotionPlanning
+from .balancing.decoupling import GearDecoupling
 from .balancing.five_bar import FiveBarGearBalancing
 from .balancing.slider_crank import SliderCrankCounterweights
 from .mechanisms.custom import CustomMechanism
 from .mechanisms.five_bar import FiveBarMechanism
+from .mechanisms.serial_arm import SerialArmMechanism
 from .mechanisms.slider_crank import SliderCrankMechanism
 from .spec_parts import DriveSpec, Strict
 from .units import Duration, Length, quantity
@@ -28,11 +31,11 @@ class NoBalancing(Strict):
 
 
 Mechanism = Annotated[
-    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism],
+    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism, SerialArmMechanism],
     Field(discriminator="template", description="the mechanism: a template with its parameters"),
 ]
 Balancing = Annotated[
-    Union[NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing],
+    Union[NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing, GearDecoupling, ComMotionPlanning],
     Field(discriminator="method", description="the balancing method and its design choices"),
 ]
 
