@@ -247,43 +247,100 @@ class TaskMotion:
         return tuple(np.stack([v[k] for v in vals], axis=-1) for k in range(3))
 
 
+def absolute_motion(chain: Chain, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray, mode: int):
+    """Absolute link angles theta, theta', theta'' (N, n) of a task-space motion (x, y[, phi])
+    with their exact derivatives, and (margin, sin gamma) for the reach and singularity checks.
+
+    With phi = theta_3 given (n = 3) the first two links reach W = P - R(phi) v3, whose
+    derivatives follow by the chain rule; then, with alpha_k = theta_k + delta_k the angles of the
+    equivalent vectors (lengths a, b): W = a e(alpha1) + b e(alpha2), so
+    [a perp(e1), b perp(e2)] alpha' = W' and the same matrix maps alpha'' to
+    W'' + a alpha1'^2 e1 + b alpha2'^2 e2 (solved by Cramer's rule, det = a b sin(alpha2 - alpha1)).
+    """
+    v = np.asarray(chain.vectors, dtype=float)
+    n = chain.n
+    Wx, Wy = x[:, 0] - chain.base[0], x[:, 1] - chain.base[1]
+    Wdx, Wdy, Wddx, Wddy = xd[:, 0], xd[:, 1], xdd[:, 0], xdd[:, 1]
+    if n == 3:
+        phi, phid, phidd = x[:, 2], xd[:, 2], xdd[:, 2]
+        c, s = np.cos(phi), np.sin(phi)
+        ux, uy = c * v[2, 0] - s * v[2, 1], s * v[2, 0] + c * v[2, 1]  # R(phi) v3
+        Wx, Wy = Wx - ux, Wy - uy
+        Wdx, Wdy = Wdx + phid * uy, Wdy - phid * ux  # - phi' perp(u)
+        w2 = phid**2
+        Wddx = Wddx + phidd * uy + w2 * ux
+        Wddy = Wddy - phidd * ux + w2 * uy
+    elif n != 2:
+        raise ValueError("task-space motions need a 2R or 3R chain")
+    a, b = math.hypot(*v[0]), math.hypot(*v[1])
+    d1, d2 = math.atan2(v[0, 1], v[0, 0]), math.atan2(v[1, 1], v[1, 0])
+    r2 = Wx * Wx + Wy * Wy
+    r = np.sqrt(r2)
+    margin = np.minimum(a + b - r, r - abs(a - b)) / (a + b)
+    cg = np.clip((r2 - a * a - b * b) / (2 * a * b), -1.0, 1.0)
+    gamma = -mode * np.arccos(cg)
+    sg = np.sin(gamma)
+    al1 = np.arctan2(Wy, Wx) - np.arctan2(b * sg, a + b * cg)
+    al2 = al1 + gamma
+    c1, s1, c2, s2 = np.cos(al1), np.sin(al1), np.cos(al2), np.sin(al2)
+    # columns p = a perp(e1) = a(-s1, c1), q = b perp(e2) = b(-s2, c2); det = a b sin(gamma)
+    det = a * b * sg
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / det
+        # x1 = (r x q)/det, x2 = (p x r)/det
+        a1d = (Wdx * b * c2 + Wdy * b * s2) * inv
+        a2d = (-a * s1 * Wdy - a * c1 * Wdx) * inv
+        Rx = Wddx + a * a1d**2 * c1 + b * a2d**2 * c2
+        Ry = Wddy + a * a1d**2 * s1 + b * a2d**2 * s2
+        a1dd = (Rx * b * c2 + Ry * b * s2) * inv
+        a2dd = (-a * s1 * Ry - a * c1 * Rx) * inv
+    th = [al1 - d1, al2 - d2]
+    thd = [a1d, a2d]
+    thdd = [a1dd, a2dd]
+    if n == 3:
+        th.append(phi)
+        thd.append(phid)
+        thdd.append(phidd)
+    return np.stack(th, 1), np.stack(thd, 1), np.stack(thdd, 1), margin, sg
+
+
 class JointSolution:
     """Joint angles, rates and accelerations (N, n) along a task-space motion, exact to
-    round-off: q by inverse kinematics, q' = J^-1 x', q'' = J^-1 (x'' - J' q')."""
+    round-off: q by inverse kinematics (eqs. 8-10), q' = J^-1 x', q'' = J^-1 (x'' - J' q')
+    (:func:`absolute_motion`). ``th``, ``thd``, ``thdd``: the absolute angles and derivatives."""
 
     def __init__(self, chain: Chain, motion: TaskMotion, mode: int, t: np.ndarray, check: bool = True):
         t = np.asarray(t, dtype=float).reshape(-1)
         x, xd, xdd = motion.values(t)
         n = chain.n
-        phi = x[:, 2] if n == 3 else None
-        q, margin = chain.inverse(x[:, :2], phi, mode)
-        J = task_jacobian(chain, q)
-        det = np.linalg.det(J)
-        scale = float(np.sum(np.hypot(*np.asarray(chain.vectors).T))) ** 2
-        self.t, self.q, self.margin, self.det = t, q, margin, det / scale
+        th, thd, thdd, margin, sg = absolute_motion(chain, x, xd, xdd, mode)
+        self.t, self.margin, self.det = t, margin, sg
+        self.th, self.thd, self.thdd = th, thd, thdd
         if check:
-            bad = np.flatnonzero(~(margin > 1e-9) | ~(np.abs(self.det) > 1e-6))
+            bad = np.flatnonzero(~(margin > 1e-9) | ~(np.abs(sg) > 1e-6))
             if bad.size:
                 k = int(bad[0])
                 what = motion.name or motion.point
                 where = "the tip" if motion.point == "tip" else "the centre of mass"
                 if not margin[k] > 1e-9:
-                    msg = (f"{what}: at t = {t[k]:.4g} s {where} target ({x[k, 0]:.4g}, {x[k, 1]:.4g}) m is out of "
-                           f"reach of the arm" + (f" with phi = {math.degrees(x[k, 2]):.4g} deg" if n == 3 else ""))
+                    msg = (f"trajectory {what}: at t = {t[k]:.4g} s {where} target ({x[k, 0]:.4g}, {x[k, 1]:.4g}) m is "
+                           f"out of reach of the arm" + (f" with phi = {math.degrees(x[k, 2]):.4g} deg" if n == 3 else ""))
                 else:
-                    msg = (f"{what}: singular configuration at t = {t[k]:.4g} s ({where} at ({x[k, 0]:.4g}, "
+                    msg = (f"trajectory {what}: singular configuration at t = {t[k]:.4g} s ({where} at ({x[k, 0]:.4g}, "
                            f"{x[k, 1]:.4g}) m: the arm is stretched or folded, its Jacobian loses rank)")
                 raise SpecFieldError(motion.path, msg)
-        n_task = xd.shape[1]
-        xd_, xdd_ = xd[:, :n], xdd[:, :n]
-        self.qd = np.linalg.solve(J, xd_[..., None])[..., 0]
-        th = np.cumsum(q, axis=1)
-        thd = np.cumsum(self.qd, axis=1)
-        w = chain.terms(th)
-        bias = np.zeros((len(t), n))
-        bias[:, :2] = -np.einsum("nk,nkd->nd", thd**2, w)  # J' q' of the point; phi is linear
-        self.qdd = np.linalg.solve(J, (xdd_ - bias)[..., None])[..., 0]
-        assert n_task >= n
+
+    @property
+    def q(self) -> np.ndarray:
+        return np.diff(self.th, axis=1, prepend=0.0)
+
+    @property
+    def qd(self) -> np.ndarray:
+        return np.diff(self.thd, axis=1, prepend=0.0)
+
+    @property
+    def qdd(self) -> np.ndarray:
+        return np.diff(self.thdd, axis=1, prepend=0.0)
 
 
 def task_jacobian(chain: Chain, q: np.ndarray) -> np.ndarray:
@@ -309,10 +366,11 @@ class JointLaw(Law):
         key = (t.shape, t.tobytes())
         sol = self._cache.get("sol")
         if sol is None or self._cache.get("key") != key:
-            sol = JointSolution(self.chain, self.motion, self.mode, t.reshape(-1), check=False)
+            js = JointSolution(self.chain, self.motion, self.mode, t.reshape(-1), check=False)
+            sol = (js.q, js.qd, js.qdd)
             self._cache.update(sol=sol, key=key)
         i = self.index
-        return (sol.q[:, i].reshape(t.shape), sol.qd[:, i].reshape(t.shape), sol.qdd[:, i].reshape(t.shape))
+        return tuple(v[:, i].reshape(t.shape) for v in sol)
 
 
 def joint_laws(chain: Chain, motion: TaskMotion, mode: int) -> list[JointLaw]:
@@ -394,47 +452,69 @@ def build(mech: SerialArmMechanism, laws: dict, t: np.ndarray) -> Model:
 
 @dataclass
 class ArmState:
-    """Centres of mass (N, n, 2) with their accelerations, joint origins (N, n, 2) and the
+    """Centres of mass (x, y: (N, n)) with their accelerations, joint origins (N, n) and the
     absolute angular accelerations (N, n) of the links."""
 
-    r: np.ndarray
-    rdd: np.ndarray
-    origins: np.ndarray
+    rx: np.ndarray
+    ry: np.ndarray
+    ax: np.ndarray
+    ay: np.ndarray
+    ox: np.ndarray
+    oy: np.ndarray
     thdd: np.ndarray
 
 
 def arm_state(arm: ArmGeometry, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> ArmState:
-    th, thd, thdd = np.cumsum(q, axis=1), np.cumsum(qd, axis=1), np.cumsum(qdd, axis=1)
+    """From joint angles (relative) and their derivatives."""
+    return absolute_state(arm, np.cumsum(q, axis=1), np.cumsum(qd, axis=1), np.cumsum(qdd, axis=1))
+
+
+def absolute_state(arm: ArmGeometry, th: np.ndarray, thd: np.ndarray, thdd: np.ndarray) -> ArmState:
+    """Positions and accelerations of the centres of mass from the absolute link angles:
+    (R u)'' = theta'' perp(R u) - theta'^2 R u for every vector u fixed in a link."""
     c, s = np.cos(th), np.sin(th)
     L = np.asarray(arm.lengths)
-    seg = np.stack([c * L, s * L], axis=-1)  # R(theta_k) (l_k, 0)
     cm = np.asarray(arm.coms)
-    rc = np.stack([c * cm[:, 0] - s * cm[:, 1], s * cm[:, 0] + c * cm[:, 1]], axis=-1)
-
-    def acc(u: np.ndarray) -> np.ndarray:  # d2/dt2 of R(theta) u: theta'' perp(Ru) - theta'^2 Ru
-        return thdd[..., None] * np.stack([-u[..., 1], u[..., 0]], axis=-1) - (thd**2)[..., None] * u
-
-    origins = np.asarray(arm.base) + np.concatenate([np.zeros_like(seg[:, :1]), np.cumsum(seg, axis=1)[:, :-1]], axis=1)
-    seg_acc = acc(seg)
-    origin_acc = np.concatenate([np.zeros_like(seg[:, :1]), np.cumsum(seg_acc, axis=1)[:, :-1]], axis=1)
-    return ArmState(origins + rc, origin_acc + acc(rc), origins, thdd)
+    w2 = thd * thd
+    segx, segy = c * L, s * L
+    rcx, rcy = c * cm[:, 0] - s * cm[:, 1], s * cm[:, 0] + c * cm[:, 1]
+    sax, say = -thdd * segy - w2 * segx, thdd * segx - w2 * segy
+    rax, ray = -thdd * rcy - w2 * rcx, thdd * rcx - w2 * rcy
+    ox = np.empty_like(segx)
+    oy = np.empty_like(segy)
+    oax = np.empty_like(segx)
+    oay = np.empty_like(segy)
+    ox[:, 0], oy[:, 0], oax[:, 0], oay[:, 0] = arm.base[0], arm.base[1], 0.0, 0.0
+    if arm.n > 1:
+        ox[:, 1:] = arm.base[0] + np.cumsum(segx[:, :-1], axis=1)
+        oy[:, 1:] = arm.base[1] + np.cumsum(segy[:, :-1], axis=1)
+        oax[:, 1:] = np.cumsum(sax[:, :-1], axis=1)
+        oay[:, 1:] = np.cumsum(say[:, :-1], axis=1)
+    return ArmState(ox + rcx, oy + rcy, oax + rax, oay + ray, ox, oy, thdd)
 
 
 def shaking_loads(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0), point=(0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
     """F = sum m (g - r''), M_P = sum [(r - P) x m (g - r'') - I theta''] (paper 002, eqs. 1-2)."""
     m = np.asarray(arm.masses)
-    f = m[:, None] * (np.asarray(gravity) - st.rdd)  # (N, n, 2)
-    d = st.r - np.asarray(point)
-    M = np.sum(d[..., 0] * f[..., 1] - d[..., 1] * f[..., 0], axis=1) - st.thdd @ np.asarray(arm.inertias)
-    return f.sum(axis=1), M
+    fx, fy = m * (gravity[0] - st.ax), m * (gravity[1] - st.ay)
+    M = ((st.rx - point[0]) * fy - (st.ry - point[1]) * fx) @ np.ones(arm.n) - st.thdd @ np.asarray(arm.inertias)
+    return np.stack([fx.sum(axis=1), fy.sum(axis=1)], axis=1), M
+
+
+def shaking_moment(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0), point=(0.0, 0.0)) -> np.ndarray:
+    """The moment of :func:`shaking_loads` alone (the optimiser's objective)."""
+    m = np.asarray(arm.masses)
+    fx, fy = m * (gravity[0] - st.ax), m * (gravity[1] - st.ay)
+    return ((st.rx - point[0]) * fy - (st.ry - point[1]) * fx) @ np.ones(arm.n) - st.thdd @ np.asarray(arm.inertias)
 
 
 def joint_torques(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0)) -> np.ndarray:
     """tau_j = sum_{k >= j} [(r_k - O_j) x m_k (r_k'' - g) + I_k theta_k''] (virtual work), (N, n)."""
     m, I = np.asarray(arm.masses), np.asarray(arm.inertias)
-    f = m[:, None] * (st.rdd - np.asarray(gravity))
+    fx, fy = m * (st.ax - gravity[0]), m * (st.ay - gravity[1])
     out = np.empty(st.thdd.shape)
     for j in range(arm.n):
-        d = st.r[:, j:] - st.origins[:, j:j + 1]
-        out[:, j] = np.sum(d[..., 0] * f[:, j:, 1] - d[..., 1] * f[:, j:, 0], axis=1) + st.thdd[:, j:] @ I[j:]
+        dx = st.rx[:, j:] - st.ox[:, j:j + 1]
+        dy = st.ry[:, j:] - st.oy[:, j:j + 1]
+        out[:, j] = np.sum(dx * fy[:, j:] - dy * fx[:, j:], axis=1) + st.thdd[:, j:] @ I[j:]
     return out
