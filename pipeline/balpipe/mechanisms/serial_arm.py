@@ -322,10 +322,10 @@ class JointSolution:
                 k = int(bad[0])
                 what = motion.name or motion.point
                 where = "the tip" if motion.point == "tip" else "the centre of mass"
-                if not margin[k] > 1e-9:
+                if margin[k] < -1e-12 or not np.isfinite(margin[k]):
                     msg = (f"trajectory {what}: at t = {t[k]:.4g} s {where} target ({x[k, 0]:.4g}, {x[k, 1]:.4g}) m is "
                            f"out of reach of the arm" + (f" with phi = {math.degrees(x[k, 2]):.4g} deg" if n == 3 else ""))
-                else:
+                else:  # on the boundary of the workspace or with a rank-deficient Jacobian
                     msg = (f"trajectory {what}: singular configuration at t = {t[k]:.4g} s ({where} at ({x[k, 0]:.4g}, "
                            f"{x[k, 1]:.4g}) m: the arm is stretched or folded, its Jacobian loses rank)")
                 raise SpecFieldError(motion.path, msg)
