@@ -176,3 +176,15 @@ def test_unknown_point_and_end_out_of_reach(tmp_path):
     assert out.returncode == 2 and "unknown point 'P17'" in out.stderr
     out = check(tmp_path, spec_text("[P1P9]", "{centre: [0 m, 0.8 m], side: 0.3 m}"))
     assert out.returncode == 2 and "trajectory P1P9: the tip pose" in out.stderr and "out of reach" in out.stderr
+
+
+def test_planning_is_deterministic():
+    """Same spec, same numbers: the optimisation's starts are seeded."""
+    text = spec_text("[P15P7]").replace("starts: 1", "starts: 2")
+    from balpipe.loader import load_text
+
+    a = study.run(load_text(text, "a.yaml")[0])
+    b = study.run(load_text(text, "a.yaml")[0])
+    pa = [(p.name, p.value) for p in a.balance.parameters]
+    assert pa == [(p.name, p.value) for p in b.balance.parameters]
+    assert a.balance.notes == b.balance.notes
