@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balpipe import registry, study
+from balpipe import study
 from balpipe.balancing.decoupling import mass_matrix_2r
 from balpipe.engine import analyse
 from balpipe.joint_space import mass_matrix

@@ -10,7 +10,7 @@ import pytest
 
 from balpipe import registry
 from balpipe.engine import analyse
-from balpipe.loader import SpecErrors, load_text
+
 from balpipe.mechanisms.serial_arm import (
     ArmGeometry,
     TaskMotion,

@@ -37,7 +37,6 @@ from typing import Literal, Union
 import numpy as np
 from pydantic import Field
 
-from .. import units
 from ..mechanisms.serial_arm import (
     ArmGeometry,
     Chain,
@@ -134,7 +133,7 @@ class ComMotionPlanning(Strict):
         "template's tip drive (motion.drive.tip)",
     )
     orientation: Orientation | None = Field(None, description="phi at both ends of every trajectory (with trajectories)")
-    phi: PhiOptimisation = Field(PhiOptimisation())
+    phi: PhiOptimisation = Field(PhiOptimisation(), description="the law of phi in case 2 and its optimisation")
     torque_rate_limit: float = Field(
         3e4, gt=0, description="case 3: largest rate of change of any actuator torque, N m/s (the paper: 3.10^4)"
     )

@@ -85,10 +85,10 @@ class GearDecoupling(Strict):
     """Paper 002: gear pair 1'-2' and mass redistribution (decoupled, linear dynamics), then gear 3."""
 
     method: Literal["gear_decoupling"] = Field(description="balancing method")
-    gear_1p: Gear1p
-    gear_2p: Gear2p = Field(Gear2p())
-    counterweights: Counterweights
-    counter_rotation: FrameGear
+    gear_1p: Gear1p = Field(description="gear 1' on link 1 at C (its inertia is solved from condition 2)")
+    gear_2p: Gear2p = Field(Gear2p(), description="gear 2' fixed on link 2 at B")
+    counterweights: Counterweights = Field(description="counterweights whose masses conditions 1 and 3 give")
+    counter_rotation: FrameGear = Field(description="gear 3 on the frame (I3 = J1)")
 
 
 @dataclass(frozen=True)
@@ -135,8 +135,7 @@ def mass_matrix_2r(model: Model, l1: float, gear: tuple[float, float, float, flo
 def balance(mech: SerialArmMechanism, method: GearDecoupling, model: Model) -> BalanceResult:
     if len(mech.links) != 2:
         raise SpecFieldError(("mechanism", "links"), f"gear_decoupling balances a 2R arm (got {len(mech.links)} links)")
-    if mech.payload is not None and mech.payload.mass > 0:
-        pass  # the payload is part of link 2's assembly: conditions (1)-(3) include it
+    # a payload on link 2 is part of link 2's assembly: conditions (1)-(3) include it
     l1 = mech.links[0].length
     g1, g2, cw = method.gear_1p, method.gear_2p, method.counterweights
     if not 0 <= g1.position < l1:
@@ -273,7 +272,6 @@ def figures(study, info: dict):
     fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.2))
     for k, s in enumerate(stages):
         an = s.analysis
-        frames = an.extra["frame_pose"]
         for j, ax in enumerate(axes):
             qdd = an.a[:, an.names.index(f"link{j + 1}"), 2] - (an.a[:, an.names.index("link1"), 2] if j else 0.0)
             ax.plot(qdd, an.efforts[f"q{j + 1}"], ".", markersize=2.5, color=style(k)["color"],
@@ -284,7 +282,6 @@ def figures(study, info: dict):
         ax.set_xlabel(f"q{j + 1}'' (rad/s²)")
         ax.set_title(f"Joint {j + 1} torque (N m)", fontsize=9)
         ax.legend(fontsize=7)
-    del frames
     fig.tight_layout()
     yield ("Torque against acceleration", to_svg(fig, "decoupling-torque"),
            "Each joint's actuator torque against its own acceleration at every sample: coupled and "
