@@ -85,6 +85,24 @@ def test_trapezoidal_case_respects_the_torque_rate_limit(paper):
     for g in dict.fromkeys(s.stage.group for s in st.stages):
         assert p[f"ramp_torque_rate_{g}"] <= limit
         assert 0 < p[f"ramp_fraction_{g}"] <= 0.25
+    # independently, on a uniform grid fine enough for the shortest ramp (P5P9): within the limit
+    # to the accuracy of central differences, and the limit is active (shorter ramps exceed it)
+    model = registry.unbalanced_model(spec)
+    T = spec.motion.duration
+    pl = cp.Planner(model, spec.mechanism, spec.balancing, T, registry.time_grid(spec), (0.0, 0.0), (0.0, 0.0))
+    name, start, end, path = cp.trajectories_of(spec.balancing, model)[4]
+    plan = pl.plan(name, start, end, path)
+    phi = cp.PhiPolynomial(start[2], end[2], T, tuple(p[f"phi_c{k}_{name}"] for k in range(3)))
+    tt = np.linspace(0, T, 400001)
+    from balpipe.mechanisms.serial_arm import joint_torques
+
+    def rate(f):
+        _, _, _, state = pl.loads(cp._com_motion(plan, cp.trapezoidal_acceleration(f), T, phi, path), plan.com_mode, tt)
+        return np.max(np.abs(np.gradient(joint_torques(pl.arm, state), tt, axis=0)))
+
+    f = p[f"ramp_fraction_{name}"]
+    assert rate(f) <= limit * 1.001
+    assert rate(0.8 * f) > limit
 
 
 def test_page_has_the_table_and_fig_2(paper):

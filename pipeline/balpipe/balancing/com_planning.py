@@ -346,11 +346,14 @@ class Planner:
 
     def ramp(self, plan: Plan, phi: Law, path: tuple) -> None:
         """Case 3: the shortest ramp fraction f whose torque rates stay within the limit
-        (bisection; rates by central differences on ``rate_samples`` samples)."""
+        (bisection; rates by central differences on ``rate_samples`` uniform samples plus 64 in
+        each ramp, so that the shortest ramps are resolved)."""
         limit = self.method.torque_rate_limit
-        tt = np.linspace(0.0, self.T, self.method.rate_samples)
+        uniform = np.linspace(0.0, self.T, self.method.rate_samples)
 
         def rate(f: float) -> float:
+            ramps = [np.linspace(a, b, 64) for a, b in ((0.0, f), (0.5 - f, 0.5 + f), (1.0 - f, 1.0))]
+            tt = np.unique(np.concatenate([uniform, self.T * np.concatenate(ramps)]))
             motion = _com_motion(plan, trapezoidal_acceleration(f), self.T, phi, path)
             _, _, sol, st = self.loads(motion, plan.com_mode, tt)
             tau = joint_torques(self.arm, st, self.gravity)
@@ -529,7 +532,8 @@ def _method_note(method: ComMotionPlanning, planner: Planner, plans: list[Plan],
         f"{o.starts - 1} normal random points, sd {o.spread} rad, numpy default_rng({o.seed})), at most "
         f"{o.max_evaluations} evaluations per start, xatol {o.tolerance}; {planner.calls} objective evaluations in "
         f"all for {len(plans)} trajectories (benchmarks/bench_paper003.py times them). Case 3: the shortest ramps (bisection on "
-        f"f) for which every joint's torque rate, by central differences on {method.rate_samples} samples, stays "
+        f"f) for which every joint's torque rate, by central differences on {method.rate_samples} samples and 64 "
+        f"in each ramp, stays "
         f"within {method.torque_rate_limit:.4g} N m/s."
     )
 
@@ -612,7 +616,7 @@ def figures(study, info: dict):
            f"({study.spec.motion.duration:g} s here) does not change the ratios (all loads scale with 1/T²) but does "
            "change case 3 (the torque-rate limit). In a horizontal plane the shaking moment about the base joint is "
            "minus joint 1's torque (paper 002, eq. 16), hence equal peaks. Torque rates: case 1 by central "
-           f"differences on the analysis grid, case 3 on {method.rate_samples} samples (the ramp search).")
+           f"differences on the analysis grid, case 3 on {method.rate_samples} samples and 64 in each ramp (the ramp search).")
     yield from _square_figure(study, info, plt, to_svg)
     # Figs. 3-4 for every trajectory: |F| and M, the four cases
     n = len(plans)

@@ -31,7 +31,7 @@ def study_figures(study: Study) -> dict:
     ]
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
     residuals, drift = [], []
-    vals = [s for s in study.stages if s.validation is not None]
+    vals = [s for s in shown_stages(study) if s.validation is not None]
     if vals:
         F0, M0 = study.unbalanced.analysis.max_force, study.unbalanced.analysis.max_moment
         residuals.append((
