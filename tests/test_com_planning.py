@@ -206,3 +206,33 @@ def test_planning_is_deterministic():
     pa = [(p.name, p.value) for p in a.balance.parameters]
     assert pa == [(p.name, p.value) for p in b.balance.parameters]
     assert a.balance.notes == b.balance.notes
+
+
+def test_single_trajectory_from_the_tip_drive():
+    """Without trajectories the method plans the template's tip motion: four stages, unprefixed."""
+    text = """name: one trajectory
+mechanism:
+  template: serial_arm
+  links:
+    - {length: 0.5 m, mass: 24.4 kg, com: 0.289 m, inertia: 1.246 kg m^2}
+    - {length: 0.3 m, mass: 8.3 kg, com: 0.098 m, inertia: 0.057 kg m^2}
+    - {length: 0.1 m, mass: 2 kg, com: 0.05 m, inertia: 0.025 kg m^2}
+  payload: {mass: 5 kg}
+motion:
+  duration: 0.5 s
+  drive:
+    tip: {from: [-0.15 m, 0.487 m, 0 deg], to: [0.15 m, 0.487 m, 120 deg]}
+balancing:
+  method: com_motion_planning
+  phi: {starts: 1, max_evaluations: 60}
+analysis: {samples: 201}
+"""
+    from balpipe.loader import load_text
+
+    st = study.run(load_text(text, "one.yaml")[0])
+    assert [s.stage.name for s in st.stages] == ["ee_quintic", "com_bang_bang", "com_bang_bang_phi_opt", "com_trapezoidal"]
+    assert [s.stage.label for s in st.stages][0] == "end-effector quintic"
+    p = {x.name: x.value for x in st.balance.parameters}
+    # the same trajectory as P15P7 of the paper's spec: the same 60.0 % force reduction
+    assert p["force_reduction"] == pytest.approx(0.5996, abs=1e-3)
+    assert st.ok
