@@ -52,6 +52,7 @@ def breakdown() -> None:
     from balpipe.report.results import results_dict
 
     print("\n== 2. in-process breakdown (one run each) ==")
+    c = time.process_time
     t0 = time.perf_counter()
     loaded = load(SPEC)
     spec = loaded.spec
@@ -71,20 +72,20 @@ def breakdown() -> None:
             calls["s"] += time.perf_counter() - s
 
     study.analyse = timed
-    t1 = time.perf_counter()
+    t1, c1 = time.perf_counter(), c()
     result = registry.balance(spec)
-    t_method = time.perf_counter() - t1
-    t2 = time.perf_counter()
+    t_method, c_method = time.perf_counter() - t1, c() - c1
+    t2, c2 = time.perf_counter(), c()
     stages = study.run_stage_analyses(spec, result)
-    t_engine = time.perf_counter() - t2
+    t_engine, c_engine = time.perf_counter() - t2, c() - c2
     study.analyse = real
-    t3 = time.perf_counter()
+    t3, c3 = time.perf_counter(), c()
     st = study.run(spec)  # (again, for the page: the method's figures need a full Study)
-    t_run = time.perf_counter() - t3
-    t4 = time.perf_counter()
+    t_run, c_run = time.perf_counter() - t3, c() - c3
+    t4, c4 = time.perf_counter(), c()
     res = results_dict(st, str(SPEC), "bench", simulated=False)
     render_page(st, res, loaded.text)
-    t_page = time.perf_counter() - t4
+    t_page, c_page = time.perf_counter() - t4, c() - c4
     evals = sum(int(p.value) for p in result.parameters if p.name.startswith("phi_evaluations"))
     # time per objective evaluation vs one engine call, on the first trajectory's optimised stage
     model = registry.unbalanced_model(spec)
@@ -93,30 +94,31 @@ def breakdown() -> None:
     name, start, end, path = cp.trajectories_of(spec.balancing, model)[0]
     plan = pl.plan(name, start, end, path)
     f = pl.objective(plan, path)
-    c = np.zeros(spec.balancing.phi.degree - 5)
+    c0 = np.zeros(spec.balancing.phi.degree - 5)
     n = 300
-    s = time.perf_counter()
+    s = time.process_time()
     for _ in range(n):
-        f(c)
-    per_eval = (time.perf_counter() - s) / n
+        f(c0)
+    per_eval = (time.process_time() - s) / n
     stage = next(x for x in result.stages if x.name.endswith("com_bang_bang_phi_opt"))
-    s = time.perf_counter()
+    s = time.process_time()
     for _ in range(5):
         engine.analyse(stage.model, t)
-    per_engine = (time.perf_counter() - s) / 5
+    per_engine = (time.process_time() - s) / 5
     rows = [
-        ("load the spec", t_load),
-        ("import scipy.optimize (first use)", t_import),
-        (f"method: plan 8 trajectories ({evals} objective evaluations, ramp search)", t_method),
-        (f"engine: {calls['n']} analyse calls of {len(t)} samples ({calls['s'] / max(calls['n'], 1) * 1e3:.1f} ms per call)", t_engine),
-        ("study.run again (method + engine + checks)", t_run),
-        ("page: results.json dict and HTML (figures)", t_page),
+        ("load the spec", t_load, None),
+        ("import scipy.optimize (first use)", t_import, None),
+        (f"method: plan 8 trajectories ({evals} objective evaluations, ramp search)", t_method, c_method),
+        (f"engine: {calls['n']} analyse calls of {len(t)} samples ({calls['s'] / max(calls['n'], 1) * 1e3:.1f} ms wall per call)", t_engine, c_engine),
+        ("study.run again (method + engine + checks)", t_run, c_run),
+        ("page: results.json dict and HTML (figures)", t_page, c_page),
     ]
     w = max(len(r[0]) for r in rows)
-    for label, sec in rows:
-        print(f"{label.ljust(w)}  {sec:7.3f} s")
-    print(f"objective evaluation (fast path, {len(t)} samples): {per_eval * 1e3:.3f} ms; one engine analyse of the "
-          f"same stage: {per_engine * 1e3:.1f} ms ({per_engine / per_eval:.0f}x)")
+    print(f"{'step'.ljust(w)}  {'wall s':>8}  {'CPU s':>8}")
+    for label, sec, cpu in rows:
+        print(f"{label.ljust(w)}  {sec:8.3f}  {'-' if cpu is None else f'{cpu:.3f}':>8}")
+    print(f"CPU time per objective evaluation (fast path, {len(t)} samples): {per_eval * 1e3:.3f} ms; per engine "
+          f"analyse of the same stage: {per_engine * 1e3:.1f} ms ({per_engine / per_eval:.0f}x)")
     print(f"stages: {len(stages)}; load average {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
 
 
