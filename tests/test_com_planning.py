@@ -208,9 +208,7 @@ def test_planning_is_deterministic():
     assert a.balance.notes == b.balance.notes
 
 
-def test_single_trajectory_from_the_tip_drive():
-    """Without trajectories the method plans the template's tip motion: four stages, unprefixed."""
-    text = """name: one trajectory
+SINGLE = """name: one trajectory
 mechanism:
   template: serial_arm
   links:
@@ -227,6 +225,11 @@ balancing:
   phi: {starts: 1, max_evaluations: 60}
 analysis: {samples: 201}
 """
+
+
+def test_single_trajectory_from_the_tip_drive():
+    """Without trajectories the method plans the template's tip motion: four stages, unprefixed."""
+    text = SINGLE
     from balpipe.loader import load_text
 
     st = study.run(load_text(text, "one.yaml")[0])
@@ -236,3 +239,19 @@ analysis: {samples: 201}
     # the same trajectory as P15P7 of the paper's spec: the same 60.0 % force reduction
     assert p["force_reduction"] == pytest.approx(0.5996, abs=1e-3)
     assert st.ok
+
+
+def test_halving_the_duration_quadruples_the_loads_and_keeps_the_reductions():
+    from balpipe.loader import load_text
+
+    text = SINGLE.replace("phi: {starts: 1, max_evaluations: 60}", "phi: {degree: 5}")
+    a = study.run(load_text(text, "a.yaml")[0])
+    b = study.run(load_text(text.replace("duration: 0.5 s", "duration: 0.25 s"), "b.yaml")[0])
+    for sa, sb in zip(a.stages[:3], b.stages[:3]):  # case 3 depends on T through the torque-rate limit
+        assert sb.analysis.max_force == pytest.approx(4 * sa.analysis.max_force, rel=1e-9)
+        assert sb.analysis.max_moment == pytest.approx(4 * sa.analysis.max_moment, rel=1e-9)
+    pa = {x.name: x.value for x in a.balance.parameters}
+    pb = {x.name: x.value for x in b.balance.parameters}
+    assert pb["force_reduction"] == pytest.approx(pa["force_reduction"], abs=1e-12)
+    assert pb["moment_reduction"] == pytest.approx(pa["moment_reduction"], abs=1e-12)
+    assert pb["ramp_fraction"] > pa["ramp_fraction"]  # the same torque-rate limit needs longer ramps
