@@ -202,3 +202,29 @@ def test_joint_solution_reports_singular_configurations(rng):
     with pytest.raises(SpecFieldError) as exc:
         JointSolution(tip_chain(arm), motion, 1, np.linspace(0, 1, 101))
     assert "trajectory stretch: singular configuration at t = 1 s" in str(exc.value)
+
+
+@pytest.mark.parametrize("drive,where,message", [
+    ({"q1": {"from": 0, "to": 1}}, ("motion", "drive"), "drive every joint (missing: q2, q3)"),
+    ({"q4": {"from": 0, "to": 1}}, ("motion", "drive", "q4"), "unknown drive 'q4'"),
+    ({"tip": {"from": [0.3, 0.3, 0], "to": [0.3, 0.4, 0]}, "q1": {"from": 0, "to": 1}},
+     ("motion", "drive", "tip"), "drive either the tip or the joints"),
+    ({"tip": {"from": [0.3, 0.3], "to": [0.3, 0.4, 0]}}, ("motion", "drive", "tip", "from"), "expected the tip pose [x, y, phi]"),
+    ({"tip": {"from": [0.3, 0.3, "2 kg"], "to": [0.3, 0.4, 0]}}, ("motion", "drive", "tip", "from"), "kg"),
+])
+def test_bad_drives_are_located(rng, drive, where, message):
+    spec = arm_spec(rng, n=3, drive=drive)
+    with pytest.raises(SpecFieldError) as exc:
+        registry.unbalanced_model(spec)
+    assert exc.value.path == where and message in exc.value.message
+
+
+def test_decoupling_and_planning_need_their_arms(rng):
+    two = arm_spec(rng, n=2, method="com_motion_planning")
+    with pytest.raises(SpecFieldError, match="plans a 3R arm"):
+        registry.balance(two)
+    three = arm_spec(rng, n=3, method="gear_decoupling", gear_1p={"position": 0.1, "mass": 1},
+                     counterweights={"link1": {"distance": 0.1}, "link2": {"distance": 0.1}},
+                     counter_rotation={"position": [0, -0.2]})
+    with pytest.raises(SpecFieldError, match="balances a 2R arm"):
+        registry.balance(three)
