@@ -30,7 +30,6 @@ engine analyses only the final stages (tests check that both agree to 1e-9).
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, field
 from typing import Literal, Union
 
@@ -228,7 +227,6 @@ class Plan:
     ramp_fraction: float = 0.0
     ramp_rate: float = 0.0
     ramp_feasible: bool = True
-    seconds: float = 0.0
 
     @property
     def com_distance(self) -> float:
@@ -471,7 +469,6 @@ def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, s
     P = lambda *a: params.append(Parameter(*a))  # noqa: E731
     m_total = planner.arm.total_mass
     for name, start, end, path in trajectories_of(method, model):
-        t0 = time.perf_counter()
         plan = planner.plan(name, start, end, path)
         # located errors on every path before optimising (case 1 and the bang-bang line)
         tip_laws = tuple(law_for(_Motion(law_name, T), a, b) for a, b in zip(plan.start, plan.end))
@@ -481,7 +478,6 @@ def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, s
         planner.optimise_phi(plan, path)
         planner.ramp(plan, PhiPolynomial(start[2], end[2], T, plan.phi_coefficients), path)
         plan.models = planner.stages(plan, law_name, path)
-        plan.seconds = time.perf_counter() - t0
         plans.append(plan)
         prefix = f"{name}_" if name else ""
         for key, label in CASES:

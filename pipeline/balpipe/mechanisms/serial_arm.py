@@ -31,7 +31,7 @@ from .. import units
 from ..model import FRAME, Attachment, Body, Driver, Law, Model, Revolute
 from ..motion import law_for
 from ..spec_parts import LinkSpec, SpecFieldError, Strict
-from ..units import Inertia, Length, Mass
+from ..units import Angle, Inertia, Length, Mass
 
 DRIVE = ("motion", "drive")
 
@@ -59,8 +59,8 @@ class SerialArmMechanism(Strict):
         "mass): +1 is the '+' root of paper 003's eq. 8, the elbow turned clockwise "
         "(sin(q2) < 0 for centres of mass on the link axes), -1 the other",
     )
-    initial: list[float] | None = Field(
-        None, description="joint angles (rad) of an arm without drives (a method plans its motion)"
+    initial: list[Angle] | None = Field(
+        None, description="joint angles q1..qn of an arm without drives (a method plans its motion)"
     )
 
     def drives(self) -> dict[str, str]:
