@@ -9,12 +9,13 @@ from typing import Any, Callable
 import numpy as np
 
 from . import units
+from .balancing import com_planning, decoupling
 from .balancing import five_bar as fb_balancing
 from .balancing import rpr3_idler, rpr3_scott_russell
 from .balancing import rrr4 as rrr4_balancing
 from .balancing import slider_crank as sc_balancing
 from .balancing.base import BalanceResult, Stage
-from .mechanisms import custom, five_bar, rpr3, rrr4, slider_crank
+from .mechanisms import custom, five_bar, rpr3, rrr4, serial_arm, slider_crank
 from .model import Law, Model
 from .motion import law_for
 from .spec_parts import SpecFieldError
@@ -37,6 +38,7 @@ class Method:
     balance: Callable[..., BalanceResult]
     templates: tuple[str, ...]
     label: str
+    uses_spec: bool = False  # balance(..., spec): the method also reads the motion and analysis settings
 
 
 TEMPLATES: dict[str, Template] = {
@@ -45,6 +47,7 @@ TEMPLATES: dict[str, Template] = {
     "five_bar": Template(five_bar.build, "five-bar (5R), fixed-sequence with gear-coupled inputs", five_bar.figures),
     "rrr4": Template(rrr4.build, "planar n-RRR parallel manipulator (4-RRR of paper 001, legs removable)", rrr4.figures),
     "rpr3": Template(rpr3.build, "3-RPR parallel manipulator", rpr3.figures),
+    "serial_arm": Template(serial_arm.build, "serial nR arm"),
 }
 METHODS: dict[str, Method] = {
     "slider_crank_counterweights": Method(
@@ -62,6 +65,12 @@ METHODS: dict[str, Method] = {
     "rpr3_scott_russell": Method(
         rpr3_scott_russell.balance, ("rpr3",),
         "Scott-Russell legs, counterweights (eqs. 30a-d), eq. 30e, one counter-rotation per leg (eq. 30f)",
+    ),
+    "gear_decoupling": Method(
+        decoupling.balance, ("serial_arm",), "decoupling by gears 1'-2' and mass redistribution, counter-rotating gear 3 (paper 002)"
+    ),
+    "com_motion_planning": Method(
+        com_planning.balance, ("serial_arm",), "centre-of-mass motion planning, phi optimised (paper 003)", uses_spec=True
     ),
 }
 
@@ -109,4 +118,6 @@ def balance(spec: Any) -> BalanceResult:
             ("balancing", "method"),
             f"method {name!r} applies to {', '.join(method.templates)}, not to {spec.mechanism.template!r}",
         )
+    if method.uses_spec:
+        return method.balance(spec.mechanism, spec.balancing, model, spec)
     return method.balance(spec.mechanism, spec.balancing, model)

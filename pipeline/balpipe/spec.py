@@ -12,6 +12,8 @@ from typing import Annotated, Literal, Union
 
 from pydantic import Field
 
+from .balancing.com_planning import ComMotionPlanning
+from .balancing.decoupling import GearDecoupling
 from .balancing.five_bar import FiveBarGearBalancing
 from .balancing.rpr3_idler import Rpr3IdlerLoop
 from .balancing.rpr3_scott_russell import Rpr3ScottRussell
@@ -21,6 +23,7 @@ from .mechanisms.custom import CustomMechanism
 from .mechanisms.five_bar import FiveBarMechanism
 from .mechanisms.rpr3 import Rpr3Mechanism
 from .mechanisms.rrr4 import RRR4Mechanism
+from .mechanisms.serial_arm import SerialArmMechanism
 from .mechanisms.slider_crank import SliderCrankMechanism
 from .spec_parts import DriveSpec, Strict
 from .units import Duration, Length, quantity
@@ -33,11 +36,14 @@ class NoBalancing(Strict):
 
 
 Mechanism = Annotated[
-    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism, RRR4Mechanism, Rpr3Mechanism],
+    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism, RRR4Mechanism, Rpr3Mechanism, SerialArmMechanism],
     Field(discriminator="template", description="the mechanism: a template with its parameters"),
 ]
 Balancing = Annotated[
-    Union[NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing, RRR4Balancing, Rpr3IdlerLoop, Rpr3ScottRussell],
+    Union[
+        NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing, RRR4Balancing, Rpr3IdlerLoop, Rpr3ScottRussell,
+        GearDecoupling, ComMotionPlanning,
+    ],
     Field(discriminator="method", description="the balancing method and its design choices"),
 ]
 

@@ -57,9 +57,26 @@ class Study:
         return ratio_reference(self.unbalanced)
 
     def extra_figures(self) -> list[tuple[str, str, str]]:
-        """Figures that only the mechanism's template knows how to draw (title, svg, caption)."""
+        """Figures that only the mechanism's template or the method knows how to draw (title,
+        svg, caption)."""
         hook = registry.TEMPLATES[self.spec.mechanism.template].figures
-        return list(hook(self)) if hook is not None else []
+        out = list(hook(self)) if hook is not None else []
+        if self.balance.figures is not None:
+            out += list(self.balance.figures(self))
+        return out
+
+    def reference_stage(self, sr: StageResult) -> StageResult:
+        """The stage whose peaks ``sr``'s ratios refer to (see :func:`reference_of`)."""
+        return reference_of(self.stages, sr)
+
+
+def reference_of(stages: list[StageResult], sr: StageResult) -> StageResult:
+    """The stage whose peaks ``sr``'s ratios refer to: ``Stage.reference`` or the first stage."""
+    if sr.stage.reference is not None:
+        for s in stages:
+            if s.stage.name == sr.stage.reference:
+                return s
+    return stages[0]
 
 
 NEAR_SINGULAR = 1e3  # condition number above which the page warns of lost accuracy
@@ -131,6 +148,7 @@ def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float) -> dict:
         "realisable": not not_realisable,
         "not_realisable": not_realisable,
         "not_realisable_parts": realisable.details(sr.stage.model),
+        "reference": unbalanced.stage.name,
     }
 
 
@@ -187,7 +205,9 @@ def run(spec: Spec) -> Study:
     balance = registry.balance(spec)
     stages = run_stage_analyses(spec, balance)
     tol = spec.analysis.balance_tolerance
-    metrics = [stage_metrics(s, stages[0], tol) for s in stages]
+    metrics = [stage_metrics(s, reference_of(stages, s), tol) for s in stages]
+    if balance.derived is not None:
+        balance.parameters.extend(balance.derived(stages))
     problems = []
     rvm = max(max(m["reactions_vs_momentum_force"], m["reactions_vs_momentum_moment"]) for m in metrics)
     if not rvm <= 1e-9 or not math.isfinite(rvm):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any, Callable
 
 from ..model import Model
 
@@ -31,6 +32,8 @@ class Stage:
     model: Model
     description: str = ""
     balances: str = ""
+    reference: str | None = None  # the stage its ratios refer to (default: the first stage)
+    group: str = ""  # stages of one motion (a spec with several motions groups them, e.g. per trajectory)
 
 
 @dataclass(frozen=True)
@@ -38,3 +41,7 @@ class BalanceResult:
     parameters: list[Parameter]
     stages: list[Stage]
     notes: list[str] = field(default_factory=list)
+    # optional hooks: figures(study) -> [(title, svg or html, caption)] drawn on the page;
+    # derived(stage_results) -> [Parameter] computed from the analysed stages (before references)
+    figures: Callable[[Any], Any] | None = None
+    derived: Callable[[Any], list[Parameter]] | None = None

@@ -13,22 +13,28 @@ from .results import joint_load_table
 INSTANTS = 5
 
 
+def shown_stages(study: Study) -> list:
+    """The stages drawn in the generic figures: all, or those of the first group when the spec
+    runs several motions (the method's figures show the other groups)."""
+    return [s for s in study.stages if s.stage.group == study.stages[0].stage.group]
+
+
 def study_figures(study: Study) -> dict:
     sims = []
-    for s in study.stages:
+    for s in shown_stages(study):
         v = s.validation
         sims.append((v.t, v.force, v.moment) if v is not None else None)
     loads = figures.loads_figure(
-        [(s.stage.label, s.analysis, sim) for s, sim in zip(study.stages, sims)], prefix="loads"
+        [(s.stage.label, s.analysis, sim) for s, sim in zip(shown_stages(study), sims)], prefix="loads"
     )
-    efforts = figures.efforts_figure([(s.stage.label, s.analysis) for s in study.stages], prefix="efforts")
+    efforts = figures.efforts_figure([(s.stage.label, s.analysis) for s in shown_stages(study)], prefix="efforts")
     mech = [
         (s.stage.label, figures.mechanism_figure(s.stage.model, s.analysis, INSTANTS, prefix=f"mech{k}", title=s.stage.label))
-        for k, s in enumerate(study.stages)
+        for k, s in enumerate(shown_stages(study))
     ]
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
     residuals, drift = [], []
-    vals = [s for s in study.stages if s.validation is not None]
+    vals = [s for s in shown_stages(study) if s.validation is not None]
     if vals:
         ref = study.reference
         F0, M0 = ref.force, ref.moment
@@ -97,7 +103,8 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
                       "player": rl.player()} if rl is not None else None,
         instants=INSTANTS,
         joint_loads=joint_load_table(study),
-        stage_names=[(s.stage.name, s.stage.label) for s in study.stages],
+        stage_names=[(s.stage.name, s.stage.label) for s in shown_stages(study)],
+        group=study.stages[0].stage.group if len(shown_stages(study)) < len(study.stages) else "",
         reference={"force": study.reference.describe("force"), "moment": study.reference.describe("moment"),
                    "floored": study.reference.floored},
         spec_text=spec_text,

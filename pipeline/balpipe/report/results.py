@@ -38,7 +38,7 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     tol = spec.analysis.balance_tolerance
     stages = []
     for s in study.stages:
-        m = stage_metrics(s, study.unbalanced, tol)
+        m = stage_metrics(s, study.reference_stage(s), tol)
         stages.append(m)
     validation = {}
     for s in study.stages:

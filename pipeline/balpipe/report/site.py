@@ -31,7 +31,9 @@ def _entry(out: Path, o) -> dict:
     }
     if e["results"]:
         st = results["stages"]
-        first, last = st[0], st[-1]
+        first = st[0]
+        # the last stage compared with the first (a spec with several motions: of the first motion)
+        last = [s for s in st if s.get("reference", first["name"]) == first["name"]][-1]
         e["not_realisable"] = [f"{s['label']}: {s['not_realisable']}" for s in st if s.get("realisable") is False]
         e["peak_f"] = f"{num(first['max_shaking_force'])} → {num(last['max_shaking_force'])}"
         e["peak_m"] = f"{num(first['max_shaking_moment'])} → {num(last['max_shaking_moment'])}"
