@@ -13,6 +13,9 @@ from typing import Annotated, Literal, Union
 from pydantic import Field
 
 from .balancing.five_bar import FiveBarGearBalancing
+from .balancing.force_balance import ForceBalance
+from .balancing.moment_balance import MomentBalance
+from .balancing.stages import Stages
 from .balancing.slider_crank import SliderCrankCounterweights
 from .mechanisms.custom import CustomMechanism
 from .mechanisms.five_bar import FiveBarMechanism
@@ -32,9 +35,17 @@ Mechanism = Annotated[
     Field(discriminator="template", description="the mechanism: a template with its parameters"),
 ]
 Balancing = Annotated[
-    Union[NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing],
+    Union[NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing, ForceBalance, MomentBalance, Stages],
     Field(discriminator="method", description="the balancing method and its design choices"),
 ]
+
+
+class Design(Strict):
+    """Another balancing design of the same mechanism, analysed beside the main one."""
+
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_\-]+$", description="short name, prefixes its stages (name:stage)")
+    label: str = Field("", description="label in figures and tables (default: the name)")
+    balancing: Balancing
 
 
 class Motion(Strict):
@@ -107,3 +118,6 @@ class Spec(Strict):
     analysis: AnalysisSettings = Field(AnalysisSettings())
     validation: ValidationSpec = Field(ValidationSpec())
     references: list[Reference] = Field([], description="published values to compare with")
+    compare: list[Design] = Field(
+        [], description="other balancing designs of the same mechanism, analysed and tabulated beside the main one"
+    )

@@ -38,3 +38,4 @@ class BalanceResult:
     parameters: list[Parameter]
     stages: list[Stage]
     notes: list[str] = field(default_factory=list)
+    details: dict = field(default_factory=dict)  # method-specific blocks for results.json (e.g. force_balance)
