@@ -184,7 +184,7 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
                             "|H| left by the discs / |H| of the counterweighted mechanism, over the samples"))
     notes = [
         f"{cond.count} independent force-balance conditions and {len(mc.matrix)} on the angular momentum "
-        f"(ranks of the momentum regressors over {cond.samples} sampled states, tolerance {cond.tolerance:g}). "
+        f"(ranks of the momentum regressors over {cond.samples} sampled states, tolerance {cond.tolerance:g}; the force count includes each disc's own: its centre of mass on its axis). "
         f"Counterweights of least added mass ({sol.total_mass:.6g} kg) meeting both, with the discs' "
         "inertias, in one linear programme; a counterweight's inertia is that of its mass spread over its region.",
         f"Counter-rotation inertias re-solved by least squares over {samples} sampled states: relative residual "
