@@ -217,3 +217,80 @@ def test_old_single_law_form_still_valid():
     law = registry.unbalanced_model(spec).drivers[0].law
     assert law.profile.__name__ == "cycloidal"
     assert math.isfinite(law(np.array([0.1]))[0][0])
+
+
+def test_conditions_do_not_depend_on_the_law_or_the_duration():
+    base = four_bar(np.random.default_rng(61))
+    other = json.loads(json.dumps(base))
+    other["motion"]["law"] = "cycloidal"
+    other["motion"]["duration"] = 0.2
+    conds = []
+    for d in (base, other):
+        spec = Spec.model_validate(d)
+        conds.append(C.find(registry.unbalanced_model(spec), registry.time_grid(spec)))
+    assert conds[0].count == conds[1].count == 4
+    assert np.allclose(conds[0].matrix, conds[1].matrix, atol=1e-9)
+
+
+def test_redundant_driver_is_set_aside_by_the_sampler():
+    """A model with more drivers than degrees of freedom (consistent laws): the finder samples
+    with a square subset and finds the same conditions (the 4-RRR's four motors, issue 8)."""
+    from dataclasses import replace as dc_replace
+
+    from balpipe.model import Driver
+
+    spec = Spec.model_validate(five_bar(np.random.default_rng(62)))
+    model = registry.unbalanced_model(spec)
+    t = registry.time_grid(spec)
+    q1 = model.drivers[0]
+    extra = Driver("q1_again", ("angle", "link1"), q1.law)  # link1's absolute angle = joint A1's
+    redundant = dc_replace(model, drivers=model.drivers + (extra,))
+    a, b = C.find(model, t), C.find(redundant, t)
+    assert a.count == b.count == 6
+    assert np.allclose(a.matrix, b.matrix, atol=1e-9)
+
+
+def test_unknown_body_in_a_region_is_located():
+    spec = Spec.model_validate(four_bar(np.random.default_rng(63), {
+        "method": "force_balance", "counterweights": [{"body": "crnk", "at": [0, 0]}]}))
+    with pytest.raises(SpecFieldError) as err:
+        registry.balance(spec)
+    assert err.value.path == ("balancing", "counterweights", 0, "body")
+    assert "crnk" in err.value.message and "crank" in err.value.message
+
+
+def test_moment_balance_without_counterweights_needs_a_force_balanced_mechanism():
+    spec = Spec.model_validate(four_bar(np.random.default_rng(64), {
+        "method": "moment_balance", "counter_rotations": FOUR_BAR_DISCS}))
+    with pytest.raises(SpecFieldError) as err:
+        registry.balance(spec)
+    assert "not force balanced" in err.value.message and "= 0 is off by" in err.value.message
+
+
+def test_moment_balance_of_an_already_force_balanced_custom_mechanism():
+    """Counterweights written into the custom spec (attachments from a force_balance run), then
+    moment_balance with no counterweights of its own: only the discs are solved."""
+    data = four_bar(np.random.default_rng(65), {"method": "force_balance", "counterweights": FOUR_BAR_REGIONS})
+    fb = registry.balance(Spec.model_validate(data)).stages[1].model
+    for b in data["mechanism"]["bodies"]:
+        b["attachments"] = [{"name": a.name, "mass": a.mass, "position": list(a.position)}
+                            for a in fb.body(b["name"]).attachments]
+    data["balancing"] = {"method": "moment_balance",
+                         "counter_rotations": [FOUR_BAR_DISCS[0], FOUR_BAR_DISCS[2]]}
+    st = study.run(Spec.model_validate(data))
+    # two frame discs cannot cancel the coupler's term: least squares, the stage claims the force only
+    res = {p.name: p.value for p in st.balance.parameters}
+    assert st.stages[2].stage.balances in ("force", "force+moment")
+    if res["moment_residual"] > 1e-9:
+        assert st.stages[2].stage.balances == "force"
+        assert st.stages[2].analysis.max_moment < st.stages[1].analysis.max_moment
+    assert st.ok, st.problems
+
+
+def test_disc_needing_negative_inertia_is_an_error_on_its_ratio():
+    data = four_bar(np.random.default_rng(66), {
+        "method": "moment_balance", "counterweights": FOUR_BAR_REGIONS,
+        "counter_rotations": [dict(FOUR_BAR_DISCS[0], ratio=1.0), FOUR_BAR_DISCS[1], FOUR_BAR_DISCS[2]]})
+    with pytest.raises(SpecFieldError) as err:
+        registry.balance(Spec.model_validate(data))
+    assert err.value.path[:2] == ("balancing", "counter_rotations")

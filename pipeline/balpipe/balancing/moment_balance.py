@@ -135,11 +135,17 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
                                  + "): give counterweights")
     mc = moment_conditions(with_discs, discs, t, method.rank_tolerance, method.samples, method.seed + 1)
     regions = regions_from_spec(with_discs, method.counterweights, root + ("counterweights",))
+    unmet: list[tuple[str, float]] = []
     try:
         sol = LM.solve(with_discs, cond, regions, method.polygon_sides, moment=mc)
     except LM.Infeasible as exc:
-        raise SpecFieldError(root + ("counter_rotations",), str(exc).replace(
-            "force-balance condition(s)", "force- and moment-balance condition(s)")) from None
+        # the parts cannot cancel the moment for every motion: least-mass force balance, then
+        # the least-squares discs (the stage claims the force only)
+        unmet = [c for c in exc.conditions if c[0] in mc.equations()] or exc.conditions
+        try:
+            sol = LM.solve(with_discs, cond, regions, method.polygon_sides) if regions else LM.Solution([], 0.0, method.polygon_sides, 0.0, [])
+        except LM.Infeasible as exc_force:
+            raise SpecFieldError(root + ("counterweights",), str(exc_force)) from None
     balanced = with_discs
     for cw in sol.counterweights:
         if cw.mass > 0:
@@ -182,16 +188,26 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
                                 f"disc on {s.carrier}, geared to {s.geared_to} with ratio {s.ratio:g}"))
     params.append(Parameter("moment_residual", residual, "", "angular-momentum regressor (least squares)",
                             "|H| left by the discs / |H| of the counterweighted mechanism, over the samples"))
-    notes = [
+    if unmet:
+        notes_unmet = [
+            "No counterweights in the allowed regions with these counter-rotations can cancel the shaking "
+            "moment for every motion; unmet angular-momentum condition(s): "
+            + "; ".join(f"{eq} (left at {r:.4g})" for eq, r in unmet[:4]) + ("; ..." if len(unmet) > 4 else "")
+            + ". The counterweights are those of least mass for the force alone and the discs' inertias the "
+            "least-squares fit."
+        ]
+    else:
+        notes_unmet = []
+    notes = notes_unmet + [
         f"{cond.count} independent force-balance conditions and {len(mc.matrix)} on the angular momentum "
         f"(ranks of the momentum regressors over {cond.samples} sampled states, tolerance {cond.tolerance:g}; the force count includes each disc's own: its centre of mass on its axis). "
-        f"Counterweights of least added mass ({sol.total_mass:.6g} kg) meeting both, with the discs' "
-        "inertias, in one linear programme; a counterweight's inertia is that of its mass spread over its region.",
+        + (f"Counterweights of least added mass ({sol.total_mass:.6g} kg) meeting both, with the discs' "
+           "inertias, in one linear programme; a counterweight's inertia is that of its mass spread over its region."
+           if not unmet else f"Counterweights of least added mass for the force: {sol.total_mass:.6g} kg."),
         f"Counter-rotation inertias re-solved by least squares over {samples} sampled states: relative residual "
         f"{residual:.2g}" + (" (the moment is cancelled for every motion)." if cancelled else
                              f", above {MOMENT_TOLERANCE:g}: the stage claims only the force."),
     ]
-    p_cw = R.parameters(cw_model)
     details = {
         "force_balance": cond.to_json(R.parameters(model.add(tuple(b for b in with_discs.bodies if b.name in discs)))),
         "moment_balance": {
@@ -204,9 +220,9 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
             "residual": residual, "samples": samples, "tolerance": MOMENT_TOLERANCE,
             "added_inertia": float(np.sum(inertias)), "total_mass": sol.total_mass,
             "polygon_sides": sol.polygon_sides, "disc_accuracy": sol.disc_accuracy,
+            "unmet": [{"equation": eq, "residual": r} for eq, r in unmet],
         },
     }
-    del p_cw
     stages = [
         Stage("unbalanced", "unbalanced", model, "the mechanism as given"),
         Stage("counterweights", "counterweights", cw_model, "force balanced by counterweights", balances="force"),
