@@ -298,3 +298,17 @@ def test_disc_needing_negative_inertia_is_an_error_on_its_ratio():
     with pytest.raises(SpecFieldError) as err:
         registry.balance(Spec.model_validate(data))
     assert err.value.path[:2] == ("balancing", "counter_rotations")
+
+
+def test_error_in_a_compared_design_is_located(tmp_path, capsys):
+    from balpipe.cli import main
+
+    text = (SPECS / "custom_four_bar_balancing.yaml").read_text()
+    head, _, tail = text.rpartition("{body: rocker, name: cw_rocker")
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(head + "{body: rokker, name: cw_rocker" + tail)
+    assert main(["check", str(bad)]) == 2
+    err = capsys.readouterr().err
+    line = 1 + (head + "{").count("\n")
+    assert f"bad.yaml:{line}:" in err
+    assert "compare[0].balancing.counterweights[2].body: design 'force_only': unknown body 'rokker'" in err
