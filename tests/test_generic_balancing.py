@@ -203,7 +203,10 @@ def test_compare_block_puts_designs_side_by_side():
     assert st.ok, st.problems
     out = results_dict(st, "x.yaml", "h", simulated=False)
     rows = out["comparison"]["rows"]
-    assert [r["stage"] for r in rows] == ["unbalanced", "counterweights", "counter_rotations", "force_only:counterweights"]
+    assert [r["stage"] for r in rows] == ["unbalanced", "counterweights", "counter_rotations",
+                                          "force_only:counterweights", "crank_only:crank_cw"]
+    assert rows[4]["design"] == "crank_only" and rows[4]["added_mass"] == pytest.approx(1.0)
+    assert 0.05 < rows[4]["force_ratio"] < 1  # a partial balance: reduced, not cancelled
     main, other = rows[2], rows[3]
     assert main["added_inertia"] > 0 and other["added_inertia"] == 0
     assert main["max_shaking_moment"] <= 1e-9 * rows[0]["max_shaking_moment"]
