@@ -83,11 +83,13 @@ def add_discs(model: Model, specs: list[CounterRotationSpec], root: tuple) -> Mo
     return out
 
 
-def solve_inertias(model: Model, discs: list[str], t: np.ndarray, samples: int = 0, seed: int = 0
-                   ) -> tuple[np.ndarray, float, int]:
+def solve_inertias(model: Model, discs: list[str], t: np.ndarray, samples: int = 0, seed: int = 0,
+                   states: R.States | None = None) -> tuple[np.ndarray, float, int]:
     """Least-squares disc inertias cancelling the angular momentum of the force-balanced
-    ``model`` (discs present with zero inertia). Returns (inertias, relative residual, samples)."""
-    st = R.sample_states(model, t, samples, seed)
+    ``model`` (discs present with zero inertia). Returns (inertias, relative residual, samples).
+    ``states`` may come from the same model with other masses (the kinematics do not depend on
+    them)."""
+    st = states if states is not None else R.sample_states(model, t, samples, seed)
     Y = R.angular_regressor(st)
     names = R.param_names(model, angular=True)
     p = R.parameters(model, angular=True)
@@ -108,10 +110,10 @@ def set_disc_inertias(model: Model, inertias: dict[str, float]) -> Model:
 
 
 def moment_conditions(model: Model, discs: list[str], t: np.ndarray, tolerance: float, samples: int = 0,
-                      seed: int = 0) -> LM.MomentConditions:
+                      seed: int = 0, states: R.States | None = None) -> LM.MomentConditions:
     """The angular-momentum conditions of ``model`` (discs included): the row space of Y_H about
     the origin, in RREF with the discs' inertias as first pivots."""
-    st = R.sample_states(model, t, samples, seed)
+    st = states if states is not None else R.sample_states(model, t, samples, seed)
     Y = R.angular_regressor(st)
     names = R.param_names(model, angular=True)
     rs = R.row_space(Y, C.column_scale(model, angular=True), tolerance)
@@ -125,7 +127,8 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
     root = ("balancing",)
     discs = [s.name for s in method.counter_rotations]
     with_discs = add_discs(model, method.counter_rotations, root + ("counter_rotations",))
-    cond = C.find(with_discs, t, method.rank_tolerance, method.samples, method.seed)
+    states = R.sample_states(with_discs, t, method.samples, method.seed)  # conditions of both momenta
+    cond = C.find(with_discs, t, method.rank_tolerance, states=states)
     p0 = R.parameters(with_discs)
     if not method.counterweights:
         bad = [(eq, r) for eq, r in zip(cond.equations(), cond.residuals(p0)) if abs(r) > 1e-9 * C.scale_of(with_discs)]
@@ -133,7 +136,7 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
             raise SpecFieldError(root + ("counterweights",), "the mechanism is not force balanced ("
                                  + "; ".join(f"{eq} is off by {r:.4g}" for eq, r in bad)
                                  + "): give counterweights")
-    mc = moment_conditions(with_discs, discs, t, method.rank_tolerance, method.samples, method.seed + 1)
+    mc = moment_conditions(with_discs, discs, t, method.rank_tolerance, states=states)
     regions = regions_from_spec(with_discs, method.counterweights, root + ("counterweights",))
     unmet: list[tuple[str, float]] = []
     try:
@@ -150,9 +153,10 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
     for cw in sol.counterweights:
         if cw.mass > 0:
             balanced = add_counterweight(balanced, cw.region.body, cw.region.name, cw.mass, cw.position, cw.inertia)
-    # the discs' inertias by least squares on the counterweighted model: the residual says how
-    # exactly the angular momentum is cancelled over the samples
-    inertias, residual, samples = solve_inertias(balanced, discs, t, method.samples, method.seed + 2)
+    # the discs' inertias by least squares on the counterweighted model, over states sampled anew
+    # (another seed): the residual says how exactly the angular momentum is cancelled beyond the
+    # states the conditions came from
+    inertias, residual, samples = solve_inertias(balanced, discs, t, method.samples, method.seed + 1)
     for k, (name, J) in enumerate(zip(discs, inertias)):
         if J < -1e-9 * max(1e-12, float(np.max(np.abs(inertias)))):
             raise SpecFieldError(
