@@ -315,3 +315,58 @@ def test_error_in_a_compared_design_is_located(tmp_path, capsys):
     line = 1 + (head + "{").count("\n")
     assert f"bad.yaml:{line}:" in err
     assert "compare[0].balancing.counterweights[2].body: design 'force_only': unknown body 'rokker'" in err
+
+
+def test_page_shows_conditions_and_designs_side_by_side():
+    from balpipe.report.page import render_page
+
+    spec = load(SPECS / "custom_four_bar_balancing.yaml").spec
+    st = study.run(spec)
+    html = render_page(st, results_dict(st, "x.yaml", "h", simulated=False), "text")
+    assert "Designs side by side" in html and "crank counterweight only" in html
+    assert "Force-balance conditions" in html and "Moment balance by counter-rotations" in html
+    assert "<code>mx[crank] + 0.08 m[coupler]" in html  # the crank's condition, L1 = 0.08 m
+    assert "Design force_only</strong>: 4 force-balance conditions" in html
+
+
+def test_per_drive_trapezoidal_fraction():
+    data = five_bar(np.random.default_rng(71))
+    data["motion"]["drive"]["q1"].update({"law": "trapezoidal", "accel_fraction": 0.25})
+    data["motion"]["accel_fraction"] = 0.5
+    laws = {d.name: d.law for d in registry.unbalanced_model(Spec.model_validate(data)).drivers}
+    T = data["motion"]["duration"]
+    _, v, a = laws["q1"](np.array([0.1 * T, 0.5 * T]))
+    assert a[1] == 0.0 and a[0] > 0  # cruising at mid-motion: the drive's fraction 0.25, not 0.5
+
+
+@pytest.mark.parametrize("step,message", [
+    ({"name": "a", "remove": ["link1.nothing"]}, "carries no part 'nothing'"),
+    ({"name": "a", "parts": [{"body": "link9", "name": "p", "mass": 1.0}]}, "unknown body 'link9'"),
+    ({"name": "a", "parts": [{"body": "link1", "name": "p", "mass": 1.0, "position": "Z"}]}, "no point 'Z'"),
+])
+def test_stage_errors_are_located(step, message):
+    data = five_bar(np.random.default_rng(72), {"method": "stages", "stages": [step]})
+    with pytest.raises(SpecFieldError) as err:
+        registry.balance(Spec.model_validate(data))
+    assert message in err.value.message and err.value.path[:3] == ("balancing", "stages", 0)
+
+
+def test_custom_attachment_errors_are_located():
+    data = five_bar(np.random.default_rng(73))
+    data["mechanism"]["bodies"][1]["attachments"] = [{"name": "g", "mass": 0.2, "position": "Q", "kind": "gear"}]
+    with pytest.raises(SpecFieldError) as err:
+        registry.unbalanced_model(Spec.model_validate(data))
+    assert err.value.path == ("mechanism", "bodies", 1, "attachments", 0, "position")
+    data["mechanism"]["bodies"][1]["attachments"] = [{"name": "g", "mass": 0.2, "position": "B2", "kind": "gear",
+                                                      "inertia": 0.001, "radius": 0.03}]
+    body = registry.unbalanced_model(Spec.model_validate(data)).body("link2")
+    assert body.attachments[0].kind == "gear" and body.attachments[0].position == tuple(body.points["B2"])
+
+
+def test_generic_results_are_deterministic():
+    from balpipe.report.results import dumps, timeseries_csv
+
+    spec = load(SPECS / "custom_four_bar_balancing.yaml").spec
+    a, b = study.run(spec), study.run(spec)
+    assert dumps(results_dict(a, "x", "h", False)) == dumps(results_dict(b, "x", "h", False))
+    assert timeseries_csv(a) == timeseries_csv(b)

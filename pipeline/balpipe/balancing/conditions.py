@@ -136,6 +136,11 @@ def _snap(x: float) -> float:
 
 
 def fmt_coefficient(x: float) -> str:
+    """A short decimal (up to 4 significant digits: 0.08, 1.5) when exact, else a fraction with a
+    small denominator (4/11) when exact, else 6 significant digits."""
+    short = f"{x:.4g}"
+    if float(short) == x and "e" not in short:
+        return short
     f = Fraction(x).limit_denominator(64)
     if float(f) == x:
         return str(f.numerator) if f.denominator == 1 else f"{f.numerator}/{f.denominator}"
