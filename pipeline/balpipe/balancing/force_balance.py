@@ -71,9 +71,12 @@ def _point(model: Model, body: str, p: Point, path: tuple) -> Vec2:
     if not isinstance(p, str):
         return (float(p[0]), float(p[1]))
     try:
-        return tuple(model.body(body).point(p))
-    except KeyError as exc:
-        raise SpecFieldError(path, str(exc).strip("'\"")) from None
+        b = model.body(body)
+    except KeyError:
+        raise SpecFieldError(path, f"unknown body {body!r}") from None
+    if p not in b.points:
+        raise SpecFieldError(path, f"body {body!r} has no point {p!r} (known: {', '.join(b.points) or 'none'})")
+    return tuple(b.points[p])
 
 
 def regions_from_spec(model: Model, specs: list[CounterweightRegionSpec], root: tuple) -> list[LM.Region]:

@@ -14,7 +14,9 @@ kinematics (r_k, theta_k and their rates) do not depend on the masses, so one se
 states gives regressors Y with P = Y_P p and H = Y_H p for every mass distribution p.
 
 States are sampled away from the motion's path: from configurations along it, the driven
-coordinates are displaced at random and the constraints re-solved (Newton-Raphson, the engine's),
+coordinates are displaced at random (uniformly within +-0.6 rad, +-0.15 model sizes; halved in
+each further round if too few samples close) and the constraints re-solved (Newton-Raphson, the
+engine's; with redundant actuation, a subset of drivers that makes the system square),
 and velocities are random combinations of the null space of the joint constraints' Jacobian (every
 feasible velocity, independent of the drivers). Configurations whose joint Jacobian is nearly
 singular (smallest to largest singular value below :data:`MIN_CONDITION`) are discarded.
@@ -144,14 +146,14 @@ def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0) 
         LENGTH_SPREAD * size if _is_length(model, p) else ANGLE_SPREAD for p in driver_prims
     ])
     poses, rates, discarded, dof = [], [], 0, None
-    for _ in range(6):  # rounds, until enough good samples
+    for round_ in range(6):  # rounds, until enough good samples; smaller displacements each round
         need = target - sum(len(p) for p in poses)
         if need <= 0:
             break
         k = rng.integers(0, len(tc), size=2 * need)
         scale = rng.uniform(-1, 1, size=(2 * need, len(driver_prims)))
         scale[: len(tc)] = 0.0  # keep the path's own configurations too
-        values = base_values[k] + scale * spread
+        values = base_values[k] + scale * spread * 0.5**round_
         trial = replace(sq, prims=[
             replace(p, law=_Table(values[:, j])) if p.owner in sq.driver_rows else p
             for j, p in _enumerate_drivers(sq.prims, sq.driver_rows)
