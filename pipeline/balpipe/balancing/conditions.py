@@ -72,7 +72,8 @@ class ForceConditions:
             "parameters": self.names,
             "conditions": [
                 {"equation": eq, "residual": float(r), "unit": self.unit(k),
-                 "coefficients": {self.names[j]: float(v) for j, v in enumerate(row) if v != 0.0}}
+                 "coefficients": {self.names[j]: float(v) for j, v in enumerate(row)
+                                  if abs(v) > 1e-10 * float(np.max(np.abs(row)))}}
                 for k, (eq, r, row) in enumerate(zip(self.equations(), res, self.matrix))
             ],
         }
@@ -104,7 +105,8 @@ def _pivot_order(names: list[str]) -> list[int]:
 
 def rref(A: np.ndarray, order: list[int], tol: float = 1e-10) -> tuple[np.ndarray, list[int]]:
     """Reduced row echelon form of the full-row-rank ``A`` with pivots searched in the column
-    ``order``; entries below ``tol`` x the row's largest are set to zero."""
+    ``order``. The entries are kept as computed (the conditions are used to round-off); only
+    :func:`equation` rounds them for reading."""
     M = A.copy()
     rows = M.shape[0]
     pivots: list[int] = []
@@ -122,10 +124,6 @@ def rref(A: np.ndarray, order: list[int], tol: float = 1e-10) -> tuple[np.ndarra
                 M[i] -= M[i, col] * M[r]
         pivots.append(col)
         r += 1
-    for i in range(len(pivots)):
-        row = M[i]
-        row[np.abs(row) < tol * np.max(np.abs(row))] = 0.0
-        M[i] = [_snap(v) for v in row]
     return M[: len(pivots)], pivots
 
 
@@ -147,10 +145,13 @@ def fmt_coefficient(x: float) -> str:
     return f"{x:.6g}"
 
 
-def equation(row: np.ndarray, names: list[str]) -> str:
-    """'mx[crank] + 0.2 m[coupler] - 1/2 my[slider] = 0'."""
+def equation(row: np.ndarray, names: list[str], tol: float = 1e-10) -> str:
+    """'mx[crank] + 0.2 m[coupler] - 1/2 my[slider] = 0': entries below ``tol`` x the row's
+    largest are left out, the others snapped to simple fractions when within 1e-9."""
     terms = []
+    big = float(np.max(np.abs(row))) if len(row) else 0.0
     for v, n in zip(row, names):
+        v = 0.0 if abs(v) <= tol * big else _snap(float(v))
         if v == 0.0:
             continue
         sign = "-" if v < 0 else "+"

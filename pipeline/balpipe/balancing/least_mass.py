@@ -148,8 +148,8 @@ def solve(model: Model, cond: ForceConditions, regions: list[Region], sides: int
     if res.status != 0:
         raise ValueError(f"least-mass counterweights: the solver stopped: {res.message}")
     z = res.x.copy()
-    active = z > 1e-12 * max(1.0, float(np.max(z)))
-    for _ in range(3):  # polish: conditions to round-off
+    active = z > 1e-12 * max(1.0, float(np.max(z, initial=0.0)))
+    for _ in range(3 if active.any() else 0):  # polish: conditions to round-off
         dz = np.linalg.lstsq(A[:, active], b - A @ z, rcond=None)[0]
         z[active] += dz
     z = np.maximum(z, 0.0)
