@@ -160,7 +160,9 @@ def solve(model: Model, cond: ForceConditions, regions: list[Region], sides: int
         d = G4[4 * bidx : 4 * bidx + 4, idx] @ z[idx]
         mu = float(d[0])
         pos = (float(d[1] / mu), float(d[2] / mu)) if mu > 0 else tuple(reg.points[0])
-        inertia = max(0.0, float(d[3] - mu * (pos[0] ** 2 + pos[1] ** 2))) if moment is not None else 0.0
+        inertia = float(d[3] - mu * (pos[0] ** 2 + pos[1] ** 2)) if moment is not None else 0.0
+        if inertia <= 1e-12 * max(float(d[3]), 1e-300):  # a point mass, to round-off
+            inertia = 0.0
         placed.append(Placed(reg, mu, pos, inertia))
     p = p0 + G @ z[: G.shape[1]]
     total = float(sum(c.mass for c in placed))
