@@ -11,9 +11,10 @@ from typing import Annotated, Literal, Union
 import numpy as np
 from pydantic import Field
 
-from ..model import FRAME, Attachment, Body, Driver, Gear, Model, Prismatic, Revolute
+from ..model import FRAME, Body, Driver, Gear, Model, Prismatic, Revolute
 from ..spec_parts import SpecFieldError, Strict
 from ..units import Angle, Inertia, Length, Mass, PositiveLength
+from ..model import Attachment
 
 Point = Union[str, tuple[Length, Length]]
 
@@ -107,6 +108,23 @@ class CustomMechanism(Strict):
         return out
 
 
+def _attachments(b: CustomBody, path: tuple) -> tuple[Attachment, ...]:
+    out, seen = [], set()
+    for k, a in enumerate(b.attachments):
+        if a.name in seen:
+            raise SpecFieldError(path + ("attachments", k, "name"), f"part name {a.name!r} is used twice on {b.name!r}")
+        seen.add(a.name)
+        if isinstance(a.position, str):
+            if a.position not in b.points:
+                raise SpecFieldError(path + ("attachments", k, "position"),
+                                     f"{b.name!r} has no point {a.position!r} (known: {', '.join(b.points) or 'none'})")
+            pos = tuple(b.points[a.position])
+        else:
+            pos = (float(a.position[0]), float(a.position[1]))
+        out.append(Attachment(a.name, a.mass, pos, a.inertia, a.kind, a.radius))
+    return tuple(out)
+
+
 def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
     names = [b.name for b in mech.bodies]
     root = ("mechanism",)
@@ -172,19 +190,3 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
         frame_points={k: tuple(v) for k, v in mech.frame_points.items()},
     )
 
-
-def _attachments(b: CustomBody, path: tuple) -> tuple[Attachment, ...]:
-    out, seen = [], set()
-    for k, a in enumerate(b.attachments):
-        if a.name in seen:
-            raise SpecFieldError(path + ("attachments", k, "name"), f"part name {a.name!r} is used twice on {b.name!r}")
-        seen.add(a.name)
-        if isinstance(a.position, str):
-            if a.position not in b.points:
-                raise SpecFieldError(path + ("attachments", k, "position"),
-                                     f"{b.name!r} has no point {a.position!r} (known: {', '.join(b.points) or 'none'})")
-            pos = tuple(b.points[a.position])
-        else:
-            pos = (float(a.position[0]), float(a.position[1]))
-        out.append(Attachment(a.name, a.mass, pos, a.inertia, a.kind, a.radius))
-    return tuple(out)
