@@ -189,4 +189,3 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
         initial={b.name: tuple(b.pose) for b in mech.bodies},
         frame_points={k: tuple(v) for k, v in mech.frame_points.items()},
     )
-
