@@ -53,6 +53,9 @@ METHODS: dict[str, Method] = {
     "five_bar_gear_balancing": Method(
         fb_balancing.balance, ("five_bar",), "counterweights + counter-rotating gears 5, 6, 7 (eqs. 9-21)"
     ),
+}
+# methods for every template (they read only the model)
+METHODS.update({
     "force_balance": Method(
         generic_force.balance, (), "force-balance conditions from the momentum + least-mass counterweights", True
     ),
@@ -60,7 +63,7 @@ METHODS: dict[str, Method] = {
         generic_moment.balance, (), "least-mass counterweights + counter-rotations from the angular momentum", True
     ),
     "stages": Method(generic_stages.balance, (), "stages written by hand, each adding parts", True),
-}
+})
 
 
 def scalar_laws(motion: Any, dims: dict[str, str]) -> dict[str, Law]:

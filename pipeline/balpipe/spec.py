@@ -13,13 +13,13 @@ from typing import Annotated, Literal, Union
 from pydantic import Field
 
 from .balancing.five_bar import FiveBarGearBalancing
-from .balancing.force_balance import ForceBalance
-from .balancing.moment_balance import MomentBalance
-from .balancing.stages import Stages
 from .balancing.slider_crank import SliderCrankCounterweights
 from .mechanisms.custom import CustomMechanism
 from .mechanisms.five_bar import FiveBarMechanism
 from .mechanisms.slider_crank import SliderCrankMechanism
+from .balancing.force_balance import ForceBalance
+from .balancing.moment_balance import MomentBalance
+from .balancing.stages import Stages
 from .spec_parts import DriveSpec, Strict
 from .units import Duration, Length, quantity
 
