@@ -95,31 +95,41 @@ def model_size(model: Model) -> float:
     return max([1e-3] + r)
 
 
+def _joint_and_driver_prims(c: Compiled) -> tuple[list, list]:
+    """:func:`compile_model` appends one primitive per driver after the joints' (a driver may
+    share its name with the joint it drives, so names cannot tell them apart)."""
+    nd = len(c.model.drivers)
+    return list(c.prims[: len(c.prims) - nd]), list(c.prims[len(c.prims) - nd :])
+
+
 def _square_subset(c: Compiled, q: np.ndarray) -> Compiled:
     """The compiled model restricted to its joints and a set of drivers that make the system
     square and regular at ``q`` (all of them unless the actuation is redundant)."""
     n = 3 * c.nb
-    driver_names = set(c.driver_rows)
-    joint_prims = [p for p in c.prims if p.owner not in driver_names]
-    chosen = list(joint_prims)
-    for p in c.prims:
-        if p.owner not in driver_names:
-            continue
-        trial = _restrict(c, chosen + [p])
+    joint_prims, driver_prims = _joint_and_driver_prims(c)
+    chosen: list = []
+    for p in driver_prims:
+        trial = _restrict(c, joint_prims, chosen + [p])
         J = jacobian(trial, _extend(q[None, :]))[0, :, 3:]
-        if np.linalg.matrix_rank(J) == J.shape[0] and J.shape[0] <= n:
+        if J.shape[0] <= n and np.linalg.matrix_rank(J) == J.shape[0]:
             chosen.append(p)
-    return _restrict(c, chosen)
+    return _restrict(c, joint_prims, chosen)
 
 
-def _restrict(c: Compiled, prims: list) -> Compiled:
+def _restrict(c: Compiled, joint_prims: list, driver_prims: list) -> Compiled:
+    """A compiled model with these joints and drivers only (drivers last, as compile_model does;
+    ``model`` keeps only the matching drivers so that the split above still holds)."""
     owner: list[str] = []
     rows: dict[str, int] = {}
-    for p in prims:
-        if p.owner in c.driver_rows:
-            rows[p.owner] = len(owner)
+    for p in joint_prims:
         owner.extend([p.owner] * p.rows)
-    return replace(c, prims=list(prims), row_owner=owner, driver_rows=rows, joint_rows={})
+    for p in driver_prims:
+        rows[p.owner] = len(owner)
+        owner.extend([p.owner] * p.rows)
+    names = {p.owner for p in driver_prims}
+    model = replace(c.model, drivers=tuple(d for d in c.model.drivers if d.name in names))
+    return replace(c, model=model, prims=joint_prims + list(driver_prims), row_owner=owner, driver_rows=rows,
+                   joint_rows={})
 
 
 def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0) -> States:
@@ -137,10 +147,9 @@ def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0) 
     q_first, ok, _ = _newton(_square_subset(c, c.q0), c.q0[None, :], t[:1], max_iter=50)
     sq = _square_subset(c, q_first[0] if ok[0] else c.q0)
     base = solve_positions(sq, tc)
-    driver_prims = [p for p in sq.prims if p.owner in sq.driver_rows]
+    joint_prims, driver_prims = _joint_and_driver_prims(sq)
     base_values = np.array([p.law(tc)[0] for p in driver_prims]).T if driver_prims else np.zeros((len(tc), 0))
-    joint_prims = [p for p in sq.prims if p.owner not in sq.driver_rows]
-    joints_only = _restrict(sq, joint_prims)
+    joints_only = _restrict(sq, joint_prims, [])
     size = model_size(model)
     spread = np.array([
         LENGTH_SPREAD * size if _is_length(model, p) else ANGLE_SPREAD for p in driver_prims
@@ -154,9 +163,8 @@ def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0) 
         scale = rng.uniform(-1, 1, size=(2 * need, len(driver_prims)))
         scale[: len(tc)] = 0.0  # keep the path's own configurations too
         values = base_values[k] + scale * spread * 0.5**round_
-        trial = replace(sq, prims=[
-            replace(p, law=_Table(values[:, j])) if p.owner in sq.driver_rows else p
-            for j, p in _enumerate_drivers(sq.prims, sq.driver_rows)
+        trial = replace(sq, prims=joint_prims + [
+            replace(p, law=_Table(values[:, j])) for j, p in enumerate(driver_prims)
         ])
         q, ok, _ = _newton(trial, base[k], np.arange(2 * need, dtype=float))
         Jj = jacobian(joints_only, _extend(q))[:, :, 3:]
@@ -183,16 +191,6 @@ def states_from_analysis(model: Model, analysis) -> States:
     c = compile_model(model)
     S = len(analysis.t)
     return _body_frames(model, c, analysis.q.reshape(S, -1), analysis.v.reshape(S, -1), -1, 0)
-
-
-def _enumerate_drivers(prims, driver_rows):
-    j = 0
-    for p in prims:
-        if p.owner in driver_rows:
-            yield j, p
-            j += 1
-        else:
-            yield -1, p
 
 
 def _is_length(model: Model, prim) -> bool:
