@@ -185,12 +185,15 @@ def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0) 
     return _body_frames(model, c, q, v, dof or 0, discarded)
 
 
-def states_from_analysis(model: Model, analysis) -> States:
-    """The states along an engine analysis of ``model`` (its own motion), for checking
-    Y_P p = P and Y_H p = H against the engine."""
+def states_from_analysis(model: Model, *analyses) -> States:
+    """The states along engine analyses of ``model`` (its own motions, concatenated): for checking
+    Y_P p = P and Y_H p = H against the engine, or for conditions restricted to a family of
+    motions (e.g. a translating platform: several analyses of such motions, passed to
+    ``conditions.find(model, t, states=...)``)."""
     c = compile_model(model)
-    S = len(analysis.t)
-    return _body_frames(model, c, analysis.q.reshape(S, -1), analysis.v.reshape(S, -1), -1, 0)
+    q = np.concatenate([a.q.reshape(len(a.t), -1) for a in analyses])
+    v = np.concatenate([a.v.reshape(len(a.t), -1) for a in analyses])
+    return _body_frames(model, c, q, v, -1, 0)
 
 
 def _is_length(model: Model, prim) -> bool:
