@@ -46,7 +46,7 @@ class CounterRotationSpec(Strict):
     geared_to: str = Field(description="the body the disc is geared to")
     ratio: float = Field(description="(w_disc - w_carrier) / (w_geared - w_carrier); -r_g / r_disc for an external mesh")
     mass: Mass = Field(0.0, description="mass of the disc (on its axis; counted by the force balance)")
-    radius: PositiveLength | None = Field(None, description="pitch radius of the disc (drawing)")
+    radius: PositiveLength | None = Field(None, description="radius of the disc, for drawing (the mesh is modelled as a couple)")
 
 
 class MomentBalance(FinderSettings):
@@ -76,9 +76,11 @@ def add_discs(model: Model, specs: list[CounterRotationSpec], root: tuple) -> Mo
             raise SpecFieldError(path + ("at",), f"the frame has no point {s.at!r}")
         try:
             out = add_counter_rotation(out, s.name, carrier=s.carrier, at=at, geared_to=s.geared_to,
-                                       ratio=s.ratio, inertia=0.0, mass=s.mass, radius=s.radius)
+                                       ratio=s.ratio, inertia=0.0, mass=s.mass)
         except ValueError as exc:
             raise SpecFieldError(path + ("ratio",), str(exc)) from None
+        if s.radius is not None:  # drawing only: the mesh stays a couple (no pitch radii, no tooth forces)
+            out = out.replace_body(replace(out.body(s.name), radius=s.radius))
         names.append(s.name)
     return out
 
