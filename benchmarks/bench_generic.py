@@ -5,7 +5,7 @@ regressor + SVD + RREF: :func:`balpipe.balancing.conditions.find`), of the least
 counterweight synthesis alone (:func:`balpipe.balancing.least_mass.solve`, linprog), of the
 moment-balance method (conditions of both momenta, joint linear programme, least-squares disc
 inertias) and of a whole ``balpipe build --no-sim`` of the custom four-bar spec. Best of 5
-(perf_counter); asserts nothing. The 4-RRR (issue 8) is added by its branch.
+(perf_counter); asserts nothing. The 4-RRR of paper 001 is included when its spec is present.
 """
 
 from __future__ import annotations
@@ -48,6 +48,8 @@ def main() -> None:
         ("random five-bar (custom, 2 DOF)", Spec.model_validate(five_bar(np.random.default_rng(2), {
             "method": "moment_balance", "counterweights": FIVE_BAR_REGIONS, "counter_rotations": FIVE_BAR_DISCS})), FIVE_BAR_REGIONS),
     ]
+    if (ROOT / "specs/paper001_4rrr.yaml").exists():  # after the rrr4 branch is merged
+        cases.insert(2, ("4-RRR, paper 001 (redundant actuation)", load(ROOT / "specs/paper001_4rrr.yaml").spec, None))
     print(f"{'model':38s} {'bodies':>6s} {'conds':>5s} {'gap':>9s} {'finder ms':>10s} {'least-mass ms':>14s} {'moment_balance ms':>18s}")
     for label, spec, regions in cases:
         model = registry.unbalanced_model(spec)
