@@ -39,7 +39,7 @@ def test_eight_trajectories_with_their_reductions(paper):
         # every ratio refers to the same trajectory's end-effector quintic
         for s in st.stages:
             if s.stage.group == n:
-                assert st.reference(s).stage.name == f"{n}_ee_quintic"
+                assert st.reference_stage(s).stage.name == f"{n}_ee_quintic"
     # our reading of the paper (PAPERS.md: 46.0-60.0 % and 42.3-64.8 %)
     assert p["force_reduction_min"] == pytest.approx(0.460, abs=1e-3)
     assert p["force_reduction_max"] == pytest.approx(0.600, abs=1e-3)

@@ -103,7 +103,7 @@ def cmd_check(args) -> int:
         try:
             loaded = load(f)
             try:
-                registry.balance(loaded.spec)
+                registry.balance_designs(loaded.spec)
             except SpecFieldError as exc:
                 raise loaded.error(exc) from None
             print(f"{f}: ok")

@@ -136,14 +136,18 @@ class Polynomial(Law):
 def law_for(motion, start: float, end: float, drive=None) -> Law:
     """The law of one coordinate from ``start`` to ``end`` (SI) following the spec's ``motion``
     section (law, duration, accel_fraction); ``drive`` gives the polynomial law's boundary
-    velocities and accelerations."""
+    velocities and accelerations, and may name its own ``law`` and ``accel_fraction``."""
     T = motion.duration
-    if motion.law == "polynomial":
+    law = getattr(drive, "law", None) or motion.law
+    fraction = getattr(drive, "accel_fraction", None) or motion.accel_fraction
+    if law == "polynomial":
         d = drive
         return Polynomial.from_boundary(
             (start, d.start_velocity if d else 0.0, d.start_acceleration if d else 0.0),
             (end, d.end_velocity if d else 0.0, d.end_acceleration if d else 0.0),
             T,
         )
-    profile = trapezoidal(motion.accel_fraction) if motion.law == "trapezoidal" else PROFILES[motion.law]
+    if law not in PROFILES and law != "trapezoidal":
+        raise ValueError(f"unknown law {law!r}; known: {', '.join(sorted(PROFILES) + ['polynomial', 'trapezoidal'])}")
+    profile = trapezoidal(fraction) if law == "trapezoidal" else PROFILES[law]
     return PointToPoint(start, end, T, profile)

@@ -3,7 +3,7 @@ unbalanced model and its balancing stages."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Callable
 
 import numpy as np
@@ -13,7 +13,10 @@ from .balancing import com_planning, decoupling
 from .balancing import five_bar as fb_balancing
 from .balancing import rpr3_idler, rpr3_scott_russell
 from .balancing import rrr4 as rrr4_balancing
+from .balancing import force_balance as generic_force
+from .balancing import moment_balance as generic_moment
 from .balancing import slider_crank as sc_balancing
+from .balancing import stages as generic_stages
 from .balancing.base import BalanceResult, Stage
 from .mechanisms import custom, five_bar, rpr3, rrr4, serial_arm, slider_crank
 from .model import Law, Model
@@ -39,6 +42,7 @@ class Method:
     templates: tuple[str, ...]
     label: str
     uses_spec: bool = False  # balance(..., spec): the method also reads the motion and analysis settings
+    generic: bool = False  # applies to every template; balance() also receives the time grid t
 
 
 TEMPLATES: dict[str, Template] = {
@@ -73,6 +77,16 @@ METHODS: dict[str, Method] = {
         com_planning.balance, ("serial_arm",), "centre-of-mass motion planning, phi optimised (paper 003)", uses_spec=True
     ),
 }
+# methods for every template (they read only the model)
+METHODS.update({
+    "force_balance": Method(
+        generic_force.balance, (), "force-balance conditions from the momentum + least-mass counterweights", generic=True
+    ),
+    "moment_balance": Method(
+        generic_moment.balance, (), "least-mass counterweights + counter-rotations from the angular momentum", generic=True
+    ),
+    "stages": Method(generic_stages.balance, (), "stages written by hand, each adding parts", generic=True),
+})
 
 
 def scalar_laws(motion: Any, dims: dict[str, str]) -> dict[str, Law]:
@@ -106,18 +120,49 @@ def unbalanced_model(spec: Any) -> Model:
     return template.build(mech, laws, time_grid(spec))
 
 
-def balance(spec: Any) -> BalanceResult:
-    """The unbalanced model and the method's stages, with every semantic check of the spec."""
-    name = spec.balancing.method
+def balance(spec: Any, balancing: Any = None) -> BalanceResult:
+    """The unbalanced model and the method's stages, with every semantic check of the spec;
+    ``balancing`` replaces ``spec.balancing`` (the designs of ``spec.compare``)."""
+    balancing = balancing if balancing is not None else spec.balancing
+    name = balancing.method
     model = unbalanced_model(spec)
     if name == "none":
         return BalanceResult([], [Stage("unbalanced", "unbalanced", model, "the mechanism as given")])
     method = METHODS[name]
+    if method.generic:
+        return method.balance(spec.mechanism, balancing, model, t=time_grid(spec))
     if spec.mechanism.template not in method.templates:
         raise SpecFieldError(
             ("balancing", "method"),
             f"method {name!r} applies to {', '.join(method.templates)}, not to {spec.mechanism.template!r}",
         )
     if method.uses_spec:
-        return method.balance(spec.mechanism, spec.balancing, model, spec)
-    return method.balance(spec.mechanism, spec.balancing, model)
+        return method.balance(spec.mechanism, balancing, model, spec)
+    return method.balance(spec.mechanism, balancing, model)
+
+
+def balance_designs(spec: Any) -> BalanceResult:
+    """:func:`balance`, then the stages of every design in ``spec.compare`` after the main
+    design's, named ``design:stage`` (their unbalanced stage, the same model, is dropped);
+    parameters are prefixed the same way and details go to ``details["compare"][design]``."""
+    main = balance(spec)
+    designs = getattr(spec, "compare", None) or []
+    if not designs:
+        return main
+    stages, params, notes = list(main.stages), list(main.parameters), list(main.notes)
+    details = dict(main.details)
+    details["compare"] = {}
+    for k, d in enumerate(designs):
+        try:
+            res = balance(spec, d.balancing)
+        except SpecFieldError as exc:
+            path = exc.path
+            if path[:1] == ("balancing",):
+                path = ("compare", k) + path
+            raise SpecFieldError(path, f"design {d.name!r}: {exc.message}") from None
+        for s in res.stages[1:]:
+            stages.append(replace(s, name=f"{d.name}:{s.name}", label=f"{d.label or d.name}: {s.label}"))
+        params += [replace(p, name=f"{d.name}:{p.name}") for p in res.parameters]
+        notes += [f"{d.label or d.name}: {n}" for n in res.notes]
+        details["compare"][d.name] = res.details
+    return replace(main, parameters=params, stages=stages, notes=notes, details=details)

@@ -15,10 +15,13 @@ from pydantic import Field
 from .balancing.com_planning import ComMotionPlanning
 from .balancing.decoupling import GearDecoupling
 from .balancing.five_bar import FiveBarGearBalancing
+from .balancing.force_balance import ForceBalance
+from .balancing.moment_balance import MomentBalance
 from .balancing.rpr3_idler import Rpr3IdlerLoop
 from .balancing.rpr3_scott_russell import Rpr3ScottRussell
 from .balancing.rrr4 import RRR4Balancing
 from .balancing.slider_crank import SliderCrankCounterweights
+from .balancing.stages import Stages
 from .mechanisms.custom import CustomMechanism
 from .mechanisms.five_bar import FiveBarMechanism
 from .mechanisms.rpr3 import Rpr3Mechanism
@@ -42,10 +45,18 @@ Mechanism = Annotated[
 Balancing = Annotated[
     Union[
         NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing, RRR4Balancing, Rpr3IdlerLoop, Rpr3ScottRussell,
-        GearDecoupling, ComMotionPlanning,
+        GearDecoupling, ComMotionPlanning, ForceBalance, MomentBalance, Stages,
     ],
     Field(discriminator="method", description="the balancing method and its design choices"),
 ]
+
+
+class Design(Strict):
+    """Another balancing design of the same mechanism, analysed beside the main one."""
+
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_\-]+$", description="short name, prefixes its stages (name:stage)")
+    label: str = Field("", description="label in figures and tables (default: the name)")
+    balancing: Balancing
 
 
 class Motion(Strict):
@@ -118,3 +129,6 @@ class Spec(Strict):
     analysis: AnalysisSettings = Field(AnalysisSettings())
     validation: ValidationSpec = Field(ValidationSpec())
     references: list[Reference] = Field([], description="published values to compare with")
+    compare: list[Design] = Field(
+        [], description="other balancing designs of the same mechanism, analysed and tabulated beside the main one"
+    )

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -60,3 +60,10 @@ class DriveSpec(Strict):
     end_velocity: float = Field(0.0, description="polynomial law only: velocity at the end (SI)")
     start_acceleration: float = Field(0.0, description="polynomial law only: acceleration at t = 0 (SI)")
     end_acceleration: float = Field(0.0, description="polynomial law only: acceleration at the end (SI)")
+    law: Literal["quintic", "cycloidal", "bang_bang", "trapezoidal", "polynomial"] | None = Field(
+        None, description="this drive's own law (quintic, cycloidal, bang_bang, trapezoidal, polynomial); "
+        "default: motion.law"
+    )
+    accel_fraction: float | None = Field(
+        None, gt=0, le=0.5, description="trapezoidal law: this drive's acceleration fraction (default: motion.accel_fraction)"
+    )

@@ -202,7 +202,7 @@ def _decimals(x: float) -> int:
 
 def run(spec: Spec) -> Study:
     """Balance and analyse every stage; collect checks and problems (no simulation)."""
-    balance = registry.balance(spec)
+    balance = registry.balance_designs(spec)
     stages = run_stage_analyses(spec, balance)
     tol = spec.analysis.balance_tolerance
     metrics = [stage_metrics(s, reference_of(stages, s), tol) for s in stages]

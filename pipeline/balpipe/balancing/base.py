@@ -45,3 +45,4 @@ class BalanceResult:
     # derived(stage_results) -> [Parameter] computed from the analysed stages (before references)
     figures: Callable[[Any], Any] | None = None
     derived: Callable[[Any], list[Parameter]] | None = None
+    details: dict = field(default_factory=dict)  # method-specific blocks for results.json (e.g. force_balance)

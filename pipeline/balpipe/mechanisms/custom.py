@@ -15,8 +15,20 @@ from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle, mesh_geometry
 from ..model import FRAME, Body, Driver, Gear, Model, Prismatic, Revolute
 from ..spec_parts import SpecFieldError, Strict
 from ..units import Angle, Inertia, Length, Mass, PositiveLength
+from ..model import Attachment
 
 Point = Union[str, tuple[Length, Length]]
+
+
+class CustomAttachment(Strict):
+    """A rigid part fixed to a custom body (its mass, centre and inertia add to the body's)."""
+
+    name: str = Field(min_length=1, description="name, unique on the body")
+    mass: Mass = Field(description="mass")
+    position: tuple[Length, Length] | str = Field((0.0, 0.0), description="centre of mass, [x, y] in the body frame or a named point")
+    inertia: Inertia = Field(0.0, description="centroidal moment of inertia")
+    kind: Literal["counterweight", "gear", "payload", "part"] = Field("counterweight", description="for drawing and accounting")
+    radius: PositiveLength | None = Field(None, description="drawn as a disc of this radius (a gear's pitch radius)")
 
 
 class CustomBody(Strict):
@@ -32,6 +44,7 @@ class CustomBody(Strict):
     )
     radius: PositiveLength | None = Field(None, description="draw the body as a disc of this radius (gears)")
     kind: Literal["link", "gear", "slider", "platform"] = Field("link", description="for drawing and accounting")
+    attachments: list[CustomAttachment] = Field([], description="parts fixed to the body: counterweights, carried gears, payloads")
 
 
 class RevoluteSpec(Strict):
@@ -107,6 +120,23 @@ class CustomMechanism(Strict):
         return out
 
 
+def _attachments(b: CustomBody, path: tuple) -> tuple[Attachment, ...]:
+    out, seen = [], set()
+    for k, a in enumerate(b.attachments):
+        if a.name in seen:
+            raise SpecFieldError(path + ("attachments", k, "name"), f"part name {a.name!r} is used twice on {b.name!r}")
+        seen.add(a.name)
+        if isinstance(a.position, str):
+            if a.position not in b.points:
+                raise SpecFieldError(path + ("attachments", k, "position"),
+                                     f"{b.name!r} has no point {a.position!r} (known: {', '.join(b.points) or 'none'})")
+            pos = tuple(b.points[a.position])
+        else:
+            pos = (float(a.position[0]), float(a.position[1]))
+        out.append(Attachment(a.name, a.mass, pos, a.inertia, a.kind, a.radius))
+    return tuple(out)
+
+
 def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
     names = [b.name for b in mech.bodies]
     root = ("mechanism",)
@@ -159,8 +189,9 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
             raise SpecFieldError(dp, "a driver needs either joint, or body and coordinate")
         drivers.append(Driver(d.name, target, laws[d.name]))
     model_bodies = tuple(
-        Body(b.name, b.mass, tuple(b.com), b.inertia, dict(b.points), outline=tuple(b.points), radius=b.radius, kind=b.kind)
-        for b in mech.bodies
+        Body(b.name, b.mass, tuple(b.com), b.inertia, dict(b.points), outline=tuple(b.points), radius=b.radius,
+             kind=b.kind, attachments=_attachments(b, root + ("bodies", k)))
+        for k, b in enumerate(mech.bodies)
     )
     model = Model(
         name="custom",

@@ -71,7 +71,30 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
         "torque_driven": {s.stage.name: s.torque.to_json() for s in study.stages if s.torque is not None}
         if simulated else None,
     }
+    out["comparison"] = comparison(study, stages)
+    if study.balance.details:
+        out["balancing_details"] = study.balance.details
     return _clean(out)
+
+
+def comparison(study: Study, metrics: list[dict]) -> dict:
+    """Every stage (the main design's and those of ``compare``) side by side: what it adds and
+    what it costs. Joint loads are the peak bearing load over the revolute joints (and the
+    normal force of prismatic pairs), with the joint that carries it."""
+    table = joint_load_table(study)
+    rows = []
+    for s, m in zip(study.stages, metrics):
+        loads = [(row["peaks"].get(s.stage.name, 0.0), row["joint"]) for row in table if row["unit"] == "N"]
+        peak, joint = max(loads) if loads else (0.0, "")
+        design, _, stage = s.stage.name.rpartition(":")
+        rows.append({
+            "stage": s.stage.name, "label": s.stage.label, "design": design or "main", "balances": s.stage.balances,
+            "added_mass": m["added_mass"], "added_inertia": m["added_inertia"],
+            "max_actuator_effort": m["max_actuator_effort"], "max_joint_load": peak, "max_joint_load_joint": joint,
+            "max_shaking_force": m["max_shaking_force"], "max_shaking_moment": m["max_shaking_moment"],
+            "force_ratio": m["force_ratio"], "moment_ratio": m["moment_ratio"],
+        })
+    return {"reference": study.unbalanced.stage.name, "rows": rows}
 
 
 def dumps(results: dict) -> str:

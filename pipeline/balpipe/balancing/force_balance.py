@@ -1,0 +1,159 @@
+"""The ``force_balance`` method, for any model (every template, ``custom`` included): the
+force-balance conditions from the linear-momentum regressor (:mod:`.conditions`, paper 001's
+route) and the counterweights of least added mass in the regions the spec allows
+(:mod:`.least_mass`). Stages: ``unbalanced``, ``counterweights``.
+"""
+
+from __future__ import annotations
+
+from typing import Literal, Union
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from ..model import Model, Vec2
+from ..spec_parts import SpecFieldError, Strict
+from ..units import Length, PositiveLength
+from . import conditions as C
+from . import least_mass as LM
+from . import regressor as R
+from .base import BalanceResult, Parameter, Stage
+from .parts import add_counterweight
+
+Point = Union[str, tuple[Length, Length]]
+
+
+class DiscRegionSpec(Strict):
+    """A disc on the body: centre and radius."""
+
+    centre: Point = Field(description="centre, [x, y] in the body frame or a named point of the body")
+    radius: PositiveLength = Field(description="radius")
+
+
+class CounterweightRegionSpec(Strict):
+    """A point-mass counterweight on a body, within one region of the body's frame: ``at`` a
+    fixed point, on a ``segment`` [from, to], or in a ``disc``."""
+
+    body: str = Field(description="the body that carries the counterweight")
+    name: str | None = Field(None, description="name (default: cw_<body>)")
+    at: Point | None = Field(None, description="a fixed position ([x, y] or a named point)")
+    segment: tuple[Point, Point] | None = Field(None, description="anywhere on this segment")
+    disc: DiscRegionSpec | None = Field(None, description="anywhere in this disc")
+
+    @model_validator(mode="after")
+    def _one_region(self):
+        given = [k for k in ("at", "segment", "disc") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError(f"give exactly one of at, segment, disc (got {', '.join(given) or 'none'})")
+        return self
+
+
+class FinderSettings(Strict):
+    """How the conditions are found."""
+
+    rank_tolerance: float = Field(C.RANK_TOLERANCE, gt=0, lt=1e-3, description="singular values below this fraction of the largest are dropped")
+    samples: int = Field(0, ge=0, le=10_000, description="sampled states (0: 2 x 4 x bodies + 12)")
+    seed: int = Field(0, ge=0, description="seed of the state sampler")
+    polygon_sides: int = Field(LM.POLYGON_SIDES, ge=8, le=4096, description="sides of the polygon inscribed in each disc region")
+
+
+class ForceBalance(FinderSettings):
+    """Force-balance conditions of any mechanism from its momentum, and the counterweights of
+    least added mass in the allowed regions."""
+
+    method: Literal["force_balance"] = Field(description="balancing method")
+    counterweights: list[CounterweightRegionSpec] = Field(
+        min_length=1, description="where counterweights may go (one counterweight per entry)"
+    )
+
+
+def _point(model: Model, body: str, p: Point, path: tuple) -> Vec2:
+    if not isinstance(p, str):
+        return (float(p[0]), float(p[1]))
+    try:
+        b = model.body(body)
+    except KeyError:
+        raise SpecFieldError(path, f"unknown body {body!r}") from None
+    if p not in b.points:
+        raise SpecFieldError(path, f"body {body!r} has no point {p!r} (known: {', '.join(b.points) or 'none'})")
+    return tuple(b.points[p])
+
+
+def regions_from_spec(model: Model, specs: list[CounterweightRegionSpec], root: tuple) -> list[LM.Region]:
+    names = [b.name for b in model.bodies]
+    out, seen = [], set()
+    for k, s in enumerate(specs):
+        path = root + (k,)
+        if s.body not in names:
+            raise SpecFieldError(path + ("body",), f"unknown body {s.body!r} (bodies: {', '.join(names)})")
+        name = s.name or f"cw_{s.body}"
+        if name in seen:
+            raise SpecFieldError(path + ("name",), f"counterweight name {name!r} used twice: name them")
+        seen.add(name)
+        if s.at is not None:
+            out.append(LM.Region(name, s.body, "point", (_point(model, s.body, s.at, path + ("at",)),)))
+        elif s.segment is not None:
+            pts = tuple(_point(model, s.body, p, path + ("segment", i)) for i, p in enumerate(s.segment))
+            out.append(LM.Region(name, s.body, "segment", pts))
+        else:
+            c = _point(model, s.body, s.disc.centre, path + ("disc", "centre"))
+            out.append(LM.Region(name, s.body, "disc", (c,), s.disc.radius))
+    return out
+
+
+def force_stage(model: Model, specs: list[CounterweightRegionSpec], settings: FinderSettings,
+                t: np.ndarray, root: tuple = ("balancing", "counterweights"), prefix: str = ""):
+    """Conditions of ``model``, least-mass counterweights and the counterweighted model.
+
+    Returns (model with counterweights, parameters, details for results.json, notes)."""
+    cond = C.find(model, t, settings.rank_tolerance, settings.samples, settings.seed)
+    p0 = R.parameters(model)
+    regions = regions_from_spec(model, specs, root)
+    try:
+        sol = LM.solve(model, cond, regions, settings.polygon_sides)
+    except LM.Infeasible as exc:
+        raise SpecFieldError(root, str(exc)) from None
+    out = model
+    params = [Parameter(f"{prefix}force_conditions", cond.count, "", "momentum regressor rank",
+                        "independent force-balance conditions")]
+    for cw in sol.counterweights:
+        if cw.mass > 0:
+            out = add_counterweight(out, cw.region.body, cw.region.name, cw.mass, cw.position)
+        d = f"{cw.region.name} on {cw.region.body}, {cw.region.describe()}"
+        params += [
+            Parameter(f"{prefix}{cw.region.name}.mass", cw.mass, "kg", "least added mass (linprog)", d),
+            Parameter(f"{prefix}{cw.region.name}.x", cw.position[0], "m", "least added mass (linprog)", f"{cw.region.name}: x in {cw.region.body}'s frame"),
+            Parameter(f"{prefix}{cw.region.name}.y", cw.position[1], "m", "least added mass (linprog)", f"{cw.region.name}: y in {cw.region.body}'s frame"),
+        ]
+    params.append(Parameter(f"{prefix}counterweight_mass", sol.total_mass, "kg", "least added mass (linprog)", "total mass of the counterweights"))
+    details = cond.to_json(p0)
+    details.update({
+        "counterweights": [
+            {"name": c.region.name, "body": c.region.body, "region": c.region.describe(), "mass": c.mass,
+             "position": list(c.position)} for c in sol.counterweights
+        ],
+        "total_mass": sol.total_mass,
+        "polygon_sides": sol.polygon_sides,
+        "disc_accuracy": sol.disc_accuracy,
+        "residual_after": sol.residual,
+    })
+    gap = "no singular value dropped" if not np.isfinite(cond.gap) else f"gap between the last kept and the first dropped singular value {cond.gap:.3g}"
+    notes = [
+        f"{cond.count} independent force-balance conditions: rank of the linear-momentum regressor over "
+        f"{cond.samples} sampled states of mobility {cond.dof} (tolerance {cond.tolerance:g} of the largest "
+        f"singular value; {gap}). The counterweights of least added mass total {sol.total_mass:.6g} kg"
+        + (f"; disc regions are replaced by inscribed {sol.polygon_sides}-gons (within "
+           f"{sol.disc_accuracy:.1e} of their radius)" if any(r.kind == "disc" for r in regions) else "")
+        + "."
+    ]
+    return out, params, details, notes
+
+
+def balance(mech, method: ForceBalance, model: Model, t: np.ndarray) -> BalanceResult:
+    cw_model, params, details, notes = force_stage(model, method.counterweights, method, t)
+    stages = [
+        Stage("unbalanced", "unbalanced", model, "the mechanism as given"),
+        Stage("counterweights", "least-mass counterweights", cw_model,
+              "counterweights of least added mass meeting every force-balance condition", balances="force"),
+    ]
+    return BalanceResult(params, stages, notes, details={"force_balance": details})

@@ -1,0 +1,100 @@
+"""The ``stages`` method: hand-written balancing stages for any template. Each stage adds parts
+to the model of the stage before it, changes them (a part of the same name on the same body
+replaces the earlier one) or removes them; the first stage is always the mechanism as given."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Literal
+
+import numpy as np
+from pydantic import Field
+
+from ..model import Attachment, Model
+from ..spec_parts import SpecFieldError, Strict
+from ..units import Inertia, Length, Mass, PositiveLength
+from .base import BalanceResult, Stage
+from .force_balance import Point, _point
+from .moment_balance import CounterRotationSpec, add_discs, set_disc_inertias
+
+
+class PartSpec(Strict):
+    """A rigid part fixed to a body: counterweight, carried gear, payload."""
+
+    body: str = Field(description="the body that carries the part")
+    name: str = Field(min_length=1, description="name, unique on the body (a later stage may change it by name)")
+    mass: Mass = Field(description="mass")
+    position: Point = Field((0.0, 0.0), description="centre of mass, [x, y] in the body frame or a named point")
+    inertia: Inertia = Field(0.0, description="centroidal moment of inertia")
+    kind: Literal["counterweight", "gear", "payload", "part"] = Field("counterweight", description="for drawing and accounting")
+    radius: PositiveLength | None = Field(None, description="drawn as a disc of this radius")
+
+
+class GivenCounterRotation(CounterRotationSpec):
+    """A counter-rotating disc with a given inertia."""
+
+    inertia: Inertia = Field(description="centroidal inertia of the disc")
+
+
+class StageStep(Strict):
+    """One stage: parts added or changed relative to the stage before."""
+
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_\-]+$", description="short name (CSV columns, references)")
+    label: str = Field("", description="label in figures and tables (default: the name)")
+    description: str = Field("", description="what the stage does")
+    balances: Literal["", "force", "moment", "force+moment"] = Field(
+        "", description="what the stage claims to cancel (checked against the analysis)"
+    )
+    parts: list[PartSpec] = Field([], description="parts added (or changed, by body and name)")
+    remove: list[str] = Field([], description="parts removed, as body.name")
+    counter_rotations: list[GivenCounterRotation] = Field([], description="counter-rotating discs added")
+
+
+class Stages(Strict):
+    """Balancing stages written by hand, each relative to the one before."""
+
+    method: Literal["stages"] = Field(description="balancing method")
+    stages: list[StageStep] = Field(min_length=1, description="the stages after the unbalanced one, in order")
+
+
+def attach(model: Model, part: PartSpec, path: tuple) -> Model:
+    """``model`` with ``part`` on its body; a part of the same name there is replaced."""
+    try:
+        body = model.body(part.body)
+    except KeyError:
+        raise SpecFieldError(path + ("body",), f"unknown body {part.body!r} (bodies: {', '.join(b.name for b in model.bodies)})") from None
+    pos = _point(model, part.body, part.position, path + ("position",))
+    new = Attachment(part.name, part.mass, pos, part.inertia, part.kind, part.radius)
+    kept = tuple(a for a in body.attachments if a.name != part.name)
+    return model.replace_body(replace(body, attachments=kept + (new,)))
+
+
+def detach(model: Model, ref: str, path: tuple) -> Model:
+    body_name, _, name = ref.partition(".")
+    try:
+        body = model.body(body_name)
+    except KeyError:
+        raise SpecFieldError(path, f"unknown body {body_name!r} (write body.part)") from None
+    if not any(a.name == name for a in body.attachments):
+        raise SpecFieldError(path, f"{body_name!r} carries no part {name!r} (parts: {', '.join(a.name for a in body.attachments) or 'none'})")
+    return model.replace_body(replace(body, attachments=tuple(a for a in body.attachments if a.name != name)))
+
+
+def balance(mech, method: Stages, model: Model, t: np.ndarray | None = None) -> BalanceResult:
+    stages = [Stage("unbalanced", "unbalanced", model, "the mechanism as given")]
+    current = model
+    seen = {"unbalanced"}
+    for k, step in enumerate(method.stages):
+        path = ("balancing", "stages", k)
+        if step.name in seen:
+            raise SpecFieldError(path + ("name",), f"stage name {step.name!r} is used twice")
+        seen.add(step.name)
+        for i, ref in enumerate(step.remove):
+            current = detach(current, ref, path + ("remove", i))
+        for i, part in enumerate(step.parts):
+            current = attach(current, part, path + ("parts", i))
+        if step.counter_rotations:
+            current = add_discs(current, step.counter_rotations, path + ("counter_rotations",))
+            current = set_disc_inertias(current, {c.name: c.inertia for c in step.counter_rotations})
+        stages.append(Stage(step.name, step.label or step.name, current, step.description, step.balances))
+    return BalanceResult([], stages, [])
