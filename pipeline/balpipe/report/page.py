@@ -40,7 +40,7 @@ def study_figures(study: Study) -> dict:
             "residuals": residuals, "drift": drift}
 
 
-def render_page(study: Study, results: dict, spec_text: str) -> str:
+def render_page(study: Study, results: dict, spec_text: str, history: dict | None = None) -> str:
     spec = study.spec
     validation_rows = []
     for s in study.stages:
@@ -68,4 +68,5 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
         joint_loads=joint_load_table(study),
         stage_names=[(s.stage.name, s.stage.label) for s in study.stages],
         spec_text=spec_text,
+        history=history,
     )

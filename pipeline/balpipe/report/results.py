@@ -69,6 +69,7 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
         "validation": validation if simulated else None,
         "reactionless": study.reactionless.to_json() if study.reactionless is not None else None,
     }
+    out["paper"] = spec.paper  # the site index filters by it
     return _clean(out)
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from . import site_filter
 from .render import environment, num
 
 
@@ -44,11 +45,13 @@ def _entry(out: Path, o) -> dict:
         else:
             passed = all(v.get("passed") for v in val.values())
             e["validation"] = '<span class="badge ok">pass</span>' if passed else '<span class="badge bad">fail</span>'
+    e.update(site_filter.facets(e, results, out, o.slug))  # search, filter and history link
     return e
 
 
 def write_site(out: Path, outcomes: list) -> None:
     entries = [_entry(out, o) for o in sorted(outcomes, key=lambda o: o.source)]
     n_ok = sum(e["status"] == "ok" for e in entries)
-    html = environment().get_template("index.html").render(entries=entries, n_ok=n_ok, n_failed=len(entries) - n_ok)
+    html = environment().get_template("index.html").render(entries=entries, n_ok=n_ok, n_failed=len(entries) - n_ok,
+                                                           filters=site_filter.options(entries))
     (out / "index.html").write_text(html, encoding="utf-8")
