@@ -26,7 +26,6 @@ import json
 import os
 import subprocess
 import tempfile
-import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
@@ -64,7 +63,6 @@ class SpecHistory:
     reused: int = 0  # taken from the build's results.json
     status: str = "ok"  # "ok", "untracked" (no commit yet), "error" (cannot read the history)
     message: str = ""
-    seconds: float = 0.0
     files: list[str] = field(default_factory=list)
 
 
@@ -285,7 +283,6 @@ def run(paths: list[str], out: Path, cache_dir: Path, simulate: bool = True, job
             else:
                 todo[h] = (text, f"{c.hash[:10]}:{c.path}", simulate, h)
     failures: dict[str, str] = {}
-    start = time.perf_counter()
     if todo:
         results = (ProcessPoolExecutor(max_workers=jobs).map(_compute_job, todo.values())
                    if jobs > 1 and len(todo) > 1 else map(_compute_job, todo.values()))
@@ -295,7 +292,6 @@ def run(paths: list[str], out: Path, cache_dir: Path, simulate: bool = True, job
             else:
                 cache.put(h, fig)
                 known[h] = fig
-    compute_seconds = time.perf_counter() - start
 
     outcomes = []
     for k, w in enumerate(works):
@@ -312,7 +308,6 @@ def run(paths: list[str], out: Path, cache_dir: Path, simulate: bool = True, job
             if bad:
                 o.status, o.message = "crash", bad[0]
             o.files = write(w, known, out, failures, simulate)
-            o.seconds = compute_seconds * (o.computed / max(1, len(todo)))
         outcomes.append(o)
         if progress:
             progress(k + 1, len(works), o)
