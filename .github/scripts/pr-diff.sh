@@ -21,36 +21,31 @@ trap 'rm -f "$err"' EXIT
 
 changes="$(git diff --name-status -M --diff-filter=ADMR "$base" HEAD -- "$specs/*.yaml" "$specs/*.yml")"
 
+n=0
 {
-  echo "## balpipe: specs changed by this pull request"
+  echo "# balpipe: specs changed by this pull request"
   echo
   if [ -z "$changes" ]; then
     echo "No spec in \`$specs/\` changed (compared with \`$(git rev-parse --short "$base")\`)."
   fi
   while IFS=$'\t' read -r status old new; do
     [ -n "$status" ] || continue
+    n=$((n + 1))
     case "$status" in
       A)
-        echo "### \`$old\`: new spec"
+        echo "## \`$old\`: new spec"
         echo
         echo "No earlier version to compare with; its page is in the site artifact."
         echo
         ;;
       D)
-        echo "### \`$old\`: removed"
+        echo "## \`$old\`: removed"
         echo
         ;;
       M | R*)
-        before="$old"
-        after="${new:-$old}"
-        if [ "$before" = "$after" ]; then
-          echo "### \`$after\`"
-        else
-          echo "### \`$after\` (renamed from \`$before\`)"
-        fi
-        echo
-        if ! "$python" -m balpipe diff "$base:$before" "$after" -f markdown "$@" 2>"$err"; then
-          echo "balpipe diff failed:"
+        # balpipe diff writes its own "## balpipe diff: BASE:OLD -> NEW" heading
+        if ! "$python" -m balpipe diff "$base:$old" "${new:-$old}" -f markdown "$@" 2>"$err"; then
+          echo "## \`${new:-$old}\`: balpipe diff failed"
           echo
           echo '```'
           cat "$err"
@@ -61,4 +56,4 @@ changes="$(git diff --name-status -M --diff-filter=ADMR "$base" HEAD -- "$specs/
     esac
   done <<<"$changes"
 } >"$out"
-echo "pr-diff: $(grep -c '^### ' "$out" || true) changed spec(s) -> $out" >&2
+echo "pr-diff: $n changed spec(s) -> $out" >&2
