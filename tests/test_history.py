@@ -117,6 +117,12 @@ def test_second_run_computes_nothing_and_writes_the_same_bytes(tmp_path, monkeyp
     third = history.run(["specs"], repo.path / "out2", cache, simulate=False)
     assert third[0].computed == 0
     assert {p.name: p.read_bytes() for p in (repo.path / "out2" / "osc").iterdir()} == files
+    # computed again in two processes, from an empty cache: the same bytes
+    monkeypatch.undo()
+    monkeypatch.chdir(repo.path)
+    fourth = history.run(["specs"], repo.path / "out3", repo.path / "cache3", simulate=False, jobs=2)
+    assert fourth[0].computed == 3
+    assert {p.name: p.read_bytes() for p in (repo.path / "out3" / "osc").iterdir()} == files
 
 
 def test_only_the_new_commit_is_computed(tmp_path, monkeypatch):
@@ -224,3 +230,27 @@ def test_build_puts_the_history_in_the_study_page_and_the_index(tmp_path, monkey
     assert not build_("b").skipped
     for name in ("index.html", "osc/index.html", "osc/history.html", "osc/history.json", "osc/results.json"):
         assert (repo.path / "out" / name).read_bytes() == (repo.path / "b" / name).read_bytes(), name
+
+
+def test_with_the_simulation_the_validation_status_is_recorded(tmp_path, monkeypatch):
+    repo = Repo(tmp_path / "repo")
+    repo.copy_spec("offset_slider_crank.yaml", SPEC)
+    repo.commit("first design", {SPEC: repo.read(SPEC) + "analysis:\n  samples: 81\n"})
+    monkeypatch.chdir(repo.path)
+    o = history.run(["specs"], Path("out"), Path("cache"), simulate=True)[0]
+    assert (o.commits, o.computed) == (1, 1)
+    point = json.loads(Path("out/osc/history.json").read_text())["commits"][0]
+    assert point["validation"] == "pass"
+    assert [s["validation"] for s in point["stages"]] == ["pass", "pass"]
+    b = build(["specs"], Options(out=Path("built"), simulate=True))[0]
+    assert b.status == "ok"
+    built = json.loads(Path("built/osc/results.json").read_text())
+    assert recorded(point) == headline(built)
+    # the build's results serve a history with an empty cache: nothing computed, same figures
+    o = history.run(["specs"], Path("built"), Path("cache2"), simulate=True)[0]
+    assert (o.computed, o.reused) == (0, 1)
+    assert json.loads(Path("built/osc/history.json").read_text()) == json.loads(Path("out/osc/history.json").read_text())
+    # figures without the simulation are another cache entry, with the validation skipped
+    o = history.run(["specs"], Path("nosim"), Path("cache"), simulate=False)[0]
+    assert o.computed == 1
+    assert json.loads(Path("nosim/osc/history.json").read_text())["commits"][0]["validation"] == "skipped"

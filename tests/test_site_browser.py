@@ -195,11 +195,12 @@ def test_index_search_and_filters(server, browser):
     p.fill("#f-q", "no such study")
     assert visible_specs(p) == [] and p.is_visible("#f-none")
     # a shared link restores the filter
-    p.goto(server + "index.html#status=invalid%20spec", wait_until="load")
+    p.goto(server + "index.html#status=invalid", wait_until="load")
     p.reload(wait_until="load")
     shown = visible_specs(p)
     assert len(shown) == 1 and "broken" in shown[0]
-    assert p.eval_on_selector("#f-status", "s => s.value") == "invalid spec"
+    assert p.eval_on_selector("#f-status", "s => s.value") == "invalid"
+    assert p.eval_on_selector_all("#f-status option", "els => els.map(e => e.value)") == ["", "invalid", "ok"]
     papers = p.eval_on_selector_all("#f-paper option", "els => els.map(e => e.value)")
     assert any(v.startswith("000:") for v in papers)
     p.select_option("#f-status", "")

@@ -284,8 +284,11 @@ def run(paths: list[str], out: Path, cache_dir: Path, simulate: bool = True, job
                 todo[h] = (text, f"{c.hash[:10]}:{c.path}", simulate, h)
     failures: dict[str, str] = {}
     if todo:
-        results = (ProcessPoolExecutor(max_workers=jobs).map(_compute_job, todo.values())
-                   if jobs > 1 and len(todo) > 1 else map(_compute_job, todo.values()))
+        if jobs > 1 and len(todo) > 1:
+            with ProcessPoolExecutor(max_workers=min(jobs, len(todo))) as pool:
+                results = list(pool.map(_compute_job, todo.values()))
+        else:
+            results = [_compute_job(job) for job in todo.values()]
         for h, fig, err in results:
             if fig is None:
                 failures[h] = err

@@ -13,6 +13,8 @@ from .history_page import index_link
 
 FACETS = ("paper", "template", "method", "status")
 NO_PAPER = "(no paper)"
+# the index's status labels -> short filter values (also the labels of the status drop-down)
+STATUS = {"invalid spec": "invalid", "internal error": "internal-error"}
 
 
 def facets(entry: dict, results: dict | None, out: Path, slug: str) -> dict:
@@ -23,9 +25,9 @@ def facets(entry: dict, results: dict | None, out: Path, slug: str) -> dict:
         "paper": paper,
         "template": r.get("mechanism") or "",
         "method": r.get("method") or "",
-        "status": entry["status"],
+        "status": STATUS.get(entry["status"], entry["status"]),
     }
-    words = [entry["title"], entry["source"], *f.values()]
+    words = [entry["title"], entry["source"], f["paper"], f["template"], f["method"]]
     return {"facets": f, "search_text": " ".join(w for w in words if w).lower(),
             "history": index_link(out, slug)}
 
