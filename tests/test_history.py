@@ -173,6 +173,9 @@ def test_history_outside_git_is_a_usage_error(tmp_path):
     r = balpipe("history", "specs", "-o", "out", "--no-sim", cwd=tmp_path)
     assert r.returncode == 2
     assert "not in a git repository" in r.stderr and "Traceback" not in r.stderr
+    h = balpipe("history", "--help", cwd=tmp_path)
+    assert h.returncode == 0 and "usage: balpipe history" in h.stdout and "--cache" in h.stdout
+    assert "history" in balpipe("--help", cwd=tmp_path).stdout
     for args in (["history"], ["history", "nope"], ["history", "specs", "-j", "0"], ["history", "specs", "--max-commits", "0"]):
         r = balpipe(*args, cwd=tmp_path)
         assert r.returncode == 2 and "Traceback" not in r.stderr, args

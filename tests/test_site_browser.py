@@ -234,3 +234,15 @@ def test_links_are_relative_and_resolve(site):
             assert not parts.scheme and not parts.netloc and not url.startswith("/"), f"{page}: {url}"
             target = Path(urljoin(page.as_posix(), parts.path))
             assert target.exists() and top in target.resolve().parents, f"{page}: {url} -> {target}"
+
+
+def test_the_watcher_sees_a_missing_asset_and_a_script_error(site, server, browser):
+    """Negative control: a page outside the site with a missing script and a failing one."""
+    probe = site / "probe"
+    probe.mkdir(exist_ok=True)
+    (probe / "page.html").write_text('<!doctype html><link rel="icon" href="data:,"><title>probe</title>'
+                                     '<script src="missing.js"></script><script>undefinedFunction()</script>\n')
+    w = Watched(browser)
+    w.page.goto(server.replace(SUBFOLDER + "/", "probe/page.html"), wait_until="load")
+    assert any(p.startswith("HTTP 404") and p.endswith("/probe/missing.js") for p in w.problems), w.problems
+    assert any("undefinedFunction" in p for p in w.problems), w.problems
