@@ -37,6 +37,7 @@
     if (k === "q") { q.value = v; }
     else if (sel[k] && Array.prototype.some.call(sel[k].options, function (o) { return o.value === v; })) { sel[k].value = v; }
   });
+  document.getElementById("filters").addEventListener("submit", function (e) { e.preventDefault(); });
   [q].concat(keys.map(function (k) { return sel[k]; })).forEach(function (el) {
     el.addEventListener("input", apply);
     el.addEventListener("change", apply);

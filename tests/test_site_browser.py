@@ -191,6 +191,8 @@ def test_index_search_and_filters(server, browser):
     shown = visible_specs(p)
     assert len(shown) == 1 and "scott-russell" in shown[0]
     assert p.text_content("#f-count") == "1 of 3 shown"
+    p.press("#f-q", "Enter")  # no form submission, no reload
+    assert "?" not in p.url and len(visible_specs(p)) == 1
     assert "q=scott%20russell" in p.evaluate("location.hash") and "method=" in p.evaluate("location.hash")
     p.fill("#f-q", "no such study")
     assert visible_specs(p) == [] and p.is_visible("#f-none")
