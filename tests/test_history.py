@@ -214,6 +214,9 @@ def test_build_puts_the_history_in_the_study_page_and_the_index(tmp_path, monkey
     assert "history.json" in page and "crank counterweight further out" in page
     hist_page = (folder / "history.html").read_text()
     assert 'href="index.html"' in hist_page  # the study page exists now: linked
+    # parameters that change are plotted and listed per commit; the others are named once
+    assert "same value at every commit: rcp2 = -0.5." in hist_page
+    assert "mcp2 = 2.1, mcp1 = 8.4, rcp1 = -0.5<" in hist_page
     assert json.loads((folder / "history.json").read_text())["commits"][0]["hash"] == hashes[0]
     index = (repo.path / "out" / "index.html").read_text()
     assert 'href="osc/history.html"' in index and "3 commits" in index

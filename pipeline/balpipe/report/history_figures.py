@@ -113,9 +113,24 @@ def _parameters(commits: list[dict]) -> list[tuple[str, str]]:
     return list(out.items())
 
 
+def changing_parameters(commits: list[dict]) -> tuple[list[tuple[str, str]], list[tuple[str, str, float]]]:
+    """The computed parameters whose value differs between the commits that have figures
+    (name, unit), and those that keep one value throughout (name, unit, value)."""
+    changing, constant = [], []
+    valid = [c for c in commits if c.get("parameters")]
+    for name, unit in _parameters(commits):
+        values = [next((p["value"] for p in c["parameters"] if p["name"] == name), None) for c in valid]
+        if len(set(values)) > 1:
+            changing.append((name, unit))
+        elif values:
+            constant.append((name, unit, values[0]))
+    return changing, constant
+
+
 def parameters_history_figure(commits: list[dict], prefix: str = "hist-params") -> str | None:
-    """One small panel per computed balancing parameter (its unit in the title)."""
-    params = _parameters(commits)
+    """One small panel per computed balancing parameter that changes along the history (its
+    unit in the title); None when none changes."""
+    params = changing_parameters(commits)[0]
     if not params:
         return None
     ncol = min(3, len(params))

@@ -15,7 +15,7 @@ import hashlib
 import json
 from pathlib import Path
 
-from .history_figures import (added_history_figure, flagged, loads_history_figure,
+from .history_figures import (added_history_figure, changing_parameters, flagged, loads_history_figure,
                               parameters_history_figure)
 from .render import environment, num
 
@@ -48,6 +48,8 @@ def _peaks(c: dict, key: str) -> str:
 def view(history: dict, prefix: str = "hist") -> dict:
     """What the templates need: figures (title, svg, caption) and one row per commit."""
     commits = history.get("commits") or []
+    changing, constant = changing_parameters(commits)
+    shown = {name for name, _ in changing}
     rows = []
     for i, c in enumerate(commits):
         st = c.get("stages") or []
@@ -67,7 +69,8 @@ def view(history: dict, prefix: str = "hist") -> dict:
             "added_mass": num(st[-1].get("added_mass")) if st else "—",
             "last_stage": st[-1]["label"] if st else "",
             "problems": c.get("problems") or [],
-            "parameters": ", ".join(f"{p['name']} = {num(p['value'])}" for p in c.get("parameters") or []),
+            "parameters": ", ".join(f"{p['name']} = {num(p['value'])}" for p in c.get("parameters") or []
+                                    if p["name"] in shown),
         })
     figures = []
     if commits:
@@ -80,7 +83,8 @@ def view(history: dict, prefix: str = "hist") -> dict:
         params = parameters_history_figure(commits, f"{prefix}-params")
         if params is not None:
             figures.append(("Computed balancing parameters per commit", params,
-                            "Each computed parameter in its own unit, as in the parameter table of the study page."))
+                            "Each computed parameter that changes along the history, in its own unit, as in the "
+                            "parameter table of the study page."))
     last = commits[-1] if commits else {}
     return {
         "source": history.get("source", ""),
@@ -88,6 +92,8 @@ def view(history: dict, prefix: str = "hist") -> dict:
         "n": len(commits),
         "rows": rows,
         "figures": figures,
+        "constant": [f"{name} = {num(value, 6)}{' ' + unit.replace('^2', '²') if unit else ''}"
+                     for name, unit, value in constant],
         "simulated": bool(history.get("simulated")),
         "shallow": bool(history.get("shallow")),
         "uncommitted": bool(history.get("uncommitted_changes")),
