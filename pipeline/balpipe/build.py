@@ -22,6 +22,7 @@ from pathlib import Path
 
 from . import study as study_mod
 from .loader import SpecErrors, load, schema
+from .report import history_page
 from .report.page import render_page
 from .report.results import dumps, results_dict, timeseries_csv
 from .spec_parts import SpecFieldError
@@ -120,6 +121,7 @@ def build_one(path: Path, opts: Options) -> Outcome:
         return Outcome(source, slug, "error", str(exc), spec_error=True, seconds=time.perf_counter() - start)
     h = input_hash(loaded.text, opts)
     target = opts.out / slug
+    h = history_page.mix_hash(h, target)  # a new history.json re-renders the page
     if not opts.force:
         previous = _read_results(target)
         if previous is not None and previous.get("input_hash") == h:
@@ -136,12 +138,13 @@ def build_one(path: Path, opts: Options) -> Outcome:
             extra = {"timing.json": json.dumps(times, indent=2, sort_keys=True) + "\n",
                      "timing.js": timing_script(times)}
         results = results_dict(st, source, h, simulated=st.stages[0].validation is not None)
-        page = render_page(st, results, loaded.text)
+        page = render_page(st, results, loaded.text, history=history_page.section(target))
         _write_atomic_dir(target, {
             "index.html": page,
             "results.json": dumps(results),
             "timeseries.csv": timeseries_csv(st),
             **extra,
+            **history_page.build_files(target),
         })
         status = "ok" if st.ok else "failed"
         return Outcome(source, slug, status, "; ".join(st.problems), results, seconds=time.perf_counter() - start)

@@ -47,6 +47,9 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--no-sim", action="store_true", help="skip the pymunk validation of both designs")
     s = sub.add_parser("schema", help="print the JSON Schema of a spec", description="Print the spec JSON Schema.")
     s.add_argument("-o", "--out", metavar="FILE", help="write to FILE instead of stdout")
+    from .history_cli import add_parser as _add_history_parser
+
+    _add_history_parser(sub)
     return p
 
 
@@ -149,6 +152,10 @@ def cmd_schema(args) -> int:
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
+        if args.command == "history":  # balpipe.history_cli
+            from .history_cli import cmd_history
+
+            return cmd_history(args)
         return {"build": cmd_build, "check": cmd_check, "diff": cmd_diff, "schema": cmd_schema}[args.command](args)
     except KeyboardInterrupt:
         print("balpipe: interrupted", file=sys.stderr)

@@ -62,7 +62,7 @@ def study_figures(study: Study) -> dict:
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
-def render_page(study: Study, results: dict, spec_text: str) -> str:
+def render_page(study: Study, results: dict, spec_text: str, history: dict | None = None) -> str:
     spec = study.spec
     validation_rows = []
     for s in study.stages:
@@ -108,4 +108,5 @@ def render_page(study: Study, results: dict, spec_text: str) -> str:
         reference={"force": study.reference.describe("force"), "moment": study.reference.describe("moment"),
                    "floored": study.reference.floored},
         spec_text=spec_text,
+        history=history,
     )

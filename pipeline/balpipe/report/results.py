@@ -74,6 +74,7 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     out["comparison"] = comparison(study, stages)
     if study.balance.details:
         out["balancing_details"] = study.balance.details
+    out["paper"] = spec.paper  # the site index filters by it
     return _clean(out)
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from . import site_filter
 from .render import environment, num
 
 
@@ -48,6 +49,7 @@ def _entry(out: Path, o) -> dict:
         else:
             passed = all(v.get("passed") for v in val.values())
             e["validation"] = '<span class="badge ok">pass</span>' if passed else '<span class="badge bad">fail</span>'
+    e.update(site_filter.facets(e, results, out, o.slug))  # search, filter and history link
     return e
 
 
@@ -56,6 +58,7 @@ def write_site(out: Path, outcomes: list) -> None:
     n_ok = sum(e["status"] == "ok" for e in entries)
     n_flagged = sum(e["status"] == "ok" and bool(e["not_realisable"]) for e in entries)
     html = environment().get_template("index.html").render(
-        entries=entries, n_ok=n_ok - n_flagged, n_failed=len(entries) - n_ok, n_flagged=n_flagged
+        entries=entries, n_ok=n_ok - n_flagged, n_failed=len(entries) - n_ok, n_flagged=n_flagged,
+        filters=site_filter.options(entries),
     )
     (out / "index.html").write_text(html, encoding="utf-8")

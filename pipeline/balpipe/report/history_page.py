@@ -1,0 +1,138 @@
+"""The history section of a study page, the standalone ``history.html``, and how ``build``
+takes them in.
+
+``balpipe history`` writes ``<out>/<slug>/history.json``. When ``balpipe build`` rebuilds that
+spec's folder it keeps the file (:func:`build_files`), re-renders ``history.html`` and puts the
+same section into the study page (:func:`section`); the file's content is part of the build's
+input hash (:func:`mix_hash`), so a new history re-renders the page even if the spec did not
+change. Both pages render the section from ``history.json`` alone: the same bytes whichever
+command ran last.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+from .history_figures import (added_history_figure, changing_parameters, flagged, loads_history_figure,
+                              parameters_history_figure)
+from .render import environment, num
+
+HISTORY_FILE = "history.json"
+HISTORY_PAGE = "history.html"
+
+
+def load(folder: Path) -> tuple[str, dict] | None:
+    """The raw text and the data of ``folder/history.json``, or None."""
+    try:
+        text = (folder / HISTORY_FILE).read_text(encoding="utf-8")
+        return text, json.loads(text)
+    except (OSError, ValueError):
+        return None
+
+
+def _date(iso: str) -> str:
+    """'2026-11-22T00:22:26+00:00' -> '2026-11-22 00:22'."""
+    return iso[:16].replace("T", " ") if iso else ""
+
+
+def _peaks(c: dict, key: str) -> str:
+    st = c.get("stages") or []
+    if not st:
+        return "—"
+    a, b = st[0].get(key), st[-1].get(key)
+    return num(a) if len(st) == 1 else f"{num(a)} → {num(b)}"
+
+
+def view(history: dict, prefix: str = "hist") -> dict:
+    """What the templates need: figures (title, svg, caption) and one row per commit."""
+    commits = history.get("commits") or []
+    changing, constant = changing_parameters(commits)
+    shown = {name for name, _ in changing}
+    rows = []
+    for i, c in enumerate(commits):
+        st = c.get("stages") or []
+        rows.append({
+            "index": i + 1,
+            "hash": c["hash"],
+            "short": c["short"],
+            "date": _date(c.get("date", "")),
+            "iso_date": c.get("date", ""),
+            "subject": c.get("subject", ""),
+            "path": c.get("path", ""),
+            "status": c.get("status"),
+            "validation": c.get("validation"),
+            "flagged": flagged(c),
+            "peak_f": _peaks(c, "max_shaking_force"),
+            "peak_m": _peaks(c, "max_shaking_moment"),
+            "added_mass": num(st[-1].get("added_mass")) if st else "—",
+            "last_stage": st[-1]["label"] if st else "",
+            "problems": c.get("problems") or [],
+            "parameters": ", ".join(f"{p['name']} = {num(p['value'])}" for p in c.get("parameters") or []
+                                    if p["name"] in shown),
+        })
+    figures = []
+    if commits:
+        figures.append(("Peak shaking loads per commit", loads_history_figure(commits, f"{prefix}-loads"),
+                        "Peak over the motion of the shaking force |F| (N) and moment |M| (N m) on the frame, "
+                        "each balancing stage as on the stage table, for the spec as it was at each commit."))
+        figures.append(("Added mass and inertia per commit", added_history_figure(commits, f"{prefix}-added"),
+                        "Mass (kg) and declared rotating inertia (kg m²) each balancing stage adds to the "
+                        "unbalanced mechanism."))
+        params = parameters_history_figure(commits, f"{prefix}-params")
+        if params is not None:
+            figures.append(("Computed balancing parameters per commit", params,
+                            "Each computed parameter that changes along the history, in its own unit, as in the "
+                            "parameter table of the study page."))
+    last = commits[-1] if commits else {}
+    return {
+        "source": history.get("source", ""),
+        "spec": last.get("spec") or history.get("source", ""),
+        "n": len(commits),
+        "rows": rows,
+        "figures": figures,
+        "constant": [f"{name} = {num(value, 6)}{' ' + unit.replace('^2', '²') if unit else ''}"
+                     for name, unit, value in constant],
+        "simulated": bool(history.get("simulated")),
+        "shallow": bool(history.get("shallow")),
+        "uncommitted": bool(history.get("uncommitted_changes")),
+    }
+
+
+def render_history_page(history: dict, has_study_page: bool) -> str:
+    """The standalone ``history.html`` of one spec."""
+    return environment().get_template("history.html").render(
+        h=view(history, "hist"), has_study_page=has_study_page)
+
+
+def section(folder: Path) -> dict | None:
+    """The history section of the study page in ``folder``, if a history was recorded."""
+    got = load(folder)
+    return view(got[1], "hist") if got is not None else None
+
+
+def mix_hash(h: str, folder: Path) -> str:
+    """The build's input hash, extended by the content of ``history.json`` when there is one."""
+    got = load(folder)
+    if got is None:
+        return h
+    return hashlib.sha256((h + "\n" + got[0]).encode()).hexdigest()[:16]
+
+
+def build_files(folder: Path) -> dict[str, str]:
+    """Files that ``build`` writes beside a study page: the history kept and its page re-rendered."""
+    got = load(folder)
+    if got is None:
+        return {}
+    return {HISTORY_FILE: got[0], HISTORY_PAGE: render_history_page(got[1], has_study_page=True)}
+
+
+def index_link(out: Path, slug: str) -> dict | None:
+    """For the site index: the history page of a spec and its number of commits, if any."""
+    folder = out / slug
+    if not (folder / HISTORY_PAGE).exists():
+        return None
+    got = load(folder)
+    n = len(got[1].get("commits") or []) if got else 0
+    return {"link": f"{slug}/{HISTORY_PAGE}", "commits": n}

@@ -1,0 +1,250 @@
+"""The report site as a team meets it: served from a subfolder of a web server
+(``python -m http.server``), every page and asset loads in a real browser with no console error
+and no 404, the links stay relative, and the index's search and filter work.
+
+The browser is the system's Chromium driven by playwright for Python (``pip install '.[test]'``;
+no browser download: ``executable_path`` points at the installed one, ``BALPIPE_CHROMIUM``
+overrides it). Without either, the browser tests are skipped with the reason; the static check
+of the links runs everywhere.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.request
+from html.parser import HTMLParser
+from pathlib import Path
+from urllib.parse import urljoin, urlsplit
+
+import pytest
+
+from _gitrepo import Repo, edit
+
+from balpipe import history
+from balpipe.build import Options, build
+
+SUBFOLDER = "team/balpipe"
+
+
+def chromium() -> str | None:
+    for cand in (os.environ.get("BALPIPE_CHROMIUM"), "/usr/bin/chromium", shutil.which("chromium"),
+                 shutil.which("chromium-browser"), shutil.which("google-chrome")):
+        if cand and Path(cand).exists():
+            return cand
+    return None
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory) -> Path:
+    """A git repository of three specs (one with two commits, one invalid), its history and a
+    simulated build, written to <root>/team/balpipe; returns <root>."""
+    tmp = tmp_path_factory.mktemp("site")
+    repo = Repo(tmp / "repo")
+    repo.copy_spec("scott_russell.yaml", "specs/scott_russell.yaml")
+    repo.copy_spec("offset_slider_crank.yaml", "specs/osc.yaml")
+    repo.commit("two designs", {"specs/scott_russell.yaml": repo.read("specs/scott_russell.yaml"),
+                                "specs/osc.yaml": repo.read("specs/osc.yaml")})
+    repo.commit("heavier slider", {"specs/osc.yaml": edit(repo.read("specs/osc.yaml"), "{mass: 600 g}", "{mass: 700 g}")})
+    repo.commit("a broken spec", {"specs/broken.yaml": "name: broken\nmechanism: {template: slider_crank\n"})
+    root = tmp / "www"
+    out = root / SUBFOLDER
+    cwd = os.getcwd()
+    os.chdir(repo.path)
+    try:
+        history.run(["specs"], out, tmp / "cache", simulate=False)
+        outcomes = build(["specs"], Options(out=out, simulate=True))
+    finally:
+        os.chdir(cwd)
+    assert sorted(o.status for o in outcomes) == ["error", "ok", "ok"], [o.message for o in outcomes]
+    (root / "index.html").write_text("<!doctype html><title>another site</title>\n")  # the server's own root
+    return root
+
+
+@pytest.fixture(scope="module")
+def server(site):
+    """``python -m http.server`` on 127.0.0.1 and a free port, serving the folder above the site."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    proc = subprocess.Popen([sys.executable, "-m", "http.server", str(port), "--bind", "127.0.0.1",
+                             "--directory", str(site)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    base = f"http://127.0.0.1:{port}/"
+    try:
+        deadline = time.monotonic() + 20
+        while True:
+            try:
+                urllib.request.urlopen(base, timeout=1).close()
+                break
+            except (urllib.error.URLError, OSError):
+                if proc.poll() is not None or time.monotonic() > deadline:
+                    raise RuntimeError("http.server did not start")
+                time.sleep(0.1)
+        yield base + SUBFOLDER + "/"
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        pytest.skip("playwright for Python is not installed: pip install '.[test]'")
+    exe = chromium()
+    if exe is None:
+        pytest.skip("no Chromium found (/usr/bin/chromium, chromium on PATH, or BALPIPE_CHROMIUM)")
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=exe)
+        try:
+            yield b
+        finally:
+            b.close()
+
+
+class Watched:
+    """A browser page that records console errors, page errors, failed requests, HTTP errors and
+    every URL it requested."""
+
+    def __init__(self, browser):
+        self.page = browser.new_page()
+        self.problems: list[str] = []
+        self.requested: list[str] = []
+        p = self.page
+        p.on("console", lambda m: self.problems.append(f"console {m.type}: {m.text} ({p.url})")
+             if m.type in ("error", "assert") else None)
+        p.on("pageerror", lambda e: self.problems.append(f"JavaScript error: {e} ({p.url})"))
+        p.on("requestfailed", lambda r: self.problems.append(f"request failed: {r.url} ({r.failure})"))
+        p.on("response", lambda r: self.problems.append(f"HTTP {r.status}: {r.url}") if r.status >= 400 else None)
+        p.on("request", lambda r: self.requested.append(r.url))
+
+
+def test_every_page_and_asset_loads_from_a_subfolder(site, server, browser):
+    w = Watched(browser)
+    pages, assets, queue = set(), set(), [server + "index.html"]
+    while queue:
+        url = queue.pop(0)
+        if url in pages:
+            continue
+        pages.add(url)
+        resp = w.page.goto(url, wait_until="load")
+        assert resp is not None and resp.status == 200, url
+        w.page.wait_for_timeout(150)  # let the page's scripts run (player, timing, filter)
+        for href in w.page.eval_on_selector_all("a[href]", "els => els.map(e => e.href)"):
+            target = href.split("#")[0]
+            assert target.startswith(server), f"{url} links outside the site's folder: {href}"
+            if target.endswith(".html"):
+                queue.append(target)
+            else:
+                assets.add(target)
+    for a in sorted(assets):
+        r = w.page.request.get(a)
+        assert r.status == 200, f"{a}: HTTP {r.status}"
+    on_disk = {server + p.relative_to(site / SUBFOLDER).as_posix() for p in (site / SUBFOLDER).rglob("*.html")}
+    assert on_disk == pages, f"pages not reachable from the index: {sorted(on_disk - pages)}"
+    outside = [u for u in w.requested if not (u.startswith(server) or u.startswith("data:"))]
+    assert not outside, f"requests outside the site's folder: {outside}"
+    assert not w.problems, "\n".join(w.problems)
+    # what was loaded: three study pages, two history pages, their data files and scripts
+    names = {u[len(server):] for u in pages | assets | set(w.requested)}
+    for expected in ("scott_russell/index.html", "osc/history.html", "osc/history.json", "osc/results.json",
+                     "osc/timeseries.csv", "scott_russell/timing.js", "balpipe.schema.json"):
+        assert expected in names, expected
+
+
+def test_scripts_ran_in_the_pages(server, browser):
+    w = Watched(browser)
+    w.page.goto(server + "scott_russell/index.html", wait_until="load")
+    cells = w.page.eval_on_selector_all("[data-timing]", "els => els.map(e => e.textContent)")
+    assert cells and all(re.fullmatch(r"\d+\.\d{3} s", c) for c in cells), cells  # timing.js filled them
+    assert w.page.eval_on_selector("canvas", "c => c.width") > 0  # the reactionless player
+    assert w.page.locator("#history").count() == 1
+    assert not w.problems, "\n".join(w.problems)
+
+
+def visible_specs(page) -> list[str]:
+    return page.eval_on_selector_all(
+        "#studies tbody.entry", "els => els.filter(e => !e.hidden).map(e => e.dataset.text)")
+
+
+def test_index_search_and_filters(server, browser):
+    w = Watched(browser)
+    p = w.page
+    p.goto(server + "index.html", wait_until="load")
+    assert len(visible_specs(p)) == 3 and p.text_content("#f-count") == "3 of 3 shown"
+    options = p.eval_on_selector_all("#f-method option", "els => els.map(e => e.value)")
+    assert options == ["", "slider_crank_counterweights"]
+    p.select_option("#f-method", "slider_crank_counterweights")
+    assert len(visible_specs(p)) == 2  # the invalid spec has no method
+    p.fill("#f-q", "scott russell")
+    shown = visible_specs(p)
+    assert len(shown) == 1 and "scott-russell" in shown[0]
+    assert p.text_content("#f-count") == "1 of 3 shown"
+    p.press("#f-q", "Enter")  # no form submission, no reload
+    assert "?" not in p.url and len(visible_specs(p)) == 1
+    assert "q=scott%20russell" in p.evaluate("location.hash") and "method=" in p.evaluate("location.hash")
+    p.fill("#f-q", "no such study")
+    assert visible_specs(p) == [] and p.is_visible("#f-none")
+    # a shared link restores the filter
+    p.goto(server + "index.html#status=invalid", wait_until="load")
+    p.reload(wait_until="load")
+    shown = visible_specs(p)
+    assert len(shown) == 1 and "broken" in shown[0]
+    assert p.eval_on_selector("#f-status", "s => s.value") == "invalid"
+    assert p.eval_on_selector_all("#f-status option", "els => els.map(e => e.value)") == ["", "invalid", "ok"]
+    papers = p.eval_on_selector_all("#f-paper option", "els => els.map(e => e.value)")
+    assert any(v.startswith("000:") for v in papers)
+    p.select_option("#f-status", "")
+    p.select_option("#f-paper", next(v for v in papers if v.startswith("000:")))
+    assert len(visible_specs(p)) == 2
+    assert not w.problems, "\n".join(w.problems)
+
+
+class _Links(HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.urls: list[str] = []
+
+    def handle_starttag(self, tag, attrs):
+        for k, v in attrs:
+            if k in ("href", "src", "xlink:href", "action") and v is not None:
+                self.urls.append(v)
+
+
+def test_links_are_relative_and_resolve(site):
+    """Without a browser too: every href and src in every page is relative and names a file of
+    the site, so the site works from any folder of any server (and from file://)."""
+    top = site / SUBFOLDER
+    for page in sorted(top.rglob("*.html")):
+        parser = _Links()
+        parser.feed(page.read_text(encoding="utf-8"))
+        for url in parser.urls:
+            if url.startswith("#") or url.startswith("data:"):
+                continue
+            parts = urlsplit(url)
+            assert not parts.scheme and not parts.netloc and not url.startswith("/"), f"{page}: {url}"
+            target = Path(urljoin(page.as_posix(), parts.path))
+            assert target.exists() and top in target.resolve().parents, f"{page}: {url} -> {target}"
+
+
+def test_the_watcher_sees_a_missing_asset_and_a_script_error(site, server, browser):
+    """Negative control: a page outside the site with a missing script and a failing one."""
+    probe = site / "probe"
+    probe.mkdir(exist_ok=True)
+    (probe / "page.html").write_text('<!doctype html><link rel="icon" href="data:,"><title>probe</title>'
+                                     '<script src="missing.js"></script><script>undefinedFunction()</script>\n')
+    w = Watched(browser)
+    w.page.goto(server.replace(SUBFOLDER + "/", "probe/page.html"), wait_until="load")
+    assert any(p.startswith("HTTP 404") and p.endswith("/probe/missing.js") for p in w.problems), w.problems
+    assert any("undefinedFunction" in p for p in w.problems), w.problems
