@@ -65,8 +65,9 @@ def parse(value: Any, dimension: str) -> float:
     Refuses booleans, NaN, infinities, strings without a unit (but for dimensionless values)
     and magnitudes above :data:`MAX_ABS`, with a message saying what is expected."""
     kind = "number" if dimension == "dimensionless" else dimension
+    a = "an" if kind[0] in "aeiou" else "a"
     if isinstance(value, bool):
-        raise ValueError(f"expected a {kind}, got a boolean ({str(value).lower()})")
+        raise ValueError(f"expected {a} {kind}, got a boolean ({str(value).lower()})")
     if isinstance(value, (int, float)):
         try:
             v = float(value)
@@ -78,7 +79,7 @@ def parse(value: Any, dimension: str) -> float:
             low = value.strip().lower().lstrip("+-.")
             if low in ("nan", "inf", "infinity"):
                 raise ValueError(f"{kind} must be a finite number, got {value!r}")
-            raise ValueError(f"expected a {kind} like '{_example(dimension)}', got {value!r}")
+            raise ValueError(f"expected {a} {kind} like '{_example(dimension)}', got {value!r}")
         unit = _normalise_unit(m.group(2))
         table = UNITS[dimension]
         if unit == "" and dimension != "dimensionless":
@@ -95,7 +96,7 @@ def parse(value: Any, dimension: str) -> float:
     else:
         what = {"dict": "a mapping", "list": "a list", "NoneType": "nothing (null)"}.get(
             type(value).__name__, type(value).__name__)
-        raise ValueError(f"expected a {kind} (a number{'' if dimension == 'dimensionless' else ' or a string with a unit'}), got {what}")
+        raise ValueError(f"expected {a} {kind} (a number{'' if dimension == 'dimensionless' else ' or a string with a unit'}), got {what}")
     if not math.isfinite(v):
         raise ValueError(f"{kind} must be a finite number, got {value!r}")
     if abs(v) > MAX_ABS[dimension]:

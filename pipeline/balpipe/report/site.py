@@ -18,6 +18,13 @@ def _entry(out: Path, o) -> dict:
             results = json.loads((out / o.slug / "results.json").read_text(encoding="utf-8"))
         except (OSError, ValueError):
             results = None
+    if getattr(o, "kept_previous", False):
+        # failed its checks after a good build: the good page stays, the failed one is in failed/
+        stale = True
+        try:
+            results = json.loads((out / o.slug / "results.json").read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            results = None
     e = {
         "title": (results or {}).get("spec") or Path(o.source).name,
         "source": o.source,
@@ -27,6 +34,7 @@ def _entry(out: Path, o) -> dict:
         "results": results if not stale else None,
         "errors": o.message if o.status in ("error", "crash", "failed") else "",
         "error_short": (o.message.splitlines() or [""])[0],
+        "failed_link": f"{o.slug}/failed/index.html" if getattr(o, "kept_previous", False) else None,
     }
     if e["results"]:
         st = results["stages"]
@@ -51,4 +59,6 @@ def write_site(out: Path, outcomes: list) -> None:
     entries = [_entry(out, o) for o in sorted(outcomes, key=lambda o: o.source)]
     n_ok = sum(e["status"] == "ok" for e in entries)
     html = environment().get_template("index.html").render(entries=entries, n_ok=n_ok, n_failed=len(entries) - n_ok)
-    (out / "index.html").write_text(html, encoding="utf-8")
+    from ..build import write_file_atomic  # replaced in one step, never through a planted symlink
+
+    write_file_atomic(out / "index.html", html)
