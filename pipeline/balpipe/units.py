@@ -91,7 +91,7 @@ def parse(value: Any, dimension: str) -> float:
             factor = table[unit]
         else:
             known = ", ".join(sorted(k for k in table if k)) or "none"
-            raise ValueError(f"unit {m.group(2)!r} is not a {dimension} unit (use one of: {known})")
+            raise ValueError(f"unit {m.group(2)!r} is not {a} {kind} unit (use one of: {known})")
         v = float(m.group(1)) * factor
     else:
         what = {"dict": "a mapping", "list": "a list", "NoneType": "nothing (null)"}.get(

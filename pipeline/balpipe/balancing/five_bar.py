@@ -235,11 +235,12 @@ def balance(mech: FiveBarMechanism, method: FiveBarGearBalancing, model: Model) 
         P(f"mCW{j + 2}", masses[j + 2], "kg", f"eq. {10 + j}", f"counterweight on distal link {j + 2}")
         ms_p = lp.mass + masses[j]
         P(f"m{j}_star", ms_p, "kg", "eq. 14: m* = m + m_CW", f"balanced input link {j} (link + counterweight)")
-        P(f"r{j}_star", -(lp.mass * lp.com + masses[j] * cw.proximal) / ms_p, "m", "Sec. VI",
+        # a massless link and counterweight have no centre of mass: 0 (on the joint)
+        P(f"r{j}_star", -(lp.mass * lp.com + masses[j] * cw.proximal) / ms_p if ms_p else 0.0, "m", "Sec. VI",
           f"distance of the balanced link {j}'s centre of mass from A{j}, on the side opposite B{j}")
         ms_d = ld.mass + masses[j + 2]
         P(f"m{j + 2}_star", ms_d, "kg", "eq. 14: m* = m + m_CW", f"balanced distal link {j + 2} (link + counterweight)")
-        P(f"r{j + 2}_star", abs(ld.mass * ld.com + masses[j + 2] * cw.distal) / ms_d, "m", "Sec. VI",
+        P(f"r{j + 2}_star", abs(ld.mass * ld.com + masses[j + 2] * cw.distal) / ms_d if ms_d else 0.0, "m", "Sec. VI",
           f"distance of the balanced link {j + 2}'s centre of mass from B{j} (0: on the joint)")
 
     cw_model = model
