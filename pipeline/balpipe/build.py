@@ -244,6 +244,9 @@ def build_one(path: Path, opts: Options) -> Outcome:
     if not opts.force:
         previous = _read_results(target)
         if previous is not None and previous.get("input_hash") == h:
+            stale_failed = target / "failed"
+            if stale_failed.exists() or stale_failed.is_symlink():  # the spec is back to its good page
+                _remove(stale_failed)
             return Outcome(source, slug, previous.get("status", "ok"), "unchanged", previous, skipped=True,
                            seconds=time.perf_counter() - start)
     try:

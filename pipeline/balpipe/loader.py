@@ -152,7 +152,38 @@ def _message(err: dict) -> str:
         return f"must be {op} {bound} (got {err.get('input')!r})"
     if kind == "union_tag_not_found":
         return f"missing the key {err.get('ctx', {}).get('discriminator', '')} that says which kind this is"
+    got = _describe(err.get("input"))
+    expected = {
+        "string_type": "text (a string)", "dict_type": "a mapping (key: value)", "model_type": "a mapping (key: value)",
+        "list_type": "a list", "tuple_type": "a list", "bool_type": "true or false", "bool_parsing": "true or false",
+        "int_type": "a whole number", "int_parsing": "a whole number", "float_type": "a number",
+        "float_parsing": "a number", "finite_number": "a finite number",
+    }.get(kind)
+    if expected:
+        return f"expected {expected}, got {got}"
+    if kind == "literal_error":
+        return f"expected {ctx.get('expected', 'one of the listed values')}, got {got}"
+    if kind in ("too_short", "too_long"):
+        return f"{'too few' if kind == 'too_short' else 'too many'} items: {msg.split(', ', 1)[-1]}"
+    if kind == "string_too_short":
+        return "must not be empty"
+    if msg.startswith("Input should be "):
+        return f"expected {msg[len('Input should be '):]}, got {got}"
     return msg
+
+
+def _describe(value: Any) -> str:
+    """A short description of a value for an error message."""
+    if value is None:
+        return "nothing (null)"
+    if isinstance(value, bool):
+        return f"a boolean ({str(value).lower()})"
+    if isinstance(value, dict):
+        return "a mapping"
+    if isinstance(value, (list, tuple)):
+        return f"a list of {len(value)}"
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _check_duplicates(node: yaml.Node, file: str, path: tuple = ()) -> list[SpecError]:
