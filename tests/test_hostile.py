@@ -436,3 +436,20 @@ def test_interrupt_is_clean_at_any_jobs(tmp_path, sig, code, jobs):
     assert len(err.strip().splitlines()) <= 1 + len(list(d.iterdir())), err  # progress lines + one line
     assert err.strip().splitlines()[-1].startswith("balpipe: ")
     _unchanged(out, old)
+
+
+def test_simulation_steps_are_bounded_before_the_simulation_starts(tmp_path, monkeypatch, capsys):
+    """The default step shrinks with the fastest body's speed (validate.default_settings): a
+    motion so fast that the simulation would take more than a million steps is refused by
+    check and build before any simulation, naming the limit."""
+    from balpipe import validate
+
+    monkeypatch.setattr(validate, "default_settings", lambda model, analysis: (1e-9, 100))
+    (tmp_path / "s.yaml").write_text(quick(SCOTT))
+    rc = main(["check", str(tmp_path / "s.yaml")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "motion.duration" in err and "limit 1,000,000" in err
+    rc = main(["build", str(tmp_path / "s.yaml"), "-o", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "limit 1,000,000" in err
+    assert main(["build", str(tmp_path / "s.yaml"), "-o", str(tmp_path / "out"), "--no-sim"]) == 0

@@ -28,7 +28,7 @@ from importlib import resources
 from pathlib import Path
 
 from . import study as study_mod
-from .limits import check_finite
+from .limits import check_finite, check_simulation
 from .loader import LoadedSpec, SpecError, SpecErrors, load, schema
 from .report.page import render_page
 from .report.results import dumps, results_dict, timeseries_csv
@@ -205,14 +205,17 @@ def remove_temporaries(out: Path) -> None:
                     pass
 
 
-def analyse(loaded: LoadedSpec):
+def analyse(loaded: LoadedSpec, simulate: bool = True):
     """Balance and analyse one loaded spec (no simulation, nothing written): the study, or
     :class:`SpecErrors` for every problem of the spec, located. ``check`` and ``build`` share it,
-    so a spec that passes ``check`` does not fail ``build`` for its input."""
+    so a spec that passes ``check`` does not fail ``build`` for its input. With ``simulate`` the
+    simulation's limits are checked too."""
     try:
         with _quiet_numpy():
             st = study_mod.run(loaded.spec)
             check_finite(st)
+            if simulate:
+                check_simulation(st)
         return st
     except SpecFieldError as exc:
         raise loaded.error(exc) from None
@@ -251,7 +254,7 @@ def build_one(path: Path, opts: Options) -> Outcome:
                            seconds=time.perf_counter() - start)
     try:
         try:
-            st = analyse(loaded)
+            st = analyse(loaded, simulate=opts.simulate)
         except SpecErrors as exc:
             return Outcome(source, slug, "error", str(exc), spec_error=True, seconds=time.perf_counter() - start)
         extra: dict[str, str] = {}

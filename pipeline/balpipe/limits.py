@@ -46,3 +46,25 @@ def check_finite(study: Any) -> None:
                     f"stage {s.stage.name!r}: the {what} overflows ({peak}); the motion is too fast for "
                     "its duration or the masses and lengths are too large",
                 )
+
+
+def check_simulation(study: Any) -> None:
+    """Before the pymunk validation starts: the number of steps of each stage's simulation,
+    duration / dt with the spec's dt or the default one (which shrinks with the fastest body's
+    angular speed), is at most :data:`MAX_SIM_STEPS`."""
+    spec = study.spec
+    if not spec.validation.enabled:
+        return
+    from .validate import default_settings
+
+    T = spec.motion.duration
+    for s in study.stages:
+        dt = spec.validation.dt or default_settings(s.stage.model, s.analysis)[0]
+        steps = T / dt if dt > 0 else math.inf
+        if not math.isfinite(steps) or steps > MAX_SIM_STEPS:
+            raise SpecFieldError(
+                ("validation", "dt") if spec.validation.dt else ("motion", "duration"),
+                f"stage {s.stage.name!r}: the simulation would take {steps:.3g} steps of {dt:.3g} s "
+                f"(limit {MAX_SIM_STEPS:,}); the motion is too fast for its duration: lengthen it, or set "
+                "validation.enabled: false",
+            )
