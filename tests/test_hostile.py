@@ -489,3 +489,14 @@ def test_simulation_steps_are_bounded_before_the_simulation_starts(tmp_path, mon
     err = capsys.readouterr().err
     assert rc == 2 and "limit 1,000,000" in err
     assert main(["build", str(tmp_path / "s.yaml"), "-o", str(tmp_path / "out"), "--no-sim"]) == 0
+
+
+def test_control_characters_in_file_names_never_reach_the_index(tmp_path):
+    d = tmp_path / "specs"
+    d.mkdir()
+    (d / "a\x1b[31m.yaml").write_text("name: [\n")
+    r = balpipe("build", d, "-o", tmp_path / "out", "--no-sim")
+    no_traceback(r)
+    assert r.returncode == 2
+    index = (tmp_path / "out" / "index.html").read_text()
+    assert "\x1b" not in index and "a\\x1b[31m.yaml" in index

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .render import environment, num
+from .render import environment, num, printable
 
 
 def _entry(out: Path, o) -> dict:
@@ -26,14 +26,14 @@ def _entry(out: Path, o) -> dict:
         except (OSError, ValueError):
             results = None
     e = {
-        "title": (results or {}).get("spec") or Path(o.source).name,
-        "source": o.source,
+        "title": printable((results or {}).get("spec") or Path(o.source).name),
+        "source": printable(o.source),
         "link": f"{o.slug}/index.html" if page.exists() else None,
         "status": {"ok": "ok", "failed": "failed", "error": "invalid spec", "crash": "internal error"}.get(o.status, o.status),
         "stale": stale,
         "results": results if not stale else None,
-        "errors": o.message if o.status in ("error", "crash", "failed") else "",
-        "error_short": (o.message.splitlines() or [""])[0],
+        "errors": printable(o.message) if o.status in ("error", "crash", "failed") else "",
+        "error_short": printable((o.message.splitlines() or [""])[0]),
         "failed_link": f"{o.slug}/failed/index.html" if getattr(o, "kept_previous", False) else None,
     }
     if e["results"]:
