@@ -67,6 +67,10 @@ class LoadedSpec:
 def _format_path(path: tuple) -> str:
     out = ""
     for p in path:
+        if not isinstance(p, int):
+            p = str(p)
+            if not p or not p.isprintable() or p != p.strip():  # keys are data: show them quoted
+                p = repr(p)
         out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
     return out
 
@@ -93,6 +97,8 @@ def _find(node: yaml.Node | None, path: tuple) -> tuple[yaml.Node | None, bool]:
 
 def _key_node(node: yaml.Node | None, path: tuple) -> yaml.Node | None:
     """For an unknown key the error is at the key itself, not at its value."""
+    if not path:
+        return None
     parent, ok = _find(node, path[:-1])
     if ok and isinstance(parent, yaml.MappingNode):
         for k, _ in parent.value:
@@ -120,7 +126,8 @@ def _clean_loc(loc: tuple, data: Any) -> tuple:
     out: list = []
     cur = data
     for part in loc:
-        if isinstance(part, str) and ("[" in part or part.startswith("function-")):
+        in_document = isinstance(cur, dict) and part in cur
+        if isinstance(part, str) and ("[" in part or part.startswith("function-")) and not in_document:
             continue
         if isinstance(cur, dict) and part not in cur and any(cur.get(d) == part for d in _DISCRIMINATORS):
             continue
