@@ -156,3 +156,73 @@ def test_with_gravity_a_force_balanced_stage_keeps_exactly_its_weight(rng):
     weight = st.stages[1].stage.model.total_mass() * 9.80665
     assert m["force_balanced"] and m["max_inertial_force"] <= 1e-9 * st.stages[0].analysis.max_inertial_force
     assert m["max_shaking_force"] == pytest.approx(weight, rel=1e-12)
+
+
+# --- issue 7, item 1: the slider translates, so its centre-of-mass offset drops out of eq. 15 ---
+
+def test_offset_slider_com_issue_example_gives_eq15_masses():
+    """specs/offset_slider_crank.yaml with the slider's centre of mass 50 mm along the guide from
+    C: eq. 15 gives mcp2 = 2.1 kg and mcp1 = 8.4 kg (not 2.3 / 8.8) and the force is cancelled."""
+    from pathlib import Path
+
+    from balpipe.loader import load_text
+
+    text = (Path(__file__).resolve().parents[1] / "specs" / "offset_slider_crank.yaml").read_text()
+    text = text.replace("slider:  {mass: 600 g}", "slider:  {mass: 600 g, com: [0.05 m, 0 m]}")
+    assert "com: [0.05 m" in text
+    spec, _ = load_text(text, "offset.yaml")
+    st = study.run(spec)
+    params = {p.name: p.value for p in st.balance.parameters}
+    assert params["mcp2"] == pytest.approx(2.1, rel=1e-12)
+    assert params["mcp1"] == pytest.approx(8.4, rel=1e-12)
+    cw = _stage(st, "counterweights")
+    assert cw.analysis.max_force <= 1e-9 * st.stages[0].analysis.max_force
+    assert not st.problems
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_slider_com_anywhere_leaves_the_force_balanced(seed):
+    """Random slider centre of mass (along and across the guide): the counterweights of eq. 15
+    do not depend on it and the total centre of mass stays fixed."""
+    rng = np.random.default_rng(300 + seed)
+    base = slider_crank_spec(rng)
+    sx, sy = (float(v) for v in rng.uniform(-0.2, 0.2, 2))
+    mech = base.mechanism.model_dump(by_alias=True)
+    mech["slider"]["com"] = (sx, sy)
+    spec = slider_crank_spec(np.random.default_rng(300 + seed), mechanism=mech)
+    st, st0 = study.run(spec), study.run(base)
+    p = {q.name: q.value for q in st.balance.parameters}
+    p0 = {q.name: q.value for q in st0.balance.parameters}
+    assert p["mcp1"] == pytest.approx(p0["mcp1"], rel=1e-12)
+    assert p["mcp2"] == pytest.approx(p0["mcp2"], rel=1e-12)
+    cw = _stage(st, "counterweights").analysis
+    assert cw.max_force <= 1e-9 * st.stages[0].analysis.max_force
+    assert np.ptp(cw.com, axis=0).max() < 1e-12
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_scott_russell_with_slider_com_along_the_guide_is_fully_balanced(seed):
+    """Along the guide, the slider's offset drops out of the moment too (s x v_C = 0 for s along
+    the guide); eq. 20 still cancels the moment."""
+    rng = np.random.default_rng(400 + seed)
+    base = slider_crank_spec(rng, scott_russell=True, moment_unknown="coupler_counterweight_inertia")
+    mech = base.mechanism.model_dump(by_alias=True)
+    mech["slider"]["com"] = (float(rng.uniform(-0.1, 0.1)), 0.0)
+    spec = slider_crank_spec(np.random.default_rng(400 + seed), scott_russell=True,
+                             moment_unknown="coupler_counterweight_inertia", mechanism=mech)
+    st = study.run(spec)
+    full = _stage(st, "full").analysis
+    unb = st.stages[0].analysis
+    assert full.max_force <= 1e-9 * unb.max_force
+    assert full.max_moment <= 1e-9 * unb.max_moment
+
+
+def test_slider_com_across_the_guide_is_refused_only_for_the_moment(rng):
+    base = slider_crank_spec(rng, scott_russell=True, moment_unknown="coupler_counterweight_inertia")
+    mech = base.mechanism.model_dump(by_alias=True)
+    mech["slider"]["com"] = (0.0, 0.02)
+    spec = slider_crank_spec(np.random.default_rng(20261122), scott_russell=True,
+                             moment_unknown="coupler_counterweight_inertia", mechanism=mech)
+    with pytest.raises(SpecFieldError) as e:
+        registry.balance(spec)
+    assert e.value.path == ("mechanism", "slider", "com") and "across the guide" in e.value.message

@@ -3,6 +3,11 @@
 A spec is rebuilt only when its text, the build options or balpipe's own code changed (the
 input hash is stored in results.json). Each page is written to a temporary folder and moved into
 place only when complete, so a failing spec never damages a page built before.
+
+The output folder is the only place written: files are created fresh (never opened through a
+symlink planted in the folder; a planted link is replaced, its target untouched), the index and
+schema are replaced atomically, a lock file serialises concurrent builds of the same folder,
+and files and folders get the modes the umask gives (a web server can read the site).
 """
 
 from __future__ import annotations
@@ -10,18 +15,21 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import secrets
 import shutil
-import tempfile
+import signal
 import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 
 from . import study as study_mod
-from .loader import SpecErrors, load, schema
+from .limits import check_finite, check_simulation
+from .loader import LoadedSpec, SpecError, SpecErrors, load, schema
 from .report import history_page
 from .report.page import render_page
 from .report.results import dumps, results_dict, timeseries_csv
@@ -40,6 +48,7 @@ class Outcome:
     seconds: float = 0.0
     spec_error: bool = False
     skipped: bool = False
+    kept_previous: bool = False  # failed its checks: the earlier good page stays, this build is in failed/
 
 
 @dataclass(frozen=True)
@@ -49,12 +58,24 @@ class Options:
     force: bool = False
 
 
-def find_specs(paths: list[str]) -> list[Path]:
-    """Spec files named on the command line or found (*.yaml, *.yml) in named folders, sorted."""
+class OutputError(Exception):
+    """The output folder cannot be used (a file, not writable): nothing was written."""
+
+
+def find_specs(paths: list[str], problems: list[str] | None = None) -> list[Path]:
+    """Spec files named on the command line or found (*.yaml, *.yml) in named folders, sorted.
+    Folders that cannot be read are appended to ``problems`` (not silently skipped)."""
     found: list[Path] = []
     for p in map(Path, paths):
         if p.is_dir():
-            found += sorted(q for q in p.rglob("*") if q.suffix in (".yaml", ".yml") and q.is_file())
+            def unreadable(exc: OSError) -> None:
+                if problems is not None:
+                    problems.append(f"{exc.filename}: cannot read the folder: {exc.strerror or exc}")
+            files = []
+            for root, dirs, names in os.walk(p, onerror=unreadable):
+                dirs.sort()
+                files += [Path(root) / n for n in names if Path(n).suffix in (".yaml", ".yml")]
+            found += sorted(q for q in files if q.is_file())
         else:
             found.append(p)
     seen, unique = set(), []
@@ -66,8 +87,18 @@ def find_specs(paths: list[str]) -> list[Path]:
     return unique
 
 
+MAX_SLUG = 80  # characters of a page folder's name (file systems allow 255 bytes)
+
+
 def slug_for(path: Path) -> str:
-    return "".join(c if c.isalnum() or c in "-_" else "-" for c in path.stem)
+    """The page folder of a spec: its file name's stem with other characters than letters,
+    digits, '-' and '_' replaced by '-'; long names are cut and end in a hash of the stem."""
+    stem = path.stem
+    slug = "".join(c if (c.isalnum() and c.isascii()) or c in "-_" else "-" for c in stem)
+    if len(slug) > MAX_SLUG or not slug.strip("-_"):
+        digest = hashlib.sha256(stem.encode("utf-8", "surrogateescape")).hexdigest()[:10]
+        slug = slug[: MAX_SLUG - 11] + "-" + digest
+    return slug
 
 
 @lru_cache(maxsize=1)
@@ -92,15 +123,56 @@ def input_hash(text: str, opts: Options) -> str:
     return h.hexdigest()[:16]
 
 
+TMP_MARK = ".balpipe-tmp-"  # temporary files and folders in the output folder carry this
+
+
+def _tmp_name(name: str) -> str:
+    return f".{name[:100]}{TMP_MARK}{os.getpid()}-{secrets.token_hex(4)}"
+
+
+def _write_new(path: Path, content: str) -> None:
+    """Create ``path`` (it must not exist: never writes through a planted symlink); mode from
+    the umask."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o666)
+    with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
+        f.write(content)
+
+
+def _remove(path: Path) -> None:
+    """Remove a file, a symlink (not its target) or a folder tree (rmtree does not follow links)."""
+    if path.is_symlink() or path.is_file():
+        path.unlink()
+    elif path.is_dir():
+        shutil.rmtree(path, ignore_errors=True)
+
+
+def write_file_atomic(path: Path, content: str) -> None:
+    """Replace ``path`` in one step: a reader sees the old or the new file, never a part; a
+    symlink at ``path`` is replaced by the file, its target is left alone."""
+    tmp = path.with_name(_tmp_name(path.name))
+    try:
+        _write_new(tmp, content)
+        os.replace(tmp, path)
+    except BaseException:
+        if tmp.exists():
+            tmp.unlink()
+        raise
+
+
 def _write_atomic_dir(target: Path, files: dict[str, str]) -> None:
+    """Write a page folder next to ``target`` and move it into place when complete. Modes follow
+    the umask (os.mkdir(0o777)), not tempfile's 0700."""
     target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
+    tmp = target.with_name(_tmp_name(target.name))
+    os.mkdir(tmp, 0o777)
     try:
         for name, content in files.items():
-            (tmp / name).write_text(content, encoding="utf-8")
+            _write_new(tmp / name, content)
         old = None
-        if target.exists():
-            old = target.with_name(f".{target.name}.old-{os.getpid()}")
+        if target.is_symlink() or target.is_file():
+            target.unlink()  # planted: replace the link itself
+        elif target.exists():
+            old = target.with_name(_tmp_name(target.name + ".old"))
             target.rename(old)
         tmp.rename(target)
         if old is not None:
@@ -108,6 +180,58 @@ def _write_atomic_dir(target: Path, files: dict[str, str]) -> None:
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+
+
+def remove_temporaries(out: Path) -> None:
+    """Remove what an interrupted build left: temporaries of balpipe's own naming only."""
+    try:
+        entries = list(out.iterdir())
+    except OSError:
+        return
+    for e in entries:
+        if e.name.startswith(".") and TMP_MARK in e.name:
+            try:
+                _remove(e)
+            except OSError:
+                pass
+        elif e.is_dir() and not e.is_symlink():  # a page folder: its failed/ is written inside
+            try:
+                inner = [f for f in e.iterdir() if f.name.startswith(".") and TMP_MARK in f.name]
+            except OSError:
+                continue
+            for f in inner:
+                try:
+                    _remove(f)
+                except OSError:
+                    pass
+
+
+def analyse(loaded: LoadedSpec, simulate: bool = True):
+    """Balance and analyse one loaded spec (no simulation, nothing written): the study, or
+    :class:`SpecErrors` for every problem of the spec, located. ``check`` and ``build`` share it,
+    so a spec that passes ``check`` does not fail ``build`` for its input. With ``simulate`` the
+    simulation's limits are checked too."""
+    try:
+        with _quiet_numpy():
+            st = study_mod.run(loaded.spec)
+            check_finite(st)
+            if simulate:
+                check_simulation(st)
+        return st
+    except SpecFieldError as exc:
+        raise loaded.error(exc) from None
+    except ArithmeticError as exc:  # overflow, division by zero from extreme input
+        raise SpecErrors([SpecError(str(loaded.path), None, None, "",
+                                    f"the computation failed on this spec's numbers ({type(exc).__name__}: {exc}); "
+                                    "check the magnitudes of masses, lengths and the duration")]) from None
+
+
+@contextmanager
+def _quiet_numpy():
+    import numpy as np
+
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        yield
 
 
 def build_one(path: Path, opts: Options) -> Outcome:
@@ -125,10 +249,16 @@ def build_one(path: Path, opts: Options) -> Outcome:
     if not opts.force:
         previous = _read_results(target)
         if previous is not None and previous.get("input_hash") == h:
+            stale_failed = target / "failed"
+            if stale_failed.exists() or stale_failed.is_symlink():  # the spec is back to its good page
+                _remove(stale_failed)
             return Outcome(source, slug, previous.get("status", "ok"), "unchanged", previous, skipped=True,
                            seconds=time.perf_counter() - start)
     try:
-        st = study_mod.run(loaded.spec)
+        try:
+            st = analyse(loaded, simulate=opts.simulate)
+        except SpecErrors as exc:
+            return Outcome(source, slug, "error", str(exc), spec_error=True, seconds=time.perf_counter() - start)
         extra: dict[str, str] = {}
         if opts.simulate and loaded.spec.validation.enabled:
             from .validation_stage import simulate_study, timing, timing_script
@@ -139,14 +269,22 @@ def build_one(path: Path, opts: Options) -> Outcome:
                      "timing.js": timing_script(times)}
         results = results_dict(st, source, h, simulated=st.stages[0].validation is not None)
         page = render_page(st, results, loaded.text, history=history_page.section(target))
-        _write_atomic_dir(target, {
+        files = {
             "index.html": page,
             "results.json": dumps(results),
             "timeseries.csv": timeseries_csv(st),
             **extra,
             **history_page.build_files(target),
-        })
+        }
         status = "ok" if st.ok else "failed"
+        previous = _read_results(target) if not target.is_symlink() else None
+        if status == "failed" and previous is not None and previous.get("status") == "ok":
+            # the README's promise: a failing spec never replaces a good page; its own page goes
+            # beside it, in failed/
+            _write_atomic_dir(target / "failed", files)
+            return Outcome(source, slug, status, "; ".join(st.problems), results, seconds=time.perf_counter() - start,
+                           kept_previous=True)
+        _write_atomic_dir(target, files)
         return Outcome(source, slug, status, "; ".join(st.problems), results, seconds=time.perf_counter() - start)
     except SpecFieldError as exc:
         return Outcome(source, slug, "error", str(loaded.error(exc)), spec_error=True, seconds=time.perf_counter() - start)
@@ -157,42 +295,136 @@ def build_one(path: Path, opts: Options) -> Outcome:
 
 def _read_results(folder: Path) -> dict | None:
     try:
-        return json.loads((folder / "results.json").read_text(encoding="utf-8"))
+        data = json.loads((folder / "results.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
+    return data if isinstance(data, dict) else None
+
+
+def prepare_output(out: Path) -> None:
+    """Create the output folder and make sure it can be written, before any work: raises
+    :class:`OutputError` (nothing written) for a path that is a file or a folder that cannot be
+    written."""
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"the output path {out} is a file, not a folder; choose another -o")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot create the output folder {out}: {exc.strerror or exc}") from None
+    probe = out / _tmp_name("probe")
+    try:
+        _write_new(probe, "")
+        probe.unlink()
+    except OSError as exc:
+        raise OutputError(f"cannot write to the output folder {out}: {exc.strerror or exc}; "
+                          "the site there was left as it was") from None
+
+
+@contextmanager
+def locked(out: Path):
+    """Hold an exclusive lock on ``out/.balpipe.lock`` for the build: a second build of the same
+    folder waits, so pages and the index of two builds never interleave."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        yield
+        return
+    fd = os.open(out / ".balpipe.lock", os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o666)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            import sys
+
+            print(f"balpipe: waiting for another build of {out} to finish", file=sys.stderr)
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)
+
+
+def _worker_init() -> None:
+    """Build workers leave Ctrl-C to the main process (no traceback from each worker); SIGTERM
+    ends them silently (its default action)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _clashes(specs: list[Path]) -> dict[Path, str]:
+    """Specs whose page folders would be the same (x.yaml and x.yml, 'a b' and 'a-b', names that
+    differ only in case): each gets a message naming the others."""
+    groups: dict[str, list[Path]] = {}
+    for p in specs:
+        groups.setdefault(slug_for(p).lower(), []).append(p)
+    out = {}
+    for group in groups.values():
+        if len(group) > 1:
+            for p in group:
+                others = ", ".join(str(q) for q in group if q is not p)
+                out[p] = (f"{p}: its page {slug_for(p)}/ would be the same as that of {others}; "
+                          "rename one of these files")
+    return out
 
 
 def build(paths: list[str], opts: Options, jobs: int = 1, progress=None) -> list[Outcome]:
-    """Build every spec (in parallel with ``jobs`` > 1), then the site index and schema."""
-    specs = find_specs(paths)
-    slugs: dict[str, Path] = {}
-    outcomes: list[Outcome] = []
+    """Build every spec (in parallel with ``jobs`` > 1), then the site index and schema.
+
+    Raises :class:`OutputError` before any work when the output folder cannot be used. On
+    KeyboardInterrupt (Ctrl-C, or SIGTERM turned into one by the CLI) the workers are stopped,
+    temporaries removed and the exception re-raised; the index is not rewritten, so the previous
+    site stays whole."""
+    problems: list[str] = []
+    specs = find_specs(paths, problems)
+    outcomes: list[Outcome] = [Outcome(msg.split(":", 1)[0], "", "error", msg, spec_error=True) for msg in problems]
+    clash = _clashes(specs)
     todo: list[Path] = []
     for p in specs:
-        s = slug_for(p)
-        if s in slugs:
-            outcomes.append(Outcome(str(p), s, "error", f"{p}: same page name as {slugs[s]}; rename one", spec_error=True))
-            continue
-        slugs[s] = p
-        todo.append(p)
-    opts.out.mkdir(parents=True, exist_ok=True)
+        if p in clash:
+            outcomes.append(Outcome(str(p), slug_for(p), "error", clash[p], spec_error=True))
+        else:
+            todo.append(p)
+    prepare_output(opts.out)
+    if progress:
+        for o in outcomes:  # refused before any work: k = 0
+            progress(0, len(todo), o)
+    with locked(opts.out):
+        remove_temporaries(opts.out)
+        try:
+            _run(todo, opts, jobs, progress, outcomes)
+        except BaseException:
+            remove_temporaries(opts.out)
+            raise
+        from .report.site import write_site
+
+        write_site(opts.out, [o for o in outcomes if o.slug])
+        write_file_atomic(opts.out / "balpipe.schema.json", json.dumps(schema(), indent=2, sort_keys=True) + "\n")
+    return outcomes
+
+
+def _run(todo: list[Path], opts: Options, jobs: int, progress, outcomes: list[Outcome]) -> None:
     total = len(todo)
     if jobs > 1 and total > 1:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # forked workers start ignoring it
+        pool = ProcessPoolExecutor(max_workers=min(jobs, total), initializer=_worker_init)
+        try:
             futures = [pool.submit(build_one, p, opts) for p in todo]
+        finally:
+            signal.signal(signal.SIGINT, previous)
+        try:
             for k, f in enumerate(futures):
                 o = f.result()
                 outcomes.append(o)
                 if progress:
                     progress(k + 1, total, o)
+        except BaseException:
+            for proc in list(getattr(pool, "_processes", {}).values()):
+                proc.terminate()
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
+        pool.shutdown()
     else:
         for k, p in enumerate(todo):
             o = build_one(p, opts)
             outcomes.append(o)
             if progress:
                 progress(k + 1, total, o)
-    from .report.site import write_site
-
-    write_site(opts.out, outcomes)
-    (opts.out / "balpipe.schema.json").write_text(json.dumps(schema(), indent=2, sort_keys=True) + "\n", encoding="utf-8")
-    return outcomes

@@ -11,6 +11,15 @@ from pathlib import Path
 from . import __version__
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143  # 128 + SIGINT, 128 + SIGTERM
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main process so that builds stop as cleanly as on Ctrl-C."""
+
+
+def _on_sigterm(signum, frame) -> None:
+    raise Terminated()
 
 
 class _Parser(argparse.ArgumentParser):
@@ -70,6 +79,9 @@ def cmd_build(args) -> int:
     opts = Options(out=Path(args.out), simulate=not args.no_sim, force=args.force)
 
     def progress(k: int, total: int, o) -> None:
+        if k == 0:  # refused before any work (unreadable folder, page name clash)
+            print(o.message, file=sys.stderr)
+            return
         if args.quiet and o.status in ("ok",):
             return
         tag = "unchanged" if o.skipped else o.status
@@ -77,7 +89,13 @@ def cmd_build(args) -> int:
         if o.status != "ok" and o.message and not o.skipped:
             print("    " + o.message.replace("\n", "\n    "), file=sys.stderr)
 
-    outcomes = build(args.paths, opts, jobs=args.jobs, progress=progress)
+    from .build import OutputError
+
+    try:
+        outcomes = build(args.paths, opts, jobs=args.jobs, progress=progress)
+    except OutputError as exc:
+        print(f"balpipe: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
     if not outcomes:
         print("balpipe: error: no spec files (*.yaml) found", file=sys.stderr)
         return EXIT_USAGE
@@ -91,31 +109,41 @@ def cmd_build(args) -> int:
 
 
 def cmd_check(args) -> int:
-    from . import registry
-    from .build import find_specs
+    """Everything ``build`` checks before simulating: schema, units, limits, geometry, the
+    balancing, the analysis of every stage (singular motions) and the references. Keeps going
+    past a spec that fails."""
+    from .build import _clashes, analyse, find_specs
     from .loader import SpecErrors, load
-    from .spec_parts import SpecFieldError
 
     missing = _missing(args.paths)
     if missing:
         print(f"balpipe: error: no such file or folder: {', '.join(missing)}", file=sys.stderr)
         return EXIT_USAGE
-    files = find_specs(args.paths)
-    bad = 0
+    problems: list[str] = []
+    files = find_specs(args.paths, problems)
+    for msg in problems:
+        print(msg, file=sys.stderr)
+    clash = _clashes(files)
+    bad = crashed = 0
     for f in files:
         try:
-            loaded = load(f)
-            try:
-                registry.balance_designs(loaded.spec)
-            except SpecFieldError as exc:
-                raise loaded.error(exc) from None
+            if f in clash:
+                raise SpecErrors([])
+            analyse(load(f))
             print(f"{f}: ok")
         except SpecErrors as exc:
             bad += 1
-            print(str(exc), file=sys.stderr)
-    print(f"balpipe: {len(files) - bad} valid, {bad} invalid", file=sys.stderr)
-    if not files:
+            print(str(exc) or clash[f], file=sys.stderr)
+        except Exception as exc:  # a bug in balpipe: report it, check the other specs
+            crashed += 1
+            print(f"{f}: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
+    bad += len(problems)
+    print(f"balpipe: {len(files) - bad - crashed + len(problems)} valid, {bad} invalid"
+          + (f", {crashed} internal errors" if crashed else ""), file=sys.stderr)
+    if not files and not problems:
         return EXIT_USAGE
+    if crashed:
+        return EXIT_FAILED
     return EXIT_USAGE if bad else EXIT_OK
 
 
@@ -131,10 +159,20 @@ def cmd_diff(args) -> int:
         return EXIT_USAGE
     data = diff.compare(a, b)
     text = diff.to_html(data, a, b) if args.format == "html" else diff.RENDERERS[args.format](data)
-    if args.out:
-        Path(args.out).write_text(text, encoding="utf-8")
-    else:
+    return _emit(text, args.out)
+
+
+def _emit(text: str, out: str | None) -> int:
+    """Write ``text`` to the file ``out`` (or stdout); a path that cannot be written is a usage
+    error with the reason, not a traceback."""
+    if not out:
         sys.stdout.write(text)
+        return EXIT_OK
+    try:
+        Path(out).write_text(text, encoding="utf-8")
+    except OSError as exc:
+        print(f"balpipe: error: cannot write {out}: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_USAGE
     return EXIT_OK
 
 
@@ -142,27 +180,36 @@ def cmd_schema(args) -> int:
     from .loader import schema
 
     text = json.dumps(schema(), indent=2, sort_keys=True) + "\n"
-    if args.out:
-        Path(args.out).write_text(text, encoding="utf-8")
-    else:
-        sys.stdout.write(text)
-    return EXIT_OK
+    return _emit(text, args.out)
 
 
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    else:  # pragma: no cover - embedded use
+        previous = None
     try:
         if args.command == "history":  # balpipe.history_cli
             from .history_cli import cmd_history
 
             return cmd_history(args)
         return {"build": cmd_build, "check": cmd_check, "diff": cmd_diff, "schema": cmd_schema}[args.command](args)
+    except Terminated:
+        print("balpipe: terminated; the site is as the last complete build left it", file=sys.stderr)
+        return EXIT_TERMINATED
     except KeyboardInterrupt:
-        print("balpipe: interrupted", file=sys.stderr)
-        return 130
+        print("balpipe: interrupted; the site is as the last complete build left it", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except BrokenPipeError:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_OK
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

@@ -20,7 +20,7 @@ from typing import Any
 from .loader import LoadedSpec, SpecError, SpecErrors, load, load_text
 from .report.results import _clean
 from .spec_parts import SpecFieldError
-from .study import Study, run, stage_metrics
+from .study import Study, stage_metrics
 
 ROUND_OFF = 1e-9  # ratios to the unbalanced peak below this are cancelled loads
 STAGE_KEYS = ("max_shaking_force", "max_shaking_moment", "force_ratio", "moment_ratio",
@@ -56,8 +56,10 @@ def read_side(ref: str) -> LoadedSpec:
 
 def run_side(ref: str, simulate: bool) -> Side:
     loaded = read_side(ref)
+    from .build import analyse  # the checks and limits of check and build, errors located
+
+    st = analyse(loaded, simulate=simulate)
     try:
-        st = run(loaded.spec)
         if simulate and loaded.spec.validation.enabled:
             from .validation_stage import simulate_study
 

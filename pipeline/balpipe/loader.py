@@ -9,6 +9,7 @@ at the same place.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -16,6 +17,7 @@ from typing import Any
 import yaml
 from pydantic import ValidationError
 
+from .limits import check_limits
 from .spec import Spec
 from .spec_parts import SpecFieldError
 
@@ -65,6 +67,10 @@ class LoadedSpec:
 def _format_path(path: tuple) -> str:
     out = ""
     for p in path:
+        if not isinstance(p, int):
+            p = str(p)
+            if not p or not p.isprintable() or p != p.strip():  # keys are data: show them quoted
+                p = repr(p)
         out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
     return out
 
@@ -91,6 +97,8 @@ def _find(node: yaml.Node | None, path: tuple) -> tuple[yaml.Node | None, bool]:
 
 def _key_node(node: yaml.Node | None, path: tuple) -> yaml.Node | None:
     """For an unknown key the error is at the key itself, not at its value."""
+    if not path:
+        return None
     parent, ok = _find(node, path[:-1])
     if ok and isinstance(parent, yaml.MappingNode):
         for k, _ in parent.value:
@@ -118,7 +126,8 @@ def _clean_loc(loc: tuple, data: Any) -> tuple:
     out: list = []
     cur = data
     for part in loc:
-        if isinstance(part, str) and ("[" in part or part.startswith("function-")):
+        in_document = isinstance(cur, dict) and part in cur
+        if isinstance(part, str) and ("[" in part or part.startswith("function-")) and not in_document:
             continue
         if isinstance(cur, dict) and part not in cur and any(cur.get(d) == part for d in _DISCRIMINATORS):
             continue
@@ -150,7 +159,38 @@ def _message(err: dict) -> str:
         return f"must be {op} {bound} (got {err.get('input')!r})"
     if kind == "union_tag_not_found":
         return f"missing the key {err.get('ctx', {}).get('discriminator', '')} that says which kind this is"
+    got = _describe(err.get("input"))
+    expected = {
+        "string_type": "text (a string)", "dict_type": "a mapping (key: value)", "model_type": "a mapping (key: value)",
+        "list_type": "a list", "tuple_type": "a list", "bool_type": "true or false", "bool_parsing": "true or false",
+        "int_type": "a whole number", "int_parsing": "a whole number", "float_type": "a number",
+        "float_parsing": "a number", "finite_number": "a finite number",
+    }.get(kind)
+    if expected:
+        return f"expected {expected}, got {got}"
+    if kind == "literal_error":
+        return f"expected {ctx.get('expected', 'one of the listed values')}, got {got}"
+    if kind in ("too_short", "too_long"):
+        return f"{'too few' if kind == 'too_short' else 'too many'} items: {msg.split(', ', 1)[-1]}"
+    if kind == "string_too_short":
+        return "must not be empty"
+    if msg.startswith("Input should be "):
+        return f"expected {msg[len('Input should be '):]}, got {got}"
     return msg
+
+
+def _describe(value: Any) -> str:
+    """A short description of a value for an error message."""
+    if value is None:
+        return "nothing (null)"
+    if isinstance(value, bool):
+        return f"a boolean ({str(value).lower()})"
+    if isinstance(value, dict):
+        return "a mapping"
+    if isinstance(value, (list, tuple)):
+        return f"a list of {len(value)}"
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _check_duplicates(node: yaml.Node, file: str, path: tuple = ()) -> list[SpecError]:
@@ -169,17 +209,147 @@ def _check_duplicates(node: yaml.Node, file: str, path: tuple = ()) -> list[Spec
     return errors
 
 
+#: Limits of a spec file, checked before any work (README, "Limits").
+MAX_FILE_BYTES = 1_000_000
+MAX_DEPTH = 64
+MAX_VALUES = 200_000  # values after alias expansion (an alias bomb multiplies them)
+
+_CONTROL = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x84\x86-\x9f\ufffe\uffff]")
+_CONTROL_NAMES = {0: "NUL", 7: "BEL", 8: "BS", 0x1B: "ESC", 0x7F: "DEL"}
+
+
+def _control_message(ch: str) -> str:
+    name = _CONTROL_NAMES.get(ord(ch))
+    return f"control character U+{ord(ch):04X}{f' ({name})' if name else ''} is not allowed in a spec"
+
+
+def _check_text(text: str, file: str) -> None:
+    """Control characters (raw in the file) with their line and column."""
+    errors = []
+    for m in _CONTROL.finditer(text):
+        line = text.count("\n", 0, m.start()) + 1
+        col = m.start() - (text.rfind("\n", 0, m.start()) + 1) + 1
+        errors.append(SpecError(file, line, col, "", _control_message(m.group())))
+        if len(errors) >= 5:
+            break
+    if errors:
+        raise SpecErrors(errors)
+
+
+def _yaml_error(exc: yaml.YAMLError, file: str) -> SpecErrors:
+    mark = getattr(exc, "problem_mark", None)
+    problem = getattr(exc, "problem", None) or str(exc)
+    context = getattr(exc, "context", None)
+    msg = f"malformed YAML: {problem}" + (f" ({context})" if context else "")
+    line, col = (mark.line + 1, mark.column + 1) if mark else (None, None)
+    return SpecErrors([SpecError(file, line, col, "", msg)])
+
+
+def _check_nesting(text: str, file: str) -> None:
+    """Nesting depth from the event stream (iterative: a deeply nested document would otherwise
+    overflow the C composer's stack) before any tree is built."""
+    depth = 0
+    for ev in yaml.parse(text, Loader=_Loader):
+        if isinstance(ev, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
+            depth += 1
+            if depth > MAX_DEPTH:
+                m = ev.start_mark
+                raise SpecErrors([SpecError(file, m.line + 1, m.column + 1, "",
+                                            f"nested deeper than {MAX_DEPTH} levels (limit)")])
+        elif isinstance(ev, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
+            depth -= 1
+
+
+def _children(node: yaml.Node) -> list[yaml.Node]:
+    if isinstance(node, yaml.MappingNode):
+        return [x for kv in node.value for x in kv]
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    return []
+
+
+def _check_aliases(root: yaml.Node, file: str) -> None:
+    """Refuse recursive aliases and alias bombs: the size of the document with every alias
+    expanded is computed on the shared node graph (linear time) and bounded by MAX_VALUES."""
+    size: dict[int, int] = {}
+    depth: dict[int, int] = {}
+    on_path: set[int] = set()
+    stack: list[tuple[yaml.Node, bool]] = [(root, False)]
+
+    def fail(node: yaml.Node, msg: str) -> SpecErrors:
+        m = node.start_mark
+        return SpecErrors([SpecError(file, m.line + 1, m.column + 1, "", msg)])
+
+    while stack:
+        node, done = stack.pop()
+        key = id(node)
+        kids = _children(node)
+        if done:
+            on_path.discard(key)
+            size[key] = 1 + sum(size[id(k)] for k in kids)
+            depth[key] = 1 + max((depth[id(k)] for k in kids), default=0)
+            if size[key] > MAX_VALUES:
+                raise fail(node, f"aliases expand this value to more than {MAX_VALUES} values (limit; an alias bomb?)")
+            if depth[key] > MAX_DEPTH:
+                raise fail(node, f"aliases nest this value deeper than {MAX_DEPTH} levels (limit)")
+            continue
+        if key in size:
+            continue
+        on_path.add(key)
+        stack.append((node, True))
+        for k in kids:
+            if id(k) in on_path:
+                raise fail(k, "recursive alias: this value contains itself")
+            if id(k) not in size:
+                stack.append((k, False))
+
+
+def _check_strings(node: yaml.Node, file: str, path: tuple = ()) -> list[SpecError]:
+    """Control characters that reached a string through a YAML escape ("\\x1b", "\\0")."""
+    errors: list[SpecError] = []
+    stack = [(node, path)]
+    seen: set[int] = set()
+    while stack:
+        n, p = stack.pop()
+        if id(n) in seen:
+            continue
+        seen.add(id(n))
+        if isinstance(n, yaml.ScalarNode):
+            m = _CONTROL.search(n.value) if isinstance(n.value, str) else None
+            if m:
+                mk = n.start_mark
+                errors.append(SpecError(file, mk.line + 1, mk.column + 1, _format_path(p), _control_message(m.group())))
+        elif isinstance(n, yaml.MappingNode):
+            for k, v in n.value:
+                stack.append((k, p))
+                stack.append((v, p + (k.value if isinstance(k, yaml.ScalarNode) else "?",)))
+        elif isinstance(n, yaml.SequenceNode):
+            stack += [(v, p + (i,)) for i, v in enumerate(n.value)]
+    return sorted(errors, key=lambda e: (e.line or 0, e.column or 0))[:5]
+
+
 def load_text(text: str, file: str) -> tuple[Spec, yaml.Node]:
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    _check_text(text, file)
     try:
-        node = yaml.compose(text, Loader=_Loader)
-        data = yaml.load(text, Loader=_Loader)
+        _check_nesting(text, file)
+        loader = _Loader(text)
+        try:
+            node = loader.get_single_node()
+            if node is not None:
+                _check_aliases(node, file)
+            data = loader.construct_document(node) if node is not None else None
+        finally:
+            loader.dispose()
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        problem = getattr(exc, "problem", None) or str(exc)
-        context = getattr(exc, "context", None)
-        msg = f"malformed YAML: {problem}" + (f" ({context})" if context else "")
-        line, col = (mark.line + 1, mark.column + 1) if mark else (None, None)
-        raise SpecErrors([SpecError(file, line, col, "", msg)]) from None
+        raise _yaml_error(exc, file) from None
+    except RecursionError:
+        raise SpecErrors([SpecError(file, None, None, "", f"nested too deeply (limit {MAX_DEPTH} levels)")]) from None
+    if node is not None:
+        bad = _check_strings(node, file)
+        if bad:
+            raise SpecErrors(bad)
     if node is None or not isinstance(data, dict):
         raise SpecErrors([SpecError(file, 1, 1, "", "the spec must be a YAML mapping (name:, mechanism:, motion:, ...)")])
     dup = _check_duplicates(node, file)
@@ -197,16 +367,44 @@ def load_text(text: str, file: str) -> tuple[Spec, yaml.Node]:
         # one line per place: a union may report the same field several times
         unique = list(dict.fromkeys(errors))
         raise SpecErrors(sorted(unique, key=lambda e: (e.line or 0, e.column or 0))) from None
+    try:
+        check_limits(spec)
+    except SpecFieldError as exc:
+        raise SpecErrors([_located(file, node, exc.path, exc.message)]) from None
     return spec, node
+
+
+def decode(raw: bytes, file: str) -> str:
+    """UTF-8 text of a spec file; other encodings are refused with the line and column of the
+    first byte that is not UTF-8."""
+    for bom, name in ((b"\xff\xfe\x00\x00", "UTF-32"), (b"\x00\x00\xfe\xff", "UTF-32"),
+                      (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16")):
+        if raw.startswith(bom):
+            raise SpecErrors([SpecError(file, 1, 1, "", f"the file is {name} (byte-order mark); save it as UTF-8")])
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        start = raw.rfind(b"\n", 0, exc.start) + 1
+        col = len(raw[start:exc.start].decode("utf-8", errors="replace")) + 1
+        hint = " (UTF-16?)" if b"\x00" in raw[:64] else ""
+        raise SpecErrors([SpecError(file, line, col, "",
+                                    f"not UTF-8{hint}: byte 0x{raw[exc.start]:02x} cannot be decoded; save the file as UTF-8")]) from None
 
 
 def load(path: str | Path) -> LoadedSpec:
     """Read and validate one spec file; raises :class:`SpecErrors`."""
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SpecErrors([SpecError(str(p), None, None, "", f"cannot read the file: {exc}")]) from None
+        size = p.stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise SpecErrors([SpecError(str(p), None, None, "",
+                                        f"file too large: {size} bytes (limit {MAX_FILE_BYTES} bytes)")])
+        raw = p.read_bytes()
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        raise SpecErrors([SpecError(str(p), None, None, "", f"cannot read the file: {reason}")]) from None
+    text = decode(raw, str(p))
     spec, node = load_text(text, str(p))
     return LoadedSpec(p, text, spec, node)
 

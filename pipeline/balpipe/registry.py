@@ -102,6 +102,11 @@ def scalar_laws(motion: Any, dims: dict[str, str]) -> dict[str, Law]:
                 values.append(units.parse(raw, dims[name]))
             except ValueError as exc:
                 raise SpecFieldError(path + (key,), str(exc)) from None
+        for key in ("start_velocity", "end_velocity", "start_acceleration", "end_acceleration"):
+            try:
+                units.check_rate(getattr(drive, key), dims[name])
+            except ValueError as exc:
+                raise SpecFieldError(path + (key,), f"{exc} ({name})") from None
         out[name] = law_for(motion, values[0], values[1], drive)
     return out
 

@@ -29,7 +29,7 @@ from .mechanisms.rrr4 import RRR4Mechanism
 from .mechanisms.serial_arm import SerialArmMechanism
 from .mechanisms.slider_crank import SliderCrankMechanism
 from .spec_parts import DriveSpec, Strict
-from .units import Duration, Length, quantity
+from .units import Duration, Length, count, number, quantity
 
 
 class NoBalancing(Strict):
@@ -69,8 +69,8 @@ class Motion(Strict):
         "polynomial meeting the drives' boundary velocities and accelerations",
     )
     duration: Duration = Field(description="duration of the motion")
-    accel_fraction: float = Field(
-        1 / 3, gt=0, le=0.5, description="trapezoidal law: fraction of the duration spent accelerating"
+    accel_fraction: number(gt=0, le=0.5) = Field(
+        1 / 3, description="trapezoidal law: fraction of the duration spent accelerating"
     )
     drive: dict[str, DriveSpec] = Field(
         description="driven coordinates by name (the template lists them: e.g. crank, slider, "
@@ -81,12 +81,12 @@ class Motion(Strict):
 class AnalysisSettings(Strict):
     """How the motion is sampled and the loads are expressed."""
 
-    samples: int = Field(501, ge=3, le=200_000, description="number of time samples over the motion")
+    samples: count(ge=3, le=200_000) = Field(501, description="number of time samples over the motion")
     gravity: bool = Field(False, description="gravity along -y; most papers work in a horizontal plane")
-    g: Annotated[float, quantity("acceleration", gt=0)] = Field(9.80665, description="gravitational acceleration")
+    g: quantity("acceleration", gt=0) = Field(9.80665, description="gravitational acceleration")
     moment_point: tuple[Length, Length] = Field((0.0, 0.0), description="point about which shaking moments are taken")
-    balance_tolerance: float = Field(
-        1e-9, gt=0, lt=1,
+    balance_tolerance: number(gt=0, lt=1) = Field(
+        1e-9,
         description="a stage counts as balanced when its peak is below this fraction of the reference load (the unbalanced peak, floored by 1 % of the gross inertial load)",
     )
 
@@ -95,9 +95,9 @@ class ValidationSpec(Strict):
     """Settings of the pymunk validation of every stage."""
 
     enabled: bool = Field(True, description="simulate every stage in pymunk")
-    dt: float | None = Field(None, gt=0, description="time step in s (default chosen per mechanism)")
-    iterations: int | None = Field(None, ge=1, le=10_000, description="solver iterations per step")
-    tolerance: float = Field(0.01, gt=0, le=0.01, description="pass when residuals are below this fraction of the reference loads: the unbalanced peaks, floored by 1 % of the gross inertial load (at most 1 %)")
+    dt: quantity("time", gt=0) | None = Field(None, description="time step in s (default chosen per mechanism); at least duration / 1e6 (a limit: one million steps)")
+    iterations: count(ge=1, le=10_000) | None = Field(None, description="solver iterations per step")
+    tolerance: number(gt=0, le=0.01) = Field(0.01, description="pass when residuals are below this fraction of the reference loads: the unbalanced peaks, floored by 1 % of the gross inertial load (at most 1 %)")
     reactionless: bool | None = Field(None, description="free-floating frame demonstration (default: on for paper specs)")
 
 
@@ -108,9 +108,9 @@ class Reference(Strict):
         description="a computed parameter's name (e.g. mcp1), or stage.metric for a stage result "
         "(e.g. unbalanced.max_shaking_force)"
     )
-    published: float = Field(description="the value printed in the paper, in SI units")
+    published: number() = Field(description="the value printed in the paper, in SI units")
     unit: str = Field("", description="unit of the value, for display")
-    tolerance: float = Field(0.005, ge=0, description="relative tolerance for 'agrees'")
+    tolerance: number(ge=0) = Field(0.005, description="relative tolerance for 'agrees'")
     note: str = Field("", description="what the paper says, misprints, how to read it")
     expect: Literal["agree", "differ"] = Field(
         "agree", description="'differ' when the published value is known not to reproduce (the note says why)"

@@ -6,7 +6,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from .units import Inertia, Length, Mass, PositiveLength
+from .units import Inertia, Length, Mass, PositiveLength, Rate, RateRate, number
 
 
 class SpecFieldError(ValueError):
@@ -25,7 +25,7 @@ class SpecFieldError(ValueError):
 class Strict(BaseModel):
     """Base of every spec section: unknown keys are errors, values are immutable."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True, allow_inf_nan=False)
 
 
 class LinkSpec(Strict):
@@ -56,14 +56,14 @@ class DriveSpec(Strict):
 
     start: Any = Field(alias="from", description="value at t = 0 (angle, length or [x, y] point)")
     end: Any = Field(alias="to", description="value at t = duration")
-    start_velocity: float = Field(0.0, description="polynomial law only: velocity at t = 0 (SI)")
-    end_velocity: float = Field(0.0, description="polynomial law only: velocity at the end (SI)")
-    start_acceleration: float = Field(0.0, description="polynomial law only: acceleration at t = 0 (SI)")
-    end_acceleration: float = Field(0.0, description="polynomial law only: acceleration at the end (SI)")
+    start_velocity: Rate = Field(0.0, description="polynomial law only: velocity at t = 0 (SI, or with a unit: rad/s, deg/s, rpm, m/s, mm/s)")
+    end_velocity: Rate = Field(0.0, description="polynomial law only: velocity at the end (SI or with a unit)")
+    start_acceleration: RateRate = Field(0.0, description="polynomial law only: acceleration at t = 0 (SI, or with a unit: rad/s^2, deg/s^2, m/s^2, mm/s^2)")
+    end_acceleration: RateRate = Field(0.0, description="polynomial law only: acceleration at the end (SI or with a unit)")
     law: Literal["quintic", "cycloidal", "bang_bang", "trapezoidal", "polynomial"] | None = Field(
         None, description="this drive's own law (quintic, cycloidal, bang_bang, trapezoidal, polynomial); "
         "default: motion.law"
     )
-    accel_fraction: float | None = Field(
-        None, gt=0, le=0.5, description="trapezoidal law: this drive's acceleration fraction (default: motion.accel_fraction)"
+    accel_fraction: number(gt=0, le=0.5) | None = Field(
+        None, description="trapezoidal law: this drive's acceleration fraction (default: motion.accel_fraction)"
     )

@@ -1,7 +1,13 @@
 """Quantities with units in specs: ``0.25 s``, ``30 deg``, ``12 g``, ``0.012 kg m^2``.
 
 A bare number is taken in SI units. Strings are ``<number> <unit>``; the unit must belong to the
-field's dimension, so ``"30 deg"`` in a length field is an error, not a silent 0.52 m.
+field's dimension, so ``"30 deg"`` in a length field is an error, not a silent 0.52 m, and a
+string without a unit (``"0.2"``) is an error too (write ``0.2 m`` or the bare number 0.2).
+
+Every numeric spec field is one of the types below (:func:`quantity`, :func:`number`,
+:func:`count`, :data:`Sign`, :data:`Rate`): they refuse booleans, NaN and infinities, and
+magnitudes beyond :data:`MAX_ABS` (stated limits: a 1e300 m link would overflow the engine), with
+a message that names the field's kind and the limit.
 Hand-written on purpose: six dimensions and a dozen units do not justify a units library's
 import time in a tool that loads hundreds of specs.
 """
@@ -27,11 +33,21 @@ UNITS: dict[str, dict[str, float]] = {
         for lu, lf in _LENGTH.items()
         if lu != "km"
     },
-    "acceleration": {"m/s^2": 1.0, "g0": 9.80665},
+    "acceleration": {"m/s^2": 1.0, "mm/s^2": 1e-3, "cm/s^2": 1e-2, "g0": 9.80665},
+    "velocity": {"m/s": 1.0, "mm/s": 1e-3, "cm/s": 1e-2},
+    "angular velocity": {"rad/s": 1.0, "deg/s": math.pi / 180, "rpm": math.pi / 30, "rev/s": 2 * math.pi},
+    "angular acceleration": {"rad/s^2": 1.0, "deg/s^2": math.pi / 180},
     "dimensionless": {"": 1.0},
 }
 SI = {"length": "m", "angle": "rad", "time": "s", "mass": "kg", "inertia": "kg m^2",
-      "acceleration": "m/s^2", "dimensionless": ""}
+      "acceleration": "m/s^2", "velocity": "m/s", "angular velocity": "rad/s",
+      "angular acceleration": "rad/s^2", "dimensionless": ""}
+
+#: Largest magnitude accepted per dimension, in SI units: beyond these a planar mechanism is not
+#: what the spec means, and products such as m L^2 w^2 approach float overflow.
+MAX_ABS = {"length": 1e4, "angle": 1e5, "time": 1e5, "mass": 1e6, "inertia": 1e12,
+           "acceleration": 1e7, "velocity": 1e6, "angular velocity": 1e6,
+           "angular acceleration": 1e9, "dimensionless": 1e12}
 
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _QTY = re.compile(rf"^\s*({_NUM})\s*(.*?)\s*$")
@@ -44,53 +60,180 @@ def _normalise_unit(unit: str) -> str:
 
 
 def parse(value: Any, dimension: str) -> float:
-    """Convert a number or a ``"<number> <unit>"`` string of ``dimension`` to SI."""
+    """Convert a number or a ``"<number> <unit>"`` string of ``dimension`` to SI.
+
+    Refuses booleans, NaN, infinities, strings without a unit (but for dimensionless values)
+    and magnitudes above :data:`MAX_ABS`, with a message saying what is expected."""
+    kind = "number" if dimension == "dimensionless" else dimension
+    a = "an" if kind[0] in "aeiou" else "a"
     if isinstance(value, bool):
-        raise ValueError(f"expected a {dimension}, got a boolean")
+        raise ValueError(f"expected {a} {kind}, got a boolean ({str(value).lower()})")
     if isinstance(value, (int, float)):
-        v = float(value)
+        try:
+            v = float(value)
+        except OverflowError:
+            raise ValueError(f"{kind} too large (got an integer of {len(str(abs(value)))} digits)") from None
     elif isinstance(value, str):
         m = _QTY.match(value)
         if not m:
-            raise ValueError(f"expected a {dimension} like '{_example(dimension)}', got {value!r}")
+            low = value.strip().lower().lstrip("+-.")
+            if low in ("nan", "inf", "infinity"):
+                raise ValueError(f"{kind} must be a finite number, got {value!r}")
+            raise ValueError(f"expected {a} {kind} like '{_example(dimension)}', got {value!r}")
         unit = _normalise_unit(m.group(2))
         table = UNITS[dimension]
         if unit == "" and dimension != "dimensionless":
-            factor = 1.0
+            raise ValueError(
+                f"{value.strip()!r} has no unit: write '{m.group(1)} {SI[dimension]}' or the bare number "
+                f"{m.group(1)} (SI units)"
+            )
         elif unit in table:
             factor = table[unit]
         else:
             known = ", ".join(sorted(k for k in table if k)) or "none"
-            raise ValueError(f"unit {m.group(2)!r} is not a {dimension} unit (use one of: {known})")
+            raise ValueError(f"unit {m.group(2)!r} is not {a} {kind} unit (use one of: {known})")
         v = float(m.group(1)) * factor
     else:
-        raise ValueError(f"expected a {dimension} (number or string with a unit), got {type(value).__name__}")
+        what = {"dict": "a mapping", "list": "a list", "NoneType": "nothing (null)"}.get(
+            type(value).__name__, type(value).__name__)
+        raise ValueError(f"expected {a} {kind} (a number{'' if dimension == 'dimensionless' else ' or a string with a unit'}), got {what}")
     if not math.isfinite(v):
-        raise ValueError(f"{dimension} must be finite")
+        raise ValueError(f"{kind} must be a finite number, got {value!r}")
+    if abs(v) > MAX_ABS[dimension]:
+        u = f" {SI[dimension]}" if SI[dimension] else ""
+        raise ValueError(f"{kind} out of range: |{v:.4g}|{u} exceeds the limit {MAX_ABS[dimension]:g}{u}")
     return v
 
 
 def _example(dimension: str) -> str:
     return {"length": "0.2 m", "angle": "30 deg", "time": "0.25 s", "mass": "12 g",
-            "inertia": "0.01 kg m^2", "acceleration": "9.81 m/s^2", "dimensionless": "0.5"}[dimension]
+            "inertia": "0.01 kg m^2", "acceleration": "9.81 m/s^2", "velocity": "0.5 m/s",
+            "angular velocity": "2 rad/s", "angular acceleration": "10 rad/s^2",
+            "dimensionless": "0.5"}[dimension]
 
 
 def quantity(dimension: str, **field_kwargs: Any) -> Any:
-    """An annotated float field of ``dimension`` (accepts numbers in SI or strings with units)."""
-    units = ", ".join(k for k in UNITS[dimension] if k)
-    schema = {
-        "anyOf": [
-            {"type": "number"},
-            {"type": "string", "pattern": rf"^\s*{_NUM}\s*[^\s].*$", "examples": [_example(dimension)]},
-        ],
-        "description": f"{dimension} in {SI[dimension] or 'SI'}, or a string with a unit ({units})",
-    }
+    """An annotated float field of ``dimension`` (accepts numbers in SI or strings with units).
+
+    The generic numeric field type of specs: finite, no booleans, units of its kind, bounded
+    by :data:`MAX_ABS`; ``field_kwargs`` add pydantic bounds (``gt``, ``ge``, ``le``, ...).
+    Use it bare (``x: Length``) or as ``x: quantity("time", gt=0) = Field(...)``; never nested
+    inside another ``Annotated[float, ...]`` (pydantic would then skip the unit parser)."""
+    if dimension == "dimensionless":
+        schema = {"type": "number", "description": "a finite number"}
+    else:
+        units = ", ".join(k for k in UNITS[dimension] if k)
+        schema = {
+            "anyOf": [
+                {"type": "number"},
+                {"type": "string", "pattern": rf"^\s*{_NUM}\s*[^\s].*$", "examples": [_example(dimension)]},
+            ],
+            "description": f"{dimension} in {SI[dimension] or 'SI'}, or a string with a unit ({units})",
+        }
     return Annotated[
         float,
         BeforeValidator(lambda v: parse(v, dimension)),
         WithJsonSchema(schema),
         Field(**field_kwargs),
     ]
+
+
+def number(**field_kwargs: Any) -> Any:
+    """A finite dimensionless number field (no booleans, no NaN or infinities)."""
+    return quantity("dimensionless", **field_kwargs)
+
+
+def _parse_count(value: Any) -> int:
+    if isinstance(value, bool):
+        raise ValueError(f"expected a whole number, got a boolean ({str(value).lower()})")
+    if isinstance(value, int):
+        return value
+    if isinstance(value, str):
+        try:
+            value = float(value.strip())
+        except ValueError:
+            raise ValueError(f"expected a whole number, got {value!r}") from None
+    if isinstance(value, float):
+        if math.isfinite(value) and value == int(value) and abs(value) < 2**53:
+            return int(value)
+        raise ValueError(f"expected a whole number, got {value!r}")
+    raise ValueError(f"expected a whole number, got {type(value).__name__}")
+
+
+def count(**field_kwargs: Any) -> Any:
+    """A whole-number field (samples, iterations): no booleans, no fractions; bounds as kwargs."""
+    return Annotated[int, BeforeValidator(_parse_count), Field(**field_kwargs)]
+
+
+def _parse_sign(value: Any) -> int:
+    if isinstance(value, bool) or value not in (1, -1) or not isinstance(value, (int, float)):
+        raise ValueError(f"expected +1 or -1, got {value!r}")
+    return int(value)
+
+
+#: +1 or -1 (working and assembly modes, branches); booleans and other numbers refused.
+Sign = Annotated[int, BeforeValidator(_parse_sign), WithJsonSchema({"enum": [1, -1]})]
+
+
+class RateValue(float):
+    """A boundary velocity or acceleration in SI, remembering whether its unit was linear
+    (``m/s``), angular (``rad/s``) or absent (a bare SI number), so that the drive it belongs to
+    can refuse ``rad/s`` on a slider (:func:`check_rate`)."""
+
+    kind: str | None = None
+
+    def __new__(cls, value: float, kind: str | None):
+        obj = super().__new__(cls, value)
+        obj.kind = kind
+        return obj
+
+    def __reduce__(self):  # pickled into build workers
+        return (RateValue, (float(self), self.kind))
+
+
+def _rate_parser(order: int):
+    dims = ("velocity", "angular velocity") if order == 1 else ("acceleration", "angular acceleration")
+
+    def parse_rate(value: Any) -> RateValue:
+        if isinstance(value, RateValue):
+            return value
+        if isinstance(value, str):
+            m = _QTY.match(value)
+            unit = _normalise_unit(m.group(2)) if m else ""
+            for dim in dims:
+                if unit and unit in UNITS[dim]:
+                    return RateValue(parse(value, dim), dim)
+            if m and unit:
+                known = ", ".join(k for d in dims for k in UNITS[d])
+                raise ValueError(f"unit {m.group(2)!r} is not a {dims[0]} unit (use one of: {known})")
+        return RateValue(parse(value, dims[0]) if isinstance(value, str) else parse(value, "dimensionless"), None)
+
+    return parse_rate
+
+
+def _rate(order: int) -> Any:
+    what = "velocity" if order == 1 else "acceleration"
+    units = ", ".join(k for d in (("velocity", "angular velocity") if order == 1 else ("acceleration", "angular acceleration")) for k in UNITS[d])
+    schema = {"anyOf": [{"type": "number"}, {"type": "string", "pattern": rf"^\s*{_NUM}\s*[^\s].*$"}],
+              "description": f"{what} of the driven coordinate in SI (rad or m based), or a string with a unit ({units})"}
+    # Any, not float: pydantic's float validator would drop the RateValue's unit kind
+    return Annotated[Any, BeforeValidator(_rate_parser(order)), WithJsonSchema(schema)]
+
+
+#: Boundary velocity / acceleration of a drive: SI number, or a linear or angular unit.
+Rate = _rate(1)
+RateRate = _rate(2)
+
+
+def check_rate(value: float, coordinate: str) -> None:
+    """Raise ValueError when ``value`` (a :class:`RateValue`) has a unit of the wrong kind for a
+    coordinate of dimension ``coordinate`` ("angle" or "length")."""
+    kind = getattr(value, "kind", None)
+    if kind is None:
+        return
+    angular = kind.startswith("angular")
+    if angular != (coordinate == "angle"):
+        raise ValueError(f"a {'angular' if angular else 'linear'} unit on a coordinate that is a {coordinate}")
 
 
 Length = quantity("length")
@@ -101,3 +244,5 @@ Duration = quantity("time", gt=0)
 Mass = quantity("mass", ge=0)
 PositiveMass = quantity("mass", gt=0)
 Inertia = quantity("inertia", ge=0)
+Acceleration = quantity("acceleration")
+Number = number()

@@ -43,7 +43,7 @@ from ..mechanisms.five_bar import FiveBarMechanism, GearPart, Synthesis
 from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
 from ..model import Attachment, Body, Gear, Model, Revolute
 from ..spec_parts import SpecFieldError, Strict
-from ..units import Inertia, Length, Mass
+from ..units import Inertia, Length, Mass, number
 from .base import BalanceResult, Parameter, Stage
 
 
@@ -64,7 +64,7 @@ class CounterRotation(Strict):
     """Gears 3', 4' fixed on the distal links at B_j, meshing with gears 6, 7 on axes A_j carried
     by the input links (r3' + r6 = l1, r4' + r7 = l2)."""
 
-    ratio: float = Field(1.0, gt=0, description="U63 = U74 = r3'/r6 = r4'/r7 (the paper: 1)")
+    ratio: number(gt=0) = Field(1.0, description="U63 = U74 = r3'/r6 = r4'/r7 (the paper: 1)")
     gear_3p: GearPart = Field(
         GearPart(), description="gears 3' and 4' (each), fixed on the distal links at B_j in the full stage"
     )
@@ -253,11 +253,12 @@ def balance(mech: FiveBarMechanism, method: FiveBarGearBalancing, model: Model) 
         P(f"mCW{j + 2}", masses[j + 2], "kg", f"eq. {10 + j}", f"counterweight on distal link {j + 2}")
         ms_p = lp.mass + masses[j]
         P(f"m{j}_star", ms_p, "kg", "eq. 14: m* = m + m_CW", f"balanced input link {j} (link + counterweight)")
-        P(f"r{j}_star", -(lp.mass * lp.com + masses[j] * cw.proximal) / ms_p, "m", "Sec. VI",
+        # a massless link and counterweight have no centre of mass: 0 (on the joint)
+        P(f"r{j}_star", -(lp.mass * lp.com + masses[j] * cw.proximal) / ms_p if ms_p else 0.0, "m", "Sec. VI",
           f"distance of the balanced link {j}'s centre of mass from A{j}, on the side opposite B{j}")
         ms_d = ld.mass + masses[j + 2]
         P(f"m{j + 2}_star", ms_d, "kg", "eq. 14: m* = m + m_CW", f"balanced distal link {j + 2} (link + counterweight)")
-        P(f"r{j + 2}_star", abs(ld.mass * ld.com + masses[j + 2] * cw.distal) / ms_d, "m", "Sec. VI",
+        P(f"r{j + 2}_star", abs(ld.mass * ld.com + masses[j + 2] * cw.distal) / ms_d if ms_d else 0.0, "m", "Sec. VI",
           f"distance of the balanced link {j + 2}'s centre of mass from B{j} (0: on the joint)")
 
     cw_model = model

@@ -44,10 +44,16 @@ class SliderCrankCounterweights(Strict):
 
 def _counterweight_masses(mech: SliderCrankMechanism, c1: float, c2: float) -> tuple[float, float]:
     """Eq. 15 in lengths: mcp2 = -(m2 p2 + m3 L2) / c2, mcp1 = -(m1 p1 + (m2 + mcp2 + m3) L1) / c1
-    (p_i = r_i L_i the centre of mass positions, c_i = rcp_i L_i the counterweights')."""
+    (p_i = r_i L_i the centre of mass positions, c_i = rcp_i L_i the counterweights').
+
+    Derived from the linear momentum: the slider translates, so its momentum is m3 v_C wherever
+    its centre of mass sits on it (s constant in the frame: d(C + s)/dt = v_C), and v_C = d/dt
+    (L1 e1 + L2 e2) because C stays on the guide. The total momentum
+    (m1 p1 + mcp1 c1 + (m2 + mcp2 + m3) L1) de1/dt + (m2 p2 + mcp2 c2 + m3 L2) de2/dt vanishes
+    for every motion when both brackets do: eq. 15, with no term in the slider's offset."""
     m1, m2, m3 = mech.crank.mass, mech.coupler.mass, mech.slider.mass
     L1, L2 = mech.crank.length, mech.coupler.length
-    mcp2 = -(m2 * mech.coupler.com + m3 * (L2 + mech.slider.com[0])) / c2
+    mcp2 = -(m2 * mech.coupler.com + m3 * L2) / c2
     mcp1 = -(m1 * mech.crank.com + (m2 + mcp2 + m3) * L1) / c1
     return mcp1, mcp2
 
@@ -73,9 +79,9 @@ def balance(mech: SliderCrankMechanism, method: SliderCrankCounterweights, model
     for key, c in (("crank_counterweight", c1), ("coupler_counterweight", c2)):
         if c == 0:
             raise SpecFieldError(path + (key,), "a counterweight at the joint itself cannot balance anything")
-    if mech.crank.com_offset or mech.coupler.com_offset or mech.slider.com[1]:
+    if mech.crank.com_offset or mech.coupler.com_offset:
         raise SpecFieldError(
-            ("mechanism",), "eq. 15 assumes centres of mass on the link axes (com_offset 0, slider com y 0)"
+            ("mechanism",), "eq. 15 assumes centres of mass on the link axes (com_offset 0)"
         )
     mcp1, mcp2 = _counterweight_masses(mech, c1, c2)
     for key, m, name in (("coupler_counterweight", mcp2, "mcp2"), ("crank_counterweight", mcp1, "mcp1")):
@@ -130,6 +136,14 @@ def balance(mech: SliderCrankMechanism, method: SliderCrankCounterweights, model
     if method.moment_unknown is None:
         notes.append("Scott-Russell geometry: eq. 20 could cancel the moment too; name moment_unknown to do it.")
         return BalanceResult(params, stages, notes)
+    if mech.slider.com[1]:
+        # the slider's angular momentum about C's line gains -m3 s_y v_C (s across the guide),
+        # which eq. 20 does not hold; along the guide s x v_C = 0 and the offset drops out
+        raise SpecFieldError(
+            ("mechanism", "slider", "com"),
+            f"eq. 20 needs the slider's centre of mass on the guide line; {mech.slider.com[1]:g} m across "
+            "the guide adds a moment m3 s_y v_C that no counterweight inertia cancels",
+        )
     # eq. 20: I1 + (m1 r1^2 + mcp1 rcp1^2 + m2 + mcp2) L1^2 - I2 - (m2 r2^2 + mcp2 rcp2^2) L1^2 = 0
     lhs = eq20_lhs(mech.crank.inertia, mech.crank.mass, mech.crank.com, mcp1, c1, L1,
                    mech.coupler.inertia, mech.coupler.mass, mech.coupler.com, mcp2, c2)

@@ -12,10 +12,9 @@ import numpy as np
 from pydantic import Field
 
 from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle, mesh_geometry
-from ..model import FRAME, Body, Driver, Gear, Model, Prismatic, Revolute
+from ..model import FRAME, Attachment, Body, Driver, Gear, Model, Prismatic, Revolute
 from ..spec_parts import SpecFieldError, Strict
-from ..units import Angle, Inertia, Length, Mass, PositiveLength
-from ..model import Attachment
+from ..units import Angle, Inertia, Length, Mass, Number, PositiveLength
 
 Point = Union[str, tuple[Length, Length]]
 
@@ -62,7 +61,7 @@ class PrismaticSpec(Strict):
     guide: str = Field(description="body carrying the guide (or 'frame')")
     slider: str = Field(description="sliding body")
     point_guide: Point = Field(description="a point of the guide's axis")
-    axis: tuple[float, float] = Field(description="direction of the guide in the guide's frame")
+    axis: tuple[Number, Number] = Field(description="direction of the guide in the guide's frame")
     point_slider: Point = Field((0.0, 0.0), description="the slider's point that stays on the axis")
     angle: Angle = Field(0.0, description="constant angle of the slider relative to the guide")
 
@@ -73,7 +72,7 @@ class GearSpec(Strict):
     a: str = Field(description="driving gear's body")
     b: str = Field(description="driven gear's body")
     carrier: str = Field(FRAME, description="body holding both axes ('frame' for fixed axes)")
-    ratio: float = Field(description="(w_b - w_c) / (w_a - w_c); -r_a/r_b for an external mesh")
+    ratio: Number = Field(description="(w_b - w_c) / (w_a - w_c); -r_a/r_b for an external mesh")
     radius_a: PositiveLength | None = Field(
         None,
         description="pitch radius of gear a; with radius_b the mesh passes its tooth force between "

@@ -39,7 +39,7 @@ from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
 from ..model import FRAME, Attachment, Body, Driver, Gear, Law, Model, Revolute
 from ..motion import law_for
 from ..spec_parts import LinkSpec, SpecFieldError, Strict
-from ..units import Inertia, Length, Mass, PositiveLength
+from ..units import Inertia, Length, Mass, PositiveLength, Sign
 
 GRIPPER_PATH = ("motion", "drive", "gripper")
 
@@ -87,7 +87,7 @@ class FiveBarMechanism(Strict):
     template: Literal["five_bar"] = Field(description="mechanism template")
     pivots: Pivots = Field(description="base pivots A1, A2 (the paper: (-l0, 0), (+l0, 0))")
     links: FiveBarLinks
-    working_modes: tuple[Literal[1, -1], Literal[1, -1]] = Field(
+    working_modes: tuple[Sign, Sign] = Field(
         (1, -1),
         description="sigma1, sigma2: +1 puts B_j on the counter-clockwise side of A_jC (the sign "
         "of the root in eq. 2; the paper's Fig. 3 is [+1, -1])",

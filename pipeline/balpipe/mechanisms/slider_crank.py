@@ -15,7 +15,7 @@ from pydantic import Field
 
 from ..model import FRAME, Body, Driver, Model, Prismatic, Revolute
 from ..spec_parts import BodySpec, LinkSpec, SpecFieldError, Strict
-from ..units import Length
+from ..units import Length, Sign
 
 
 class SliderCrankMechanism(Strict):
@@ -27,7 +27,7 @@ class SliderCrankMechanism(Strict):
     crank: LinkSpec = Field(description="link 1, AB")
     coupler: LinkSpec = Field(description="link 2, BC")
     slider: BodySpec = Field(description="link 3, the slider; its frame origin is C")
-    branch: Literal[1, -1] = Field(1, description="+1: slider on the +x side of B, -1: on the -x side")
+    branch: Sign = Field(1, description="+1: slider on the +x side of B, -1: on the -x side")
 
     def drives(self) -> dict[str, str]:
         """Coordinates that can be driven, with their dimension."""

@@ -29,7 +29,15 @@ plt.rcParams.update({
     "grid.alpha": 0.3,
     "axes.spines.top": False,
     "axes.spines.right": False,
+    "text.usetex": False,
 })
+
+
+def literal(text: str) -> str:
+    """A name (spec, point, body, driver, stage) as matplotlib text that is shown literally:
+    every '$' is escaped, so that mathtext never parses user data (an unbalanced '$\\frac{'
+    would otherwise crash the figure). Matplotlib prints an escaped '\\$' as '$'."""
+    return str(text).replace("$", r"\$")
 
 STAGE_STYLES = [
     {"color": "black", "linestyle": "-", "linewidth": 1.4},
@@ -71,12 +79,12 @@ def loads_figure(stages: list, prefix: str = "loads") -> str:
     ]
     for k, (label, an, sim) in enumerate(stages):
         for ax, title, fn in panels:
-            ax.plot(an.t, fn(an.force, an.moment), label=label, **style(k))
+            ax.plot(an.t, fn(an.force, an.moment), label=literal(label), **style(k))
             if sim is not None:
                 ts, Fs, Ms = sim
                 ax.plot(ts, fn(Fs, Ms), color=SIM_COLORS[k % len(SIM_COLORS)], linestyle=":",
-                        linewidth=1.0, label=f"{label} (pymunk)")
-            ax.set_title(title, fontsize=9)
+                        linewidth=1.0, label=literal(f"{label} (pymunk)"))
+            ax.set_title(literal(title), fontsize=9)
     for ax in axes[1]:
         ax.set_xlabel("time (s)")
     handles, labels = axes[0, 0].get_legend_handles_labels()
@@ -93,8 +101,8 @@ def efforts_figure(stages: list, prefix: str = "efforts") -> str:
     for ax, name in zip(axes[0], names):
         for k, (label, an) in enumerate(stages):
             if name in an.efforts:
-                ax.plot(an.t, an.efforts[name], label=label, **style(k))
-        ax.set_title(f"Actuator effort: {name} (N m or N)", fontsize=9)
+                ax.plot(an.t, an.efforts[name], label=literal(label), **style(k))
+        ax.set_title(literal(f"Actuator effort: {name} (N m or N)"), fontsize=9)
         ax.set_xlabel("time (s)")
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
@@ -156,12 +164,12 @@ def mechanism_figure(model: Model, analysis, instants: int = 5, prefix: str = "m
         ax.plot([a[0], b[0]], [a[1], b[1]], color="0.3", linewidth=1.0, linestyle="-")
     for name, p in model.frame_points.items():
         ax.plot(p[0], p[1], marker="^", color="black", markersize=9)
-        ax.annotate(name, p, textcoords="offset points", xytext=(4, -12), fontsize=8)
+        ax.annotate(literal(name), p, textcoords="offset points", xytext=(4, -12), fontsize=8)
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     if title:
-        ax.set_title(title, fontsize=9)
+        ax.set_title(literal(title), fontsize=9)
     fig.tight_layout()
     return to_svg(fig, prefix)
 
@@ -178,11 +186,11 @@ def series_figure(t: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel: s
     """A plain time-series plot: one line per (label, values), stage styles in order."""
     fig, ax = plt.subplots(figsize=(6.0, 3.0))
     for k, (label, y) in enumerate(curves):
-        ax.plot(t, y, label=label, **style(k))
+        ax.plot(t, y, label=literal(label), **style(k))
     ax.set_xlabel("time (s)")
     ax.set_ylabel(ylabel)
     if title:
-        ax.set_title(title, fontsize=9)
+        ax.set_title(literal(title), fontsize=9)
     ax.legend(fontsize=7)
     fig.tight_layout()
     return to_svg(fig, prefix)
@@ -196,8 +204,8 @@ def drift_figure(runs: list, prefix: str = "drift") -> str:
     ``runs``: (label, t, drift (N, 2) in m, rotation (N,) in rad)."""
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 2.8))
     for k, (label, t, drift, rot) in enumerate(runs):
-        a1.plot(t, 1000 * np.hypot(drift[:, 0], drift[:, 1]), label=label, **style(k))
-        a2.plot(t, np.degrees(rot), label=label, **style(k))
+        a1.plot(t, 1000 * np.hypot(drift[:, 0], drift[:, 1]), label=literal(label), **style(k))
+        a2.plot(t, np.degrees(rot), label=literal(label), **style(k))
     a1.set_title("Drift of the free frame (mm)", fontsize=9)
     a2.set_title("Rotation of the free frame (deg)", fontsize=9)
     for a in (a1, a2):
@@ -213,8 +221,8 @@ def residual_figure(stages: list, prefix: str = "residuals") -> str:
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 2.8))
     for k, (label, t, fe, me, F0, M0) in enumerate(stages):
         c = SIM_COLORS[k % len(SIM_COLORS)]
-        a1.plot(t, fe / F0 if F0 > 0 else fe, color=c, label=label, linewidth=1.0)
-        a2.plot(t, me / M0 if M0 > 0 else me, color=c, label=label, linewidth=1.0)
+        a1.plot(t, fe / F0 if F0 > 0 else fe, color=c, label=literal(label), linewidth=1.0)
+        a2.plot(t, me / M0 if M0 > 0 else me, color=c, label=literal(label), linewidth=1.0)
     a1.set_title("|F_sim - F_analytic| / reference force", fontsize=9)
     a2.set_title("|M_sim - M_analytic| / reference moment", fontsize=9)
     for a in (a1, a2):
@@ -237,7 +245,7 @@ def overlay_figure(old, new, prefix: str = "overlay") -> str:
     for ax, title, fn in panels:
         ax.plot(old.t, fn(old), color="0.55", linestyle="--", linewidth=1.6, label="old")
         ax.plot(new.t, fn(new), color="black", linestyle="-", linewidth=1.3, label="new")
-        ax.set_title(title, fontsize=9)
+        ax.set_title(literal(title), fontsize=9)
     for ax in axes[1]:
         ax.set_xlabel("time (s)")
     axes[0, 0].legend(fontsize=8)

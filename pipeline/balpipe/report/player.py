@@ -76,6 +76,8 @@ def player_html(stages: list[dict], element_id: str = "player") -> str:
     pad = 0.15 * float(max(hi - lo)) if np.all(np.isfinite(hi)) else 0.1
     box = [round(float(lo[0] - pad), 4), round(float(lo[1] - pad), 4), round(float(hi[0] + pad), 4), round(float(hi[1] + pad), 4)]
     payload = json.dumps({"stages": data, "box": box}, separators=(",", ":"), sort_keys=True)
+    # names are data: no '</script>' or '<!--' can end the script early
+    payload = payload.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
     width = 300 * max(1, len(stages))
     return f"""<canvas id="{element_id}" width="{width}" height="300" style="max-width:100%;border:1px solid #d9dee4"></canvas>
 <script>

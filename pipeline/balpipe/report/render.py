@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from functools import lru_cache
 from importlib import resources
 
@@ -39,6 +40,15 @@ def ratio(x) -> str:
     return f"{x:.2e}"
 
 
+_CONTROL = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f]")
+
+
+def printable(text: str) -> str:
+    """Text with its control characters shown as escapes (a file name may hold them): they never
+    reach a page raw."""
+    return _CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", str(text))
+
+
 def unit(u: str) -> str:
     """Display form of a unit: 'kg m^2' -> 'kg m²'."""
     return (u or "").replace("^2", "²").replace("^3", "³")
@@ -56,5 +66,6 @@ def environment() -> jinja2.Environment:
     env.filters["num"] = num
     env.filters["ratio"] = ratio
     env.filters["unit"] = unit
+    env.filters["printable"] = printable
     env.globals["version"] = __version__
     return env

@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 
 from . import site_filter
-from .render import environment, num
+from .render import environment, num, printable
 
 
 def _entry(out: Path, o) -> dict:
@@ -19,15 +19,23 @@ def _entry(out: Path, o) -> dict:
             results = json.loads((out / o.slug / "results.json").read_text(encoding="utf-8"))
         except (OSError, ValueError):
             results = None
+    if getattr(o, "kept_previous", False):
+        # failed its checks after a good build: the good page stays, the failed one is in failed/
+        stale = True
+        try:
+            results = json.loads((out / o.slug / "results.json").read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            results = None
     e = {
-        "title": (results or {}).get("spec") or Path(o.source).name,
-        "source": o.source,
+        "title": printable((results or {}).get("spec") or Path(o.source).name),
+        "source": printable(o.source),
         "link": f"{o.slug}/index.html" if page.exists() else None,
         "status": {"ok": "ok", "failed": "failed", "error": "invalid spec", "crash": "internal error"}.get(o.status, o.status),
         "stale": stale,
         "results": results if not stale else None,
-        "errors": o.message if o.status in ("error", "crash", "failed") else "",
-        "error_short": (o.message.splitlines() or [""])[0],
+        "errors": printable(o.message) if o.status in ("error", "crash", "failed") else "",
+        "error_short": printable((o.message.splitlines() or [""])[0]),
+        "failed_link": f"{o.slug}/failed/index.html" if getattr(o, "kept_previous", False) else None,
         "not_realisable": [],
     }
     if e["results"]:
@@ -61,4 +69,6 @@ def write_site(out: Path, outcomes: list) -> None:
         entries=entries, n_ok=n_ok - n_flagged, n_failed=len(entries) - n_ok, n_flagged=n_flagged,
         filters=site_filter.options(entries),
     )
-    (out / "index.html").write_text(html, encoding="utf-8")
+    from ..build import write_file_atomic  # replaced in one step, never through a planted symlink
+
+    write_file_atomic(out / "index.html", html)
