@@ -156,7 +156,7 @@ def test_no_numeric_field_escapes_the_units_parsers():
 
     walk(Spec, "Spec")
     assert len(seen) > 15
-    assert not unchecked, unchecked
+    assert not unchecked, "\n".join(unchecked)
 
 
 def test_schema_says_numbers_or_strings_with_units():

@@ -56,7 +56,7 @@ from ..mechanisms.serial_arm import (
 from ..model import Law, Model
 from ..motion import PointToPoint, bang_bang, law_for, quintic
 from ..spec_parts import SpecFieldError, Strict
-from ..units import Angle, Length, PositiveLength
+from ..units import Angle, Length, PositiveLength, count, number, quantity
 from .base import BalanceResult, Parameter, Stage
 
 ROOT = ("balancing",)
@@ -74,7 +74,7 @@ class TestSquare(Strict):
 
     centre: tuple[Length, Length] = Field(description="centre E of the square")
     side: PositiveLength = Field(description="edge length")
-    divisions: int = Field(4, ge=1, le=50, description="segments per edge")
+    divisions: count(ge=1, le=50) = Field(4, description="segments per edge")
     first_corner: Literal["bottom-left", "bottom-right", "top-right", "top-left"] = Field(
         "bottom-left", description="corner of P1 (the paper's figure is not legible: bottom-left reproduces its list)"
     )
@@ -113,12 +113,12 @@ class PhiOptimisation(Strict):
     """phi(tau) = phi0 + (phif - phi0) s5(tau) + sum_k c_k 64 tau^3 (1 - tau)^3 (2 tau - 1)^k,
     k = 0 .. degree - 6: the degree-``degree`` polynomials with phi, phi', phi'' fixed at both ends."""
 
-    degree: int = Field(8, ge=5, le=14, description="degree of the polynomial (5: the 3-4-5 law, nothing to optimise)")
-    starts: int = Field(4, ge=1, le=50, description="multi-start: the 3-4-5 law plus starts - 1 random points")
-    seed: int = Field(0, ge=0, description="seed of the random starting points (numpy default_rng)")
-    spread: float = Field(0.5, gt=0, description="standard deviation of the random starting coefficients (rad)")
-    max_evaluations: int = Field(300, ge=10, le=100_000, description="objective evaluations per start (Nelder-Mead)")
-    tolerance: float = Field(1e-4, gt=0, description="Nelder-Mead xatol (rad) and fatol (relative to the start's peak)")
+    degree: count(ge=5, le=14) = Field(8, description="degree of the polynomial (5: the 3-4-5 law, nothing to optimise)")
+    starts: count(ge=1, le=50) = Field(4, description="multi-start: the 3-4-5 law plus starts - 1 random points")
+    seed: count(ge=0) = Field(0, description="seed of the random starting points (numpy default_rng)")
+    spread: quantity("angle", gt=0) = Field(0.5, description="standard deviation of the random starting coefficients (rad)")
+    max_evaluations: count(ge=10, le=100_000) = Field(300, description="objective evaluations per start (Nelder-Mead)")
+    tolerance: number(gt=0) = Field(1e-4, description="Nelder-Mead xatol (rad) and fatol (relative to the start's peak)")
 
 
 class ComMotionPlanning(Strict):
@@ -133,10 +133,10 @@ class ComMotionPlanning(Strict):
     )
     orientation: Orientation | None = Field(None, description="phi at both ends of every trajectory (with trajectories)")
     phi: PhiOptimisation = Field(PhiOptimisation(), description="the law of phi in case 2 and its optimisation")
-    torque_rate_limit: float = Field(
-        3e4, gt=0, description="case 3: largest rate of change of any actuator torque, N m/s (the paper: 3.10^4)"
+    torque_rate_limit: number(gt=0) = Field(
+        3e4, description="case 3: largest rate of change of any actuator torque, N m/s (the paper: 3.10^4)"
     )
-    rate_samples: int = Field(4001, ge=101, le=100_001, description="case 3: samples on which torque rates are measured (central differences)")
+    rate_samples: count(ge=101, le=100_001) = Field(4001, description="case 3: samples on which torque rates are measured (central differences)")
 
 
 # --------------------------------------------------------------------------------------------

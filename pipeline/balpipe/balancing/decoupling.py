@@ -40,7 +40,7 @@ from pydantic import Field
 from ..mechanisms.serial_arm import SerialArmMechanism
 from ..model import FRAME, Attachment, Model
 from ..spec_parts import SpecFieldError, Strict
-from ..units import Inertia, Length, Mass, PositiveLength
+from ..units import Inertia, Length, Mass, PositiveLength, number
 from .base import BalanceResult, Parameter, Stage
 from .parts import add_counter_rotation, add_counterweight
 
@@ -52,7 +52,7 @@ class Gear1p(Strict):
 
     position: Length = Field(description="l_AC: position of C along link 1 from A (between A and B in the paper)")
     mass: Mass = Field(0.0, description="m1'")
-    ratio: float = Field(-1.0, lt=0, description="w1' - w1 = ratio (w2 - w1); -1 for identical gears (the paper)")
+    ratio: number(lt=0) = Field(-1.0, description="w1' - w1 = ratio (w2 - w1); -1 for identical gears (the paper)")
 
 
 class Gear2p(Strict):

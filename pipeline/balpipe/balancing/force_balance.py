@@ -13,7 +13,7 @@ from pydantic import Field, model_validator
 
 from ..model import Model, Vec2
 from ..spec_parts import SpecFieldError, Strict
-from ..units import Length, PositiveLength
+from ..units import Length, PositiveLength, count, number
 from . import conditions as C
 from . import least_mass as LM
 from . import regressor as R
@@ -51,10 +51,10 @@ class CounterweightRegionSpec(Strict):
 class FinderSettings(Strict):
     """How the conditions are found."""
 
-    rank_tolerance: float = Field(C.RANK_TOLERANCE, gt=0, lt=1e-3, description="singular values below this fraction of the largest are dropped")
-    samples: int = Field(0, ge=0, le=10_000, description="sampled states (0: 2 x 4 x bodies + 12)")
-    seed: int = Field(0, ge=0, description="seed of the state sampler")
-    polygon_sides: int = Field(LM.POLYGON_SIDES, ge=8, le=4096, description="sides of the polygon inscribed in each disc region")
+    rank_tolerance: number(gt=0, lt=1e-3) = Field(C.RANK_TOLERANCE, description="singular values below this fraction of the largest are dropped")
+    samples: count(ge=0, le=10_000) = Field(0, description="sampled states (0: 2 x 4 x bodies + 12)")
+    seed: count(ge=0) = Field(0, description="seed of the state sampler")
+    polygon_sides: count(ge=8, le=4096) = Field(LM.POLYGON_SIDES, description="sides of the polygon inscribed in each disc region")
 
 
 class ForceBalance(FinderSettings):

@@ -25,7 +25,7 @@ from pydantic import Field
 
 from ..model import FRAME, Model
 from ..spec_parts import SpecFieldError, Strict
-from ..units import Mass, PositiveLength
+from ..units import Mass, Number, PositiveLength
 from . import regressor as R
 from . import conditions as C
 from .base import BalanceResult, Parameter, Stage
@@ -44,7 +44,7 @@ class CounterRotationSpec(Strict):
     carrier: str = Field(FRAME, description="body holding the disc's axis ('frame' for a fixed axis)")
     at: Point = Field(description="the axis: [x, y] in the carrier's frame (global on the frame) or a named point")
     geared_to: str = Field(description="the body the disc is geared to")
-    ratio: float = Field(description="(w_disc - w_carrier) / (w_geared - w_carrier); -r_g / r_disc for an external mesh")
+    ratio: Number = Field(description="(w_disc - w_carrier) / (w_geared - w_carrier); -r_g / r_disc for an external mesh")
     mass: Mass = Field(0.0, description="mass of the disc (on its axis; counted by the force balance)")
     radius: PositiveLength | None = Field(None, description="radius of the disc, for drawing (the mesh is modelled as a couple)")
 
