@@ -1,4 +1,4 @@
-"""The ``balpipe`` command line: build, check, diff, schema."""
+"""The ``balpipe`` command line: build, check, diff, schema, sweep (:mod:`balpipe.cli_sweep`)."""
 
 from __future__ import annotations
 
@@ -47,6 +47,9 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--no-sim", action="store_true", help="skip the pymunk validation of both designs")
     s = sub.add_parser("schema", help="print the JSON Schema of a spec", description="Print the spec JSON Schema.")
     s.add_argument("-o", "--out", metavar="FILE", help="write to FILE instead of stdout")
+    from .cli_sweep import add_parser as add_sweep
+
+    add_sweep(sub)
     return p
 
 
@@ -149,7 +152,10 @@ def cmd_schema(args) -> int:
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
-        return {"build": cmd_build, "check": cmd_check, "diff": cmd_diff, "schema": cmd_schema}[args.command](args)
+        from .cli_sweep import cmd_sweep
+
+        return {"build": cmd_build, "check": cmd_check, "diff": cmd_diff, "schema": cmd_schema,
+                "sweep": cmd_sweep}[args.command](args)
     except KeyboardInterrupt:
         print("balpipe: interrupted", file=sys.stderr)
         return 130
