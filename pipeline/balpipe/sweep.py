@@ -63,7 +63,7 @@ class Vary:
 
     def raw(self, x: float) -> Any:
         """The spec value for the number x in this vary's unit."""
-        return f"{x!r} {self.unit}" if self.unit else float(x)
+        return f"{float(x)!r} {self.unit}" if self.unit else float(x)
 
     def extremes(self) -> list:
         return list(self.values) if self.values else [self.raw(self.lo), self.raw(self.hi)]
@@ -74,6 +74,17 @@ def _number(text: str, arg: str) -> tuple[float, str]:
     if not m:
         raise SweepError(f"--vary {arg}: {text.strip()!r} is not a number with an optional unit")
     return float(m.group(1)), m.group(2)
+
+
+def _conversion(frm: str, to: str, arg: str) -> float:
+    """Factor from unit ``frm`` to unit ``to`` of the same dimension (HI given in another unit)."""
+    from .units import UNITS, _normalise_unit
+
+    a, b = _normalise_unit(frm), _normalise_unit(to)
+    for table in UNITS.values():
+        if a in table and b in table:
+            return table[a] / table[b]
+    raise SweepError(f"--vary {arg}: LO and HI have units of different kinds ({to!r}, {frm!r})")
 
 
 def parse_vary(arg: str) -> Vary:
@@ -98,7 +109,7 @@ def parse_vary(arg: str) -> Vary:
     lo, ulo = _number(parts[0], arg)
     hi, uhi = _number(parts[1], arg)
     if ulo and uhi and ulo != uhi:
-        raise SweepError(f"--vary {arg}: LO and HI have different units ({ulo!r}, {uhi!r}); use one unit")
+        hi = hi * _conversion(uhi, ulo, arg)
     unit = ulo or uhi
     if len(parts) == 3:
         try:
