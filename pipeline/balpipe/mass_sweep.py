@@ -137,20 +137,23 @@ class MassSweep:
 
     def peaks(self, P: np.ndarray, chunk: int = CHUNK) -> dict[str, np.ndarray]:
         """Peak |F|, |M| and |effort| of every design (rows of P, (D, np)) by blocks of matrix
-        products: the sweep's fast path."""
+        products: the sweep's fast path. One product per block with the stacked regressor
+        [Fx; Fy; M; efforts]^T, designs as rows; peaks as max and min (no temporaries of |x|)."""
         P = np.atleast_2d(np.asarray(P, dtype=float))
         D, n = P.shape
         N = len(self.t)
-        YF = self.YF.reshape(2 * N, n)
-        G = self.G.reshape(-1, n)
+        nd = self.G.shape[1]
+        Y = np.concatenate([self.YF[:, 0, :], self.YF[:, 1, :], self.YM,
+                            np.transpose(self.G, (1, 0, 2)).reshape(nd * N, n)]).T.copy()  # (np, rows)
         out = {"max_shaking_force": np.empty(D), "max_shaking_moment": np.empty(D), "max_actuator_effort": np.zeros(D)}
         for s in range(0, D, chunk):
-            Pc = P[s : s + chunk].T  # (np, d)
-            F = (YF @ Pc).reshape(N, 2, -1)
-            out["max_shaking_force"][s : s + chunk] = np.sqrt((F * F).sum(axis=1)).max(axis=0)
-            out["max_shaking_moment"][s : s + chunk] = np.abs(self.YM @ Pc).max(axis=0)
-            if G.shape[0]:
-                out["max_actuator_effort"][s : s + chunk] = np.abs(G @ Pc).max(axis=0)
+            R = P[s : s + chunk] @ Y  # (d, rows)
+            fx, fy, m = R[:, :N], R[:, N : 2 * N], R[:, 2 * N : 3 * N]
+            out["max_shaking_force"][s : s + chunk] = np.sqrt(np.max(fx * fx + fy * fy, axis=1))
+            out["max_shaking_moment"][s : s + chunk] = np.maximum(m.max(axis=1), -m.min(axis=1))
+            if nd:
+                e = R[:, 3 * N :]
+                out["max_actuator_effort"][s : s + chunk] = np.maximum(e.max(axis=1), -e.min(axis=1))
         return out
 
 
