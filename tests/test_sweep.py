@@ -217,8 +217,10 @@ def test_sweep_output_is_deterministic(tmp_path):
     a, b = tmp_path / "a", tmp_path / "b"
     assert balpipe("sweep", SR, *args, "-o", a, "-j", "1").returncode == 0
     assert balpipe("sweep", SR, *args, "-o", b, "-j", "2").returncode == 0
+    c = tmp_path / "c"
+    assert balpipe("sweep", SR, *args, "-o", c).returncode == 0  # default: all cores when worth it
     for f in ("sweep.csv", "index.html"):
-        assert (a / f).read_bytes() == (b / f).read_bytes()
+        assert (a / f).read_bytes() == (b / f).read_bytes() == (c / f).read_bytes()
 
 
 def test_sweep_on_a_local_two_worker_dask_cluster_equals_local_run():

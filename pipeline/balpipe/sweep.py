@@ -27,6 +27,7 @@ import math
 import os
 import re
 import sys
+import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -35,6 +36,7 @@ import yaml
 from pydantic import ValidationError
 
 MAX_DESIGNS = 100_000
+POOL_WORTH = 3.0  # s: estimated remaining in-process work above which jobs=0 starts a process pool
 METRICS = ("added_mass", "added_inertia", "max_shaking_force", "max_shaking_moment", "max_actuator_effort")
 UNITS_OF = {"added_mass": "kg", "added_inertia": "kg m^2", "max_shaking_force": "N", "max_shaking_moment": "N m",
             "max_actuator_effort": "N m or N"}
@@ -376,8 +378,9 @@ def _chunks(designs: list[tuple], workers: int) -> list[list[tuple[int, tuple]]]
 
 def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
         progress: Callable[[int, int], None] | None = None) -> SweepResult:
-    """Evaluate every design of the plan: locally (``jobs`` processes, 0 = all cores, 1 = in
-    this process) or on the dask.distributed scheduler at ``scheduler``."""
+    """Evaluate every design of the plan: locally (``jobs`` processes; 1 = in this process;
+    0 = all cores, after timing the first chunk in this process, if the rest would take more
+    than :data:`POOL_WORTH` seconds) or on the dask.distributed scheduler at ``scheduler``."""
     from .engine import AnalysisError
     from .mass_sweep import MassSweep, check_parameters
     from .spec_parts import SpecFieldError
@@ -416,7 +419,18 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     else:
         workers = jobs or os.cpu_count() or 1
         chunks = _chunks(p.designs, workers)
-        if workers == 1 or len(chunks) == 1:
+        if jobs == 0 and len(chunks) > 1:  # all cores only when the work outweighs starting them
+            t0 = time.perf_counter()
+            part = evaluate_chunk(p.data, paths, chunks[0], p.stage, base_key)
+            rows.extend(part)
+            done += len(part)
+            if progress:
+                progress(done, total)
+            per_design = (time.perf_counter() - t0) / len(part)
+            chunks = chunks[1:]
+            if per_design * (total - done) < POOL_WORTH:
+                workers = 1
+        if workers == 1 or len(chunks) <= 1:
             for c in chunks:
                 part = evaluate_chunk(p.data, paths, c, p.stage, base_key)
                 rows.extend(part)
