@@ -148,6 +148,9 @@ def test_sweep_cli_grid_fast_path_matches_full_analysis(tmp_path):
         assert float(row["max_shaking_force [N]"]) == pytest.approx(an.max_force, rel=1e-9, abs=1e-9)
         eff = max(float(np.max(np.abs(e))) for e in an.efforts.values())
         assert float(row["max_actuator_effort [N m or N]"]) == pytest.approx(eff, rel=1e-9)
+        an0 = analyse(registry.balance_designs(spec).stages[0].model, registry.time_grid(spec))
+        assert float(row["unbalanced_max_shaking_moment [N m]"]) == pytest.approx(an0.max_moment, rel=1e-9)
+        assert float(row["moment_ratio [1]"]) == pytest.approx(an.max_moment / an0.max_moment, rel=1e-9)
     page = (out / "index.html").read_text()
     assert "Pareto front" in page and "<svg" in page
     linked = sorted((out / "designs").glob("*.yaml"))

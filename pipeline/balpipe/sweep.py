@@ -37,9 +37,11 @@ from pydantic import ValidationError
 
 MAX_DESIGNS = 100_000
 POOL_WORTH = 3.0  # s: estimated remaining in-process work above which jobs=0 starts a process pool
-METRICS = ("added_mass", "added_inertia", "max_shaking_force", "max_shaking_moment", "max_actuator_effort")
+METRICS = ("added_mass", "added_inertia", "max_shaking_force", "max_shaking_moment", "max_actuator_effort",
+           "unbalanced_max_shaking_force", "unbalanced_max_shaking_moment", "force_ratio", "moment_ratio")
 UNITS_OF = {"added_mass": "kg", "added_inertia": "kg m^2", "max_shaking_force": "N", "max_shaking_moment": "N m",
-            "max_actuator_effort": "N m or N"}
+            "max_actuator_effort": "N m or N", "unbalanced_max_shaking_force": "N",
+            "unbalanced_max_shaking_moment": "N m", "force_ratio": "1", "moment_ratio": "1"}
 
 _NUM = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
 
@@ -282,8 +284,8 @@ def _has(data: Any, path: tuple) -> bool:
 
 
 def _pick_stage(result, stage: str | None):
-    if stage is None:
-        return result.stages[-1]
+    if stage is None:  # the main method's last stage (compared designs prefix theirs with "name:")
+        return [s for s in result.stages if ":" not in s.name][-1]
     for s in result.stages:
         if s.name == stage:
             return s
@@ -321,13 +323,28 @@ def _error_text(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {exc}" if not str(exc) else str(exc)
 
 
-def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]], stage: str | None,
-                   base_key: tuple | None) -> list[dict]:
-    """Rows of one chunk of designs. A design with the base geometry returns its parameter
-    vector ``p`` for the parent's fast path; any other is analysed here by the engine."""
+def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
+    """Fast path: the design's parameter vector ``row[tag + 'p']`` (the parent does the product);
+    otherwise a full engine analysis, peaks in ``row``. Returns the route taken."""
+    from .balancing.regressor import parameters
     from .engine import analyse
     from .mass_sweep import geometry_key
-    from .balancing.regressor import parameters
+
+    if key is not None and geometry_key(model, t, g, P) == key:
+        row[tag + "p"] = parameters(model, angular=True)
+        return "mass"
+    an = analyse(model, t, g, P)
+    row[tag + "max_shaking_force"] = an.max_force
+    row[tag + "max_shaking_moment"] = an.max_moment
+    row[tag + "max_actuator_effort"] = max((float(np.max(np.abs(e))) for e in an.efforts.values()), default=0.0)
+    return "full"
+
+
+def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]], stage: str | None,
+                   keys: tuple) -> list[dict]:
+    """Rows of one chunk of designs. For the chosen stage and the design's unbalanced stage
+    (``keys``: their base geometries, or None), a design with the base geometry returns its
+    parameter vector for the parent's fast path; any other is analysed here by the engine."""
     from .study import _total_inertia
 
     rows = []
@@ -336,19 +353,11 @@ def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]
         try:
             spec, sr, base = build_design(data, paths, values, stage)
             row["si"] = [float(get_attr_path(spec, p)) for p in paths]
-            model = sr.model
-            row["added_mass"] = model.total_mass() - base.model.total_mass()
-            row["added_inertia"] = _total_inertia(model) - _total_inertia(base.model)
+            row["added_mass"] = sr.model.total_mass() - base.model.total_mass()
+            row["added_inertia"] = _total_inertia(sr.model) - _total_inertia(base.model)
             t, g, P = _settings(spec)
-            if base_key is not None and geometry_key(model, t, g, P) == base_key:
-                row["route"] = "mass"
-                row["p"] = parameters(model, angular=True)
-            else:
-                row["route"] = "full"
-                an = analyse(model, t, g, P)
-                row["max_shaking_force"] = an.max_force
-                row["max_shaking_moment"] = an.max_moment
-                row["max_actuator_effort"] = max((float(np.max(np.abs(e))) for e in an.efforts.values()), default=0.0)
+            row["route"] = _stage_loads(sr.model, keys[0], t, g, P, "", row)
+            _stage_loads(base.model, keys[1], t, g, P, "unbalanced_", row)
         except Exception as exc:  # a failing design is a row with its error, not a crashed sweep
             row = {"design": index, "values": values, "error": _error_text(exc)}
         rows.append(row)
@@ -390,12 +399,14 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     try:
         from . import registry
 
-        base = _pick_stage(registry.balance_designs(base_spec), p.stage)
+        result = registry.balance_designs(base_spec)
+        base = _pick_stage(result, p.stage)
         t, g, P = _settings(base_spec)
         ms = MassSweep.build(base.model, t, g, P)
-        base_key, base_name = ms.key, base.name
+        ms0 = MassSweep.build(result.stages[0].model, t, g, P)
+        base_key, base_name = (ms.key, ms0.key), base.name
     except (SpecFieldError, AnalysisError, ValueError) as exc:  # no fast path: every design in full
-        ms, base_key, base_name = None, None, p.stage or "last"
+        ms, ms0, base_key, base_name = None, None, (None, None), p.stage or "last"
         notes = [f"the base spec's stage cannot be analysed ({_error_text(exc)}): no fast path"]
     else:
         notes = []
@@ -449,20 +460,27 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
                     if progress:
                         progress(done, total)
     rows.sort(key=lambda r: r["design"])
-    fast = [r for r in rows if "p" in r]
-    if fast:  # the fast path: every mass-only design in blocks of matrix products
-        Pm = np.array([r.pop("p") for r in fast])
-        bad = check_parameters(ms.names, Pm)
-        peaks = ms.peaks(Pm)
+    for tag, sweep in (("", ms), ("unbalanced_", ms0)):  # the fast path, in blocks of matrix products
+        fast = [r for r in rows if tag + "p" in r]
+        if not fast:
+            continue
+        Pm = np.array([r.pop(tag + "p") for r in fast])
+        bad = check_parameters(sweep.names, Pm)
+        peaks = sweep.peaks(Pm)
         for k, r in enumerate(fast):
             if bad[k]:
-                for m in METRICS:
-                    r.pop(m, None)
-                r.pop("si", None)
+                for key in list(r):
+                    if key not in ("design", "values", "route"):
+                        r.pop(key)
                 r["error"] = bad[k]
             else:
                 for key, arr in peaks.items():
-                    r[key] = float(arr[k])
+                    r[tag + key] = float(arr[k])
+    for r in rows:
+        if "error" not in r:
+            for q in ("force", "moment"):
+                ref = r[f"unbalanced_max_shaking_{q}"]
+                r[f"{q}_ratio"] = r[f"max_shaking_{q}"] / ref if ref > 0 else 0.0
     res = SweepResult(p, rows, base_name, notes=notes)
     res.fast = sum(r.get("route") == "mass" and "error" not in r for r in rows)
     res.full = sum(r.get("route") == "full" and "error" not in r for r in rows)
