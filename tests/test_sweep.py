@@ -236,3 +236,14 @@ def test_sweep_on_a_local_two_worker_dask_cluster_equals_local_run():
         remote = run(p, scheduler=cl.scheduler_address)
     assert local.fast == 4 and local.full == 4
     assert csv_text(remote) == csv_text(local)
+
+
+def test_design_values_never_modify_the_base_spec():
+    from balpipe.sweep import with_values
+
+    base = {"a": {"b": [1.0, {"c": 2.0}], "d": 3.0}, "e": 4.0}
+    d = with_values(base, [("a", "b", 1, "c"), ("a", "d"), ("e",)], ("5 m", 6.0, 7.0))
+    assert d == {"a": {"b": [1.0, {"c": "5 m"}], "d": 6.0}, "e": 7.0}
+    assert base == {"a": {"b": [1.0, {"c": 2.0}], "d": 3.0}, "e": 4.0}
+    with pytest.raises(KeyError):
+        with_values(base, [("a", "x", "y")], (1.0,))

@@ -143,6 +143,24 @@ def set_path(data: Any, path: tuple, value: Any) -> None:
         raise KeyError(path)
 
 
+def with_values(data: dict, paths: list[tuple], values: tuple) -> dict:
+    """A copy of ``data`` with the values set, copying only the containers along the paths (the
+    rest is shared with ``data``, which is never modified)."""
+    d = dict(data)
+    for path, value in zip(paths, values):
+        cur = d
+        for p in path[:-1]:
+            try:
+                nxt = cur[p]
+            except (KeyError, IndexError, TypeError):
+                break  # set_path reports it
+            nxt = dict(nxt) if isinstance(nxt, dict) else list(nxt) if isinstance(nxt, list) else nxt
+            cur[p] = nxt
+            cur = nxt
+        set_path(d, path, value)
+    return d
+
+
 def get_attr_path(obj: Any, path: tuple) -> Any:
     for p in path:
         obj = obj[p] if isinstance(p, int) or isinstance(obj, dict) else getattr(obj, p)
@@ -303,10 +321,7 @@ def build_design(data: dict, paths: list[tuple], values: tuple, stage: str | Non
     """Spec, chosen stage and unbalanced model of one design (raises on an invalid design)."""
     from . import registry
 
-    d = copy.deepcopy(data)
-    for p, v in zip(paths, values):
-        set_path(d, p, v)
-    spec = _validate(d)
+    spec = _validate(with_values(data, paths, values))
     result = registry.balance_designs(spec)
     return spec, _pick_stage(result, stage), result.stages[0]
 
@@ -546,9 +561,7 @@ def design_spec_text(res: SweepResult, index: int) -> str:
     """The spec of design ``index``: the base spec's YAML with the varied fields set, so that
     ``balpipe build`` gives its full report."""
     row = res.rows[index]
-    d = copy.deepcopy(res.plan.data)
-    for v, raw in zip(res.plan.varies, row["values"]):
-        set_path(d, v.path, raw)
+    d = copy.deepcopy(with_values(res.plan.data, [v.path for v in res.plan.varies], row["values"]))
     d["name"] = f"{d.get('name', 'design')} — sweep design {index}"
     head = (f"# Design {index} of the sweep of {res.plan.file}: "
             + ", ".join(f"{v.name} = {raw}" for v, raw in zip(res.plan.varies, row["values"])) + "\n")
