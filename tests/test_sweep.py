@@ -247,3 +247,17 @@ def test_design_values_never_modify_the_base_spec():
     assert base == {"a": {"b": [1.0, {"c": 2.0}], "d": 3.0}, "e": 4.0}
     with pytest.raises(KeyError):
         with_values(base, [("a", "x", "y")], (1.0,))
+
+
+def test_sweep_help_progress_and_exit_codes(tmp_path):
+    r = balpipe("sweep", "--help")
+    assert r.returncode == 0 and "--vary" in r.stdout and "--scheduler" in r.stdout
+    r = balpipe("sweep", SR, "--vary", "mechanism.slider.mass=0.5,1", "-o", tmp_path / "a", "-j", "1")
+    assert r.returncode == 0 and "sweep [" in r.stderr and "2/2 designs" in r.stderr  # progress on stderr
+    # every design fails (the coupler cannot follow a 0.35 m crank): exit 1, rows with errors
+    r = balpipe("sweep", SR, "--vary", "mechanism.crank.length=0.3,0.35", "-o", tmp_path / "b", "-q", "-j", "1")
+    assert r.returncode == 1 and "2 failed" in r.stderr
+    rows = _rows(tmp_path / "b" / "sweep.csv")
+    assert [x["status"] for x in rows] == ["error", "error"]
+    r = balpipe("sweep", tmp_path / "missing.yaml", "--vary", "a.b=1,2", "-o", tmp_path / "c")
+    assert r.returncode == 2 and "Traceback" not in r.stderr
