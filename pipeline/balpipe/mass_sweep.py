@@ -30,7 +30,7 @@ from .engine import (
     _extend, _joint_reactions, _multipliers, _radial_tooth_loads, _rotate, _tooth_rows, analyse,
     compile_model, jacobian,
 )
-from .model import Model, Prismatic, Revolute
+from .model import Model
 
 CHUNK = 512  # designs per block of the batched products (bounds the memory: CHUNK x N x rows)
 
@@ -155,15 +155,3 @@ class MassSweep:
                 e = R[:, 3 * N :]
                 out["max_actuator_effort"][s : s + chunk] = np.maximum(e.max(axis=1), -e.min(axis=1))
         return out
-
-
-def peak_joint_force(model: Model, reactions: dict[str, dict[str, np.ndarray]]) -> float:
-    """Largest revolute bearing force or prismatic normal force along the motion."""
-    best = 0.0
-    for jt in model.joints:
-        r = reactions[jt.name]
-        if isinstance(jt, Revolute):
-            best = max(best, float(np.max(np.hypot(r["Fx"], r["Fy"]))))
-        elif isinstance(jt, Prismatic):
-            best = max(best, float(np.max(np.abs(r["N"]))))
-    return best
