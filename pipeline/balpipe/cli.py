@@ -1,4 +1,4 @@
-"""The ``balpipe`` command line: build, check, diff, schema."""
+"""The ``balpipe`` command line: build, check, diff, schema, sweep (:mod:`balpipe.cli_sweep`)."""
 
 from __future__ import annotations
 
@@ -59,6 +59,10 @@ def _parser() -> argparse.ArgumentParser:
     from .history_cli import add_parser as _add_history_parser
 
     _add_history_parser(sub)
+
+    from .cli_sweep import add_parser as add_sweep
+
+    add_sweep(sub)
     return p
 
 
@@ -197,7 +201,10 @@ def main(argv: list[str] | None = None) -> int:
             from .history_cli import cmd_history
 
             return cmd_history(args)
-        return {"build": cmd_build, "check": cmd_check, "diff": cmd_diff, "schema": cmd_schema}[args.command](args)
+        from .cli_sweep import cmd_sweep
+
+        return {"build": cmd_build, "check": cmd_check, "diff": cmd_diff, "schema": cmd_schema,
+                "sweep": cmd_sweep}[args.command](args)
     except Terminated:
         print("balpipe: terminated; the site is as the last complete build left it", file=sys.stderr)
         return EXIT_TERMINATED

@@ -59,6 +59,7 @@ class States:
     rate: np.ndarray
     dof: int
     discarded: int
+    acc: np.ndarray | None = None  # (S, nb, 3) second derivatives, from analyses only
 
     @property
     def count(self) -> int:
@@ -193,18 +194,22 @@ def states_from_analysis(model: Model, *analyses) -> States:
     c = compile_model(model)
     q = np.concatenate([a.q.reshape(len(a.t), -1) for a in analyses])
     v = np.concatenate([a.v.reshape(len(a.t), -1) for a in analyses])
-    return _body_frames(model, c, q, v, -1, 0)
+    acc = np.concatenate([a.a.reshape(len(a.t), -1) for a in analyses])
+    return _body_frames(model, c, q, v, -1, 0, acc)
 
 
 def _is_length(model: Model, prim) -> bool:
     return hasattr(prim, "a")  # projection primitives drive lengths (prismatic, x, y)
 
 
-def _body_frames(model: Model, c: Compiled, q: np.ndarray, v: np.ndarray, dof: int, discarded: int) -> States:
-    """Centre-of-mass coordinates -> body-frame origins: r_o = r_c - A c, r_o' = r_c' - w A' c."""
+def _body_frames(model: Model, c: Compiled, q: np.ndarray, v: np.ndarray, dof: int, discarded: int,
+                 acc: np.ndarray | None = None) -> States:
+    """Centre-of-mass coordinates -> body-frame origins: r_o = r_c - A c, r_o' = r_c' - w A' c,
+    r_o'' = r_c'' - (alpha perp(A c) - w^2 A c)."""
     S = q.shape[0]
     qb, vb = q.reshape(S, c.nb, 3), v.reshape(S, c.nb, 3)
     pose, rate = qb.copy(), vb.copy()
+    ab = None if acc is None else acc.reshape(S, c.nb, 3).copy()
     for k, b in enumerate(model.bodies):
         _, com, _ = b.mass_properties()
         th, w = qb[:, k, 2], vb[:, k, 2]
@@ -214,7 +219,11 @@ def _body_frames(model: Model, c: Compiled, q: np.ndarray, v: np.ndarray, dof: i
         pose[:, k, 1] -= ay
         rate[:, k, 0] -= -w * ay
         rate[:, k, 1] -= w * ax
-    return States(c.names, pose, rate, dof, discarded)
+        if ab is not None:
+            al = ab[:, k, 2]
+            ab[:, k, 0] -= -al * ay - w * w * ax
+            ab[:, k, 1] -= al * ax - w * w * ay
+    return States(c.names, pose, rate, dof, discarded, ab)
 
 
 def _columns(states: States, point: tuple[float, float] = (0.0, 0.0)):
@@ -273,3 +282,65 @@ def row_space(Y: np.ndarray, scale: np.ndarray, tolerance: float = 1e-9) -> RowS
     rank = int(np.sum(s > tolerance * s[0]))
     gap = float(s[rank - 1] / s[rank]) if 0 < rank < len(s) and s[rank] > 0 else math.inf
     return RowSpace(rank, vt[:rank] / scale, s, tolerance, gap)
+
+
+def _accelerations(states: States):
+    """Body-frame origin accelerations r_o'' (S, nb, 2), e1'' and e2'' (S, nb, 2), alpha (S, nb)."""
+    if states.acc is None:
+        raise ValueError("these states have no accelerations (use states_from_analysis)")
+    th, w, al = states.pose[..., 2], states.rate[..., 2], states.acc[..., 2]
+    co, si = np.cos(th), np.sin(th)
+    e1, e2 = np.stack([co, si], -1), np.stack([-si, co], -1)
+    dde1 = al[..., None] * e2 - (w * w)[..., None] * e1
+    dde2 = -al[..., None] * e1 - (w * w)[..., None] * e2
+    return states.acc[..., :2], e1, e2, dde1, dde2, al
+
+
+def shaking_regressor(states: States, gravity: tuple[float, float] = (0.0, 0.0),
+                      point: tuple[float, float] = (0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+    """Shaking force and moment, linear in (m, mx, my, J) per body (the momentum route of
+    :mod:`balpipe.engine`, differentiated): F = sum m g - dP/dt and, about ``point`` P,
+    M_P = sum (r_c - P) x m g - dH_P/dt, with r = r_o - P, e1'' = alpha e2 - w^2 e1,
+    e2'' = -alpha e1 - w^2 e2:
+
+        dP/dt   = sum m r_o'' + mx e1'' + my e2''
+        dH_P/dt = sum m r x r_o'' + mx (r x e1'' + e1 x r_o'') + my (r x e2'' + e2 x r_o'') + J alpha
+
+    Returns Y_F (S, 2, 4 nb) and Y_M (S, 4 nb): F = Y_F p, M = Y_M p with p = parameters(model,
+    angular=True)."""
+    rdd, e1, e2, dde1, dde2, al = _accelerations(states)
+    g = np.asarray(gravity, dtype=float)
+    r = states.pose[..., :2] - np.asarray(point, dtype=float)
+    S, nb = al.shape
+    gS = np.broadcast_to(g, rdd.shape)
+    YF = np.stack([gS - rdd, -dde1, -dde2, np.zeros_like(rdd)], axis=2)  # (S, nb, 4, 2)
+    YM = np.stack([
+        _cross(r, gS) - _cross(r, rdd),
+        _cross(e1, gS) - _cross(r, dde1) - _cross(e1, rdd),
+        _cross(e2, gS) - _cross(r, dde2) - _cross(e2, rdd),
+        -al,
+    ], axis=2)  # (S, nb, 4)
+    return np.transpose(YF, (0, 3, 1, 2)).reshape(S, 2, 4 * nb), YM.reshape(S, 4 * nb)
+
+
+def dynamics_regressor(states: States, gravity: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
+    """Y_D (S, 3 nb, 4 nb): the inertial less the applied (weight) generalized forces of every body
+    in body-frame-origin coordinates (x, y, theta of the frame origin), linear in (m, mx, my, J):
+
+        x, y:  m (r_o'' - g) + mx e1'' + my e2''
+        theta: mx e1 x (r_o'' - g) + my e2 x (r_o'' - g) + J alpha
+
+    (Newton-Euler about the frame origin: J = I + m |c|^2). The dynamics read
+    Phi_q^T lambda = -Y_D p in these coordinates (:mod:`balpipe.mass_sweep`)."""
+    rdd, e1, e2, dde1, dde2, al = _accelerations(states)
+    a = rdd - np.asarray(gravity, dtype=float)
+    S, nb = al.shape
+    Y = np.zeros((S, nb, 3, nb, 4))
+    for k in range(nb):
+        Y[:, k, 0:2, k, 0] = a[:, k]
+        Y[:, k, 0:2, k, 1] = dde1[:, k]
+        Y[:, k, 0:2, k, 2] = dde2[:, k]
+        Y[:, k, 2, k, 1] = _cross(e1[:, k], a[:, k])
+        Y[:, k, 2, k, 2] = _cross(e2[:, k], a[:, k])
+        Y[:, k, 2, k, 3] = al[:, k]
+    return Y.reshape(S, 3 * nb, 4 * nb)

@@ -1,0 +1,608 @@
+"""Design sweeps over numeric spec fields (issue 13, item 3): ``balpipe sweep SPEC --vary PATH=RANGE``.
+
+A sweep varies fields of one spec (dotted paths, e.g. ``mechanism.crank.mass``), builds every
+design's model and balancing, and analyses the chosen stage (default: the last stage of the
+spec's method). Designs whose model has the base spec's geometry (only masses, inertias,
+counterweights differ) take the fast path: one engine analysis of the base design and a matrix
+product per design (:mod:`balpipe.mass_sweep`); the others a full engine analysis. Designs are
+evaluated locally on a process pool, or on a dask.distributed cluster.
+
+Ranges (units as in the spec; the first value's unit applies to a second without one):
+
+* ``LO:HI:N``   N evenly spaced values (grid), e.g. ``mechanism.crank.mass=0.5 kg:2 kg:7``;
+* ``a,b,c``     the listed values (grid);
+* ``LO:HI``     bounds for ``--sample random`` or ``--sample lhs`` (``-n`` designs, ``--seed``).
+
+Every vary is checked before any work: the path must name a field of the spec's schema, its
+values must validate (unit of the right kind, bounds), and the number of designs must stay below
+the limit (``--max-designs``, default :data:`MAX_DESIGNS`). A design that fails (invalid spec,
+no balancing solution, cannot assemble, negative counterweight) is a row with its error.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import math
+import os
+import re
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+import yaml
+from pydantic import ValidationError
+
+MAX_DESIGNS = 100_000
+POOL_WORTH = 3.0  # s: estimated remaining in-process work above which jobs=0 starts a process pool
+METRICS = ("added_mass", "added_inertia", "max_shaking_force", "max_shaking_moment", "max_actuator_effort",
+           "unbalanced_max_shaking_force", "unbalanced_max_shaking_moment", "force_ratio", "moment_ratio")
+UNITS_OF = {"added_mass": "kg", "added_inertia": "kg m^2", "max_shaking_force": "N", "max_shaking_moment": "N m",
+            "max_actuator_effort": "N m or N", "unbalanced_max_shaking_force": "N",
+            "unbalanced_max_shaking_moment": "N m", "force_ratio": "1", "moment_ratio": "1"}
+
+_NUM = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
+
+
+class SweepError(Exception):
+    """Bad sweep input, located (spec file, line, field, and the --vary argument)."""
+
+
+@dataclass(frozen=True)
+class Vary:
+    """One ``--vary PATH=RANGE``: ``values`` for a grid, or ``lo``/``hi`` (numbers in ``unit``)."""
+
+    arg: str
+    path: tuple[str | int, ...]
+    values: tuple = ()
+    lo: float | None = None
+    hi: float | None = None
+    unit: str = ""
+
+    @property
+    def name(self) -> str:
+        return ".".join(map(str, self.path))
+
+    def raw(self, x: float) -> Any:
+        """The spec value for the number x in this vary's unit."""
+        return f"{float(x)!r} {self.unit}" if self.unit else float(x)
+
+    def extremes(self) -> list:
+        return list(self.values) if self.values else [self.raw(self.lo), self.raw(self.hi)]
+
+
+def _number(text: str, arg: str) -> tuple[float, str]:
+    m = _NUM.match(text)
+    if not m:
+        raise SweepError(f"--vary {arg}: {text.strip()!r} is not a number with an optional unit")
+    return float(m.group(1)), m.group(2)
+
+
+def _conversion(frm: str, to: str, arg: str) -> float:
+    """Factor from unit ``frm`` to unit ``to`` of the same dimension (HI given in another unit)."""
+    from .units import UNITS, _normalise_unit
+
+    a, b = _normalise_unit(frm), _normalise_unit(to)
+    for table in UNITS.values():
+        if a in table and b in table:
+            return table[a] / table[b]
+    raise SweepError(f"--vary {arg}: LO and HI have units of different kinds ({to!r}, {frm!r})")
+
+
+def parse_vary(arg: str) -> Vary:
+    """``PATH=RANGE`` -> :class:`Vary` (syntax only; :func:`check` validates against the spec)."""
+    if "=" not in arg:
+        raise SweepError(f"--vary {arg}: expected PATH=RANGE, e.g. mechanism.crank.mass=0.5kg:2kg:7")
+    path_text, rng = arg.split("=", 1)
+    path = tuple(int(p) if p.isdigit() else p for p in path_text.strip().split("."))
+    if not path or any(p == "" for p in path):
+        raise SweepError(f"--vary {arg}: empty field in the path {path_text!r}")
+    if "," in rng:
+        vals = []
+        unit0 = ""
+        for part in rng.split(","):
+            x, u = _number(part, arg)
+            unit0 = u or unit0
+            vals.append(x)
+        return Vary(arg, path, tuple(f"{x!r} {unit0}" if unit0 else x for x in vals), unit=unit0)
+    parts = rng.split(":")
+    if len(parts) not in (2, 3):
+        raise SweepError(f"--vary {arg}: the range must be LO:HI:N, LO:HI or a,b,c")
+    lo, ulo = _number(parts[0], arg)
+    hi, uhi = _number(parts[1], arg)
+    if ulo and uhi and ulo != uhi:
+        hi = hi * _conversion(uhi, ulo, arg)
+    unit = ulo or uhi
+    if len(parts) == 3:
+        try:
+            n = int(parts[2])
+        except ValueError:
+            raise SweepError(f"--vary {arg}: N must be an integer (got {parts[2]!r})") from None
+        if n < 1:
+            raise SweepError(f"--vary {arg}: N must be at least 1")
+        xs = np.linspace(lo, hi, n) if n > 1 else np.array([lo])
+        return Vary(arg, path, tuple(f"{float(x)!r} {unit}" if unit else float(x) for x in xs), unit=unit)
+    return Vary(arg, path, (), lo, hi, unit)
+
+
+def set_path(data: Any, path: tuple, value: Any) -> None:
+    """Set ``data[p0][p1]...`` = value; the last key may be new (an optional field)."""
+    cur = data
+    for k, p in enumerate(path[:-1]):
+        try:
+            cur = cur[p]
+        except (KeyError, IndexError, TypeError):
+            raise KeyError(path[: k + 1]) from None
+    if isinstance(cur, dict):
+        cur[path[-1]] = value
+    elif isinstance(cur, list) and isinstance(path[-1], int) and path[-1] < len(cur):
+        cur[path[-1]] = value
+    else:
+        raise KeyError(path)
+
+
+def with_values(data: dict, paths: list[tuple], values: tuple) -> dict:
+    """A copy of ``data`` with the values set, copying only the containers along the paths (the
+    rest is shared with ``data``, which is never modified)."""
+    d = dict(data)
+    for path, value in zip(paths, values):
+        cur = d
+        for p in path[:-1]:
+            try:
+                nxt = cur[p]
+            except (KeyError, IndexError, TypeError):
+                break  # set_path reports it
+            nxt = dict(nxt) if isinstance(nxt, dict) else list(nxt) if isinstance(nxt, list) else nxt
+            cur[p] = nxt
+            cur = nxt
+        set_path(d, path, value)
+    return d
+
+
+def get_attr_path(obj: Any, path: tuple) -> Any:
+    for p in path:
+        obj = obj[p] if isinstance(p, int) or isinstance(obj, dict) else getattr(obj, p)
+    return obj
+
+
+# ------------------------------------------------------------------------------------------
+# Checking the sweep against the spec, before any work
+
+
+@dataclass
+class Plan:
+    """A checked sweep: the base spec, the varies and the designs (each a tuple of raw values)."""
+
+    file: str
+    text: str
+    data: dict
+    varies: list[Vary]
+    designs: list[tuple]
+    stage: str | None = None
+    sample: str = "grid"
+    seed: int = 0
+
+
+def _located(loaded, path: tuple, message: str, vary: Vary | None = None) -> str:
+    from .loader import _located as locate
+
+    where = str(locate(str(loaded.path), loaded.node, path, message))
+    return where + (f" (--vary {vary.arg})" if vary else "")
+
+
+def _validate(data: dict):
+    from .spec import Spec
+
+    return Spec.model_validate(data)
+
+
+def _errors_at(loaded, data: dict, exc: ValidationError, vary: Vary) -> list[str]:
+    from .loader import _clean_loc, _message
+
+    out = []
+    for err in exc.errors():
+        loc = _clean_loc(err["loc"], data)
+        if err["type"] == "extra_forbidden" and loc == vary.path:
+            out.append(_located(loaded, vary.path, "unknown path: not a field of the spec schema", vary))
+        else:
+            out.append(_located(loaded, loc, _message(err), vary))
+    return out
+
+
+def designs_of(varies: list[Vary], sample: str, n: int, seed: int) -> list[tuple]:
+    """The designs: the grid's Cartesian product, or n seeded random / Latin-hypercube points."""
+    if sample == "grid":
+        return list(itertools.product(*[v.values for v in varies]))
+    if n < 1:
+        raise SweepError(f"--sample {sample} needs -n N >= 1 designs")
+    if sample == "random":
+        u = np.random.default_rng(seed).uniform(size=(n, len(varies)))
+    elif sample == "lhs":
+        from scipy.stats import qmc
+
+        u = qmc.LatinHypercube(d=len(varies), seed=seed).random(n)
+    else:
+        raise SweepError(f"unknown --sample {sample!r} (grid, random, lhs)")
+    out = []
+    for row in u:
+        vals = []
+        for v, x in zip(varies, row):
+            if v.values:  # a list: pick one of its values
+                vals.append(v.values[min(int(x * len(v.values)), len(v.values) - 1)])
+            else:
+                vals.append(v.raw(v.lo + x * (v.hi - v.lo)))
+        out.append(tuple(vals))
+    return out
+
+
+def plan(spec_file: str, vary_args: list[str], sample: str = "grid", n: int = 0, seed: int = 0,
+         max_designs: int = MAX_DESIGNS, stage: str | None = None) -> Plan:
+    """Parse and check everything; raises :class:`SweepError` (all problems, located) or the
+    loader's ``SpecErrors`` for an invalid base spec."""
+    from .loader import load
+
+    loaded = load(spec_file)
+    data = yaml.safe_load(loaded.text)
+    if not vary_args:
+        raise SweepError("nothing to vary: give at least one --vary PATH=RANGE")
+    varies = [parse_vary(a) for a in vary_args]
+    problems: list[str] = []
+    seen = set()
+    for v in varies:
+        if v.path in seen:
+            problems.append(f"--vary {v.arg}: {v.name} is varied twice")
+        seen.add(v.path)
+        if sample == "grid" and not v.values:
+            problems.append(f"--vary {v.arg}: a grid needs LO:HI:N or a,b,c (LO:HI is for --sample random|lhs)")
+            continue
+        for raw in v.extremes():
+            trial = copy.deepcopy(data)
+            try:
+                set_path(trial, v.path, raw)
+            except KeyError as exc:
+                bad = exc.args[0]
+                problems.append(_located(loaded, bad, f"unknown path: {'.'.join(map(str, bad))} is not in the spec", v))
+                break
+            old = get_attr_path(data, v.path) if _has(data, v.path) else None
+            if isinstance(old, (dict, list, bool)):
+                problems.append(_located(loaded, v.path, "not a numeric field", v))
+                break
+            try:
+                spec = _validate(trial)
+                value = get_attr_path(spec, v.path)
+                if isinstance(value, bool) or not isinstance(value, (int, float)):
+                    problems.append(_located(loaded, v.path, "not a numeric field", v))
+                    break
+            except ValidationError as exc:
+                problems.extend(_errors_at(loaded, trial, exc, v))
+                break
+            except (AttributeError, KeyError, IndexError, TypeError):
+                problems.append(_located(loaded, v.path, "not a numeric field", v))
+                break
+    if problems:
+        raise SweepError("\n".join(dict.fromkeys(problems)))
+    size = math.prod(len(v.values) for v in varies) if sample == "grid" else n
+    if size > max_designs:
+        raise SweepError(f"the sweep has {size} designs, above the limit of {max_designs} (--max-designs)")
+    return Plan(str(loaded.path), loaded.text, data, varies, designs_of(varies, sample, n, seed), stage, sample, seed)
+
+
+def _has(data: Any, path: tuple) -> bool:
+    try:
+        get_attr_path(data, path)
+        return True
+    except (KeyError, IndexError, TypeError, AttributeError):
+        return False
+
+
+# ------------------------------------------------------------------------------------------
+# Evaluating designs (in worker processes or dask workers)
+
+
+def _pick_stage(result, stage: str | None):
+    if stage is None:  # the main method's last stage (compared designs prefix theirs with "name:")
+        return [s for s in result.stages if ":" not in s.name][-1]
+    for s in result.stages:
+        if s.name == stage:
+            return s
+    raise ValueError(f"no stage {stage!r}; stages: {', '.join(s.name for s in result.stages)}")
+
+
+def _settings(spec) -> tuple[np.ndarray, tuple, tuple]:
+    from . import registry
+    from .study import gravity_vector
+
+    return registry.time_grid(spec), gravity_vector(spec), tuple(spec.analysis.moment_point)
+
+
+def build_design(data: dict, paths: list[tuple], values: tuple, stage: str | None):
+    """Spec, chosen stage and unbalanced model of one design (raises on an invalid design)."""
+    from . import registry
+
+    spec = _validate(with_values(data, paths, values))
+    result = registry.balance_designs(spec)
+    return spec, _pick_stage(result, stage), result.stages[0]
+
+
+def _error_text(exc: BaseException) -> str:
+    from .spec_parts import SpecFieldError
+
+    if isinstance(exc, ValidationError):
+        from .loader import _format_path, _message
+
+        return "; ".join(f"{_format_path(tuple(e['loc']))}: {_message(e)}" for e in exc.errors())
+    if isinstance(exc, SpecFieldError):
+        return f"{'.'.join(map(str, exc.path))}: {exc.message}"
+    return f"{type(exc).__name__}: {exc}" if not str(exc) else str(exc)
+
+
+def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
+    """Fast path: the design's parameter vector ``row[tag + 'p']`` (the parent does the product);
+    otherwise a full engine analysis, peaks in ``row``. Returns the route taken."""
+    from .balancing.regressor import parameters
+    from .engine import analyse
+    from .mass_sweep import geometry_key
+
+    if key is not None and geometry_key(model, t, g, P) == key:
+        row[tag + "p"] = parameters(model, angular=True)
+        return "mass"
+    an = analyse(model, t, g, P)
+    row[tag + "max_shaking_force"] = an.max_force
+    row[tag + "max_shaking_moment"] = an.max_moment
+    row[tag + "max_actuator_effort"] = max((float(np.max(np.abs(e))) for e in an.efforts.values()), default=0.0)
+    return "full"
+
+
+def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]], stage: str | None,
+                   keys: tuple) -> list[dict]:
+    """Rows of one chunk of designs. For the chosen stage and the design's unbalanced stage
+    (``keys``: their base geometries, or None), a design with the base geometry returns its
+    parameter vector for the parent's fast path; any other is analysed here by the engine."""
+    from .study import _total_inertia
+
+    rows = []
+    for index, values in chunk:
+        row: dict[str, Any] = {"design": index, "values": values}
+        try:
+            spec, sr, base = build_design(data, paths, values, stage)
+            row["si"] = [float(get_attr_path(spec, p)) for p in paths]
+            row["added_mass"] = sr.model.total_mass() - base.model.total_mass()
+            row["added_inertia"] = _total_inertia(sr.model) - _total_inertia(base.model)
+            t, g, P = _settings(spec)
+            row["route"] = _stage_loads(sr.model, keys[0], t, g, P, "", row)
+            _stage_loads(base.model, keys[1], t, g, P, "unbalanced_", row)
+        except Exception as exc:  # a failing design is a row with its error, not a crashed sweep
+            row = {"design": index, "values": values, "error": _error_text(exc)}
+        rows.append(row)
+    return rows
+
+
+# ------------------------------------------------------------------------------------------
+# Running
+
+
+@dataclass
+class SweepResult:
+    plan: Plan
+    rows: list[dict]
+    base_stage: str
+    fast: int = 0
+    full: int = 0
+    failed: int = 0
+    notes: list[str] = field(default_factory=list)
+
+
+def _chunks(designs: list[tuple], workers: int) -> list[list[tuple[int, tuple]]]:
+    items = list(enumerate(designs))
+    size = max(1, min(256, math.ceil(len(items) / max(1, 4 * workers))))
+    return [items[i : i + size] for i in range(0, len(items), size)]
+
+
+def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
+        progress: Callable[[int, int], None] | None = None) -> SweepResult:
+    """Evaluate every design of the plan: locally (``jobs`` processes; 1 = in this process;
+    0 = all cores, after timing the first chunk in this process, if the rest would take more
+    than :data:`POOL_WORTH` seconds) or on the dask.distributed scheduler at ``scheduler``."""
+    from .engine import AnalysisError
+    from .mass_sweep import MassSweep, check_parameters
+    from .spec_parts import SpecFieldError
+
+    paths = [v.path for v in p.varies]
+    base_spec = _validate(p.data)
+    try:
+        from . import registry
+
+        result = registry.balance_designs(base_spec)
+        base = _pick_stage(result, p.stage)
+        t, g, P = _settings(base_spec)
+        ms = MassSweep.build(base.model, t, g, P)
+        ms0 = MassSweep.build(result.stages[0].model, t, g, P)
+        base_key, base_name = (ms.key, ms0.key), base.name
+    except (SpecFieldError, AnalysisError, ValueError) as exc:  # no fast path: every design in full
+        ms, ms0, base_key, base_name = None, None, (None, None), p.stage or "last"
+        notes = [f"the base spec's stage cannot be analysed ({_error_text(exc)}): no fast path"]
+    else:
+        notes = []
+    total = len(p.designs)
+    done = 0
+    rows: list[dict] = []
+    if scheduler:
+        from distributed import Client, as_completed
+
+        with Client(scheduler) as client:
+            workers = max(1, len(client.scheduler_info()["workers"]))
+            chunks = _chunks(p.designs, workers)
+            [fdata] = client.scatter([p.data], broadcast=True)
+            futures = [client.submit(evaluate_chunk, fdata, paths, c, p.stage, base_key, pure=False) for c in chunks]
+            for fut in as_completed(futures):
+                part = fut.result()
+                rows.extend(part)
+                done += len(part)
+                if progress:
+                    progress(done, total)
+    else:
+        workers = jobs or os.cpu_count() or 1
+        chunks = _chunks(p.designs, workers)
+        if jobs == 0 and len(chunks) > 1:  # all cores only when the work outweighs starting them
+            t0 = time.perf_counter()
+            part = evaluate_chunk(p.data, paths, chunks[0], p.stage, base_key)
+            rows.extend(part)
+            done += len(part)
+            if progress:
+                progress(done, total)
+            per_design = (time.perf_counter() - t0) / len(part)
+            chunks = chunks[1:]
+            if per_design * (total - done) < POOL_WORTH:
+                workers = 1
+        if workers == 1 or len(chunks) <= 1:
+            for c in chunks:
+                part = evaluate_chunk(p.data, paths, c, p.stage, base_key)
+                rows.extend(part)
+                done += len(part)
+                if progress:
+                    progress(done, total)
+        else:
+            from concurrent.futures import ProcessPoolExecutor, as_completed as done_futures
+
+            with ProcessPoolExecutor(max_workers=workers) as pool:
+                futs = [pool.submit(evaluate_chunk, p.data, paths, c, p.stage, base_key) for c in chunks]
+                for fut in done_futures(futs):
+                    part = fut.result()
+                    rows.extend(part)
+                    done += len(part)
+                    if progress:
+                        progress(done, total)
+    rows.sort(key=lambda r: r["design"])
+    for tag, sweep in (("", ms), ("unbalanced_", ms0)):  # the fast path, in blocks of matrix products
+        fast = [r for r in rows if tag + "p" in r]
+        if not fast:
+            continue
+        Pm = np.array([r.pop(tag + "p") for r in fast])
+        bad = check_parameters(sweep.names, Pm)
+        peaks = sweep.peaks(Pm)
+        for k, r in enumerate(fast):
+            if bad[k]:
+                for key in list(r):
+                    if key not in ("design", "values", "route"):
+                        r.pop(key)
+                r["error"] = bad[k]
+            else:
+                for key, arr in peaks.items():
+                    r[tag + key] = float(arr[k])
+    for r in rows:
+        if "error" not in r:
+            for q in ("force", "moment"):
+                ref = r[f"unbalanced_max_shaking_{q}"]
+                r[f"{q}_ratio"] = r[f"max_shaking_{q}"] / ref if ref > 0 else 0.0
+    res = SweepResult(p, rows, base_name, notes=notes)
+    res.fast = sum(r.get("route") == "mass" and "error" not in r for r in rows)
+    res.full = sum(r.get("route") == "full" and "error" not in r for r in rows)
+    res.failed = sum("error" in r for r in rows)
+    mark_pareto(rows)
+    return res
+
+
+def pareto(points: np.ndarray) -> np.ndarray:
+    """Mask of the non-dominated rows of ``points`` (D, 2), both objectives minimised."""
+    D = len(points)
+    keep = np.ones(D, dtype=bool)
+    order = np.lexsort((points[:, 1], points[:, 0]))
+    best = math.inf
+    for i in order:
+        if points[i, 1] < best:
+            best = points[i, 1]
+        else:
+            keep[i] = False
+    return keep
+
+
+def mark_pareto(rows: list[dict]) -> None:
+    """``pareto_moment`` / ``pareto_effort``: on the front of added mass against peak shaking
+    moment / peak actuator effort (designs with errors are on neither)."""
+    ok = [r for r in rows if "error" not in r]
+    for key, metric in (("pareto_moment", "max_shaking_moment"), ("pareto_effort", "max_actuator_effort")):
+        for r in rows:
+            r[key] = False
+        if ok:
+            pts = np.array([[r["added_mass"], r[metric]] for r in ok])
+            for r, k in zip(ok, pareto(pts)):
+                r[key] = bool(k)
+
+
+# ------------------------------------------------------------------------------------------
+# Output
+
+
+def csv_text(res: SweepResult) -> str:
+    """The table: one row per design, varied fields in SI units, metrics in SI units."""
+    import csv
+    import io
+
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    names = [v.name for v in res.plan.varies]
+    w.writerow(["design", "status", "route", *names, *[f"{m} [{UNITS_OF[m]}]" for m in METRICS],
+                "pareto_moment", "pareto_effort", "error"])
+    for r in res.rows:
+        si = r.get("si") or [""] * len(names)
+        vals = [repr(x) if isinstance(x, float) else x for x in si]
+        if "error" in r:
+            w.writerow([r["design"], "error", r.get("route", ""), *(vals if r.get("si") else list(map(str, r["values"]))),
+                        *[""] * len(METRICS), False, False, r["error"]])
+        else:
+            w.writerow([r["design"], "ok", r["route"], *vals, *[repr(float(r[m])) for m in METRICS],
+                        r["pareto_moment"], r["pareto_effort"], ""])
+    return buf.getvalue()
+
+
+def design_spec_text(res: SweepResult, index: int) -> str:
+    """The spec of design ``index``: the base spec's YAML with the varied fields set, so that
+    ``balpipe build`` gives its full report."""
+    row = res.rows[index]
+    d = copy.deepcopy(with_values(res.plan.data, [v.path for v in res.plan.varies], row["values"]))
+    d["name"] = f"{d.get('name', 'design')} — sweep design {index}"
+    head = (f"# Design {index} of the sweep of {res.plan.file}: "
+            + ", ".join(f"{v.name} = {raw}" for v, raw in zip(res.plan.varies, row["values"])) + "\n")
+    return head + yaml.safe_dump(d, sort_keys=False, allow_unicode=True)
+
+
+def write(res: SweepResult, out: str, specs: str = "pareto", parquet: bool = False) -> list[str]:
+    """Write sweep.csv, index.html and the designs' specs (``pareto``, ``all`` or ``none``)."""
+    from pathlib import Path
+
+    from .report.sweep_page import render
+
+    o = Path(out)
+    (o / "designs").mkdir(parents=True, exist_ok=True)
+    written = []
+    (o / "sweep.csv").write_text(csv_text(res), encoding="utf-8")
+    written.append(str(o / "sweep.csv"))
+    if parquet:
+        import pyarrow.csv as pacsv
+        import pyarrow.parquet as pq
+
+        pq.write_table(pacsv.read_csv(str(o / "sweep.csv")), str(o / "sweep.parquet"))
+        written.append(str(o / "sweep.parquet"))
+    linked = set()
+    for r in res.rows:
+        if specs == "all" or (specs == "pareto" and (r.get("pareto_moment") or r.get("pareto_effort"))):
+            linked.add(r["design"])
+    for i in sorted(linked):
+        (o / "designs" / f"design_{i:06d}.yaml").write_text(design_spec_text(res, i), encoding="utf-8")
+    (o / "index.html").write_text(render(res, linked), encoding="utf-8")
+    written.append(str(o / "index.html"))
+    return written
+
+
+def progress_printer(quiet: bool) -> Callable[[int, int], None]:
+    """A one-line progress bar on stderr (nothing with quiet)."""
+    def show(done: int, total: int) -> None:
+        if quiet:
+            return
+        width = 30
+        k = int(width * done / max(1, total))
+        end = "\n" if done >= total else ""
+        print(f"\rsweep [{'#' * k}{'.' * (width - k)}] {done}/{total} designs", end=end, file=sys.stderr, flush=True)
+    return show
