@@ -41,20 +41,18 @@ from . import conditions as C
 from . import least_mass as LM
 from . import regressor as R
 from .parts import add_counterweight
-from .rrr4_conditions import LinearCondition, as_matrix
+from .rrr4_conditions import LinearCondition
 
 TRANSLATING_MOVES = 8  # translating-platform motions sampled for the special-kinematics count
 MOVE_SAMPLES = 21  # states per move
-MOVE_REACH = 0.3  # moves within this fraction of the smaller platform half-size (times 2) of the start
+MOVE_REACH = 0.6  # moves start and end within this fraction of the smaller platform half-size of the start pose
 
 
 def finder_name(paper: str) -> str:
     """The finder's parameter for one of the paper's: 'm12' -> 'm[link12]', 'm12p12' ->
     'mx[link12]', 'm12q12' -> 'my[link12]', 'm5' -> 'm[platform]', 'm5p5' -> 'mx[platform]'."""
-    body = "platform" if paper.startswith("m5") else f"link{paper[1:3]}"
-    if paper in ("m5",) or len(paper) == 3:
-        return f"m[{body}]"
-    return ("mx" if paper[-2 if body == "platform" else -3] == "p" else "my") + f"[{body}]"
+    body, rest = ("platform", paper[2:]) if paper.startswith("m5") else (f"link{paper[1:3]}", paper[3:])
+    return {"": "m", "p": "mx", "q": "my"}[rest[:1]] + f"[{body}]"
 
 
 def to_finder(rows: list[LinearCondition], names: list[str]) -> np.ndarray:
@@ -96,7 +94,7 @@ def translating_states(model: Model, moves: int = TRANSLATING_MOVES, samples: in
     x0, y0, ph0 = (float(law(np.zeros(1))[0][0]) for law in pose)
     plat = model.body("platform").points
     half = min(max(abs(p[0]) for p in plat.values()), max(abs(p[1]) for p in plat.values()))
-    reach = 2 * MOVE_REACH * half
+    reach = MOVE_REACH * half
     T = float(getattr(pose[0], "duration", 1.0))
     t = np.linspace(0.0, T, samples)
     rng = np.random.default_rng(seed)
