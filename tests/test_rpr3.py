@@ -394,13 +394,39 @@ def test_template_figures_reproduce_fig_4(idler):
 
 
 def test_methods_compared_on_the_same_3rpr():
+    """Issue 9, item 5, through the generic ``compare:`` block: both methods' stages on the same 3-RPR
+    in the "Designs side by side" table with the counter-rotations needed and the peak moment
+    before them; the paper's Fig. 8 keeps the main design's stages only."""
+    from balpipe.report.page import render_page
+    from balpipe.report.results import results_dict
+
     s = study.run(load(SPECS / "paper000_rpr3_scott_russell_corrected.yaml").spec)
-    assert s.ok
-    title, table, _ = list(s.extra_figures())[-1]
-    assert title == "The two methods on the same 3-RPR"
-    rows = table.split("<tr>")[2:]
-    assert rows[0].startswith("<td>Scott-Russell") and "<td>3</td>" in rows[0]
-    assert rows[1].startswith("<td>idler loop") and "<td>6</td>" in rows[1]
+    assert s.ok, s.problems
+    out = results_dict(s, "x.yaml", "h", simulated=False)
+    rows = {r["stage"]: r for r in out["comparison"]["rows"]}
+    assert list(rows) == ["unbalanced", "scott_russell", "counterweights", "counter_rotations",
+                          "idler:idler_loop", "idler:counterweights", "idler:counter_rotations"]
+    sr, idl = rows["counter_rotations"], rows["idler:counter_rotations"]
+    assert sr["counter_rotations"] == 3 and idl["counter_rotations"] == 6  # "counter-rotations divided by 2"
+    assert rows["counterweights"]["counter_rotations"] == 0 and rows["idler:counterweights"]["counter_rotations"] == 0
+    assert sr["moment_before_counter_rotations"] == rows["counterweights"]["max_shaking_moment"]
+    assert idl["moment_before_counter_rotations"] == rows["idler:counterweights"]["max_shaking_moment"]
+    un = rows["unbalanced"]
+    for r in (sr, idl):  # both balance force and moment; the counterweights raised the moment first
+        assert r["max_shaking_force"] <= TOL * un["max_shaking_force"]
+        assert r["max_shaking_moment"] <= TOL * un["max_shaking_moment"]
+        assert r["moment_before_counter_rotations"] > 5 * un["max_shaking_moment"]
+        assert r["added_mass"] > 0 and r["added_inertia"] > 0 and r["max_actuator_effort"] > 0
+        assert r["max_joint_load"] > 0 and r["max_joint_load_joint"]
+    by_name = {st.stage.name: st for st in s.stages}
+    assert idl["added_mass"] == pytest.approx(by_name["idler:counter_rotations"].added_mass)
+    html = render_page(s, out, "text")
+    assert "Designs side by side" in html and "Peak |M| before counter-rotations (N m)" in html
+    assert "idler loop (Sec. 2): counter-rotations" in html
+    # Fig. 8 and the factor table: the Scott-Russell stages only
+    title, svg, _ = list(s.extra_figures())[0]
+    assert title.startswith("Shaking force and moment, every stage (Fig. 8") and "idler" not in svg
+    assert "idler" not in list(s.extra_figures())[1][1]
 
 
 def test_prismatic_equivalent_of_revolute_torques():

@@ -232,7 +232,7 @@ def test_leg_by_leg_solution_satisfies_eq17_and_balances(seed):
     data, spec, model = regular_random(200 + seed)
     res = recipe.balance(spec.mechanism, spec.balancing, model)
     names = [s.name for s in res.stages]
-    assert names == ["unbalanced", "leg_by_leg", "general"]
+    assert names == ["unbalanced", "leg_by_leg", "least_mass", "general"]
     rows = cond.eq17(recipe.geometry(spec.mechanism))
     for st in res.stages[1:]:
         p = mass_parameters(st.model)
@@ -246,7 +246,7 @@ def test_leg_by_leg_solution_satisfies_eq17_and_balances(seed):
         an = analyse(st.model, t)
         assert an.max_force <= 1e-9 * an0.max_force, st.name
     # only the general stage leaves l12, l32 and the platform alone
-    gen = res.stages[2].model
+    gen = res.stages[3].model
     for name in ("link12", "link32", "platform"):
         assert gen.body(name).attachments == ()
 
@@ -269,7 +269,8 @@ def test_paper_spec_study():
     assert any("eq. 17" in t for t in titles) and any("Figs. 2a, 4a, 6" in t for t in titles)
     table = figs[0][1]
     assert table.count("<tr>") == 13 and "eq17.12" in table
-    assert "<svg" in figs[1][1]
+    assert "Generic condition finder" in figs[1][0] and "least-mass" in figs[1][1]
+    assert "<svg" in figs[2][1]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -299,7 +300,7 @@ def test_fewer_legs_analyse_and_balance_leg_by_leg(keep, actuators, com):
     data["analysis"] = {"samples": 101}
     st = study.run(spec_of(data))
     assert st.ok, st.problems
-    assert [s.stage.name for s in st.stages] == ["unbalanced", "leg_by_leg"]
+    assert [s.stage.name for s in st.stages] == ["unbalanced", "leg_by_leg", "least_mass"]
     assert st.stages[1].analysis.max_inertial_force <= 1e-9 * st.stages[0].analysis.max_inertial_force
     assert st.stages[0].analysis.extra["redundant_actuators"] == 0
     assert st.stages[0].stage.model.name == f"{len(keep)}-RRR"
@@ -363,8 +364,8 @@ def test_special_kinematics_keep_links_parallel_and_balance_with_eight_condition
     for a, b in pairs.items():
         assert np.abs(np.sin(th[a] - th[b])).max() < 1e-9, (a, b)
     names = [s.stage.name for s in st.stages]
-    assert names == ["unbalanced", "leg_by_leg", "general", "special"]
-    sp = st.stages[3]
+    assert names == ["unbalanced", "leg_by_leg", "least_mass", "general", "special"]
+    sp = st.stages[4]
     F0 = st.stages[0].analysis.max_inertial_force
     assert sp.analysis.max_inertial_force <= 1e-9 * F0
     p = mass_parameters(sp.stage.model)
@@ -390,7 +391,7 @@ def test_special_kinematics_with_a_turning_platform_skip_the_fig6_stage():
     data["motion"]["drive"]["platform"] = {"from": [-0.04, -0.03, 0.0], "to": [0.03, 0.02, 0.1]}
     spec = spec_of(data)
     res = registry.balance(spec)
-    assert [s.name for s in res.stages] == ["unbalanced", "leg_by_leg", "general"]
+    assert [s.name for s in res.stages] == ["unbalanced", "leg_by_leg", "least_mass", "general"]
     assert any("does not rotate" in n for n in res.notes)
 
 

@@ -34,7 +34,6 @@ from ..spec_parts import LinkSpec, SpecFieldError, Strict
 from ..units import Length
 from .base import BalanceResult, Parameter, Stage
 from .parts import add_counter_rotation, add_counterweight
-from .rpr3_idler import Rpr3IdlerLoop
 from .slider_crank import eq20_lhs
 
 PATH = ("balancing",)
@@ -65,12 +64,6 @@ class Rpr3ScottRussell(Strict):
         description="what eq. 30e is solved for: the crank's or coupler's inertia (the link is redesigned "
         "in every stage), or the inertia of the crank's or coupler's counterweight (a disc); omit to "
         "keep the design as given (the page then shows eq. 30e's residual)",
-    )
-    compare_with: Rpr3IdlerLoop | None = Field(
-        None,
-        description="an idler-loop design for the same 3-RPR: the page compares the two methods (counter-"
-        "rotations, added mass and inertia, peak actuator efforts and joint loads, peak moment before the "
-        "counter-rotations)",
     )
 
 

@@ -33,6 +33,7 @@ from ..model import Model
 from ..spec_parts import SpecFieldError, Strict
 from ..units import Mass, PositiveLength
 from . import rrr4_conditions as cond
+from . import rrr4_generic as generic
 from .base import BalanceResult, Parameter, Stage
 from .parts import add_counterweight
 
@@ -63,6 +64,11 @@ class RRR4Balancing(Strict):
     )
     topologies: bool = Field(
         True, description="also build the eq. 17 design (Fig. 4a) and, for fig5a/fig5b kinematics, eq. 19/21's (Fig. 6)"
+    )
+    least_mass: bool = Field(
+        True,
+        description="also build the least-mass design: the generic condition finder's conditions met by one "
+        "counter-mass per link anywhere within the leg-by-leg distances of its proximal joint (linprog)",
     )
 
 
@@ -208,6 +214,9 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
     params.append(Parameter("added_mass_leg_by_leg", lbl.total_mass() - base_mass, "kg", "eqs. 8-11",
                             "counter-masses of the leg-by-leg balancing"))
     notes = []
+    details: dict = {}
+    if spec.least_mass or len(legs) == 4:
+        found = finder_stage(mech, spec, model, lbl, stages, params, notes, details)
     if len(legs) == 4:
         g = geometry(mech)
         rows = cond.eq17(g)
@@ -246,8 +255,10 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
                         f"({eq}); they are sums of eq. 17's rows (the table shows them with their residuals) and "
                         "sufficient for balance: the special stage meets them with counter-masses on fewer links "
                         "than eq. 17 needs, and the engine finds its shaking force cancelled although eq. 17 does "
-                        "not hold. They need not all be necessary: how many independent conditions this motion "
-                        "class has is the rank of its momentum regressor, not of the printed list."
+                        "not hold. "
+                        + ("They are not all necessary: " if found.translating.count < 8 else "")
+                        + "the generic finder's count for this motion class (the rank of its momentum regressor) "
+                        "is in the note above."
                     )
         names = list(mass_parameters(model))
         params.append(Parameter("eq17_conditions", len(rows), "", "eq. 17", "number of printed general conditions"))
@@ -263,7 +274,102 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
             f"A {len(legs)}-RRR: the leg-by-leg balancing (eqs. 8-11) applies; eq. 17 is written for four "
             "legs (paper 001 takes legs out by giving them zero mass, which keeps them in the kinematics)."
         )
-    return BalanceResult(params, stages, notes)
+    return BalanceResult(params, stages, notes, details=details)
+
+
+def finder_grid(model: Model, samples: int = 9) -> np.ndarray:
+    """Instants of the platform's move (the finder samples states around the configurations there)."""
+    law = getattr(model.drivers[0].law, "pose", (None,))[0]
+    return np.linspace(0.0, float(getattr(law, "duration", 1.0)), samples)
+
+
+def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Model, stages: list,
+                 params: list, notes: list, details: dict) -> generic.FinderCheck:
+    """The generic condition finder on the model (issue 8): its count, eq. 17's rows and the
+    leg-by-leg design checked against its space, the translating-platform count of the special
+    kinematics, and (``spec.least_mass``) the least-mass stage after the leg-by-leg one."""
+    legs = resolve_legs(mech)
+    four = len(legs) == 4
+    g = geometry(mech) if four else None
+    special = four and mech.kinematics != "general" and not platform_rotates(model)
+    found = generic.check(model, finder_grid(model), cond.eq17(g) if four else [],
+                          cond.special(g, mech.kinematics) if special else None)
+    gen = found.general
+    src = "momentum regressor rank"
+    params += [
+        Parameter("finder_conditions", gen.count, "", src, "independent force-balance conditions found by the generic "
+                  "condition finder (every motion)"),
+        Parameter("finder_gap", gen.gap, "", src, "last kept / first dropped singular value of the regressor"),
+        Parameter("leg_by_leg_in_finder_space", found.design_residual(lbl), "", src,
+                  "largest residual of the leg-by-leg design over the finder's conditions / (total mass x model size)"),
+    ]
+    details["finder"] = gen.to_json(generic.R.parameters(model))
+    if four:
+        params.append(Parameter("eq17_in_finder_space", float(found.eq17.max()), "", "eq. 17",
+                                "largest distance of eq. 17's printed rows from the finder's space (relative)"))
+        details["finder"]["eq17_in_space"] = {r.name: float(v) for r, v in zip(cond.eq17(g), found.eq17)}
+    if special:
+        tr = found.translating
+        eq = cond.SPECIAL_EQ[mech.kinematics]
+        params += [
+            Parameter("translating_conditions", tr.count, "", src, "independent force-balance conditions for "
+                      "translating-platform motions (finder on states of such motions only)"),
+            Parameter("translating_gap", tr.gap, "", src, "last kept / first dropped singular value, translating"),
+            Parameter("translating_in_printed_span", float(found.special_in_printed.max()), "", eq,
+                      f"largest distance of the finder's translating conditions from the span of {eq}'s eight"),
+            Parameter("printed_reduced_conditions", found.reduced_count, "", eq,
+                      f"{eq}'s eight with m5 p5 and m5 q5 eliminated: independent combinations left"),
+            Parameter("printed_reduced_in_translating", float(found.reduced_in_translating.max()), "", eq,
+                      "their largest distance from the finder's translating space"),
+        ]
+        details["finder_translating"] = tr.to_json(generic.R.parameters(model))
+        details["finder_translating"]["printed_in_space"] = {
+            r.name: float(v) for r, v in zip(cond.special(g, mech.kinematics), found.printed_in_translating)}
+        notes.append(
+            f"Special kinematics ({mech.kinematics}) with a translating platform: the generic finder, run on states "
+            f"of translating-platform motions only, finds {tr.count} independent conditions where the paper prints "
+            f"{len(cond.SPECIAL_ROWS[mech.kinematics])} ({eq}). The printed ones are sufficient: each computed "
+            f"condition is a combination of them (distance {found.special_in_printed.max():.1e}). Two of them only "
+            "fix m5 p5 and m5 q5, i.e. how the paper splits the platform's mass m5 into point masses mu_5i at the "
+            "joints C_i; with a translating platform every C_i has the platform's velocity, so the split does not "
+            f"matter. Eliminating m5 p5 and m5 q5 from the printed rows leaves {found.reduced_count} combinations, "
+            f"which span the computed space (distance {found.reduced_in_translating.max():.1e})."
+        )
+    if spec.least_mass:
+        radii = {f"link{i}{j}": (spec.counterweights.proximal if j == 1 else spec.counterweights.distal)
+                 for i in legs for j in (1, 2)}
+        lm, sol = generic.least_mass(model, radii, gen)
+        k = [s.name for s in stages].index("leg_by_leg") + 1
+        stages.insert(k, Stage("least_mass", "least-mass counter-masses (generic conditions, linprog)", lm,
+                               "one counter-mass per link within the leg-by-leg distance of its proximal joint "
+                               "(proximal %.4g m, distal %.4g m), least total mass meeting the finder's %d conditions"
+                               % (spec.counterweights.proximal, spec.counterweights.distal, gen.count), "force"))
+        added_lbl = lbl.total_mass() - model.total_mass()
+        params.append(Parameter("added_mass_least_mass", sol.total_mass, "kg", "least added mass (linprog)",
+                                "counter-masses of the least-mass design"))
+        for cw in sol.counterweights:
+            ij = cw.region.body[4:]
+            params += [
+                Parameter(f"m_lm{ij}", cw.mass, "kg", "least added mass (linprog)", f"least-mass counter-mass on l{ij}"),
+                Parameter(f"x_lm{ij}", cw.position[0], "m", "least added mass (linprog)", f"its position along l{ij}"),
+                Parameter(f"y_lm{ij}", cw.position[1], "m", "least added mass (linprog)", f"its position normal to l{ij}"),
+            ]
+        saved = added_lbl - sol.total_mass
+        same = abs(saved) <= 1e-9 * max(added_lbl, 1e-300)
+        notes.append(
+            f"Generic condition finder: {gen.count} independent force-balance conditions (singular-value gap "
+            f"{gen.gap:.3g})" + (f"; each of eq. 17's twelve printed conditions lies in their space (largest "
+                                 f"distance {found.eq17.max():.1e})" if four else "")
+            + f"; the leg-by-leg design meets them (residual {found.design_residual(lbl):.1e}). The least-mass "
+            f"counter-masses within the same distances of the proximal joints add {sol.total_mass:.6g} kg, the "
+            f"leg-by-leg ones {added_lbl:.6g} kg: "
+            + ("the same mass: the leg-by-leg design is already of least mass for these positions." if same
+               else f"{saved:.6g} kg less.")
+        )
+        details["least_mass"] = {"total_mass": sol.total_mass, "leg_by_leg_mass": added_lbl,
+                                 "counter_masses": [{"body": c.region.body, "mass": c.mass, "position": list(c.position),
+                                                     "region": c.region.describe()} for c in sol.counterweights]}
+    return found
 
 
 def eq17_residuals(mech: RRR4Mechanism, model: Model) -> list[tuple[cond.LinearCondition, float]]:

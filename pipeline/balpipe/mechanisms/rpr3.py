@@ -326,8 +326,14 @@ PAPER_FIGURES = {"rpr3_idler_loop": "Fig. 4", "rpr3_scott_russell": "Fig. 8"}
 ADDED_LINKAGE = {"rpr3_idler_loop": "idler_loop", "rpr3_scott_russell": "scott_russell"}
 
 
+def _own(study) -> list:
+    """The main design's stages (those of ``compare`` designs are named design:stage and shown in
+    the generic "Designs side by side" table, not in the paper's figures)."""
+    return [s for s in study.stages if ":" not in s.stage.name]
+
+
 def _stage(study, name: str):
-    for s in study.stages:
+    for s in _own(study):
         if s.stage.name == name:
             return s
     return None
@@ -352,7 +358,7 @@ def figures(study):
               ("(b) shaking force along y (N)", lambda a: a.force[:, 1]),
               ("(c) shaking moment about O (N m)", lambda a: a.moment))
     for ax, (title, fn) in zip(axes, panels):
-        for s in study.stages:
+        for s in _own(study):
             st = styles.get(s.stage.name, {"color": "tab:red", "linestyle": "-.", "linewidth": 1.0})
             ax.plot(s.analysis.t, fn(s.analysis), label=s.stage.label, **st)
         ax.set_title(title, fontsize=9)
@@ -372,44 +378,6 @@ def figures(study):
     yield ("Peak loads and the moment factor", _factor_table(study, method), _factor_caption(study, method))
     if study.spec.mechanism.actuation == "revolute":
         yield _prismatic_forces_figure(study, plt, to_svg)
-    other = getattr(study.spec.balancing, "compare_with", None)
-    if other is not None:
-        yield ("The two methods on the same 3-RPR", _comparison_table(study, other),
-               "Both methods' stages analysed on the spec's 3-RPR and motion. Added mass and inertia: over the "
-               "unbalanced 3-RPR (links, counterweights and counter-rotations); peak joint load: the largest "
-               "force that a revolute joint carries; peak moment before the counter-rotations: the "
-               "counterweights stage's.")
-
-
-def _method_row(label: str, stages: list, analyses: list) -> str:
-    base = stages[0].model
-    last, an_last = stages[-1], analyses[-1]
-    cw_an = next(a for s, a in zip(stages, analyses) if s.name == "counterweights")
-    inert = lambda m: sum(b.inertia + sum(a.inertia for a in b.attachments) for b in m.bodies)  # noqa: E731
-    discs = sum(1 for b in last.model.bodies if b.kind == "gear")
-    effort = max(float(np.max(np.abs(e))) for e in an_last.efforts.values())
-    loads = [float(np.max(np.hypot(r["Fx"], r["Fy"]))) for r in an_last.reactions.values() if "Fx" in r]
-    return (f"<tr><td>{label}</td><td>{discs}</td><td>{last.model.total_mass() - base.total_mass():.4g}</td>"
-            f"<td>{inert(last.model) - inert(base):.4g}</td><td>{effort:.4g}</td><td>{max(loads):.4g}</td>"
-            f"<td>{cw_an.max_moment:.4g}</td><td>{an_last.max_force:.3g} / {an_last.max_moment:.3g}</td></tr>")
-
-
-def _comparison_table(study, other) -> str:
-    from .. import registry  # the registry imports this module
-    from ..engine import analyse
-
-    spec = study.spec
-    t = registry.time_grid(spec)
-    stages = registry.METHODS[other.method].balance(spec.mechanism, other, study.unbalanced.stage.model).stages
-    analyses = [analyse(s.model, t, (0.0, -spec.analysis.g) if spec.analysis.gravity else (0.0, 0.0),
-                        tuple(spec.analysis.moment_point)) for s in stages]
-    own = [s.stage for s in study.stages]
-    rows = [_method_row(registry.METHODS[spec.balancing.method].label, own, [s.analysis for s in study.stages]),
-            _method_row(registry.METHODS[other.method].label, stages, analyses)]
-    return ("<table><thead><tr><th>method</th><th>counter-rotations</th><th>added mass (kg)</th>"
-            "<th>added inertia (kg m²)</th><th>peak actuator effort (N m or N)</th><th>peak joint load (N)</th>"
-            "<th>peak moment before counter-rotations (N m)</th><th>last stage max |F| / max |M| (N, N m)</th>"
-            "</tr></thead><tbody>" + "".join(rows) + "</tbody></table>")
 
 
 def prismatic_equivalent(mech: Rpr3Mechanism, pose: Pose, t: np.ndarray, torques: np.ndarray) -> np.ndarray:
@@ -432,7 +400,7 @@ def _prismatic_forces_figure(study, plt, to_svg):
     mech = study.spec.mechanism
     pose = pose_of(study.unbalanced.stage.model)
     fig, axes = plt.subplots(1, 3, figsize=(10.5, 2.9), sharey=True)
-    for k, s in enumerate((study.stages[0], study.stages[-1])):
+    for k, s in enumerate((study.stages[0], _own(study)[-1])):
         an = s.analysis
         tau = np.stack([an.efforts[f"theta{i}"] for i in (1, 2, 3)], axis=1)
         f = prismatic_equivalent(mech, pose, an.t, tau)
@@ -454,7 +422,7 @@ def _prismatic_forces_figure(study, plt, to_svg):
 
 def _factor_table(study, method: str) -> str:
     rows = []
-    for s in study.stages:
+    for s in _own(study):
         an = s.analysis
         rows.append(
             f"<tr><td>{s.stage.label}</td><td>{an.max_force:.6g}</td><td>{an.max_moment:.6g}</td>"

@@ -84,18 +84,30 @@ def comparison(study: Study, metrics: list[dict]) -> dict:
     normal force of prismatic pairs), with the joint that carries it."""
     table = joint_load_table(study)
     rows = []
+    before: dict[str, float] = {}  # per design: peak moment of its latest stage without counter-rotations
     for s, m in zip(study.stages, metrics):
         loads = [(row["peaks"].get(s.stage.name, 0.0), row["joint"]) for row in table if row["unit"] == "N"]
         peak, joint = max(loads) if loads else (0.0, "")
         design, _, stage = s.stage.name.rpartition(":")
+        discs = counter_rotations(s.stage.model, study.unbalanced.stage.model)
+        if discs == 0:
+            before[design or "main"] = m["max_shaking_moment"]
         rows.append({
             "stage": s.stage.name, "label": s.stage.label, "design": design or "main", "balances": s.stage.balances,
             "added_mass": m["added_mass"], "added_inertia": m["added_inertia"],
             "max_actuator_effort": m["max_actuator_effort"], "max_joint_load": peak, "max_joint_load_joint": joint,
             "max_shaking_force": m["max_shaking_force"], "max_shaking_moment": m["max_shaking_moment"],
             "force_ratio": m["force_ratio"], "moment_ratio": m["moment_ratio"],
+            "counter_rotations": discs,
+            "moment_before_counter_rotations": before.get(design or "main", study.unbalanced.analysis.max_moment),
         })
     return {"reference": study.unbalanced.stage.name, "rows": rows}
+
+
+def counter_rotations(model, unbalanced) -> int:
+    """Counter-rotating discs (gear bodies) that a stage adds to the unbalanced mechanism."""
+    had = {b.name for b in unbalanced.bodies if b.kind == "gear"}
+    return sum(1 for b in model.bodies if b.kind == "gear" and b.name not in had)
 
 
 def dumps(results: dict) -> str:

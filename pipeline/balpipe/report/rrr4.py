@@ -12,7 +12,7 @@ from ..balancing import rrr4 as recipe
 from ..balancing import rrr4_conditions as cond
 from ..mechanisms.rrr4 import mass_parameters, resolve_legs
 
-FIGURE_OF_STAGE = {"leg_by_leg": "Fig. 2a", "general": "Fig. 4a", "special": "Fig. 6"}
+FIGURE_OF_STAGE = {"leg_by_leg": "Fig. 2a", "least_mass": "least mass", "general": "Fig. 4a", "special": "Fig. 6"}
 TOL = 1e-9
 
 
@@ -36,6 +36,51 @@ def conditions_table(study) -> str | None:
         body.append(f"<tr><td>{html.escape(r.name)}</td><td><code>{html.escape(r.text())}</code></td>{''.join(cells)}</tr>")
     return (f"<table><tr><th>Condition</th><th>Linear equation (kg m; masses in kg)</th>{head}</tr>"
             + "".join(body) + "</table>")
+
+
+def finder_table(study) -> str | None:
+    """An HTML table: the generic condition finder's counts beside the paper's, eq. 17's rows in
+    its space, the leg-by-leg and least-mass counter-masses side by side (issue 8)."""
+    det = study.balance.details
+    if "finder" not in det:
+        return None
+    p = {x.name: x.value for x in study.balance.parameters}
+    mech = study.spec.mechanism
+    four = len(resolve_legs(mech)) == 4
+    rows = [("force-balance conditions, every motion", f"{int(p['finder_conditions'])}",
+             "12 (eq. 17)" if four else "", f"singular-value gap {p['finder_gap']:.3g}")]
+    if four:
+        rows.append(("eq. 17's printed rows: largest distance from the computed space", f"{p['eq17_in_finder_space']:.1e}",
+                     "0", "relative, scaled columns; at most 1e-9: in the space"))
+    rows.append(("leg-by-leg design (eqs. 8-11): largest residual", f"{p['leg_by_leg_in_finder_space']:.1e}", "0",
+                 "/ (total mass x model size)"))
+    if "translating_conditions" in p:
+        eq = cond.SPECIAL_EQ[mech.kinematics]
+        rows += [
+            ("conditions, translating platform (Fig. 5" + mech.kinematics[-1] + ")", f"{int(p['translating_conditions'])}",
+             f"8 ({eq})", f"singular-value gap {p['translating_gap']:.3g}"),
+            ("computed translating conditions: largest distance from the span of the printed eight",
+             f"{p['translating_in_printed_span']:.1e}", "", "the printed eight are sufficient"),
+            (f"{eq}'s rows with m5 p5, m5 q5 eliminated: independent combinations", f"{int(p['printed_reduced_conditions'])}",
+             "", f"largest distance from the computed space {p['printed_reduced_in_translating']:.1e}"),
+        ]
+    body = "".join(f"<tr><td>{html.escape(a)}</td><td class=\"num\">{b}</td><td class=\"num\">{html.escape(c)}</td>"
+                   f"<td>{html.escape(d)}</td></tr>" for a, b, c, d in rows)
+    out = ("<table><tr><th>Generic condition finder</th><th>computed</th><th>paper</th><th></th></tr>" + body + "</table>")
+    lm = det.get("least_mass")
+    if lm:
+        stage = next((s for s in study.stages if s.stage.name == "leg_by_leg"), None)
+        lbl = {b.name: a for b in stage.stage.model.bodies for a in b.attachments if a.kind == "counterweight"} if stage else {}
+        cells = []
+        for c in lm["counter_masses"]:
+            a = lbl.get(c["body"])
+            lb = f"{a.mass:.4g} kg at ({a.position[0]:.4g}, {a.position[1]:.4g}) m" if a else "none"
+            pos = f"{c['mass']:.4g} kg at ({c['position'][0]:.4g}, {c['position'][1]:.4g}) m" if c["mass"] > 0 else "none"
+            cells.append(f"<tr><td>l{c['body'][4:]}</td><td>{lb}</td><td>{pos}</td></tr>")
+        out += ("<table><tr><th>Link</th><th>leg-by-leg counter-mass (eqs. 8-11)</th><th>least-mass counter-mass "
+                "(linprog, same allowed positions)</th></tr>" + "".join(cells)
+                + f"<tr><th>added mass</th><th>{lm['leg_by_leg_mass']:.6g} kg</th><th>{lm['total_mass']:.6g} kg</th></tr></table>")
+    return out
 
 
 def topology_figure(study):
@@ -106,10 +151,25 @@ def figures(study):
             "condition's largest term. Count: 12 printed conditions, independent (each holds one dependent "
             "first moment with coefficient 1).",
         )
+    finder = finder_table(study)
+    if finder is not None:
+        yield (
+            "Generic condition finder against the printed conditions; least-mass counter-masses",
+            finder,
+            "The force-balance conditions computed from the linear-momentum regressor of the model (any mechanism's "
+            "route, no loop algebra), counted by the rank of the regressor over sampled states, against the paper's "
+            "printed ones mapped onto the finder's parameters (m_ij p_ij = mx[link ij], m_ij q_ij = my[link ij], "
+            "m5 p5 = mx[platform]: the body frames are the paper's). A printed row lies in the computed space when "
+            "its distance from it (relative, in columns scaled to one unit) is at most 1e-9. With special kinematics "
+            "the finder is also run on states of translating-platform motions only (eight random straight moves at "
+            "the start angle). Second table: the counter-masses of the leg-by-leg design and of least total mass "
+            "(linear programme over the same allowed positions: within the leg-by-leg distance of each link's "
+            "proximal joint), link frames as in the paper (x along the link from its proximal joint).",
+        )
     svg = topology_figure(study)
     if svg is not None:
         yield (
-            "Balance topologies (paper 001, Figs. 2a, 4a, 6)",
+            "Balance topologies (paper 001, Figs. 2a, 4a, 6; least mass)",
             svg,
             "Each force-balanced stage at t = 0: links (black), joints (circles), base pivots (triangles), each "
             "body's centre of mass (blue cross), counter-masses as red discs (area proportional to mass, the "
