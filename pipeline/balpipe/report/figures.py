@@ -86,15 +86,18 @@ def loads_figure(stages: list, prefix: str = "loads") -> str:
     return to_svg(fig, prefix)
 
 
-def efforts_figure(stages: list, prefix: str = "efforts") -> str:
-    """Actuator torque (or force) of every driver, every stage."""
+def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = None) -> str:
+    """Actuator torque (or force) of every driver, every stage; ``units``: driver -> 'N m' or 'N'."""
+    units = units or {}
     names = sorted({n for _, an in stages for n in an.efforts})
     fig, axes = plt.subplots(1, max(1, len(names)), figsize=(4.6 * max(1, len(names)), 2.8), squeeze=False)
     for ax, name in zip(axes[0], names):
         for k, (label, an) in enumerate(stages):
             if name in an.efforts:
                 ax.plot(an.t, an.efforts[name], label=label, **style(k))
-        ax.set_title(f"Actuator effort: {name} (N m or N)", fontsize=9)
+        u = units.get(name, "")
+        ax.set_title(f"Actuator effort: {name}" + (f" ({u})" if u else ""), fontsize=9)
+        ax.set_ylabel({"N m": "torque (N m)", "N": "force (N)"}.get(u, "effort"))
         ax.set_xlabel("time (s)")
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()

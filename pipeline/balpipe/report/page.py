@@ -6,7 +6,8 @@ import numpy as np
 
 from .. import realisable
 from ..study import Study
-from . import figures
+from . import figures, present, toc
+from .inputs import input_rows
 from .render import environment
 from .results import joint_load_table
 
@@ -27,7 +28,9 @@ def study_figures(study: Study) -> dict:
     loads = figures.loads_figure(
         [(s.stage.label, s.analysis, sim) for s, sim in zip(shown_stages(study), sims)], prefix="loads"
     )
-    efforts = figures.efforts_figure([(s.stage.label, s.analysis) for s in shown_stages(study)], prefix="efforts")
+    efforts = figures.efforts_figure([(s.stage.label, s.analysis) for s in shown_stages(study)], prefix="efforts",
+                                     units={d.name: present.driver_unit(s.stage.model, d.name)
+                                            for s in shown_stages(study) for d in s.stage.model.drivers})
     mech = [
         (s.stage.label, figures.mechanism_figure(s.stage.model, s.analysis, INSTANTS, prefix=f"mech{k}", title=s.stage.label))
         for k, s in enumerate(shown_stages(study))
@@ -62,7 +65,8 @@ def study_figures(study: Study) -> dict:
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
-def render_page(study: Study, results: dict, spec_text: str, history: dict | None = None) -> str:
+def render_page(study: Study, results: dict, spec_text: str, history: dict | None = None,
+                nav: dict | None = None) -> str:
     spec = study.spec
     validation_rows = []
     for s in study.stages:
@@ -90,7 +94,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                 "per_driver": ", ".join(f"{k} {v:.2g}" for k, v in sorted(q.tracking_error.items())),
             })
     rl = study.reactionless
-    return environment().get_template("spec.html").render(
+    return toc.add_toc(environment().get_template("spec.html").render(
         r=results,
         paper=spec.paper,
         description=spec.description,
@@ -109,4 +113,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                    "floored": study.reference.floored},
         spec_text=spec_text,
         history=history,
-    )
+        actuators=results.get("actuators") or [],
+        nav=nav or {},
+        inputs=input_rows(spec),
+    ))

@@ -62,3 +62,26 @@ def write_site(out: Path, outcomes: list) -> None:
         filters=site_filter.options(entries),
     )
     (out / "index.html").write_text(html, encoding="utf-8")
+    (out / "site_nav.js").write_text(site_nav_script(entries), encoding="utf-8")
+
+
+def site_nav_script(entries: list[dict]) -> str:
+    """``site_nav.js``: previous/next links between the study pages in the index's order,
+    written once per build so that a cached page needs no rebuild when another spec changes."""
+    pages = [[e["link"].split("/")[0], e["title"]] for e in entries if e.get("link")]
+    data = json.dumps(pages, separators=(",", ":"), sort_keys=True, ensure_ascii=False)
+    return f"""// previous/next between the studies of this site (written by balpipe build)
+(function() {{
+const P = {data};
+const here = location.pathname.split("/").slice(-2)[0];
+const k = P.findIndex(p => p[0] === here);
+if (k < 0) return;
+function link(p, rel, text) {{ const a = document.createElement("a"); a.href = "../" + p[0] + "/index.html";
+  a.rel = rel; a.textContent = text + p[1]; return a; }}
+document.querySelectorAll(".sitenav").forEach(el => {{
+  if (k > 0) el.append(" · ", link(P[k - 1], "prev", "\u2190 previous: "));
+  if (k < P.length - 1) el.append(" · ", link(P[k + 1], "next", "next: "));
+  if (k < P.length - 1) el.lastChild.textContent += " \u2192";
+}});
+}})();
+"""
