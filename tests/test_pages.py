@@ -62,5 +62,6 @@ def test_table_of_contents_links_every_h2():
     page = "<!--toc--><h2>Balancing stages</h2>x<h2 id='k'>Other</h2><h2>Balancing stages</h2>"
     out = toc.add_toc(page)
     assert '<a href="#balancing-stages">Balancing stages</a>' in out
-    assert '<a href="#balancing-stages-2">' in out and '<h2 id="balancing-stages-2">' in out
+    assert '<a href="#balancing-stages-section">' in out and '<h2 id="balancing-stages-section">' in out
+    assert toc.add_toc('<!--toc--><section id="history"><h2>History</h2></section>').count('id="history"') == 1
     assert toc.add_toc("<h2>x</h2>") == "<h2>x</h2>"  # no marker, no change

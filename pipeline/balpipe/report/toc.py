@@ -21,6 +21,7 @@ def add_toc(page: str, marker: str = "<!--toc-->") -> str:
     without the marker)."""
     if marker not in page:
         return page
+    taken = set(re.findall(r'\bid="([^"]+)"', page))  # ids already in the page stay unique
     seen: dict[str, int] = {}
     items: list[tuple[str, str]] = []
 
@@ -32,8 +33,11 @@ def add_toc(page: str, marker: str = "<!--toc-->") -> str:
             ident = found.group(1)
         else:
             base = slugify(title)
-            seen[base] = seen.get(base, 0) + 1
-            ident = base if seen[base] == 1 else f"{base}-{seen[base]}"
+            ident = base if base not in taken else f"{base}-section"
+            while ident in taken:
+                seen[base] = seen.get(base, 1) + 1
+                ident = f"{base}-{seen[base]}"
+            taken.add(ident)
             attrs = f' id="{ident}"{attrs}'
         items.append((ident, title))
         return f"<h2{attrs}>{body}</h2>"
