@@ -300,8 +300,11 @@ def residual_figure(stages: list, prefix: str = "residuals") -> str:
     return to_svg(fig, prefix)
 
 
-def overlay_figure(old, new, prefix: str = "overlay") -> str:
-    """One stage of two designs: Fx, Fy, |F| and M over time, old dashed grey, new solid black."""
+def overlay_figure(old, new, prefix: str = "overlay", round_off: tuple[bool, bool] = (False, False),
+                   scale: tuple[float, float] | None = None) -> str:
+    """One stage of two designs: Fx, Fy, |F| and M over time, old dashed grey, new solid black.
+    A load that is round-off in both designs (``round_off`` = (force, moment)) is drawn as zero
+    on the unbalanced ``scale`` (peak |F|, peak |M|), with a note, not as a signal."""
     fig, axes = plt.subplots(2, 2, figsize=(9.0, 5.2), sharex=False)
     panels = [
         (axes[0, 0], "Shaking force Fx (N)", lambda a: a.force[:, 0]),
@@ -309,9 +312,18 @@ def overlay_figure(old, new, prefix: str = "overlay") -> str:
         (axes[1, 0], "Shaking force |F| (N)", lambda a: np.hypot(a.force[:, 0], a.force[:, 1])),
         (axes[1, 1], "Shaking moment M (N m)", lambda a: a.moment),
     ]
-    for ax, title, fn in panels:
-        ax.plot(old.t, fn(old), color="0.55", linestyle="--", linewidth=1.6, label="old")
-        ax.plot(new.t, fn(new), color="black", linestyle="-", linewidth=1.3, label="new")
+    for n, (ax, title, fn) in enumerate(panels):
+        quiet = round_off[1] if n == 3 else round_off[0]
+        if quiet:
+            ax.plot(old.t, np.zeros_like(old.t), color="0.55", linestyle="--", linewidth=1.6, label="old")
+            ax.plot(new.t, np.zeros_like(new.t), color="black", linestyle="-", linewidth=1.3, label="new")
+            lim = (scale[1] if n == 3 else scale[0]) if scale else 1.0
+            ax.set_ylim(-1.05 * lim, 1.05 * lim)
+            ax.text(0.5, 0.85, "round-off in both designs (shown as 0,\non the unbalanced scale)", transform=ax.transAxes,
+                    ha="center", va="top", fontsize=8, color="0.3")
+        else:
+            ax.plot(old.t, fn(old), color="0.55", linestyle="--", linewidth=1.6, label="old")
+            ax.plot(new.t, fn(new), color="black", linestyle="-", linewidth=1.3, label="new")
         ax.set_title(title, fontsize=9)
     for ax in axes[1]:
         ax.set_xlabel("time (s)")
