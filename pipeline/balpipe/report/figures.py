@@ -95,8 +95,10 @@ def loads_figure(stages: list, prefix: str = "loads") -> str:
     for ax, title, fn in panels:
         same = coinciding([(label, fn(an.force, an.moment)) for label, an, _ in stages])
         if same:
-            ax.text(0.01, 0.98, "coincide: " + "; ".join(same), transform=ax.transAxes, fontsize=7.5,
-                    va="top", ha="left", color="0.25", bbox={"facecolor": "white", "edgecolor": "0.8", "alpha": 0.85})
+            note = ax.text(0.01, 0.98, "coincide:\n" + "\n".join(same[:4]) + ("\n…" if len(same) > 4 else ""),
+                           transform=ax.transAxes, fontsize=7, va="top", ha="left", color="0.25",
+                           bbox={"facecolor": "white", "edgecolor": "0.8", "alpha": 0.85})
+            note.set_in_layout(False)
     for k, (label, an, sim) in enumerate(stages):
         for ax, title, fn in panels:
             ax.plot(an.t, fn(an.force, an.moment), label=label, **marked(k, len(an.t)))
