@@ -177,6 +177,8 @@ def check_figures_and_anchors(page, url: str) -> None:
         if inner.count():
             b = inner.first.bounding_box()
             assert b and b["width"] > 100 and b["height"] > 50, f"{url}: figure {k}'s drawing has no size"
+    sw, cw = page.evaluate("[document.documentElement.scrollWidth, document.documentElement.clientWidth]")
+    assert sw <= cw + 1, f"{url}: the page is wider than the window ({sw} > {cw} px)"
     missing = page.evaluate("""() => [...document.querySelectorAll('a[href^="#"]')]
         .map(a => a.getAttribute('href').slice(1)).filter(id => id && !document.getElementById(id))""")
     assert not missing, f"{url}: in-page links to nothing: {missing}"
