@@ -57,15 +57,19 @@ def marked(k: int, n: int) -> dict:
 
 
 def coinciding(curves: list[tuple[str, np.ndarray]], rel: float = 1e-6) -> list[str]:
-    """Labels of curve pairs that agree within ``rel`` of the panel's largest value."""
+    """Groups of curves that agree within ``rel`` of the panel's largest value, as
+    "a = b = c" (each curve in the group of the first it agrees with)."""
     scale = max([float(np.max(np.abs(y))) for _, y in curves] + [0.0]) or 1.0
-    out = []
-    for i in range(len(curves)):
-        for j in range(i + 1, len(curves)):
-            (a, ya), (b, yb) = curves[i], curves[j]
-            if ya.shape == yb.shape and float(np.max(np.abs(ya - yb))) <= rel * scale:
-                out.append(f"{a} = {b}")
-    return out
+    groups: list[list[int]] = []
+    for i, (_, y) in enumerate(curves):
+        for g in groups:
+            y0 = curves[g[0]][1]
+            if y0.shape == y.shape and float(np.max(np.abs(y0 - y))) <= rel * scale:
+                g.append(i)
+                break
+        else:
+            groups.append([i])
+    return [" = ".join(curves[i][0] for i in g) for g in groups if len(g) > 1]
 
 
 def to_svg(fig, prefix: str) -> str:
@@ -92,13 +96,11 @@ def loads_figure(stages: list, prefix: str = "loads") -> str:
         (axes[1, 0], "Shaking force |F| (N)", lambda F, M: np.hypot(F[:, 0], F[:, 1])),
         (axes[1, 1], "Shaking moment M (N m)", lambda F, M: M),
     ]
+    notes: dict[str, list[str]] = {}  # coinciding groups -> the panels where they coincide
     for ax, title, fn in panels:
         same = coinciding([(label, fn(an.force, an.moment)) for label, an, _ in stages])
         if same:
-            note = ax.text(0.01, 0.98, "coincide:\n" + "\n".join(same[:4]) + ("\n…" if len(same) > 4 else ""),
-                           transform=ax.transAxes, fontsize=7, va="top", ha="left", color="0.25",
-                           bbox={"facecolor": "white", "edgecolor": "0.8", "alpha": 0.85})
-            note.set_in_layout(False)
+            notes.setdefault("; ".join(same), []).append(title.split(" (")[0].replace("Shaking ", ""))
     for k, (label, an, sim) in enumerate(stages):
         for ax, title, fn in panels:
             ax.plot(an.t, fn(an.force, an.moment), label=label, **marked(k, len(an.t)))
@@ -112,7 +114,12 @@ def loads_figure(stages: list, prefix: str = "loads") -> str:
     handles, labels = axes[0, 0].get_legend_handles_labels()
     ncol = min(len(labels), 3)
     fig.legend(handles, labels, loc="lower center", ncol=ncol, fontsize=9.5, frameon=False)
-    fig.tight_layout(rect=(0, 0.04 + 0.035 * math.ceil(len(labels) / ncol), 1, 1))
+    bottom = 0.04 + 0.035 * math.ceil(len(labels) / ncol)
+    if notes:
+        lines = [f"Coincide in {', '.join(where)}: {groups}" for groups, where in notes.items()]
+        fig.text(0.01, bottom, "\n".join(lines), fontsize=8, color="0.25", va="bottom", ha="left", wrap=True)
+        bottom += 0.03 * len(lines) + 0.01
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     return to_svg(fig, prefix)
 
 
