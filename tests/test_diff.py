@@ -21,7 +21,7 @@ def test_diff_of_two_spec_files_in_every_format(tmp_path):
     r = balpipe("diff", old, new, "--no-sim", "-f", "json")
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
-    assert d["inputs"] == [{"field": "balancing.crank_counterweight", "old": -0.1, "new": -0.12}]
+    assert d["inputs"] == [{"field": "balancing.crank_counterweight", "old": -0.1, "new": -0.12, "unit": "m"}]
     mcp1 = next(p for p in d["parameters"] if p["name"] == "mcp1")
     # eq. 15: mcp1 scales as 1 / rcp1
     assert abs(mcp1["new"] - mcp1["old"] * 0.1 / 0.12) < 1e-9
@@ -37,6 +37,13 @@ def test_diff_of_two_spec_files_in_every_format(tmp_path):
     assert balpipe("diff", old, new, "--no-sim", "-f", "html", "-o", out).returncode == 0
     html = out.read_text()
     assert html.count("<svg") == 3 and "Design comparison" in html
+    # readable names with units; round-off stages drawn as zero on the unbalanced scale, said so
+    assert "added mass (kg)" in html and "unit (SI)" in html and "max_shaking_force" not in html
+    assert "is round-off in both designs" in html and "round-off in both designs (shown as 0" in html
+    assert "report site" not in html  # no site beside the file: no dead link
+    (tmp_path / "index.html").write_text("<title>balpipe report site</title>")
+    assert balpipe("diff", old, new, "--no-sim", "-f", "html", "-o", out).returncode == 0
+    assert '<a href="index.html">&larr; report site</a>' in out.read_text()
 
 
 def test_diff_against_a_git_revision(tmp_path):
@@ -52,7 +59,7 @@ def test_diff_against_a_git_revision(tmp_path):
     r = balpipe("diff", "HEAD:specs/sc.yaml", "specs/sc.yaml", "--no-sim", "-f", "json", cwd=repo)
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
-    assert d["inputs"] == [{"field": "mechanism.slider.mass", "old": 0.6, "new": 0.7}]
+    assert d["inputs"] == [{"field": "mechanism.slider.mass", "old": 0.6, "new": 0.7, "unit": "kg"}]
     bad = balpipe("diff", "NOPE:specs/sc.yaml", "specs/sc.yaml", cwd=repo)
     assert bad.returncode == 2 and "cannot read it from git" in bad.stderr and "Traceback" not in bad.stderr
 
@@ -67,4 +74,8 @@ def test_diff_with_simulation_reports_residual_changes(tmp_path):
     d = json.loads(r.stdout)
     cw = next(s for s in d["stages"] if s["name"] == "counterweights")
     assert cw["validation"]["passed"] == {"old": True, "new": False}
+    text = balpipe("diff", old, new).stdout
+    stages, _, sim = text.partition("Simulation residuals (numerical, not a design change):")
+    assert "pymunk validation passed" in stages and "residual" not in stages.split("Stages:")[1]
+    assert "pymunk force residual" in sim
     assert d["status"] == {"old": "ok", "new": "failed"}

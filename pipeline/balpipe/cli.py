@@ -54,6 +54,8 @@ def _parser() -> argparse.ArgumentParser:
                    help="output format (default: text)")
     d.add_argument("-o", "--out", metavar="FILE", help="write to FILE instead of stdout")
     d.add_argument("--no-sim", action="store_true", help="skip the pymunk validation of both designs")
+    d.add_argument("--site", metavar="URL", default="",
+                   help="HTML: the report site's index to link back to (default: an index.html beside or above -o)")
     s = sub.add_parser("schema", help="print the JSON Schema of a spec", description="Print the spec JSON Schema.")
     s.add_argument("-o", "--out", metavar="FILE", help="write to FILE instead of stdout")
     from .history_cli import add_parser as _add_history_parser
@@ -162,7 +164,8 @@ def cmd_diff(args) -> int:
         print(str(exc), file=sys.stderr)
         return EXIT_USAGE
     data = diff.compare(a, b)
-    text = diff.to_html(data, a, b) if args.format == "html" else diff.RENDERERS[args.format](data)
+    text = (diff.to_html(data, a, b, site=diff.site_link(args.site, args.out)) if args.format == "html"
+            else diff.RENDERERS[args.format](data))
     return _emit(text, args.out)
 
 

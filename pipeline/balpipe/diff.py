@@ -23,6 +23,13 @@ from .spec_parts import SpecFieldError
 from .study import Study, stage_metrics
 
 ROUND_OFF = 1e-9  # ratios to the unbalanced peak below this are cancelled loads
+# readable names and units of the stage results (the JSON keeps the keys)
+STAGE_NAMES = {
+    "max_shaking_force": "peak |F| (N)", "max_shaking_moment": "peak |M| (N m)",
+    "force_ratio": "|F| vs unbalanced", "moment_ratio": "|M| vs unbalanced",
+    "max_actuator_effort": "peak actuator effort (N m or N, largest driver)", "added_mass": "added mass (kg)",
+    "added_inertia": "added inertia (kg m²)",
+}
 STAGE_KEYS = ("max_shaking_force", "max_shaking_moment", "force_ratio", "moment_ratio",
               "max_actuator_effort", "added_mass", "added_inertia")
 
@@ -90,12 +97,36 @@ def _change(old: float | None, new: float | None) -> dict:
     return d
 
 
+def _input_units(side: Side) -> dict[str, str]:
+    """SI unit of every input field with a declared dimension (as on the study page)."""
+    from .report.inputs import input_rows
+
+    return {r["path"]: r["unit"].replace("^2", "²") for r in input_rows(side.loaded.spec) if r["unit"]}
+
+
+def site_link(site: str, out: str | None) -> str:
+    """The link back to the report site: ``site`` if given, else an ``index.html`` of a balpipe
+    site beside or above the output file (relative), else none."""
+    if site:
+        return site
+    if out:
+        folder = Path(out).resolve().parent
+        for rel, cand in (("index.html", folder / "index.html"), ("../index.html", folder.parent / "index.html")):
+            try:
+                if cand.exists() and "balpipe" in cand.read_text(encoding="utf-8")[:2000]:
+                    return rel
+            except OSError:
+                continue
+    return ""
+
+
 def compare(a: Side, b: Side) -> dict:
     """The differences between two studies, as plain data (the JSON output)."""
     ia = _flatten(a.loaded.spec.model_dump(mode="json", by_alias=True))
     ib = _flatten(b.loaded.spec.model_dump(mode="json", by_alias=True))
+    units = _input_units(a) | _input_units(b)
     inputs = [
-        {"field": k, "old": ia.get(k), "new": ib.get(k)}
+        {"field": k, "old": ia.get(k), "new": ib.get(k), "unit": units.get(k, "")}
         for k in sorted(set(ia) | set(ib)) if ia.get(k) != ib.get(k)
     ]
     pa = {p.name: p for p in a.study.balance.parameters}
@@ -165,11 +196,12 @@ def _rel(d: dict) -> str:
 def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
     """Sections as (title, rows, header) for the text and Markdown renderers."""
     sections = []
-    sections.append(("Inputs", [[d["field"], _fmt(d["old"]), _fmt(d["new"])] for d in data["inputs"]],
-                     ["field", "old", "new"]))
+    sections.append(("Inputs", [[d["field"], _fmt(d["old"]), _fmt(d["new"]), d.get("unit", "")] for d in data["inputs"]],
+                     ["field", "old", "new", "unit (SI)"]))
     sections.append(("Computed parameters", [[p["name"], _fmt(p["old"]), _fmt(p["new"]), _rel(p), p["unit"]] for p in data["parameters"]],
                      ["parameter", "old", "new", "change", "unit"]))
-    rows = []
+    rows: list[list[str]] = []
+    sim: list[list[str]] = []
     for s in data["stages"]:
         # a load cancelled to round-off in both designs is not a change worth a row
         quiet = {
@@ -180,16 +212,21 @@ def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
             d = s[key]
             if d["old"] == d["new"] or any(quiet[w] and w in key for w in quiet):
                 continue
-            rows.append([s["name"], key, _fmt(d["old"]), _fmt(d["new"]), _rel(d)])
+            rows.append([s["name"], STAGE_NAMES.get(key, key), _fmt(d["old"]), _fmt(d["new"]), _rel(d)])
         v = s.get("validation")
         if v:
+            # the simulation's residuals are numerical noise, not a design change: their own section
             for key in ("force_residual", "moment_residual"):
                 d = v[key]
                 if d["old"] != d["new"]:
-                    rows.append([s["name"], f"pymunk {key}", _fmt(d["old"]), _fmt(d["new"]), _rel(d)])
+                    sim.append([s["name"], f"pymunk {key.replace('_', ' ')} (vs reference load)", _fmt(d["old"]),
+                                _fmt(d["new"]), _rel(d)])
             if v["passed"]["old"] != v["passed"]["new"]:
-                rows.append([s["name"], "pymunk passed", _fmt(v["passed"]["old"]), _fmt(v["passed"]["new"]), ""])
+                rows.append([s["name"], "pymunk validation passed", _fmt(v["passed"]["old"]), _fmt(v["passed"]["new"]), ""])
     sections.append(("Stages", rows, ["stage", "result", "old", "new", "change"]))
+    if sim:
+        sections.append(("Simulation residuals (numerical, not a design change)", sim,
+                         ["stage", "residual", "old", "new", "change"]))
     sections.append(("References", [[r["name"], _fmt(r["published"]), _fmt(r["old"]), _fmt(r["new"]), f"{r['old_status']} -> {r['new_status']}"] for r in data["references"]],
                      ["reference", "published", "old", "new", "status"]))
     return sections
@@ -226,17 +263,28 @@ def to_json(data: dict) -> str:
     return json.dumps(data, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
 
 
-def to_html(data: dict, a: Side, b: Side) -> str:
+def to_html(data: dict, a: Side, b: Side, site: str = "") -> str:
+    """The HTML page; a stage whose loads are round-off in both designs is drawn on the
+    unbalanced stage's scale (flat at zero) and said so, not plotted as a signal."""
     from .report.figures import overlay_figure
     from .report.render import environment
 
     figs = []
     names_b = {s.stage.name: s for s in b.study.stages}
+    quiet = {s["name"]: (all(isinstance(x, float) and x <= ROUND_OFF for x in (s["force_ratio"]["old"], s["force_ratio"]["new"])),
+                         all(isinstance(x, float) and x <= ROUND_OFF for x in (s["moment_ratio"]["old"], s["moment_ratio"]["new"])))
+             for s in data["stages"]}
+    ua, ub = a.study.unbalanced.analysis, b.study.unbalanced.analysis
+    scale = (max(ua.max_force, ub.max_force), max(ua.max_moment, ub.max_moment))
     for k, sa in enumerate(a.study.stages):
         sb = names_b.get(sa.stage.name)
         if sb is not None:
-            figs.append((sa.stage.label, overlay_figure(sa.analysis, sb.analysis, prefix=f"diff{k}")))
-    return environment().get_template("diff.html").render(d=data, sections=_rows(data), figures=figs)
+            qf, qm = quiet.get(sa.stage.name, (False, False))
+            note = " and ".join(w for w, q in (("force", qf), ("moment", qm)) if q)
+            figs.append((sa.stage.label, overlay_figure(sa.analysis, sb.analysis, prefix=f"diff{k}",
+                                                        round_off=(qf, qm), scale=scale), note))
+    return environment().get_template("diff.html").render(d=data, sections=_rows(data), figures=figs, site=site,
+                                                          round_off=ROUND_OFF)
 
 
 RENDERERS = {"text": to_text, "markdown": to_markdown, "json": to_json}

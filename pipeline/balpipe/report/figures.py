@@ -49,8 +49,35 @@ STAGE_STYLES = [
 SIM_COLORS = ["tab:orange", "tab:blue", "tab:green", "tab:purple", "tab:brown"]
 
 
+MARKERS = ["o", "s", "^", "D", "v"]
+
+
 def style(k: int) -> dict:
     return STAGE_STYLES[k % len(STAGE_STYLES)]
+
+
+def marked(k: int, n: int) -> dict:
+    """A stage's line style with its own marker, placed at staggered samples (offset per stage)
+    so that curves that coincide stay distinguishable."""
+    every = max(1, n // 12)
+    return {**style(k), "marker": MARKERS[k % len(MARKERS)], "markersize": 4.5, "markerfacecolor": "none",
+            "markevery": (min(n - 1, (k * every) // max(1, len(MARKERS))), every)}
+
+
+def coinciding(curves: list[tuple[str, np.ndarray]], rel: float = 1e-6) -> list[str]:
+    """Groups of curves that agree within ``rel`` of the panel's largest value, as
+    "a = b = c" (each curve in the group of the first it agrees with)."""
+    scale = max([float(np.max(np.abs(y))) for _, y in curves] + [0.0]) or 1.0
+    groups: list[list[int]] = []
+    for i, (_, y) in enumerate(curves):
+        for g in groups:
+            y0 = curves[g[0]][1]
+            if y0.shape == y.shape and float(np.max(np.abs(y0 - y))) <= rel * scale:
+                g.append(i)
+                break
+        else:
+            groups.append([i])
+    return [" = ".join(curves[i][0] for i in g) for g in groups if len(g) > 1]
 
 
 def to_svg(fig, prefix: str) -> str:
@@ -70,16 +97,21 @@ def to_svg(fig, prefix: str) -> str:
 def loads_figure(stages: list, prefix: str = "loads") -> str:
     """Fx, Fy, |F| and M over time, every stage on the same axes (paper 000 Fig. 4 style).
     ``stages``: list of (label, Analysis, simulated or None) with simulated = (t, F, M)."""
-    fig, axes = plt.subplots(2, 2, figsize=(9.0, 5.6), sharex=True)
+    fig, axes = plt.subplots(2, 2, figsize=(11.0, 6.4), sharex=True)
     panels = [
         (axes[0, 0], "Shaking force Fx (N)", lambda F, M: F[:, 0]),
         (axes[0, 1], "Shaking force Fy (N)", lambda F, M: F[:, 1]),
         (axes[1, 0], "Shaking force |F| (N)", lambda F, M: np.hypot(F[:, 0], F[:, 1])),
         (axes[1, 1], "Shaking moment M (N m)", lambda F, M: M),
     ]
+    notes: dict[str, list[str]] = {}  # coinciding groups -> the panels where they coincide
+    for ax, title, fn in panels:
+        same = coinciding([(label, fn(an.force, an.moment)) for label, an, _ in stages])
+        if same:
+            notes.setdefault("; ".join(same), []).append(title.split(" (")[0].replace("Shaking ", ""))
     for k, (label, an, sim) in enumerate(stages):
         for ax, title, fn in panels:
-            ax.plot(an.t, fn(an.force, an.moment), label=literal(label), **style(k))
+            ax.plot(an.t, fn(an.force, an.moment), label=literal(label), **marked(k, len(an.t)))
             if sim is not None:
                 ts, Fs, Ms = sim
                 ax.plot(ts, fn(Fs, Ms), color=SIM_COLORS[k % len(SIM_COLORS)], linestyle=":",
@@ -89,22 +121,30 @@ def loads_figure(stages: list, prefix: str = "loads") -> str:
         ax.set_xlabel("time (s)")
     handles, labels = axes[0, 0].get_legend_handles_labels()
     ncol = min(len(labels), 3)
-    fig.legend(handles, labels, loc="lower center", ncol=ncol, fontsize=8, frameon=False)
-    fig.tight_layout(rect=(0, 0.04 + 0.035 * math.ceil(len(labels) / ncol), 1, 1))
+    fig.legend(handles, labels, loc="lower center", ncol=ncol, fontsize=9.5, frameon=False)
+    bottom = 0.04 + 0.035 * math.ceil(len(labels) / ncol)
+    if notes:
+        lines = [f"Coincide in {', '.join(where)}: {groups}" for groups, where in notes.items()]
+        fig.text(0.01, bottom, "\n".join(lines), fontsize=8, color="0.25", va="bottom", ha="left", wrap=True)
+        bottom += 0.03 * len(lines) + 0.01
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     return to_svg(fig, prefix)
 
 
-def efforts_figure(stages: list, prefix: str = "efforts") -> str:
-    """Actuator torque (or force) of every driver, every stage."""
+def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = None) -> str:
+    """Actuator torque (or force) of every driver, every stage; ``units``: driver -> 'N m' or 'N'."""
+    units = units or {}
     names = sorted({n for _, an in stages for n in an.efforts})
     fig, axes = plt.subplots(1, max(1, len(names)), figsize=(4.6 * max(1, len(names)), 2.8), squeeze=False)
     for ax, name in zip(axes[0], names):
         for k, (label, an) in enumerate(stages):
             if name in an.efforts:
                 ax.plot(an.t, an.efforts[name], label=literal(label), **style(k))
-        ax.set_title(literal(f"Actuator effort: {name} (N m or N)"), fontsize=9)
+        u = units.get(name, "")
+        ax.set_title(literal(f"Actuator effort: {name}" + (f" ({u})" if u else "")), fontsize=9)
+        ax.set_ylabel({"N m": "torque (N m)", "N": "force (N)"}.get(u, "effort"))
         ax.set_xlabel("time (s)")
-    axes[0][0].legend(fontsize=7)
+    axes[0][0].legend(fontsize=8.5)
     fig.tight_layout()
     return to_svg(fig, prefix)
 
@@ -116,9 +156,11 @@ def _global_point(pose, p) -> np.ndarray:
 
 
 def mechanism_figure(model: Model, analysis, instants: int = 5, prefix: str = "mech",
-                     title: str = "") -> str:
+                     title: str = "", limits: tuple[float, float, float, float] | None = None) -> str:
     """The mechanism drawn at several instants (light to dark), counterweights as discs whose
-    area grows with their mass, gears as circles, and the paths of the link points."""
+    area grows with their mass, gears as circles, and the paths of the link points. The last
+    instant carries the spec's names (points, links, counterweights); ``limits`` (x0, y0, x1,
+    y1) gives every panel of a figure the same scale."""
     fig, ax = plt.subplots(figsize=(6.0, 4.6))
     N = len(analysis.t)
     ks = np.unique(np.linspace(0, N - 1, instants).round().astype(int))
@@ -160,18 +202,60 @@ def mechanism_figure(model: Model, analysis, instants: int = 5, prefix: str = "m
                 g = np.array([_global_point(pose, p) for p in pts])
                 ax.plot(g[:, 0], g[:, 1], color="black", alpha=alpha, linewidth=2.2, solid_capstyle="round")
                 ax.plot(g[:, 0], g[:, 1], "o", color="white", markeredgecolor="black", markersize=4, alpha=alpha)
+    _label_names(ax, model, poses[ks[-1]], span)
     for (a, b) in model.guides:
         ax.plot([a[0], b[0]], [a[1], b[1]], color="0.3", linewidth=1.0, linestyle="-")
     for name, p in model.frame_points.items():
         ax.plot(p[0], p[1], marker="^", color="black", markersize=9)
         ax.annotate(literal(name), p, textcoords="offset points", xytext=(4, -12), fontsize=8)
     ax.set_aspect("equal")
+    if limits is not None:
+        x0, y0, x1, y1 = limits
+        ax.set_xlim(x0, x1)
+        ax.set_ylim(y0, y1)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     if title:
         ax.set_title(literal(title), fontsize=9)
     fig.tight_layout()
     return to_svg(fig, prefix)
+
+
+def _label_names(ax, model: Model, pose_row: np.ndarray, span: float) -> None:
+    """Names of the spec at one instant: every body point (once per place), every link at the
+    middle of its outline, every counterweight and carried gear."""
+    placed: set[tuple[float, float]] = {(round(p[0] / span, 2), round(p[1] / span, 2)) for p in model.frame_points.values()}
+    for i, b in enumerate(model.bodies):
+        pose = pose_row[i]
+        for name, p in b.points.items():
+            g = _global_point(pose, p)
+            key = (round(g[0] / span, 2), round(g[1] / span, 2))
+            if key in placed:
+                continue
+            placed.add(key)
+            ax.annotate(name, g, textcoords="offset points", xytext=(5, 5), fontsize=8, color="0.15")
+        pts = [b.points[p] for p in b.outline]
+        if len(pts) >= 2:
+            mid = 0.5 * (_global_point(pose, pts[0]) + _global_point(pose, pts[1]))
+            ax.annotate(b.name, mid, textcoords="offset points", xytext=(0, -11), fontsize=7.5, color="tab:blue",
+                        ha="center", style="italic")
+        elif b.radius:
+            ax.annotate(b.name, _global_point(pose, (0, 0)), textcoords="offset points", xytext=(0, -11),
+                        fontsize=7.5, color="tab:green", ha="center", style="italic")
+        for a in b.attachments:
+            if a.kind == "counterweight" or a.radius:
+                ax.annotate(a.name, _global_point(pose, a.position), textcoords="offset points", xytext=(6, -3),
+                            fontsize=7.5, color="tab:red" if a.kind == "counterweight" else "tab:green")
+
+
+def common_limits(items: list[tuple[Model, np.ndarray]], pad: float = 0.08) -> tuple[float, float, float, float]:
+    """One box for every panel: every point, attachment and disc rim of every (model, poses)."""
+    from .player import _extent_points
+
+    xy = np.vstack([_extent_points(m, p) for m, p in items])
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    d = pad * float(max(hi - lo)) or 0.05
+    return (float(lo[0] - d), float(lo[1] - d), float(hi[0] + d), float(hi[1] + d))
 
 
 def _span(model: Model, poses: np.ndarray) -> float:
@@ -210,7 +294,7 @@ def drift_figure(runs: list, prefix: str = "drift") -> str:
     a2.set_title("Rotation of the free frame (deg)", fontsize=9)
     for a in (a1, a2):
         a.set_xlabel("time (s)")
-    a1.legend(fontsize=7)
+    a1.legend(fontsize=8.5)
     fig.tight_layout()
     return to_svg(fig, prefix)
 
@@ -228,13 +312,16 @@ def residual_figure(stages: list, prefix: str = "residuals") -> str:
     for a in (a1, a2):
         a.set_xlabel("time (s)")
         a.set_yscale("log")
-    a1.legend(fontsize=7)
+    a1.legend(fontsize=8.5)
     fig.tight_layout()
     return to_svg(fig, prefix)
 
 
-def overlay_figure(old, new, prefix: str = "overlay") -> str:
-    """One stage of two designs: Fx, Fy, |F| and M over time, old dashed grey, new solid black."""
+def overlay_figure(old, new, prefix: str = "overlay", round_off: tuple[bool, bool] = (False, False),
+                   scale: tuple[float, float] | None = None) -> str:
+    """One stage of two designs: Fx, Fy, |F| and M over time, old dashed grey, new solid black.
+    A load that is round-off in both designs (``round_off`` = (force, moment)) is drawn as zero
+    on the unbalanced ``scale`` (peak |F|, peak |M|), with a note, not as a signal."""
     fig, axes = plt.subplots(2, 2, figsize=(9.0, 5.2), sharex=False)
     panels = [
         (axes[0, 0], "Shaking force Fx (N)", lambda a: a.force[:, 0]),
@@ -242,9 +329,18 @@ def overlay_figure(old, new, prefix: str = "overlay") -> str:
         (axes[1, 0], "Shaking force |F| (N)", lambda a: np.hypot(a.force[:, 0], a.force[:, 1])),
         (axes[1, 1], "Shaking moment M (N m)", lambda a: a.moment),
     ]
-    for ax, title, fn in panels:
-        ax.plot(old.t, fn(old), color="0.55", linestyle="--", linewidth=1.6, label="old")
-        ax.plot(new.t, fn(new), color="black", linestyle="-", linewidth=1.3, label="new")
+    for n, (ax, title, fn) in enumerate(panels):
+        quiet = round_off[1] if n == 3 else round_off[0]
+        if quiet:
+            ax.plot(old.t, np.zeros_like(old.t), color="0.55", linestyle="--", linewidth=1.6, label="old")
+            ax.plot(new.t, np.zeros_like(new.t), color="black", linestyle="-", linewidth=1.3, label="new")
+            lim = (scale[1] if n == 3 else scale[0]) if scale else 1.0
+            ax.set_ylim(-1.05 * lim, 1.05 * lim)
+            ax.text(0.5, 0.85, "round-off in both designs (shown as 0,\non the unbalanced scale)", transform=ax.transAxes,
+                    ha="center", va="top", fontsize=8, color="0.3")
+        else:
+            ax.plot(old.t, fn(old), color="0.55", linestyle="--", linewidth=1.6, label="old")
+            ax.plot(new.t, fn(new), color="black", linestyle="-", linewidth=1.3, label="new")
         ax.set_title(literal(title), fontsize=9)
     for ax in axes[1]:
         ax.set_xlabel("time (s)")

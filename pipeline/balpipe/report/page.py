@@ -6,7 +6,8 @@ import numpy as np
 
 from .. import realisable
 from ..study import Study
-from . import figures
+from . import figures, present, toc
+from .inputs import input_rows
 from .render import environment
 from .results import joint_load_table
 
@@ -19,6 +20,13 @@ def shown_stages(study: Study) -> list:
     return [s for s in study.stages if s.stage.group == study.stages[0].stage.group]
 
 
+def drawn_times(study: Study) -> list[float]:
+    """The instants (s) the mechanism drawings show, as :func:`figures.mechanism_figure` picks them."""
+    t = study.stages[0].analysis.t
+    ks = np.unique(np.linspace(0, len(t) - 1, INSTANTS).round().astype(int))
+    return [float(t[k]) for k in ks]
+
+
 def study_figures(study: Study) -> dict:
     sims = []
     for s in shown_stages(study):
@@ -27,9 +35,13 @@ def study_figures(study: Study) -> dict:
     loads = figures.loads_figure(
         [(s.stage.label, s.analysis, sim) for s, sim in zip(shown_stages(study), sims)], prefix="loads"
     )
-    efforts = figures.efforts_figure([(s.stage.label, s.analysis) for s in shown_stages(study)], prefix="efforts")
+    efforts = figures.efforts_figure([(s.stage.label, s.analysis) for s in shown_stages(study)], prefix="efforts",
+                                     units={d.name: present.driver_unit(s.stage.model, d.name)
+                                            for s in shown_stages(study) for d in s.stage.model.drivers})
+    limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
     mech = [
-        (s.stage.label, figures.mechanism_figure(s.stage.model, s.analysis, INSTANTS, prefix=f"mech{k}", title=s.stage.label))
+        (s.stage.label, figures.mechanism_figure(s.stage.model, s.analysis, INSTANTS, prefix=f"mech{k}",
+                                                 title=s.stage.label, limits=limits))
         for k, s in enumerate(shown_stages(study))
     ]
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
@@ -62,7 +74,8 @@ def study_figures(study: Study) -> dict:
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
-def render_page(study: Study, results: dict, spec_text: str, history: dict | None = None) -> str:
+def render_page(study: Study, results: dict, spec_text: str, history: dict | None = None,
+                nav: dict | None = None) -> str:
     spec = study.spec
     validation_rows = []
     for s in study.stages:
@@ -90,7 +103,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                 "per_driver": ", ".join(f"{k} {v:.2g}" for k, v in sorted(q.tracking_error.items())),
             })
     rl = study.reactionless
-    return environment().get_template("spec.html").render(
+    return toc.add_toc(environment().get_template("spec.html").render(
         r=results,
         paper=spec.paper,
         description=spec.description,
@@ -102,6 +115,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                       "same_base": rl.same_base,
                       "player": rl.player()} if rl is not None else None,
         instants=INSTANTS,
+        instant_times=", ".join(f"{t:.4g}" for t in drawn_times(study)),
         joint_loads=joint_load_table(study),
         stage_names=[(s.stage.name, s.stage.label) for s in shown_stages(study)],
         group=study.stages[0].stage.group if len(shown_stages(study)) < len(study.stages) else "",
@@ -109,4 +123,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                    "floored": study.reference.floored},
         spec_text=spec_text,
         history=history,
-    )
+        actuators=results.get("actuators") or [],
+        nav=nav or {},
+        inputs=input_rows(spec),
+    ))

@@ -1,8 +1,9 @@
 """A small self-contained canvas player: the mechanism moving on its free-floating frame.
 
 The page embeds, per stage, the outline of every body (local points) and its pose at about 60
-frames, plus the frame's pose; a few lines of JavaScript draw them side by side. No library, no
-external file: a few kilobytes per page.
+frames, plus the frame's pose; a few lines of JavaScript draw them side by side. Controls:
+play/pause, a time slider, the speed (real time by default, the time scale shown); keyboard:
+Tab to the canvas, space to pause, arrows to step. No library, no external file.
 """
 
 from __future__ import annotations
@@ -79,21 +80,36 @@ def player_html(stages: list[dict], element_id: str = "player") -> str:
     # names are data: no '</script>' or '<!--' can end the script early
     payload = payload.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
     width = 300 * max(1, len(stages))
-    return f"""<canvas id="{element_id}" width="{width}" height="300" style="max-width:100%;border:1px solid #d9dee4"></canvas>
+    eid = element_id
+    return f"""<div class="player" id="{eid}-box">
+<canvas id="{eid}" width="{width}" height="300" style="max-width:100%;border:1px solid #d9dee4" role="img" aria-label="Animation of the mechanism on its free-floating frame, one panel per stage"></canvas>
+<div class="player-controls">
+<button type="button" id="{eid}-play" aria-controls="{eid}" aria-label="Pause">Pause</button>
+<label for="{eid}-time">time</label>
+<input type="range" id="{eid}-time" min="0" max="1000" step="1" value="0" aria-label="Time along the motion">
+<label for="{eid}-speed">speed</label>
+<select id="{eid}-speed" aria-label="Playback speed"><option value="0.1">0.1×</option><option value="0.25">0.25×</option><option value="0.5">0.5×</option><option value="1" selected>1× (real time)</option><option value="2">2×</option><option value="4">4×</option></select>
+<output id="{eid}-clock" for="{eid}-time" aria-live="off"></output>
+</div>
+</div>
 <script>
 (function() {{
 const D = {payload};
-const cv = document.getElementById("{element_id}"), g = cv.getContext("2d");
-const n = D.stages[0].t.length, W = 300, H = 300, b = D.box;
+const cv = document.getElementById("{eid}"), g = cv.getContext("2d");
+const btn = document.getElementById("{eid}-play"), slider = document.getElementById("{eid}-time");
+const speedSel = document.getElementById("{eid}-speed"), clock = document.getElementById("{eid}-clock");
+const W = 300, H = 300, b = D.box;
+const T0 = D.stages[0].t[0], T1 = D.stages[0].t[D.stages[0].t.length - 1], span = Math.max(T1 - T0, 1e-9);
 const s = Math.min(W / (b[2] - b[0]), (H - 40) / (b[3] - b[1]));
 function P(x, y, k) {{ return [k * W + (x - b[0]) * s, H - 30 - (y - b[1]) * s]; }}
 function T(pose, p) {{ const c = Math.cos(pose[2]), si = Math.sin(pose[2]);
   return [pose[0] + c * p[0] - si * p[1], pose[1] + si * p[0] + c * p[1]]; }}
-let f = 0;
+function frameAt(st, time) {{ let i = 0; while (i + 1 < st.t.length && st.t[i + 1] <= time + 1e-12) i++; return i; }}
+let time = T0, playing = true, last = null;
 function draw() {{
   g.clearRect(0, 0, cv.width, cv.height);
   D.stages.forEach((st, k) => {{
-    const i = Math.min(f, st.t.length - 1), base = st.base[i];
+    const i = frameAt(st, time), base = st.base[i];
     g.fillStyle = "#e8edf3"; g.strokeStyle = "#8aa4c0";
     g.beginPath(); st.pivots.forEach((p, j) => {{ const q = P(...T(base, p), k); j ? g.lineTo(...q) : g.moveTo(...q); }});
     g.closePath(); g.stroke();
@@ -108,7 +124,9 @@ function draw() {{
       if (sh.slider) {{ const c = P(...T(pose, [0, 0]), k); g.fillStyle = "#ccc"; g.fillRect(c[0] - 8, c[1] - 5, 16, 10); }}
       sh.gears.forEach(gr => {{ const c = P(...T(pose, gr), k); g.strokeStyle = "#2e8b57"; g.beginPath();
         g.arc(c[0], c[1], gr[2] * s, 0, 2 * Math.PI); g.stroke(); }});
-      sh.cw.forEach(cw => {{ const c = P(...T(pose, cw), k); g.fillStyle = "rgba(214,39,40,0.6)"; g.beginPath();
+      sh.cw.forEach(cw => {{ const c = P(...T(pose, cw), k), o = P(...T(pose, [0, 0]), k);
+        g.strokeStyle = "rgba(214,39,40,0.8)"; g.beginPath(); g.moveTo(...o); g.lineTo(...c); g.stroke();
+        g.fillStyle = "rgba(214,39,40,0.6)"; g.beginPath();
         g.arc(c[0], c[1], 3 + 2 * Math.sqrt(cw[2]), 0, 2 * Math.PI); g.fill(); }});
       if (sh.line.length > 1) {{ g.strokeStyle = "#111"; g.lineWidth = 3; g.beginPath();
         sh.line.forEach((p, m) => {{ const q = P(...T(pose, p), k); m ? g.lineTo(...q) : g.moveTo(...q); }}); g.stroke(); g.lineWidth = 1; }}
@@ -116,10 +134,28 @@ function draw() {{
     g.fillStyle = "#1d232b"; g.font = "12px sans-serif";
     g.fillText(st.label, k * W + 8, 16);
     const dx = base[0] * 1000, dy = base[1] * 1000, rot = base[2] * 180 / Math.PI;
-    g.fillText(`t = ${{st.t[i].toFixed(3)}} s  frame: (${{dx.toFixed(2)}}, ${{dy.toFixed(2)}}) mm, ${{rot.toFixed(3)}} deg`, k * W + 8, H - 8);
+    g.fillText(`frame: (${{dx.toFixed(2)}}, ${{dy.toFixed(2)}}) mm, ${{rot.toFixed(3)}} deg`, k * W + 8, H - 8);
   }});
-  f = (f + 1) % (n + 15);
+  slider.value = String(Math.round(1000 * (time - T0) / span));
+  clock.textContent = `t = ${{time.toFixed(3)}} s of ${{T1.toFixed(3)}} s · ${{speedSel.value}}× real time`;
 }}
-draw(); setInterval(draw, 50);
+function tick(now) {{
+  if (!playing) {{ last = null; return; }}
+  if (last !== null) {{ time += (now - last) / 1000 * parseFloat(speedSel.value);
+    if (time > T1) time = T0 + (time - T1) % span; }}
+  last = now; draw(); requestAnimationFrame(tick);
+}}
+function setPlaying(on) {{ playing = on; btn.textContent = on ? "Pause" : "Play"; btn.setAttribute("aria-label", btn.textContent);
+  cv.dataset.playing = on ? "1" : "0"; if (on) {{ last = null; requestAnimationFrame(tick); }} }}
+btn.addEventListener("click", () => setPlaying(!playing));
+slider.addEventListener("input", () => {{ setPlaying(false); time = T0 + span * parseInt(slider.value, 10) / 1000; draw(); }});
+speedSel.addEventListener("change", draw);
+cv.tabIndex = 0;
+cv.addEventListener("keydown", ev => {{
+  if (ev.key === " " || ev.key === "k") {{ ev.preventDefault(); setPlaying(!playing); }}
+  else if (ev.key === "ArrowRight" || ev.key === "ArrowLeft") {{ ev.preventDefault(); setPlaying(false);
+    time = Math.min(T1, Math.max(T0, time + (ev.key === "ArrowRight" ? 1 : -1) * span / 100)); draw(); }}
+}});
+draw(); setPlaying(!matchMedia("(prefers-reduced-motion: reduce)").matches);
 }})();
 </script>"""

@@ -26,18 +26,41 @@ def num(x, digits: int = 4) -> str:
     return f"{x:.{max(1, digits - 1)}e}"
 
 
-def ratio(x) -> str:
-    """A ratio to the unbalanced peak: percent when readable, otherwise scientific."""
+def ratio(x, tol: float | None = None) -> str:
+    """A ratio to a reference, one format for a whole column: percent (4 significant digits,
+    scientific inside the percent when tiny), or "N.NN ×" from ten times on. With ``tol`` (the
+    stage's balance tolerance) a ratio at or below it is round-off and shows as "~0"."""
     if x is None:
         return "—"
     x = float(x)
+    if not math.isfinite(x):
+        return str(x)
     if x == 0:
         return "0"
+    if tol is not None and abs(x) <= tol:
+        return "~0"
     if abs(x) >= 10:
-        return f"{x:.3g} ×"
-    if abs(x) >= 1e-3:
-        return f"{100 * x:.3g} %"
-    return f"{x:.2e}"
+        return f"{x:.4g} ×"
+    return f"{num(100 * x)} %"
+
+
+def tol(x) -> str:
+    """A tolerance as written in a spec: 1e-09 -> '1e-9'."""
+    if x is None:
+        return "—"
+    m, _, e = f"{float(x):.3g}".partition("e")
+    return f"{m}e{int(e)}" if e else m
+
+
+def load(x, ref, tolerance, unit_text: str = "", of: str = "reference") -> str:
+    """A peak load: "0 (< 1e-9 of reference)" when it is at most ``tolerance`` times ``ref``
+    (round-off of a balanced stage), otherwise :func:`num` with the unit."""
+    if x is None:
+        return "—"
+    suffix = f" {unit_text}" if unit_text else ""
+    if ref and tolerance is not None and abs(float(x)) <= float(tolerance) * abs(float(ref)):
+        return f"0 (< {tol(tolerance)} of {of})"
+    return num(x) + suffix
 
 
 _CONTROL = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f]")
@@ -65,6 +88,8 @@ def environment() -> jinja2.Environment:
     )
     env.filters["num"] = num
     env.filters["ratio"] = ratio
+    env.filters["tol"] = tol
+    env.filters["load"] = load
     env.filters["unit"] = unit
     env.filters["printable"] = printable
     env.globals["version"] = __version__

@@ -11,6 +11,7 @@ import numpy as np
 
 from .. import __version__
 from ..study import Study, stage_metrics
+from . import present
 
 SCHEMA_VERSION = 1
 
@@ -72,6 +73,10 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
         if simulated else None,
     }
     out["comparison"] = comparison(study, stages)
+    # what balancing costs a motor: peak, RMS effort and peak power per stage and driver
+    out["actuators"] = present.effort_rows(
+        [(s.stage.name, s.stage.label, s.stage.model, s.analysis) for s in study.stages])
+    out["moving_mass"] = sum(b.mass_properties()[0] for b in study.unbalanced.stage.model.bodies)
     if study.balance.details:
         out["balancing_details"] = study.balance.details
     out["paper"] = spec.paper  # the site index filters by it
@@ -163,5 +168,5 @@ def timeseries_csv(study: Study) -> str:
     buf.write(",".join(c for c, _ in cols) + "\n")
     data = np.column_stack([v for _, v in cols])
     for row in data:
-        buf.write(",".join(f"{v:.12g}" for v in row) + "\n")
+        buf.write(",".join(f"{v + 0.0:.12g}" for v in row) + "\n")  # + 0.0: no "-0"
     return buf.getvalue()

@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 
 from . import site_filter
-from .render import environment, num, printable
+from .render import environment, load, num, printable, ratio
 
 
 def _entry(out: Path, o) -> dict:
@@ -36,6 +36,7 @@ def _entry(out: Path, o) -> dict:
         "errors": printable(o.message) if o.status in ("error", "crash", "failed") else "",
         "error_short": printable((o.message.splitlines() or [""])[0]),
         "failed_link": f"{o.slug}/failed/index.html" if getattr(o, "kept_previous", False) else None,
+        "error_rest": printable("\n".join(o.message.splitlines()[1:])) if o.status in ("error", "crash", "failed") else "",
         "not_realisable": [],
     }
     if e["results"]:
@@ -44,9 +45,12 @@ def _entry(out: Path, o) -> dict:
         # the last stage compared with the first (a spec with several motions: of the first motion)
         last = [s for s in st if s.get("reference", first["name"]) == first["name"]][-1]
         e["not_realisable"] = [f"{s['label']}: {s['not_realisable']}" for s in st if s.get("realisable") is False]
-        e["peak_f"] = f"{num(first['max_shaking_force'])} → {num(last['max_shaking_force'])}"
-        e["peak_m"] = f"{num(first['max_shaking_moment'])} → {num(last['max_shaking_moment'])}"
+        tol = results.get("checks", {}).get("balance_tolerance")
+        ref = results.get("checks", {}).get("reference") or {}
+        e["peak_f"] = f"{num(first['max_shaking_force'])} → {load(last['max_shaking_force'], ref.get('force'), tol)}"
+        e["peak_m"] = f"{num(first['max_shaking_moment'])} → {load(last['max_shaking_moment'], ref.get('moment'), tol)}"
         e["added_mass"] = f"{num(last['added_mass'])} kg"
+        e.update(_costs(results, first, last))
         refs = results.get("references") or []
         agree = sum(r["status"] == "agrees" for r in refs)
         known = sum(r["status"] != "agrees" and r.get("expected") == "differ" for r in refs)
@@ -61,14 +65,80 @@ def _entry(out: Path, o) -> dict:
     return e
 
 
+def _costs(results: dict, first: dict, last: dict) -> dict:
+    """What each stage claims and whether it holds (a warning mark where a stage makes the
+    moment worse than its reference), and what balancing costs: added mass relative to the
+    moving mass, peak/RMS actuator effort and peak power per driver (unbalanced -> last stage),
+    the largest joint-load increase over the stages."""
+    tol = (results.get("checks") or {}).get("balance_tolerance")
+    claims = []
+    for s in results["stages"][1:]:
+        parts = [p for p in ("force", "moment") if p in (s.get("balances") or "")]
+        holds = all(s.get(f"{p}_balanced") for p in parts)
+        claims.append({
+            "label": s["label"], "claims": " and ".join(parts) or "—", "holds": holds if parts else None,
+            "realisable": s.get("realisable", True) is not False,
+            "worse": (s.get("moment_ratio") or 0.0) > 1.0 + 1e-9,
+            "moment": ratio(s.get("moment_ratio"), tol), "force": ratio(s.get("force_ratio"), tol),
+        })
+    mm = results.get("moving_mass") or 0.0
+    added = f"{num(last['added_mass'])} kg" + (f" ({ratio(last['added_mass'] / mm)} of {num(mm)} kg)" if mm else "")
+    acts = results.get("actuators") or []
+    efforts = []
+    for a0 in [a for a in acts if a["stage"] == first["name"]]:
+        a1 = next((a for a in acts if a["stage"] == last["name"] and a["driver"] == a0["driver"]), None)
+        if a1 is None:
+            continue
+        u = a0["unit"]
+        efforts.append(f"{a0['driver']}: peak {num(a0['peak'])} → {num(a1['peak'])} {u}, RMS {num(a0['rms'])} → "
+                       f"{num(a1['rms'])} {u}, power {num(a0['power'])} → {num(a1['power'])} W")
+    rows = (results.get("comparison") or {}).get("rows") or []
+    base = next((r for r in rows if r["stage"] == first["name"]), None)
+    joint = ""
+    if base is not None:
+        incs = [(r["max_joint_load"] - base["max_joint_load"], r) for r in rows if r["design"] == base["design"]]
+        inc, r = max(incs, key=lambda x: x[0]) if incs else (0.0, base)
+        if inc > 0:
+            joint = (f"+{num(inc)} N ({r['label']}, joint {r['max_joint_load_joint']}; "
+                     f"{ratio(inc / base['max_joint_load']) if base['max_joint_load'] else '—'} of {num(base['max_joint_load'])} N)")
+        else:
+            joint = "none"
+    return {"claims": claims, "added_mass": added, "efforts": efforts, "joint_increase": joint}
+
+
 def write_site(out: Path, outcomes: list) -> None:
     entries = [_entry(out, o) for o in sorted(outcomes, key=lambda o: o.source)]
     n_ok = sum(e["status"] == "ok" for e in entries)
     n_flagged = sum(e["status"] == "ok" and bool(e["not_realisable"]) for e in entries)
+    n_invalid = sum(e["status"] == "invalid spec" for e in entries)  # the command line's counts
     html = environment().get_template("index.html").render(
-        entries=entries, n_ok=n_ok - n_flagged, n_failed=len(entries) - n_ok, n_flagged=n_flagged,
+        entries=entries, n_ok=n_ok - n_flagged, n_failed=len(entries) - n_ok - n_invalid, n_flagged=n_flagged,
+        n_invalid=n_invalid, n_ok_cli=n_ok,
         filters=site_filter.options(entries),
     )
     from ..build import write_file_atomic  # replaced in one step, never through a planted symlink
 
     write_file_atomic(out / "index.html", html)
+    write_file_atomic(out / "site_nav.js", site_nav_script(entries))
+
+
+def site_nav_script(entries: list[dict]) -> str:
+    """``site_nav.js``: previous/next links between the study pages in the index's order,
+    written once per build so that a cached page needs no rebuild when another spec changes."""
+    pages = [[e["link"].split("/")[0], e["title"]] for e in entries if e.get("link")]
+    data = json.dumps(pages, separators=(",", ":"), sort_keys=True, ensure_ascii=False)
+    return f"""// previous/next between the studies of this site (written by balpipe build)
+(function() {{
+const P = {data};
+const here = location.pathname.split("/").slice(-2)[0];
+const k = P.findIndex(p => p[0] === here);
+if (k < 0) return;
+function link(p, rel, text) {{ const a = document.createElement("a"); a.href = "../" + p[0] + "/index.html";
+  a.rel = rel; a.textContent = text + p[1]; return a; }}
+document.querySelectorAll(".sitenav").forEach(el => {{
+  if (k > 0) el.append(" · ", link(P[k - 1], "prev", "\u2190 previous: "));
+  if (k < P.length - 1) el.append(" · ", link(P[k + 1], "next", "next: "));
+  if (k < P.length - 1) el.lastChild.textContent += " \u2192";
+}});
+}})();
+"""
