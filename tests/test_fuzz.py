@@ -178,6 +178,14 @@ def _assert_located(exc: SpecErrors) -> None:
         assert "Traceback" not in e.message and "Input should be" not in e.message, e.message
 
 
+def _load_or_fail_located(text: str) -> None:
+    """The loader takes ``text`` or refuses it with located errors only, never another exception."""
+    try:
+        load_text(text, "s.yaml")
+    except SpecErrors as exc:
+        _assert_located(exc)
+
+
 # --- the suite --------------------------------------------------------------------------------
 
 @fuzz_settings(ci=150, long=20000)
@@ -186,11 +194,7 @@ def _assert_located(exc: SpecErrors) -> None:
 @example({"": 1, " a": 2})
 def test_random_documents_load_or_fail_located(doc):
     COUNT["loader"] += 1
-    text = yaml.safe_dump(doc, allow_unicode=True) if not isinstance(doc, str) else doc
-    try:
-        load_text(text, "s.yaml")
-    except SpecErrors as exc:
-        _assert_located(exc)
+    _load_or_fail_located(yaml.safe_dump(doc, allow_unicode=True) if not isinstance(doc, str) else doc)
 
 
 @fuzz_settings(ci=60, long=8000)
@@ -200,10 +204,7 @@ def test_random_documents_load_or_fail_located(doc):
 @example("name: x\n'function-after[x]': 1\n")
 def test_mutated_specs_load_or_fail_located(text):
     COUNT["mutations"] += 1
-    try:
-        load_text(text, "s.yaml")
-    except SpecErrors as exc:
-        _assert_located(exc)
+    _load_or_fail_located(text)
 
 
 @fuzz_settings(ci=10, long=1500)

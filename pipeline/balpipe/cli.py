@@ -72,15 +72,23 @@ def _missing(paths: list[str]) -> list[str]:
     return [p for p in paths if not Path(p).exists()]
 
 
+def paths_jobs_problem(paths: list[str], jobs: int) -> str | None:
+    """What is wrong with the spec paths and ``--jobs`` of a command that runs specs in parallel
+    (``build``, ``history``): a usage error to print, or None."""
+    missing = _missing(paths)
+    if missing:
+        return f"no such file or folder: {', '.join(missing)}"
+    if jobs < 1:
+        return "--jobs must be at least 1"
+    return None
+
+
 def cmd_build(args) -> int:
     from .build import Options, build
 
-    missing = _missing(args.paths)
-    if missing:
-        print(f"balpipe: error: no such file or folder: {', '.join(missing)}", file=sys.stderr)
-        return EXIT_USAGE
-    if args.jobs < 1:
-        print("balpipe: error: --jobs must be at least 1", file=sys.stderr)
+    problem = paths_jobs_problem(args.paths, args.jobs)
+    if problem:
+        print(f"balpipe: error: {problem}", file=sys.stderr)
         return EXIT_USAGE
     opts = Options(out=Path(args.out), simulate=not args.no_sim, force=args.force)
 

@@ -32,13 +32,11 @@ def add_parser(sub) -> argparse.ArgumentParser:
 
 def cmd_history(args) -> int:
     from . import history
+    from .cli import paths_jobs_problem
 
-    missing = [p for p in args.paths if not Path(p).exists()]
-    if missing:
-        print(f"balpipe: error: no such file or folder: {', '.join(missing)}", file=sys.stderr)
-        return EXIT_USAGE
-    if args.jobs < 1:
-        print("balpipe: error: --jobs must be at least 1", file=sys.stderr)
+    problem = paths_jobs_problem(args.paths, args.jobs)
+    if problem:
+        print(f"balpipe: error: {problem}", file=sys.stderr)
         return EXIT_USAGE
     if args.max_commits is not None and args.max_commits < 1:
         print("balpipe: error: --max-commits must be at least 1", file=sys.stderr)

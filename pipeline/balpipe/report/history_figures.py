@@ -69,15 +69,15 @@ def _plot(ax, x, y, k: int, label: str) -> None:
     ax.plot(x, y, marker="o", markersize=3.5, label=label, **st)
 
 
-def loads_history_figure(commits: list[dict], prefix: str = "hist-loads") -> str:
-    """Peak shaking force |F| and moment |M| of every stage, per commit."""
-    stages = _stage_names(commits)
+def _panels_figure(commits: list[dict], stages: list[tuple[str, str]], panels: tuple[tuple[str, str], ...],
+                   height: float, first_style: int, prefix: str) -> str:
+    """Two panels, one per (results key, title) in ``panels``: every stage's value per commit,
+    one legend under both."""
     x = np.arange(len(commits))
-    fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.4))
-    for ax, key, title in ((axes[0], "max_shaking_force", "Peak shaking force |F| (N)"),
-                           (axes[1], "max_shaking_moment", "Peak shaking moment |M| (N m)")):
+    fig, axes = plt.subplots(1, 2, figsize=(9.0, height))
+    for ax, (key, title) in zip(axes, panels):
         for k, (name, label) in enumerate(stages):
-            _plot(ax, x, _series(commits, name, key), k, label)
+            _plot(ax, x, _series(commits, name, key), k + first_style, label)
         ax.set_title(title, fontsize=9)
         _commit_axis(ax, commits)
     handles, labels = axes[0].get_legend_handles_labels()
@@ -85,24 +85,20 @@ def loads_history_figure(commits: list[dict], prefix: str = "hist-loads") -> str
         fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 4), fontsize=8, frameon=False)
     fig.tight_layout(rect=(0, 0.08, 1, 1))
     return to_svg(fig, prefix)
+
+
+def loads_history_figure(commits: list[dict], prefix: str = "hist-loads") -> str:
+    """Peak shaking force |F| and moment |M| of every stage, per commit."""
+    return _panels_figure(commits, _stage_names(commits),
+                          (("max_shaking_force", "Peak shaking force |F| (N)"),
+                           ("max_shaking_moment", "Peak shaking moment |M| (N m)")), 3.4, 0, prefix)
 
 
 def added_history_figure(commits: list[dict], prefix: str = "hist-added") -> str:
     """Mass and rotating inertia that each balancing stage adds to the unbalanced mechanism."""
-    stages = _stage_names(commits)[1:] or _stage_names(commits)
-    x = np.arange(len(commits))
-    fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.2))
-    for ax, key, title in ((axes[0], "added_mass", "Added mass (kg)"),
-                           (axes[1], "added_inertia", "Added inertia (kg m²)")):
-        for k, (name, label) in enumerate(stages):
-            _plot(ax, x, _series(commits, name, key), k + 1, label)
-        ax.set_title(title, fontsize=9)
-        _commit_axis(ax, commits)
-    handles, labels = axes[0].get_legend_handles_labels()
-    if labels:
-        fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 4), fontsize=8, frameon=False)
-    fig.tight_layout(rect=(0, 0.08, 1, 1))
-    return to_svg(fig, prefix)
+    return _panels_figure(commits, _stage_names(commits)[1:] or _stage_names(commits),
+                          (("added_mass", "Added mass (kg)"), ("added_inertia", "Added inertia (kg m²)")),
+                          3.2, 1, prefix)
 
 
 def _parameters(commits: list[dict]) -> list[tuple[str, str]]:

@@ -10,6 +10,7 @@ One module per job:
 * :mod:`.floating`: the reactionless demonstration on a free-floating frame;
 * :mod:`.torque`: the torque-driven run, which checks the inverse dynamics (the actuators apply
   the engine's efforts; pymunk integrates the motion).
+* :mod:`.verdict`: the pass/fail verdict the results share.
 
 Public API
     ``validate(model, analysis, unbalanced_peaks, settings=None, expect=()) -> StageValidation``

@@ -100,9 +100,10 @@ from ..engine import Analysis
 from ..model import Model
 from .run import SimulationRun, _model_scale, _relative_poses, _run_adaptive
 from .settings import MAX_ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings
+from .verdict import Verdict
 
 @dataclass
-class StageValidation:
+class StageValidation(Verdict):
     """The simulation of one stage against its analysis.
 
     Curves on the analysis grid ``t``: ``force`` (N, 2), ``moment`` (N,) (simulated, same
@@ -157,16 +158,10 @@ class StageValidation:
     moment_reference: float = math.nan
     reference_basis: str = "force: unbalanced peak; moment: unbalanced peak"
 
-    @property
-    def status(self) -> str:
-        return "pass" if self.passed else "fail"
-
     def to_json(self) -> dict:
         """Plain, deterministic summary (no curves, no wall-clock times)."""
         return {
-            "passed": bool(self.passed),
-            "status": self.status,
-            "reasons": "; ".join(self.reasons),
+            **self.verdict_json(),
             "force_residual": float(self.force_residual),
             "moment_residual": float(self.moment_residual),
             "force_peak": float(self.force_peak),

@@ -50,6 +50,7 @@ from .loads import _on_grid  # the same sampling of the loads as the position-dr
 from .run import SimulationRun, simulate
 from .settings import ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings
 from .space import build_space
+from .verdict import Verdict
 
 __all__ = ["TorqueDriven", "torque_driven", "floored_model", "TRACKING_TOLERANCE", "CALIBRATION_FACTOR"]
 
@@ -63,7 +64,7 @@ MIN_RESOLUTION = 10.0
 
 
 @dataclass
-class TorqueDriven:
+class TorqueDriven(Verdict):
     """One stage driven by its actuators' efforts.
 
     Curves on the analysis grid ``t``: ``force`` (N, 2), ``moment`` (N,): simulated shaking
@@ -103,15 +104,9 @@ class TorqueDriven:
     notes: list[str] = field(default_factory=list)
     timing: dict[str, float] = field(default_factory=dict)
 
-    @property
-    def status(self) -> str:
-        return "pass" if self.passed else "fail"
-
     def to_json(self) -> dict:
         return {
-            "passed": bool(self.passed),
-            "status": self.status,
-            "reasons": "; ".join(self.reasons),
+            **self.verdict_json(),
             "tracking_error": {k: float(v) for k, v in sorted(self.tracking_error.items())},
             "travel": {k: float(v) for k, v in sorted(self.travel.items())},
             "tracking_error_max": float(self.tracking_error_max),
