@@ -249,7 +249,20 @@ def _check_nesting(text: str, file: str) -> None:
     """Nesting depth from the event stream (iterative: a deeply nested document would otherwise
     overflow the C composer's stack) before any tree is built."""
     depth = 0
-    for ev in yaml.parse(text, Loader=_Loader):
+    events = yaml.parse(text, Loader=_Loader)
+    while True:
+        try:
+            ev = next(events)
+        except StopIteration:
+            return
+        except yaml.YAMLError as exc:
+            # PyYAML >= 6.0.4 has a nesting limit of its own, which a document far deeper than
+            # ours reaches first: the same refusal, in the same words on every PyYAML
+            if "nesting depth" in str(getattr(exc, "problem", "") or ""):
+                m = exc.problem_mark
+                raise SpecErrors([SpecError(file, m.line + 1 if m else None, m.column + 1 if m else None, "",
+                                            f"nested deeper than {MAX_DEPTH} levels (limit)")]) from None
+            raise
         if isinstance(ev, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
             depth += 1
             if depth > MAX_DEPTH:
