@@ -28,7 +28,7 @@ from pydantic import Field
 from ..mechanisms import rpr3
 from ..model import FRAME, Body, Model, Revolute
 from ..spec_parts import LinkSpec, SpecFieldError, Strict
-from ..units import Length
+from ..units import Length, Sign
 from .base import BalanceResult, Parameter, Stage
 from .parts import add_counter_rotation, add_counterweight
 
@@ -51,7 +51,7 @@ class Rpr3IdlerLoop(Strict):
     E: tuple[Length, Length] = Field((0.0, 0.0), description="base pivot E of the idler loop (the paper: O)")
     link5: LinkSpec = Field(description="link 5, EF (length L5, centre of mass r5 L5 from E)")
     link6: LinkSpec = Field(description="link 6, FP (length L6, centre of mass r6 L6 from F)")
-    branch: Literal[1, -1] = Field(
+    branch: Sign = Field(
         1, description="+1: F on the left of the line E -> P at t = 0, -1: on its right (the paper: -1, F above E)"
     )
     counterweights: IdlerCounterweights

@@ -31,7 +31,7 @@ from pydantic import Field
 from ..mechanisms import rpr3
 from ..model import FRAME, Body, Model, Revolute
 from ..spec_parts import LinkSpec, SpecFieldError, Strict
-from ..units import Length
+from ..units import Length, Sign
 from .base import BalanceResult, Parameter, Stage
 from .parts import add_counter_rotation, add_counterweight
 from .slider_crank import eq20_lhs
@@ -57,7 +57,7 @@ class Rpr3ScottRussell(Strict):
     method: Literal["rpr3_scott_russell"] = Field(description="balancing method")
     crank: LinkSpec = Field(description="link 1, AB, pivoted on the base at A_i (the paper's L1, m1, r1, I1)")
     coupler: LinkSpec = Field(description="link 2, BC, pinned to the piston at C (L2 = L1, m2, r2, I2)")
-    branch: Literal[1, -1] = Field(1, description="+1: B on the left of the leg axis A_i -> C_i, -1: on its right")
+    branch: Sign = Field(1, description="+1: B on the left of the leg axis A_i -> C_i, -1: on its right")
     counterweights: ScottRussellCounterweights
     moment_unknown: MomentUnknown | None = Field(
         None,

@@ -38,7 +38,7 @@ from .. import units
 from ..model import FRAME, Body, Driver, Law, Model, Revolute
 from ..motion import law_for
 from ..spec_parts import SpecFieldError, Strict
-from ..units import Inertia, Length, Mass, PositiveLength
+from ..units import Inertia, Length, Mass, PositiveLength, Sign
 
 PLATFORM_PATH = ("motion", "drive", "platform")
 LEGS = (1, 2, 3, 4)
@@ -65,7 +65,7 @@ class LegSpec(Strict):
     )
     proximal: RRRLink = Field(description="link l_i1, A_iB_i")
     distal: RRRLink = Field(description="link l_i2, B_iC_i")
-    elbow: Literal[1, -1] | None = Field(
+    elbow: Sign | None = Field(
         None, description="+1: B_i on the counter-clockwise side of A_iC_i (default +1, or derived)"
     )
 

@@ -31,7 +31,7 @@ from .. import units
 from ..model import FRAME, Attachment, Body, Driver, Law, Model, Revolute
 from ..motion import law_for
 from ..spec_parts import LinkSpec, SpecFieldError, Strict
-from ..units import Angle, Inertia, Length, Mass
+from ..units import Angle, Inertia, Length, Mass, Sign
 
 DRIVE = ("motion", "drive")
 
@@ -53,7 +53,7 @@ class SerialArmMechanism(Strict):
     base: tuple[Length, Length] = Field((0.0, 0.0), description="position of joint 1 on the frame")
     links: list[LinkSpec] = Field(min_length=1, max_length=12, description="links 1..n from the base to the tip")
     payload: Payload | None = Field(None, description="payload on the last link")
-    working_mode: Literal[1, -1] = Field(
+    working_mode: Sign = Field(
         1,
         description="branch of the inverse kinematics of a task-space motion (tip or centre of "
         "mass): +1 is the '+' root of paper 003's eq. 8, the elbow turned clockwise "
