@@ -25,18 +25,10 @@ from balpipe.balancing import least_mass as LM
 from balpipe.balancing import rrr4 as recipe
 from balpipe.balancing import rrr4_generic as G
 from balpipe.loader import load
+from bench_generic import best  # noqa: E402  (benchmarks/ is on sys.path when run as a script)
 
 ROOT = Path(__file__).resolve().parent.parent
 SPECS = [ROOT / "specs" / "paper001_4rrr.yaml", ROOT / "specs" / "paper001_4rrr_fig6a.yaml"]
-
-
-def best(fn, repeats: int = 5):
-    times, out = [], None
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
 
 
 def main() -> None:

@@ -17,24 +17,9 @@ from balpipe.balancing import rrr4_generic as G
 from balpipe.engine import analyse
 from balpipe.mechanisms.rrr4 import mass_parameters
 from balpipe.balancing.parts import add_counterweight
-from test_rrr4 import paper_data, regular_random, spec_of
+from test_rrr4 import paper_data, regular_random, spec_of, special_data
 
 TOL = 1e-9
-
-
-def special_data(kind: str) -> dict:
-    """The paper spec with the special kinematics of Fig. 5a / 5b and a translating platform."""
-    data = paper_data()
-    legs = data["mechanism"]["legs"]
-    for i in (3, 4):
-        legs[i] = {"proximal": {"mass": 0.7, "com": 0.12, "inertia": 0.005},
-                   "distal": {"mass": 0.5, "com": 0.1, "com_offset": 0.01, "inertia": 0.004}}
-    legs[1]["pivot"] = [-0.35, -0.1]
-    legs[2]["pivot"] = [0.3, -0.25]
-    data["mechanism"]["kinematics"] = kind
-    data["motion"]["drive"]["platform"] = {"from": [-0.04, -0.03, 0.0], "to": [0.03, 0.02, 0.0]}
-    data["analysis"] = {"samples": 101}
-    return data
 
 
 def test_finder_parameters_are_the_papers():
