@@ -32,6 +32,7 @@ class Template:
     build: Callable[..., Model]
     label: str
     figures: Callable[..., Any] | None = None
+    notation: Any = None  # the papers' symbols of the inputs: a table or table(mechanism_spec) (balpipe.notation)
 
 
 @dataclass(frozen=True)
@@ -43,6 +44,7 @@ class Method:
     label: str
     uses_spec: bool = False  # balance(..., spec): the method also reads the motion and analysis settings
     generic: bool = False  # applies to every template; balance() also receives the time grid t
+    notation: Any = None  # the papers' symbols of the inputs: a table or table(method_spec) (balpipe.notation)
 
 
 TEMPLATES: dict[str, Template] = {
@@ -87,6 +89,19 @@ METHODS.update({
     ),
     "stages": Method(generic_stages.balance, (), "stages written by hand, each adding parts", generic=True),
 })
+
+# the papers' symbols of each template's and method's inputs (balpipe.notation, the inputs table)
+for _name, _table in (("slider_crank", slider_crank.NOTATION), ("custom", custom.notation),
+                      ("five_bar", five_bar.NOTATION), ("rrr4", rrr4.NOTATION), ("rpr3", rpr3.NOTATION),
+                      ("serial_arm", serial_arm.notation)):
+    TEMPLATES[_name] = replace(TEMPLATES[_name], notation=_table)
+for _name, _table in (("slider_crank_counterweights", sc_balancing.NOTATION),
+                      ("five_bar_gear_balancing", fb_balancing.NOTATION),
+                      ("rrr4_counter_masses", rrr4_balancing.NOTATION), ("rpr3_idler_loop", rpr3_idler.NOTATION),
+                      ("rpr3_scott_russell", rpr3_scott_russell.NOTATION), ("gear_decoupling", decoupling.NOTATION),
+                      ("com_motion_planning", com_planning.NOTATION), ("force_balance", generic_force.notation),
+                      ("moment_balance", generic_moment.notation), ("stages", generic_stages.notation)):
+    METHODS[_name] = replace(METHODS[_name], notation=_table)
 
 
 def scalar_laws(motion: Any, dims: dict[str, str]) -> dict[str, Law]:

@@ -703,3 +703,32 @@ def _square_figure(study, info, plt, to_svg):
            "counter-clockwise from P1 at the " + (method.test_square.first_corner if method.test_square else "—") +
            " corner (our reading of the figure, which reproduces the paper's list of segments). Arrows: the tip's "
            "straight paths of case 1; dashed: the centre of mass' straight paths of cases 2-3. Base joint: triangle.")
+
+
+def _notation() -> dict:
+    from ..notation import Sym, ours
+
+    return {
+        "balancing.test_square.centre": Sym("E", "centre of the tested square (Fig. 2)"),
+        "balancing.test_square.side": ours("a", "edge length of the tested square"),
+        "balancing.test_square.divisions": ours("n_{div}", "segments per edge (points P_1, P_2, ...)"),
+        "balancing.test_square.first_corner": ours("P_1", "corner of P_1, points numbered counter-clockwise"),
+        "balancing.trajectories[<k>]": Sym("P_iP_j", "tip trajectory <k> between two points of the square"),
+        "balancing.trajectories[<k>].name": ours("name", "label of trajectory <k>"),
+        "balancing.trajectories[<k>].start": ours("x_0", "start point of the tip on trajectory <k>"),
+        "balancing.trajectories[<k>].end": ours("x_f", "end point of the tip on trajectory <k>"),
+        "balancing.orientation.start": Sym("φ_0", "orientation φ of the last link at the start of every trajectory"),
+        "balancing.orientation.end": Sym("φ_f", "orientation φ at the end"),
+        "balancing.phi.degree": ours("deg φ", "degree of the polynomial law of φ (ends fixed to second order)"),
+        "balancing.phi.starts": ours("starts", "multi-start: the 3-4-5 law plus random points"),
+        "balancing.phi.seed": ours("seed", "seed of the random starting points"),
+        "balancing.phi.spread": ours("σ_c", "spread of the random starting coefficients"),
+        "balancing.phi.max_evaluations": ours("evaluations", "objective evaluations per start (Nelder-Mead)"),
+        "balancing.phi.tolerance": ours("tol", "Nelder-Mead tolerance"),
+        "balancing.torque_rate_limit": ours("|τ̇|_{max}", "case 3: largest rate of change of any actuator torque (the paper: 3·10^4 N m/s)", unit="N m/s"),
+        "balancing.rate_samples": ours("N_{rate}", "case 3: samples on which torque rates are measured"),
+    }
+
+
+#: Paper 003's symbols (Sec. 3, Fig. 2) for this method's inputs.
+NOTATION = _notation()

@@ -287,3 +287,41 @@ def figures(study, info: dict):
            "Each joint's actuator torque against its own acceleration at every sample: coupled and "
            "nonlinear before, on the line tau = J q'' after decoupling"
            + (" (with gravity on, the decoupled arm's total centre of mass is on A: no gravity torque)." if study.spec.analysis.gravity else "."))
+
+
+def _notation() -> dict:
+    """Paper 002's symbols (Figs. 1, 3-4, eqs. 3-16): joints A, B, centres of mass S_1, S_2,
+    angles θ_1, θ_2; they replace the serial arm's generic ones for the 2R arm."""
+    from ..notation import Sym, drive_table, ours
+
+    table = drive_table({"q1": Sym("θ_1", "angle of link 1 relative to the base"),
+                         "q2": Sym("θ_2", "angle of link 2 relative to link 1")}, end_time="T")
+    table.update({
+        "mechanism.base": Sym("A", "joint A of link 1 on the frame"),
+        "mechanism.links[0].length": Sym("l_1", "length AB of link 1"),
+        "mechanism.links[0].mass": Sym("m_1", "mass of link 1"),
+        "mechanism.links[0].com": Sym("l_{AS1}", "distance of link 1's centre of mass S_1 from A"),
+        "mechanism.links[0].com_offset": ours("e_1", "offset of S_1 normal to AB"),
+        "mechanism.links[0].inertia": Sym("I_{S1}", "axial moment of inertia of link 1 about S_1"),
+        "mechanism.links[1].length": Sym("l_2", "length of link 2 from B"),
+        "mechanism.links[1].mass": Sym("m_2", "mass of link 2"),
+        "mechanism.links[1].com": Sym("l_{BS2}", "distance of link 2's centre of mass S_2 from B"),
+        "mechanism.links[1].com_offset": ours("e_2", "offset of S_2 normal to link 2"),
+        "mechanism.links[1].inertia": Sym("I_{S2}", "axial moment of inertia of link 2 about S_2"),
+        "motion.duration": ours("T", "duration of the motion"),
+        "balancing.gear_1p.position": Sym("l_{AC}", "position of gear 1''s axis C along link 1 from A"),
+        "balancing.gear_1p.mass": Sym("m_{1'}", "mass of gear 1'"),
+        "balancing.gear_1p.ratio": ours("U_{1'2}", "ω_1' − ω_1 = U (ω_2 − ω_1); −1 for identical gears"),
+        "balancing.gear_2p.mass": Sym("m_{2'}", "mass of gear 2', fixed on link 2 at B"),
+        "balancing.gear_2p.inertia": Sym("I_{S2'}", "axial moment of inertia of gear 2'"),
+        "balancing.counterweights.link1.distance": ours("l_{A,cw1}", "distance of link 1's counterweight from A (puts the total centre of mass on A)"),
+        "balancing.counterweights.link1.inertia": ours("I_{cw1}", "centroidal inertia of link 1's counterweight"),
+        "balancing.counterweights.link2.distance": ours("l_{B,cw2}", "distance of link 2's counterweight from B (puts link 2 + gear 2' centre of mass on B)"),
+        "balancing.counterweights.link2.inertia": ours("I_{cw2}", "centroidal inertia of link 2's counterweight"),
+        "balancing.counter_rotation.position": ours("O_3", "centre of the counter-rotating gear 3 on the frame (I_3 = J_1)"),
+    })
+    return table
+
+
+#: Paper 002's symbols for this method's inputs and for the 2R arm it balances.
+NOTATION = _notation()

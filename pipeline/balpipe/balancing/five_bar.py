@@ -370,3 +370,27 @@ def _full_stage(model: Model, links: dict[str, Body], I: dict[str, float], mech:
             Gear(f"{j + 2}'-{j + 5}", dist, name, prox, -U, None, U * r_planet, r_planet, cr.pressure_angle),
         ]
     return full.add(tuple(new_bodies), tuple(new_joints), init)
+
+
+def _notation() -> dict:
+    from ..notation import Sym, ours
+
+    return {
+        "balancing.counterweights.proximal": Sym(
+            "−r_{CW1} = −r_{CW2}", "counterweights 1, 2 along A_jB_j from A_j (negative: beyond A_j, at r_{CW} from it)"),
+        "balancing.counterweights.distal": Sym(
+            "−r_{CW3} = −r_{CW4}", "counterweights 3, 4 along B_jP from B_j (negative: beyond B_j)"),
+        "balancing.counter_rotation.ratio": Sym("U_{63} = U_{74}", "ratios of the planetary gears 6, 7 to gears 3', 4'"),
+        "balancing.counter_rotation.gear_3p.mass": Sym("m_{3'} = m_{4'}", "mass of gears 3', 4' on the distal links at B_j"),
+        "balancing.counter_rotation.gear_3p.inertia": Sym("I_{3'} = I_{4'}", "axial moment of inertia of gears 3', 4'"),
+        "balancing.counter_rotation.planet_mass": ours("m_6 = m_7", "mass of the planetary gears 6, 7 (their inertias are computed, eqs. 20-21)"),
+        "balancing.counter_rotation.gear_1p_inertia": Sym("I_{1'} = I_{2'}", "axial moment of inertia of gears 1', 2' in the moment-balanced design"),
+        "balancing.counter_rotation.pressure_angle": ours("α", "pressure angle of the meshes 3'-6 and 4'-7"),
+        "balancing.balanced_inertias.proximal": Sym("I_1 = I_2", "centroidal inertia of the balanced input links (link + counterweight), as eq. 17 reads it"),
+        "balancing.balanced_inertias.distal": Sym("I_3 = I_4", "centroidal inertia of the balanced distal links, as eq. 17 reads it"),
+        "balancing.point_mass_stage": ours("point masses", "also analyse the balancing with point-mass counterweights on the bare links"),
+    }
+
+
+#: Paper 004's symbols (eqs. 9-21, Sec. VI) for this method's inputs.
+NOTATION = _notation()

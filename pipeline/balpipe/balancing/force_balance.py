@@ -157,3 +157,27 @@ def balance(mech, method: ForceBalance, model: Model, t: np.ndarray) -> BalanceR
               "counterweights of least added mass meeting every force-balance condition", balances="force"),
     ]
     return BalanceResult(params, stages, notes, details={"force_balance": details})
+
+
+def counterweight_notation(counterweights: list[CounterweightRegionSpec], root: str = "balancing") -> dict:
+    """Symbols of the allowed counterweight regions, named after each counterweight:
+    r_<name> for a fixed position, its segment's ends, its disc's centre and radius."""
+    from ..notation import ours
+
+    table = {}
+    for k, c in enumerate(counterweights):
+        p, n = f"{root}.counterweights[{k}]", c.name or f"cw_{c.body}"
+        table.update({
+            f"{p}.body": ours(f"`{n}`", f"the body that carries `{n}`"),
+            f"{p}.at": ours(f"r_{{{n}}}", f"position of `{n}` on `{c.body}` (fixed)"),
+            f"{p}.segment[0]": ours(f"`{n}`", f"`{n}` anywhere on a segment of `{c.body}`: first end"),
+            f"{p}.segment[1]": ours(f"`{n}`", f"`{n}` anywhere on a segment of `{c.body}`: second end"),
+            f"{p}.disc.centre": ours(f"`{n}`", f"`{n}` anywhere in a disc on `{c.body}`: its centre"),
+            f"{p}.disc.radius": ours(f"`{n}`", f"`{n}` anywhere in a disc on `{c.body}`: its radius"),
+        })
+    return table
+
+
+def notation(method: ForceBalance) -> dict:
+    """Symbols of this method's inputs, named after the spec's counterweights."""
+    return counterweight_notation(method.counterweights)

@@ -237,3 +237,31 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
               balances="force+moment" if cancelled else "force"),
     ]
     return BalanceResult(params, stages, notes, details=details)
+
+
+def counter_rotation_notation(discs: list, root: str) -> dict:
+    """Symbols of counter-rotating discs named after each disc: U_<disc>, m_<disc>, r_<disc>
+    (and I_<disc> when the spec gives the inertia)."""
+    from ..notation import ours
+
+    table = {}
+    for k, d in enumerate(discs):
+        p, n = f"{root}[{k}]", d.name
+        table.update({
+            f"{p}.carrier": ours(f"`{n}`", f"body holding the axis of `{n}`"),
+            f"{p}.at": ours(f"`{n}`", f"axis of `{n}` on its carrier"),
+            f"{p}.geared_to": ours(f"`{n}`", f"the body `{n}` is geared to"),
+            f"{p}.ratio": ours(f"U_{{{n}}}", f"ratio of `{n}`: (ω_{{disc}} − ω_{{carrier}}) / (ω_{{geared}} − ω_{{carrier}})"),
+            f"{p}.mass": ours(f"m_{{{n}}}", f"mass of `{n}`"),
+            f"{p}.radius": ours(f"r_{{{n}}}", f"radius of `{n}` (drawing)"),
+            f"{p}.inertia": ours(f"I_{{{n}}}", f"centroidal inertia of `{n}`"),
+        })
+    return table
+
+
+def notation(method: MomentBalance) -> dict:
+    """Symbols of this method's inputs, named after the spec's counterweights and discs."""
+    from .force_balance import counterweight_notation
+
+    return {**counterweight_notation(method.counterweights),
+            **counter_rotation_notation(method.counter_rotations, "balancing.counter_rotations")}

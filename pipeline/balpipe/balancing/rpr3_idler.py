@@ -237,3 +237,30 @@ def balance(mech: rpr3.Rpr3Mechanism, method: Rpr3IdlerLoop, model: Model, t: np
         "their spin, 2 theta6' - phi' and 2 theta5' - theta6'.",
     ]
     return BalanceResult(params, stages, notes)
+
+
+def _notation() -> dict:
+    from ..notation import Sym, ours
+
+    return {
+        "balancing.E": Sym("E", "base pivot of the idler loop E-F-P (the paper: E = O)"),
+        "balancing.link5.length": Sym("L_5", "length EF of link 5"),
+        "balancing.link5.mass": Sym("m_5", "mass of link 5"),
+        "balancing.link5.com": Sym("r_5 L_5", "centre of mass S_5 from E along EF"),
+        "balancing.link5.com_offset": ours("e_5", "offset of S_5 normal to EF"),
+        "balancing.link5.inertia": Sym("I_5", "axial moment of inertia of link 5"),
+        "balancing.link6.length": Sym("L_6", "length FP of link 6"),
+        "balancing.link6.mass": Sym("m_6", "mass of link 6"),
+        "balancing.link6.com": Sym("r_6 L_6", "centre of mass S_6 from F along FP"),
+        "balancing.link6.com_offset": ours("e_6", "offset of S_6 normal to FP"),
+        "balancing.link6.inertia": Sym("I_6", "axial moment of inertia of link 6"),
+        "balancing.branch": ours("σ", "assembly branch of the idler loop (side of F)"),
+        "balancing.counterweights.cylinder": Sym("r_{cp1} L_1", "counterweight M_{cp1} on each cylinder, from A_i towards C_i (negative: beyond A_i)"),
+        "balancing.counterweights.piston": Sym("r_{cp2} L_1", "counterweight M_{cp2} on each piston, from B_i towards C_i"),
+        "balancing.counterweights.link5": Sym("r_{cp5} L_5", "counterweight M_{cp5} on link 5, from E towards F (negative: beyond E)"),
+        "balancing.counterweights.link6": Sym("r_{cp6} L_6", "counterweight M_{cp6} on link 6, from F towards P (negative: beyond F)"),
+    }
+
+
+#: Paper 000's symbols (Sec. 2, Fig. 3, eqs. 4-9) for this method's inputs.
+NOTATION = _notation()

@@ -280,3 +280,39 @@ def balance(mech: rpr3.Rpr3Mechanism, method: Rpr3ScottRussell, model: Model) ->
               balances="force+moment" if ok30e else "force"),
     ]
     return BalanceResult(params, stages, notes)
+
+
+def _notation() -> dict:
+    from ..notation import Sym, ours
+
+    return {
+        # Sec. 3 renumbers the leg: the piston is link 3, the cylinder link 4 (Fig. 6)
+        "mechanism.cylinder.mass": Sym("m_4", "mass of each cylinder, link 4 of the leg (Sec. 3.2)"),
+        "mechanism.cylinder.com": Sym("r_4 L_3", "centre of mass S_4 of the cylinder from A_i towards C_i"),
+        "mechanism.cylinder.inertia": Sym("I_4", "axial moment of inertia of each cylinder (printed \"I_6\" in Sec. 3.4)"),
+        "mechanism.piston.length": Sym("L_3", "length of the piston, link 3"),
+        "mechanism.piston.mass": Sym("m_3", "mass of each piston, link 3"),
+        "mechanism.piston.com": Sym("r_3 L_3", "centre of mass S_3 of the piston from C"),
+        "mechanism.piston.inertia": Sym("I_3", "axial moment of inertia of each piston"),
+        "balancing.crank.length": Sym("L_1", "length AB of the Scott-Russell crank, link 1"),
+        "balancing.crank.mass": Sym("m_1", "mass of the crank"),
+        "balancing.crank.com": Sym("r_1 L_1", "centre of mass S_1 of the crank from A_i along AB"),
+        "balancing.crank.com_offset": ours("e_1", "offset of S_1 normal to AB"),
+        "balancing.crank.inertia": Sym("I_1", "axial moment of inertia of the crank"),
+        "balancing.coupler.length": Sym("L_2", "length BC of the coupler, link 2 (L_2 = L_1, eq. 19)"),
+        "balancing.coupler.mass": Sym("m_2", "mass of the coupler"),
+        "balancing.coupler.com": Sym("r_2 L_2", "centre of mass S_2 of the coupler from B along BC"),
+        "balancing.coupler.com_offset": ours("e_2", "offset of S_2 normal to BC"),
+        "balancing.coupler.inertia": Sym("I_2", "axial moment of inertia of the coupler"),
+        "balancing.branch": ours("σ", "+1: B on the left of the leg axis A_i → C_i"),
+        "balancing.counterweights.crank": Sym("r_{cp1} L_1", "counterweight M_{cp1} on the crank, from A_i towards B (negative: beyond A_i)"),
+        "balancing.counterweights.coupler": Sym("r_{cp2} L_2", "counterweight M_{cp2} on the coupler, from B towards C (negative: beyond B)"),
+        "balancing.counterweights.piston": Sym("r_{cp3} L_3", "counterweight M_{cp3} on the piston, from C (negative: away from C_i)"),
+        "balancing.counterweights.cylinder": Sym("r_{cp4} L_3", "counterweight M_{cp4} on the cylinder, from A_i towards C_i (negative: beyond A_i)"),
+        "balancing.moment_unknown": ours("unknown", "the inertia that eq. 30e is solved for"),
+    }
+
+
+#: Paper 000's symbols (Sec. 3, Figs. 6-7, eqs. 21-30) for this method's inputs; they rename the
+#: 3-RPR's cylinder and piston as Sec. 3 does.
+NOTATION = _notation()

@@ -173,3 +173,21 @@ def balance(mech: SliderCrankMechanism, method: SliderCrankCounterweights, model
               f"eq. 20 solved for the {on} counterweight's inertia", balances="force+moment")
     )
     return BalanceResult(params, stages, notes)
+
+
+def _notation() -> dict:
+    from ..notation import Sym, ours
+
+    return {
+        "balancing.crank_counterweight": Sym(
+            "r_{cp1} L_1", "position of counterweight M_1 along the crank from A (negative: beyond A)"),
+        "balancing.coupler_counterweight": Sym(
+            "r_{cp2} L_2", "position of counterweight M_2 along the coupler from B (negative: beyond B)"),
+        "balancing.crank_counterweight_mass": Sym("m_{cp1}", "mass of M_1 as built, instead of eq. 15's"),
+        "balancing.coupler_counterweight_mass": Sym("m_{cp2}", "mass of M_2 as built, instead of eq. 15's"),
+        "balancing.moment_unknown": ours("unknown", "the inertia that eq. 20 is solved for"),
+    }
+
+
+#: Paper 000's symbols (eqs. 14-15, 20) for this method's inputs.
+NOTATION = _notation()

@@ -98,3 +98,28 @@ def balance(mech, method: Stages, model: Model, t: np.ndarray | None = None) -> 
             current = set_disc_inertias(current, {c.name: c.inertia for c in step.counter_rotations})
         stages.append(Stage(step.name, step.label or step.name, current, step.description, step.balances))
     return BalanceResult([], stages, [])
+
+
+def notation(method: Stages) -> dict:
+    """Symbols of the hand-written stages' parts, named after each part: m_<part>, I_<part>..."""
+    from ..notation import ours
+    from .moment_balance import counter_rotation_notation
+
+    table = {}
+    for k, s in enumerate(method.stages):
+        p = f"balancing.stages[{k}]"
+        table[f"{p}.label"] = ours(f"`{s.name}`", f"label of stage `{s.name}`")
+        table[f"{p}.balances"] = ours(f"`{s.name}`", f"what stage `{s.name}` claims to balance")
+        table[f"{p}.remove"] = ours(f"`{s.name}`", f"parts stage `{s.name}` removes")
+        for j, part in enumerate(s.parts):
+            q, n = f"{p}.parts[{j}]", part.name
+            table.update({
+                f"{q}.body": ours(f"`{n}`", f"the body that carries `{n}` (stage `{s.name}`)"),
+                f"{q}.mass": ours(f"m_{{{n}}}", f"mass of `{n}` on `{part.body}` (stage `{s.name}`)"),
+                f"{q}.position": ours(f"r_{{{n}}}", f"centre of mass of `{n}`, in `{part.body}`'s frame"),
+                f"{q}.inertia": ours(f"I_{{{n}}}", f"centroidal inertia of `{n}`"),
+                f"{q}.kind": ours("kind", f"what `{n}` is"),
+                f"{q}.radius": ours(f"r_{{{n},disc}}", f"radius of `{n}` drawn as a disc"),
+            })
+        table.update(counter_rotation_notation(s.counter_rotations, f"{p}.counter_rotations"))
+    return table

@@ -208,3 +208,60 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
                 key = "radius_b" if j.radius_a is not None and j.radius_b is None else "radius_a"
                 raise SpecFieldError(root + ("joints", k, key), str(exc)) from None
     return model
+
+
+def notation(mech: CustomMechanism) -> dict:
+    """Symbols named after the spec's own bodies, points, joints and drivers: m_<body>,
+    I_<body>, S_<body> (centre of mass), m_<part> of an attachment, U_<gear pair>, q_<driver>."""
+    from ..notation import drive_table, ours
+
+    table = drive_table({d.name: ours(f"q_{{{d.name}}}", f"coordinate driven by `{d.name}`") for d in mech.drivers}, end_time="T")
+    for name in mech.frame_points:
+        table[f"mechanism.frame_points.{name}"] = ours(f"`{name}`", f"fixed point `{name}` on the frame")
+    for k, b in enumerate(mech.bodies):
+        p, n = f"mechanism.bodies[{k}]", b.name
+        table.update({
+            f"{p}.mass": ours(f"m_{{{n}}}", f"mass of `{n}`"),
+            f"{p}.com": ours(f"S_{{{n}}}", f"centre of mass of `{n}`, in its own frame"),
+            f"{p}.inertia": ours(f"I_{{{n}}}", f"moment of inertia of `{n}` about its centre of mass"),
+            f"{p}.pose": ours(f"(x, y, θ)_{{{n}}}", f"pose of `{n}`'s frame at the start (assembly guess): x, y and angle"),
+            f"{p}.radius": ours(f"r_{{{n}}}", f"radius of `{n}` drawn as a disc"),
+            f"{p}.kind": ours("kind", f"what `{n}` is, for drawing and accounting"),
+        })
+        for pt in b.points:
+            table[f"{p}.points.{pt}"] = ours(f"`{pt}`", f"point `{pt}` of `{n}`, in `{n}`'s frame")
+        for j, a in enumerate(b.attachments):
+            q = f"{p}.attachments[{j}]"
+            table.update({
+                f"{q}.mass": ours(f"m_{{{a.name}}}", f"mass of `{a.name}`, fixed on `{n}`"),
+                f"{q}.position": ours(f"S_{{{a.name}}}", f"centre of mass of `{a.name}`, in `{n}`'s frame"),
+                f"{q}.inertia": ours(f"I_{{{a.name}}}", f"moment of inertia of `{a.name}`"),
+                f"{q}.radius": ours(f"r_{{{a.name}}}", f"radius of `{a.name}` drawn as a disc"),
+                f"{q}.kind": ours("kind", f"what `{a.name}` is"),
+            })
+    for k, j in enumerate(mech.joints):
+        p = f"mechanism.joints[{k}]"
+        table.update({
+            f"{p}.type": ours(f"`{j.name}`", f"kind of joint `{j.name}`"),
+            f"{p}.a": ours(f"`{j.name}`", f"first body of joint `{j.name}`"),
+            f"{p}.b": ours(f"`{j.name}`", f"second body of joint `{j.name}`"),
+            f"{p}.point_a": ours(f"`{j.name}`", f"centre of joint `{j.name}` on its first body"),
+            f"{p}.point_b": ours(f"`{j.name}`", f"centre of joint `{j.name}` on its second body"),
+            f"{p}.guide": ours(f"`{j.name}`", f"body carrying the guide of `{j.name}`"),
+            f"{p}.slider": ours(f"`{j.name}`", f"sliding body of `{j.name}`"),
+            f"{p}.point_guide": ours(f"`{j.name}`", f"a point of `{j.name}`'s axis"),
+            f"{p}.axis": ours(f"`{j.name}`", f"direction of `{j.name}`'s guide"),
+            f"{p}.point_slider": ours(f"`{j.name}`", f"the slider's point on `{j.name}`'s axis"),
+            f"{p}.angle": ours(f"θ_{{{j.name}}}", f"constant angle of the slider of `{j.name}` relative to its guide"),
+            f"{p}.carrier": ours(f"`{j.name}`", f"body holding both axes of gear pair `{j.name}`"),
+            f"{p}.ratio": ours(f"U_{{{j.name}}}", f"ratio of gear pair `{j.name}`: (ω_b − ω_c) / (ω_a − ω_c)"),
+            f"{p}.radius_a": ours(f"r_{{{j.name},a}}", f"pitch radius of the driving gear of `{j.name}`"),
+            f"{p}.radius_b": ours(f"r_{{{j.name},b}}", f"pitch radius of the driven gear of `{j.name}`"),
+            f"{p}.pressure_angle": ours(f"α_{{{j.name}}}", f"pressure angle of gear pair `{j.name}`"),
+        })
+    for k, d in enumerate(mech.drivers):
+        p = f"mechanism.drivers[{k}]"
+        for field, what in (("joint", "joint it drives"), ("body", "body whose coordinate it drives"),
+                            ("coordinate", "coordinate of the body it drives"), ("point", "point of the body it drives")):
+            table[f"{p}.{field}"] = ours(f"`{d.name}`", f"driver `{d.name}`: {what}")
+    return table

@@ -520,3 +520,50 @@ def figures(study):
         "theta1 follows the motion law; theta2 follows it through gears 1', 5, 2' (theta2 - theta2i = "
         "U21 (theta1 - theta1i))." if coupled else "Both inputs follow the inverse kinematics of the straight path.",
     )
+
+
+def _notation() -> dict:
+    from ..notation import Sym, drive_table, ours
+
+    table = drive_table({"gripper": Sym("P", "gripper position (x, y)")}, end_time="T")
+    table.update({
+        "mechanism.pivots.A1": Sym("A_1", "base pivot of input link 1, (−l_0, 0) in the paper"),
+        "mechanism.pivots.A2": Sym("A_2", "base pivot of input link 2, (l_0, 0) in the paper"),
+        "mechanism.links.proximal.length": Sym("l_1", "length A_1B_1 = A_2B_2 of the input links 1, 2"),
+        "mechanism.links.proximal.mass": Sym("m_1 = m_2", "mass of each bare input link"),
+        "mechanism.links.proximal.com": Sym("r_1 = r_2", "centre of mass S_j of the input links from A_j along A_jB_j"),
+        "mechanism.links.proximal.com_offset": ours("e_1 = e_2", "offset of S_1, S_2 normal to the link"),
+        "mechanism.links.proximal.inertia": Sym("I_1 = I_2", "axial moment of inertia of each bare input link"),
+        "mechanism.links.distal.length": Sym("l_2", "length B_1P = B_2P of the distal links 3, 4"),
+        "mechanism.links.distal.mass": Sym("m_3 = m_4", "mass of each bare distal link"),
+        "mechanism.links.distal.com": Sym("r_3 = r_4", "centre of mass of the distal links from B_j along B_jP"),
+        "mechanism.links.distal.com_offset": ours("e_3 = e_4", "offset of S_3, S_4 normal to the link"),
+        "mechanism.links.distal.inertia": Sym("I_3 = I_4", "axial moment of inertia of each bare distal link"),
+        "mechanism.links.proximal_2.length": Sym("l_1", "length A_2B_2 of input link 2"),
+        "mechanism.links.proximal_2.mass": Sym("m_2", "mass of input link 2"),
+        "mechanism.links.proximal_2.com": Sym("r_2", "centre of mass of link 2 from A_2"),
+        "mechanism.links.proximal_2.com_offset": ours("e_2", "offset of S_2 normal to link 2"),
+        "mechanism.links.proximal_2.inertia": Sym("I_2", "axial moment of inertia of link 2"),
+        "mechanism.links.distal_2.length": Sym("l_2", "length B_2P of distal link 4"),
+        "mechanism.links.distal_2.mass": Sym("m_4", "mass of distal link 4"),
+        "mechanism.links.distal_2.com": Sym("r_4", "centre of mass of link 4 from B_2"),
+        "mechanism.links.distal_2.com_offset": ours("e_4", "offset of S_4 normal to link 4"),
+        "mechanism.links.distal_2.inertia": Sym("I_4", "axial moment of inertia of link 4"),
+        "mechanism.working_modes": Sym("(σ_1, σ_2)", "working modes: +1 puts B_j on the counter-clockwise side of A_jP (eq. 2)"),
+        "mechanism.coupling.r1p": Sym("r_{1'}", "pitch radius of gear 1' on input link 1"),
+        "mechanism.coupling.gear_1p.mass": Sym("m_{1'}", "mass of gear 1' (on link 1 at A_1)"),
+        "mechanism.coupling.gear_1p.inertia": Sym("I_{1'}", "axial moment of inertia of gear 1', before moment balancing"),
+        "mechanism.coupling.gear_2p.mass": Sym("m_{2'}", "mass of gear 2' (on link 2 at A_2)"),
+        "mechanism.coupling.gear_2p.inertia": Sym("I_{2'}", "axial moment of inertia of gear 2', before moment balancing"),
+        "mechanism.coupling.gear_5.mass": Sym("m_5", "mass of the idler gear 5 on the frame"),
+        "mechanism.coupling.gear_5.inertia": Sym("I_5", "axial moment of inertia of gear 5, before moment balancing"),
+        "mechanism.coupling.pressure_angle": ours("α", "pressure angle of the meshes 1'-5 and 5-2'"),
+        "motion.drive.gripper.start": Sym("P_i = (x_i, y_i)", "initial position of the gripper"),
+        "motion.drive.gripper.end": Sym("P_f = (x_f, y_f)", "final position of the gripper"),
+        "motion.duration": ours("T", "duration of the fifth-order law of θ_1 (the paper gives none)"),
+    })
+    return table
+
+
+#: Paper 004's symbols (Sec. II, Figs. 3-6, Sec. VI) for this template's inputs.
+NOTATION = _notation()

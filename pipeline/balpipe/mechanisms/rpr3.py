@@ -450,3 +450,34 @@ def _factor_caption(study, method: str) -> str:
     if paper:
         text += f"; the paper reports {paper} (the reference `counterweights.moment_ratio` compares it with the unbalanced 3-RPR)."
     return text + "."
+
+
+def _notation() -> dict:
+    from ..notation import Sym, drive_table, ours
+
+    table = drive_table({"x": Sym("x", "x of the platform's point P"), "y": Sym("y", "y of P"),
+                         "phi": Sym("φ", "platform angle, C_1C_2 to A_1A_2")})
+    for d, s in (("x", "x"), ("y", "y"), ("phi", "φ")):
+        table[f"motion.drive.{d}.start"] = Sym(f"{s}_0", f"{table[f'motion.drive.{d}.start'].text.split(':')[0]} at t = 0 (eq. 10)")
+        table[f"motion.drive.{d}.end"] = Sym(f"{s}_f", f"{table[f'motion.drive.{d}.end'].text.split(':')[0]} at t = t_f (eq. 10)")
+    table.update({
+        "mechanism.base_radius": Sym("R_b", "circumradius of the base triangle A_1A_2A_3"),
+        "mechanism.platform_radius": Sym("R_p", "circumradius of the platform triangle C_1C_2C_3"),
+        "mechanism.cylinder.mass": Sym("m_1", "mass of each cylinder, link i1 (Sec. 2)"),
+        "mechanism.cylinder.com": Sym("r_1 L_1", "centre of mass S_{1i} of the cylinder from A_i towards C_i"),
+        "mechanism.cylinder.inertia": Sym("I_1", "axial moment of inertia of each cylinder"),
+        "mechanism.piston.length": Sym("L_1", "length B_iC_i of the piston"),
+        "mechanism.piston.mass": Sym("m_2", "mass of each piston, link i2"),
+        "mechanism.piston.com": Sym("r_2 L_1", "centre of mass S_{2i} of the piston from B_i towards C_i"),
+        "mechanism.piston.inertia": Sym("I_2", "axial moment of inertia of each piston"),
+        "mechanism.platform.mass": Sym("m_p", "mass of the platform (centre of mass at P)"),
+        "mechanism.platform.inertia": Sym("I_p", "axial moment of inertia of the platform"),
+        "mechanism.actuation": ours("actuation", "actuated joint of each leg: prismatic B_i or revolute A_i"),
+        "mechanism.stroke": ours("|A_iC_i|_{min}, |A_iC_i|_{max}", "range of the leg length the prismatic pair allows"),
+        "motion.duration": Sym("t_f", "duration of the motion (eq. 10)"),
+    })
+    return table
+
+
+#: Paper 000's symbols (Sec. 2, Fig. 2; Sec. 2.1, eq. 10) for this template's inputs.
+NOTATION = _notation()

@@ -421,3 +421,35 @@ def figures(study):
 
 __all__ = ["RRR4Mechanism", "LegSpec", "RRRLink", "PlatformSpec", "build", "resolve_legs",
            "mass_parameters", "leg_motion", "corner", "figures"]
+
+
+def _notation() -> dict:
+    from ..notation import Sym, drive_table, ours
+
+    table = drive_table({"platform": Sym("(x, y, θ_5)", "platform pose: position of its centre and orientation θ_5")}, end_time="T")
+    table.update({
+        "mechanism.platform.half_width": Sym("c_5", "half width of the platform"),
+        "mechanism.platform.half_height": Sym("d_5", "half height of the platform"),
+        "mechanism.platform.mass": Sym("m_5", "mass of the platform"),
+        "mechanism.platform.com": Sym("(p_5, q_5)", "centre of mass of the platform from its centre"),
+        "mechanism.platform.inertia": ours("I_5", "centroidal moment of inertia of the platform"),
+        "mechanism.legs.<i>.pivot": Sym("A_<i> = (a_<i>, b_<i>)", "base pivot of leg <i>"),
+        "mechanism.legs.<i>.elbow": ours("σ_<i>", "leg <i>: +1 puts B_<i> on the counter-clockwise side of A_<i>C_<i>"),
+        "mechanism.kinematics": ours("kinematics", "general, or the special kinematics of Fig. 5a / 5b"),
+        "mechanism.actuators": ours("actuators", "actuated joints"),
+        "motion.duration": ours("T", "duration of the motion"),
+    })
+    for j, name, a, b in ((1, "proximal", "A", "B"), (2, "distal", "B", "C")):
+        p = f"mechanism.legs.<i>.{name}"
+        table.update({
+            f"{p}.length": Sym(f"l_{{<i>{j}}}", f"length {a}_<i>{b}_<i> of link <i>{j}"),
+            f"{p}.mass": Sym(f"m_{{<i>{j}}}", f"mass of the bare link <i>{j}"),
+            f"{p}.com": Sym(f"p_{{<i>{j}}}", f"centre of mass of link <i>{j} along the link from {a}_<i>"),
+            f"{p}.com_offset": Sym(f"q_{{<i>{j}}}", f"centre of mass of link <i>{j} normal to the link (left positive)"),
+            f"{p}.inertia": ours(f"I_{{<i>{j}}}", f"centroidal moment of inertia of link <i>{j}"),
+        })
+    return table
+
+
+#: Paper 001's symbols (Sec. II, Fig. 1) for this template's inputs.
+NOTATION = _notation()

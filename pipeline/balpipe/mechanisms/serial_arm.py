@@ -518,3 +518,35 @@ def joint_torques(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0)) -> np.ndar
         dy = st.ry[:, j:] - st.oy[:, j:j + 1]
         out[:, j] = np.sum(dx * fy[:, j:] - dy * fx[:, j:], axis=1) + st.thdd[:, j:] @ I[j:]
     return out
+
+
+def notation(mech: SerialArmMechanism) -> dict:
+    """Symbols of an n-link arm's inputs: paper 003's for the 3R arm (joints O, A, B, tip C:
+    l_OA, l_AB, l_BC; r_i, m_i, I_i; q_i), the same pattern with l_i for other arms (paper 002's
+    method renames them as that paper does)."""
+    from ..notation import Sym, drive_table, ours
+
+    n = len(mech.links)
+    joints = "OABC" if n == 3 else None
+    table = drive_table({f"q{k}": Sym(f"q_{k}", f"angle of joint {k}") for k in range(1, n + 1)}, end_time="t_f")
+    table.update(drive_table({"tip": Sym("(x, y, φ)", "tip pose: position and orientation of the last link")}, end_time="t_f"))
+    for k in range(1, n + 1):
+        p = f"mechanism.links[{k - 1}]"
+        length = f"l_{{{joints[k - 1]}{joints[k]}}}" if joints else f"l_{k}"
+        table.update({
+            f"{p}.length": Sym(length, f"length of link {k}, joint {k} to joint {k + 1}" if k < n else f"length of link {k}, joint {k} to the tip"),
+            f"{p}.mass": Sym(f"m_{k}", f"mass of link {k}"),
+            f"{p}.com": Sym(f"r_{k}", f"distance of link {k}'s centre of mass S_{k} from joint {k}, along the link"),
+            f"{p}.com_offset": ours(f"e_{k}", f"offset of S_{k} normal to link {k}"),
+            f"{p}.inertia": Sym(f"I_{k}", f"axial moment of inertia of link {k} about S_{k}"),
+        })
+        table[f"mechanism.initial[{k - 1}]"] = ours(f"q_{k}(0)", f"angle of joint {k} of an arm without drives")
+    table.update({
+        "mechanism.base": ours("O" if joints else "A", "position of joint 1 on the frame"),
+        "mechanism.payload.mass": Sym("m_p", "mass of the payload"),
+        "mechanism.payload.inertia": ours("I_p", "centroidal inertia of the payload"),
+        "mechanism.payload.position": ours("r_p", "position of the payload in the last link's frame"),
+        "mechanism.working_mode": Sym("±", "branch of the inverse kinematics (+1: the '+' root of paper 003's eq. 8)"),
+        "motion.duration": Sym("t_f", "duration of the motion"),
+    })
+    return table

@@ -110,3 +110,33 @@ def build(mech: SliderCrankMechanism, laws: dict, t: np.ndarray) -> Model:
         frame_points={"A": tuple(A)},
         guides=(((lo - pad, guide_origin[1]), (hi + pad, guide_origin[1])),),
     )
+
+
+def _notation() -> dict:
+    from ..notation import Sym, drive_table, ours
+
+    table = {
+        "mechanism.pivot": Sym("A", "the crank's pivot on the frame"),
+        "mechanism.offset": Sym("a", "offset of the slider's guide from A (Scott-Russell: a = 0, eq. 19)"),
+        "mechanism.crank.length": Sym("L_1", "length AB of the crank, link 1"),
+        "mechanism.crank.mass": Sym("m_1", "mass of the crank"),
+        "mechanism.crank.com": Sym("r_1 L_1", "distance of the crank's centre of mass S_1 from A along AB"),
+        "mechanism.crank.com_offset": ours("e_1", "offset of S_1 normal to AB"),
+        "mechanism.crank.inertia": Sym("I_1", "axial moment of inertia of the crank about S_1"),
+        "mechanism.coupler.length": Sym("L_2", "length BC of the coupler, link 2"),
+        "mechanism.coupler.mass": Sym("m_2", "mass of the coupler"),
+        "mechanism.coupler.com": Sym("r_2 L_2", "distance of the coupler's centre of mass S_2 from B along BC"),
+        "mechanism.coupler.com_offset": ours("e_2", "offset of S_2 normal to BC"),
+        "mechanism.coupler.inertia": Sym("I_2", "axial moment of inertia of the coupler about S_2"),
+        "mechanism.slider.mass": Sym("m_3", "mass of the slider, link 3"),
+        "mechanism.slider.com": Sym("d_{CS3}", "centre of mass S_3 of the slider from C"),
+        "mechanism.slider.inertia": Sym("I_3", "axial moment of inertia of the slider"),
+        "mechanism.branch": ours("σ", "assembly branch: +1 puts the slider on the +x side of B"),
+        "motion.duration": Sym("t_f", "duration of the motion"),
+    }
+    table.update(drive_table({"crank": Sym("θ_1", "crank angle"), "slider": ours("x_C", "slider position along the guide")}))
+    return table
+
+
+#: Paper 000's symbols (Sec. 3.1, Fig. 5, eqs. 11-20) for this template's inputs.
+NOTATION = _notation()

@@ -34,12 +34,22 @@ def _annotated_unit(tp) -> str | None:
     return None
 
 
+def _tuple_units(tp) -> str | None:
+    """"m, m, rad" for a fixed tuple whose elements have different units (a pose), else None."""
+    for arg in (typing.get_args(tp) if typing.get_origin(tp) is not tuple else (tp,)):
+        if typing.get_origin(arg) is tuple:
+            units = [_annotated_unit(a) or "" for a in typing.get_args(arg)]
+            if Ellipsis not in typing.get_args(arg) and len(set(units)) > 1:
+                return ", ".join(units)
+    return None
+
+
 def _walk(value, path: str, unit: str | None, out: list[dict]) -> None:
     if isinstance(value, BaseModel):
         for name, info in type(value).model_fields.items():
             u = _unit_of(info.metadata)
             if u is None:
-                u = _annotated_unit(info.annotation)
+                u = _tuple_units(info.annotation) or _annotated_unit(info.annotation)
             _walk(getattr(value, name), f"{path}.{name}" if path else name, u, out)
     elif isinstance(value, dict):
         for k in value:

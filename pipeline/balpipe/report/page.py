@@ -7,7 +7,7 @@ import numpy as np
 from .. import realisable
 from ..study import Study
 from . import figures, present, toc
-from .inputs import input_rows
+from .notation_table import notation_groups
 from .render import environment
 from .results import joint_load_table
 
@@ -125,5 +125,5 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         history=history,
         actuators=results.get("actuators") or [],
         nav=nav or {},
-        inputs=input_rows(spec),
+        inputs=notation_groups(spec),
     ))

@@ -1,0 +1,227 @@
+"""The papers' symbols for the inputs of a spec: small declarative tables, one per template and
+balancing method, that the report's inputs table reads (:mod:`balpipe.report.inputs`).
+
+A table maps a *path pattern* to a :class:`Sym`. A pattern is a spec field path
+(``mechanism.links.proximal.mass``) in which ``<name>`` matches one key or list index and
+captures it: ``mechanism.legs.<i>.proximal.mass`` matches ``mechanism.legs.3.proximal.mass``
+with ``i = 3``; the capture is substituted into the symbol and the text. A symbol is written
+in a small markup, rendered by :func:`symbol_html`: letters are variables (italic), ``_1`` or
+``_{cw1}`` a subscript, ``^*`` or ``^{*}`` a superscript, ``'`` a prime; anything else is
+copied. ``m_1 = m_2`` gives *m*\\ :sub:`1` = *m*\\ :sub:`2`.
+
+The notation of a study is the method's table, then the template's, then :data:`COMMON`; the
+first pattern that matches wins, so a method can rename the template's parts (the 3-RPR's
+cylinder is link 1 of the idler loop's paper section and link 4 of the Scott-Russell legs').
+A table may also be a function of the spec section (``custom`` names its symbols after the
+spec's own bodies).
+"""
+
+from __future__ import annotations
+
+import html
+import re
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any, Callable, Mapping, Union
+
+
+@dataclass(frozen=True)
+class Sym:
+    """One input's symbol (markup, see the module docstring), its meaning in words, and whether
+    the symbol is the paper's (``paper=False``: a name of ours, marked "not in the paper")."""
+
+    symbol: str
+    text: str
+    paper: bool = True
+    unit: str | None = None  # for a plain number whose unit the spec's type does not carry
+
+    def filled(self, captures: Mapping[str, str]) -> "Sym":
+        s, t = self.symbol, self.text
+        for k, v in captures.items():
+            s = s.replace(f"<{k}>", v)
+            t = t.replace(f"<{k}>", v)
+        return Sym(s, t, self.paper, self.unit)
+
+
+def ours(symbol: str, text: str, unit: str | None = None) -> Sym:
+    """A symbol the paper does not use (a name of balpipe's, or a quantity the paper leaves out)."""
+    return Sym(symbol, text, paper=False, unit=unit)
+
+
+Table = Mapping[str, Sym]
+TableSource = Union[Table, Callable[[Any], Table], None]
+
+
+@lru_cache(maxsize=512)
+def _pattern(key: str) -> re.Pattern:
+    out, pos = [], 0
+    for m in re.finditer(r"<(\w+)>", key):
+        out.append(re.escape(key[pos:m.start()]))
+        out.append(rf"(?P<{m.group(1)}>[^.\[\]]+)")
+        pos = m.end()
+    out.append(re.escape(key[pos:]))
+    return re.compile("".join(out) + r"\Z")
+
+
+def lookup(tables: list[Table], path: str) -> Sym | None:
+    """The symbol of ``path`` from the first table with a matching pattern (exact keys first)."""
+    for table in tables:
+        if path in table:
+            return table[path].filled({})
+        for key, sym in table.items():
+            if "<" in key:
+                m = _pattern(key).match(path)
+                if m:
+                    return sym.filled(m.groupdict())
+    return None
+
+
+def table_of(source: TableSource, section: Any) -> Table:
+    """A template's or method's table for this spec section (a mapping, a function of the
+    section, or nothing)."""
+    if source is None:
+        return {}
+    if callable(source):
+        return source(section)
+    return source
+
+
+def symbol_html(markup: str) -> str:
+    """HTML of a symbol: ``m_{CW1}`` -> ``<var>m</var><sub>CW1</sub>``; runs of one or two
+    letters are ``<var>``, longer words and subscripts upright, a `name` in backticks is copied
+    as it is (spec names with underscores); everything is escaped."""
+    out: list[str] = []
+    pos = 0
+    while pos < len(markup):
+        c = markup[pos]
+        if c in "_^" and pos + 1 < len(markup):
+            nxt = markup[pos + 1]
+            if nxt == "{":
+                end = markup.find("}", pos + 2)
+                end = len(markup) if end < 0 else end
+                body, pos = markup[pos + 2:end], end + 1
+            else:
+                body, pos = nxt, pos + 2
+            tag = "sub" if c == "_" else "sup"
+            out.append(f"<{tag}>{html.escape(body)}</{tag}>")
+        elif c == "`":
+            end = markup.find("`", pos + 1)
+            end = len(markup) if end < 0 else end
+            out.append(f'<span class="name">{html.escape(markup[pos + 1:end])}</span>')
+            pos = end + 1
+        elif c.isalpha():
+            end = pos + 1
+            while end < len(markup) and (markup[end].isalpha() or "\u0300" <= markup[end] <= "\u036f"):
+                end += 1
+            word = html.escape(markup[pos:end])
+            # one- or two-letter runs are variables (italic); longer ones are words (law, method)
+            out.append(f"<var>{word}</var>" if len(markup[pos:end].rstrip("\u0307\u0308")) <= 2 else word)
+            pos = end
+        else:
+            out.append(html.escape(c))
+            pos += 1
+    return "".join(out)
+
+
+_TEXT = re.compile(r"`([^`]*)`|([^\W\d_])_(\{[^}]*\}|\d+'?|[^\W\d_]'?)")
+
+
+def text_html(text: str) -> str:
+    """HTML of a description: ``A_jB_j`` -> A<sub>j</sub>B<sub>j</sub>, ``S_{1i}`` -> S<sub>1i</sub>
+    (one digit run, one letter or a braced group), a `name` in backticks copied as it is."""
+    out, pos = [], 0
+    for m in _TEXT.finditer(text):
+        out.append(html.escape(text[pos:m.start()]))
+        if m.group(1) is not None:
+            out.append(f'<span class="name">{html.escape(m.group(1))}</span>')
+        else:
+            sub = m.group(3)[1:-1] if m.group(3).startswith("{") else m.group(3)
+            out.append(f"{html.escape(m.group(2))}<sub>{html.escape(sub)}</sub>")
+        pos = m.end()
+    out.append(html.escape(text[pos:]))
+    return "".join(out)
+
+
+def dotted(symbol: str, dots: int) -> str:
+    """``θ_1`` -> ``θ̇_1`` (one dot) or ``θ̈_1`` (two): a time derivative over the base letter."""
+    mark = {1: "\u0307", 2: "\u0308"}[dots]
+    m = re.match(r"[^\W\d_]", symbol)
+    if not m:
+        return f"d{'^' + str(dots) if dots > 1 else ''}({symbol})/dt{'^' + str(dots) if dots > 1 else ''}"
+    return symbol[:1] + mark + symbol[1:]
+
+
+def drive_table(drives: Mapping[str, Sym], end_time: str = "t_f") -> Table:
+    """Rows of ``motion.drive.<name>.*`` from the drives' coordinate symbols: start and end values
+    q(0), q(t_f), and the polynomial law's end velocities and accelerations."""
+    out: dict[str, Sym] = {}
+    for name, s in drives.items():
+        base = f"motion.drive.{name}"
+        mk = Sym if s.paper else ours
+        out[f"{base}.start"] = mk(f"{s.symbol}(0)", f"{s.text}: at the start")
+        out[f"{base}.end"] = mk(f"{s.symbol}({end_time})", f"{s.text}: at the end")
+        for i in ("start", "end"):
+            at = "0" if i == "start" else end_time
+            out[f"{base}.{i}[<k>]"] = mk(f"{s.symbol}({at})_<k>", f"{s.text}: component <k> at the {i}")
+            out[f"{base}.{i}_velocity"] = ours(f"{dotted(s.symbol, 1)}({at})", f"{s.text}: rate at the {i} (polynomial law)")
+            out[f"{base}.{i}_acceleration"] = ours(f"{dotted(s.symbol, 2)}({at})", f"{s.text}: second derivative at the {i} (polynomial law)")
+        out[f"{base}.law"] = ours(f"law({s.symbol})", f"{s.text}: its own motion law")
+        out[f"{base}.accel_fraction"] = ours(f"κ({s.symbol})", f"{s.text}: acceleration fraction of its trapezoidal law")
+    return out
+
+
+#: Inputs every spec has: the motion law, the analysis and the validation settings.
+COMMON: dict[str, Sym] = {
+    "mechanism.template": ours("template", "mechanism template"),
+    "motion.law": ours("law", "motion law of the driven coordinates (quintic: the 3-4-5 polynomial)"),
+    "motion.duration": ours("T", "duration of the motion"),
+    "motion.accel_fraction": ours("κ", "trapezoidal law: fraction of the duration spent accelerating (and decelerating)"),
+    "motion.drive.<d>.start": ours("<d>(0)", "driven coordinate <d> at the start"),
+    "motion.drive.<d>.end": ours("<d>(T)", "driven coordinate <d> at the end"),
+    "motion.drive.<d>.start[<k>]": ours("<d>(0)_<k>", "driven coordinate <d>, component <k>, at the start"),
+    "motion.drive.<d>.end[<k>]": ours("<d>(T)_<k>", "driven coordinate <d>, component <k>, at the end"),
+    "motion.drive.<d>.start_velocity": ours("<d>'(0)", "rate of <d> at the start (polynomial law)"),
+    "motion.drive.<d>.end_velocity": ours("<d>'(T)", "rate of <d> at the end (polynomial law)"),
+    "motion.drive.<d>.start_acceleration": ours("<d>''(0)", "second derivative of <d> at the start (polynomial law)"),
+    "motion.drive.<d>.end_acceleration": ours("<d>''(T)", "second derivative of <d> at the end (polynomial law)"),
+    "motion.drive.<d>.law": ours("law(<d>)", "the drive's own motion law"),
+    "motion.drive.<d>.accel_fraction": ours("κ(<d>)", "the drive's acceleration fraction (trapezoidal law)"),
+    "balancing.method": ours("method", "balancing method"),
+    "compare[<k>].balancing.method": ours("method", "balancing method of a compared design"),
+    "analysis.samples": ours("N", "time samples over the motion"),
+    "analysis.gravity": ours("gravity", "gravity along −y"),
+    "analysis.g": Sym("g", "gravitational acceleration"),
+    "analysis.moment_point": ours("O", "point about which the shaking moment is taken"),
+    "analysis.balance_tolerance": ours("ε", "a stage counts as balanced when its peak is at most this fraction of its reference"),
+    "validation.enabled": ours("simulate", "simulate every stage in pymunk"),
+    "validation.dt": ours("Δt", "pymunk time step"),
+    "validation.iterations": ours("iterations", "pymunk solver iterations per step"),
+    "validation.tolerance": ours("ε_{sim}", "pymunk residuals pass below this fraction of the reference loads"),
+    "validation.reactionless": ours("free frame", "free-floating frame demonstration"),
+    # the generic finder's settings, shared by force_balance and moment_balance
+    "balancing.rank_tolerance": ours("ε_{rank}", "singular values below this fraction of the largest are dropped"),
+    "balancing.samples": ours("N_{states}", "sampled states of the momentum regressor (0: automatic)"),
+    "balancing.seed": ours("seed", "seed of the state sampler"),
+    "balancing.polygon_sides": ours("n_{sides}", "sides of the polygon inscribed in each disc region"),
+}
+
+
+GROUPS = ("Geometry", "Mass parameters", "Motion", "Balancing method", "Analysis and validation")
+
+_MASS_LEAVES = {"mass", "inertia", "com", "com_offset", "payload", "platform_split"}
+
+
+def group_of(path: str, unit: str) -> str:
+    """The group of an input in the table: geometry and mass parameters of the mechanism, its
+    motion, the balancing method (with compared designs), analysis and validation settings."""
+    head = path.split(".", 1)[0].split("[", 1)[0]
+    if head == "motion":
+        return "Motion"
+    if head in ("balancing", "compare"):
+        return "Balancing method"
+    if head in ("analysis", "validation"):
+        return "Analysis and validation"
+    leaves = set(re.split(r"[.\[\]]+", path))
+    if unit in ("kg", "kg m^2") or leaves & _MASS_LEAVES:
+        return "Mass parameters"
+    return "Geometry"
