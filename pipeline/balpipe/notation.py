@@ -28,24 +28,31 @@ from typing import Any, Callable, Mapping, Union
 @dataclass(frozen=True)
 class Sym:
     """One input's symbol (markup, see the module docstring), its meaning in words, and whether
-    the symbol is the paper's (``paper=False``: a name of ours, marked "not in the paper")."""
+    the symbol is the paper's (``paper=False``: a name of ours, marked "not in the paper"; a
+    ``setting`` of balpipe's, such as the number of samples, is neither and is not marked)."""
 
     symbol: str
     text: str
     paper: bool = True
     unit: str | None = None  # for a plain number whose unit the spec's type does not carry
+    setting: bool = False
 
     def filled(self, captures: Mapping[str, str]) -> "Sym":
         s, t = self.symbol, self.text
         for k, v in captures.items():
             s = s.replace(f"<{k}>", v)
             t = t.replace(f"<{k}>", v)
-        return Sym(s, t, self.paper, self.unit)
+        return Sym(s, t, self.paper, self.unit, self.setting)
 
 
 def ours(symbol: str, text: str, unit: str | None = None) -> Sym:
     """A symbol the paper does not use (a name of balpipe's, or a quantity the paper leaves out)."""
     return Sym(symbol, text, paper=False, unit=unit)
+
+
+def setting(symbol: str, text: str, unit: str | None = None) -> Sym:
+    """A setting of balpipe's (samples, tolerances, which designs to build): no paper quantity."""
+    return Sym(symbol, text, paper=False, unit=unit, setting=True)
 
 
 Table = Mapping[str, Sym]
@@ -172,10 +179,10 @@ def drive_table(drives: Mapping[str, Sym], end_time: str = "t_f") -> Table:
 
 #: Inputs every spec has: the motion law, the analysis and the validation settings.
 COMMON: dict[str, Sym] = {
-    "mechanism.template": ours("template", "mechanism template"),
-    "motion.law": ours("law", "motion law of the driven coordinates (quintic: the 3-4-5 polynomial)"),
+    "mechanism.template": setting("template", "mechanism template"),
+    "motion.law": setting("law", "motion law of the driven coordinates (quintic: the 3-4-5 polynomial)"),
     "motion.duration": ours("T", "duration of the motion"),
-    "motion.accel_fraction": ours("κ", "trapezoidal law: fraction of the duration spent accelerating (and decelerating)"),
+    "motion.accel_fraction": setting("κ", "trapezoidal law: fraction of the duration spent accelerating (and decelerating)"),
     "motion.drive.<d>.start": ours("<d>(0)", "driven coordinate <d> at the start"),
     "motion.drive.<d>.end": ours("<d>(T)", "driven coordinate <d> at the end"),
     "motion.drive.<d>.start[<k>]": ours("<d>(0)_<k>", "driven coordinate <d>, component <k>, at the start"),
@@ -184,25 +191,25 @@ COMMON: dict[str, Sym] = {
     "motion.drive.<d>.end_velocity": ours("<d>'(T)", "rate of <d> at the end (polynomial law)"),
     "motion.drive.<d>.start_acceleration": ours("<d>''(0)", "second derivative of <d> at the start (polynomial law)"),
     "motion.drive.<d>.end_acceleration": ours("<d>''(T)", "second derivative of <d> at the end (polynomial law)"),
-    "motion.drive.<d>.law": ours("law(<d>)", "the drive's own motion law"),
-    "motion.drive.<d>.accel_fraction": ours("κ(<d>)", "the drive's acceleration fraction (trapezoidal law)"),
-    "balancing.method": ours("method", "balancing method"),
-    "compare[<k>].balancing.method": ours("method", "balancing method of a compared design"),
-    "analysis.samples": ours("N", "time samples over the motion"),
-    "analysis.gravity": ours("gravity", "gravity along −y"),
+    "motion.drive.<d>.law": setting("law(<d>)", "the drive's own motion law"),
+    "motion.drive.<d>.accel_fraction": setting("κ(<d>)", "the drive's acceleration fraction (trapezoidal law)"),
+    "balancing.method": setting("method", "balancing method"),
+    "compare[<k>].balancing.method": setting("method", "balancing method of a compared design"),
+    "analysis.samples": setting("N", "time samples over the motion"),
+    "analysis.gravity": setting("gravity", "gravity along −y"),
     "analysis.g": Sym("g", "gravitational acceleration"),
-    "analysis.moment_point": ours("O", "point about which the shaking moment is taken"),
-    "analysis.balance_tolerance": ours("ε", "a stage counts as balanced when its peak is at most this fraction of its reference"),
-    "validation.enabled": ours("simulate", "simulate every stage in pymunk"),
-    "validation.dt": ours("Δt", "pymunk time step"),
-    "validation.iterations": ours("iterations", "pymunk solver iterations per step"),
-    "validation.tolerance": ours("ε_{sim}", "pymunk residuals pass below this fraction of the reference loads"),
-    "validation.reactionless": ours("free frame", "free-floating frame demonstration"),
+    "analysis.moment_point": setting("O", "point about which the shaking moment is taken"),
+    "analysis.balance_tolerance": setting("ε", "a stage counts as balanced when its peak is at most this fraction of its reference"),
+    "validation.enabled": setting("simulate", "simulate every stage in pymunk"),
+    "validation.dt": setting("Δt", "pymunk time step"),
+    "validation.iterations": setting("iterations", "pymunk solver iterations per step"),
+    "validation.tolerance": setting("ε_{sim}", "pymunk residuals pass below this fraction of the reference loads"),
+    "validation.reactionless": setting("free frame", "free-floating frame demonstration"),
     # the generic finder's settings, shared by force_balance and moment_balance
-    "balancing.rank_tolerance": ours("ε_{rank}", "singular values below this fraction of the largest are dropped"),
-    "balancing.samples": ours("N_{states}", "sampled states of the momentum regressor (0: automatic)"),
-    "balancing.seed": ours("seed", "seed of the state sampler"),
-    "balancing.polygon_sides": ours("n_{sides}", "sides of the polygon inscribed in each disc region"),
+    "balancing.rank_tolerance": setting("ε_{rank}", "singular values below this fraction of the largest are dropped"),
+    "balancing.samples": setting("N_{states}", "sampled states of the momentum regressor (0: automatic)"),
+    "balancing.seed": setting("seed", "seed of the state sampler"),
+    "balancing.polygon_sides": setting("n_{sides}", "sides of the polygon inscribed in each disc region"),
 }
 
 

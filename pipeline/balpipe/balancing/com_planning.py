@@ -706,7 +706,7 @@ def _square_figure(study, info, plt, to_svg):
 
 
 def _notation() -> dict:
-    from ..notation import Sym, ours
+    from ..notation import Sym, ours, setting
 
     return {
         "balancing.test_square.centre": Sym("E", "centre of the tested square (Fig. 2)"),
@@ -720,13 +720,13 @@ def _notation() -> dict:
         "balancing.orientation.start": Sym("φ_0", "orientation φ of the last link at the start of every trajectory"),
         "balancing.orientation.end": Sym("φ_f", "orientation φ at the end"),
         "balancing.phi.degree": ours("deg φ", "degree of the polynomial law of φ (ends fixed to second order)"),
-        "balancing.phi.starts": ours("starts", "multi-start: the 3-4-5 law plus random points"),
-        "balancing.phi.seed": ours("seed", "seed of the random starting points"),
-        "balancing.phi.spread": ours("σ_c", "spread of the random starting coefficients"),
-        "balancing.phi.max_evaluations": ours("evaluations", "objective evaluations per start (Nelder-Mead)"),
-        "balancing.phi.tolerance": ours("tol", "Nelder-Mead tolerance"),
+        "balancing.phi.starts": setting("starts", "multi-start: the 3-4-5 law plus random points"),
+        "balancing.phi.seed": setting("seed", "seed of the random starting points"),
+        "balancing.phi.spread": setting("σ_c", "spread of the random starting coefficients"),
+        "balancing.phi.max_evaluations": setting("evaluations", "objective evaluations per start (Nelder-Mead)"),
+        "balancing.phi.tolerance": setting("tol", "Nelder-Mead tolerance"),
         "balancing.torque_rate_limit": ours("|τ̇|_{max}", "case 3: largest rate of change of any actuator torque (the paper: 3·10^4 N m/s)", unit="N m/s"),
-        "balancing.rate_samples": ours("N_{rate}", "case 3: samples on which torque rates are measured"),
+        "balancing.rate_samples": setting("N_{rate}", "case 3: samples on which torque rates are measured"),
     }
 
 

@@ -373,7 +373,7 @@ def _full_stage(model: Model, links: dict[str, Body], I: dict[str, float], mech:
 
 
 def _notation() -> dict:
-    from ..notation import Sym, ours
+    from ..notation import Sym, ours, setting
 
     return {
         "balancing.counterweights.proximal": Sym(
@@ -388,7 +388,7 @@ def _notation() -> dict:
         "balancing.counter_rotation.pressure_angle": ours("α", "pressure angle of the meshes 3'-6 and 4'-7"),
         "balancing.balanced_inertias.proximal": Sym("I_1 = I_2", "centroidal inertia of the balanced input links (link + counterweight), as eq. 17 reads it"),
         "balancing.balanced_inertias.distal": Sym("I_3 = I_4", "centroidal inertia of the balanced distal links, as eq. 17 reads it"),
-        "balancing.point_mass_stage": ours("point masses", "also analyse the balancing with point-mass counterweights on the bare links"),
+        "balancing.point_mass_stage": setting("point masses", "also analyse the balancing with point-mass counterweights on the bare links"),
     }
 
 

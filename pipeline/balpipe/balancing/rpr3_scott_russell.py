@@ -283,7 +283,7 @@ def balance(mech: rpr3.Rpr3Mechanism, method: Rpr3ScottRussell, model: Model) ->
 
 
 def _notation() -> dict:
-    from ..notation import Sym, ours
+    from ..notation import Sym, ours, setting
 
     return {
         # Sec. 3 renumbers the leg: the piston is link 3, the cylinder link 4 (Fig. 6)
@@ -309,7 +309,7 @@ def _notation() -> dict:
         "balancing.counterweights.coupler": Sym("r_{cp2} L_2", "counterweight M_{cp2} on the coupler, from B towards C (negative: beyond B)"),
         "balancing.counterweights.piston": Sym("r_{cp3} L_3", "counterweight M_{cp3} on the piston, from C (negative: away from C_i)"),
         "balancing.counterweights.cylinder": Sym("r_{cp4} L_3", "counterweight M_{cp4} on the cylinder, from A_i towards C_i (negative: beyond A_i)"),
-        "balancing.moment_unknown": ours("unknown", "the inertia that eq. 30e is solved for"),
+        "balancing.moment_unknown": setting("unknown", "the inertia that eq. 30e is solved for"),
     }
 
 

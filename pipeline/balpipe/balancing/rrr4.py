@@ -380,7 +380,7 @@ def eq17_residuals(mech: RRR4Mechanism, model: Model) -> list[tuple[cond.LinearC
 
 
 def _notation() -> dict:
-    from ..notation import Sym, ours
+    from ..notation import Sym, ours, setting
 
     return {
         "balancing.counterweights.proximal": ours("d_{i1}", "distance of the counter-mass on each link l_{i1} from A_i (Fig. 2a)"),
@@ -388,8 +388,8 @@ def _notation() -> dict:
         "balancing.platform_split[<k>]": Sym("μ_{5,<k>}", "the platform's point mass at C of the <k>-th leg present (eqs. 2-4)"),
         "balancing.platform_split": Sym("μ_{5i}", "the platform's point masses at the C_i (eqs. 2-4)"),
         "balancing.independent": Sym("p_{i2} kept", "distal links whose p_{i2} stays as built (Sec. II.B-D, Figs. 2b-d)"),
-        "balancing.topologies": ours("eq. 17 / 19 designs", "also build the eq. 17 design (Fig. 4a) and eq. 19/21's (Fig. 6)"),
-        "balancing.least_mass": ours("least mass", "also build the least-mass design (generic condition finder + linprog)"),
+        "balancing.topologies": setting("eq. 17 / 19 designs", "also build the eq. 17 design (Fig. 4a) and eq. 19/21's (Fig. 6)"),
+        "balancing.least_mass": setting("least mass", "also build the least-mass design (generic condition finder + linprog)"),
     }
 
 

@@ -176,7 +176,7 @@ def balance(mech: SliderCrankMechanism, method: SliderCrankCounterweights, model
 
 
 def _notation() -> dict:
-    from ..notation import Sym, ours
+    from ..notation import Sym, setting
 
     return {
         "balancing.crank_counterweight": Sym(
@@ -185,7 +185,7 @@ def _notation() -> dict:
             "r_{cp2} L_2", "position of counterweight M_2 along the coupler from B (negative: beyond B)"),
         "balancing.crank_counterweight_mass": Sym("m_{cp1}", "mass of M_1 as built, instead of eq. 15's"),
         "balancing.coupler_counterweight_mass": Sym("m_{cp2}", "mass of M_2 as built, instead of eq. 15's"),
-        "balancing.moment_unknown": ours("unknown", "the inertia that eq. 20 is solved for"),
+        "balancing.moment_unknown": setting("unknown", "the inertia that eq. 20 is solved for"),
     }
 
 

@@ -453,7 +453,7 @@ def _factor_caption(study, method: str) -> str:
 
 
 def _notation() -> dict:
-    from ..notation import Sym, drive_table, ours
+    from ..notation import Sym, drive_table, ours, setting
 
     table = drive_table({"x": Sym("x", "x of the platform's point P"), "y": Sym("y", "y of P"),
                          "phi": Sym("φ", "platform angle, C_1C_2 to A_1A_2")})
@@ -472,7 +472,7 @@ def _notation() -> dict:
         "mechanism.piston.inertia": Sym("I_2", "axial moment of inertia of each piston"),
         "mechanism.platform.mass": Sym("m_p", "mass of the platform (centre of mass at P)"),
         "mechanism.platform.inertia": Sym("I_p", "axial moment of inertia of the platform"),
-        "mechanism.actuation": ours("actuation", "actuated joint of each leg: prismatic B_i or revolute A_i"),
+        "mechanism.actuation": setting("actuation", "actuated joint of each leg: prismatic B_i or revolute A_i"),
         "mechanism.stroke": ours("|A_iC_i|_{min}, |A_iC_i|_{max}", "range of the leg length the prismatic pair allows"),
         "motion.duration": Sym("t_f", "duration of the motion (eq. 10)"),
     })

@@ -424,7 +424,7 @@ __all__ = ["RRR4Mechanism", "LegSpec", "RRRLink", "PlatformSpec", "build", "reso
 
 
 def _notation() -> dict:
-    from ..notation import Sym, drive_table, ours
+    from ..notation import Sym, drive_table, ours, setting
 
     table = drive_table({"platform": Sym("(x, y, θ_5)", "platform pose: position of its centre and orientation θ_5")}, end_time="T")
     table.update({
@@ -436,7 +436,7 @@ def _notation() -> dict:
         "mechanism.legs.<i>.pivot": Sym("A_<i> = (a_<i>, b_<i>)", "base pivot of leg <i>"),
         "mechanism.legs.<i>.elbow": ours("σ_<i>", "leg <i>: +1 puts B_<i> on the counter-clockwise side of A_<i>C_<i>"),
         "mechanism.kinematics": ours("kinematics", "general, or the special kinematics of Fig. 5a / 5b"),
-        "mechanism.actuators": ours("actuators", "actuated joints"),
+        "mechanism.actuators": setting("actuators", "actuated joints"),
         "motion.duration": ours("T", "duration of the motion"),
     })
     for j, name, a, b in ((1, "proximal", "A", "B"), (2, "distal", "B", "C")):

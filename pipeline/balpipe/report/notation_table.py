@@ -98,7 +98,8 @@ def _row(r: dict, sym: N.Sym | None, has_paper: bool) -> dict:
     if sym is None:
         symbol, text, marked = Markup("<code>") + escape(leaf) + Markup("</code>"), "", False
     else:
-        symbol, text, marked = Markup(N.symbol_html(sym.symbol)), sym.text, has_paper and not sym.paper
+        symbol, text = Markup(N.symbol_html(sym.symbol)), sym.text
+        marked = has_paper and not sym.paper and not sym.setting
     unit = r["unit"] or (sym.unit if sym is not None and sym.unit else "")
     return {"path": r["path"], "symbol": symbol, "text": text, "text_html": Markup(N.text_html(text)),
             "not_in_paper": marked, "missing": sym is None, "value": r["value"], "unit": unit}
