@@ -303,7 +303,7 @@ def _notation() -> dict:
         "mechanism.links[0].com": Sym("l_{AS1}", "distance of link 1's centre of mass S_1 from A"),
         "mechanism.links[0].com_offset": ours("e_1", "offset of S_1 normal to AB"),
         "mechanism.links[0].inertia": Sym("I_{S1}", "axial moment of inertia of link 1 about S_1"),
-        "mechanism.links[1].length": Sym("l_2", "length of link 2 from B"),
+        "mechanism.links[1].length": ours("l_2", "length of link 2 from B (its tip; the dynamics do not depend on it)"),
         "mechanism.links[1].mass": Sym("m_2", "mass of link 2"),
         "mechanism.links[1].com": Sym("l_{BS2}", "distance of link 2's centre of mass S_2 from B"),
         "mechanism.links[1].com_offset": ours("e_2", "offset of S_2 normal to link 2"),
