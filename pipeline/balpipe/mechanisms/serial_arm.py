@@ -542,7 +542,8 @@ def notation(mech: SerialArmMechanism) -> dict:
         })
         table[f"mechanism.initial[{k - 1}]"] = ours(f"q_{k}(0)", f"angle of joint {k} of an arm without drives")
     table.update({
-        "mechanism.base": ours("O" if joints else "A", "position of joint 1 on the frame"),
+        "mechanism.base": (Sym("O", "joint O of link 1 on the frame") if joints
+                           else ours("A", "position of joint 1 on the frame")),
         "mechanism.payload.mass": Sym("m_p", "mass of the payload"),
         "mechanism.payload.inertia": ours("I_p", "centroidal inertia of the payload"),
         "mechanism.payload.position": ours("r_p", "position of the payload in the last link's frame"),
