@@ -35,6 +35,7 @@ import numpy as np
 from pydantic import Field
 
 from .. import units
+from ..joint_laws import PoseJointLaw, body_point
 from ..model import FRAME, Body, Driver, Law, Model, Revolute
 from ..motion import law_for
 from ..spec_parts import SpecFieldError, Strict
@@ -214,15 +215,7 @@ def _wrap(a):
 
 def corner_motion(mech: RRR4Mechanism, i: int, pose) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """C_i(t), its velocity and acceleration (N, 2) from the pose laws' values."""
-    (x, xd, xdd), (y, yd, ydd), (ph, phd, phdd) = pose
-    c = corner(mech, i)
-    co, si = np.cos(ph), np.sin(ph)
-    Rc = np.stack([co * c[0] - si * c[1], si * c[0] + co * c[1]], axis=-1)
-    Rpc = np.stack([-Rc[:, 1], Rc[:, 0]], axis=-1)
-    C = np.stack([x, y], axis=-1) + Rc
-    Cd = np.stack([xd, yd], axis=-1) + phd[:, None] * Rpc
-    Cdd = np.stack([xdd, ydd], axis=-1) + phdd[:, None] * Rpc - (phd**2)[:, None] * Rc
-    return C, Cd, Cdd
+    return body_point(pose, corner(mech, i))
 
 
 def reach_margin(leg: Leg, C: np.ndarray) -> np.ndarray:
@@ -254,7 +247,7 @@ def leg_motion(leg: Leg, C, Cd, Cdd, ref: tuple[float, float] | None = None) -> 
 
 
 @dataclass(frozen=True)
-class JointLaw(Law):
+class JointLaw(PoseJointLaw):
     """The law of an actuated joint, by inverse kinematics of the platform pose's laws.
 
     ``kind``: "A" (theta_i1), "B" (theta_i2 - theta_i1) or "C" (theta5 - theta_i2). The link
@@ -267,22 +260,16 @@ class JointLaw(Law):
     pose: tuple[Law, Law, Law]
     ref: tuple[float, float]
 
-    def __call__(self, t):
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        key = t.tobytes()
-        cache = self.__dict__.setdefault("_cache", {})  # the engine asks for the same grid often
-        if key not in cache:
-            if len(cache) > 8:
-                cache.clear()
-            pose = tuple(law(t) for law in self.pose)
-            cache[key] = (pose, leg_motion(self.leg, *corner_motion(self.mech, self.leg.i, pose), self.ref))
-        pose, lm = cache[key]
-        if self.kind == "A":
-            return lm.th1.copy(), lm.w1.copy(), lm.a1.copy()
-        if self.kind == "B":
-            return lm.th2 - lm.th1, lm.w2 - lm.w1, lm.a2 - lm.a1
+    @property
+    def coordinate(self) -> str:
+        return self.kind
+
+    def solve(self, t):
+        pose = tuple(law(t) for law in self.pose)
+        lm = leg_motion(self.leg, *corner_motion(self.mech, self.leg.i, pose), self.ref)
         ph = pose[2]
-        return ph[0] - lm.th2, ph[1] - lm.w2, ph[2] - lm.a2
+        return {"A": (lm.th1, lm.w1, lm.a1), "B": (lm.th2 - lm.th1, lm.w2 - lm.w1, lm.a2 - lm.a1),
+                "C": (ph[0] - lm.th2, ph[1] - lm.w2, ph[2] - lm.a2)}
 
 
 def check_workspace(mech: RRR4Mechanism, legs: dict[int, Leg], pose_laws, t: np.ndarray) -> None:
