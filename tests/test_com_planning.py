@@ -257,3 +257,37 @@ def test_halving_the_duration_quadruples_the_loads_and_keeps_the_reductions():
     assert pb["moment_reduction"] == pytest.approx(pa["moment_reduction"], abs=1e-12)
     assert pb["ramp_fraction"] > pa["ramp_fraction"]  # the same torque-rate limit needs longer ramps
 
+
+def test_each_trajectory_is_validated_against_its_own_unbalanced_reference(monkeypatch):
+    """Several trajectories in one spec: the pymunk residuals of a trajectory's stages are relative
+    to that trajectory's end-effector quintic (its Stage.reference), as its ratios are, not to the
+    first trajectory's."""
+    from balpipe import validation_stage
+    from balpipe.loader import load_text
+
+    text = replaced(spec_text("[P1P13, P5P9]"), "  samples: 501", "  samples: 101")
+    st = study.run(load_text(text, "two.yaml")[0])
+    seen = {}
+
+    class Done:
+        passed, reasons, dt, iterations = True, [], 1e-4, 10
+
+    def validate(model, analysis, peaks, settings, expect, reference=None):
+        name = next(s.stage.name for s in st.stages if s.stage.model is model)
+        seen[name] = (peaks, reference)
+        return Done()
+
+    monkeypatch.setattr(validation_stage, "validate", validate)
+    monkeypatch.setattr(validation_stage, "torque_driven", lambda *a, **k: Done())
+    validation_stage.simulate_study(st)
+    assert len(seen) == len(st.stages) == 8
+    refs = {}
+    for s in st.stages:
+        own = next(r for r in st.stages if r.stage.name == f"{s.stage.group}_ee_quintic")
+        want = study.ratio_reference(own)
+        peaks, ref = seen[s.stage.name]
+        assert ref == want and peaks == (want.force_peak, want.moment_peak), s.stage.name
+        refs[s.stage.group] = ref
+    # the two trajectories' references differ: the test could tell them apart
+    a, b = refs["P1P13"], refs["P5P9"]
+    assert abs(a.force - b.force) > 0.05 * a.force or abs(a.moment - b.moment) > 0.05 * a.moment
