@@ -84,3 +84,31 @@ def test_serial_arm_joints_share_one_solution_per_grid(monkeypatch):
     assert len(solved) == 1
     assert np.allclose(chain.point(q), np.stack([laws[0](t)[0], laws[1](t)[0]], axis=1), atol=1e-12)
     assert np.allclose(q.sum(axis=1), laws[2](t)[0], atol=1e-12)  # phi = q1 + q2 + q3
+
+
+def test_dyad_rates_recover_the_link_rates(rng):
+    """Two links at angles alpha_k(t) (random quadratics): from the end point's velocity and
+    acceleration the dyad's rates and accelerations are the alpha_k' and alpha_k''; a stretched
+    dyad gives non-finite values, no exception (the templates check the configuration)."""
+    from balpipe.joint_laws import dyad_rates
+
+    t = np.linspace(0, 1, 50)
+    for _ in range(5):
+        a, b = rng.uniform(0.2, 1.0, 2)
+        p, q, r = rng.uniform(-2, 2, (3, 2))
+        al = [p[k] + q[k] * t + r[k] * t**2 for k in (0, 1)]
+        w = [q[k] + 2 * r[k] * t for k in (0, 1)]
+        acc = [2 * r[k] * np.ones_like(t) for k in (0, 1)]
+        if np.min(np.abs(np.sin(al[1] - al[0]))) < 1e-2:
+            continue
+        e = [(np.cos(x), np.sin(x)) for x in al]
+        L = (a, b)
+        Cd = [sum(L[k] * w[k] * (-e[k][1], e[k][0])[i] for k in (0, 1)) for i in (0, 1)]
+        Cdd = [sum(L[k] * (acc[k] * (-e[k][1], e[k][0])[i] - w[k] ** 2 * e[k][i]) for k in (0, 1)) for i in (0, 1)]
+        det = a * b * np.sin(al[1] - al[0])
+        w1, w2, a1, a2 = dyad_rates(a, *e[0], b, *e[1], det, Cd, Cdd)
+        for got, want in ((w1, w[0]), (w2, w[1]), (a1, acc[0]), (a2, acc[1])):
+            assert np.allclose(got, want, rtol=1e-9, atol=1e-9)
+    one = np.ones(1)
+    w1, *_ = dyad_rates(1.0, one, 0 * one, 1.0, one, 0 * one, 0 * one, (one, one), (one, one))
+    assert not np.all(np.isfinite(w1))

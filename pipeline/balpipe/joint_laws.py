@@ -12,7 +12,9 @@ and live here:
 * :class:`PoseJointLaw`: a driver's law that is one coordinate of such an inverse-kinematics
   solution. The template says how to solve a time grid for all the coordinates at once
   (:meth:`PoseJointLaw.solve`) and which coordinate the law is (:attr:`PoseJointLaw.coordinate`);
-  the solution is computed once per time grid and shared by the laws that share a store.
+  the solution is computed once per time grid and shared by the laws that share a store;
+* :func:`dyad_rates`: the angular rates and accelerations of a two-link dyad whose end point's
+  velocity and acceleration are known (the n-RRR's legs, the serial arm's first two links).
 
 Used by the 3-RPR (paper 000: leg lengths or angles from the platform pose), the n-RRR (paper
 001: joint angles from the platform pose) and the serial arm (papers 002-003: joint angles from
@@ -46,6 +48,28 @@ def body_point(pose: tuple[Triple, Triple, Triple], c) -> Triple:
     Cd = np.stack([xd, yd], axis=-1) + fd[:, None] * jrc
     Cdd = np.stack([xdd, ydd], axis=-1) + fdd[:, None] * jrc - (fd**2)[:, None] * rc
     return C, Cd, Cdd
+
+
+def dyad_rates(a: float, c1, s1, b: float, c2, s2, det, Cd, Cdd) -> tuple[np.ndarray, ...]:
+    """Angular rates and accelerations (w1, w2, a1, a2) of a dyad, two links of lengths ``a``
+    and ``b`` at absolute angles alpha1, alpha2 (cosines and sines ``c1, s1, c2, s2``), whose
+    end point moves with velocity and acceleration ``Cd = (x', y')``, ``Cdd = (x'', y'')``
+    (pairs of (N,) arrays): a perp(e1) w1 + b perp(e2) w2 = C' and, differentiating,
+    a perp(e1) a1 + b perp(e2) a2 = C'' + a w1^2 e1 + b w2^2 e2, by Cramer's rule with
+    ``det`` = a b sin(alpha2 - alpha1) (inf or NaN where the dyad is stretched or folded: the
+    callers check the configuration). The second-order inverse kinematics of the n-RRR's legs
+    and of the serial arm's first two links."""
+    (Wdx, Wdy), (Wddx, Wddy) = Cd, Cdd
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / det
+        # x1 = (r x q)/det, x2 = (p x r)/det with the columns p = a perp(e1), q = b perp(e2)
+        w1 = (Wdx * b * c2 + Wdy * b * s2) * inv
+        w2 = (-a * s1 * Wdy - a * c1 * Wdx) * inv
+        Rx = Wddx + a * w1**2 * c1 + b * w2**2 * c2
+        Ry = Wddy + a * w1**2 * s1 + b * w2**2 * s2
+        a1 = (Rx * b * c2 + Ry * b * s2) * inv
+        a2 = (-a * s1 * Ry - a * c1 * Rx) * inv
+    return w1, w2, a1, a2
 
 
 def grid_key(t: np.ndarray) -> tuple:

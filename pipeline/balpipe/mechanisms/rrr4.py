@@ -35,7 +35,7 @@ import numpy as np
 from pydantic import Field
 
 from .. import units
-from ..joint_laws import PoseJointLaw, body_point
+from ..joint_laws import PoseJointLaw, body_point, dyad_rates
 from ..model import FRAME, Body, Driver, Law, Model, Revolute
 from ..motion import law_for
 from ..spec_parts import SpecFieldError, Strict
@@ -235,15 +235,11 @@ def leg_motion(leg: Leg, C, Cd, Cdd, ref: tuple[float, float] | None = None) -> 
     if ref is not None:
         th1 = ref[0] + _wrap(th1 - ref[0])
         th2 = ref[1] + _wrap(th2 - ref[1])
-    e1 = np.stack([np.cos(th1), np.sin(th1)], axis=-1)
-    e2 = np.stack([np.cos(th2), np.sin(th2)], axis=-1)
-    # [l1 e1perp, l2 e2perp] [w1, w2]^T = Cd
-    M = np.stack([np.stack([-leg.l1 * e1[:, 1], -leg.l2 * e2[:, 1]], axis=-1),
-                  np.stack([leg.l1 * e1[:, 0], leg.l2 * e2[:, 0]], axis=-1)], axis=1)
-    w = np.linalg.solve(M, Cd[..., None])[..., 0]
-    rhs = Cdd + (leg.l1 * w[:, 0] ** 2)[:, None] * e1 + (leg.l2 * w[:, 1] ** 2)[:, None] * e2
-    a = np.linalg.solve(M, rhs[..., None])[..., 0]
-    return LegMotion(th1, th2, w[:, 0], w[:, 1], a[:, 0], a[:, 1])
+    c1, s1, c2, s2 = np.cos(th1), np.sin(th1), np.cos(th2), np.sin(th2)
+    # l1 perp(e1) w1 + l2 perp(e2) w2 = C' and its derivative (det = l1 l2 sin(theta2 - theta1))
+    det = leg.l1 * leg.l2 * (c1 * s2 - s1 * c2)
+    w1, w2, a1, a2 = dyad_rates(leg.l1, c1, s1, leg.l2, c2, s2, det, (Cd[:, 0], Cd[:, 1]), (Cdd[:, 0], Cdd[:, 1]))
+    return LegMotion(th1, th2, w1, w2, a1, a2)
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,7 @@ import numpy as np
 from pydantic import Field
 
 from .. import units
-from ..joint_laws import PoseJointLaw, body_point
+from ..joint_laws import PoseJointLaw, body_point, dyad_rates
 from ..model import FRAME, Attachment, Body, Driver, Law, Model, Revolute
 from ..motion import law_for
 from ..spec_parts import LinkSpec, SpecFieldError, Strict
@@ -280,17 +280,8 @@ def absolute_motion(chain: Chain, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray
     al1 = np.arctan2(Wy, Wx) - np.arctan2(b * sg, a + b * cg)
     al2 = al1 + gamma
     c1, s1, c2, s2 = np.cos(al1), np.sin(al1), np.cos(al2), np.sin(al2)
-    # columns p = a perp(e1) = a(-s1, c1), q = b perp(e2) = b(-s2, c2); det = a b sin(gamma)
-    det = a * b * sg
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = 1.0 / det
-        # x1 = (r x q)/det, x2 = (p x r)/det
-        a1d = (Wdx * b * c2 + Wdy * b * s2) * inv
-        a2d = (-a * s1 * Wdy - a * c1 * Wdx) * inv
-        Rx = Wddx + a * a1d**2 * c1 + b * a2d**2 * c2
-        Ry = Wddy + a * a1d**2 * s1 + b * a2d**2 * s2
-        a1dd = (Rx * b * c2 + Ry * b * s2) * inv
-        a2dd = (-a * s1 * Ry - a * c1 * Rx) * inv
+    # det = a b sin(gamma)
+    a1d, a2d, a1dd, a2dd = dyad_rates(a, c1, s1, b, c2, s2, a * b * sg, (Wdx, Wdy), (Wddx, Wddy))
     th = [al1 - d1, al2 - d2]
     thd = [a1d, a2d]
     thdd = [a1dd, a2dd]
