@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from _edits import replaced
 
 ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"
@@ -79,7 +80,7 @@ def test_bad_spec_does_not_stop_the_others_nor_damage_its_old_page(work):
     page = work / "out" / "offset_slider_crank" / "index.html"
     before = page.read_bytes()
     spec = work / "specs" / "offset_slider_crank.yaml"
-    spec.write_text(spec.read_text().replace("mass: 600 g", "mass: -600 g"))
+    spec.write_text(replaced(spec.read_text(), "mass: 600 g", "mass: -600 g"))
     (work / "specs" / "broken.yaml").write_text("name: broken\nmechanism: {template: slider_crank\n")
     r = balpipe("build", "specs", "-o", "out", "--no-sim", cwd=work)
     assert r.returncode == 2
@@ -94,7 +95,7 @@ def test_bad_spec_does_not_stop_the_others_nor_damage_its_old_page(work):
 
 def test_a_stage_that_misses_its_claim_fails_the_build(work):
     spec = work / "specs" / "scott_russell.yaml"
-    spec.write_text(spec.read_text().replace("samples: 501", "samples: 501\n  balance_tolerance: 1.0e-18"))
+    spec.write_text(replaced(spec.read_text(), "samples: 501", "samples: 501\n  balance_tolerance: 1.0e-18"))
     r = balpipe("build", spec, "-o", "out", "--no-sim", cwd=work)
     assert r.returncode == 1
     res = json.loads((work / "out" / "scott_russell" / "results.json").read_text())
@@ -104,7 +105,7 @@ def test_a_stage_that_misses_its_claim_fails_the_build(work):
 
 def test_unreachable_geometry_is_a_located_spec_error(work):
     spec = work / "specs" / "offset_slider_crank.yaml"
-    spec.write_text(spec.read_text().replace("offset: 30 mm", "offset: 250 mm"))
+    spec.write_text(replaced(spec.read_text(), "offset: 30 mm", "offset: 250 mm"))
     r = balpipe("check", spec)
     assert r.returncode == 2
     assert "offset_slider_crank.yaml:14:" in r.stderr and "mechanism.coupler.length: the coupler" in r.stderr
@@ -123,7 +124,7 @@ def test_a_counterweight_10_percent_off_fails_validation_visibly(work):
     """As built with mcp1 10 % heavier than eq. 15's 8.4 kg: the analysis and the pymunk
     simulation both see the residual force; the page and the index say so; exit 1."""
     spec = work / "specs" / "offset_slider_crank.yaml"
-    spec.write_text(spec.read_text().replace("coupler_counterweight: -0.15 m",
+    spec.write_text(replaced(spec.read_text(), "coupler_counterweight: -0.15 m",
                                               "coupler_counterweight: -0.15 m\n  crank_counterweight_mass: 9.24 kg"))
     r = balpipe("build", spec, "-o", "out", cwd=work)
     assert r.returncode == 1, r.stderr

@@ -18,6 +18,7 @@ from balpipe.loader import load
 from balpipe.mechanisms.serial_arm import ArmGeometry, TaskMotion, com_chain, joint_laws, with_joint_laws
 from balpipe.motion import PointToPoint, bang_bang, quintic
 from test_serial_arm import arm_spec
+from _edits import replaced
 
 SPEC = Path(__file__).resolve().parents[1] / "specs" / "paper003_com_planning.yaml"
 
@@ -169,10 +170,10 @@ def test_phi_polynomial_ends_and_derivatives():
 
 def spec_text(trajectories: str, square: str = "{centre: [0 m, 0.487 m], side: 0.3 m}") -> str:
     text = SPEC.read_text(encoding="utf-8")
-    text = text.replace("test_square: {centre: [0 m, 0.487 m], side: 0.3 m, divisions: 4, first_corner: bottom-left}",
+    text = replaced(text, "test_square: {centre: [0 m, 0.487 m], side: 0.3 m, divisions: 4, first_corner: bottom-left}",
                         f"test_square: {square}")
-    text = text.replace("trajectories: [P1P13, P2P12, P3P11, P4P10, P5P9, P15P7, P14P8, P13P9]", f"trajectories: {trajectories}")
-    return text.replace("starts: 3", "starts: 1").split("references:")[0]
+    text = replaced(text, "trajectories: [P1P13, P2P12, P3P11, P4P10, P5P9, P15P7, P14P8, P13P9]", f"trajectories: {trajectories}")
+    return replaced(text, "starts: 3", "starts: 1").split("references:")[0]
 
 
 def check(tmp_path, text):
@@ -198,7 +199,7 @@ def test_unknown_point_and_end_out_of_reach(tmp_path):
 
 def test_planning_is_deterministic():
     """Same spec, same numbers: the optimisation's starts are seeded."""
-    text = spec_text("[P15P7]").replace("starts: 1", "starts: 2")
+    text = replaced(spec_text("[P15P7]"), "starts: 1", "starts: 2")
     from balpipe.loader import load_text
 
     a = study.run(load_text(text, "a.yaml")[0])
@@ -244,9 +245,9 @@ def test_single_trajectory_from_the_tip_drive():
 def test_halving_the_duration_quadruples_the_loads_and_keeps_the_reductions():
     from balpipe.loader import load_text
 
-    text = SINGLE.replace("phi: {starts: 1, max_evaluations: 60}", "phi: {degree: 5}")
+    text = replaced(SINGLE, "phi: {starts: 1, max_evaluations: 60}", "phi: {degree: 5}")
     a = study.run(load_text(text, "a.yaml")[0])
-    b = study.run(load_text(text.replace("duration: 0.5 s", "duration: 0.25 s"), "b.yaml")[0])
+    b = study.run(load_text(replaced(text, "duration: 0.5 s", "duration: 0.25 s"), "b.yaml")[0])
     for sa, sb in zip(a.stages[:3], b.stages[:3]):  # case 3 depends on T through the torque-rate limit
         assert sb.analysis.max_force == pytest.approx(4 * sa.analysis.max_force, rel=1e-9)
         assert sb.analysis.max_moment == pytest.approx(4 * sa.analysis.max_moment, rel=1e-9)
@@ -255,3 +256,38 @@ def test_halving_the_duration_quadruples_the_loads_and_keeps_the_reductions():
     assert pb["force_reduction"] == pytest.approx(pa["force_reduction"], abs=1e-12)
     assert pb["moment_reduction"] == pytest.approx(pa["moment_reduction"], abs=1e-12)
     assert pb["ramp_fraction"] > pa["ramp_fraction"]  # the same torque-rate limit needs longer ramps
+
+
+def test_each_trajectory_is_validated_against_its_own_unbalanced_reference(monkeypatch):
+    """Several trajectories in one spec: the pymunk residuals of a trajectory's stages are relative
+    to that trajectory's end-effector quintic (its Stage.reference), as its ratios are, not to the
+    first trajectory's."""
+    from balpipe import validation_stage
+    from balpipe.loader import load_text
+
+    text = replaced(spec_text("[P1P13, P5P9]"), "  samples: 501", "  samples: 101")
+    st = study.run(load_text(text, "two.yaml")[0])
+    seen = {}
+
+    class Done:
+        passed, reasons, dt, iterations = True, [], 1e-4, 10
+
+    def validate(model, analysis, peaks, settings, expect, reference=None):
+        name = next(s.stage.name for s in st.stages if s.stage.model is model)
+        seen[name] = (peaks, reference)
+        return Done()
+
+    monkeypatch.setattr(validation_stage, "validate", validate)
+    monkeypatch.setattr(validation_stage, "torque_driven", lambda *a, **k: Done())
+    validation_stage.simulate_study(st)
+    assert len(seen) == len(st.stages) == 8
+    refs = {}
+    for s in st.stages:
+        own = next(r for r in st.stages if r.stage.name == f"{s.stage.group}_ee_quintic")
+        want = study.ratio_reference(own)
+        peaks, ref = seen[s.stage.name]
+        assert ref == want and peaks == (want.force_peak, want.moment_peak), s.stage.name
+        refs[s.stage.group] = ref
+    # the two trajectories' references differ: the test could tell them apart
+    a, b = refs["P1P13"], refs["P5P9"]
+    assert abs(a.force - b.force) > 0.05 * a.force or abs(a.moment - b.moment) > 0.05 * a.moment

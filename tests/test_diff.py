@@ -5,6 +5,7 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
+from _edits import replaced
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -17,7 +18,7 @@ def test_diff_of_two_spec_files_in_every_format(tmp_path):
     old = tmp_path / "old.yaml"
     new = tmp_path / "new.yaml"
     shutil.copy(ROOT / "specs" / "scott_russell.yaml", old)
-    new.write_text(old.read_text().replace("crank_counterweight: -0.1 m", "crank_counterweight: -0.12 m"))
+    new.write_text(replaced(old.read_text(), "crank_counterweight: -0.1 m", "crank_counterweight: -0.12 m"))
     r = balpipe("diff", old, new, "--no-sim", "-f", "json")
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
@@ -55,7 +56,7 @@ def test_diff_against_a_git_revision(tmp_path):
     subprocess.run(["git", "init", "-q"], cwd=repo, check=True)
     subprocess.run(git + ["add", "."], cwd=repo, check=True)
     subprocess.run(git + ["commit", "-qm", "one"], cwd=repo, check=True)
-    spec.write_text(spec.read_text().replace("mass: 600 g", "mass: 700 g"))
+    spec.write_text(replaced(spec.read_text(), "mass: 600 g", "mass: 700 g"))
     r = balpipe("diff", "HEAD:specs/sc.yaml", "specs/sc.yaml", "--no-sim", "-f", "json", cwd=repo)
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
@@ -67,7 +68,7 @@ def test_diff_against_a_git_revision(tmp_path):
 def test_diff_with_simulation_reports_residual_changes(tmp_path):
     old = ROOT / "specs" / "offset_slider_crank.yaml"
     new = tmp_path / "new.yaml"
-    new.write_text(old.read_text().replace("coupler_counterweight: -0.15 m",
+    new.write_text(replaced(old.read_text(), "coupler_counterweight: -0.15 m",
                                            "coupler_counterweight: -0.15 m\n  crank_counterweight_mass: 9.24 kg"))
     r = balpipe("diff", old, new, "-f", "json")
     assert r.returncode == 0, r.stderr

@@ -21,6 +21,7 @@ from balpipe.mechanisms.five_bar import (
 )
 from balpipe.spec import Spec
 from balpipe.spec_parts import SpecFieldError
+from _edits import replaced
 
 SPEC = Path(__file__).resolve().parents[1] / "specs" / "paper004_five_bar.yaml"
 TOL = 1e-9
@@ -300,7 +301,7 @@ def test_coupling_gears_that_do_not_fit():
 
 
 def test_errors_are_located_in_the_file():
-    text = SPEC.read_text().replace("r1p: 0.14 m", "r1p: 0.3 m")
+    text = replaced(SPEC.read_text(), "r1p: 0.14 m", "r1p: 0.3 m")
     spec, node = load_text(text, "paper004.yaml")
     from balpipe.loader import LoadedSpec
 

@@ -23,6 +23,7 @@ from balpipe.spec_parts import SpecFieldError
 from balpipe.validation_stage import simulate_study
 from conftest import slider_crank_spec
 from generic_specs import FIVE_BAR_DISCS, FIVE_BAR_REGIONS, FOUR_BAR_DISCS, FOUR_BAR_REGIONS, five_bar, four_bar
+from _edits import replaced
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
 
@@ -158,14 +159,17 @@ def test_infeasible_region_names_the_condition():
     assert "mx[" in err.value.message and "= 0 (left at" in err.value.message
 
 
-def test_infeasible_spec_is_a_located_error(tmp_path):
+def test_infeasible_spec_is_a_located_error(tmp_path, capsys):
     from balpipe.cli import main
 
     text = (SPECS / "custom_four_bar_balancing.yaml").read_text()
-    text = text.replace("disc: {centre: [0.14, 0], radius: 0.25}", "at: [0.1, 0]")
+    # the coupler's counterweight a point mass, in the main design and in the compared one
+    text = replaced(text, "disc: {centre: [0.14, 0], radius: 0.25}", "at: [0.1, 0]", count=2)
     bad = tmp_path / "bad.yaml"
     bad.write_text(text)
     assert main(["check", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad}:41:75: balancing.counter_rotations[0].ratio: disc 'disc_crank' would need a negative inertia" in err
 
 
 def test_conditions_read_cleanly():

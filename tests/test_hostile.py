@@ -20,6 +20,7 @@ import pytest
 from balpipe import build as build_mod
 from balpipe.cli import main
 from balpipe.loader import SpecErrors, load, load_text
+from _edits import replaced
 
 ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"
@@ -30,7 +31,8 @@ FAST = "  samples: 501"  # replaced by fewer samples to keep these builds quick
 
 
 def quick(text: str) -> str:
-    return text.replace(FAST, "  samples: 41") if FAST in text else text
+    """Fewer samples where the spec sets 501 (a speed-up only; specs on the default keep it)."""
+    return replaced(text, FAST, "  samples: 41") if FAST in text else text
 
 
 def balpipe(*args, cwd=None, timeout=300, **kw):
@@ -118,8 +120,7 @@ def test_file_size_limit(tmp_path):
      "references[0].published: number must be a finite number"),
 ])
 def test_extreme_numbers_are_refused_up_front(tmp_path, old, new, words):
-    assert old in OFFSET
-    msg = _load_error(tmp_path, OFFSET.replace(old, new))
+    msg = _load_error(tmp_path, replaced(OFFSET, old, new))
     assert words in msg
 
 
@@ -132,12 +133,12 @@ def _assert_checks(p: Path, text: str) -> None:
 
 
 def test_huge_duration_within_limits_builds(tmp_path):
-    _assert_checks(tmp_path / "slow.yaml", quick(OFFSET).replace("duration: 0.5 s", "duration: 90000 s"))
+    _assert_checks(tmp_path / "slow.yaml", replaced(quick(OFFSET), "duration: 0.5 s", "duration: 90000 s"))
 
 
 def test_five_bar_with_massless_distal_links_checks(tmp_path):
     _assert_checks(tmp_path / "fb.yaml",
-                   quick(FIVE).replace("distal:   {length: 0.30 m, mass: 1.0 kg", "distal:   {length: 0.30 m, mass: 0 kg"))
+                   replaced(quick(FIVE), "distal:   {length: 0.30 m, mass: 1.0 kg", "distal:   {length: 0.30 m, mass: 0 kg"))
 
 
 def test_check_goes_on_past_a_crashing_spec_and_matches_build(tmp_path):
@@ -418,7 +419,7 @@ def test_a_failing_spec_keeps_the_earlier_good_page(tmp_path):
     assert balpipe("build", spec, "-o", out, "--no-sim").returncode == 0
     good = (out / "s" / "index.html").read_text()
     # as built with a wrong counterweight: the counterweights stage no longer cancels the force
-    spec.write_text(quick(SCOTT).replace("  moment_unknown:", "  crank_counterweight_mass: 1 kg\n  moment_unknown:"))
+    spec.write_text(replaced(quick(SCOTT), "  moment_unknown:", "  crank_counterweight_mass: 1 kg\n  moment_unknown:"))
     r = balpipe("build", spec, "-o", out, "--no-sim")
     no_traceback(r)
     assert r.returncode == 1

@@ -23,6 +23,7 @@ from balpipe.model import FRAME, Body, Driver, Gear, Model, Revolute
 from balpipe.motion import PROFILES, PointToPoint
 from balpipe.report.results import joint_load_table, timeseries_csv
 from balpipe.spec_parts import SpecFieldError
+from _edits import replaced
 
 SPEC = Path(__file__).resolve().parents[1] / "specs" / "paper004_five_bar.yaml"
 TAN20 = math.tan(math.radians(20.0))
@@ -136,8 +137,8 @@ def test_couple_only_gears_leave_the_bearings_unloaded(paper):
 
 
 def test_pressure_angle_is_read_from_the_spec():
-    text = SPEC.read_text().replace("    r1p: 0.14 m\n", "    r1p: 0.14 m\n    pressure_angle: 25 deg\n")
-    text = text.replace("    planet_mass: 0 kg\n", "    planet_mass: 0 kg\n    pressure_angle: 14.5 deg\n")
+    text = replaced(SPEC.read_text(), "    r1p: 0.14 m\n", "    r1p: 0.14 m\n    pressure_angle: 25 deg\n")
+    text = replaced(text, "    planet_mass: 0 kg\n", "    planet_mass: 0 kg\n    pressure_angle: 14.5 deg\n")
     spec, _ = load_text(text, "five_bar.yaml")
     stages = {s.name: s for s in registry.balance(spec).stages}
     t = registry.time_grid(spec)

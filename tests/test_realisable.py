@@ -21,6 +21,7 @@ from balpipe.motion import PROFILES, PointToPoint
 from balpipe.report.results import results_dict
 from balpipe.spec_parts import SpecFieldError
 from balpipe import study as study_mod
+from _edits import replaced
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "specs" / "paper004_five_bar.yaml"
@@ -92,7 +93,7 @@ def test_paper004_point_mass_stage_is_fully_balanced_with_the_computed_inertias(
 
 
 def test_point_mass_stage_needs_balanced_inertias():
-    text = SPEC.read_text().replace("  balanced_inertias: {proximal: 0.012 kg m^2, distal: 0.010 kg m^2}\n", "")
+    text = replaced(SPEC.read_text(), "  balanced_inertias: {proximal: 0.012 kg m^2, distal: 0.010 kg m^2}\n", "")
     spec, _ = load_text(text, "p.yaml")
     with pytest.raises(SpecFieldError) as exc:
         registry.balance(spec)

@@ -14,6 +14,7 @@ from balpipe.loader import load
 from balpipe.mechanisms import rpr3
 from balpipe.spec import Spec
 from balpipe.spec_parts import SpecFieldError
+from _edits import replaced
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
 TOL = 1e-9
@@ -301,7 +302,7 @@ PAPER_IDLER = (SPECS / "paper000_rpr3_idler_loop.yaml").read_text()
 
 
 def test_pose_outside_the_workspace_names_the_time_and_the_leg(tmp_path):
-    text = PAPER_IDLER.replace("  actuation: revolute", "  actuation: revolute\n  stroke: [0.12 m, 0.5 m]")
+    text = replaced(PAPER_IDLER, "  actuation: revolute", "  actuation: revolute\n  stroke: [0.12 m, 0.5 m]")
     msg = _bad(tmp_path, text)
     line = next(k for k, s in enumerate(text.splitlines(), 1) if s.strip().startswith("x: {from"))
     assert msg.startswith(f"{tmp_path / 's.yaml'}:{line}:")
@@ -310,30 +311,31 @@ def test_pose_outside_the_workspace_names_the_time_and_the_leg(tmp_path):
 
 
 def test_prismatic_actuation_at_the_homothetic_pose_is_singular(tmp_path):
-    msg = _bad(tmp_path, PAPER_IDLER.replace("  actuation: revolute", "  actuation: prismatic"))
+    msg = _bad(tmp_path, replaced(PAPER_IDLER, "  actuation: revolute", "  actuation: prismatic"))
     assert "mechanism.actuation: prismatic actuation is singular at t = 0 s" in msg
     assert "leg lines A_iC_i meet in one point" in msg
 
 
 def test_printed_counterweight_positions_give_a_located_negative_mass(tmp_path):
-    msg = _bad(tmp_path, PAPER_IDLER.replace("cylinder: -0.1 m      # rcp1 = -2", "cylinder: 0.025 m"))
+    msg = _bad(tmp_path, replaced(PAPER_IDLER, "cylinder: -0.1 m      # rcp1 = -2", "cylinder: 0.025 m"))
     assert "balancing.counterweights.cylinder: eq. 5a gives a negative counterweight mass mcp1 = -3 kg" in msg
 
 
 def test_idler_loop_out_of_reach(tmp_path):
-    msg = _bad(tmp_path, PAPER_IDLER.replace("link6: {length: 0.1581 m", "link6: {length: 0.03 m"))
+    msg = _bad(tmp_path, replaced(PAPER_IDLER, "link6: {length: 0.1581 m", "link6: {length: 0.03 m"))
     assert "balancing.link6.length: the idler loop cannot reach P at t = 0 s" in msg
 
 
 def test_scott_russell_needs_eq_29(tmp_path):
-    text = (SPECS / "paper000_rpr3_scott_russell.yaml").read_text().replace(
-        "platform: {mass: 1 kg, inertia: 0.01 kg m^2}", "platform: {mass: 1 kg, inertia: 0.02 kg m^2}")
+    text = replaced((SPECS / "paper000_rpr3_scott_russell.yaml").read_text(),
+                    "platform: {mass: 1 kg, inertia: 0.01 kg m^2}", "platform: {mass: 1 kg, inertia: 0.02 kg m^2}")
     msg = _bad(tmp_path, text)
     assert "mechanism.platform.inertia: eq. 29" in msg and "Ip = mp Rp^2 = 0.01" in msg
 
 
 def test_scott_russell_out_of_reach_names_the_leg(tmp_path):
-    text = (SPECS / "paper000_rpr3_scott_russell.yaml").read_text().replace("length: 0.25 m", "length: 0.12 m")
+    # crank and coupler both (eq. 19 needs L2 = L1)
+    text = replaced((SPECS / "paper000_rpr3_scott_russell.yaml").read_text(), "length: 0.25 m", "length: 0.12 m", count=2)
     msg = _bad(tmp_path, text)
     assert "balancing.crank.length: the Scott-Russell mechanism of leg 2 cannot reach C at t = " in msg
 

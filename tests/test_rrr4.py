@@ -21,6 +21,7 @@ from balpipe.model import FRAME, Driver, Model, Revolute
 from balpipe.motion import PROFILES, PointToPoint
 from balpipe.spec import Spec
 from balpipe.spec_parts import SpecFieldError
+from _edits import replaced
 
 SPEC_FILE = "specs/paper001_4rrr.yaml"
 
@@ -325,8 +326,7 @@ def test_pose_outside_the_workspace_names_time_and_leg(tmp_path, capsys):
     """The platform driven out of leg 1's reach: exit 2, one located line naming time and leg."""
     from balpipe.cli import main
 
-    text = open(SPEC_FILE).read().replace("to: [0.05 m, 0.04 m, 10 deg]", "to: [0.3 m, 0.0 m, 10 deg]")
-    assert "0.3 m, 0.0 m" in text
+    text = replaced(open(SPEC_FILE).read(), "to: [0.05 m, 0.04 m, 10 deg]", "to: [0.3 m, 0.0 m, 10 deg]")
     path = tmp_path / "far.yaml"
     path.write_text(text)
     with pytest.raises(SpecFieldError) as exc:

@@ -11,6 +11,7 @@ from balpipe.engine import analyse
 from balpipe.spec_parts import SpecFieldError
 
 from conftest import slider_crank_spec
+from _edits import replaced
 
 LAWS = ["quintic", "cycloidal", "bang_bang", "trapezoidal", "polynomial"]
 
@@ -168,8 +169,7 @@ def test_offset_slider_com_issue_example_gives_eq15_masses():
     from balpipe.loader import load_text
 
     text = (Path(__file__).resolve().parents[1] / "specs" / "offset_slider_crank.yaml").read_text()
-    text = text.replace("slider:  {mass: 600 g}", "slider:  {mass: 600 g, com: [0.05 m, 0 m]}")
-    assert "com: [0.05 m" in text
+    text = replaced(text, "slider:  {mass: 600 g}", "slider:  {mass: 600 g, com: [0.05 m, 0 m]}")
     spec, _ = load_text(text, "offset.yaml")
     st = study.run(spec)
     params = {p.name: p.value for p in st.balance.parameters}

@@ -4,6 +4,7 @@ import pytest
 
 from balpipe import units
 from balpipe.loader import SpecErrors, load_text, schema
+from _edits import replaced
 
 GOOD = """\
 name: test
@@ -36,18 +37,18 @@ def test_good_spec_loads_with_units():
 
 
 def test_malformed_yaml():
-    (e,) = errors(GOOD.replace("drive: {crank", "drive: [crank"))
+    (e,) = errors(replaced(GOOD, "drive: {crank", "drive: [crank"))
     assert e.startswith("s.yaml:9:") and "malformed YAML" in e
 
 
 def test_unknown_key_points_at_the_key():
-    text = GOOD.replace("slider: {mass: 500 g}", "slider: {mass: 500 g, colour: red}")
+    text = replaced(GOOD, "slider: {mass: 500 g}", "slider: {mass: 500 g, colour: red}")
     (e,) = errors(text)
     assert e == at(text, 6, "colour") + ": mechanism.slider.colour: unknown key (not part of the spec schema; check the spelling)"
 
 
 def test_wrong_type():
-    (e,) = errors(GOOD.replace("duration: 0.5 s", "duration: [1, 2]"))
+    (e,) = errors(replaced(GOOD, "duration: 0.5 s", "duration: [1, 2]"))
     assert e.startswith("s.yaml:8:13: motion.duration:") and "time" in e
 
 
@@ -57,25 +58,25 @@ def test_wrong_type():
     ("duration: 0.5 s", "duration: 0 s", 8, "0 s", "motion.duration: must be > 0"),
 ])
 def test_negative_or_zero_values(old, new, line, token, where):
-    text = GOOD.replace(old, new)
+    text = replaced(GOOD, old, new)
     (e,) = errors(text)
     assert e.startswith(f"{at(text, line, token)}: {where}")
 
 
 def test_wrong_unit_dimension():
-    (e,) = errors(GOOD.replace("length: 0.2 m", "length: 0.2 deg"))
+    (e,) = errors(replaced(GOOD, "length: 0.2 m", "length: 0.2 deg"))
     assert "mechanism.crank.length: unit 'deg' is not a length unit" in e
 
 
 def test_unknown_template_and_duplicate_key():
-    (e,) = errors(GOOD.replace("template: slider_crank", "template: slider_crunk"))
+    (e,) = errors(replaced(GOOD, "template: slider_crank", "template: slider_crunk"))
     assert e.startswith("s.yaml:3:13: mechanism.template: unknown value 'slider_crunk'")
     (e,) = errors(GOOD + "name: again\n")
     assert e.startswith("s.yaml:10:1: name: duplicate key")
 
 
 def test_several_errors_are_all_reported_in_line_order():
-    text = GOOD.replace("mass: 1 kg, com: 0.1 m", "mass: -1 kg, com: 0.1 m").replace("duration: 0.5 s", "duration: 0")
+    text = replaced(replaced(GOOD, "mass: 1 kg, com: 0.1 m", "mass: -1 kg, com: 0.1 m"), "duration: 0.5 s", "duration: 0")
     es = errors(text)
     assert [e.split(":")[1] for e in es] == ["4", "8"]
 

@@ -14,6 +14,7 @@ from balpipe import registry, units
 from balpipe.loader import SpecErrors, load_text
 from balpipe.spec import Spec
 from balpipe.spec_parts import SpecFieldError
+from _edits import replaced
 
 ROOT = Path(__file__).resolve().parents[1]
 SCOTT = (ROOT / "specs" / "scott_russell.yaml").read_text()
@@ -22,8 +23,7 @@ FIVE = (ROOT / "specs" / "paper004_five_bar.yaml").read_text()
 
 
 def _with(text: str, old: str, new: str) -> str:
-    assert old in text, old
-    return text.replace(old, new, 1)
+    return replaced(text, old, new)
 
 
 def _errors(text: str) -> str:

@@ -366,8 +366,29 @@ def _clashes(specs: list[Path]) -> dict[Path, str]:
     return out
 
 
-def build(paths: list[str], opts: Options, jobs: int = 1, progress=None) -> list[Outcome]:
-    """Build every spec (in parallel with ``jobs`` > 1), then the site index and schema.
+def usable_cores() -> int:
+    """The cores this process may run on: ``os.process_cpu_count()`` (Python 3.13), else the
+    scheduler's affinity mask, else ``os.cpu_count()``; at least 1."""
+    count = getattr(os, "process_cpu_count", None)
+    if count is not None:
+        n = count()
+    elif hasattr(os, "sched_getaffinity"):
+        n = len(os.sched_getaffinity(0))
+    else:  # pragma: no cover - macOS, Windows before 3.13
+        n = os.cpu_count()
+    return max(1, n or 1)
+
+
+def default_jobs(specs: int) -> int:
+    """``build``'s default number of processes: one per usable core, at most one per spec."""
+    return max(1, min(usable_cores(), specs))
+
+
+def build(paths: list[str], opts: Options, jobs: int | None = None, progress=None) -> list[Outcome]:
+    """Build every spec (in parallel with ``jobs`` > 1; default, None: :func:`default_jobs`,
+    one process per usable core, at most one per spec; 1: one after another in this process),
+    then the site index and schema. The pages, the index and the order of the outcomes (and of
+    the ``progress`` calls: the specs' order) do not depend on ``jobs``.
 
     Raises :class:`OutputError` before any work when the output folder cannot be used. On
     KeyboardInterrupt (Ctrl-C, or SIGTERM turned into one by the CLI) the workers are stopped,
@@ -387,6 +408,8 @@ def build(paths: list[str], opts: Options, jobs: int = 1, progress=None) -> list
     if progress:
         for o in outcomes:  # refused before any work: k = 0
             progress(0, len(todo), o)
+    if jobs is None:
+        jobs = default_jobs(len(todo))
     with locked(opts.out):
         remove_temporaries(opts.out)
         try:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from .study import Study
+from .study import Study, ratio_reference
 from .validate import FreeFloating, ValidationSettings, free_floating, validate
 from .validate.run import _model_scale
 from .validate.torque import torque_driven
@@ -84,11 +84,13 @@ class Reactionless:
 def simulate_study(study: Study) -> None:
     """Validate every stage; failures become problems of the study (the build exits 1)."""
     settings = settings_for(study)
-    # relative to the unbalanced inertial peaks (the shaking loads' peaks without gravity),
-    # floored by the model's gross inertial loads (balpipe.load_reference)
-    ref = study.reference
-    F0, M0 = ref.force_peak, ref.moment_peak
     for s in study.stages:
+        # relative to the unbalanced inertial peaks (the shaking loads' peaks without gravity) of
+        # the stage's own reference (Stage.reference: with several trajectories, that trajectory's
+        # unbalanced stage; else the first stage), floored by that model's gross inertial loads
+        # (balpipe.load_reference): the same denominators as the stage's ratios
+        ref = ratio_reference(study.reference_stage(s))
+        F0, M0 = ref.force_peak, ref.moment_peak
         expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
         s.validation = validate(s.stage.model, s.analysis, (F0, M0), settings, expect, reference=ref)
         if not s.validation.passed:

@@ -33,6 +33,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
+from ..joint_laws import PoseJointLaw, body_point
 from ..model import FRAME, Body, Driver, Law, Model, Prismatic, Revolute
 from ..spec_parts import SpecFieldError, Strict
 from ..units import Inertia, Length, Mass, PositiveLength
@@ -123,17 +124,9 @@ class Pose:
 
     def joint_point(self, c: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """C(t), C'(t), C''(t) (N, 2) of the platform point with local coordinates ``c``:
-        C = P + R(phi) c, C' = P' + phi' J R c, C'' = P'' + phi'' J R c - phi'^2 R c."""
-        x, xd, xdd = self.x(t)
-        y, yd, ydd = self.y(t)
-        f, fd, fdd = self.phi(t)
-        cf, sf = np.cos(f), np.sin(f)
-        rc = np.stack([cf * c[0] - sf * c[1], sf * c[0] + cf * c[1]], axis=1)
-        jrc = np.stack([-rc[:, 1], rc[:, 0]], axis=1)
-        P = np.stack([x, y], axis=1)
-        Pd = np.stack([xd, yd], axis=1)
-        Pdd = np.stack([xdd, ydd], axis=1)
-        return P + rc, Pd + fd[:, None] * jrc, Pdd + fdd[:, None] * jrc - (fd**2)[:, None] * rc
+        C = P + R(phi) c, C' = P' + phi' J R c, C'' = P'' + phi'' J R c - phi'^2 R c
+        (:func:`balpipe.joint_laws.body_point`)."""
+        return body_point((self.x(t), self.y(t), self.phi(t)), c)
 
 
 def leg_coordinates(A: np.ndarray, C, Cd, Cdd) -> dict[str, np.ndarray]:
@@ -152,7 +145,7 @@ def leg_coordinates(A: np.ndarray, C, Cd, Cdd) -> dict[str, np.ndarray]:
 
 
 @dataclass(frozen=True)
-class LegLaw(Law):
+class LegLaw(PoseJointLaw):
     """The law of leg i's actuated coordinate (``rho`` or ``theta``) from the platform pose by
     inverse kinematics, exact to second order (chain rule)."""
 
@@ -161,10 +154,9 @@ class LegLaw(Law):
     c: tuple[float, float]
     coordinate: Literal["rho", "theta"]
 
-    def __call__(self, t):
-        t = np.atleast_1d(np.asarray(t, dtype=float))
+    def solve(self, t):
         C, Cd, Cdd = self.pose.joint_point(np.asarray(self.c), t)
-        return leg_coordinates(np.asarray(self.A), C, Cd, Cdd)[self.coordinate]
+        return leg_coordinates(np.asarray(self.A), C, Cd, Cdd)
 
 
 def pose_laws(laws: dict[str, Law]) -> Pose:

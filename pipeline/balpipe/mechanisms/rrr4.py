@@ -35,6 +35,7 @@ import numpy as np
 from pydantic import Field
 
 from .. import units
+from ..joint_laws import PoseJointLaw, body_point, dyad_rates
 from ..model import FRAME, Body, Driver, Law, Model, Revolute
 from ..motion import law_for
 from ..spec_parts import SpecFieldError, Strict
@@ -214,15 +215,7 @@ def _wrap(a):
 
 def corner_motion(mech: RRR4Mechanism, i: int, pose) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """C_i(t), its velocity and acceleration (N, 2) from the pose laws' values."""
-    (x, xd, xdd), (y, yd, ydd), (ph, phd, phdd) = pose
-    c = corner(mech, i)
-    co, si = np.cos(ph), np.sin(ph)
-    Rc = np.stack([co * c[0] - si * c[1], si * c[0] + co * c[1]], axis=-1)
-    Rpc = np.stack([-Rc[:, 1], Rc[:, 0]], axis=-1)
-    C = np.stack([x, y], axis=-1) + Rc
-    Cd = np.stack([xd, yd], axis=-1) + phd[:, None] * Rpc
-    Cdd = np.stack([xdd, ydd], axis=-1) + phdd[:, None] * Rpc - (phd**2)[:, None] * Rc
-    return C, Cd, Cdd
+    return body_point(pose, corner(mech, i))
 
 
 def reach_margin(leg: Leg, C: np.ndarray) -> np.ndarray:
@@ -242,19 +235,15 @@ def leg_motion(leg: Leg, C, Cd, Cdd, ref: tuple[float, float] | None = None) -> 
     if ref is not None:
         th1 = ref[0] + _wrap(th1 - ref[0])
         th2 = ref[1] + _wrap(th2 - ref[1])
-    e1 = np.stack([np.cos(th1), np.sin(th1)], axis=-1)
-    e2 = np.stack([np.cos(th2), np.sin(th2)], axis=-1)
-    # [l1 e1perp, l2 e2perp] [w1, w2]^T = Cd
-    M = np.stack([np.stack([-leg.l1 * e1[:, 1], -leg.l2 * e2[:, 1]], axis=-1),
-                  np.stack([leg.l1 * e1[:, 0], leg.l2 * e2[:, 0]], axis=-1)], axis=1)
-    w = np.linalg.solve(M, Cd[..., None])[..., 0]
-    rhs = Cdd + (leg.l1 * w[:, 0] ** 2)[:, None] * e1 + (leg.l2 * w[:, 1] ** 2)[:, None] * e2
-    a = np.linalg.solve(M, rhs[..., None])[..., 0]
-    return LegMotion(th1, th2, w[:, 0], w[:, 1], a[:, 0], a[:, 1])
+    c1, s1, c2, s2 = np.cos(th1), np.sin(th1), np.cos(th2), np.sin(th2)
+    # l1 perp(e1) w1 + l2 perp(e2) w2 = C' and its derivative (det = l1 l2 sin(theta2 - theta1))
+    det = leg.l1 * leg.l2 * (c1 * s2 - s1 * c2)
+    w1, w2, a1, a2 = dyad_rates(leg.l1, c1, s1, leg.l2, c2, s2, det, (Cd[:, 0], Cd[:, 1]), (Cdd[:, 0], Cdd[:, 1]))
+    return LegMotion(th1, th2, w1, w2, a1, a2)
 
 
 @dataclass(frozen=True)
-class JointLaw(Law):
+class JointLaw(PoseJointLaw):
     """The law of an actuated joint, by inverse kinematics of the platform pose's laws.
 
     ``kind``: "A" (theta_i1), "B" (theta_i2 - theta_i1) or "C" (theta5 - theta_i2). The link
@@ -267,22 +256,16 @@ class JointLaw(Law):
     pose: tuple[Law, Law, Law]
     ref: tuple[float, float]
 
-    def __call__(self, t):
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        key = t.tobytes()
-        cache = self.__dict__.setdefault("_cache", {})  # the engine asks for the same grid often
-        if key not in cache:
-            if len(cache) > 8:
-                cache.clear()
-            pose = tuple(law(t) for law in self.pose)
-            cache[key] = (pose, leg_motion(self.leg, *corner_motion(self.mech, self.leg.i, pose), self.ref))
-        pose, lm = cache[key]
-        if self.kind == "A":
-            return lm.th1.copy(), lm.w1.copy(), lm.a1.copy()
-        if self.kind == "B":
-            return lm.th2 - lm.th1, lm.w2 - lm.w1, lm.a2 - lm.a1
+    @property
+    def coordinate(self) -> str:
+        return self.kind
+
+    def solve(self, t):
+        pose = tuple(law(t) for law in self.pose)
+        lm = leg_motion(self.leg, *corner_motion(self.mech, self.leg.i, pose), self.ref)
         ph = pose[2]
-        return ph[0] - lm.th2, ph[1] - lm.w2, ph[2] - lm.a2
+        return {"A": (lm.th1, lm.w1, lm.a1), "B": (lm.th2 - lm.th1, lm.w2 - lm.w1, lm.a2 - lm.a1),
+                "C": (ph[0] - lm.th2, ph[1] - lm.w2, ph[2] - lm.a2)}
 
 
 def check_workspace(mech: RRR4Mechanism, legs: dict[int, Leg], pose_laws, t: np.ndarray) -> None:

@@ -28,6 +28,7 @@ import numpy as np
 from pydantic import Field
 
 from .. import units
+from ..joint_laws import PoseJointLaw, body_point, dyad_rates
 from ..model import FRAME, Attachment, Body, Driver, Law, Model, Revolute
 from ..motion import law_for
 from ..spec_parts import LinkSpec, SpecFieldError, Strict
@@ -263,13 +264,9 @@ def absolute_motion(chain: Chain, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray
     Wdx, Wdy, Wddx, Wddy = xd[:, 0], xd[:, 1], xdd[:, 0], xdd[:, 1]
     if n == 3:
         phi, phid, phidd = x[:, 2], xd[:, 2], xdd[:, 2]
-        c, s = np.cos(phi), np.sin(phi)
-        ux, uy = c * v[2, 0] - s * v[2, 1], s * v[2, 0] + c * v[2, 1]  # R(phi) v3
-        Wx, Wy = Wx - ux, Wy - uy
-        Wdx, Wdy = Wdx + phid * uy, Wdy - phid * ux  # - phi' perp(u)
-        w2 = phid**2
-        Wddx = Wddx + phidd * uy + w2 * ux
-        Wddy = Wddy - phidd * ux + w2 * uy
+        # W: the point -v3 of the last link's frame placed at the target, phi its angle
+        W, Wd, Wdd = body_point(((Wx, Wdx, Wddx), (Wy, Wdy, Wddy), (phi, phid, phidd)), -v[2])
+        Wx, Wy, Wdx, Wdy, Wddx, Wddy = W[:, 0], W[:, 1], Wd[:, 0], Wd[:, 1], Wdd[:, 0], Wdd[:, 1]
     elif n != 2:
         raise ValueError("task-space motions need a 2R or 3R chain")
     a, b = math.hypot(*v[0]), math.hypot(*v[1])
@@ -283,17 +280,8 @@ def absolute_motion(chain: Chain, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray
     al1 = np.arctan2(Wy, Wx) - np.arctan2(b * sg, a + b * cg)
     al2 = al1 + gamma
     c1, s1, c2, s2 = np.cos(al1), np.sin(al1), np.cos(al2), np.sin(al2)
-    # columns p = a perp(e1) = a(-s1, c1), q = b perp(e2) = b(-s2, c2); det = a b sin(gamma)
-    det = a * b * sg
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = 1.0 / det
-        # x1 = (r x q)/det, x2 = (p x r)/det
-        a1d = (Wdx * b * c2 + Wdy * b * s2) * inv
-        a2d = (-a * s1 * Wdy - a * c1 * Wdx) * inv
-        Rx = Wddx + a * a1d**2 * c1 + b * a2d**2 * c2
-        Ry = Wddy + a * a1d**2 * s1 + b * a2d**2 * s2
-        a1dd = (Rx * b * c2 + Ry * b * s2) * inv
-        a2dd = (-a * s1 * Ry - a * c1 * Rx) * inv
+    # det = a b sin(gamma)
+    a1d, a2d, a1dd, a2dd = dyad_rates(a, c1, s1, b, c2, s2, a * b * sg, (Wdx, Wdy), (Wddx, Wddy))
     th = [al1 - d1, al2 - d2]
     thd = [a1d, a2d]
     thdd = [a1dd, a2dd]
@@ -352,8 +340,9 @@ def task_jacobian(chain: Chain, q: np.ndarray) -> np.ndarray:
 
 
 @dataclass(eq=False)
-class JointLaw(Law):
-    """Joint ``index`` of a task-space motion, as a scalar law for a driver."""
+class JointLaw(PoseJointLaw):
+    """Joint ``index`` of a task-space motion, as a scalar law for a driver. The laws of one
+    motion share ``_cache``: one inverse-kinematics solution per time grid for every joint."""
 
     chain: Chain
     motion: TaskMotion
@@ -361,16 +350,17 @@ class JointLaw(Law):
     index: int
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
-    def __call__(self, t):
-        t = np.asarray(t, dtype=float)
-        key = (t.shape, t.tobytes())
-        sol = self._cache.get("sol")
-        if sol is None or self._cache.get("key") != key:
-            js = JointSolution(self.chain, self.motion, self.mode, t.reshape(-1), check=False)
-            sol = (js.q, js.qd, js.qdd)
-            self._cache.update(sol=sol, key=key)
-        i = self.index
-        return tuple(v[:, i].reshape(t.shape) for v in sol)
+    @property
+    def coordinate(self) -> int:
+        return self.index
+
+    def store(self) -> dict:
+        return self._cache
+
+    def solve(self, t):
+        js = JointSolution(self.chain, self.motion, self.mode, t, check=False)
+        q, qd, qdd = js.q, js.qd, js.qdd
+        return {i: (q[:, i], qd[:, i], qdd[:, i]) for i in range(self.chain.n)}
 
 
 def joint_laws(chain: Chain, motion: TaskMotion, mode: int) -> list[JointLaw]:

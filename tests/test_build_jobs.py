@@ -1,0 +1,80 @@
+"""``build``'s number of processes: by default one per usable core (at most one per spec), and
+the same site, outcomes and progress order whatever the number."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from _edits import replaced
+from balpipe import build as build_mod
+from balpipe.build import Options, build, default_jobs, usable_cores
+
+SPECS = Path(__file__).resolve().parents[1] / "specs"
+
+
+def _site(tmp_path: Path, jobs: int | None, simulate: bool = True):
+    """Three specs (two small ones, simulated, and an invalid one) built with ``jobs``: the
+    outcomes, the progress calls and the output folder."""
+    d = tmp_path / "specs"
+    if not d.exists():
+        d.mkdir()
+        (d / "a_scott.yaml").write_text(replaced((SPECS / "scott_russell.yaml").read_text(),
+                                                 "  samples: 501", "  samples: 41"))
+        (d / "b_broken.yaml").write_text("name: broken\nmechanism: {template: slider_crank\n")
+        (d / "c_offset.yaml").write_text((SPECS / "offset_slider_crank.yaml").read_text()
+                                         + "analysis:\n  samples: 41\n")
+    out = tmp_path / f"out-{jobs}"
+    calls = []
+    outcomes = build([str(d)], Options(out=out, simulate=simulate), jobs=jobs,
+                     progress=lambda k, n, o: calls.append((k, n, o.source, o.status)))
+    return outcomes, calls, out
+
+
+def _files(out: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(out)): p.read_bytes() for p in sorted(out.rglob("*"))
+            if p.is_file() and p.name != ".balpipe.lock"}
+
+
+def test_output_and_progress_do_not_depend_on_jobs(tmp_path):
+    o1, c1, out1 = _site(tmp_path, 1)
+    o2, c2, out2 = _site(tmp_path, 2)
+    assert [(o.source, o.status) for o in o1] == [(o.source, o.status) for o in o2]
+    assert [o.status for o in o1] == ["ok", "error", "ok"]  # the specs' order
+    assert c1 == c2 and [k for k, *_ in c1] == [1, 2, 3]
+    f1, f2 = _files(out1), _files(out2)
+    assert set(f1) == set(f2)
+    timing = {f for f in f1 if Path(f).name in ("timing.json", "timing.js")}
+    assert len(timing) == 4  # both simulated pages have them: the only files that may differ
+    assert {f for f in f1 if f.endswith("results.json")} == {"a_scott/results.json", "c_offset/results.json"}
+    for f in sorted(set(f1) - timing):
+        assert f1[f] == f2[f], f
+
+
+def test_default_is_one_process_per_usable_core_at_most_one_per_spec(tmp_path, monkeypatch):
+    seen = []
+    monkeypatch.setattr(build_mod, "_run", lambda todo, opts, jobs, progress, outcomes: seen.append((len(todo), jobs)))
+    monkeypatch.setattr(build_mod, "usable_cores", lambda: 3)
+    d = tmp_path / "specs"
+    d.mkdir()
+    for k in range(5):
+        (d / f"s{k}.yaml").write_text("name: x\n")
+    build([str(d)], Options(out=tmp_path / "o"))
+    build([str(d / "s0.yaml"), str(d / "s1.yaml")], Options(out=tmp_path / "o"))
+    build([str(d / "s0.yaml")], Options(out=tmp_path / "o"))
+    build([str(d)], Options(out=tmp_path / "o"), jobs=1)
+    assert seen == [(5, 3), (2, 2), (1, 1), (5, 1)]
+
+
+def test_usable_cores_follows_the_affinity_mask(monkeypatch):
+    if hasattr(os, "process_cpu_count"):
+        monkeypatch.setattr(os, "process_cpu_count", lambda: 1)
+    elif hasattr(os, "sched_getaffinity"):
+        monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {3})
+    else:  # pragma: no cover
+        pytest.skip("no affinity on this platform")
+    monkeypatch.setattr(os, "cpu_count", lambda: 64)
+    assert usable_cores() == 1 and default_jobs(12) == 1
+    assert default_jobs(0) == 1  # nothing to build: still a valid pool size
