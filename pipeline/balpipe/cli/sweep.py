@@ -5,11 +5,11 @@ from __future__ import annotations
 import argparse
 import sys
 
-EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+from .common import EXIT_FAILED, EXIT_OK, EXIT_USAGE
 
 
 def add_parser(sub) -> None:
-    from .sweep import MAX_DESIGNS
+    from ..sweep import MAX_DESIGNS
 
     s = sub.add_parser(
         "sweep", help="sweep numeric spec fields; table, Pareto fronts, design specs",
@@ -40,9 +40,10 @@ def add_parser(sub) -> None:
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
 
-def cmd_sweep(args) -> int:
-    from .loader import SpecErrors
-    from .sweep import SweepError, plan, progress_printer, run, write
+def run(args) -> int:
+    from ..loader import SpecErrors
+    from ..sweep import SweepError, plan, progress_printer, write
+    from ..sweep import run as run_sweep
 
     if args.jobs < 0:
         print("balpipe: error: --jobs must be >= 0", file=sys.stderr)
@@ -67,7 +68,7 @@ def cmd_sweep(args) -> int:
     except FileNotFoundError as exc:
         print(f"balpipe: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
-    res = run(p, jobs=args.jobs, scheduler=args.scheduler, progress=progress_printer(args.quiet))
+    res = run_sweep(p, jobs=args.jobs, scheduler=args.scheduler, progress=progress_printer(args.quiet))
     written = write(res, args.out, args.specs, args.parquet)
     print(f"balpipe: {len(res.rows)} designs: {res.fast} mass-only (fast path), {res.full} full analyses, "
           f"{res.failed} failed; {written[-1]}", file=sys.stderr)
