@@ -35,7 +35,7 @@ import numpy as np
 import yaml
 from pydantic import ValidationError
 
-MAX_DESIGNS = 100_000
+from .sweep_spec import MAX_DESIGNS  # noqa: E402  (one limit for --max-designs and sweep.max_designs)
 POOL_WORTH = 3.0  # s: estimated remaining in-process work above which jobs=0 starts a process pool
 METRICS = ("added_mass", "added_inertia", "max_shaking_force", "max_shaking_moment", "max_actuator_effort",
            "unbalanced_max_shaking_force", "unbalanced_max_shaking_moment", "force_ratio", "moment_ratio")
@@ -60,6 +60,12 @@ class Vary:
     lo: float | None = None
     hi: float | None = None
     unit: str = ""
+    origin: str = "--vary"  # or "sweep.vary": the spec's sweep block
+
+    @property
+    def where(self) -> str:
+        """How messages name this vary: ``--vary PATH=RANGE``, or ``sweep.vary`` (the spec's block)."""
+        return f"{self.origin} {self.arg}" if self.origin == "--vary" else self.origin
 
     @property
     def name(self) -> str:
@@ -76,7 +82,7 @@ class Vary:
 def _number(text: str, arg: str) -> tuple[float, str]:
     m = _NUM.match(text)
     if not m:
-        raise SweepError(f"--vary {arg}: {text.strip()!r} is not a number with an optional unit")
+        raise SweepError(f"{arg}: {text.strip()!r} is not a number with an optional unit")
     return float(m.group(1)), m.group(2)
 
 
@@ -88,43 +94,45 @@ def _conversion(frm: str, to: str, arg: str) -> float:
     for table in UNITS.values():
         if a in table and b in table:
             return table[a] / table[b]
-    raise SweepError(f"--vary {arg}: LO and HI have units of different kinds ({to!r}, {frm!r})")
+    raise SweepError(f"{arg}: LO and HI have units of different kinds ({to!r}, {frm!r})")
 
 
-def parse_vary(arg: str) -> Vary:
-    """``PATH=RANGE`` -> :class:`Vary` (syntax only; :func:`check` validates against the spec)."""
+def parse_vary(arg: str, origin: str = "--vary") -> Vary:
+    """``PATH=RANGE`` -> :class:`Vary` (syntax only; :func:`plan` validates against the spec).
+    Messages start with ``origin arg`` (``--vary PATH=RANGE``)."""
+    tag = f"{origin} {arg}" if origin else arg
     if "=" not in arg:
-        raise SweepError(f"--vary {arg}: expected PATH=RANGE, e.g. mechanism.crank.mass=0.5kg:2kg:7")
+        raise SweepError(f"{tag}: expected PATH=RANGE, e.g. mechanism.crank.mass=0.5kg:2kg:7")
     path_text, rng = arg.split("=", 1)
     path = tuple(int(p) if p.isdigit() else p for p in path_text.strip().split("."))
     if not path or any(p == "" for p in path):
-        raise SweepError(f"--vary {arg}: empty field in the path {path_text!r}")
+        raise SweepError(f"{tag}: empty field in the path {path_text!r}")
     if "," in rng:
         vals = []
         unit0 = ""
         for part in rng.split(","):
-            x, u = _number(part, arg)
+            x, u = _number(part, tag)
             unit0 = u or unit0
             vals.append(x)
-        return Vary(arg, path, tuple(f"{x!r} {unit0}" if unit0 else x for x in vals), unit=unit0)
+        return Vary(arg, path, tuple(f"{x!r} {unit0}" if unit0 else x for x in vals), unit=unit0, origin=origin)
     parts = rng.split(":")
     if len(parts) not in (2, 3):
-        raise SweepError(f"--vary {arg}: the range must be LO:HI:N, LO:HI or a,b,c")
-    lo, ulo = _number(parts[0], arg)
-    hi, uhi = _number(parts[1], arg)
+        raise SweepError(f"{tag}: the range must be LO:HI:N, LO:HI or a,b,c")
+    lo, ulo = _number(parts[0], tag)
+    hi, uhi = _number(parts[1], tag)
     if ulo and uhi and ulo != uhi:
-        hi = hi * _conversion(uhi, ulo, arg)
+        hi = hi * _conversion(uhi, ulo, tag)
     unit = ulo or uhi
     if len(parts) == 3:
         try:
             n = int(parts[2])
         except ValueError:
-            raise SweepError(f"--vary {arg}: N must be an integer (got {parts[2]!r})") from None
+            raise SweepError(f"{tag}: N must be an integer (got {parts[2]!r})") from None
         if n < 1:
-            raise SweepError(f"--vary {arg}: N must be at least 1")
+            raise SweepError(f"{tag}: N must be at least 1")
         xs = np.linspace(lo, hi, n) if n > 1 else np.array([lo])
-        return Vary(arg, path, tuple(f"{float(x)!r} {unit}" if unit else float(x) for x in xs), unit=unit)
-    return Vary(arg, path, (), lo, hi, unit)
+        return Vary(arg, path, tuple(f"{float(x)!r} {unit}" if unit else float(x) for x in xs), unit=unit, origin=origin)
+    return Vary(arg, path, (), lo, hi, unit, origin)
 
 
 def set_path(data: Any, path: tuple, value: Any) -> None:
@@ -186,10 +194,24 @@ class Plan:
 
 
 def _located(loaded, path: tuple, message: str, vary: Vary | None = None) -> str:
-    from .loader import _located as locate
+    """A problem at the spec field ``path``, named after its vary: ``file:line:col: field:
+    message (--vary PATH=RANGE)``, or for a vary of the spec's ``sweep:`` block, at that entry:
+    ``file:line:col: sweep.vary.PATH: field: message``."""
+    from .loader import _format_path, _located as locate
 
+    if vary is not None and vary.origin != "--vary":
+        key = vary.arg.split("=", 1)[0]
+        text = message if tuple(path) == vary.path else f"{_format_path(tuple(path))}: {message}"
+        return str(locate(str(loaded.path), loaded.node, ("sweep", "vary", key), text, at_key=True))
     where = str(locate(str(loaded.path), loaded.node, path, message))
-    return where + (f" (--vary {vary.arg})" if vary else "")
+    return where + (f" ({vary.where})" if vary else "")
+
+
+def _vary_problem(loaded, v: Vary, message: str) -> str:
+    """A problem of the vary itself (not of the field it names)."""
+    if v.origin == "--vary":
+        return f"{v.where}: {message}"
+    return _located(loaded, v.path, message, v)
 
 
 def _validate(data: dict):
@@ -237,25 +259,42 @@ def designs_of(varies: list[Vary], sample: str, n: int, seed: int) -> list[tuple
     return out
 
 
-def plan(spec_file: str, vary_args: list[str], sample: str = "grid", n: int = 0, seed: int = 0,
-         max_designs: int = MAX_DESIGNS, stage: str | None = None) -> Plan:
+def plan(spec_file: str, vary_args: list[str] | None = None, sample: str | None = None, n: int | None = None,
+         seed: int | None = None, max_designs: int | None = None, stage: str | None = None) -> Plan:
     """Parse and check everything; raises :class:`SweepError` (all problems, located) or the
-    loader's ``SpecErrors`` for an invalid base spec."""
+    loader's ``SpecErrors`` for an invalid base spec. What is not given (None, or no
+    ``vary_args``) comes from the spec's ``sweep:`` block (:class:`balpipe.sweep_spec.SweepSpec`),
+    else the defaults (grid, seed 0, :data:`MAX_DESIGNS`, the method's last stage)."""
     from .loader import load
 
     loaded = load(spec_file)
     data = yaml.safe_load(loaded.text)
-    if not vary_args:
-        raise SweepError("nothing to vary: give at least one --vary PATH=RANGE")
-    varies = [parse_vary(a) for a in vary_args]
+    data.pop("sweep", None)  # the designs are specs without the block (validated once, above)
+    block = loaded.spec.sweep
+    if vary_args:
+        varies = [parse_vary(a) for a in vary_args]
+    elif block is not None:
+        varies = [parse_vary(f"{k}={v}", origin="sweep.vary") for k, v in block.vary.items()]
+    else:
+        raise SweepError("nothing to vary: give at least one --vary PATH=RANGE, or a sweep: block in the spec")
+    limit_from_block = max_designs is None and block is not None
+    if block is not None:
+        sample = sample if sample is not None else block.sample
+        n = n if n is not None else block.designs
+        seed = seed if seed is not None else block.seed
+        max_designs = max_designs if max_designs is not None else block.max_designs
+        stage = stage if stage is not None else block.stage
+    sample = sample or "grid"
+    n, seed = n or 0, seed or 0
+    max_designs = MAX_DESIGNS if max_designs is None else max_designs
     problems: list[str] = []
     seen = set()
     for v in varies:
         if v.path in seen:
-            problems.append(f"--vary {v.arg}: {v.name} is varied twice")
+            problems.append(_vary_problem(loaded, v, f"{v.name} is varied twice"))
         seen.add(v.path)
         if sample == "grid" and not v.values:
-            problems.append(f"--vary {v.arg}: a grid needs LO:HI:N or a,b,c (LO:HI is for --sample random|lhs)")
+            problems.append(_vary_problem(loaded, v, "a grid needs LO:HI:N or a,b,c (LO:HI is for random and lhs samples)"))
             continue
         for raw in v.extremes():
             trial = copy.deepcopy(data)
@@ -285,7 +324,13 @@ def plan(spec_file: str, vary_args: list[str], sample: str = "grid", n: int = 0,
         raise SweepError("\n".join(dict.fromkeys(problems)))
     size = math.prod(len(v.values) for v in varies) if sample == "grid" else n
     if size > max_designs:
-        raise SweepError(f"the sweep has {size} designs, above the limit of {max_designs} (--max-designs)")
+        msg = f"the sweep has {size} designs, above the limit of {max_designs}"
+        if limit_from_block:
+            from .loader import _located as locate
+
+            at = ("sweep", "max_designs") if "max_designs" in block.model_fields_set else ("sweep",)
+            raise SweepError(str(locate(str(loaded.path), loaded.node, at, msg + " (sweep.max_designs)")))
+        raise SweepError(msg + " (--max-designs)")
     return Plan(str(loaded.path), loaded.text, data, varies, designs_of(varies, sample, n, seed), stage, sample, seed)
 
 
@@ -561,7 +606,7 @@ def design_spec_text(res: SweepResult, index: int) -> str:
     """The spec of design ``index``: the base spec's YAML with the varied fields set, so that
     ``balpipe build`` gives its full report."""
     row = res.rows[index]
-    d = copy.deepcopy(with_values(res.plan.data, [v.path for v in res.plan.varies], row["values"]))
+    d = copy.deepcopy(with_values(res.plan.data, [v.path for v in res.plan.varies], row["values"]))  # no sweep block
     d["name"] = f"{d.get('name', 'design')} — sweep design {index}"
     head = (f"# Design {index} of the sweep of {res.plan.file}: "
             + ", ".join(f"{v.name} = {raw}" for v, raw in zip(res.plan.varies, row["values"])) + "\n")

@@ -14,7 +14,8 @@ def add_parser(sub) -> None:
     s = sub.add_parser(
         "sweep", help="sweep numeric spec fields; table, Pareto fronts, design specs",
         description="Vary numeric fields of a spec (dotted paths, units as in the spec) over a grid or "
-        "seeded random / Latin-hypercube samples; write sweep.csv, a page with the Pareto fronts of added "
+        "seeded random / Latin-hypercube samples, as given by --vary or else by the spec's sweep: block "
+        "(flags override the block; --vary replaces its vary list); write sweep.csv, a page with the Pareto fronts of added "
         "mass against peak shaking moment and peak actuator effort, and the specs of the designs on them. "
         "Designs that change only masses, inertias and counterweights take the fast path (one analysis, "
         "a matrix product per design).",
@@ -25,11 +26,11 @@ def add_parser(sub) -> None:
     )
     s.add_argument("spec", metavar="SPEC", help="the base spec file")
     s.add_argument("--vary", action="append", default=[], metavar="PATH=RANGE", help="a field and its range (repeat)")
-    s.add_argument("--sample", choices=["grid", "random", "lhs"], default="grid", help="design of experiments (default: grid)")
-    s.add_argument("-n", "--designs", type=int, default=0, metavar="N", help="number of designs for random and lhs")
-    s.add_argument("--seed", type=int, default=0, help="seed of random and lhs (default 0)")
+    s.add_argument("--sample", choices=["grid", "random", "lhs"], default=None, help="design of experiments (default: grid)")
+    s.add_argument("-n", "--designs", type=int, default=None, metavar="N", help="number of designs for random and lhs")
+    s.add_argument("--seed", type=int, default=None, help="seed of random and lhs (default 0)")
     s.add_argument("--stage", metavar="NAME", help="the stage whose loads are reported (default: the method's last)")
-    s.add_argument("--max-designs", type=int, default=MAX_DESIGNS, metavar="N",
+    s.add_argument("--max-designs", type=int, default=None, metavar="N",
                    help=f"refuse sweeps with more designs (default {MAX_DESIGNS})")
     s.add_argument("-o", "--out", default="sweep", metavar="DIR", help="output folder (default: sweep)")
     s.add_argument("--specs", choices=["pareto", "all", "none"], default="pareto",
