@@ -446,10 +446,13 @@ def _chunks(designs: list[tuple], workers: int) -> list[list[tuple[int, tuple]]]
 
 
 def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
-        progress: Callable[[int, int], None] | None = None) -> SweepResult:
-    """Evaluate every design of the plan: locally (``jobs`` processes; 1 = in this process;
-    0 = all cores, after timing the first chunk in this process, if the rest would take more
-    than :data:`POOL_WORTH` seconds) or on the dask.distributed scheduler at ``scheduler``."""
+        progress: Callable[[int, int], None] | None = None, affine: bool = True) -> SweepResult:
+    """Evaluate every design of the plan. A mass-only sweep (``affine``, and the probes of
+    :func:`balpipe.sweep_affine.build_route` agree) needs no spec per design: its designs'
+    parameters are one matrix product. Otherwise every design is built: locally (``jobs``
+    processes; 1 = in this process; 0 = all cores, after timing the first chunk in this process,
+    if the rest would take more than :data:`POOL_WORTH` seconds) or on the dask.distributed
+    scheduler at ``scheduler``."""
     from .engine import AnalysisError
     from .mass_sweep import MassSweep, check_parameters
     from .spec_parts import SpecFieldError
@@ -473,7 +476,27 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     total = len(p.designs)
     done = 0
     rows: list[dict] = []
-    if scheduler:
+    route, pre, pre_rows = None, {}, []
+    if ms is not None and affine:
+        from .sweep_affine import build_route
+
+        route = build_route(p, base_key, (ms.names, ms0.names))
+    if route is not None:
+        notes.append(f"Mass-only sweep: every design's masses and inertias are affine in the varied values "
+                     f"(found and checked on {route.probes} designs built in full); the others were not built "
+                     f"one by one but evaluated as matrix products.")  # mass-only: designs as matrix products, no spec built per design
+        rows, F = route.rows(p.designs)
+        pre = dict(zip(("", "unbalanced_"), route.parameters(F)))
+        flagged = set(np.flatnonzero(route.unbuildable(F)).tolist())
+        for i in sorted(flagged):  # a design that cannot be built: its own error, as built in full
+            rows[i] = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, base_key)[0]
+        if flagged:
+            keep = np.array([i not in flagged for i in range(total)])
+            pre = {tag: P[keep] for tag, P in pre.items()}
+        pre_rows = [r for r in rows if r["design"] not in flagged]
+        if progress:
+            progress(total, total)
+    elif scheduler:
         from distributed import Client, as_completed
 
         with Client(scheduler) as client:
@@ -522,9 +545,11 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     rows.sort(key=lambda r: r["design"])
     for tag, sweep in (("", ms), ("unbalanced_", ms0)):  # the fast path, in blocks of matrix products
         fast = [r for r in rows if tag + "p" in r]
+        Pm = np.array([r.pop(tag + "p") for r in fast])
+        if tag in pre:  # the affine route's designs: their parameters as one matrix
+            fast, Pm = pre_rows + fast, np.concatenate([pre[tag], Pm.reshape(-1, pre[tag].shape[1])])
         if not fast:
             continue
-        Pm = np.array([r.pop(tag + "p") for r in fast])
         bad = check_parameters(sweep.names, Pm)
         peaks = sweep.peaks(Pm)
         for k, r in enumerate(fast):
@@ -546,20 +571,39 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     res.full = sum(r.get("route") == "full" and "error" not in r for r in rows)
     res.failed = sum("error" in r for r in rows)
     mark_pareto(rows)
+    if route is not None and not _front_confirmed(p, paths, rows, F, route, base_key):
+        return run(p, jobs, scheduler, progress, affine=False)
     return res
+
+
+def _front_confirmed(p: Plan, paths: list[tuple], rows: list[dict], F: np.ndarray, route, keys: tuple) -> bool:
+    """The affine route's designs on a Pareto front (at most 64), built in full, have the
+    predicted parameters (to the route's tolerance); else the sweep is run design by design."""
+    from .sweep_affine import TOL
+
+    front = [r["design"] for r in rows if "error" not in r and (r["pareto_moment"] or r["pareto_effort"])][:64]
+    scale = np.maximum(np.abs(F).max(axis=0), 1e-300)
+    for i in front:
+        full = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, keys)[0]
+        if "error" in full or "unbalanced_p" not in full:
+            return False
+        got = np.concatenate([full["p"], full["unbalanced_p"]])
+        want = np.concatenate(route.parameters(F[i : i + 1]), axis=1)[0]
+        if np.any(np.abs(got - want) > 1e-9 * scale[2 : 2 + got.size]):
+            return False
+    return True
 
 
 def pareto(points: np.ndarray) -> np.ndarray:
     """Mask of the non-dominated rows of ``points`` (D, 2), both objectives minimised."""
     D = len(points)
     keep = np.ones(D, dtype=bool)
+    if D == 0:
+        return keep
     order = np.lexsort((points[:, 1], points[:, 0]))
-    best = math.inf
-    for i in order:
-        if points[i, 1] < best:
-            best = points[i, 1]
-        else:
-            keep[i] = False
+    y = points[order, 1]
+    best_before = np.concatenate([[math.inf], np.minimum.accumulate(y)[:-1]])  # the best of the designs before
+    keep[order] = y < best_before
     return keep
 
 
