@@ -383,20 +383,48 @@ def _error_text(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {exc}" if not str(exc) else str(exc)
 
 
-def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
-    """Fast path: the design's parameter vector ``row[tag + 'p']`` (the parent does the product);
-    otherwise a full engine analysis, peaks in ``row``. Returns the route taken."""
-    from .balancing.regressor import parameters
-    from .engine import analyse
-    from .mass_sweep import geometry_key
+_GEOMETRIES: dict[tuple, Any] = {}  # geometry key -> MassSweep of the canonical model (per process)
+MAX_GEOMETRIES = 32
 
-    if key is not None and geometry_key(model, t, g, P) == key:
+
+def canonical(model):
+    """The model with every body's mass 1 kg, centre of mass at its frame origin, inertia
+    1 kg m^2, and massless attachments: its :class:`balpipe.mass_sweep.MassSweep` depends on the
+    geometry alone, so every design of that geometry gets the same numbers, in any chunk or worker."""
+    from dataclasses import replace
+
+    bodies = tuple(replace(b, mass=1.0, com=(0.0, 0.0), inertia=1.0,
+                           attachments=tuple(replace(a, mass=0.0, inertia=0.0) for a in b.attachments))
+                   for b in model.bodies)
+    return replace(model, bodies=bodies)
+
+
+def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
+    """Fast path: the design's parameter vector ``row[tag + 'p']`` (the parent does the product).
+    Otherwise one engine analysis per geometry (a :class:`balpipe.mass_sweep.MassSweep` of the
+    canonical model, cached in this process: the design's other stage and the other designs of
+    that geometry reuse it) and the design's peaks through its regressors, in ``row``. Returns the
+    route taken."""
+    from .balancing.regressor import parameters
+    from .mass_sweep import MassSweep, geometry_key
+
+    gkey = geometry_key(model, t, g, P)
+    if key is not None and gkey == key:
         row[tag + "p"] = parameters(model, angular=True)
         return "mass"
-    an = analyse(model, t, g, P)
-    row[tag + "max_shaking_force"] = an.max_force
-    row[tag + "max_shaking_moment"] = an.max_moment
-    row[tag + "max_actuator_effort"] = max((float(np.max(np.abs(e))) for e in an.efforts.values()), default=0.0)
+    for b in model.bodies:  # as the engine refuses it (compile_model)
+        m, _, i = b.mass_properties()
+        if m < 0 or i < 0:
+            raise ValueError(f"body {b.name!r} has a negative mass or inertia")
+    ms = _GEOMETRIES.get(gkey)
+    if ms is None:
+        ms = MassSweep.build(canonical(model), t, g, P)
+        if len(_GEOMETRIES) >= MAX_GEOMETRIES:
+            _GEOMETRIES.clear()
+        _GEOMETRIES[gkey] = ms
+    peaks = ms.peaks(parameters(model, angular=True)[None, :])
+    for name, arr in peaks.items():
+        row[tag + name] = float(arr[0])
     return "full"
 
 
@@ -404,7 +432,8 @@ def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]
                    keys: tuple) -> list[dict]:
     """Rows of one chunk of designs. For the chosen stage and the design's unbalanced stage
     (``keys``: their base geometries, or None), a design with the base geometry returns its
-    parameter vector for the parent's fast path; any other is analysed here by the engine."""
+    parameter vector for the parent's fast path; any other is analysed here by the engine, once
+    per geometry (:func:`_stage_loads`)."""
     from .study import _total_inertia
 
     rows = []
