@@ -130,3 +130,15 @@ def test_build_ignores_the_block(tmp_path):
     for x in (a, b):
         x.pop("spec", None), x.pop("source", None), x.pop("input_hash", None)
     assert a.get("stages") and a["stages"] == b["stages"]
+
+
+def test_check_reports_the_blocks_paths_located(tmp_path, capsys):
+    from balpipe.cli import main
+
+    f = tmp_path / "spec.yaml"
+    f.write_text(_with("mechanism.crank.mass: 500 g:2 kg:3", "mechanism.crank.mas: 500 g:2 kg:3"))
+    assert main(["check", str(f)]) == 2
+    err = capsys.readouterr().err
+    line = _line_of(f.read_text(), "mechanism.crank.mas:")
+    assert f"spec.yaml:{line}:5: sweep.vary.mechanism.crank.mas: unknown path" in err and "1 invalid" in err
+    assert main(["check", str(FIXTURE)]) == 0

@@ -15,10 +15,11 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     """Everything ``build`` checks before simulating: schema, units, limits, geometry, the
-    balancing, the analysis of every stage (singular motions) and the references. Keeps going
-    past a spec that fails."""
+    balancing, the analysis of every stage (singular motions), the references, and the paths and
+    values of a ``sweep:`` block. Keeps going past a spec that fails."""
     from ..build import _clashes, analyse, find_specs
     from ..loader import SpecErrors, load
+    from ..sweep import SweepError, plan
 
     gone = missing(args.paths)
     if gone:
@@ -33,11 +34,17 @@ def run(args) -> int:
         try:
             if f in clash:
                 raise SpecErrors([])
-            analyse(load(f))
+            loaded = load(f)
+            analyse(loaded)
+            if loaded.spec.sweep is not None:  # its paths and values against the spec, as balpipe sweep does
+                try:
+                    plan(str(f))
+                except SweepError as exc:
+                    raise SpecErrors([]) from exc
             print(f"{f}: ok")
         except SpecErrors as exc:
             bad += 1
-            print(str(exc) or clash[f], file=sys.stderr)
+            print(str(exc) or str(exc.__cause__ or "") or clash[f], file=sys.stderr)
         except Exception as exc:  # a bug in balpipe: report it, check the other specs
             crashed += 1
             print(f"{f}: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
