@@ -418,7 +418,16 @@ def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
             raise ValueError(f"body {b.name!r} has a negative mass or inertia")
     ms = _GEOMETRIES.get(gkey)
     if ms is None:
-        ms = MassSweep.build(canonical(model), t, g, P)
+        try:
+            ms = MassSweep.build(canonical(model), t, g, P)
+        except Exception:  # the design's own analysis says why (or succeeds)
+            from .engine import analyse
+
+            an = analyse(model, t, g, P)
+            row[tag + "max_shaking_force"] = an.max_force
+            row[tag + "max_shaking_moment"] = an.max_moment
+            row[tag + "max_actuator_effort"] = max((float(np.max(np.abs(e))) for e in an.efforts.values()), default=0.0)
+            return "full"
         if len(_GEOMETRIES) >= MAX_GEOMETRIES:
             _GEOMETRIES.clear()
         _GEOMETRIES[gkey] = ms
