@@ -12,11 +12,16 @@ method computes are linear in the spec's masses and inertias (force balancing, e
 so k + 1 designs built in full (the box's lower corner and one step per varied field) give every
 design's f as one matrix product, without validating, templating or balancing a spec per design.
 
-Nothing is assumed: the route is taken only when every probe keeps the base geometry
-(:func:`balpipe.mass_sweep.geometry_key`) and f, built in full at check designs (the box's upper
-corner, and designs of the sweep itself), equals the affine prediction to :data:`TOL` of its
-scale. Otherwise (a length, a duration, a non-linear method), :func:`balpipe.sweep.run` builds
-every design. The varied values in SI are converted per value exactly as the spec's unit parser
+Affinity is checked, not assumed: the route is taken only when every probe keeps the base
+geometry (:func:`balpipe.mass_sweep.geometry_key`) and the same parts, and f, built in full at
+check designs (the box's upper corner, and designs of the sweep itself), equals the affine
+prediction to :data:`TOL` of its scale; :func:`balpipe.sweep.run` then builds the designs on the
+Pareto fronts in full and compares them too. Otherwise (a length, a duration, a counterweight
+position, a centre of mass) it builds every design. These are checks at finite points: a method
+whose output were affine at all of them but not between them would slip through. f also holds
+the declared masses and inertias (bodies and attachments), so that a design a method would
+refuse for a negative one (eq. 20's counterweight inertia) is found and built in full for its
+own error. The varied values in SI are converted per value exactly as the spec's unit parser
 does (number times the unit's factor), not interpolated.
 """
 
