@@ -11,9 +11,15 @@
    chain with the same three bodies (crank: revolute, coupler: revolute, slider: prismatic) and
    masses, over the mechanism's own joint trajectories. RNEA does not close the loop, so it
    does less work per sample than the constrained inverse dynamics: a generous anchor.
-3. End to end ``balpipe.sweep.run`` (spec validation, balancing, fast path) on ``--e2e`` designs
-   varying crank, coupler and slider masses: in process (jobs=1), on a local process pool of two,
-   and on a local two-worker dask.distributed cluster (if installed).
+3. End to end ``balpipe.sweep.run`` on ``--e2e`` designs varying crank, coupler and slider
+   masses: before (every design's spec validated, templated and balanced; ``affine=False``) and
+   after (the mass-only route of :mod:`balpipe.sweep_affine`), in process; the per-design route
+   on a local process pool of two and on a local two-worker dask.distributed cluster (if installed).
+4. A geometry sweep (a length and a mass): two engine analyses per design before, one per
+   geometry after.
+
+On a machine shared with other jobs, OpenBLAS threads fight for the cores; set
+``OPENBLAS_NUM_THREADS=1`` for steadier numbers (the matrix products have 12 columns).
 """
 
 from __future__ import annotations
@@ -128,14 +134,31 @@ def end_to_end(n: int, dask: bool) -> None:
              sample="lhs", n=n, seed=1)
     print(f"3. end to end sweep.run, {n} designs (LHS over crank, coupler, slider masses), 501 samples; "
           f"{os.cpu_count()} cores on this machine")
-    t0 = time.perf_counter()
+    start = time.perf_counter()
+    before = run(p, jobs=1, affine=False)
+    t0 = time.perf_counter() - start
+    print(f"   before: every design's spec built (validation, template, method), jobs=1: {t0:.2f} s = "
+          f"{n / t0:,.0f} designs/s")
+    start = time.perf_counter()
     local = run(p, jobs=1)
-    t1 = time.perf_counter() - t0
-    print(f"   in process (jobs=1): {t1:.2f} s = {n / t1:,.0f} designs/s ({local.fast} on the fast path)")
+    t1 = time.perf_counter() - start
+    print(f"   after: mass-only route (k+1 designs built, the rest as matrix products), jobs=1: {t1:.2f} s = "
+          f"{n / t1:,.0f} designs/s ({local.fast} on the fast path); {t0 / t1:.1f}x")
+    big = plan(str(SPEC), ["mechanism.crank.mass=0.5:2", "mechanism.coupler.mass=0.5:2", "mechanism.slider.mass=0.2:1"],
+               sample="lhs", n=10 * n, seed=1)
+    start = time.perf_counter()
+    run(big, jobs=1)
+    t10 = time.perf_counter() - start
+    print(f"   after, {10 * n} designs: {t10:.2f} s = {10 * n / t10:,.0f} designs/s "
+          f"({10 * n / t10 / (n / t0):.0f}x the per-design route's rate)")
+    worst = max(abs(a[m] - b[m]) / max(1.0, abs(b[m])) for a, b in zip(local.rows, before.rows)
+                for m in ("max_shaking_moment", "max_shaking_force", "max_actuator_effort", "added_mass"))
+    print(f"   largest relative difference between the two routes: {worst:.1e}")
     t0 = time.perf_counter()
-    run(p, jobs=2)
+    pool = run(p, jobs=2, affine=False)
     t2 = time.perf_counter() - t0
-    print(f"   process pool, 2 workers: {t2:.2f} s = {n / t2:,.0f} designs/s; ratio to in process {t1 / t2:.2f}x")
+    print(f"   per-design route on a process pool, 2 workers: {t2:.2f} s = {n / t2:,.0f} designs/s")
+    geometry_sweep()
     if not dask:
         return
     try:
@@ -147,13 +170,43 @@ def end_to_end(n: int, dask: bool) -> None:
 
     logging.getLogger("distributed").setLevel(logging.ERROR)
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
-        run(p, scheduler=cl.scheduler_address)  # warm the workers (imports)
+        run(p, scheduler=cl.scheduler_address, affine=False)  # warm the workers (imports)
         t0 = time.perf_counter()
-        remote = run(p, scheduler=cl.scheduler_address)
+        remote = run(p, scheduler=cl.scheduler_address, affine=False)
         t3 = time.perf_counter() - t0
-    same = csv_text(remote) == csv_text(local)
-    print(f"   dask LocalCluster, 2 workers (warm): {t3:.2f} s = {n / t3:,.0f} designs/s; ratio to the local "
-          f"process pool {t2 / t3:.2f}x, to in process {t1 / t3:.2f}x; table identical to the local run: {same}")
+    same = csv_text(remote) == csv_text(pool)
+    print(f"   per-design route on a dask LocalCluster, 2 workers (warm): {t3:.2f} s = {n / t3:,.0f} designs/s; "
+          f"ratio to the local process pool {t2 / t3:.2f}x; table identical to the local run: {same}")
+
+
+def geometry_sweep(lengths: int = 5, masses: int = 20) -> None:
+    """4. A grid over a length and a mass (offset slider-crank, 501 samples): every design has its
+    own spec and model; before, two engine analyses per design (chosen and unbalanced stage);
+    after, one analysis per geometry (the canonical model's regressors) shared by both stages and
+    by the designs of that geometry."""
+    from balpipe import sweep
+    from balpipe.engine import analyse
+    from balpipe.sweep import build_design, plan, run
+
+    spec = ROOT / "specs" / "offset_slider_crank.yaml"
+    p = plan(str(spec), [f"mechanism.crank.length=0.09:0.1:{lengths}", f"mechanism.crank.mass=0.5:2:{masses}"])
+    n = len(p.designs)
+    paths = [v.path for v in p.varies]
+    m = min(n, 6)
+    t0 = time.perf_counter()
+    for values in p.designs[:m]:  # the previous per-design path: two engine analyses
+        s, sr, base = build_design(p.data, paths, values, None)
+        t, g, P = sweep._settings(s)
+        analyse(sr.model, t, g, P), analyse(base.model, t, g, P)
+    old = (time.perf_counter() - t0) / m
+    sweep._GEOMETRIES.clear()
+    start = time.perf_counter()
+    res = run(p, jobs=1)
+    t1 = time.perf_counter() - start
+    print(f"4. geometry sweep, offset slider-crank, crank length x crank mass grid {lengths} x {masses} = {n} designs")
+    print(f"   before: two engine analyses per design: {1 / old:,.1f} designs/s (timed on {m} designs)")
+    print(f"   after: one analysis per geometry, jobs=1: {t1:.2f} s = {n / t1:,.1f} designs/s ({res.full} designs, "
+          f"{res.failed} failed); {old * n / t1:.1f}x")
 
 
 def main() -> None:

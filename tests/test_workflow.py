@@ -14,7 +14,7 @@ import yaml
 
 from _gitrepo import Repo, edit
 
-from balpipe.history_cli import DEFAULT_CACHE
+from balpipe.cli.history import DEFAULT_CACHE
 
 ROOT = Path(__file__).resolve().parents[1]
 WORKFLOW = ROOT / ".github" / "workflows" / "report-site.yml"

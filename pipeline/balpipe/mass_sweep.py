@@ -57,10 +57,9 @@ def check_parameters(names: list[str], P: np.ndarray) -> list[str | None]:
         Ic = np.where(m > 0, J - (mx**2 + my**2) / np.where(m > 0, m, 1.0), J)
     scale = np.maximum(np.abs(J), 1e-300)
     bad = (m < 0) | (Ic < -1e-12 * scale)
-    out: list[str | None] = []
-    for d in range(D):
-        k = np.flatnonzero(bad[d])
-        out.append(f"body {names[k[0]]!r} has a negative mass or inertia" if len(k) else None)
+    out: list[str | None] = [None] * D
+    for d in np.flatnonzero(bad.any(axis=1)):
+        out[d] = f"body {names[int(np.argmax(bad[d]))]!r} has a negative mass or inertia"
     return out
 
 

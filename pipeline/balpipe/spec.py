@@ -29,6 +29,7 @@ from .mechanisms.rrr4 import RRR4Mechanism
 from .mechanisms.serial_arm import SerialArmMechanism
 from .mechanisms.slider_crank import SliderCrankMechanism
 from .spec_parts import DriveSpec, Strict
+from .sweep_spec import SweepSpec
 from .units import Duration, Length, count, number, quantity
 
 
@@ -131,4 +132,7 @@ class Spec(Strict):
     references: list[Reference] = Field([], description="published values to compare with")
     compare: list[Design] = Field(
         [], description="other balancing designs of the same mechanism, analysed and tabulated beside the main one"
+    )
+    sweep: SweepSpec | None = Field(
+        None, description="a design sweep run by 'balpipe sweep SPEC' (flags override it); 'balpipe build' ignores it"
     )

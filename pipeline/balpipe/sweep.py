@@ -35,7 +35,7 @@ import numpy as np
 import yaml
 from pydantic import ValidationError
 
-MAX_DESIGNS = 100_000
+from .sweep_spec import MAX_DESIGNS  # noqa: E402  (one limit for --max-designs and sweep.max_designs)
 POOL_WORTH = 3.0  # s: estimated remaining in-process work above which jobs=0 starts a process pool
 METRICS = ("added_mass", "added_inertia", "max_shaking_force", "max_shaking_moment", "max_actuator_effort",
            "unbalanced_max_shaking_force", "unbalanced_max_shaking_moment", "force_ratio", "moment_ratio")
@@ -60,6 +60,12 @@ class Vary:
     lo: float | None = None
     hi: float | None = None
     unit: str = ""
+    origin: str = "--vary"  # or "sweep.vary": the spec's sweep block
+
+    @property
+    def where(self) -> str:
+        """How messages name this vary: ``--vary PATH=RANGE``, or ``sweep.vary`` (the spec's block)."""
+        return f"{self.origin} {self.arg}" if self.origin == "--vary" else self.origin
 
     @property
     def name(self) -> str:
@@ -76,7 +82,7 @@ class Vary:
 def _number(text: str, arg: str) -> tuple[float, str]:
     m = _NUM.match(text)
     if not m:
-        raise SweepError(f"--vary {arg}: {text.strip()!r} is not a number with an optional unit")
+        raise SweepError(f"{arg}: {text.strip()!r} is not a number with an optional unit")
     return float(m.group(1)), m.group(2)
 
 
@@ -88,43 +94,45 @@ def _conversion(frm: str, to: str, arg: str) -> float:
     for table in UNITS.values():
         if a in table and b in table:
             return table[a] / table[b]
-    raise SweepError(f"--vary {arg}: LO and HI have units of different kinds ({to!r}, {frm!r})")
+    raise SweepError(f"{arg}: LO and HI have units of different kinds ({to!r}, {frm!r})")
 
 
-def parse_vary(arg: str) -> Vary:
-    """``PATH=RANGE`` -> :class:`Vary` (syntax only; :func:`check` validates against the spec)."""
+def parse_vary(arg: str, origin: str = "--vary") -> Vary:
+    """``PATH=RANGE`` -> :class:`Vary` (syntax only; :func:`plan` validates against the spec).
+    Messages start with ``origin arg`` (``--vary PATH=RANGE``)."""
+    tag = f"{origin} {arg}" if origin else arg
     if "=" not in arg:
-        raise SweepError(f"--vary {arg}: expected PATH=RANGE, e.g. mechanism.crank.mass=0.5kg:2kg:7")
+        raise SweepError(f"{tag}: expected PATH=RANGE, e.g. mechanism.crank.mass=0.5kg:2kg:7")
     path_text, rng = arg.split("=", 1)
     path = tuple(int(p) if p.isdigit() else p for p in path_text.strip().split("."))
     if not path or any(p == "" for p in path):
-        raise SweepError(f"--vary {arg}: empty field in the path {path_text!r}")
+        raise SweepError(f"{tag}: empty field in the path {path_text!r}")
     if "," in rng:
         vals = []
         unit0 = ""
         for part in rng.split(","):
-            x, u = _number(part, arg)
+            x, u = _number(part, tag)
             unit0 = u or unit0
             vals.append(x)
-        return Vary(arg, path, tuple(f"{x!r} {unit0}" if unit0 else x for x in vals), unit=unit0)
+        return Vary(arg, path, tuple(f"{x!r} {unit0}" if unit0 else x for x in vals), unit=unit0, origin=origin)
     parts = rng.split(":")
     if len(parts) not in (2, 3):
-        raise SweepError(f"--vary {arg}: the range must be LO:HI:N, LO:HI or a,b,c")
-    lo, ulo = _number(parts[0], arg)
-    hi, uhi = _number(parts[1], arg)
+        raise SweepError(f"{tag}: the range must be LO:HI:N, LO:HI or a,b,c")
+    lo, ulo = _number(parts[0], tag)
+    hi, uhi = _number(parts[1], tag)
     if ulo and uhi and ulo != uhi:
-        hi = hi * _conversion(uhi, ulo, arg)
+        hi = hi * _conversion(uhi, ulo, tag)
     unit = ulo or uhi
     if len(parts) == 3:
         try:
             n = int(parts[2])
         except ValueError:
-            raise SweepError(f"--vary {arg}: N must be an integer (got {parts[2]!r})") from None
+            raise SweepError(f"{tag}: N must be an integer (got {parts[2]!r})") from None
         if n < 1:
-            raise SweepError(f"--vary {arg}: N must be at least 1")
+            raise SweepError(f"{tag}: N must be at least 1")
         xs = np.linspace(lo, hi, n) if n > 1 else np.array([lo])
-        return Vary(arg, path, tuple(f"{float(x)!r} {unit}" if unit else float(x) for x in xs), unit=unit)
-    return Vary(arg, path, (), lo, hi, unit)
+        return Vary(arg, path, tuple(f"{float(x)!r} {unit}" if unit else float(x) for x in xs), unit=unit, origin=origin)
+    return Vary(arg, path, (), lo, hi, unit, origin)
 
 
 def set_path(data: Any, path: tuple, value: Any) -> None:
@@ -186,10 +194,24 @@ class Plan:
 
 
 def _located(loaded, path: tuple, message: str, vary: Vary | None = None) -> str:
-    from .loader import _located as locate
+    """A problem at the spec field ``path``, named after its vary: ``file:line:col: field:
+    message (--vary PATH=RANGE)``, or for a vary of the spec's ``sweep:`` block, at that entry:
+    ``file:line:col: sweep.vary.PATH: field: message``."""
+    from .loader import _format_path, _located as locate
 
+    if vary is not None and vary.origin != "--vary":
+        key = vary.arg.split("=", 1)[0]
+        text = message if tuple(path) == vary.path else f"{_format_path(tuple(path))}: {message}"
+        return str(locate(str(loaded.path), loaded.node, ("sweep", "vary", key), text, at_key=True))
     where = str(locate(str(loaded.path), loaded.node, path, message))
-    return where + (f" (--vary {vary.arg})" if vary else "")
+    return where + (f" ({vary.where})" if vary else "")
+
+
+def _vary_problem(loaded, v: Vary, message: str) -> str:
+    """A problem of the vary itself (not of the field it names)."""
+    if v.origin == "--vary":
+        return f"{v.where}: {message}"
+    return _located(loaded, v.path, message, v)
 
 
 def _validate(data: dict):
@@ -237,25 +259,42 @@ def designs_of(varies: list[Vary], sample: str, n: int, seed: int) -> list[tuple
     return out
 
 
-def plan(spec_file: str, vary_args: list[str], sample: str = "grid", n: int = 0, seed: int = 0,
-         max_designs: int = MAX_DESIGNS, stage: str | None = None) -> Plan:
+def plan(spec_file: str, vary_args: list[str] | None = None, sample: str | None = None, n: int | None = None,
+         seed: int | None = None, max_designs: int | None = None, stage: str | None = None) -> Plan:
     """Parse and check everything; raises :class:`SweepError` (all problems, located) or the
-    loader's ``SpecErrors`` for an invalid base spec."""
+    loader's ``SpecErrors`` for an invalid base spec. What is not given (None, or no
+    ``vary_args``) comes from the spec's ``sweep:`` block (:class:`balpipe.sweep_spec.SweepSpec`),
+    else the defaults (grid, seed 0, :data:`MAX_DESIGNS`, the method's last stage)."""
     from .loader import load
 
     loaded = load(spec_file)
     data = yaml.safe_load(loaded.text)
-    if not vary_args:
-        raise SweepError("nothing to vary: give at least one --vary PATH=RANGE")
-    varies = [parse_vary(a) for a in vary_args]
+    data.pop("sweep", None)  # the designs are specs without the block (validated once, above)
+    block = loaded.spec.sweep
+    if vary_args:
+        varies = [parse_vary(a) for a in vary_args]
+    elif block is not None:
+        varies = [parse_vary(f"{k}={v}", origin="sweep.vary") for k, v in block.vary.items()]
+    else:
+        raise SweepError("nothing to vary: give at least one --vary PATH=RANGE, or a sweep: block in the spec")
+    limit_from_block = max_designs is None and block is not None
+    if block is not None:
+        sample = sample if sample is not None else block.sample
+        n = n if n is not None else block.designs
+        seed = seed if seed is not None else block.seed
+        max_designs = max_designs if max_designs is not None else block.max_designs
+        stage = stage if stage is not None else block.stage
+    sample = sample or "grid"
+    n, seed = n or 0, seed or 0
+    max_designs = MAX_DESIGNS if max_designs is None else max_designs
     problems: list[str] = []
     seen = set()
     for v in varies:
         if v.path in seen:
-            problems.append(f"--vary {v.arg}: {v.name} is varied twice")
+            problems.append(_vary_problem(loaded, v, f"{v.name} is varied twice"))
         seen.add(v.path)
         if sample == "grid" and not v.values:
-            problems.append(f"--vary {v.arg}: a grid needs LO:HI:N or a,b,c (LO:HI is for --sample random|lhs)")
+            problems.append(_vary_problem(loaded, v, "a grid needs LO:HI:N or a,b,c (LO:HI is for random and lhs samples)"))
             continue
         for raw in v.extremes():
             trial = copy.deepcopy(data)
@@ -285,7 +324,13 @@ def plan(spec_file: str, vary_args: list[str], sample: str = "grid", n: int = 0,
         raise SweepError("\n".join(dict.fromkeys(problems)))
     size = math.prod(len(v.values) for v in varies) if sample == "grid" else n
     if size > max_designs:
-        raise SweepError(f"the sweep has {size} designs, above the limit of {max_designs} (--max-designs)")
+        msg = f"the sweep has {size} designs, above the limit of {max_designs}"
+        if limit_from_block:
+            from .loader import _located as locate
+
+            at = ("sweep", "max_designs") if "max_designs" in block.model_fields_set else ("sweep",)
+            raise SweepError(str(locate(str(loaded.path), loaded.node, at, msg + " (sweep.max_designs)")))
+        raise SweepError(msg + " (--max-designs)")
     return Plan(str(loaded.path), loaded.text, data, varies, designs_of(varies, sample, n, seed), stage, sample, seed)
 
 
@@ -338,20 +383,57 @@ def _error_text(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {exc}" if not str(exc) else str(exc)
 
 
-def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
-    """Fast path: the design's parameter vector ``row[tag + 'p']`` (the parent does the product);
-    otherwise a full engine analysis, peaks in ``row``. Returns the route taken."""
-    from .balancing.regressor import parameters
-    from .engine import analyse
-    from .mass_sweep import geometry_key
+_GEOMETRIES: dict[tuple, Any] = {}  # geometry key -> MassSweep of the canonical model (per process)
+MAX_GEOMETRIES = 32
 
-    if key is not None and geometry_key(model, t, g, P) == key:
+
+def canonical(model):
+    """The model with every body's mass 1 kg, centre of mass at its frame origin, inertia
+    1 kg m^2, and massless attachments: its :class:`balpipe.mass_sweep.MassSweep` depends on the
+    geometry alone, so every design of that geometry gets the same numbers, in any chunk or worker."""
+    from dataclasses import replace
+
+    bodies = tuple(replace(b, mass=1.0, com=(0.0, 0.0), inertia=1.0,
+                           attachments=tuple(replace(a, mass=0.0, inertia=0.0) for a in b.attachments))
+                   for b in model.bodies)
+    return replace(model, bodies=bodies)
+
+
+def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
+    """Fast path: the design's parameter vector ``row[tag + 'p']`` (the parent does the product).
+    Otherwise one engine analysis per geometry (a :class:`balpipe.mass_sweep.MassSweep` of the
+    canonical model, cached in this process: the design's other stage and the other designs of
+    that geometry reuse it) and the design's peaks through its regressors, in ``row``. Returns the
+    route taken."""
+    from .balancing.regressor import parameters
+    from .mass_sweep import MassSweep, geometry_key
+
+    gkey = geometry_key(model, t, g, P)
+    if key is not None and gkey == key:
         row[tag + "p"] = parameters(model, angular=True)
         return "mass"
-    an = analyse(model, t, g, P)
-    row[tag + "max_shaking_force"] = an.max_force
-    row[tag + "max_shaking_moment"] = an.max_moment
-    row[tag + "max_actuator_effort"] = max((float(np.max(np.abs(e))) for e in an.efforts.values()), default=0.0)
+    for b in model.bodies:  # as the engine refuses it (compile_model)
+        m, _, i = b.mass_properties()
+        if m < 0 or i < 0:
+            raise ValueError(f"body {b.name!r} has a negative mass or inertia")
+    ms = _GEOMETRIES.get(gkey)
+    if ms is None:
+        try:
+            ms = MassSweep.build(canonical(model), t, g, P)
+        except Exception:  # the design's own analysis says why (or succeeds)
+            from .engine import analyse
+
+            an = analyse(model, t, g, P)
+            row[tag + "max_shaking_force"] = an.max_force
+            row[tag + "max_shaking_moment"] = an.max_moment
+            row[tag + "max_actuator_effort"] = max((float(np.max(np.abs(e))) for e in an.efforts.values()), default=0.0)
+            return "full"
+        if len(_GEOMETRIES) >= MAX_GEOMETRIES:
+            _GEOMETRIES.clear()
+        _GEOMETRIES[gkey] = ms
+    peaks = ms.peaks(parameters(model, angular=True)[None, :])
+    for name, arr in peaks.items():
+        row[tag + name] = float(arr[0])
     return "full"
 
 
@@ -359,7 +441,8 @@ def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]
                    keys: tuple) -> list[dict]:
     """Rows of one chunk of designs. For the chosen stage and the design's unbalanced stage
     (``keys``: their base geometries, or None), a design with the base geometry returns its
-    parameter vector for the parent's fast path; any other is analysed here by the engine."""
+    parameter vector for the parent's fast path; any other is analysed here by the engine, once
+    per geometry (:func:`_stage_loads`)."""
     from .study import _total_inertia
 
     rows = []
@@ -401,10 +484,13 @@ def _chunks(designs: list[tuple], workers: int) -> list[list[tuple[int, tuple]]]
 
 
 def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
-        progress: Callable[[int, int], None] | None = None) -> SweepResult:
-    """Evaluate every design of the plan: locally (``jobs`` processes; 1 = in this process;
-    0 = all cores, after timing the first chunk in this process, if the rest would take more
-    than :data:`POOL_WORTH` seconds) or on the dask.distributed scheduler at ``scheduler``."""
+        progress: Callable[[int, int], None] | None = None, affine: bool = True) -> SweepResult:
+    """Evaluate every design of the plan. A mass-only sweep (``affine``, and the probes of
+    :func:`balpipe.sweep_affine.build_route` agree) needs no spec per design: its designs'
+    parameters are one matrix product. Otherwise every design is built: locally (``jobs``
+    processes; 1 = in this process; 0 = all cores, after timing the first chunk in this process,
+    if the rest would take more than :data:`POOL_WORTH` seconds) or on the dask.distributed
+    scheduler at ``scheduler``."""
     from .engine import AnalysisError
     from .mass_sweep import MassSweep, check_parameters
     from .spec_parts import SpecFieldError
@@ -428,7 +514,27 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     total = len(p.designs)
     done = 0
     rows: list[dict] = []
-    if scheduler:
+    route, pre, pre_rows = None, {}, []
+    if ms is not None and affine:
+        from .sweep_affine import build_route
+
+        route = build_route(p, base_key, (ms.names, ms0.names))
+    if route is not None:
+        notes.append(f"Mass-only sweep: every design's masses and inertias are affine in the varied values "
+                     f"(found and checked on {route.probes} designs built in full); the others were not built "
+                     f"one by one but evaluated as matrix products.")  # mass-only: designs as matrix products, no spec built per design
+        rows, F = route.rows(p.designs)
+        pre = dict(zip(("", "unbalanced_"), route.parameters(F)))
+        flagged = set(np.flatnonzero(route.unbuildable(F)).tolist())
+        for i in sorted(flagged):  # a design that cannot be built: its own error, as built in full
+            rows[i] = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, base_key)[0]
+        if flagged:
+            keep = np.array([i not in flagged for i in range(total)])
+            pre = {tag: P[keep] for tag, P in pre.items()}
+        pre_rows = [r for r in rows if r["design"] not in flagged]
+        if progress:
+            progress(total, total)
+    elif scheduler:
         from distributed import Client, as_completed
 
         with Client(scheduler) as client:
@@ -477,9 +583,11 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     rows.sort(key=lambda r: r["design"])
     for tag, sweep in (("", ms), ("unbalanced_", ms0)):  # the fast path, in blocks of matrix products
         fast = [r for r in rows if tag + "p" in r]
+        Pm = np.array([r.pop(tag + "p") for r in fast])
+        if tag in pre:  # the affine route's designs: their parameters as one matrix
+            fast, Pm = pre_rows + fast, np.concatenate([pre[tag], Pm.reshape(-1, pre[tag].shape[1])])
         if not fast:
             continue
-        Pm = np.array([r.pop(tag + "p") for r in fast])
         bad = check_parameters(sweep.names, Pm)
         peaks = sweep.peaks(Pm)
         for k, r in enumerate(fast):
@@ -501,20 +609,39 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     res.full = sum(r.get("route") == "full" and "error" not in r for r in rows)
     res.failed = sum("error" in r for r in rows)
     mark_pareto(rows)
+    if route is not None and not _front_confirmed(p, paths, rows, F, route, base_key):
+        return run(p, jobs, scheduler, progress, affine=False)
     return res
+
+
+def _front_confirmed(p: Plan, paths: list[tuple], rows: list[dict], F: np.ndarray, route, keys: tuple) -> bool:
+    """The affine route's designs on a Pareto front (at most 64), built in full, have the
+    predicted parameters (to the route's tolerance); else the sweep is run design by design."""
+    from .sweep_affine import TOL
+
+    front = [r["design"] for r in rows if "error" not in r and (r["pareto_moment"] or r["pareto_effort"])][:64]
+    scale = np.maximum(np.abs(F).max(axis=0), 1e-300)
+    for i in front:
+        full = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, keys)[0]
+        if "error" in full or "unbalanced_p" not in full:
+            return False
+        got = np.concatenate([full["p"], full["unbalanced_p"]])
+        want = np.concatenate(route.parameters(F[i : i + 1]), axis=1)[0]
+        if np.any(np.abs(got - want) > 1e-9 * scale[2 : 2 + got.size]):
+            return False
+    return True
 
 
 def pareto(points: np.ndarray) -> np.ndarray:
     """Mask of the non-dominated rows of ``points`` (D, 2), both objectives minimised."""
     D = len(points)
     keep = np.ones(D, dtype=bool)
+    if D == 0:
+        return keep
     order = np.lexsort((points[:, 1], points[:, 0]))
-    best = math.inf
-    for i in order:
-        if points[i, 1] < best:
-            best = points[i, 1]
-        else:
-            keep[i] = False
+    y = points[order, 1]
+    best_before = np.concatenate([[math.inf], np.minimum.accumulate(y)[:-1]])  # the best of the designs before
+    keep[order] = y < best_before
     return keep
 
 
@@ -561,7 +688,7 @@ def design_spec_text(res: SweepResult, index: int) -> str:
     """The spec of design ``index``: the base spec's YAML with the varied fields set, so that
     ``balpipe build`` gives its full report."""
     row = res.rows[index]
-    d = copy.deepcopy(with_values(res.plan.data, [v.path for v in res.plan.varies], row["values"]))
+    d = copy.deepcopy(with_values(res.plan.data, [v.path for v in res.plan.varies], row["values"]))  # no sweep block
     d["name"] = f"{d.get('name', 'design')} — sweep design {index}"
     head = (f"# Design {index} of the sweep of {res.plan.file}: "
             + ", ".join(f"{v.name} = {raw}" for v, raw in zip(res.plan.varies, row["values"])) + "\n")

@@ -5,16 +5,17 @@ from __future__ import annotations
 import argparse
 import sys
 
-EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+from .common import EXIT_FAILED, EXIT_OK, EXIT_USAGE
 
 
 def add_parser(sub) -> None:
-    from .sweep import MAX_DESIGNS
+    from ..sweep import MAX_DESIGNS
 
     s = sub.add_parser(
         "sweep", help="sweep numeric spec fields; table, Pareto fronts, design specs",
         description="Vary numeric fields of a spec (dotted paths, units as in the spec) over a grid or "
-        "seeded random / Latin-hypercube samples; write sweep.csv, a page with the Pareto fronts of added "
+        "seeded random / Latin-hypercube samples, as given by --vary or else by the spec's sweep: block "
+        "(flags override the block; --vary replaces its vary list); write sweep.csv, a page with the Pareto fronts of added "
         "mass against peak shaking moment and peak actuator effort, and the specs of the designs on them. "
         "Designs that change only masses, inertias and counterweights take the fast path (one analysis, "
         "a matrix product per design).",
@@ -25,11 +26,11 @@ def add_parser(sub) -> None:
     )
     s.add_argument("spec", metavar="SPEC", help="the base spec file")
     s.add_argument("--vary", action="append", default=[], metavar="PATH=RANGE", help="a field and its range (repeat)")
-    s.add_argument("--sample", choices=["grid", "random", "lhs"], default="grid", help="design of experiments (default: grid)")
-    s.add_argument("-n", "--designs", type=int, default=0, metavar="N", help="number of designs for random and lhs")
-    s.add_argument("--seed", type=int, default=0, help="seed of random and lhs (default 0)")
+    s.add_argument("--sample", choices=["grid", "random", "lhs"], default=None, help="design of experiments (default: grid)")
+    s.add_argument("-n", "--designs", type=int, default=None, metavar="N", help="number of designs for random and lhs")
+    s.add_argument("--seed", type=int, default=None, help="seed of random and lhs (default 0)")
     s.add_argument("--stage", metavar="NAME", help="the stage whose loads are reported (default: the method's last)")
-    s.add_argument("--max-designs", type=int, default=MAX_DESIGNS, metavar="N",
+    s.add_argument("--max-designs", type=int, default=None, metavar="N",
                    help=f"refuse sweeps with more designs (default {MAX_DESIGNS})")
     s.add_argument("-o", "--out", default="sweep", metavar="DIR", help="output folder (default: sweep)")
     s.add_argument("--specs", choices=["pareto", "all", "none"], default="pareto",
@@ -40,9 +41,10 @@ def add_parser(sub) -> None:
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
 
-def cmd_sweep(args) -> int:
-    from .loader import SpecErrors
-    from .sweep import SweepError, plan, progress_printer, run, write
+def run(args) -> int:
+    from ..loader import SpecErrors
+    from ..sweep import SweepError, plan, progress_printer, write
+    from ..sweep import run as run_sweep
 
     if args.jobs < 0:
         print("balpipe: error: --jobs must be >= 0", file=sys.stderr)
@@ -67,7 +69,7 @@ def cmd_sweep(args) -> int:
     except FileNotFoundError as exc:
         print(f"balpipe: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
-    res = run(p, jobs=args.jobs, scheduler=args.scheduler, progress=progress_printer(args.quiet))
+    res = run_sweep(p, jobs=args.jobs, scheduler=args.scheduler, progress=progress_printer(args.quiet))
     written = write(res, args.out, args.specs, args.parquet)
     print(f"balpipe: {len(res.rows)} designs: {res.fast} mass-only (fast path), {res.full} full analyses, "
           f"{res.failed} failed; {written[-1]}", file=sys.stderr)

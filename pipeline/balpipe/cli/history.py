@@ -7,7 +7,8 @@ import sys
 import time
 from pathlib import Path
 
-EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, paths_jobs_problem
+
 DEFAULT_CACHE = ".balpipe-cache/history"
 
 
@@ -30,9 +31,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
     return h
 
 
-def cmd_history(args) -> int:
-    from . import history
-    from .cli import paths_jobs_problem
+def run(args) -> int:
+    from .. import history
 
     problem = paths_jobs_problem(args.paths, args.jobs)
     if problem:
@@ -58,7 +58,7 @@ def cmd_history(args) -> int:
                                jobs=args.jobs, max_commits=args.max_commits, progress=progress)
     except KeyboardInterrupt:
         print("balpipe: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
     if not outcomes:
         print("balpipe: error: no spec files (*.yaml) found", file=sys.stderr)
         return EXIT_USAGE

@@ -1,0 +1,64 @@
+"""The ``balpipe`` command line: ``main()`` and the dispatch; one module per verb.
+
+:mod:`.build`, :mod:`.check`, :mod:`.diff`, :mod:`.schema`, :mod:`.history`, :mod:`.sweep` each
+give ``add_parser(sub)`` (the verb's options and help) and ``run(args) -> exit code``;
+:mod:`.common` holds the exit codes (0 ok, 1 failed, 2 usage or invalid spec, 130 interrupted,
+143 terminated) and the helpers they share.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+
+from .. import __version__
+from .common import (  # noqa: F401  (re-exported: the public names of balpipe.cli)
+    EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, EXIT_TERMINATED, EXIT_USAGE, Parser, Terminated, on_sigterm,
+    paths_jobs_problem,
+)
+
+VERBS = ("build", "check", "diff", "schema", "history", "sweep")  # the order of ``balpipe --help``
+
+
+def _verb(name: str):
+    return importlib.import_module(f"{__name__}.{name}")
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = Parser(prog="balpipe", description="Dynamic balancing of planar mechanisms from YAML specs.")
+    p.add_argument("--version", action="version", version=f"balpipe {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
+    for name in VERBS:
+        _verb(name).add_parser(sub)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, on_sigterm)
+    else:  # pragma: no cover - embedded use
+        previous = None
+    try:
+        return _verb(args.command).run(args)
+    except Terminated:
+        print("balpipe: terminated; the site is as the last complete build left it", file=sys.stderr)
+        return EXIT_TERMINATED
+    except KeyboardInterrupt:
+        print("balpipe: interrupted; the site is as the last complete build left it", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

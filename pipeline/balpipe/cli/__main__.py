@@ -1,0 +1,7 @@
+"""``python -m balpipe.cli`` (as ``python -m balpipe``)."""
+
+import sys
+
+from . import main
+
+sys.exit(main())

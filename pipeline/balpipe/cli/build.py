@@ -1,0 +1,53 @@
+"""``balpipe build PATH...``: compute, analyse, validate and report every spec (:mod:`balpipe.build`)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from .common import EXIT_FAILED, EXIT_OK, EXIT_USAGE, paths_jobs_problem, usage_error
+
+
+def add_parser(sub) -> None:
+    b = sub.add_parser("build", help="build the report site from specs",
+                       description="Compute, analyse, validate and report every spec; skip unchanged ones.")
+    b.add_argument("paths", nargs="+", metavar="PATH", help="spec files or folders of specs")
+    b.add_argument("-o", "--out", default="reports", metavar="DIR", help="output folder (default: reports)")
+    b.add_argument("-j", "--jobs", type=int, default=1, metavar="N", help="build N specs in parallel")
+    b.add_argument("--no-sim", action="store_true", help="skip the pymunk validation (quick iterations)")
+    b.add_argument("--force", action="store_true", help="rebuild specs even when unchanged")
+    b.add_argument("-q", "--quiet", action="store_true", help="print only errors and the summary")
+
+
+def run(args) -> int:
+    from ..build import Options, OutputError, build
+
+    problem = paths_jobs_problem(args.paths, args.jobs)
+    if problem:
+        return usage_error(problem)
+    opts = Options(out=Path(args.out), simulate=not args.no_sim, force=args.force)
+
+    def progress(k: int, total: int, o) -> None:
+        if k == 0:  # refused before any work (unreadable folder, page name clash)
+            print(o.message, file=sys.stderr)
+            return
+        if args.quiet and o.status in ("ok",):
+            return
+        tag = "unchanged" if o.skipped else o.status
+        print(f"[{k}/{total}] {o.source}: {tag} ({o.seconds:.2f} s)", file=sys.stderr)
+        if o.status != "ok" and o.message and not o.skipped:
+            print("    " + o.message.replace("\n", "\n    "), file=sys.stderr)
+
+    try:
+        outcomes = build(args.paths, opts, jobs=args.jobs, progress=progress)
+    except OutputError as exc:
+        return usage_error(str(exc))
+    if not outcomes:
+        return usage_error("no spec files (*.yaml) found")
+    n_err = sum(o.spec_error for o in outcomes)
+    n_fail = sum(o.status in ("failed", "crash") for o in outcomes)
+    n_ok = len(outcomes) - n_err - n_fail
+    print(f"balpipe: {n_ok} ok, {n_fail} failed, {n_err} invalid; site: {opts.out / 'index.html'}", file=sys.stderr)
+    if n_fail:
+        return EXIT_FAILED
+    return EXIT_USAGE if n_err else EXIT_OK
