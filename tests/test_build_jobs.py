@@ -78,3 +78,19 @@ def test_usable_cores_follows_the_affinity_mask(monkeypatch):
     monkeypatch.setattr(os, "cpu_count", lambda: 64)
     assert usable_cores() == 1 and default_jobs(12) == 1
     assert default_jobs(0) == 1  # nothing to build: still a valid pool size
+
+
+def test_cli_build_defaults_to_one_process_per_core_and_refuses_zero(tmp_path, monkeypatch, capsys):
+    """``balpipe build`` without ``-j`` passes ``jobs=None`` (one process per usable core, at most
+    one per spec); ``-j 0`` is a usage error (exit 2), not a traceback."""
+    from balpipe.cli import main
+
+    seen = []
+    monkeypatch.setattr(build_mod, "build", lambda paths, opts, jobs, progress: seen.append(jobs) or [])
+    spec = tmp_path / "s.yaml"
+    spec.write_text("name: x\n")
+    main(["build", str(spec), "-o", str(tmp_path / "o"), "-q"])
+    main(["build", str(spec), "-o", str(tmp_path / "o"), "-q", "-j", "1"])
+    assert seen == [None, 1]
+    assert main(["build", str(spec), "-o", str(tmp_path / "o"), "-j", "0"]) == 2
+    assert "--jobs must be at least 1" in capsys.readouterr().err

@@ -13,7 +13,8 @@ def add_parser(sub) -> None:
                        description="Compute, analyse, validate and report every spec; skip unchanged ones.")
     b.add_argument("paths", nargs="+", metavar="PATH", help="spec files or folders of specs")
     b.add_argument("-o", "--out", default="reports", metavar="DIR", help="output folder (default: reports)")
-    b.add_argument("-j", "--jobs", type=int, default=1, metavar="N", help="build N specs in parallel")
+    b.add_argument("-j", "--jobs", type=int, default=None, metavar="N",
+                   help="build N specs in parallel (default: one per usable core, at most one per spec; 1: one after another)")
     b.add_argument("--no-sim", action="store_true", help="skip the pymunk validation (quick iterations)")
     b.add_argument("--force", action="store_true", help="rebuild specs even when unchanged")
     b.add_argument("-q", "--quiet", action="store_true", help="print only errors and the summary")

@@ -36,13 +36,13 @@ def missing(paths: list[str]) -> list[str]:
     return [p for p in paths if not Path(p).exists()]
 
 
-def paths_jobs_problem(paths: list[str], jobs: int) -> str | None:
+def paths_jobs_problem(paths: list[str], jobs: int | None) -> str | None:
     """What is wrong with the spec paths and ``--jobs`` of a command that runs specs in parallel
     (``build``, ``history``): a usage error to print, or None."""
     gone = missing(paths)
     if gone:
         return f"no such file or folder: {', '.join(gone)}"
-    if jobs < 1:
+    if jobs is not None and jobs < 1:
         return "--jobs must be at least 1"
     return None
 
