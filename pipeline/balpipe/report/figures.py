@@ -245,8 +245,8 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
                   numbers: dict[str, str]) -> tuple[list, list, list]:
     """What to label at one instant, in placing order (frame pivots, joints, gears,
     counterweights, links), in model coordinates: (text, anchor, kind) triples, the links'
-    segments, and the joint markers and counterweight discs to keep clear, as (centre, radius)
-    with radius None for a marker."""
+    segments, and the joint markers, pivots, slider blocks and counterweight discs to keep clear,
+    as (centre, radius), radius None for a joint's marker and -1 for a pivot's triangle."""
     out: list[tuple[str, np.ndarray, str]] = []
     keep: list[tuple[np.ndarray, float | None]] = []
     segs: list[tuple[np.ndarray, np.ndarray]] = []
@@ -254,7 +254,7 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
     for name, p in model.frame_points.items():
         placed.add((round(p[0] / span, 2), round(p[1] / span, 2)))
         out.append((name, np.asarray(p, dtype=float), "pivot"))
-        keep.append((np.asarray(p, dtype=float), None))
+        keep.append((np.asarray(p, dtype=float), -1.0))  # the pivot's triangle
     for i, b in enumerate(model.bodies):
         if b.kind == "gear" and b.radius:
             continue  # a disc's axis: the disc carries its number
@@ -269,6 +269,8 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
     gears, cws, links = [], [], []
     for i, b in enumerate(model.bodies):
         pose = pose_row[i]
+        if b.kind == "slider":
+            keep.append((_global_point(pose, (0, 0)), 0.06 * span))  # the slider's block
         if b.radius:
             rim = _global_point(pose, (0, 0)) + b.radius * np.array([math.sqrt(0.5), math.sqrt(0.5)])
             gears.append((numbers.get(b.name, b.name), rim, "gear"))
@@ -312,7 +314,8 @@ def _place_names(fig, ax, model: Model, pose_row: np.ndarray, span: float, max_c
     blocks = []
     for c, r in keep:
         x, y = to_px(c)
-        rr = marker if r is None else max(marker, abs(float(to_px(c + np.array([r, 0.0]))[0]) - float(x)))
+        rr = marker if r is None else 5.0 * fig.dpi / 72.0 if r < 0 else \
+            max(marker, abs(float(to_px(c + np.array([r, 0.0]))[0]) - float(x)))
         blocks.append((float(x) - rr, float(y) - rr, float(x) + rr, float(y) + rr))
     requests = []
     for text, anchor, kind in items:
@@ -332,8 +335,8 @@ def _place_names(fig, ax, model: Model, pose_row: np.ndarray, span: float, max_c
         off = ((cx - pl.request.anchor[0]) * to_pt, (cy - pl.request.anchor[1]) * to_pt)
         ax.annotate(literal(text), (float(anchor[0]), float(anchor[1])), textcoords="offset points",
                     xytext=(round(off[0], 3), round(off[1], 3)), ha="center", va="center", fontsize=size,
-                    color=color, style=fstyle, weight=weight, annotation_clip=False,
-                    bbox={"boxstyle": "square,pad=0.05", "facecolor": "white", "edgecolor": "none", "alpha": 0.8},
+                    color=color, style=fstyle, weight=weight, annotation_clip=False, zorder=5,
+                    bbox={"boxstyle": "square,pad=0.05", "facecolor": "white", "edgecolor": "none", "alpha": 0.85},
                     arrowprops={"arrowstyle": "-", "color": "0.45", "linewidth": 0.6, "shrinkA": 0, "shrinkB": 0}
                     if pl.displaced else None)
     return placed
