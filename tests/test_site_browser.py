@@ -245,6 +245,29 @@ def test_player_pauses_scrubs_and_answers_the_keyboard(server, browser):
     assert not w.problems, "\n".join(w.problems)
 
 
+def test_player_names_its_parts_and_shows_a_scale_bar_per_panel(server, browser):
+    """The player's names (pivots, joints, links, counterweights) are drawn, none over another
+    (the placer leaves out what does not fit), and can be switched off; the caption says how
+    the panels' scales compare."""
+    w = Watched(browser)
+    p = w.page
+    p.goto(server + "scott_russell/index.html", wait_until="load")
+    p.click("#player-play")  # pause
+    p.eval_on_selector("#player-time", "s => { s.value = '300'; s.dispatchEvent(new Event('input')); }")
+    named = p.eval_on_selector("#player", "c => Object.keys(c.dataset).filter(k => k.startsWith('names')).map(k => +c.dataset[k])")
+    assert len(named) == 3 and all(n >= 5 for n in named), named  # A, B, C, crank, coupler at least
+    pixels = p.eval_on_selector("#player", "c => c.toDataURL()")
+    p.uncheck("#player-names")
+    assert p.eval_on_selector("#player", "c => c.dataset.names0") == "0"
+    assert p.eval_on_selector("#player", "c => c.toDataURL()") != pixels
+    p.focus("#player-names")
+    p.keyboard.press(" ")  # a real checkbox: the keyboard turns the names back on
+    assert p.is_checked("#player-names") and p.eval_on_selector("#player", "c => +c.dataset.names0") >= 5
+    caption = p.text_content("figure:has(#player) figcaption")
+    assert "scale bar" in caption and ("scales differ" in caption or "same scale" in caption)
+    assert not w.problems, "\n".join(w.problems)
+
+
 def test_scripts_ran_in_the_pages(server, browser):
     w = Watched(browser)
     w.page.goto(server + "scott_russell/index.html", wait_until="load")

@@ -80,6 +80,15 @@ class Reactionless:
             for lab, m, r in zip(self.labels, self.models, self.runs)
         ])
 
+    def player_note(self) -> str:
+        """The player caption's sentence on the panels' scales and the gears' numbers."""
+        from .report.player import scale_note
+
+        return scale_note([
+            {"label": lab, "model": m, "t": r.t, "base": r.base, "poses": r.poses}
+            for lab, m, r in zip(self.labels, self.models, self.runs)
+        ])
+
 
 def simulate_study(study: Study) -> None:
     """Validate every stage; failures become problems of the study (the build exits 1)."""

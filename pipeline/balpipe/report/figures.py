@@ -156,11 +156,23 @@ def _global_point(pose, p) -> np.ndarray:
 
 
 def mechanism_figure(model: Model, analysis, instants: int = 5, prefix: str = "mech",
-                     title: str = "", limits: tuple[float, float, float, float] | None = None) -> str:
+                     title: str = "", limits: tuple[float, float, float, float] | None = None,
+                     numbers: dict[str, str] | None = None) -> str:
     """The mechanism drawn at several instants (light to dark), counterweights as discs whose
     area grows with their mass, gears as circles, and the paths of the link points. The last
-    instant carries the spec's names (points, links, counterweights); ``limits`` (x0, y0, x1,
-    y1) gives every panel of a figure the same scale."""
+    instant carries the spec's names (points, links, counterweights) and the gears' numbers
+    (``numbers``: part name -> number, :func:`labels.gear_numbers`), placed so that no two
+    overlap (:func:`labels.place`); ``limits`` (x0, y0, x1, y1) gives every panel of a figure
+    the same scale."""
+    fig, _ = mechanism_drawing(model, analysis, instants, title, limits, numbers)
+    return to_svg(fig, prefix)
+
+
+def mechanism_drawing(model: Model, analysis, instants: int = 5, title: str = "",
+                      limits: tuple[float, float, float, float] | None = None,
+                      numbers: dict[str, str] | None = None) -> tuple:
+    """The figure of :func:`mechanism_figure` and its placed labels (:class:`labels.Placed`,
+    boxes in display pixels)."""
     fig, ax = plt.subplots(figsize=(6.0, 4.6))
     N = len(analysis.t)
     ks = np.unique(np.linspace(0, N - 1, instants).round().astype(int))
@@ -202,12 +214,10 @@ def mechanism_figure(model: Model, analysis, instants: int = 5, prefix: str = "m
                 g = np.array([_global_point(pose, p) for p in pts])
                 ax.plot(g[:, 0], g[:, 1], color="black", alpha=alpha, linewidth=2.2, solid_capstyle="round")
                 ax.plot(g[:, 0], g[:, 1], "o", color="white", markeredgecolor="black", markersize=4, alpha=alpha)
-    _label_names(ax, model, poses[ks[-1]], span)
     for (a, b) in model.guides:
         ax.plot([a[0], b[0]], [a[1], b[1]], color="0.3", linewidth=1.0, linestyle="-")
     for name, p in model.frame_points.items():
         ax.plot(p[0], p[1], marker="^", color="black", markersize=9)
-        ax.annotate(literal(name), p, textcoords="offset points", xytext=(4, -12), fontsize=8)
     ax.set_aspect("equal")
     if limits is not None:
         x0, y0, x1, y1 = limits
@@ -218,34 +228,118 @@ def mechanism_figure(model: Model, analysis, instants: int = 5, prefix: str = "m
     if title:
         ax.set_title(literal(title), fontsize=9)
     fig.tight_layout()
-    return to_svg(fig, prefix)
+    placed = _place_names(fig, ax, model, poses[ks[-1]], span, max_cw, numbers)
+    return fig, placed
 
 
-def _label_names(ax, model: Model, pose_row: np.ndarray, span: float) -> None:
-    """Names of the spec at one instant: every body point (once per place), every link at the
-    middle of its outline, every counterweight and carried gear."""
-    placed: set[tuple[float, float]] = {(round(p[0] / span, 2), round(p[1] / span, 2)) for p in model.frame_points.values()}
+LABEL_STYLES = {  # kind -> font size, colour, style, weight
+    "pivot": (8.0, "black", "normal", "normal"),
+    "joint": (8.0, "0.15", "normal", "normal"),
+    "gear": (8.5, "tab:green", "normal", "bold"),
+    "counterweight": (7.5, "tab:red", "normal", "normal"),
+    "link": (7.5, "tab:blue", "italic", "normal"),
+}
+
+
+def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float,
+                  numbers: dict[str, str]) -> tuple[list, list, list]:
+    """What to label at one instant, in placing order (frame pivots, joints, gears,
+    counterweights, links), in model coordinates: (text, anchor, kind) triples, the links'
+    segments, and the joint markers, pivots, slider blocks and counterweight discs to keep clear,
+    as (centre, radius), radius None for a joint's marker and -1 for a pivot's triangle."""
+    out: list[tuple[str, np.ndarray, str]] = []
+    keep: list[tuple[np.ndarray, float | None]] = []
+    segs: list[tuple[np.ndarray, np.ndarray]] = []
+    placed: set[tuple[float, float]] = set()
+    for name, p in model.frame_points.items():
+        placed.add((round(p[0] / span, 2), round(p[1] / span, 2)))
+        out.append((name, np.asarray(p, dtype=float), "pivot"))
+        keep.append((np.asarray(p, dtype=float), -1.0))  # the pivot's triangle
     for i, b in enumerate(model.bodies):
-        pose = pose_row[i]
+        if b.kind == "gear" and b.radius:
+            continue  # a disc's axis: the disc carries its number
         for name, p in b.points.items():
-            g = _global_point(pose, p)
+            g = _global_point(pose_row[i], p)
             key = (round(g[0] / span, 2), round(g[1] / span, 2))
             if key in placed:
                 continue
             placed.add(key)
-            ax.annotate(name, g, textcoords="offset points", xytext=(5, 5), fontsize=8, color="0.15")
-        pts = [b.points[p] for p in b.outline]
-        if len(pts) >= 2:
-            mid = 0.5 * (_global_point(pose, pts[0]) + _global_point(pose, pts[1]))
-            ax.annotate(b.name, mid, textcoords="offset points", xytext=(0, -11), fontsize=7.5, color="tab:blue",
-                        ha="center", style="italic")
-        elif b.radius:
-            ax.annotate(b.name, _global_point(pose, (0, 0)), textcoords="offset points", xytext=(0, -11),
-                        fontsize=7.5, color="tab:green", ha="center", style="italic")
+            out.append((name, g, "joint"))
+            keep.append((g, None))
+    gears, cws, links = [], [], []
+    for i, b in enumerate(model.bodies):
+        pose = pose_row[i]
+        if b.kind == "slider":
+            keep.append((_global_point(pose, (0, 0)), 0.06 * span))  # the slider's block
+        if b.radius:
+            rim = _global_point(pose, (0, 0)) + b.radius * np.array([math.sqrt(0.5), math.sqrt(0.5)])
+            gears.append((numbers.get(b.name, b.name), rim, "gear"))
         for a in b.attachments:
-            if a.kind == "counterweight" or a.radius:
-                ax.annotate(a.name, _global_point(pose, a.position), textcoords="offset points", xytext=(6, -3),
-                            fontsize=7.5, color="tab:red" if a.kind == "counterweight" else "tab:green")
+            c = _global_point(pose, a.position)
+            if a.kind == "counterweight":
+                cws.append((a.name, c, "counterweight"))
+                keep.append((c, 0.035 * span * math.sqrt(a.mass / max_cw)))
+                root = _global_point(pose, b.points[b.outline[0]] if b.outline else (0, 0))
+                segs.append((root, c))
+            elif a.radius:
+                gears.append((numbers.get(a.name, a.name), c + a.radius * np.array([math.sqrt(0.5), math.sqrt(0.5)]),
+                              "gear"))
+        pts = [_global_point(pose, b.points[p]) for p in b.outline]
+        segs += list(zip(pts[:-1], pts[1:]))
+        if len(pts) >= 2:
+            unique = [q for k, q in enumerate(pts) if not any(np.allclose(q, r) for r in pts[:k])]
+            mid = np.mean(unique, axis=0) if b.kind == "platform" and len(unique) > 2 else 0.5 * (pts[0] + pts[1])
+            links.append((b.name, mid, "link"))
+    for a, b in model.guides:
+        segs.append((np.asarray(a, dtype=float), np.asarray(b, dtype=float)))
+    return out + gears + cws + links, segs, keep
+
+
+def _place_names(fig, ax, model: Model, pose_row: np.ndarray, span: float, max_cw: float,
+                 numbers: dict[str, str] | None) -> list:
+    """Names of the spec at one instant (every body point once per place, every link, every
+    counterweight, every gear's number), placed in display pixels by :func:`labels.place` so
+    that no two overlap, avoiding the links and markers; a displaced name gets a leader line."""
+    from matplotlib.font_manager import FontProperties
+
+    from . import labels as lb
+
+    numbers = numbers if numbers is not None else lb.gear_numbers([model])
+    items, segs, keep = name_requests(model, pose_row, span, max_cw, numbers)
+    ax.apply_aspect()
+    to_px = ax.transData.transform
+    renderer = fig.canvas.get_renderer()
+    pad = 2.0 * fig.dpi / 72.0
+    marker = 3.0 * fig.dpi / 72.0
+    blocks = []
+    for c, r in keep:
+        x, y = to_px(c)
+        rr = marker if r is None else 5.0 * fig.dpi / 72.0 if r < 0 else \
+            max(marker, abs(float(to_px(c + np.array([r, 0.0]))[0]) - float(x)))
+        blocks.append((float(x) - rr, float(y) - rr, float(x) + rr, float(y) + rr))
+    requests = []
+    for text, anchor, kind in items:
+        size, _, fstyle, weight = LABEL_STYLES[kind]
+        prop = FontProperties(family="DejaVu Sans", size=size, style=fstyle, weight=weight)
+        w, h, _ = renderer.get_text_width_height_descent(str(text), prop, ismath=False)
+        x, y = float(to_px(anchor)[0]), float(to_px(anchor)[1])
+        own = [0.5 * (b[2] - b[0]) for b in blocks if b[0] <= x <= b[2] and b[1] <= y <= b[3]]
+        requests.append(lb.Request(str(text), (x, y), float(w) + 2 * pad, float(h) + pad, kind, max(own + [0.0])))
+    seg_px = [(tuple(map(float, to_px(a))), tuple(map(float, to_px(b)))) for a, b in segs]
+    x0, y0, x1, y1 = ax.bbox.extents
+    placed = lb.place(requests, seg_px, blocks, bounds=(float(x0), float(y0), float(x1), float(y1)), gap=pad)
+    to_pt = 72.0 / fig.dpi
+    for (text, anchor, kind), pl in zip(items, placed):
+        size, color, fstyle, weight = LABEL_STYLES[kind]
+        cx, cy = pl.centre
+        off = ((cx - pl.request.anchor[0]) * to_pt, (cy - pl.request.anchor[1]) * to_pt)
+        ax.annotate(literal(text), (float(anchor[0]), float(anchor[1])), textcoords="offset points",
+                    xytext=(round(off[0], 3), round(off[1], 3)), ha="center", va="center", fontsize=size,
+                    color=color, style=fstyle, weight=weight, annotation_clip=False, zorder=5,
+                    bbox={"boxstyle": "square,pad=0.05", "facecolor": "white", "edgecolor": "none", "alpha": 0.85},
+                    arrowprops={"arrowstyle": "-", "color": "0.45", "linewidth": 0.6, "shrinkA": 0, "shrinkB": 0}
+                    if pl.displaced else None)
+    return placed
 
 
 def common_limits(items: list[tuple[Model, np.ndarray]], pad: float = 0.08) -> tuple[float, float, float, float]:

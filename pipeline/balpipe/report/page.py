@@ -6,7 +6,7 @@ import numpy as np
 
 from .. import realisable
 from ..study import Study
-from . import figures, present, toc
+from . import figures, labels, present, toc
 from .notation_table import notation_groups
 from .render import environment
 from .results import joint_load_table
@@ -39,9 +39,10 @@ def study_figures(study: Study) -> dict:
                                      units={d.name: present.driver_unit(s.stage.model, d.name)
                                             for s in shown_stages(study) for d in s.stage.model.drivers})
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
+    numbers = labels.gear_numbers([s.stage.model for s in shown_stages(study)])
     mech = [
         (s.stage.label, figures.mechanism_figure(s.stage.model, s.analysis, INSTANTS, prefix=f"mech{k}",
-                                                 title=s.stage.label, limits=limits))
+                                                 title=s.stage.label, limits=limits, numbers=numbers))
         for k, s in enumerate(shown_stages(study))
     ]
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
@@ -70,7 +71,7 @@ def study_figures(study: Study) -> dict:
             "Each driven coordinate of the simulation driven by the engine's efforts (no position drive), "
             "minus its planned motion, relative to its travel.",
         ))
-    return {"loads": loads, "efforts": efforts, "mechanism": mech, "extra": extra,
+    return {"loads": loads, "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
@@ -113,7 +114,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         torque=torque_rows,
         reactionless={"base_mass": rl.base_mass, "base_inertia": rl.base_inertia, "rows": rl.rows(),
                       "same_base": rl.same_base,
-                      "player": rl.player()} if rl is not None else None,
+                      "player": rl.player(), "player_note": rl.player_note()} if rl is not None else None,
         instants=INSTANTS,
         instant_times=", ".join(f"{t:.4g}" for t in drawn_times(study)),
         joint_loads=joint_load_table(study),

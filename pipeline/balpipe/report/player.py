@@ -1,14 +1,19 @@
 """A small self-contained canvas player: the mechanism moving on its free-floating frame.
 
 The page embeds, per stage, the outline of every body (local points) and its pose at about 60
-frames, plus the frame's pose; a few lines of JavaScript draw them side by side. Controls:
-play/pause, a time slider, the speed (real time by default, the time scale shown); keyboard:
-Tab to the canvas, space to pause, arrows to step. No library, no external file.
+frames, plus the frame's pose; a few lines of JavaScript draw them in a grid of panels. Each
+panel has its own view box, from that stage's swept extent (every instant, parts and frame
+included) with a small margin, and its own scale bar in m (the caption says when the panels'
+scales differ). The spec's names (pivots, joints, counterweights, links) and the gears' numbers
+are placed so that they do not overlap, as in the drawings (:mod:`.labels`). Controls:
+play/pause, a time slider, the speed (real time by default, the time scale shown), names on or
+off; keyboard: Tab to the canvas, space to pause, arrows to step. No library, no external file.
 """
 
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 
@@ -35,35 +40,128 @@ def _outline(model: Model) -> list[dict]:
     return shapes
 
 
-def _extent_points(model: Model, poses: np.ndarray) -> np.ndarray:
-    """Global positions of every named point, attachment and disc rim over the frames."""
+def _extent_points(model: Model, poses: np.ndarray, base: np.ndarray | None = None) -> np.ndarray:
+    """Global positions of every named point, attachment and disc rim over the frames, and of
+    the frame's pivots and guides (carried by the frame's poses ``base`` where it moves)."""
     out = [poses[:, :, :2].reshape(-1, 2)]
     for i, b in enumerate(model.bodies):
         local = list(b.points.values()) + [a.position for a in b.attachments]
-        r = max([b.radius or 0.0] + [(a.radius or 0.0) for a in b.attachments])
+        r = b.radius or 0.0
         if r:
             local += [(r, 0.0), (-r, 0.0), (0.0, r), (0.0, -r)]
+        for a in b.attachments:  # a carried disc's rim, around its own centre
+            if a.radius:
+                px, py = a.position
+                local += [(px + a.radius, py), (px - a.radius, py), (px, py + a.radius), (px, py - a.radius)]
         x, y, th = poses[:, i, 0], poses[:, i, 1], poses[:, i, 2]
         for px, py in local:
             out.append(np.stack([x + np.cos(th) * px - np.sin(th) * py, y + np.sin(th) * px + np.cos(th) * py], axis=1))
-    pts = np.vstack(out)
-    fp = np.array(list(model.frame_points.values()) or [[0.0, 0.0]])
-    return np.vstack([pts, fp])
+    fixed = list(model.frame_points.values()) + [p for g in model.guides for p in g]
+    if not fixed:
+        fixed = [(0.0, 0.0)]
+    if base is None:
+        return np.vstack(out + [np.array(fixed, dtype=float)])
+    bx, by, bth = base[:, 0], base[:, 1], base[:, 2]
+    for px, py in fixed:
+        out.append(np.stack([bx + np.cos(bth) * px - np.sin(bth) * py, by + np.sin(bth) * px + np.cos(bth) * py], axis=1))
+    return np.vstack(out)
 
 
-def player_html(stages: list[dict], element_id: str = "player") -> str:
-    """``stages``: dicts with label, model, t (n,), base (n, 3) frame-origin poses and poses
-    (n, nb, 3) body-frame poses, all in the global frame of the start."""
-    data = []
-    lo = np.array([np.inf, np.inf])
-    hi = -lo
+PANEL_W = 300  # px per panel
+TOP, BOTTOM, SIDE = 22, 40, 10  # px: the stage's name above, the frame's pose and scale bar below
+MAX_COLUMNS = 4
+
+
+def nice_length(span: float) -> float:
+    """The largest 1, 2 or 5 x 10^n not above ``span`` (m): a scale bar's length."""
+    if not span > 0:
+        return 0.0
+    e = math.floor(math.log10(span))
+    for m in (5.0, 2.0, 1.0):
+        if m * 10.0**e <= span * (1 + 1e-12):
+            return m * 10.0**e
+    return 10.0 ** (e - 1) * 5.0
+
+
+def _length_text(x: float) -> str:
+    return f"{x * 1000:g} mm" if x < 0.1 else f"{x:g} m"
+
+
+def panel_views(extents: list[np.ndarray], width: int = PANEL_W) -> dict:
+    """Per-panel view boxes: every panel the same pixel size (its height from the widest
+    aspect of the stages' extents), each mechanism scaled to fill its own panel: ``box`` (x0, y0,
+    x1, y1, m, with a 6 % margin), ``view`` (ox, oy, s: pixel = (ox + s x, oy - s y) on the
+    canvas), the scale bar (length m, text) and the layout (columns, rows, panel size)."""
+    boxes = []
+    for xy in extents:
+        lo, hi = xy.min(axis=0), xy.max(axis=0)
+        d = 0.06 * float(max(hi - lo)) or 0.05
+        boxes.append((float(lo[0] - d), float(lo[1] - d), float(hi[0] + d), float(hi[1] + d)))
+    inner_w = width - 2 * SIDE
+    aspect = max((b[3] - b[1]) / (b[2] - b[0]) for b in boxes)
+    inner_h = int(round(min(max(aspect, 0.4), 1.2) * inner_w))
+    height = inner_h + TOP + BOTTOM
+    cols = min(len(boxes), MAX_COLUMNS) or 1
+    rows = -(-len(boxes) // cols)
+    panels = []
+    for k, b in enumerate(boxes):
+        s = min(inner_w / (b[2] - b[0]), inner_h / (b[3] - b[1]))
+        col, row = k % cols, k // cols
+        cx, cy = 0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3])
+        ox = col * width + SIDE + 0.5 * inner_w - s * cx
+        oy = row * height + TOP + 0.5 * inner_h + s * cy
+        bar = nice_length(0.3 * (b[2] - b[0]))
+        panels.append({"box": [round(v, 6) for v in b], "view": [round(ox, 4), round(oy, 4), round(s, 6)],
+                       "origin": [col * width, row * height], "bar": [round(bar, 9), _length_text(bar)]})
+    return {"panels": panels, "columns": cols, "rows": rows, "width": width, "height": height}
+
+
+def same_scale(views: dict, rel: float = 0.02) -> bool:
+    """Every panel at the same scale (within ``rel``)."""
+    s = [p["view"][2] for p in views["panels"]]
+    return max(s) <= (1 + rel) * min(s)
+
+
+def _labels(model: Model, numbers: dict[str, str]) -> dict:
+    """What the player names, in body frames: joints (body points, discs' axes left out),
+    links (middle of the first outline segment; a platform at its centroid), counterweights,
+    and every gear's number (:func:`labels.gear_numbers`)."""
+    joints, links, cws, gears = [], [], [], []
+    for j, b in enumerate(model.bodies):
+        if b.radius:
+            gears.append([j, 0.0, 0.0, round(b.radius, 5), numbers.get(b.name, b.name)])
+        else:
+            joints += [[j, round(p[0], 5), round(p[1], 5), n] for n, p in b.points.items()]
+        pts = [b.points[p] for p in b.outline]
+        if len(pts) >= 2:
+            uniq = list(dict.fromkeys(tuple(p) for p in pts))
+            if b.kind == "platform" and len(uniq) > 2:
+                mid = (sum(p[0] for p in uniq) / len(uniq), sum(p[1] for p in uniq) / len(uniq))
+            else:
+                mid = (0.5 * (pts[0][0] + pts[1][0]), 0.5 * (pts[0][1] + pts[1][1]))
+            links.append([j, round(mid[0], 5), round(mid[1], 5), b.name])
+        for a in b.attachments:
+            if a.kind == "counterweight":
+                cws.append([j, round(a.position[0], 5), round(a.position[1], 5), a.name])
+            elif a.radius:
+                gears.append([j, round(a.position[0], 5), round(a.position[1], 5), round(a.radius, 5),
+                              numbers.get(a.name, a.name)])
+    return {"joints": joints, "links": links, "cws": cws, "gears": gears}
+
+
+def player_data(stages: list[dict]) -> dict:
+    """The player's data: per stage its label, times, frame and body poses (about
+    :data:`FRAMES` frames), shapes, names, and its own view box (:func:`panel_views`)."""
+    from .labels import gear_numbers
+
+    numbers = gear_numbers([s["model"] for s in stages])
+    data, extents = [], []
     for s in stages:
         n = len(s["t"])
         ks = np.unique(np.linspace(0, n - 1, min(n, FRAMES)).round().astype(int))
         poses = s["poses"][ks]
         base = s["base"][ks]
-        xy = _extent_points(s["model"], poses)
-        lo, hi = np.minimum(lo, xy.min(axis=0)), np.maximum(hi, xy.max(axis=0))
+        extents.append(_extent_points(s["model"], s["poses"], s["base"]))
         fp = [[round(p[0], 5), round(p[1], 5)] for p in s["model"].frame_points.values()]
         data.append({
             "label": s["label"],
@@ -72,23 +170,51 @@ def player_html(stages: list[dict], element_id: str = "player") -> str:
             "poses": [[[round(float(v), 6) for v in body] for body in frame] for frame in poses],
             "shapes": _outline(s["model"]),
             "pivots": fp,
+            "pivot_names": list(s["model"].frame_points),
+            "names": _labels(s["model"], numbers),
             "guides": [[[round(a[0], 5), round(a[1], 5)], [round(b[0], 5), round(b[1], 5)]] for a, b in s["model"].guides],
         })
-    pad = 0.15 * float(max(hi - lo)) if np.all(np.isfinite(hi)) else 0.1
-    box = [round(float(lo[0] - pad), 4), round(float(lo[1] - pad), 4), round(float(hi[0] + pad), 4), round(float(hi[1] + pad), 4)]
-    payload = json.dumps({"stages": data, "box": box}, separators=(",", ":"), sort_keys=True)
+    views = panel_views(extents)
+    for d, p in zip(data, views["panels"]):
+        d.update(p)
+    return {"stages": data, "layout": {k: views[k] for k in ("columns", "rows", "width", "height")},
+            "same_scale": same_scale(views), "numbers": numbers}
+
+
+def scale_note(stages: list[dict]) -> str:
+    """The caption's sentence on the panels' scales, and the gears' numbers."""
+    d = player_data(stages)
+    from .labels import gear_key
+
+    note = ("Every panel is at the same scale (scale bar in each)." if d["same_scale"] else
+            "Each panel is scaled to fill its own box, so the panels' scales differ: read lengths "
+            "from each panel's scale bar.")
+    if d["numbers"]:
+        note += " Gears and counter-rotations are numbered: " + gear_key(d["numbers"]) + "."
+    return note
+
+
+def player_html(stages: list[dict], element_id: str = "player") -> str:
+    """``stages``: dicts with label, model, t (n,), base (n, 3) frame-origin poses and poses
+    (n, nb, 3) body-frame poses, all in the global frame of the start. One panel per stage, each
+    with its own view box and scale bar (:func:`panel_views`)."""
+    d = player_data(stages)
+    lay = d["layout"]
+    payload = json.dumps({"stages": d["stages"], "layout": lay}, separators=(",", ":"), sort_keys=True)
     # names are data: no '</script>' or '<!--' can end the script early
     payload = payload.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
-    width = 300 * max(1, len(stages))
+    width = lay["width"] * lay["columns"]
+    height = lay["height"] * lay["rows"]
     eid = element_id
     return f"""<div class="player" id="{eid}-box">
-<canvas id="{eid}" width="{width}" height="300" style="max-width:100%;border:1px solid #d9dee4" role="img" aria-label="Animation of the mechanism on its free-floating frame, one panel per stage"></canvas>
+<canvas id="{eid}" width="{width}" height="{height}" style="max-width:100%;border:1px solid #d9dee4" role="img" aria-label="Animation of the mechanism on its free-floating frame, one panel per stage, each with its own scale bar"></canvas>
 <div class="player-controls">
 <button type="button" id="{eid}-play" aria-controls="{eid}" aria-label="Pause">Pause</button>
 <label for="{eid}-time">time</label>
 <input type="range" id="{eid}-time" min="0" max="1000" step="1" value="0" aria-label="Time along the motion">
 <label for="{eid}-speed">speed</label>
 <select id="{eid}-speed" aria-label="Playback speed"><option value="0.1">0.1×</option><option value="0.25">0.25×</option><option value="0.5">0.5×</option><option value="1" selected>1× (real time)</option><option value="2">2×</option><option value="4">4×</option></select>
+<label><input type="checkbox" id="{eid}-names" checked> names</label>
 <output id="{eid}-clock" for="{eid}-time" aria-live="off"></output>
 </div>
 </div>
@@ -98,43 +224,113 @@ const D = {payload};
 const cv = document.getElementById("{eid}"), g = cv.getContext("2d");
 const btn = document.getElementById("{eid}-play"), slider = document.getElementById("{eid}-time");
 const speedSel = document.getElementById("{eid}-speed"), clock = document.getElementById("{eid}-clock");
-const W = 300, H = 300, b = D.box;
+const names = document.getElementById("{eid}-names");
+const L = D.layout, PW = L.width, PH = L.height;
 const T0 = D.stages[0].t[0], T1 = D.stages[0].t[D.stages[0].t.length - 1], span = Math.max(T1 - T0, 1e-9);
-const s = Math.min(W / (b[2] - b[0]), (H - 40) / (b[3] - b[1]));
-function P(x, y, k) {{ return [k * W + (x - b[0]) * s, H - 30 - (y - b[1]) * s]; }}
 function T(pose, p) {{ const c = Math.cos(pose[2]), si = Math.sin(pose[2]);
   return [pose[0] + c * p[0] - si * p[1], pose[1] + si * p[0] + c * p[1]]; }}
 function frameAt(st, time) {{ let i = 0; while (i + 1 < st.t.length && st.t[i + 1] <= time + 1e-12) i++; return i; }}
+function hit(a, b) {{ return a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3]; }}
+function segHit(p, q, b) {{ // Liang-Barsky: does segment p-q cross box b (x0, y0, x1, y1)?
+  let t0 = 0, t1 = 1; const dx = q[0] - p[0], dy = q[1] - p[1];
+  for (const [pp, qq] of [[-dx, p[0] - b[0]], [dx, b[2] - p[0]], [-dy, p[1] - b[1]], [dy, b[3] - p[1]]]) {{
+    if (pp === 0) {{ if (qq < 0) return false; }}
+    else {{ const t = qq / pp; if (pp < 0) t0 = Math.max(t0, t); else t1 = Math.min(t1, t); if (t0 > t1) return false; }}
+  }}
+  return true;
+}}
+const DIRS8 = [...Array(8).keys()].map(k => [Math.cos(k * Math.PI / 4), Math.sin(k * Math.PI / 4)]);
+const DIRS16 = [...Array(16).keys()].map(k => [Math.cos(k * Math.PI / 8), Math.sin(k * Math.PI / 8)]);
+// names that do not overlap: rings of candidates around each anchor (the report's labels.place);
+// a name with no free place in its panel is left out of that frame rather than drawn over another
+function placeNames(items, segs, marks, area) {{
+  const done = [];
+  items.forEach((it, idx) => {{
+    g.font = it.font; const w = g.measureText(it.text).width + 4, h = 12;
+    let chosen = null, fallback = null;
+    for (let k = 0; k < 6 && !chosen; k++) {{
+      const r = it.clear + 2 + k * h;
+      for (const d of (k < 2 ? DIRS8 : DIRS16)) {{
+        const cx = it.at[0] + d[0] * (r + w / 2), cy = it.at[1] - d[1] * (r + h / 2);
+        const b = [cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2];
+        if (b[0] < area[0] || b[1] < area[1] || b[2] > area[2] || b[3] > area[3] || done.some(o => hit(b, o.box))) continue;
+        if (!segs.some(s => segHit(s[0], s[1], b)) && !marks.some((m, j) => j !== it.mark && hit(b, m))) {{ chosen = [b, k > 0]; break; }}
+        if (!fallback) fallback = [b, k > 0];
+      }}
+    }}
+    chosen = chosen || fallback;
+    if (chosen) done.push({{box: chosen[0], lead: chosen[1], it}});
+  }});
+  done.forEach(o => {{
+    const b = o.box, it = o.it;
+    if (o.lead) {{ g.strokeStyle = "#888"; g.lineWidth = 0.7; g.beginPath(); g.moveTo(...it.at);
+      g.lineTo(Math.min(Math.max(it.at[0], b[0]), b[2]), Math.min(Math.max(it.at[1], b[1]), b[3])); g.stroke(); g.lineWidth = 1; }}
+    g.fillStyle = "rgba(255,255,255,0.8)"; g.fillRect(b[0], b[1], b[2] - b[0], b[3] - b[1]);
+    g.font = it.font; g.fillStyle = it.color; g.textAlign = "center"; g.textBaseline = "middle";
+    g.fillText(it.text, (b[0] + b[2]) / 2, (b[1] + b[3]) / 2);
+  }});
+  g.textAlign = "start"; g.textBaseline = "alphabetic";
+  return done.length;
+}}
 let time = T0, playing = true, last = null;
 function draw() {{
   g.clearRect(0, 0, cv.width, cv.height);
   D.stages.forEach((st, k) => {{
+    const v = st.view, s = v[2], O = st.origin;
+    const P = (x, y) => [v[0] + x * s, v[1] - y * s];
     const i = frameAt(st, time), base = st.base[i];
+    const segs = [], marks = [], items = [];
+    const mark = (q, r) => {{ marks.push([q[0] - r, q[1] - r, q[0] + r, q[1] + r]); return marks.length - 1; }};
+    g.save(); g.beginPath(); g.rect(O[0], O[1], PW, PH); g.clip();
     g.fillStyle = "#e8edf3"; g.strokeStyle = "#8aa4c0";
-    g.beginPath(); st.pivots.forEach((p, j) => {{ const q = P(...T(base, p), k); j ? g.lineTo(...q) : g.moveTo(...q); }});
+    g.beginPath(); st.pivots.forEach((p, j) => {{ const q = P(...T(base, p)); j ? g.lineTo(...q) : g.moveTo(...q); }});
     g.closePath(); g.stroke();
-    st.guides.forEach(gd => {{ const a = P(...T(base, gd[0]), k), e = P(...T(base, gd[1]), k);
-      g.strokeStyle = "#8aa4c0"; g.beginPath(); g.moveTo(...a); g.lineTo(...e); g.stroke(); }});
-    st.pivots.forEach(p => {{ const q = P(...T(base, p), k); g.fillStyle = "#22303f"; g.fillRect(q[0] - 4, q[1] - 4, 8, 8); }});
+    st.guides.forEach(gd => {{ const a = P(...T(base, gd[0])), e = P(...T(base, gd[1]));
+      g.strokeStyle = "#8aa4c0"; g.beginPath(); g.moveTo(...a); g.lineTo(...e); g.stroke(); segs.push([a, e]); }});
+    st.pivots.forEach((p, j) => {{ const q = P(...T(base, p)); g.fillStyle = "#22303f"; g.fillRect(q[0] - 4, q[1] - 4, 8, 8);
+      items.push({{text: st.pivot_names[j], at: q, clear: 4, mark: mark(q, 4), font: "11px sans-serif", color: "#111"}}); }});
     st.shapes.forEach((sh, j) => {{
       const pose = st.poses[i][j];
-      if (sh.radius) {{ const c = P(...T(pose, [0, 0]), k); g.strokeStyle = "#2e8b57"; g.beginPath();
-        g.arc(c[0], c[1], sh.radius * s, 0, 2 * Math.PI); g.stroke(); const e = P(...T(pose, [sh.radius, 0]), k);
+      if (sh.radius) {{ const c = P(...T(pose, [0, 0])); g.strokeStyle = "#2e8b57"; g.beginPath();
+        g.arc(c[0], c[1], sh.radius * s, 0, 2 * Math.PI); g.stroke(); const e = P(...T(pose, [sh.radius, 0]));
         g.beginPath(); g.moveTo(...c); g.lineTo(...e); g.stroke(); }}
-      if (sh.slider) {{ const c = P(...T(pose, [0, 0]), k); g.fillStyle = "#ccc"; g.fillRect(c[0] - 8, c[1] - 5, 16, 10); }}
-      sh.gears.forEach(gr => {{ const c = P(...T(pose, gr), k); g.strokeStyle = "#2e8b57"; g.beginPath();
+      if (sh.slider) {{ const c = P(...T(pose, [0, 0])); g.fillStyle = "#ccc"; g.fillRect(c[0] - 8, c[1] - 5, 16, 10); }}
+      sh.gears.forEach(gr => {{ const c = P(...T(pose, gr)); g.strokeStyle = "#2e8b57"; g.beginPath();
         g.arc(c[0], c[1], gr[2] * s, 0, 2 * Math.PI); g.stroke(); }});
-      sh.cw.forEach(cw => {{ const c = P(...T(pose, cw), k), o = P(...T(pose, [0, 0]), k);
-        g.strokeStyle = "rgba(214,39,40,0.8)"; g.beginPath(); g.moveTo(...o); g.lineTo(...c); g.stroke();
+      sh.cw.forEach(cw => {{ const c = P(...T(pose, cw)), o = P(...T(pose, [0, 0]));
+        g.strokeStyle = "rgba(214,39,40,0.8)"; g.beginPath(); g.moveTo(...o); g.lineTo(...c); g.stroke(); segs.push([o, c]);
         g.fillStyle = "rgba(214,39,40,0.6)"; g.beginPath();
         g.arc(c[0], c[1], 3 + 2 * Math.sqrt(cw[2]), 0, 2 * Math.PI); g.fill(); }});
       if (sh.line.length > 1) {{ g.strokeStyle = "#111"; g.lineWidth = 3; g.beginPath();
-        sh.line.forEach((p, m) => {{ const q = P(...T(pose, p), k); m ? g.lineTo(...q) : g.moveTo(...q); }}); g.stroke(); g.lineWidth = 1; }}
+        const q = sh.line.map(p => P(...T(pose, p)));
+        q.forEach((p, m) => {{ m ? g.lineTo(...p) : g.moveTo(...p); if (m) segs.push([q[m - 1], p]); }}); g.stroke(); g.lineWidth = 1; }}
     }});
+    if (names.checked) {{
+      const N = st.names, seen = [];
+      st.pivots.forEach(p => seen.push(P(...T(base, p))));
+      N.joints.forEach(n => {{ const q = P(...T(st.poses[i][n[0]], [n[1], n[2]]));
+        if (seen.some(o => Math.abs(o[0] - q[0]) < 3 && Math.abs(o[1] - q[1]) < 3)) return; seen.push(q);
+        items.push({{text: n[3], at: q, clear: 3, mark: mark(q, 3), font: "11px sans-serif", color: "#222"}}); }});
+      N.gears.forEach(n => {{ const c = P(...T(st.poses[i][n[0]], [n[1], n[2]])), r = n[3] * s * Math.SQRT1_2;
+        items.push({{text: n[4], at: [c[0] + r, c[1] - r], clear: 1, mark: -1, font: "bold 12px sans-serif", color: "#2e8b57"}}); }});
+      N.cws.forEach(n => {{ const q = P(...T(st.poses[i][n[0]], [n[1], n[2]]));
+        items.push({{text: n[3], at: q, clear: 5, mark: mark(q, 5), font: "10px sans-serif", color: "#c0282d"}}); }});
+      N.links.forEach(n => {{ const q = P(...T(st.poses[i][n[0]], [n[1], n[2]]));
+        items.push({{text: n[3], at: q, clear: 2, mark: -1, font: "italic 10px sans-serif", color: "#1f6fb4"}}); }});
+    }} else items.length = 0;
+    cv.dataset["names" + k] = String(placeNames(items, segs, marks, [O[0] + 2, O[1] + 18, O[0] + PW - 2, O[1] + PH - 36]));
+    g.restore();
     g.fillStyle = "#1d232b"; g.font = "12px sans-serif";
-    g.fillText(st.label, k * W + 8, 16);
+    g.fillText(st.label, O[0] + 8, O[1] + 15);
     const dx = base[0] * 1000, dy = base[1] * 1000, rot = base[2] * 180 / Math.PI;
-    g.fillText(`frame: (${{dx.toFixed(2)}}, ${{dy.toFixed(2)}}) mm, ${{rot.toFixed(3)}} deg`, k * W + 8, H - 8);
+    g.fillText(`frame: (${{dx.toFixed(2)}}, ${{dy.toFixed(2)}}) mm, ${{rot.toFixed(3)}} deg`, O[0] + 8, O[1] + PH - 8);
+    // scale bar, bottom right of the panel: this panel's own scale
+    const bl = st.bar[0] * s, bx = O[0] + PW - 12 - bl, by = O[1] + PH - 26;
+    g.strokeStyle = "#1d232b"; g.lineWidth = 2; g.beginPath(); g.moveTo(bx, by - 4); g.lineTo(bx, by); g.lineTo(bx + bl, by);
+    g.lineTo(bx + bl, by - 4); g.stroke(); g.lineWidth = 1; g.font = "11px sans-serif"; g.textAlign = "center";
+    g.fillText(st.bar[1], bx + bl / 2, by - 5); g.textAlign = "start";
+    if (k % L.columns) {{ g.strokeStyle = "#d9dee4"; g.beginPath(); g.moveTo(O[0] + 0.5, O[1]); g.lineTo(O[0] + 0.5, O[1] + PH); g.stroke(); }}
+    if (O[1] > 0) {{ g.strokeStyle = "#d9dee4"; g.beginPath(); g.moveTo(O[0], O[1] + 0.5); g.lineTo(O[0] + PW, O[1] + 0.5); g.stroke(); }}
   }});
   slider.value = String(Math.round(1000 * (time - T0) / span));
   clock.textContent = `t = ${{time.toFixed(3)}} s of ${{T1.toFixed(3)}} s · ${{speedSel.value}}× real time`;
@@ -150,6 +346,7 @@ function setPlaying(on) {{ playing = on; btn.textContent = on ? "Pause" : "Play"
 btn.addEventListener("click", () => setPlaying(!playing));
 slider.addEventListener("input", () => {{ setPlaying(false); time = T0 + span * parseInt(slider.value, 10) / 1000; draw(); }});
 speedSel.addEventListener("change", draw);
+names.addEventListener("change", draw);
 cv.tabIndex = 0;
 cv.addEventListener("keydown", ev => {{
   if (ev.key === " " || ev.key === "k") {{ ev.preventDefault(); setPlaying(!playing); }}
