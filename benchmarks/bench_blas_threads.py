@@ -21,11 +21,11 @@ CASE = r'''
 import time, numpy as np
 from balpipe import registry
 from balpipe.balancing import conditions as C, rrr4 as recipe
-from balpipe.loader import load
+from balpipe.loader import load_text
 a = np.random.default_rng(0).normal(size=(328, 72, 75))
 c0, w0 = time.process_time(), time.perf_counter(); np.linalg.svd(a)
 print(f"batched SVD 328 x (72 x 75): cpu {time.process_time() - c0:.2f} s, wall {time.perf_counter() - w0:.2f} s")
-spec, _ = load("specs/paper001_4rrr.yaml")
+spec, _ = load_text(open("specs/paper001_4rrr.yaml").read(), "specs/paper001_4rrr.yaml")
 model = registry.unbalanced_model(spec)
 best = None
 for _ in range(3):
@@ -40,7 +40,9 @@ def main() -> None:
         env = dict(os.environ, OPENBLAS_NUM_THREADS=threads, OMP_NUM_THREADS=threads, MKL_NUM_THREADS=threads)
         out = subprocess.run([sys.executable, "-c", CASE], cwd=ROOT, env=env, capture_output=True, text=True)
         print(f"-- BLAS threads {threads} (load average {os.getloadavg()[0]:.1f})")
-        print(out.stdout.strip() or out.stderr.strip())
+        print(out.stdout.strip())
+        if out.returncode:
+            print(out.stderr.strip())
 
 
 if __name__ == "__main__":
