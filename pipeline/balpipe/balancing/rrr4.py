@@ -309,6 +309,9 @@ def topology_designs(model: Model, g: cond.Geometry, spec: RRR4Balancing, found:
                    Parameter(f"eq17_residual_{tag}", res17, "", "eq. 17", f"largest relative residual of eq. 17, {d.figure}"),
                    Parameter(f"finder_residual_{tag}", resf, "", "momentum regressor rank",
                              f"largest residual over the finder's conditions / (total mass x model size), {d.figure}")]
+        if max(res17, resf) > 1e-9:
+            notes.append(f"{d.figure}: the counter-masses found do not meet the conditions (eq. 17 residual "
+                         f"{res17:.2g}, finder {resf:.2g}); the figure draws the design, which is not balanced.")
         out.append({"figure": d.figure, "kept": [f"l{b}" if b != "5" else "platform" for b in d.kept],
                     "assumed": d.assumed, "added_mass": added, "eq17_residual": res17, "finder_residual": resf,
                     "counter_masses": [{"body": b.name, "mass": a.mass, "position": list(a.position)}
