@@ -20,8 +20,8 @@ takes from it:
   be privileged: one kept parameter of the same kind in every leg never fixes the design (eq.
   17's 12 x 12 system is then singular, :func:`same_kind_per_leg_ranks`), so the free parameters
   are taken the way that treats every link alike, the first-moment changes of least Euclidean
-  norm (:func:`fig4b_design`). A least-norm solution of a symmetric problem is symmetric, so the
-  design has every symmetry the mechanism has. Its freedom against Fig. 2a is counted by
+  norm (:func:`fig4b_design`). When that least-norm design is unique it has every symmetry of the
+  mechanism and its mass data. Its freedom against Fig. 2a is counted by
   :func:`freedoms`.
 * **Fig. 6b**: the kinematics of Fig. 5a with the arms not crossing ("no arms need to cross one
   another", the prototype of Fig. 7 derives from it), counter-masses on the links l_i1 only as in

@@ -278,7 +278,8 @@ def figures(study):
                 "fixes the design (eq. 17's 12 x 12 system then has rank "
                 + ", ".join(f"{ranks[k]}" for k in ("p1", "q1", "p2", "q2"))
                 + "), so the free parameters are fixed by the least Euclidean norm of the sixteen first-moment "
-                "changes (every link treated alike; a least-norm design has every symmetry the mechanism has). That "
+                "changes (every link treated alike; when that least-norm design is unique it has every symmetry of the "
+                "mechanism and its mass data). That "
                 "choice is ours: the paper's drawing is not in its text. Counter-masses at the spec's distances from "
                 "the proximal joints; the panel gives the added mass and the peak shaking force over the spec's motion "
                 "relative to the unbalanced stage's peak.",
