@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import balpipe  # noqa: F401  (first: it sets one BLAS thread before numpy loads)
 import numpy as np
 import pytest
 

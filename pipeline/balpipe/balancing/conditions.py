@@ -93,7 +93,7 @@ def find(model: Model, t: np.ndarray, tolerance: float = RANK_TOLERANCE, samples
     Y = R.linear_regressor(st)
     rs = R.row_space(Y, column_scale(model), tolerance)
     names = R.param_names(model)
-    matrix, pivots = rref(rs.basis, _pivot_order(names))
+    matrix, pivots = rref(rs.basis, _pivot_order(names), pivot_tolerance(rs.gap))
     return ForceConditions(names, matrix, pivots, rs.singular, tolerance, rs.gap, st.count, st.dof)
 
 
@@ -101,6 +101,18 @@ def _pivot_order(names: list[str]) -> list[int]:
     """First moments first (body order), then masses."""
     first = [k for k, n in enumerate(names) if not n.startswith("m[")]
     return first + [k for k, n in enumerate(names) if n.startswith("m[")]
+
+
+def pivot_tolerance(gap: float) -> float:
+    """The smallest pivot (relative to the remaining rows' largest entry) that :func:`rref` may
+    divide by for a row space whose singular-value gap is ``gap``: the basis from the sampled
+    regressor is accurate to about 1 / gap, so an entry below 100 / gap may be noise, and
+    pivoting on it turns the row into noise times 1/pivot (seen: a 1e-10 pivot on mx[platform]
+    of a random idler loop's angular momentum, coefficients of 1e12, and a least-mass programme
+    that was then called infeasible). At least 1e-10, at most 1e-6."""
+    if not math.isfinite(gap) or gap <= 0:
+        return 1e-10
+    return min(1e-6, max(1e-10, 100.0 / gap))
 
 
 def rref(A: np.ndarray, order: list[int], tol: float = 1e-10) -> tuple[np.ndarray, list[int]]:

@@ -13,7 +13,8 @@ position is confined to a region of the body's frame:
 The conditions C (p0 + G z) = 0 and the total mass sum mu_k are then linear in z >= 0: a linear
 programme. With the moment (:mod:`.moment_balance`), the inertia of each generator's mass about
 the body origin, w |v|^2, is linear too, and so are the angular-momentum conditions in the
-counter-rotating discs' inertias: one linear programme again, solved by scipy.optimize.linprog (HiGHS). Its solution is polished by a least-squares
+counter-rotating discs' inertias: one linear programme again, solved by scipy.optimize.linprog (HiGHS)
+on the independent combinations of the conditions (:func:`independent_equations`). Its solution is polished by a least-squares
 correction on the active variables so that the conditions hold to round-off (the balance claim
 is 1e-9 of the unbalanced peak, tighter than the solver's feasibility tolerance). When no
 z >= 0 meets the conditions, a second programme minimises the sum of |slack| per condition and
@@ -142,7 +143,10 @@ def solve(model: Model, cond: ForceConditions, regions: list[Region], sides: int
         b = np.concatenate([b, -moment.matrix @ p0a])
         cost = cost + [0.0] * nd
         labels = labels + moment.equations()
-    res = linprog(np.array(cost), A_eq=A, b_eq=b, bounds=(0, None), method="highs")
+    A_lp, b_lp, inconsistent = independent_equations(A, b)
+    if inconsistent:
+        raise _infeasible(labels, A, b, regions)
+    res = linprog(np.array(cost), A_eq=A_lp, b_eq=b_lp, bounds=(0, None), method="highs")
     if res.status == 2 or res.x is None:
         raise _infeasible(labels, A, b, regions)
     if res.status != 0:
@@ -150,7 +154,7 @@ def solve(model: Model, cond: ForceConditions, regions: list[Region], sides: int
     z = res.x.copy()
     active = z > 1e-12 * max(1.0, float(np.max(z, initial=0.0)))
     for _ in range(3 if active.any() else 0):  # polish: conditions to round-off
-        dz = np.linalg.lstsq(A[:, active], b - A @ z, rcond=None)[0]
+        dz = np.linalg.lstsq(A_lp[:, active], b_lp - A_lp @ z, rcond=None)[0]
         z[active] += dz
     z = np.maximum(z, 0.0)
     placed = []
@@ -168,6 +172,29 @@ def solve(model: Model, cond: ForceConditions, regions: list[Region], sides: int
     total = float(sum(c.mass for c in placed))
     discs = z[G.shape[1]:] if moment is not None else np.zeros(0)
     return Solution(placed, total, sides, cond.contains(p, scale_of(model)), [float(x) for x in discs])
+
+
+EQUATION_TOLERANCE = 1e-9  # relative singular value / right-hand side left outside the kept equations
+
+
+def independent_equations(A: np.ndarray, b: np.ndarray, tol: float = EQUATION_TOLERANCE
+                          ) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The equations ``A z = b`` reduced to independent combinations ``U_r^T A z = U_r^T b`` (the
+    singular directions of ``A`` above ``tol`` x the largest), and whether ``b`` leaves more than
+    ``tol`` x |b| outside them (inconsistent). The force conditions and the angular-momentum
+    conditions are each independent, but together, mapped onto the counterweights' variables,
+    they repeat one another (a moment condition may be a combination of force ones); each was
+    computed from sampled states to about 1e-10, so the repeated rows disagree at that level and
+    an LP solver, whose feasibility tolerance is absolute (1e-7), may then call a feasible
+    programme infeasible or stop on a point the polish cannot bring to round-off."""
+    if A.size == 0:
+        return A, b, bool(np.linalg.norm(b) > 0)
+    U, sv, _ = np.linalg.svd(A, full_matrices=False)
+    r = int(np.sum(sv > tol * sv[0])) if sv.size and sv[0] > 0 else 0
+    Ur = U[:, :r]
+    nb = float(np.linalg.norm(b))
+    outside = float(np.linalg.norm(b - Ur @ (Ur.T @ b)))
+    return Ur.T @ A, Ur.T @ b, outside > tol * max(nb, 1e-300) and outside > 0
 
 
 @dataclass

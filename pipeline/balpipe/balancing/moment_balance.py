@@ -121,7 +121,7 @@ def moment_conditions(model: Model, discs: list[str], t: np.ndarray, tolerance: 
     rs = R.row_space(Y, C.column_scale(model, angular=True), tolerance)
     first = [names.index(f"J[{d}]") for d in discs]
     order = first + [k for k in range(len(names)) if k not in first]
-    matrix, _ = C.rref(rs.basis, order)
+    matrix, _ = C.rref(rs.basis, order, C.pivot_tolerance(rs.gap))
     return LM.MomentConditions(names, matrix, discs)
 
 

@@ -11,9 +11,13 @@ Stages:
   1 leg: on C_i).
 * ``general`` (Sec. III, eq. 17, Fig. 4a, four legs): links l12, l32 and the platform as built,
   the twelve conditions of eq. 17 solved for the first moments of the six other links.
-* ``special`` (Sec. IV, eq. 19 / 21, Fig. 6a / 6c, kinematics ``fig5a`` / ``fig5b`` with a
+* ``special`` (Sec. IV, eq. 19 / 21, Fig. 6a / 6b / 6c, kinematics ``fig5a`` / ``fig5b`` with a
   platform that does not rotate): the eight printed conditions solved with counter-masses on the
-  links l_i1 only (Fig. 6a) or on l11, l31, l22, l42 (Fig. 6c).
+  links l_i1 only (Fig. 6a with the arms crossing, Fig. 6b without) or on l11, l31, l22, l42 (Fig.
+  6c).
+
+With four legs and ``topologies``, the designs of Figs. 3 (a selection of ours) and 4b
+(:mod:`.rrr4_topologies`) go to ``details["topologies"]`` for the page to draw.
 
 A target first moment is realised by one counter-mass at a given distance from the link's
 proximal joint (:func:`balpipe.balancing.parts.add_counterweight`), in the direction that the
@@ -34,6 +38,7 @@ from ..spec_parts import SpecFieldError, Strict
 from ..units import Mass, PositiveLength
 from . import rrr4_conditions as cond
 from . import rrr4_generic as generic
+from . import rrr4_topologies as topologies
 from .base import BalanceResult, Parameter, Stage
 from .parts import add_counterweight
 
@@ -235,8 +240,9 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
                                 "from eq. 17's twelve conditions", "force"))
             params.append(Parameter("added_mass_general", gen.total_mass() - base_mass, "kg", "eq. 17",
                                     "counter-masses of the eq. 17 design (Fig. 4a)"))
+            topology_designs(model, g, spec, found, base_mass, params, notes, details)
             if mech.kinematics != "general":
-                fig = "Fig. 6a" if mech.kinematics == "fig5a" else "Fig. 6c"
+                fig = topologies.fig6_label(mech.kinematics, topologies.arms_cross(model))
                 eq = cond.SPECIAL_EQ[mech.kinematics]
                 if platform_rotates(model):
                     notes.append(f"The {fig} design ({eq}) is not built: the special kinematics of Fig. 5 balance "
@@ -245,6 +251,14 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
                     sp, _ = from_conditions(model, spec, cond.special(g, mech.kinematics),
                                             cond.SPECIAL_DEPENDENT[mech.kinematics], eq)
                     where = "the links l_i1 only" if mech.kinematics == "fig5a" else "links l11, l31, l22 and l42"
+                    if fig == "Fig. 6b":
+                        notes.append(
+                            "Fig. 6b: the kinematics of Fig. 5a with no two links of different legs crossing in the "
+                            "initial pose (computed), the layout of the paper's Fig. 6b, from which its prototype "
+                            "(Fig. 7) derives; counter-masses on the links l_i1 only, as in Fig. 6a. The paper calls "
+                            "its drawn Fig. 6b configuration singular and makes the prototype's joint C1 coincide with "
+                            "C2 and C3 with C4; that platform (c5 = 0) is not modelled here (eqs. 17 and 19 divide by "
+                            "c5), and the geometry, masses and motion of this spec are assumed.")
                     stages.append(Stage("special", f"special kinematics ({fig}, {eq})", sp,
                                         f"the eight conditions of {eq} (non-rotating platform), counter-masses on {where}",
                                         "force"))
@@ -275,6 +289,42 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
             "legs (paper 001 takes legs out by giving them zero mass, which keeps them in the kinematics)."
         )
     return BalanceResult(params, stages, notes, details=details)
+
+
+def topology_designs(model: Model, g: cond.Geometry, spec: RRR4Balancing, found: generic.FinderCheck,
+                     base_mass: float, params: list, notes: list, details: dict) -> None:
+    """Figs. 3 (our selection) and 4b from eq. 17 (:mod:`.rrr4_topologies`): each design's added
+    mass, eq. 17's largest residual and the finder's, in ``details["topologies"]`` for the page
+    (which draws them and analyses their shaking force)."""
+    cw = spec.counterweights
+    designs = topologies.fig3_designs(model, g, cw.proximal, cw.distal) + [
+        topologies.fig4b_design(model, g, cw.proximal, cw.distal)]
+    free = topologies.freedoms(g)
+    out = []
+    for d in designs:
+        tag = d.figure.replace("Fig. ", "fig").lower()
+        added = d.model.total_mass() - base_mass
+        res17, resf = topologies.eq17_residual(d.model, g), found.design_residual(d.model)
+        params += [Parameter(f"added_mass_{tag}", added, "kg", "eq. 17", f"counter-masses of the {d.figure} design"),
+                   Parameter(f"eq17_residual_{tag}", res17, "", "eq. 17", f"largest relative residual of eq. 17, {d.figure}"),
+                   Parameter(f"finder_residual_{tag}", resf, "", "momentum regressor rank",
+                             f"largest residual over the finder's conditions / (total mass x model size), {d.figure}")]
+        if max(res17, resf) > 1e-9:
+            notes.append(f"{d.figure}: the counter-masses found do not meet the conditions (eq. 17 residual "
+                         f"{res17:.2g}, finder {resf:.2g}); the figure draws the design, which is not balanced.")
+        out.append({"figure": d.figure, "kept": [f"l{b}" if b != "5" else "platform" for b in d.kept],
+                    "assumed": d.assumed, "added_mass": added, "eq17_residual": res17, "finder_residual": resf,
+                    "counter_masses": [{"body": b.name, "mass": a.mass, "position": list(a.position)}
+                                       for b in d.model.bodies for a in b.attachments if a.kind == "counterweight"]})
+    details["topologies"] = {"designs": out, "freedoms": free, "admissible_kept": len(topologies.admissible_kept(g)),
+                             "same_kind_per_leg_ranks": topologies.same_kind_per_leg_ranks(g)}
+    notes.append(
+        f"Figs. 3 and 4b from eq. 17: with the masses given, eq. 17 leaves {free['eq17']} first moments free "
+        f"({free['eq17_links']} with the platform as built), the leg-by-leg family of Fig. 2a (every q_ij = 0) "
+        f"{free['leg_by_leg']} ({free['leg_by_leg_links']}): the paper's six against three. Keeping three bodies as "
+        f"built fixes the rest for {details['topologies']['admissible_kept']} of the 84 triples (no two links of one "
+        "leg). The drawn designs and what each assumes are in the figures below."
+    )
 
 
 def finder_grid(model: Model, samples: int = 9) -> np.ndarray:

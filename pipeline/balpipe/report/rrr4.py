@@ -1,5 +1,5 @@
 """Report figures of the n-RRR (paper 001): eq. 17's conditions with their residuals per stage,
-and the balance topologies (Figs. 2a, 4a, 6) with their counter-masses drawn."""
+and the balance topologies (Figs. 2a, 3, 4a, 4b, 6) with their counter-masses drawn."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from ..balancing import rrr4_conditions as cond
 from ..mechanisms.rrr4 import mass_parameters, resolve_legs
 
 FIGURE_OF_STAGE = {"leg_by_leg": "Fig. 2a", "least_mass": "least mass", "general": "Fig. 4a", "special": "Fig. 6"}
+FIG3 = tuple(f"Fig. 3{c}" for c in "abcdef")
 TOL = 1e-9
 
 
@@ -83,53 +84,114 @@ def finder_table(study) -> str | None:
     return out
 
 
+def _draw(ax, model, poses, span: float, max_cw: float, title: str) -> None:
+    """One panel: ``model`` at the body poses ``poses`` (the engine's frame poses at t = 0): links,
+    joints, pivots, each body's centre of mass (cross), counter-masses as red discs of area
+    proportional to mass (``max_cw`` has the largest), the total centre of mass (star)."""
+    from matplotlib.patches import Circle, Polygon
+
+    total, weighted = 0.0, np.zeros(2)
+    for k, b in enumerate(model.bodies):
+        x, y, th = poses[k]
+        R = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+        g = lambda p: np.array([x, y]) + R @ np.asarray(p, dtype=float)  # noqa: E731
+        pts = np.array([g(b.points[n]) for n in b.outline])
+        if b.kind == "platform":
+            ax.add_patch(Polygon(pts[:-1], closed=True, facecolor="0.9", edgecolor="black", linewidth=1.5))
+        else:
+            ax.plot(pts[:, 0], pts[:, 1], color="black", linewidth=2.0, solid_capstyle="round")
+        ax.plot(pts[:, 0], pts[:, 1], "o", color="white", markeredgecolor="black", markersize=4)
+        for a in b.attachments:
+            if a.kind != "counterweight":
+                continue
+            root = g(b.points[b.outline[0]])
+            pos = g(a.position)
+            ax.plot([root[0], pos[0]], [root[1], pos[1]], color="tab:red", linewidth=1.2)
+            ax.add_patch(Circle(pos, 0.05 * span * math.sqrt(a.mass / max_cw), color="tab:red", alpha=0.6))
+        m, c, _ = b.mass_properties()
+        gc = g(c)
+        total, weighted = total + m, weighted + m * gc
+        ax.plot(gc[0], gc[1], "x", color="tab:blue", markersize=5)
+    for name, p in model.frame_points.items():
+        ax.plot(p[0], p[1], marker="^", color="black", markersize=8)
+        ax.annotate(name, p, textcoords="offset points", xytext=(4, -12), fontsize=7)
+    com = weighted / max(total, 1e-300)
+    ax.plot(com[0], com[1], "*", color="tab:purple", markersize=11)
+    ax.set_title(title, fontsize=8)
+    ax.set_aspect("equal")
+    ax.tick_params(labelsize=7)
+
+
+def _span(model) -> float:
+    return max(np.ptp([p[0] for p in model.frame_points.values()] + [0.0]),
+               np.ptp([p[1] for p in model.frame_points.values()] + [0.0]), 0.1)
+
+
+def _counter_masses(model) -> list[float]:
+    return [a.mass for b in model.bodies for a in b.attachments if a.kind == "counterweight"]
+
+
 def topology_figure(study):
     """The balanced stages at t = 0, one panel each: links, joints, pivots, each link's centre of
     mass (cross), counter-masses as red discs of area proportional to mass, and the fixed total
     centre of mass (star)."""
     from .figures import plt, to_svg
-    from matplotlib.patches import Circle, Polygon
 
     shown = [s for s in study.stages if s.stage.name in FIGURE_OF_STAGE]
     if not shown:
         return None
     fig, axes = plt.subplots(1, len(shown), figsize=(4.2 * len(shown), 4.2), squeeze=False)
-    max_cw = max([a.mass for s in shown for b in s.stage.model.bodies for a in b.attachments] + [1e-12])
+    max_cw = max([m for s in shown for m in _counter_masses(s.stage.model)] + [1e-12])
     for ax, s in zip(axes[0], shown):
-        model, an = s.stage.model, s.analysis
-        poses = an.extra["frame_pose"][0]
-        span = max(np.ptp([p[0] for p in model.frame_points.values()] + [0.0]),
-                   np.ptp([p[1] for p in model.frame_points.values()] + [0.0]), 0.1)
-        for k, b in enumerate(model.bodies):
-            x, y, th = poses[k]
-            R = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
-            g = lambda p: np.array([x, y]) + R @ np.asarray(p, dtype=float)  # noqa: E731
-            pts = np.array([g(b.points[n]) for n in b.outline])
-            if b.kind == "platform":
-                ax.add_patch(Polygon(pts[:-1], closed=True, facecolor="0.9", edgecolor="black", linewidth=1.5))
-            else:
-                ax.plot(pts[:, 0], pts[:, 1], color="black", linewidth=2.0, solid_capstyle="round")
-            ax.plot(pts[:, 0], pts[:, 1], "o", color="white", markeredgecolor="black", markersize=4)
-            for a in b.attachments:
-                if a.kind != "counterweight":
-                    continue
-                root = g(b.points[b.outline[0]])
-                pos = g(a.position)
-                ax.plot([root[0], pos[0]], [root[1], pos[1]], color="tab:red", linewidth=1.2)
-                ax.add_patch(Circle(pos, 0.05 * span * math.sqrt(a.mass / max_cw), color="tab:red", alpha=0.6))
-            _, c, _ = b.mass_properties()
-            gc = g(c)
-            ax.plot(gc[0], gc[1], "x", color="tab:blue", markersize=5)
-        for name, p in model.frame_points.items():
-            ax.plot(p[0], p[1], marker="^", color="black", markersize=8)
-            ax.annotate(name, p, textcoords="offset points", xytext=(4, -12), fontsize=7)
-        ax.plot(an.com[0, 0], an.com[0, 1], "*", color="tab:purple", markersize=11)
-        added = s.added_mass
-        ax.set_title(f"{s.stage.label}\nadded {added:.3g} kg", fontsize=8)
-        ax.set_aspect("equal")
-        ax.tick_params(labelsize=7)
+        model = s.stage.model
+        _draw(ax, model, s.analysis.extra["frame_pose"][0], _span(model), max_cw,
+              f"{s.stage.label}\nadded {s.added_mass:.3g} kg")
     fig.tight_layout()
     return to_svg(fig, "rrr4-topology")
+
+
+def designs_checked(study):
+    """Figs. 3 and 4b's designs (:mod:`balpipe.balancing.rrr4_topologies`) rebuilt from the spec,
+    each with its shaking force analysed by the engine on the study's time grid: (design, added
+    mass, peak |F| / the unbalanced stage's peak)."""
+    from ..balancing import rrr4_topologies as topo
+    from ..engine import analyse
+
+    if "topologies" not in study.balance.details:
+        return []
+    base = study.stages[0]
+    model, an0 = base.stage.model, base.analysis
+    g = recipe.geometry(study.spec.mechanism)
+    cw = study.spec.balancing.counterweights
+    designs = topo.fig3_designs(model, g, cw.proximal, cw.distal) + [topo.fig4b_design(model, g, cw.proximal, cw.distal)]
+    out = []
+    for d in designs:
+        an = analyse(d.model, an0.t)
+        out.append((d, d.model.total_mass() - model.total_mass(), an.max_force / max(an0.max_force, 1e-300)))
+    return out
+
+
+def designs_figure(study, checked, figures: tuple[str, ...]):
+    """The designs of ``figures`` (e.g. Fig. 3a..f), one panel each, at the unbalanced stage's
+    pose at t = 0 (the kinematics are the same)."""
+    from .figures import plt, to_svg
+
+    shown = [c for c in checked if c[0].figure in figures]
+    if not shown:
+        return None
+    cols = min(3, len(shown))
+    rows = (len(shown) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
+    poses = study.stages[0].analysis.extra["frame_pose"][0]
+    max_cw = max([m for d, _, _ in shown for m in _counter_masses(d.model)] + [1e-12])
+    for ax, (d, added, ratio) in zip(axes.flat, shown):
+        kept = ", ".join(f"l{b}" if b != "5" else "platform" for b in d.kept)
+        _draw(ax, d.model, poses, _span(d.model), max_cw,
+              f"{d.figure}: {kept} as built\nadded {added:.3g} kg, peak |F| / unbalanced {ratio:.1e}")
+    for ax in list(axes.flat)[len(shown):]:
+        ax.axis("off")
+    fig.tight_layout()
+    return to_svg(fig, "rrr4-" + figures[0].replace("Fig. ", "fig").lower())
 
 
 def figures(study):
@@ -169,10 +231,56 @@ def figures(study):
     svg = topology_figure(study)
     if svg is not None:
         yield (
-            "Balance topologies (paper 001, Figs. 2a, 4a, 6; least mass)",
+            "Balance topologies (paper 001, Figs. 2a, 4a" + "".join(
+                ", " + fig.replace("Fig. ", "") for fig in sorted({s.stage.label.split("(")[1].split(",")[0]
+                                                                 for s in study.stages if s.stage.name == "special"}))
+            + "; least mass)",
             svg,
             "Each force-balanced stage at t = 0: links (black), joints (circles), base pivots (triangles), each "
             "body's centre of mass (blue cross), counter-masses as red discs (area proportional to mass, the "
             "largest over the panels has the largest disc) on a line from the link's proximal joint, and the "
             "total centre of mass (purple star), which stays fixed during the motion in every panel.",
         )
+    checked = designs_checked(study)
+    if checked:
+        top = study.balance.details["topologies"]
+        fr = top["freedoms"]
+        worst = max(r for _, _, r in checked)
+        svg = designs_figure(study, checked, FIG3)
+        if svg is not None:
+            yield (
+                "Force balance topologies from the general conditions (paper 001, Fig. 3: a selection of ours)",
+                svg,
+                "Designs from eq. 17 whose link centres of mass may leave the lines through the joints. What the "
+                f"paper's text fixes: with the masses given, eq. 17 leaves {fr['eq17']} mass-position parameters free "
+                f"(the paper's six, two per loop equation) where the leg-by-leg conditions of Fig. 2 leave {fr['leg_by_leg']}; "
+                f"keeping three bodies as built fixes the other twelve first moments for {top['admissible_kept']} of the "
+                "84 triples (computed: exactly those with no two links of one leg). The paper's six panels cannot be read "
+                "from its text, so the six drawn here are our selection, not the paper's: for each pair of legs (a, b) "
+                "the distal links l_a2, l_b2 and the platform as built, one counter-mass on each of the six other links "
+                "at the spec's distance from its proximal joint, in the direction eq. 17 needs (Fig. 3b is the design "
+                "of Fig. 4a). Each panel: added mass, and the peak shaking force over the spec's motion (engine) "
+                f"relative to the unbalanced stage's peak; largest over the panels {worst:.1e}. Drawn as the stage "
+                "panels above (red discs: counter-masses, area proportional to mass, the largest in this figure has "
+                "the largest disc; blue crosses: body centres of mass; purple star: total centre of mass).",
+            )
+        svg = designs_figure(study, checked, ("Fig. 4b",))
+        if svg is not None:
+            ranks = top["same_kind_per_leg_ranks"]
+            yield (
+                "Symmetric balance topology (paper 001, Fig. 4b: reconstructed)",
+                svg,
+                "The paper's text says Fig. 4b is fully symmetric and has more design freedom than Fig. 2a. Read here "
+                "as: a counter-mass on every link, as in Fig. 2a, but from eq. 17 instead of eqs. 8-11, the platform "
+                f"as built. That family has {fr['eq17_links']} free first moments where the leg-by-leg family has "
+                f"{fr['leg_by_leg_links']} (mu_54), and its link centres of mass may leave the link lines. No leg may "
+                "be privileged, but keeping the same first moment in every leg (all p_i1, q_i1, p_i2 or q_i2) never "
+                "fixes the design (eq. 17's 12 x 12 system then has rank "
+                + ", ".join(f"{ranks[k]}" for k in ("p1", "q1", "p2", "q2"))
+                + "), so the free parameters are fixed by the least Euclidean norm of the sixteen first-moment "
+                "changes (every link treated alike; when that least-norm design is unique it has every symmetry of the "
+                "mechanism and its mass data). That "
+                "choice is ours: the paper's drawing is not in its text. Counter-masses at the spec's distances from "
+                "the proximal joints; the panel gives the added mass and the peak shaking force over the spec's motion "
+                "relative to the unbalanced stage's peak.",
+            )

@@ -1,0 +1,167 @@
+"""Paper 001's Figs. 3, 4b and 6b (issue 8): the designs derived from eq. 17 and eq. 19 lie in the
+computed condition space and cancel the shaking force for the spec's motion; the counts the page
+quotes; the layout that tells Fig. 6b from Fig. 6a; the page draws and captions them."""
+
+from __future__ import annotations
+
+import copy
+import itertools
+
+import numpy as np
+import pytest
+import yaml
+
+from balpipe import registry, study
+from balpipe.balancing import rrr4 as recipe
+from balpipe.balancing import rrr4_generic as generic
+from balpipe.balancing import rrr4_topologies as topo
+from balpipe.engine import analyse
+from balpipe.mechanisms.rrr4 import mass_parameters
+from test_rrr4 import random_data, spec_of
+
+TOL = 1e-9
+PAPER = "specs/paper001_4rrr.yaml"
+FIG6A = "specs/paper001_4rrr_fig6a.yaml"
+FIG6B = "specs/paper001_4rrr_fig6b.yaml"
+
+
+def load(path: str, samples: int | None = 101, simulate: bool = True):
+    with open(path) as fh:
+        data = yaml.safe_load(fh)
+    if samples:
+        data["analysis"] = {"samples": samples}
+    if not simulate:
+        data["validation"] = {"enabled": False}
+    return spec_of(data)
+
+
+def designs_of(spec):
+    model = registry.unbalanced_model(spec)
+    g = recipe.geometry(spec.mechanism)
+    cw = spec.balancing.counterweights
+    return model, g, topo.fig3_designs(model, g, cw.proximal, cw.distal) + [topo.fig4b_design(model, g, cw.proximal, cw.distal)]
+
+
+@pytest.mark.parametrize("source", ["paper", 71, 72])
+def test_fig3_and_fig4b_designs_lie_in_the_condition_space_and_cancel_the_force(source):
+    spec = load(PAPER) if source == "paper" else spec_of(random_data(np.random.default_rng(source)))
+    model, g, designs = designs_of(spec)
+    assert [d.figure for d in designs] == [f"Fig. 3{c}" for c in "abcdef"] + ["Fig. 4b"]
+    t = registry.time_grid(spec)
+    an0 = analyse(model, t)
+    found = generic.check(model, recipe.finder_grid(model), [])
+    assert found.general.count == 12
+    for d in designs:
+        assert topo.eq17_residual(d.model, g) <= TOL, d.figure
+        assert found.design_residual(d.model) <= TOL, d.figure
+        an = analyse(d.model, t)
+        assert an.max_force <= TOL * an0.max_force, d.figure
+        assert np.max(np.linalg.norm(an.com - an.com[0], axis=1)) <= TOL * float(np.ptp(an0.com, axis=0).max())
+        # the kept bodies carry no counter-mass, every other link exactly one
+        carried = {b.name for b in d.model.bodies for a in b.attachments if a.kind == "counterweight"}
+        kept = {f"link{b}" if b != "5" else "platform" for b in d.kept}
+        assert not carried & kept
+        assert carried == {f"link{i}{j}" for i in (1, 2, 3, 4) for j in (1, 2)} - kept, d.figure
+    # the unbalanced mechanism violates the conditions (the checks can fail)
+    assert topo.eq17_residual(model, g) > 1e-3
+
+
+def test_fig4b_is_the_least_norm_design_and_fig3_is_unique():
+    """Fig. 4b: every link's first-moment change is orthogonal to the conditions' null space at
+    the solution (the least-norm optimality condition, masses included through the Jacobian);
+    Fig. 3's twelve unknowns are fixed (its design does not depend on the starting guess)."""
+    spec = load(PAPER)
+    model, g, designs = designs_of(spec)
+    base = mass_parameters(model)
+    links = [f"{i}{j}" for i in (1, 2, 3, 4) for j in (1, 2)]
+    d4b = designs[-1]
+    p = mass_parameters(d4b.model)
+    s = np.array([p[n] - base[n] for ij in links for n in topo.first_moments(ij)])
+    # numerical Jacobian of eq. 17 in the first-moment changes (a counter-mass adds |s| / distance)
+    cw = spec.balancing.counterweights
+    rows = recipe.cond.eq17(g)
+
+    def r(sv):
+        q = dict(base)
+        for k, ij in enumerate(links):
+            q[f"m{ij}"] += float(np.hypot(*sv[2 * k:2 * k + 2])) / (cw.proximal if ij[1] == "1" else cw.distal)
+            q[f"m{ij}p{ij}"] += sv[2 * k]
+            q[f"m{ij}q{ij}"] += sv[2 * k + 1]
+        return np.array([c.residual(q) for c in rows])
+
+    h = 1e-7
+    J = np.array([(r(s + h * e) - r(s - h * e)) / (2 * h) for e in np.eye(len(s))]).T
+    null = np.linalg.svd(J)[2][12:]
+    assert np.max(np.abs(null @ s)) <= 1e-6 * np.linalg.norm(s)
+    # Fig. 3a from another route: the recipe's sequential solve gives the same counter-masses
+    a = designs[0]
+    other = topo.realise_all(model, topo.solve_counter_masses(model, g, [b for b in topo.BODIES[:-1] if b not in a.kept],
+                                                             cw.proximal, cw.distal), cw.proximal, cw.distal, "x")
+    pa, po = mass_parameters(a.model), mass_parameters(other)
+    assert max(abs(pa[k] - po[k]) for k in pa) <= 1e-12 * max(abs(v) for v in pa.values())
+
+
+@pytest.mark.parametrize("seed", [None, 73])
+def test_counts_behind_fig3_and_fig4b(seed):
+    """Six free mass-position parameters under eq. 17, three for the leg-by-leg family (paper,
+    Sec. III); three bodies kept fix the rest exactly when no two are links of one leg; the same
+    kept parameter in every leg never fixes a design."""
+    spec = load(PAPER) if seed is None else spec_of(random_data(np.random.default_rng(seed)))
+    g = recipe.geometry(spec.mechanism)
+    assert topo.freedoms(g) == {"eq17": 6, "eq17_links": 4, "leg_by_leg": 3, "leg_by_leg_links": 1}
+    same_leg = lambda k: any(a != "5" and b != "5" and a[0] == b[0] for a, b in itertools.combinations(k, 2))  # noqa: E731
+    expected = [k for k in itertools.combinations(topo.BODIES, 3) if not same_leg(k)]
+    assert topo.admissible_kept(g) == expected
+    assert len(expected) == 56
+    assert topo.same_kind_per_leg_ranks(g) == {"p1": 11, "q1": 11, "p2": 11, "q2": 11}
+
+
+def test_fig6b_spec_arms_do_not_cross_and_its_l_i1_counter_masses_balance_the_translating_platform():
+    spec = load(FIG6B)
+    res = registry.balance(spec)
+    model = res.stages[0].model
+    assert not topo.arms_cross(model)
+    assert topo.arms_cross(registry.unbalanced_model(load(FIG6A)))
+    assert topo.arms_cross(registry.unbalanced_model(load(PAPER)))
+    special = next(s for s in res.stages if s.name == "special")
+    assert special.label == "special kinematics (Fig. 6b, eq. 19)"
+    carried = {b.name for b in special.model.bodies for a in b.attachments if a.kind == "counterweight"}
+    assert carried == {"link11", "link21", "link31", "link41"}
+    t = registry.time_grid(spec)
+    an0, an = analyse(model, t), analyse(special.model, t)
+    assert an.max_force <= TOL * an0.max_force
+    # the eq. 19 design does not meet eq. 17: it balances only this motion class
+    assert topo.eq17_residual(special.model, recipe.geometry(spec.mechanism)) > 1e-3
+    assert any("Fig. 6b" in n and "C2" in n for n in res.notes)
+    # the Fig. 6a spec keeps its label
+    res_a = registry.balance(load(FIG6A))
+    assert next(s for s in res_a.stages if s.name == "special").label == "special kinematics (Fig. 6a, eq. 19)"
+
+
+def test_fig6_label():
+    assert topo.fig6_label("fig5a", True) == "Fig. 6a"
+    assert topo.fig6_label("fig5a", False) == "Fig. 6b"
+    assert topo.fig6_label("fig5b", True) == "Fig. 6c"
+
+
+def test_page_draws_fig3_and_fig4b_with_what_was_assumed():
+    from balpipe.report import rrr4 as page
+
+    spec = load(PAPER, samples=41, simulate=False)
+    st = study.run(spec)
+    figs = {title: (body, caption) for title, body, caption in page.figures(st)}
+    t3 = next(k for k in figs if "Fig. 3" in k)
+    t4 = next(k for k in figs if "Fig. 4b" in k)
+    assert "selection of ours" in t3 and "reconstructed" in t4
+    for k in (t3, t4):
+        assert figs[k][0].lstrip().startswith("<svg") or "<svg" in figs[k][0][:500]
+    assert "not the paper's" in figs[t3][1] and "56" in figs[t3][1]
+    assert "least Euclidean norm" in figs[t4][1] and "choice is ours" in figs[t4][1]
+    for c in "abcdef":
+        assert f"Fig. 3{c}" in figs[t3][0]
+    det = st.balance.details["topologies"]
+    assert [d["figure"] for d in det["designs"]][-1] == "Fig. 4b"
+    assert all(d["finder_residual"] <= TOL and d["eq17_residual"] <= TOL for d in det["designs"])
+    # deterministic
+    again = {title: body for title, body, _ in page.figures(study.run(copy.deepcopy(spec)))}
+    assert again[t3] == figs[t3][0]
