@@ -37,7 +37,7 @@ Modules, one job each: :mod:`.compile` (primitives, :func:`compile_model`), :mod
 :func:`analyse`).
 """
 
-from .analysis import Analysis, analyse
+from .analysis import Analysis, analyse, clear_cache, compiled
 from .compile import Compiled, _Angle, _Coincident, _Mesh, _perp, _Projection, _rotate, compile_model
 from .constraints import _extend, _law_values, _split, acceleration_rhs, jacobian, residual, velocity_rhs
 from .dynamics import _joint_reactions, _multipliers, _radial_tooth_loads, _tooth_rows
@@ -45,10 +45,10 @@ from .errors import AnalysisError
 from .kinematics import _solve_rect, _vel_acc
 from .positions import (
     _COARSE, _COND_LIMIT, _JUMP, _MAX_ITER, _TOL, _check_regular, _check_redundancy, _check_square,
-    _fail_position, _newton, _substep, _worst_rows, redundancy, solve_positions,
+    _fail_position, _newton, _substep, _worst_rows, condition_numbers, follow_motion, redundancy, solve_positions,
 )
 
 __all__ = [
-    "Analysis", "AnalysisError", "Compiled", "acceleration_rhs", "analyse", "compile_model", "jacobian",
+    "Analysis", "AnalysisError", "Compiled", "acceleration_rhs", "analyse", "clear_cache", "compile_model", "compiled", "jacobian",
     "redundancy", "residual", "solve_positions", "velocity_rhs",
 ]

@@ -3,16 +3,19 @@ both routes to the shaking loads."""
 
 from __future__ import annotations
 
+import functools
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..model import Model
-from .compile import _rotate, compile_model
+from . import fastpath, structure
+from .compile import Compiled, _rotate, compile_model
 from .constraints import _extend, jacobian
 from .dynamics import _joint_reactions, _multipliers, _radial_tooth_loads, _tooth_rows
 from .kinematics import _vel_acc
-from .positions import redundancy, solve_positions
+from .positions import condition_numbers, redundancy, solve_positions
 
 
 @dataclass
@@ -92,34 +95,117 @@ class Analysis:
         return self.extra["frame_pose"][k, i].tolist()
 
 
+class _Extra(dict):
+    """``Analysis.extra``, whose ``condition`` entry (the condition numbers of Phi_q along the
+    motion, an SVD per sample) is computed when first read. Pickles as a plain dict."""
+
+    def __init__(self, data: dict, condition):
+        super().__init__(data)
+        self._condition = condition
+
+    def __missing__(self, key):
+        if key == "condition" and self._condition is not None:
+            self["condition"] = value = self._condition()
+            return value
+        raise KeyError(key)
+
+    def __contains__(self, key) -> bool:
+        return super().__contains__(key) or (key == "condition" and self._condition is not None)
+
+    def get(self, key, default=None):
+        return self[key] if key in self else default
+
+    def __reduce__(self):
+        if self._condition is not None:
+            self["condition"]
+        return (dict, (dict(self),))
+
+
+_COMPILED: dict[int, tuple[weakref.ref, Compiled]] = {}
+
+
+def compiled(model: Model) -> Compiled:
+    """:func:`compile_model`, kept per model object (and its block structure, shared by every
+    model of the same pattern, :func:`.structure.decompose`)."""
+    hit = _COMPILED.get(id(model))
+    if hit is not None and hit[0]() is model:
+        return hit[1]
+    c = compile_model(model)
+    if len(_COMPILED) >= 128:
+        _COMPILED.clear()
+    _COMPILED[id(model)] = (weakref.ref(model), c)
+    return c
+
+
+def clear_cache() -> None:
+    """Forget compiled models and block structures (for benchmarks of cold calls)."""
+    _COMPILED.clear()
+    structure._CACHE.clear()
+
+
 def analyse(
     model: Model,
     t: np.ndarray,
     gravity: tuple[float, float] = (0.0, 0.0),
     moment_point: tuple[float, float] = (0.0, 0.0),
+    *,
+    method: str = "auto",
 ) -> Analysis:
-    """Kinematics, inverse dynamics and shaking loads of ``model`` at times ``t``."""
-    c = compile_model(model)
+    """Kinematics, inverse dynamics and shaking loads of ``model`` at times ``t``.
+
+    ``method``: ``"auto"`` takes the block-triangular path (:mod:`.fastpath`) where it applies
+    and the general dense path otherwise; ``"dense"`` forces the general path (continuation,
+    batched Newton-Raphson and dense batched solves on every sample's full Jacobian). Both give
+    the same results to round-off.
+    """
+    if method not in ("auto", "dense"):
+        raise ValueError(f"method must be 'auto' or 'dense', not {method!r}")
+    c = compiled(model)
     t = np.asarray(t, dtype=float)
-    q = solve_positions(c, t)
-    v, a = _vel_acc(c, q, t)
-    qx = _extend(q)
-    J = jacobian(c, qx)
-    mesh_geo = _tooth_rows(c, qx, J)  # gear meshes with pitch radii act by tooth forces
-    Jf, J0 = J[:, :, 3:], J[:, :, :3]
-    nb = c.nb
     g = np.asarray(gravity, dtype=float)
     Mdiag = np.stack([c.mass, c.mass, c.inertia], axis=1).reshape(1, -1)
-    Q = np.zeros_like(q)
-    Q[:, 0::3] = c.mass * g[0]
-    Q[:, 1::3] = c.mass * g[1]
-    rhs = Q - Mdiag * a
-    lam = _multipliers(c, Jf, rhs)
-    lam, radial_on_frame = _radial_tooth_loads(c, mesh_geo, lam)
-    gen0 = -np.einsum("nmk,nm->nk", J0, lam) + radial_on_frame  # load on the frame: Fx, Fy, M_O
+    kin = None
+    if method == "auto":
+        if c.fast is None:
+            c.fast = fastpath.prepare(c)
+        try:
+            kin = fastpath.kinematics(c, c.fast, t)
+        except fastpath.Fallback:
+            kin = None
+    if kin is None:
+        q = solve_positions(c, t)
+        v, a = _vel_acc(c, q, t)
+        cond = c.condition
+        condition = None
+    else:
+        q, v, a = kin.X[3:-1].T, kin.V[3:-1].T, kin.A[3:-1].T
+        cond = None
+        condition = functools.partial(condition_numbers, c, q)
+    if kin is not None and not c.meshes:
+        rhsT = -Mdiag.T * kin.A[3:-1]
+        rhsT[0::3] += (c.mass * g[0])[:, None]
+        rhsT[1::3] += (c.mass * g[1])[:, None]
+        lamT = fastpath.multipliers(c.fast, kin, rhsT)
+        lam = lamT.T
+        mesh_geo: list = []
+        gen0 = fastpath.frame_load(c.fast, kin.vals, lamT)
+    else:
+        qx = _extend(q)
+        J = jacobian(c, qx)
+        mesh_geo = _tooth_rows(c, qx, J)  # gear meshes with pitch radii act by tooth forces
+        Jf, J0 = J[:, :, 3:], J[:, :, :3]
+        Q = np.zeros_like(q)
+        Q[:, 0::3] = c.mass * g[0]
+        Q[:, 1::3] = c.mass * g[1]
+        rhs = Q - Mdiag * a
+        lam = _multipliers(c, Jf, rhs)
+        lam, radial_on_frame = _radial_tooth_loads(c, mesh_geo, lam)
+        gen0 = -np.einsum("nmk,nm->nk", J0, lam) + radial_on_frame  # load on the frame: Fx, Fy, M_O
     P = np.asarray(moment_point, dtype=float)
     force = gen0[:, :2]
     moment_O = gen0[:, 2]
+
+    nb = c.nb
 
     qb, vb, ab = q.reshape(-1, nb, 3), v.reshape(-1, nb, 3), a.reshape(-1, nb, 3)
     m, I = c.mass, c.inertia
@@ -151,6 +237,7 @@ def analyse(
         force_momentum=force_mom, moment_momentum=about_P(moment_mom, force_mom),
         efforts=efforts, reactions=reactions, com=com, momentum=momentum, angular_momentum=ang,
         moment_point=(float(P[0]), float(P[1])), gravity=(float(g[0]), float(g[1])),
-        extra={"frame_pose": frame_pose, "condition": c.condition, "total_mass": float(m.sum()),
-               "redundant_actuators": redundancy(c)},
+        extra=_Extra({"frame_pose": frame_pose, "total_mass": float(m.sum()),
+                      "redundant_actuators": redundancy(c), **({"condition": cond} if cond is not None else {})},
+                     condition),
     )

@@ -75,6 +75,7 @@ class Compiled:
     q0: np.ndarray  # (3 nb,) initial guess
     condition: np.ndarray | None = None  # condition numbers of Phi_q along the last motion solved
     meshes: list = field(default_factory=list)  # _Mesh: gear pairs that pass tooth forces
+    fast: object = None  # the block-triangular path's data (:func:`.fastpath.prepare`), made once
 
     @property
     def nb(self) -> int:

@@ -100,11 +100,20 @@ def _fail_position(c: Compiled, q: np.ndarray, t: float) -> AnalysisError:
     )
 
 
+def condition_numbers(c: Compiled, q: np.ndarray) -> np.ndarray:
+    """2-norm condition numbers of Phi_q (N,) at positions q (N, 3 nb)."""
+    return _condition(jacobian(c, _extend(q))[:, :, 3:])
+
+
+def _condition(J: np.ndarray) -> np.ndarray:
+    s = np.linalg.svd(J, compute_uv=False)
+    return s[:, 0] / np.maximum(s[:, -1], 1e-300)
+
+
 def _check_regular(c: Compiled, q: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Condition numbers of Phi_q along the motion; a singular configuration is an error."""
     J = jacobian(c, _extend(q))[:, :, 3:]
-    s = np.linalg.svd(J, compute_uv=False)
-    cond = s[:, 0] / np.maximum(s[:, -1], 1e-300)
+    cond = _condition(J)
     bad = np.flatnonzero(cond > _COND_LIMIT)
     if bad.size:
         k = int(bad[0])
@@ -125,8 +134,16 @@ def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
 
     The first sample is assembled from the model's initial pose; a coarse grid is then followed
     by continuation (second-order predictor), and all samples are refined at once by batched
-    Newton-Raphson from a cubic Hermite interpolation of the coarse solution.
+    Newton-Raphson from a cubic Hermite interpolation of the coarse solution. A singular
+    configuration on the way is an error (:func:`_check_regular`).
     """
+    qall = follow_motion(c, t)
+    c.condition = _check_regular(c, qall, t)
+    return qall
+
+
+def follow_motion(c: Compiled, t: np.ndarray) -> np.ndarray:
+    """:func:`solve_positions` without the regularity check (the caller makes it)."""
     _check_square(c)
     N = len(t)
     q, ok, _ = _newton(c, c.q0[None, :], t[:1], max_iter=50)
@@ -168,7 +185,6 @@ def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
     for k in np.flatnonzero(~ok | jumped):  # rare: refine sequentially from the previous sample
         prev = k - 1
         qall[k] = _substep(c, qall[prev], t[prev], t[k])[0]
-    c.condition = _check_regular(c, qall, t)
     return qall
 
 
