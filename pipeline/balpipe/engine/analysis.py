@@ -141,6 +141,7 @@ def clear_cache() -> None:
     """Forget compiled models and block structures (for benchmarks of cold calls)."""
     _COMPILED.clear()
     structure._CACHE.clear()
+    fastpath._MOTIONS.clear()
 
 
 def analyse(

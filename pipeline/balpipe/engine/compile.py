@@ -76,6 +76,7 @@ class Compiled:
     condition: np.ndarray | None = None  # condition numbers of Phi_q along the last motion solved
     meshes: list = field(default_factory=list)  # _Mesh: gear pairs that pass tooth forces
     fast: object = None  # the block-triangular path's data (:func:`.fastpath.prepare`), made once
+    com_local: np.ndarray | None = None  # (nb, 2) centres of mass in the bodies' own frames
 
     @property
     def nb(self) -> int:
@@ -168,6 +169,7 @@ def compile_model(model: Model) -> Compiled:
         model, names, np.array(mass), np.array(inertia), prims, row_owner, driver_rows, joint_rows, q0
     )
     compiled.meshes = _compile_meshes(model, idx, local, joint_rows)
+    compiled.com_local = np.array([com[n] for n in names], dtype=float).reshape(-1, 2)
     return compiled
 
 

@@ -29,7 +29,7 @@ import numpy as np
 from .compile import Compiled
 from .positions import _COND_LIMIT, _check_regular, _condition, follow_motion, redundancy
 from .constraints import _extend, jacobian
-from .structure import Decomposition, block_sigma_min, decompose, solve
+from .structure import Decomposition, block_sigma_min, decompose, invert_blocks, solve
 from .vectorised import State, Vectorised, acceleration_rhs, jacobian_values, law_table, residual, velocity_rhs, vectorise
 
 _SCREEN = 1e-4  # exact condition numbers where the lower bound exceeds this fraction of the limit
@@ -64,6 +64,7 @@ class Kinematics:
     A: np.ndarray
     vals: np.ndarray  # Jacobian values at X
     state: State
+    inverses: dict[int, np.ndarray]  # of the k x k diagonal blocks
 
 
 def kinematics(c: Compiled, p: Prepared, t: np.ndarray) -> Kinematics:
@@ -76,19 +77,19 @@ def kinematics(c: Compiled, p: Prepared, t: np.ndarray) -> Kinematics:
     if dec.explicit:
         X, state = _explicit_positions(vz, dec, f, N)
     else:
-        q = follow_motion(c, t)
         X = np.zeros((vz.ncol + 1, N))
-        X[3:-1] = q.T
+        X[3:-1] = _closed_loop_positions(c, vz, t, f).T
         state = State(vz, X[:-1])
     vals = jacobian_values(vz, state)
     if dec.explicit:
         phi = residual(vz, state, f)
         if not np.all(np.abs(phi) < _RESIDUAL):
             raise Fallback
-    _screen(c, p, vals, X, t)
-    V = solve(dec.forward, vals, velocity_rhs(vz, fd, N), offset=3)
-    A = solve(dec.forward, vals, acceleration_rhs(vz, state, V, fdd), offset=3)
-    return Kinematics(X, V, A, vals, state)
+    inverses = invert_blocks(dec, vals)
+    _screen(c, p, vals, inverses, X, t)
+    V = solve(dec.forward, vals, velocity_rhs(vz, fd, N), inverses, offset=3)
+    A = solve(dec.forward, vals, acceleration_rhs(vz, state, V, fdd), inverses, offset=3)
+    return Kinematics(X, V, A, vals, state, inverses)
 
 
 def _explicit_positions(vz: Vectorised, dec: Decomposition, f: np.ndarray, N: int) -> tuple[np.ndarray, State]:
@@ -114,10 +115,54 @@ def _explicit_positions(vz: Vectorised, dec: Decomposition, f: np.ndarray, N: in
     return X, s
 
 
-def _screen(c: Compiled, p: Prepared, vals: np.ndarray, X: np.ndarray, t: np.ndarray) -> None:
+_MOTIONS: dict[tuple, tuple[list, np.ndarray]] = {}
+
+
+def _motion_key(c: Compiled, t: np.ndarray) -> tuple:
+    """Everything the motion of the bodies' own frames depends on: the joints, the drivers (their
+    laws by identity, kept alive by the cache), the bodies' named points, the initial poses
+    (the branch) and the time grid; not the mass properties, which move only the centres of
+    mass within the bodies (a balancing stage, a mass design)."""
+    m = c.model
+    return (repr(m.joints), tuple((d.name, d.target, id(d.law)) for d in m.drivers),
+            tuple((b.name, tuple(sorted(b.points.items()))) for b in m.bodies),
+            tuple(sorted(m.initial.items())), t.tobytes())
+
+
+def _closed_loop_positions(c: Compiled, vz: Vectorised, t: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Positions (N, 3 nb) by the general continuation, or from the motion of the bodies' frames
+    solved before for the same mechanism and grid (another stage or mass design): the centres
+    of mass are placed in the bodies' frames, and the residual is checked."""
+    key = _motion_key(c, t)
+    hit = _MOTIONS.get(key)
+    com = c.com_local
+    if hit is not None:
+        frame = hit[1]
+        th = frame[:, 2::3]
+        cos, sin = np.cos(th), np.sin(th)
+        q = frame.copy()
+        q[:, 0::3] += cos * com[:, 0] - sin * com[:, 1]
+        q[:, 1::3] += sin * com[:, 0] + cos * com[:, 1]
+        X = np.zeros((vz.ncol, len(t)))
+        X[3:] = q.T
+        if np.all(np.abs(residual(vz, State(vz, X), f)) < _RESIDUAL):
+            return q
+    q = follow_motion(c, t)
+    th = q[:, 2::3]
+    cos, sin = np.cos(th), np.sin(th)
+    frame = q.copy()
+    frame[:, 0::3] -= cos * com[:, 0] - sin * com[:, 1]
+    frame[:, 1::3] -= sin * com[:, 0] + cos * com[:, 1]
+    if len(_MOTIONS) >= 32:
+        _MOTIONS.clear()
+    _MOTIONS[key] = ([d.law for d in c.model.drivers], frame)
+    return q
+
+
+def _screen(c: Compiled, p: Prepared, vals: np.ndarray, inverses: dict, X: np.ndarray, t: np.ndarray) -> None:
     """Singular configurations: the block bound, then the exact check where it is close."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        bound = np.abs(vals[p.free_slots]).max(axis=0) / block_sigma_min(p.dec, vals)
+        bound = np.abs(vals[p.free_slots]).max(axis=0) / block_sigma_min(p.dec, vals, inverses)
     close = ~(bound <= _COND_LIMIT * _SCREEN)
     if close.any():
         q = X[3:-1, close].T
@@ -128,7 +173,7 @@ def _screen(c: Compiled, p: Prepared, vals: np.ndarray, X: np.ndarray, t: np.nda
 
 def multipliers(p: Prepared, k: Kinematics, rhs: np.ndarray) -> np.ndarray:
     """lambda (m, N) from Phi_q^T lambda = rhs (n, N), square Phi_q."""
-    return solve(p.dec.backward, k.vals, rhs)[:-1]
+    return solve(p.dec.backward, k.vals, rhs, k.inverses)[:-1]
 
 
 def frame_load(p: Prepared, vals: np.ndarray, lam: np.ndarray) -> np.ndarray:

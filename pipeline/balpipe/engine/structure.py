@@ -36,6 +36,7 @@ class Step:
     off_slots: np.ndarray  # (g, w) Jacobian slots of the couplings to earlier unknowns (padded)
     off_unk: np.ndarray  # (g, w) those unknowns (padded with the zero row)
     square: bool  # a k x k block (k > 1)
+    block: int = -1  # k x k block: its index in Decomposition.blocks
 
 
 @dataclass
@@ -44,6 +45,7 @@ class Plan:
 
     steps: list[Step]
     n_unknowns: int
+    transposed: bool
 
 
 @dataclass
@@ -56,6 +58,7 @@ class Decomposition:
     pivots_constant: bool  # every 1 x 1 pivot is a constant entry
     blocks: list[tuple[list[int], list[int]]]  # (rows, free columns) per block, in order
     pad: int  # the zero slot
+    square_blocks: list[tuple[int, np.ndarray]]  # (block index, (k, k) slots) of the k x k blocks
     # explicit systems: (equations, unknowns, pivot slots) per level, angles then positions; for
     # the angles the equations index the angle rows (Vectorised.arow)
     angle_steps: list[tuple[np.ndarray, np.ndarray, np.ndarray]]
@@ -173,11 +176,17 @@ def _decompose(vz: Vectorised) -> Decomposition | None:
                         diag[a, bb] = slot_of.get((r, c), pad)
                 if not transposed:
                     offs = [[(s, cc) for cc, s in row_entries[r] if cc not in cols] for r in rows]
-                    steps.append(_step(rows, cols, diag, offs, pad, n, True))
+                    steps.append(_step(rows, cols, diag, offs, pad, n, True, position[b]))
                 else:
                     offs = [[(s, rr) for rr, s in col_entries[c] if rr not in rows] for c in cols]
-                    steps.append(_step(cols, rows, diag.T.copy(), offs, pad, n, True))
-        return Plan(steps, n)
+                    steps.append(_step(cols, rows, diag.T.copy(), offs, pad, n, True, position[b]))
+        return Plan(steps, n, transposed)
+
+    position = {b: k for k, b in enumerate(order)}
+    square_blocks = []
+    for k, (rows, cols) in enumerate(blocks):
+        if len(rows) > 1:
+            square_blocks.append((k, np.array([[slot_of.get((r, c), pad) for c in cols] for r in rows], dtype=np.intp)))
 
     explicit = all(len(rows) == 1 and (kind[rows[0]] == 1 or cols[0] % 3 != 2) for rows, cols in blocks)
     pivots_constant = all(
@@ -194,10 +203,11 @@ def _decompose(vz: Vectorised) -> Decomposition | None:
                 angle_steps.append((eq, st.unk[ang], st.diag[ang]))
             if (~ang).any():
                 position_steps.append((st.eq[~ang], st.unk[~ang], st.diag[~ang]))
-    return Decomposition(forward, build(True), explicit, pivots_constant, blocks, pad, angle_steps, position_steps)
+    return Decomposition(forward, build(True), explicit, pivots_constant, blocks, pad, square_blocks,
+                         angle_steps, position_steps)
 
 
-def _step(eqs, unks, diag, offs, pad: int, n: int, square: bool) -> Step:
+def _step(eqs, unks, diag, offs, pad: int, n: int, square: bool, block: int = -1) -> Step:
     w = max((len(o) for o in offs), default=0)
     off_slots = np.full((len(offs), w), pad, dtype=np.intp)
     off_unk = np.full((len(offs), w), n, dtype=np.intp)
@@ -205,7 +215,7 @@ def _step(eqs, unks, diag, offs, pad: int, n: int, square: bool) -> Step:
         for b, (s, u) in enumerate(o):
             off_slots[a, b] = s
             off_unk[a, b] = u
-    return Step(np.array(eqs, dtype=np.intp), np.array(unks, dtype=np.intp), diag, off_slots, off_unk, square)
+    return Step(np.array(eqs, dtype=np.intp), np.array(unks, dtype=np.intp), diag, off_slots, off_unk, square, block)
 
 
 def _topological(deps: list[set[int]]) -> list[int]:
@@ -215,10 +225,11 @@ def _topological(deps: list[set[int]]) -> list[int]:
     return list(TopologicalSorter({b: deps[b] for b in range(len(deps))}).static_order())
 
 
-def solve(plan: Plan, vals: np.ndarray, rhs: np.ndarray, offset: int = 0) -> np.ndarray:
+def solve(plan: Plan, vals: np.ndarray, rhs: np.ndarray, inverses: dict[int, np.ndarray], offset: int = 0) -> np.ndarray:
     """Solve the triangular system of ``plan`` with Jacobian values ``vals`` (nnz + 1, N) (last
-    row zero) and right-hand side ``rhs`` (equations, N). Returns (offset + n + 1, N): ``offset``
-    zero rows, the n unknowns, a zero row (padding)."""
+    row zero), the inverses of its k x k diagonal blocks (:func:`invert_blocks`) and right-hand
+    side ``rhs`` (equations, N). Returns (offset + n + 1, N): ``offset`` zero rows, the n
+    unknowns, a zero row (padding)."""
     N = rhs.shape[1]
     U = np.zeros((offset + plan.n_unknowns + 1, N))
     for st in plan.steps:
@@ -228,21 +239,50 @@ def solve(plan: Plan, vals: np.ndarray, rhs: np.ndarray, offset: int = 0) -> np.
         if not st.square:
             U[st.unk + offset] = b / vals[st.diag]
         else:
-            A = np.moveaxis(vals[st.diag], -1, 0)  # (N, k, k)
-            U[st.unk + offset] = np.linalg.solve(A, b.T[..., None])[..., 0].T
+            inv = inverses[st.block]
+            U[st.unk + offset] = np.einsum("ban,bn->an" if plan.transposed else "abn,bn->an", inv, b)
     return U
 
 
-def block_sigma_min(dec: Decomposition, vals: np.ndarray) -> np.ndarray:
-    """Smallest singular value of the diagonal blocks, per sample (N,): Phi_q is singular exactly
-    when it vanishes, and cond(Phi_q) >= max|entry| / it (a block of a block-triangular matrix
-    has its inverse as a block of the inverse)."""
+def inverse(A: np.ndarray) -> np.ndarray:
+    """Inverses of a stack of small matrices laid out (k, k, N), by Gauss-Jordan elimination with
+    partial pivoting, vectorised over the N samples (for k of a few units much faster than
+    LAPACK called per matrix). A singular matrix gives non-finite values."""
+    k, _, N = A.shape
+    M = np.empty((k, 2 * k, N))
+    M[:, :k] = A
+    M[:, k:] = np.eye(k)[:, :, None]
+    ar = np.arange(N)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for j in range(k):
+            p = j + np.argmax(np.abs(M[j:, j, :]), axis=0)
+            if np.any(p != j):
+                rowp = M[p, :, ar]  # (N, 2k)
+                M[p, :, ar] = M[j].T
+                M[j] = rowp.T
+            M[j] /= M[j, j].copy()
+            for i in range(k):
+                if i != j:
+                    M[i] -= M[i, j].copy() * M[j]
+    return M[:, k:]
+
+
+def invert_blocks(dec: Decomposition, vals: np.ndarray) -> dict[int, np.ndarray]:
+    """Inverses (k, k, N) of the k x k diagonal blocks, by block index."""
+    return {b: inverse(vals[diag]) for b, diag in dec.square_blocks}
+
+
+def block_sigma_min(dec: Decomposition, vals: np.ndarray, inverses: dict[int, np.ndarray]) -> np.ndarray:
+    """A lower bound of the smallest singular value of the diagonal blocks, per sample (N,):
+    |pivot| for a 1 x 1 block, 1 / |B^-1|_F for a k x k one. Phi_q is singular exactly when a
+    block is, and cond(Phi_q) >= max|entry| / sigma_min(block) (a diagonal block's inverse is a
+    block of the inverse of a block-triangular matrix)."""
     out = None
     for st in dec.forward.steps:
         if not st.square:
             s = np.abs(vals[st.diag]).min(axis=0)
         else:
-            A = np.moveaxis(vals[st.diag], -1, 0)
-            s = np.linalg.svd(A, compute_uv=False)[:, -1]
+            with np.errstate(invalid="ignore"):
+                s = 1.0 / np.sqrt(np.einsum("abn,abn->n", inverses[st.block], inverses[st.block]))
         out = s if out is None else np.minimum(out, s)
     return out
