@@ -22,12 +22,13 @@ the general dense path.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
 from .compile import Compiled
-from .positions import _COND_LIMIT, _check_regular, _condition, follow_motion, redundancy
+from .positions import _COND_LIMIT, _TOL, _check_regular, _condition, follow_motion, redundancy
 from .constraints import _extend, jacobian
 from .structure import Decomposition, block_sigma_min, decompose, invert_blocks, solve
 from .vectorised import State, Vectorised, acceleration_rhs, jacobian_values, law_table, residual, velocity_rhs, vectorise
@@ -122,11 +123,21 @@ def _motion_key(c: Compiled, t: np.ndarray) -> tuple:
     """Everything the motion of the bodies' own frames depends on: the joints, the drivers (their
     laws by identity, kept alive by the cache), the bodies' named points, the initial poses
     (the branch) and the time grid; not the mass properties, which move only the centres of
-    mass within the bodies (a balancing stage, a mass design)."""
+    mass within the bodies (a balancing stage, a mass design). Numbers enter exactly."""
     m = c.model
-    return (repr(m.joints), tuple((d.name, d.target, id(d.law)) for d in m.drivers),
-            tuple((b.name, tuple(sorted(b.points.items()))) for b in m.bodies),
-            tuple(sorted(m.initial.items())), t.tobytes())
+    joints = tuple((type(j).__name__, *(_exact(getattr(j, f.name)) for f in dataclasses.fields(j))) for j in m.joints)
+    return (joints, tuple((d.name, _exact(d.target), id(d.law)) for d in m.drivers),
+            tuple((b.name, _exact(sorted(b.points.items()))) for b in m.bodies),
+            _exact(sorted(m.initial.items())), t.tobytes())
+
+
+def _exact(v):
+    """A hashable, exact image of nested tuples, lists, arrays and numbers."""
+    if isinstance(v, (str, type(None))):
+        return v
+    if isinstance(v, (tuple, list, np.ndarray)):
+        return tuple(_exact(x) for x in v)
+    return float(v).hex()
 
 
 def _closed_loop_positions(c: Compiled, vz: Vectorised, t: np.ndarray, f: np.ndarray) -> np.ndarray:
@@ -145,7 +156,7 @@ def _closed_loop_positions(c: Compiled, vz: Vectorised, t: np.ndarray, f: np.nda
         q[:, 1::3] += sin * com[:, 0] + cos * com[:, 1]
         X = np.zeros((vz.ncol, len(t)))
         X[3:] = q.T
-        if np.all(np.abs(residual(vz, State(vz, X), f)) < _RESIDUAL):
+        if np.all(np.abs(residual(vz, State(vz, X), f)) < _TOL):
             return q
     q = follow_motion(c, t)
     th = q[:, 2::3]
@@ -153,7 +164,7 @@ def _closed_loop_positions(c: Compiled, vz: Vectorised, t: np.ndarray, f: np.nda
     frame = q.copy()
     frame[:, 0::3] -= cos * com[:, 0] - sin * com[:, 1]
     frame[:, 1::3] -= sin * com[:, 0] + cos * com[:, 1]
-    if len(_MOTIONS) >= 32:
+    if len(_MOTIONS) >= 16:
         _MOTIONS.clear()
     _MOTIONS[key] = ([d.law for d in c.model.drivers], frame)
     return q
