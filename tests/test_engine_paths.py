@@ -11,6 +11,7 @@ open chains exactly, so positions differ by up to ~1e-12 and what is computed fr
 
 from __future__ import annotations
 
+import math
 import pickle
 
 import numpy as np
@@ -19,7 +20,10 @@ import pytest
 from balpipe import engine, registry
 from balpipe.engine import _extend, _multipliers, _vel_acc, analyse, compiled, fastpath, jacobian
 from balpipe.engine.structure import decompose
+from balpipe.engine import AnalysisError
 from balpipe.loader import load
+from balpipe.model import FRAME, Body, Driver, Model, Prismatic, Revolute
+from balpipe.motion import PROFILES, PointToPoint
 from balpipe.study import gravity_vector
 
 # (spec, expected structure): explicit = every block 1 x 1 and linear (no Newton), blocks = the
@@ -167,3 +171,44 @@ def test_unknown_method_is_refused():
     spec, stages = _stages(CASES["slider-crank"][0])
     with pytest.raises(ValueError, match="method"):
         analyse(stages[0].model, registry.time_grid(spec), method="fast")
+
+
+def _slider_crank_pushed_too_far() -> Model:
+    """Crank 0.1, coupler 0.3, the slider driven from x = 0.3 past the dead point x = 0.4
+    (crank and coupler aligned) to 0.45, out of reach."""
+    r, L, x0 = 0.1, 0.3, 0.3
+    th = math.acos((x0 * x0 + r * r - L * L) / (2 * x0 * r))
+    tip = (r * math.cos(th), r * math.sin(th))
+    phi = math.atan2(-tip[1], x0 - tip[0])
+    bodies = (Body("crank", 1.0, (0.05, 0.0), 0.001, {"P": (0.0, 0.0), "Q": (r, 0.0)}),
+              Body("coupler", 2.0, (0.15, 0.0), 0.02, {"P": (0.0, 0.0), "Q": (L, 0.0)}),
+              Body("slider", 1.0, (0.0, 0.0), 0.001))
+    joints = (Revolute("A", FRAME, "crank", (0.0, 0.0), (0.0, 0.0)),
+              Revolute("B", "crank", "coupler", (r, 0.0), (0.0, 0.0)),
+              Revolute("C", "coupler", "slider", (L, 0.0), (0.0, 0.0)),
+              Prismatic("guide", FRAME, "slider", (0.0, 0.0), (1.0, 0.0)))
+    drive = Driver("push", ("joint", "guide"), PointToPoint(x0, r + L + 0.05, 0.2, PROFILES["quintic"]))
+    return Model("dead point", bodies, joints, (drive,),
+                 {"crank": (0.0, 0.0, th), "coupler": (tip[0], tip[1], phi), "slider": (x0, 0.0, 0.0)})
+
+
+def _rocker_driven_four_bar() -> Model:
+    from test_engine import four_bar  # the crank-rocker of test_engine.py
+
+    m = four_bar(np.random.default_rng(0))
+    phi = m.initial["rocker"][2]
+    return Model(m.name, m.bodies, m.joints,
+                 (Driver("rocker", ("joint", "D"), PointToPoint(phi, phi + 3.0, 0.4, PROFILES["quintic"])),), m.initial)
+
+
+@pytest.mark.parametrize("build,T", [(_slider_crank_pushed_too_far, 0.2), (_rocker_driven_four_bar, 0.4)])
+def test_both_paths_raise_the_same_located_error(build, T):
+    """A motion the mechanism cannot follow: the same message, time and joint from both paths."""
+    errors = []
+    for method in ("auto", "dense"):
+        engine.clear_cache()
+        with pytest.raises(AnalysisError) as exc:
+            analyse(build(), np.linspace(0.0, T, 201), method=method)
+        errors.append((str(exc.value), exc.value.time, exc.value.joint))
+    assert errors[0] == errors[1]
+    assert "t = " in errors[0][0] and errors[0][1] is not None
