@@ -22,6 +22,7 @@ build costs); ``--quick`` (~15 s) skips the simulated build and the 10^4-sample 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import os
@@ -372,19 +373,42 @@ def bench_engine(counts: list[int], repeats: int) -> dict:
     arm = arm_model()
     cases.append(("3R arm (paper 003)", arm, (0.0, 0.0), (0.0, 0.0), ARM_MOTION["duration"]))
     rows = []
-    arm_times = {}
+    times: dict[str, dict[int, float]] = {}
     for label, model, grav, mpt, dur in cases:
         for n in counts:
             t = np.linspace(0.0, dur, n)
             analyse(model, t, grav, mpt)  # warm-up
             best = best_of(lambda: analyse(model, t, grav, mpt), repeats, min_total=MIN_TOTAL)
-            rows.append([label, len(engine.compile_model(model).names), n, f"{best * 1e3:.2f}",
+            rows.append([label, len(engine.compile_model(model).names), n, f"{best * 1e3:.3f}",
                          f"{best / n * 1e6:.2f}", fmt_rate(n / best)])
-            if model is arm:
-                arm_times[n] = best
+            times.setdefault(label, {})[n] = best
     table(["model", "bodies", "samples", "best ms", "us/sample", "samples/s"], rows,
-          f"best of {repeats} repeats (time.perf_counter), Python {platform.python_version()}, numpy {np.__version__}:")
-    return arm_times
+          f"best of {repeats} repeats (time.perf_counter), Python {platform.python_version()}, numpy {np.__version__}; "
+          "repeated calls on the same model and grid (compiled model, block structure and a closed loop's "
+          "motion reused):")
+    # fixed cost per call: 3 samples; warm (as above), cold (every cache emptied before each call),
+    # and a design not seen before (a copy of the model with another mass: compiled again, the
+    # structure reused, a closed loop's motion reused when its joints and drivers are the same)
+    fixed = []
+    for label, model, grav, mpt, dur in [cases[0], cases[-1]]:
+        t = np.linspace(0.0, dur, 3)
+        warm = best_of(lambda: analyse(model, t, grav, mpt), repeats, min_total=MIN_TOTAL)
+
+        def cold():
+            engine.clear_cache()
+            analyse(model, t, grav, mpt)
+
+        def new_design():
+            b = model.bodies[0]
+            analyse(model.replace_body(dataclasses.replace(b, mass=b.mass * 1.01)), t, grav, mpt)
+
+        fixed.append([label, f"{warm * 1e3:.3f}", f"{best_of(new_design, repeats, min_total=MIN_TOTAL) * 1e3:.3f}",
+                      f"{best_of(cold, repeats, min_total=MIN_TOTAL) * 1e3:.3f}"])
+        times.setdefault(label, {})[3] = warm
+    table(["model", "same model ms", "new mass design ms", "cold ms"], fixed,
+          "fixed cost per analyse() call (3 samples, best of repeats): the same model again; a new model "
+          "differing in one mass; cold (engine.clear_cache() before each call):")
+    return times
 
 
 # ------------------------------------------------------------------------------------------
@@ -417,7 +441,7 @@ def joint_samples(an) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return rel(an.q), rel(an.v), rel(an.a)
 
 
-def bench_pinocchio(counts: list[int], repeats: int, arm_times: dict) -> None:
+def bench_pinocchio(counts: list[int], repeats: int, times: dict) -> None:
     print("\n== 3. Pinocchio RNEA on the same 3R samples ==")
     try:
         import pinocchio as pin
@@ -429,7 +453,9 @@ def bench_pinocchio(counts: list[int], repeats: int, arm_times: dict) -> None:
     arm = arm_model()
     threads = os.cpu_count() or 1
     pool = pin.ModelPool(pmodel, threads) if hasattr(pin, "rneaInParallel") else None
-    rows, agree = [], []
+    arm_times = times["3R arm (paper 003)"]
+    crank = next(k for k in times if k.startswith("slider-crank/"))
+    rows, agree, ratios = [], [], []
     for n in counts:
         t = np.linspace(0.0, ARM_MOTION["duration"], n)
         an = analyse(arm, t)
@@ -458,6 +484,9 @@ def bench_pinocchio(counts: list[int], repeats: int, arm_times: dict) -> None:
         if pool is not None:
             row.append(f"{best_par / bal:.3g}" if bal else "-")
         rows.append(row)
+        sc = times[crank].get(n)
+        ratios.append([n, fmt_rate(n / best_loop), fmt_rate(n / bal), f"{best_loop / bal:.3g}",
+                       fmt_rate(n / sc) if sc else "-", f"{best_loop / sc:.3g}" if sc else "-"])
     table(["samples", "max rel diff q1", "q2", "q3", "peak |tau1| N m", "|tau2|", "|tau3|"], agree,
           "Joint torques: balpipe driver efforts vs pinocchio.rnea (max |difference| / peak |tau|, per joint):")
     headers = ["samples", "rnea loop ms", "samples/s"]
@@ -469,6 +498,10 @@ def bench_pinocchio(counts: list[int], repeats: int, arm_times: dict) -> None:
     table(headers, rows, f"pinocchio {pin.__version__}: rnea called once per sample from Python, and the batched "
           f"rneaInParallel; ratio = balpipe throughput / Pinocchio throughput (below 1: Pinocchio is faster; "
           f"balpipe also solves the kinematics and both shaking-load routes, RNEA only the joint torques):")
+    table(["samples", "pin rnea loop samples/s", "balpipe 3R arm", "ratio", f"balpipe {crank}", "ratio"], ratios,
+          "Summary: balpipe analyse() throughput relative to Pinocchio's rnea called per sample on the 3R arm, "
+          "same run (targets of issue 13 on the arm: >= 0.1 at 10^2, >= 0.5 at 10^4; the slider-crank, a "
+          "closed loop, is given against the same anchor):")
 
 
 # ------------------------------------------------------------------------------------------
@@ -488,8 +521,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"balpipe benchmarks: {platform.platform()}, {os.cpu_count()} CPUs, Python {platform.python_version()}")
     start = time.perf_counter()
     runs = None if args.no_build else bench_builds(Path(args.specs), args.quick, args.jobs)
-    arm_times = bench_engine(counts, repeats)
-    bench_pinocchio(counts, repeats, arm_times)
+    times = bench_engine(counts, repeats)
+    bench_pinocchio(counts, repeats, times)
     report_validation(runs)
     print(f"\n(benchmarks took {time.perf_counter() - start:.1f} s)")
     return 0

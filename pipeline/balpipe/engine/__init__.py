@@ -1,0 +1,54 @@
+"""The generic planar multibody engine: kinematics, inverse dynamics and shaking loads.
+
+Coordinates are absolute: body k has q_k = (x, y, theta) of its centre of mass (attachments
+included). The frame is body 0 with q_0 = 0; it takes part in the constraint Jacobian so that
+``-J_0^T lambda`` is directly the load the mechanism puts on the frame (force, and moment about
+the origin O).
+
+Every joint and driver reduces to three constraint primitives, each vectorised over the N time
+samples:
+
+* ``coincident``: r_i + A_i s_i - r_j - A_j s_j = 0 (2 rows; revolute joints);
+* ``angle``: sum_k c_k theta_k - c0 - f(t) = 0 (relative angles, gears, angle drivers,
+  the rotation lock of a prismatic pair);
+* ``projection``: (A_i a)^T (r_j + A_j s_j - r_i - A_i s_i) - c0 - f(t) = 0 (the guide of a
+  prismatic pair, prismatic drivers, point-coordinate drivers).
+
+Position analysis is Newton-Raphson on Phi(q, t) = 0; velocities solve Phi_q q' = nu and
+accelerations Phi_q q'' = gamma (Haug, Computer-Aided Kinematics and Dynamics, ch. 3 and 6).
+Inverse dynamics solves Phi_q^T lambda = Q - M q'' (M q'' + Phi_q^T lambda = Q).
+
+Redundant actuation (more drivers than degrees of freedom, e.g. a 4-RRR with four base motors):
+the consistent over-determined position, velocity and acceleration equations are solved in least
+squares (Gauss-Newton, least squares by QR, exact for consistent drivers), and the
+multipliers are those whose actuator efforts have the least norm (:func:`_multipliers`). The
+joints alone must not be over-constrained. The shaking
+loads are computed twice, independently:
+
+(a) reactions: F_sh, M_sh = -Phi_{q0}^T lambda (all frame joints, actuator reactions and gear
+    mesh couples on the frame); a gear pair with pitch radii has its row rewritten as tooth
+    forces at the pitch point for the dynamics (:func:`_tooth_rows`, :mod:`balpipe.meshes`), so
+    that its bearings carry the tooth force;
+(b) momentum: F_sh = sum m g - dP/dt, M_O = sum r x m g - dH_O/dt.
+
+Modules, one job each: :mod:`.compile` (primitives, :func:`compile_model`), :mod:`.constraints`
+(Phi, Phi_q, nu, gamma), :mod:`.positions`, :mod:`.kinematics` (velocities, accelerations),
+:mod:`.dynamics` (multipliers, tooth loads, reactions), :mod:`.analysis` (:class:`Analysis`,
+:func:`analyse`).
+"""
+
+from .analysis import Analysis, analyse, clear_cache, compiled
+from .compile import Compiled, _Angle, _Coincident, _Mesh, _perp, _Projection, _rotate, compile_model
+from .constraints import _extend, _law_values, _split, acceleration_rhs, jacobian, residual, velocity_rhs
+from .dynamics import _joint_reactions, _multipliers, _radial_tooth_loads, _tooth_rows
+from .errors import AnalysisError
+from .kinematics import _solve_rect, _vel_acc
+from .positions import (
+    _COARSE, _COND_LIMIT, _JUMP, _MAX_ITER, _TOL, _check_regular, _check_redundancy, _check_square,
+    _fail_position, _newton, _substep, _worst_rows, condition_numbers, follow_motion, redundancy, solve_positions,
+)
+
+__all__ = [
+    "Analysis", "AnalysisError", "Compiled", "acceleration_rhs", "analyse", "clear_cache", "compile_model", "compiled", "jacobian",
+    "redundancy", "residual", "solve_positions", "velocity_rhs",
+]

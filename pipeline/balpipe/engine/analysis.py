@@ -1,0 +1,244 @@
+"""The engine's result, :class:`Analysis`, and :func:`analyse`: kinematics, inverse dynamics and
+both routes to the shaking loads."""
+
+from __future__ import annotations
+
+import functools
+import weakref
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model import Model
+from . import fastpath, structure
+from .compile import Compiled, _rotate, compile_model
+from .constraints import _extend, jacobian
+from .dynamics import _joint_reactions, _multipliers, _radial_tooth_loads, _tooth_rows
+from .kinematics import _vel_acc
+from .positions import condition_numbers, redundancy, solve_positions
+
+
+@dataclass
+class Analysis:
+    """Everything the engine computes for one model along one motion (SI units).
+
+    ``q``, ``v``, ``a``: (N, nb, 3) centre-of-mass coordinates and their derivatives.
+    ``force``/``moment``: shaking force (N, 2) and moment (N,) on the frame from the reactions
+    (route a), about ``moment_point``; ``force_momentum``/``moment_momentum`` the same from the
+    momentum derivative (route b). ``efforts``: actuator torque or force per driver, applied by
+    the actuator to the driven body. ``reactions``: constraint loads per joint (the generalized
+    forces of the joint's multipliers, see :func:`_joint_reactions`), for revolutes the force
+    exerted on body b by body a.
+    """
+
+    t: np.ndarray
+    names: list[str]
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    force: np.ndarray
+    moment: np.ndarray
+    force_momentum: np.ndarray
+    moment_momentum: np.ndarray
+    efforts: dict[str, np.ndarray]
+    reactions: dict[str, dict[str, np.ndarray]]
+    com: np.ndarray
+    momentum: np.ndarray
+    angular_momentum: np.ndarray
+    moment_point: tuple[float, float]
+    gravity: tuple[float, float]
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def max_force(self) -> float:
+        return float(np.max(np.linalg.norm(self.force, axis=1)))
+
+    @property
+    def max_moment(self) -> float:
+        return float(np.max(np.abs(self.moment)))
+
+    def static_load(self) -> tuple[np.ndarray, np.ndarray]:
+        """The part of the shaking loads due to the moving links' weight: the force m g (2,)
+        and its moment (N,) about the moment point, (r_com - P) x m g. Zero without gravity."""
+        W = self.extra["total_mass"] * np.asarray(self.gravity)
+        r = self.com - np.asarray(self.moment_point)
+        return W, r[:, 0] * W[1] - r[:, 1] * W[0]
+
+    @property
+    def inertial_force(self) -> np.ndarray:
+        """Shaking force minus the links' weight: -dP/dt (N, 2)."""
+        return self.force - self.static_load()[0]
+
+    @property
+    def inertial_moment(self) -> np.ndarray:
+        """Shaking moment minus the weight's moment: -dH_P/dt (N,)."""
+        return self.moment - self.static_load()[1]
+
+    @property
+    def max_inertial_force(self) -> float:
+        return float(np.max(np.linalg.norm(self.inertial_force, axis=1)))
+
+    @property
+    def max_inertial_moment(self) -> float:
+        return float(np.max(np.abs(self.inertial_moment)))
+
+    def route_difference(self) -> tuple[float, float]:
+        """Absolute max |reactions - momentum| of the force (N) and of the moment (N m); the
+        study divides them by the unbalanced stage's peaks."""
+        df = float(np.max(np.linalg.norm(self.force - self.force_momentum, axis=1)))
+        dm = float(np.max(np.abs(self.moment - self.moment_momentum)))
+        return df, dm
+
+    def pose(self, k: int, body: str) -> tuple[float, float, float]:
+        """Pose of a body's own frame (not its centre of mass) at sample k."""
+        i = self.names.index(body)
+        return self.extra["frame_pose"][k, i].tolist()
+
+
+class _Extra(dict):
+    """``Analysis.extra``, whose ``condition`` entry (the condition numbers of Phi_q along the
+    motion, an SVD per sample) is computed when first read. Pickles as a plain dict."""
+
+    def __init__(self, data: dict, condition):
+        super().__init__(data)
+        self._condition = condition
+
+    def __missing__(self, key):
+        if key == "condition" and self._condition is not None:
+            self["condition"] = value = self._condition()
+            return value
+        raise KeyError(key)
+
+    def __contains__(self, key) -> bool:
+        return super().__contains__(key) or (key == "condition" and self._condition is not None)
+
+    def get(self, key, default=None):
+        return self[key] if key in self else default
+
+    def __reduce__(self):
+        if self._condition is not None:
+            self["condition"]
+        return (dict, (dict(self),))
+
+
+_COMPILED: dict[int, tuple[weakref.ref, Compiled]] = {}
+
+
+def compiled(model: Model) -> Compiled:
+    """:func:`compile_model`, kept per model object (and its block structure, shared by every
+    model of the same pattern, :func:`.structure.decompose`)."""
+    hit = _COMPILED.get(id(model))
+    if hit is not None and hit[0]() is model:
+        return hit[1]
+    c = compile_model(model)
+    if len(_COMPILED) >= 128:
+        _COMPILED.clear()
+    _COMPILED[id(model)] = (weakref.ref(model), c)
+    return c
+
+
+def clear_cache() -> None:
+    """Forget compiled models and block structures (for benchmarks of cold calls)."""
+    _COMPILED.clear()
+    structure._CACHE.clear()
+    fastpath._MOTIONS.clear()
+
+
+def analyse(
+    model: Model,
+    t: np.ndarray,
+    gravity: tuple[float, float] = (0.0, 0.0),
+    moment_point: tuple[float, float] = (0.0, 0.0),
+    *,
+    method: str = "auto",
+) -> Analysis:
+    """Kinematics, inverse dynamics and shaking loads of ``model`` at times ``t``.
+
+    ``method``: ``"auto"`` takes the block-triangular path (:mod:`.fastpath`) where it applies
+    and the general dense path otherwise; ``"dense"`` forces the general path (continuation,
+    batched Newton-Raphson and dense batched solves on every sample's full Jacobian). Both give
+    the same results to round-off.
+    """
+    if method not in ("auto", "dense"):
+        raise ValueError(f"method must be 'auto' or 'dense', not {method!r}")
+    c = compiled(model)
+    t = np.asarray(t, dtype=float)
+    g = np.asarray(gravity, dtype=float)
+    Mdiag = np.stack([c.mass, c.mass, c.inertia], axis=1).reshape(1, -1)
+    kin = None
+    if method == "auto":
+        if c.fast is None:
+            c.fast = fastpath.prepare(c)
+        try:
+            kin = fastpath.kinematics(c, c.fast, t)
+        except fastpath.Fallback:
+            kin = None
+    if kin is None:
+        q = solve_positions(c, t)
+        v, a = _vel_acc(c, q, t)
+        cond = c.condition
+        condition = None
+    else:
+        q, v, a = kin.X[3:-1].T, kin.V[3:-1].T, kin.A[3:-1].T
+        cond = None
+        condition = functools.partial(condition_numbers, c, q)
+    if kin is not None and not c.meshes:
+        rhsT = -Mdiag.T * kin.A[3:-1]
+        rhsT[0::3] += (c.mass * g[0])[:, None]
+        rhsT[1::3] += (c.mass * g[1])[:, None]
+        lamT = fastpath.multipliers(c.fast, kin, rhsT)
+        lam = lamT.T
+        mesh_geo: list = []
+        gen0 = fastpath.frame_load(c.fast, kin.vals, lamT)
+    else:
+        qx = _extend(q)
+        J = jacobian(c, qx)
+        mesh_geo = _tooth_rows(c, qx, J)  # gear meshes with pitch radii act by tooth forces
+        Jf, J0 = J[:, :, 3:], J[:, :, :3]
+        Q = np.zeros_like(q)
+        Q[:, 0::3] = c.mass * g[0]
+        Q[:, 1::3] = c.mass * g[1]
+        rhs = Q - Mdiag * a
+        lam = _multipliers(c, Jf, rhs)
+        lam, radial_on_frame = _radial_tooth_loads(c, mesh_geo, lam)
+        gen0 = -np.einsum("nmk,nm->nk", J0, lam) + radial_on_frame  # load on the frame: Fx, Fy, M_O
+    P = np.asarray(moment_point, dtype=float)
+    force = gen0[:, :2]
+    moment_O = gen0[:, 2]
+
+    nb = c.nb
+
+    qb, vb, ab = q.reshape(-1, nb, 3), v.reshape(-1, nb, 3), a.reshape(-1, nb, 3)
+    m, I = c.mass, c.inertia
+    r, rd, rdd = qb[:, :, :2], vb[:, :, :2], ab[:, :, :2]
+    cross = lambda u, w: u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]  # noqa: E731
+    dP = np.einsum("k,nkd->nd", m, rdd)
+    dH = np.einsum("k,nk->n", m, cross(r, rdd)) + ab[:, :, 2] @ I
+    weight = m.sum() * g
+    force_mom = weight[None, :] - dP
+    moment_mom = np.einsum("k,nk->n", m, cross(r, np.broadcast_to(g, r.shape))) - dH
+    momentum = np.einsum("k,nkd->nd", m, rd)
+    ang = np.einsum("k,nk->n", m, cross(r, rd)) + vb[:, :, 2] @ I
+    com = np.einsum("k,nkd->nd", m, r) / m.sum() if m.sum() > 0 else np.zeros((len(t), 2))
+
+    def about_P(M: np.ndarray, F: np.ndarray) -> np.ndarray:
+        return M - (P[0] * F[:, 1] - P[1] * F[:, 0])
+
+    efforts = {name: -lam[:, row] for name, row in c.driver_rows.items()}
+    reactions = _joint_reactions(model, c, lam, mesh_geo)
+    # frame poses for drawing: frame origin = com - A(theta) com_local
+    frame_pose = np.zeros_like(qb)
+    for k, b in enumerate(model.bodies):
+        _, cl, _ = b.mass_properties()
+        frame_pose[:, k, :2] = qb[:, k, :2] - _rotate(qb[:, k, 2], np.asarray(cl))
+        frame_pose[:, k, 2] = qb[:, k, 2]
+    return Analysis(
+        t=t, names=c.names, q=qb, v=vb, a=ab,
+        force=force, moment=about_P(moment_O, force),
+        force_momentum=force_mom, moment_momentum=about_P(moment_mom, force_mom),
+        efforts=efforts, reactions=reactions, com=com, momentum=momentum, angular_momentum=ang,
+        moment_point=(float(P[0]), float(P[1])), gravity=(float(g[0]), float(g[1])),
+        extra=_Extra({"frame_pose": frame_pose, "total_mass": float(m.sum()),
+                      "redundant_actuators": redundancy(c), **({"condition": cond} if cond is not None else {})},
+                     condition),
+    )

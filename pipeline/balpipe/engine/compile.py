@@ -1,0 +1,241 @@
+"""Compilation of a :class:`~balpipe.model.Model` into constraint primitives (see the package
+docstring): body indices, joint points relative to each centre of mass, constraint rows."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..meshes import mesh_geometry
+from ..model import FRAME, Driver, Gear, Model, Prismatic, Revolute, pose_of_com
+
+
+def _perp(v: np.ndarray) -> np.ndarray:
+    """Rotate vectors (..., 2) by +90 degrees."""
+    out = np.empty_like(v)
+    out[..., 0] = -v[..., 1]
+    out[..., 1] = v[..., 0]
+    return out
+
+
+def _rotate(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """A(theta) s for theta (N,), s (2,) -> (N, 2)."""
+    c, si = np.cos(theta), np.sin(theta)
+    out = np.empty(theta.shape + (2,))
+    out[..., 0] = c * s[0] - si * s[1]
+    out[..., 1] = si * s[0] + c * s[1]
+    return out
+
+
+@dataclass
+class _Coincident:
+    owner: str
+    i: int
+    si: np.ndarray
+    j: int
+    sj: np.ndarray
+    rows: int = 2
+
+
+@dataclass
+class _Angle:
+    owner: str
+    coeffs: list[tuple[int, float]]
+    const: float = 0.0
+    law: object = None
+    rows: int = 1
+
+
+@dataclass
+class _Projection:
+    owner: str
+    i: int
+    a: np.ndarray
+    si: np.ndarray
+    j: int
+    sj: np.ndarray
+    const: float = 0.0
+    law: object = None
+    rows: int = 1
+
+
+@dataclass
+class Compiled:
+    """A model prepared for vectorised evaluation."""
+
+    model: Model
+    names: list[str]  # body names, index k+1 for body k (0 is the frame)
+    mass: np.ndarray  # (nb,)
+    inertia: np.ndarray  # (nb,)
+    prims: list
+    row_owner: list[str]  # joint/driver name per constraint row
+    driver_rows: dict[str, int]
+    joint_rows: dict[str, list[int]]
+    q0: np.ndarray  # (3 nb,) initial guess
+    condition: np.ndarray | None = None  # condition numbers of Phi_q along the last motion solved
+    meshes: list = field(default_factory=list)  # _Mesh: gear pairs that pass tooth forces
+    fast: object = None  # the block-triangular path's data (:func:`.fastpath.prepare`), made once
+    com_local: np.ndarray | None = None  # (nb, 2) centres of mass in the bodies' own frames
+
+    @property
+    def nb(self) -> int:
+        return len(self.names)
+
+
+def compile_model(model: Model) -> Compiled:
+    """Index bodies, express joint points relative to each body's centre of mass and reduce
+    joints and drivers to primitives."""
+    names = [b.name for b in model.bodies]
+    if FRAME in names:
+        raise ValueError(f"'{FRAME}' is reserved for the fixed frame")
+    if len(set(names)) != len(names):
+        raise ValueError("body names must be unique")
+    index = {FRAME: 0, **{n: k + 1 for k, n in enumerate(names)}}
+    com = {FRAME: np.zeros(2)}
+    mass, inertia = [], []
+    for b in model.bodies:
+        m, c, i = b.mass_properties()
+        if m < 0 or i < 0:
+            raise ValueError(f"body {b.name!r} has a negative mass or inertia")
+        mass.append(m)
+        inertia.append(i)
+        com[b.name] = np.array(c, dtype=float)
+
+    def idx(name: str, where: str) -> int:
+        try:
+            return index[name]
+        except KeyError:
+            raise ValueError(f"{where} refers to unknown body {name!r}") from None
+
+    def local(name: str, p) -> np.ndarray:
+        return np.asarray(p, dtype=float) - com[name]
+
+    init = {FRAME: (0.0, 0.0, 0.0)}
+    for b in model.bodies:
+        if b.name not in model.initial:
+            raise ValueError(f"body {b.name!r} has no initial pose")
+        init[b.name] = pose_of_com(b, model.initial[b.name])
+
+    prims: list = []
+    joints_by_name = {}
+    for jt in model.joints:
+        if jt.name in joints_by_name:
+            raise ValueError(f"joint name {jt.name!r} is used twice")
+        joints_by_name[jt.name] = jt
+        if isinstance(jt, Revolute):
+            prims.append(
+                _Coincident(jt.name, idx(jt.a, jt.name), local(jt.a, jt.point_a), idx(jt.b, jt.name), local(jt.b, jt.point_b))
+            )
+        elif isinstance(jt, Prismatic):
+            g, s = idx(jt.guide, jt.name), idx(jt.slider, jt.name)
+            ax = np.asarray(jt.axis, dtype=float)
+            ax = ax / np.linalg.norm(ax)
+            prims.append(_Angle(jt.name, [(s, 1.0), (g, -1.0)], jt.angle))
+            prims.append(
+                _Projection(jt.name, g, _perp(ax), local(jt.guide, jt.point_guide), s, local(jt.slider, jt.point_slider))
+            )
+        elif isinstance(jt, Gear):
+            a, b, c = idx(jt.a, jt.name), idx(jt.b, jt.name), idx(jt.carrier, jt.name)
+            coeffs: dict[int, float] = {}
+            for k, v in ((b, 1.0), (c, -1.0), (a, -jt.ratio), (c, jt.ratio)):
+                coeffs[k] = coeffs.get(k, 0.0) + v
+            if jt.phase is None:
+                th = {n: init[n][2] for n in (jt.a, jt.b, jt.carrier)}
+                phase = (th[jt.b] - th[jt.carrier]) - jt.ratio * (th[jt.a] - th[jt.carrier])
+            else:
+                phase = jt.phase
+            prims.append(_Angle(jt.name, [(k, v) for k, v in coeffs.items() if v != 0.0], phase))
+        else:  # pragma: no cover - the Joint union is closed
+            raise TypeError(jt)
+
+    driver_rows: dict[str, int] = {}
+    for d in model.drivers:
+        start = len(prims)
+        prims.append(_driver_primitive(d, joints_by_name, idx, local, model))
+        driver_rows[d.name] = start
+
+    row_owner: list[str] = []
+    joint_rows: dict[str, list[int]] = {}
+    prim_first_row = []
+    for p in prims:
+        prim_first_row.append(len(row_owner))
+        joint_rows.setdefault(p.owner, []).extend(range(len(row_owner), len(row_owner) + p.rows))
+        row_owner.extend([p.owner] * p.rows)
+    driver_rows = {n: prim_first_row[k] for n, k in driver_rows.items()}
+
+    q0 = np.array([v for n in names for v in init[n]], dtype=float)
+    compiled = Compiled(
+        model, names, np.array(mass), np.array(inertia), prims, row_owner, driver_rows, joint_rows, q0
+    )
+    compiled.meshes = _compile_meshes(model, idx, local, joint_rows)
+    compiled.com_local = np.array([com[n] for n in names], dtype=float).reshape(-1, 2)
+    return compiled
+
+
+@dataclass
+class _Mesh:
+    """A gear pair with pitch radii (see :mod:`balpipe.meshes`), indexed for the engine."""
+
+    name: str
+    row: int  # the gear's constraint row
+    ia: int
+    ib: int
+    ic: int
+    sca: np.ndarray  # bearing centres O_a, O_b on the carrier (relative to its centre of mass)
+    scb: np.ndarray
+    pitch_a: float
+    pitch_b: float
+    side: float
+    external: bool
+    tan_alpha: float
+    rows_a: list[int]  # rows of the bearings' revolute joints
+    rows_b: list[int]
+    sign_a: float  # +1 when the gear is body b of its bearing (its reaction is the force on the gear)
+    sign_b: float
+
+
+def _compile_meshes(model: Model, idx, local, joint_rows: dict[str, list[int]]) -> list[_Mesh]:
+    out = []
+    for jt in model.joints:
+        if not isinstance(jt, Gear):
+            continue
+        geo = mesh_geometry(model, jt)
+        if geo is None:
+            continue
+        ba, bb = geo.bearing_a, geo.bearing_b
+        out.append(_Mesh(
+            jt.name, joint_rows[jt.name][0], idx(jt.a, jt.name), idx(jt.b, jt.name), idx(jt.carrier, jt.name),
+            local(jt.carrier, ba.centre_carrier), local(jt.carrier, bb.centre_carrier),
+            geo.pitch_a, geo.pitch_b, geo.side, geo.external, float(np.tan(geo.pressure_angle)),
+            joint_rows[ba.joint], joint_rows[bb.joint],
+            1.0 if ba.gear_is_b else -1.0, 1.0 if bb.gear_is_b else -1.0,
+        ))
+    return out
+
+
+def _driver_primitive(d: Driver, joints: dict, idx, local, model: Model):
+    kind = d.target[0]
+    if kind == "joint":
+        jt = joints.get(d.target[1])
+        if jt is None:
+            raise ValueError(f"driver {d.name!r} refers to unknown joint {d.target[1]!r}")
+        if isinstance(jt, Revolute):
+            return _Angle(d.name, [(idx(jt.b, d.name), 1.0), (idx(jt.a, d.name), -1.0)], 0.0, d.law)
+        if isinstance(jt, Prismatic):
+            ax = np.asarray(jt.axis, dtype=float)
+            ax = ax / np.linalg.norm(ax)
+            return _Projection(
+                d.name, idx(jt.guide, d.name), ax, local(jt.guide, jt.point_guide),
+                idx(jt.slider, d.name), local(jt.slider, jt.point_slider), 0.0, d.law,
+            )
+        raise ValueError(f"driver {d.name!r}: a gear pair cannot be driven, drive one of its bodies")
+    body = d.target[1]
+    b = idx(body, d.name)
+    if kind == "angle":  # absolute angle: theta_b - theta_frame, so the reaction lands on the frame
+        return _Angle(d.name, [(b, 1.0), (0, -1.0)], 0.0, d.law)
+    if kind in ("x", "y"):
+        point = model.body(body).point(d.target[2]) if len(d.target) > 2 else (0.0, 0.0)
+        axis = np.array([1.0, 0.0]) if kind == "x" else np.array([0.0, 1.0])
+        return _Projection(d.name, 0, axis, np.zeros(2), b, local(body, point), 0.0, d.law)
+    raise ValueError(f"driver {d.name!r}: unknown target {d.target!r}")

@@ -1,0 +1,127 @@
+"""Inverse dynamics: Lagrange multipliers (least-norm efforts under redundant actuation), gear
+tooth forces and joint reactions."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..model import Model, Prismatic, Revolute
+from .compile import Compiled, _perp, _rotate
+from .constraints import _split
+
+
+def _tooth_rows(c: Compiled, qx: np.ndarray, J: np.ndarray) -> list[dict[str, np.ndarray]]:
+    """Write each mesh's generalized force as tooth forces at its pitch point (in place in J).
+
+    The gear's angle row is replaced by the rolling condition t . (v_P(b) - v_P(a)) = 0 at the
+    pitch point P = O_a + s r_a u of the bearings' centres O_a, O_b on the carrier (u from O_a
+    to O_b, t = perp(u)): on b the row is (t, (P - r_b) x t), on a (-t, -(P - r_a) x t). Where
+    the bearings are closed it equals -r_b times the angle row plus a combination of the
+    bearings' rows, so the motion, the efforts and the frame loads are unchanged, the mesh's
+    multiplier becomes the tangential tooth force (-lambda t on b) and the bearings' multipliers
+    carry it (Haug, ch. 6: a constraint's reaction is -Phi_q^T lambda for any equivalent
+    choice of rows). Returns the geometry (u, t, P, O_b) per mesh for the reactions.
+    """
+    geo = []
+    for m in c.meshes:
+        rc, thc = _split(qx, m.ic)
+        Oa = rc + _rotate(thc, m.sca)
+        Ob = rc + _rotate(thc, m.scb)
+        d = Ob - Oa
+        u = d / np.linalg.norm(d, axis=1)[:, None]
+        t = _perp(u)
+        P = Oa + (m.side * m.pitch_a) * u
+        J[:, m.row, :] = 0.0
+        for k, sign in ((m.ib, 1.0), (m.ia, -1.0)):
+            rk, _ = _split(qx, k)
+            arm = P - rk
+            J[:, m.row, 3 * k : 3 * k + 2] += sign * t
+            J[:, m.row, 3 * k + 2] += sign * (arm[:, 0] * t[:, 1] - arm[:, 1] * t[:, 0])
+        geo.append({"u": u, "t": t, "P": P, "Ob": Ob})
+    return geo
+
+
+def _radial_tooth_loads(
+    c: Compiled, geo: list[dict[str, np.ndarray]], lam: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Add each mesh's radial tooth force, |F_t| tan(pressure angle), to its bearings.
+
+    The radial pair (on b: +F_r u for an external mesh, which it pushes apart, -F_r u for an
+    internal one; the opposite on a) acts at P on the line of centres, so it has no moment about
+    either bearing and its forces on the carrier, at O_a and O_b, cancel: the increments of the
+    two bearings' multipliers below are the exact solution of Phi_q^T dlambda = Q_radial, every
+    other multiplier (and so the efforts) unchanged. When a gear is the frame itself (a fixed
+    sun), the radial force its teeth take is an applied load on the frame, not a multiplier:
+    it is returned as (Fx, Fy, M_O) per sample, to add to the frame's load -Phi_q0^T lambda.
+    """
+    on_frame = np.zeros((lam.shape[0], 3))
+    for m, g in zip(c.meshes, geo):
+        Fr = np.abs(lam[:, m.row]) * m.tan_alpha
+        on_b = (Fr if m.external else -Fr)[:, None] * g["u"]  # radial tooth force on gear b
+        lam[:, m.rows_b] -= m.sign_b * on_b  # the bearing of b takes it back ...
+        lam[:, m.rows_a] += m.sign_a * on_b  # ... and that of a the opposite one
+        for k, f in ((m.ia, -on_b), (m.ib, on_b)):
+            if k == 0:
+                P = g["P"]
+                on_frame[:, :2] += f
+                on_frame[:, 2] += P[:, 0] * f[:, 1] - P[:, 1] * f[:, 0]
+    return lam, on_frame
+
+
+def _joint_reactions(
+    model: Model, c: Compiled, lam: np.ndarray, geo: list[dict[str, np.ndarray]] | None = None
+) -> dict[str, dict[str, np.ndarray]]:
+    """Loads that each joint transmits, from its multipliers (constraint force = -Phi_q^T lam).
+
+    Revolute: force (Fx, Fy) exerted on body b by body a (Phi = P_a - P_b, so it is +lam); a
+    gear's bearing includes the tooth force. Prismatic: N, the force on the slider along the
+    guide's left normal (-lam of the guide row), and M, the moment on the slider (-lam of the
+    rotation lock). Gear: T, the torque on gear b relative to the carrier (-lam of the angle
+    row; with pitch radii the moment of the tooth force about b's centre), and with pitch radii
+    Ft = T / r_b, the tangential tooth force on b (positive when it turns b counter-clockwise)
+    and Fr >= 0, the radial one (|Ft| tan(pressure angle)).
+    """
+    out: dict[str, dict[str, np.ndarray]] = {}
+    tooth = {m.name: (m, g) for m, g in zip(c.meshes, geo or [])}
+    for jt in model.joints:
+        rows = c.joint_rows[jt.name]
+        if isinstance(jt, Revolute):
+            out[jt.name] = {"Fx": lam[:, rows[0]], "Fy": lam[:, rows[1]]}
+        elif isinstance(jt, Prismatic):
+            out[jt.name] = {"N": -lam[:, rows[1]], "M": -lam[:, rows[0]]}
+        elif jt.name in tooth:
+            m, g = tooth[jt.name]
+            F = -lam[:, rows[0]][:, None] * g["t"]  # tangential tooth force on b
+            arm = g["P"] - g["Ob"]
+            T = arm[:, 0] * F[:, 1] - arm[:, 1] * F[:, 0]
+            out[jt.name] = {"T": T, "Ft": T / m.pitch_b, "Fr": np.abs(lam[:, rows[0]]) * m.tan_alpha}
+        else:
+            out[jt.name] = {"T": -lam[:, rows[0]]}
+    return out
+
+
+def _multipliers(c: Compiled, Jf: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Lagrange multipliers from Phi_q^T lambda = Q - M q'' (N samples).
+
+    Square Jacobian: the unique solution. Redundant actuation (r more rows than coordinates):
+    Phi_q^T has an r-dimensional null space, the internal (antagonistic) loads that the
+    actuators can add without moving anything. Of all solutions, lambda_p + N z, the one whose
+    driver rows (the actuator efforts) have the least Euclidean norm is taken: z minimises
+    |S (lambda_p + N z)| with S the driver rows. The joint multipliers follow from the same
+    lambda, so every reaction is consistent with the efforts; the frame load -Phi_q0^T lambda
+    still equals minus the momentum rate, whatever the split (the null space loads every body
+    with zero net force). This is the pseudo-inverse solution tau = (G^T)^+ f of the reduced
+    dynamics G^T tau = f, G the Jacobian of the actuated coordinates.
+    """
+    A = np.transpose(Jf, (0, 2, 1))  # (N, n, m)
+    n, m = A.shape[1], A.shape[2]
+    if m == n:
+        return np.linalg.solve(A, rhs[..., None])[..., 0]
+    Q, R = np.linalg.qr(Jf, mode="complete")  # Jf = [Q1 Q2] [R1; 0]: Q2 spans the null space of A
+    y = np.linalg.solve(np.transpose(R[:, :n, :], (0, 2, 1)), rhs[..., None])[..., 0]  # R1^T y = rhs
+    lam_p = np.einsum("nmk,nk->nm", Q[:, :, :n], y)  # the least-norm solution, Q1 R1^-T rhs
+    null = Q[:, :, n:]  # (N, m, r)
+    drv = sorted(c.driver_rows.values())
+    S_null = null[:, drv, :]  # (N, d, r)
+    z = -np.einsum("nij,nj->ni", np.linalg.pinv(S_null), lam_p[:, drv])
+    return lam_p + np.einsum("nmr,nr->nm", null, z)

@@ -1,0 +1,33 @@
+"""Velocities and accelerations: Phi_q q' = nu and Phi_q q'' = gamma (Haug, eqs. 3.4.x, 6.x)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .compile import Compiled
+from .constraints import _extend, acceleration_rhs, jacobian, velocity_rhs
+
+
+def _solve_rect(J: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Solve J x = b for stacks (N, m, n) of full-column-rank J: exact when square, the least-
+    squares solution of a consistent over-determined system (redundant drivers) otherwise."""
+    if J.shape[-2] == J.shape[-1]:
+        return np.linalg.solve(J, b[..., None])[..., 0]
+    Q, R = np.linalg.qr(J)  # reduced: J = Q R, R (n, n) upper triangular
+    return np.linalg.solve(R, np.einsum("nji,nj->ni", Q, b)[..., None])[..., 0]
+
+
+def _vel_acc_safe(c: Compiled, q: np.ndarray, t: float):
+    try:
+        v, a = _vel_acc(c, q[None, :], np.array([t]))
+        return v[0], a[0]
+    except np.linalg.LinAlgError:
+        return np.zeros_like(q), np.zeros_like(q)
+
+
+def _vel_acc(c: Compiled, q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    qx = _extend(q)
+    J = jacobian(c, qx)[:, :, 3:]
+    v = _solve_rect(J, velocity_rhs(c, t))
+    a = _solve_rect(J, acceleration_rhs(c, qx, _extend(v), t))
+    return v, a

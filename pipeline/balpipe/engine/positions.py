@@ -1,0 +1,205 @@
+"""Position analysis: assembly, continuation along a coarse grid and batched Newton-Raphson on
+Phi(q, t) = 0, with the regularity (singularity) check."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .compile import Compiled
+from .constraints import _extend, jacobian, residual
+from .errors import AnalysisError
+from .kinematics import _solve_rect, _vel_acc, _vel_acc_safe
+
+_TOL = 1e-12
+_MAX_ITER = 25
+_COND_LIMIT = 1e11
+_COARSE = 17  # samples followed by continuation before the batched refinement
+_JUMP = 0.2  # rad: a refined angle this far from its interpolated guess may be another branch
+
+
+def _check_square(c: Compiled) -> None:
+    """Fewer equations than coordinates is an error; more are allowed when only drivers are
+    redundant (redundant actuation, checked by :func:`_check_redundancy` once assembled)."""
+    m, n = len(c.row_owner), 3 * c.nb
+    if m < n:
+        raise AnalysisError(
+            f"the model has {n} coordinates but {m} constraint equations: add drivers or joints "
+            "(it can move freely)"
+        )
+    if m > n and m - len(c.driver_rows) > n:
+        raise AnalysisError(
+            f"the model has {n} coordinates but its joints alone give {m - len(c.driver_rows)} "
+            "constraint equations: it is over-constrained (only actuators may be redundant)"
+        )
+
+
+def redundancy(c: Compiled) -> int:
+    """Number of redundant actuators: constraint rows beyond the coordinates (0 when square)."""
+    return len(c.row_owner) - 3 * c.nb
+
+
+def _check_redundancy(c: Compiled, q: np.ndarray, t: float) -> None:
+    """With redundant actuation the joints' own rows must be independent (else the multipliers,
+    hence the reactions, are not determined by the minimum-norm efforts)."""
+    if redundancy(c) == 0:
+        return
+    J = jacobian(c, _extend(q[None, :]))[0, :, 3:]
+    drv = set(c.driver_rows.values())
+    rows = [r for r in range(J.shape[0]) if r not in drv]
+    s = np.linalg.svd(J[rows], compute_uv=False)
+    if s[-1] <= 1e-10 * s[0]:
+        raise AnalysisError(
+            f"at t = {t:.6g} s the joints' constraint equations are dependent (condition "
+            f"{s[0] / max(s[-1], 1e-300):.2g}): the mechanism is over-constrained by its joints, "
+            "not only by redundant actuators", t,
+        )
+
+
+def _newton(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER):
+    """Batched Newton-Raphson. Returns (q, converged mask, residual norms)."""
+    q = q.copy()
+    norms = np.full(len(t), np.inf)
+    for _ in range(max_iter):
+        qx = _extend(q)
+        phi = residual(c, qx, t)
+        norms = np.abs(phi).max(axis=1)
+        todo = ~(norms < _TOL)
+        if not todo.any():
+            break
+        J = jacobian(c, qx[todo])[:, :, 3:]
+        try:
+            dq = _solve_rect(J, -phi[todo])
+        except np.linalg.LinAlgError:
+            dq = np.stack([np.linalg.lstsq(Jk, -pk, rcond=None)[0] for Jk, pk in zip(J, phi[todo])])
+        q[todo] += dq
+    qx = _extend(q)
+    norms = np.abs(residual(c, qx, t)).max(axis=1)
+    return q, norms < 1e-9, norms
+
+
+def _worst_rows(c: Compiled, values: np.ndarray) -> str:
+    order = np.argsort(-np.abs(values))
+    names: list[str] = []
+    for r in order:
+        if abs(values[r]) < 0.2 * abs(values[order[0]]):
+            break
+        if c.row_owner[r] not in names:
+            names.append(c.row_owner[r])
+    return ", ".join(repr(n) for n in names[:3])
+
+
+def _fail_position(c: Compiled, q: np.ndarray, t: float) -> AnalysisError:
+    qx = _extend(q[None, :])
+    phi = residual(c, qx, np.array([t]))[0]
+    worst = int(np.argmax(np.abs(phi)))
+    return AnalysisError(
+        f"position analysis did not converge at t = {t:.6g} s: joint {c.row_owner[worst]!r} cannot "
+        f"be closed (residual {abs(phi[worst]):.3g}); the motion leaves the mechanism's workspace",
+        t,
+        c.row_owner[worst],
+    )
+
+
+def condition_numbers(c: Compiled, q: np.ndarray) -> np.ndarray:
+    """2-norm condition numbers of Phi_q (N,) at positions q (N, 3 nb)."""
+    return _condition(jacobian(c, _extend(q))[:, :, 3:])
+
+
+def _condition(J: np.ndarray) -> np.ndarray:
+    s = np.linalg.svd(J, compute_uv=False)
+    return s[:, 0] / np.maximum(s[:, -1], 1e-300)
+
+
+def _check_regular(c: Compiled, q: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Condition numbers of Phi_q along the motion; a singular configuration is an error."""
+    J = jacobian(c, _extend(q))[:, :, 3:]
+    cond = _condition(J)
+    bad = np.flatnonzero(cond > _COND_LIMIT)
+    if bad.size:
+        k = int(bad[0])
+        u, _, _ = np.linalg.svd(J[k])
+        weak = u[:, J.shape[2] - 1]  # left vector of the smallest of the n singular values
+        raise AnalysisError(
+            f"singular configuration at t = {t[k]:.6g} s (condition number {cond[k]:.2g}): "
+            f"joints {_worst_rows(c, weak)} lose their rank (a dead point, a limit of the "
+            f"workspace or a branch change)",
+            float(t[k]),
+            c.row_owner[int(np.argmax(np.abs(weak)))],
+        )
+    return cond
+
+
+def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
+    """Positions (N, 3 nb) along the motion.
+
+    The first sample is assembled from the model's initial pose; a coarse grid is then followed
+    by continuation (second-order predictor), and all samples are refined at once by batched
+    Newton-Raphson from a cubic Hermite interpolation of the coarse solution. A singular
+    configuration on the way is an error (:func:`_check_regular`).
+    """
+    qall = follow_motion(c, t)
+    c.condition = _check_regular(c, qall, t)
+    return qall
+
+
+def follow_motion(c: Compiled, t: np.ndarray) -> np.ndarray:
+    """:func:`solve_positions` without the regularity check (the caller makes it)."""
+    _check_square(c)
+    N = len(t)
+    q, ok, _ = _newton(c, c.q0[None, :], t[:1], max_iter=50)
+    if not ok[0]:
+        raise AnalysisError(
+            "cannot assemble the mechanism at t = 0: " + str(_fail_position(c, q[0], float(t[0]))).split(": ", 1)[1],
+            float(t[0]),
+        )
+    _check_redundancy(c, q[0], float(t[0]))
+    coarse_idx = np.unique(np.linspace(0, N - 1, min(N, _COARSE)).round().astype(int))
+    tc = t[coarse_idx]
+    qc = np.zeros((len(tc), q.shape[1]))
+    vc = np.zeros_like(qc)
+    ac = np.zeros(qc.shape[1])
+    qc[0] = q[0]
+    for k in range(len(tc)):
+        if k > 0:
+            h = tc[k] - tc[k - 1]
+            guess = qc[k - 1] + vc[k - 1] * h + 0.5 * ac * h * h
+            sol, ok_k, _ = _newton(c, guess[None, :], tc[k : k + 1])
+            if not ok_k[0]:
+                # substep the continuation before giving up
+                sol = _substep(c, qc[k - 1], tc[k - 1], tc[k])
+            qc[k] = sol[0]
+        v, ac = _vel_acc(c, qc[k : k + 1], tc[k : k + 1])
+        vc[k], ac = v[0], ac[0]
+    # Hermite interpolation to the full grid
+    seg = np.clip(np.searchsorted(tc, t, side="right") - 1, 0, len(tc) - 2) if len(tc) > 1 else np.zeros(N, int)
+    if len(tc) > 1:
+        t0, t1 = tc[seg], tc[seg + 1]
+        h = (t1 - t0)[:, None]
+        s = ((t - t0) / (t1 - t0))[:, None]
+        h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
+        guess = h00 * qc[seg] + h10 * h * vc[seg] + h01 * qc[seg + 1] + h11 * h * vc[seg + 1]
+    else:
+        guess = np.repeat(qc[:1], N, axis=0)
+    qall, ok, _ = _newton(c, guess, t)
+    jumped = np.abs(qall[:, 2::3] - guess[:, 2::3]).max(axis=1) > _JUMP
+    for k in np.flatnonzero(~ok | jumped):  # rare: refine sequentially from the previous sample
+        prev = k - 1
+        qall[k] = _substep(c, qall[prev], t[prev], t[k])[0]
+    return qall
+
+
+def _substep(c: Compiled, q: np.ndarray, ta: float, tb: float, depth: int = 0) -> np.ndarray:
+    for n in (4, 16, 64):
+        cur = q.copy()
+        good = True
+        for tt in np.linspace(ta, tb, n + 1)[1:]:
+            v, a = _vel_acc_safe(c, cur, tt)
+            h = (tb - ta) / n
+            sol, ok, _ = _newton(c, (cur + v * h + 0.5 * a * h * h)[None, :], np.array([tt]))
+            if not ok[0]:
+                good = False
+                break
+            cur = sol[0]
+        if good:
+            return cur[None, :]
+    raise _fail_position(c, cur, float(tt))
