@@ -159,6 +159,9 @@ def test_page_draws_fig3_and_fig4b_with_what_was_assumed():
     assert "least Euclidean norm" in figs[t4][1] and "choice is ours" in figs[t4][1]
     for c in "abcdef":
         assert f"Fig. 3{c}" in figs[t3][0]
+    for title, (body, _) in figs.items():  # every drawing's axes carry their unit
+        if "<svg" in body[:500]:
+            assert "x (m)" in body and "y (m)" in body, title
     det = st.balance.details["topologies"]
     assert [d["figure"] for d in det["designs"]][-1] == "Fig. 4b"
     assert all(d["finder_residual"] <= TOL and d["eq17_residual"] <= TOL for d in det["designs"])

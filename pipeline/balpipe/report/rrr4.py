@@ -119,6 +119,8 @@ def _draw(ax, model, poses, span: float, max_cw: float, title: str) -> None:
     ax.plot(com[0], com[1], "*", color="tab:purple", markersize=11)
     ax.set_title(title, fontsize=8)
     ax.set_aspect("equal")
+    ax.set_xlabel("x (m)", fontsize=7)
+    ax.set_ylabel("y (m)", fontsize=7)
     ax.tick_params(labelsize=7)
 
 
