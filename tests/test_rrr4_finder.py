@@ -35,14 +35,20 @@ def test_finder_parameters_are_the_papers():
     assert G.finder_name("m5") == "m[platform]" and G.finder_name("m5q5") == "my[platform]"
 
 
+def _case(seed: int | None, base: int):
+    """The paper's manipulator (``seed`` None) or a regular random one (seed ``base + seed``):
+    its spec and unbalanced model."""
+    if seed is None:
+        spec = spec_of(paper_data())
+        return spec, registry.unbalanced_model(spec)
+    _, spec, model = regular_random(base + seed)
+    return spec, model
+
+
 @pytest.mark.parametrize("seed", [None, 0, 1, 2])
 def test_twelve_general_conditions_and_eq17_lies_in_their_space(seed):
     """12 conditions; each printed row of eq. 17 within 1e-9 of their space; a misprinted row is not."""
-    if seed is None:
-        spec = spec_of(paper_data())
-        model = registry.unbalanced_model(spec)
-    else:
-        _, spec, model = regular_random(300 + seed)
+    spec, model = _case(seed, 300)
     t = registry.time_grid(spec)
     found = G.check(model, t, cond.eq17(recipe.geometry(spec.mechanism)))
     assert found.general.count == 12
@@ -60,11 +66,7 @@ def test_twelve_general_conditions_and_eq17_lies_in_their_space(seed):
 
 @pytest.mark.parametrize("seed", [None, 0, 1])
 def test_leg_by_leg_solution_lies_in_the_computed_space(seed):
-    if seed is None:
-        spec = spec_of(paper_data())
-        model = registry.unbalanced_model(spec)
-    else:
-        _, spec, model = regular_random(310 + seed)
+    spec, model = _case(seed, 310)
     found = G.check(model, registry.time_grid(spec), cond.eq17(recipe.geometry(spec.mechanism)))
     lbl, _ = recipe.leg_by_leg(spec.mechanism, spec.balancing, model)
     assert found.design_residual(lbl) <= TOL
@@ -120,11 +122,7 @@ def test_six_conditions_suffice_for_a_translating_platform(kind):
 
 @pytest.mark.parametrize("seed", [None, 0, 1, 2])
 def test_least_mass_adds_no_more_than_leg_by_leg_and_balances(seed):
-    if seed is None:
-        spec = spec_of(paper_data())
-        model = registry.unbalanced_model(spec)
-    else:
-        _, spec, model = regular_random(320 + seed)
+    spec, model = _case(seed, 320)
     res = recipe.balance(spec.mechanism, spec.balancing, model)
     stages = {s.name: s for s in res.stages}
     lbl, lm = stages["leg_by_leg"].model, stages["least_mass"].model

@@ -514,6 +514,15 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     total = len(p.designs)
     done = 0
     rows: list[dict] = []
+
+    def take(part: list[dict]) -> None:
+        """Collect a chunk's rows and report the progress."""
+        nonlocal done
+        rows.extend(part)
+        done += len(part)
+        if progress:
+            progress(done, total)
+
     route, pre, pre_rows = None, {}, []
     if ms is not None and affine:
         from .sweep_affine import build_route
@@ -543,43 +552,28 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
             [fdata] = client.scatter([p.data], broadcast=True)
             futures = [client.submit(evaluate_chunk, fdata, paths, c, p.stage, base_key, pure=False) for c in chunks]
             for fut in as_completed(futures):
-                part = fut.result()
-                rows.extend(part)
-                done += len(part)
-                if progress:
-                    progress(done, total)
+                take(fut.result())
     else:
         workers = jobs or os.cpu_count() or 1
         chunks = _chunks(p.designs, workers)
         if jobs == 0 and len(chunks) > 1:  # all cores only when the work outweighs starting them
             t0 = time.perf_counter()
             part = evaluate_chunk(p.data, paths, chunks[0], p.stage, base_key)
-            rows.extend(part)
-            done += len(part)
-            if progress:
-                progress(done, total)
+            take(part)
             per_design = (time.perf_counter() - t0) / len(part)
             chunks = chunks[1:]
             if per_design * (total - done) < POOL_WORTH:
                 workers = 1
         if workers == 1 or len(chunks) <= 1:
             for c in chunks:
-                part = evaluate_chunk(p.data, paths, c, p.stage, base_key)
-                rows.extend(part)
-                done += len(part)
-                if progress:
-                    progress(done, total)
+                take(evaluate_chunk(p.data, paths, c, p.stage, base_key))
         else:
             from concurrent.futures import ProcessPoolExecutor, as_completed as done_futures
 
             with ProcessPoolExecutor(max_workers=workers) as pool:
                 futs = [pool.submit(evaluate_chunk, p.data, paths, c, p.stage, base_key) for c in chunks]
                 for fut in done_futures(futs):
-                    part = fut.result()
-                    rows.extend(part)
-                    done += len(part)
-                    if progress:
-                        progress(done, total)
+                    take(fut.result())
     rows.sort(key=lambda r: r["design"])
     for tag, sweep in (("", ms), ("unbalanced_", ms0)):  # the fast path, in blocks of matrix products
         fast = [r for r in rows if tag + "p" in r]
