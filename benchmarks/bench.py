@@ -381,11 +381,13 @@ def new_geometry_time(base: Model, other: Model, t: np.ndarray, grav, mpt, repea
                       warm_start: bool = True) -> float:
     """Best time of analyse() on a new geometry when only ``base`` was solved before (each call
     on a fresh copy of ``other``: compiled again, its motion not cached). ``warm_start=False``
-    disables the start from the base's motion (the sequential continuation, as before it)."""
+    disables the start from the base's motion (the sequential continuation, as before it and as
+    outside :func:`balpipe.engine.fastpath.warm_designs`, where it is off by default)."""
     from balpipe.engine import fastpath
 
     engine.clear_cache()
-    analyse(base, t, grav, mpt)
+    with fastpath.warm_designs():
+        analyse(base, t, grav, mpt)
     motions, designs = dict(fastpath._MOTIONS), {k: list(v) for k, v in fastpath._WARM.items()}
     saved = fastpath._warm_start
 
@@ -399,7 +401,8 @@ def new_geometry_time(base: Model, other: Model, t: np.ndarray, grav, mpt, repea
     if not warm_start:
         fastpath._warm_start = lambda *args: None
     try:
-        return best_of(call, repeats, min_total=MIN_TOTAL)
+        with fastpath.warm_designs():
+            return best_of(call, repeats, min_total=MIN_TOTAL)
     finally:
         fastpath._warm_start = saved
 

@@ -82,7 +82,8 @@ def test_designs_analysed_in_turn_equal_cold_analyses(case, samples):
     cold = [[_cold(m, t, g, mp) for m in models] for models in designs]
     engine.clear_cache()
     before = dict(fastpath.STATS)
-    warm = [[analyse(m, t, g, mp) for m in models] for models in designs]
+    with fastpath.warm_designs():
+        warm = [[analyse(m, t, g, mp) for m in models] for models in designs]
     counts = {k: fastpath.STATS[k] - before[k] for k in before}
     topologies = len({repr([type(j).__name__ for j in s.model.joints]) for s in stages})
     assert counts["continuation"] == topologies  # the first design only
@@ -114,7 +115,8 @@ def test_a_design_on_the_other_branch_falls_back_to_the_continuation():
     other = _flipped(_stretched(base, "crank", 1.01))
     ref = _cold(other, t, g, mp)
     engine.clear_cache()
-    first = analyse(base, t, g, mp)
+    with fastpath.warm_designs():
+        first = analyse(base, t, g, mp)
     assert np.abs(ref.q[:, 2, 2] - first.q[:, 2, 2]).min() > 0.5  # really another branch
     # what an unguarded warm start would give: the previous branch
     c = engine.compiled(other)
@@ -125,7 +127,8 @@ def test_a_design_on_the_other_branch_falls_back_to_the_continuation():
     unguarded = fastpath._block_newton(c.fast.vz, c.fast.dec, start, f)
     assert unguarded is not None and np.abs(unguarded[:, 8] - ref.q[:, 2, 2]).max() > 0.5
     before = dict(fastpath.STATS)
-    an = analyse(other, t, g, mp)
+    with fastpath.warm_designs():
+        an = analyse(other, t, g, mp)
     assert fastpath.STATS["warm_rejected"] == before["warm_rejected"] + 1
     assert fastpath.STATS["continuation"] == before["continuation"] + 1
     _assert_same(an, ref, "flipped four-bar")
@@ -138,11 +141,13 @@ def test_a_very_different_design_falls_back_to_the_continuation():
     other = _stretched(stages[0].model, "crank", 0.6)
     ref = _cold(other, t, g, mp)
     engine.clear_cache()
-    analyse(stages[0].model, t, g, mp)
     before = dict(fastpath.STATS)
-    an = analyse(other, t, g, mp)
+    with fastpath.warm_designs():
+        analyse(stages[0].model, t, g, mp)
+        an = analyse(other, t, g, mp)
     assert fastpath.STATS["warm"] == before["warm"]
-    assert fastpath.STATS["continuation"] == before["continuation"] + 1
+    assert fastpath.STATS["warm_rejected"] == before["warm_rejected"] + 1
+    assert fastpath.STATS["continuation"] == before["continuation"] + 2
     _assert_same(an, ref, "slider-crank x0.6")
 
 
@@ -150,8 +155,9 @@ def test_the_nearest_design_is_the_start():
     """Of the designs solved before with the same structure, the nearest in its numbers."""
     stages, t, g, mp = _setting("slider-crank")
     engine.clear_cache()
-    for f in (0.8, 0.99, 0.9):
-        analyse(_stretched(stages[0].model, "crank", f), t, g, mp)
+    with fastpath.warm_designs():
+        for f in (0.8, 0.99, 0.9):
+            analyse(_stretched(stages[0].model, "crank", f), t, g, mp)
     c = engine.compiled(_stretched(stages[0].model, "crank", 0.985))
     skey, numbers = fastpath._structure_key(c, t)
     designs = fastpath._WARM[skey]
@@ -169,7 +175,21 @@ def test_a_design_that_cannot_move_still_raises_the_located_error():
     with pytest.raises(engine.AnalysisError) as cold:
         analyse(other, t, g, mp)
     engine.clear_cache()
-    analyse(stages[0].model, t, g, mp)
-    with pytest.raises(engine.AnalysisError) as warm:
+    with fastpath.warm_designs(), pytest.raises(engine.AnalysisError) as warm:
+        analyse(stages[0].model, t, g, mp)
         analyse(_stretched(stages[0].model, "crank", 1.2), t, g, mp)
     assert str(warm.value) == str(cold.value)
+
+
+def test_off_by_default_and_outside_the_block():
+    """Without :func:`fastpath.warm_designs` a new geometry runs the continuation (a build's
+    numbers do not depend on what ran before in its process), and nothing is kept for it."""
+    stages, t, g, mp = _setting("slider-crank")
+    engine.clear_cache()
+    with fastpath.warm_designs():
+        analyse(stages[0].model, t, g, mp)
+    before = dict(fastpath.STATS)
+    analyse(_stretched(stages[0].model, "crank", 0.99), t, g, mp)
+    assert fastpath.STATS["warm"] == before["warm"]
+    assert fastpath.STATS["continuation"] == before["continuation"] + 1
+    assert sum(len(v) for v in fastpath._WARM.values()) == 1  # the design of the block only

@@ -13,7 +13,8 @@ substitution on the decomposed Jacobian (:mod:`.structure`), the constraints eva
   (a sweep's next design: other lengths, the same joints, drivers, point names and grid) starts
   a Newton-Raphson by blocks on all samples at once from the motion of the nearest design solved
   before, accepted when it converges everywhere on the branch of its own initial pose, else the
-  continuation runs (:func:`_warm_start`; counts in :data:`STATS`).
+  continuation runs (:func:`_warm_start`; counts in :data:`STATS`). Opt-in, within
+  :func:`warm_designs` (the last digits would otherwise depend on the history).
 * Velocities Phi_q q' = nu, accelerations Phi_q q'' = gamma: forward substitution.
 * Multipliers Phi_q^T lambda = Q - M q'': backward substitution on the same values.
 * Regularity: cond(Phi_q) >= max|entry| / sigma_min(block) for every diagonal block; samples
@@ -29,7 +30,9 @@ the general dense path.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -164,8 +167,8 @@ def _closed_loop_positions(c: Compiled, vz: Vectorised, dec: Decomposition, t: n
         if np.all(np.abs(residual(vz, State(vz, X), f)) < _TOL):
             STATS["reused"] += 1
             return q
-    skey, numbers = _structure_key(c, t)
-    q = _warm_start(c, vz, dec, f, skey, numbers)
+    skey, numbers = _structure_key(c, t) if _WARM_ENABLED else (None, None)
+    q = _warm_start(c, vz, dec, f, skey, numbers) if _WARM_ENABLED else None
     if q is None:
         STATS["continuation"] += 1
         q = _polish(vz, dec, follow_motion(c, t), f)
@@ -173,6 +176,8 @@ def _closed_loop_positions(c: Compiled, vz: Vectorised, dec: Decomposition, t: n
     if len(_MOTIONS) >= 16:
         _MOTIONS.clear()
     _MOTIONS[key] = ([d.law for d in c.model.drivers], frame)
+    if skey is None:
+        return q
     designs = _WARM.setdefault(skey, [])
     if len(designs) >= 8:
         del designs[0]
@@ -194,12 +199,34 @@ def _place(frame: np.ndarray, com: np.ndarray) -> np.ndarray:
 
 
 # Warm start across geometry: per structure (:func:`_structure_key`), the frame motions of the
-# designs solved last, with their numbers.
+# designs solved last, with their numbers; on within :func:`warm_designs` only.
 _WARM: dict[tuple, list[tuple[np.ndarray, np.ndarray]]] = {}
+_WARM_ENABLED = False
 STATS = {"reused": 0, "warm": 0, "warm_rejected": 0, "continuation": 0}
 _SAME_POSE = 1e-8  # warm start: the first sample against the assembled initial pose (relative)
 _STEP_CHANGE = 0.5  # warm start: a step's angle change against the start's, in its largest step
 _CHORD = 0.1  # warm start: a new Jacobian after a step that reduced the residual less than this factor
+
+
+@contextlib.contextmanager
+def warm_designs() -> Iterator[None]:
+    """Within this block, :func:`balpipe.engine.analyse` of a closed loop with a new geometry
+    (other lengths or poses; the same joints, drivers, point names and time grid) starts from the
+    motion of the nearest design analysed before in the block's process instead of the
+    sequential continuation (:func:`_warm_start`).
+
+    Off by default: a warm-started motion equals the continuation's only to round-off (~1e-15 of
+    each quantity's peak), so with it a design's numbers would depend, in their last digits, on
+    which designs ran before in the same process (a build must give the same bytes for the same
+    spec; a sweep the same table for any chunking). A caller that accepts that (an optimiser, an
+    interactive sweep) opts in here."""
+    global _WARM_ENABLED
+    previous = _WARM_ENABLED
+    _WARM_ENABLED = True
+    try:
+        yield
+    finally:
+        _WARM_ENABLED = previous
 
 
 def _structure_key(c: Compiled, t: np.ndarray) -> tuple[tuple, np.ndarray]:
