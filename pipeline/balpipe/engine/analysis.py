@@ -142,6 +142,7 @@ def clear_cache() -> None:
     _COMPILED.clear()
     structure._CACHE.clear()
     fastpath._MOTIONS.clear()
+    fastpath._WARM.clear()
 
 
 def analyse(
