@@ -379,32 +379,25 @@ def slider_crank_new_geometry() -> Model:
 
 def new_geometry_time(base: Model, other: Model, t: np.ndarray, grav, mpt, repeats: int,
                       warm_start: bool = True) -> float:
-    """Best time of analyse() on a new geometry when only ``base`` was solved before (each call
-    on a fresh copy of ``other``: compiled again, its motion not cached). ``warm_start=False``
-    disables the start from the base's motion (the sequential continuation, as before it and as
-    outside :func:`balpipe.engine.fastpath.warm_designs`, where it is off by default)."""
+    """Best time of analyse() on a new geometry, as a sweep runs it: the base design's motion
+    recorded as the anchor (:func:`balpipe.engine.record_anchors`), each call on a fresh copy of
+    ``other`` (compiled again, its motion not known) within :func:`balpipe.engine.warm_start`.
+    ``warm_start=False``: without the anchors (the sequential continuation, as before them)."""
     from balpipe.engine import fastpath
 
     engine.clear_cache()
-    with fastpath.warm_designs():
+    with engine.record_anchors() as anchors:
         analyse(base, t, grav, mpt)
-    motions, designs = dict(fastpath._MOTIONS), {k: list(v) for k, v in fastpath._WARM.items()}
-    saved = fastpath._warm_start
+    motions = dict(fastpath._MOTIONS)
 
     def call():
         fastpath._MOTIONS.clear()
         fastpath._MOTIONS.update(motions)
-        fastpath._WARM.clear()
-        fastpath._WARM.update({k: list(v) for k, v in designs.items()})
+        anchors.solved.clear()
         analyse(dataclasses.replace(other), t, grav, mpt)
 
-    if not warm_start:
-        fastpath._warm_start = lambda *args: None
-    try:
-        with fastpath.warm_designs():
-            return best_of(call, repeats, min_total=MIN_TOTAL)
-    finally:
-        fastpath._warm_start = saved
+    with engine.warm_start(anchors if warm_start else None):
+        return best_of(call, repeats, min_total=MIN_TOTAL)
 
 
 def bench_engine(counts: list[int], repeats: int) -> dict:

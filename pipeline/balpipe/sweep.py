@@ -389,14 +389,12 @@ MAX_GEOMETRIES = 32
 
 def canonical(model):
     """The model with every body's mass 1 kg, centre of mass at its frame origin, inertia
-    1 kg m^2, and massless attachments: its :class:`balpipe.mass_sweep.MassSweep` depends on the
-    geometry alone, so every design of that geometry gets the same numbers, in any chunk or worker."""
-    from dataclasses import replace
+    1 kg m^2, and massless attachments (:func:`balpipe.engine.fastpath.frame_model`): its
+    :class:`balpipe.mass_sweep.MassSweep` depends on the geometry alone, so every design of that
+    geometry gets the same numbers, in any chunk or worker."""
+    from .engine.fastpath import frame_model
 
-    bodies = tuple(replace(b, mass=1.0, com=(0.0, 0.0), inertia=1.0,
-                           attachments=tuple(replace(a, mass=0.0, inertia=0.0) for a in b.attachments))
-                   for b in model.bodies)
-    return replace(model, bodies=bodies)
+    return frame_model(model)
 
 
 def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
@@ -438,11 +436,21 @@ def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
 
 
 def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]], stage: str | None,
-                   keys: tuple) -> list[dict]:
+                   keys: tuple, anchors=None) -> list[dict]:
     """Rows of one chunk of designs. For the chosen stage and the design's unbalanced stage
     (``keys``: their base geometries, or None), a design with the base geometry returns its
     parameter vector for the parent's fast path; any other is analysed here by the engine, once
-    per geometry (:func:`_stage_loads`)."""
+    per geometry (:func:`_stage_loads`), a closed loop starting from the base spec's motions
+    (``anchors``, :mod:`balpipe.engine.warmstart`: no sequential continuation, and the same
+    numbers in any chunk or worker)."""
+    from .engine import warm_start
+
+    with warm_start(anchors):
+        return _evaluate(data, paths, chunk, stage, keys)
+
+
+def _evaluate(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]], stage: str | None,
+              keys: tuple) -> list[dict]:
     from .study import _total_inertia
 
     rows = []
@@ -491,7 +499,7 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     processes; 1 = in this process; 0 = all cores, after timing the first chunk in this process,
     if the rest would take more than :data:`POOL_WORTH` seconds) or on the dask.distributed
     scheduler at ``scheduler``."""
-    from .engine import AnalysisError
+    from .engine import AnalysisError, record_anchors, warm_start
     from .mass_sweep import MassSweep, check_parameters
     from .spec_parts import SpecFieldError
 
@@ -503,109 +511,112 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
         result = registry.balance_designs(base_spec)
         base = _pick_stage(result, p.stage)
         t, g, P = _settings(base_spec)
-        ms = MassSweep.build(base.model, t, g, P)
-        ms0 = MassSweep.build(result.stages[0].model, t, g, P)
+        with record_anchors() as anchors:  # the base's motions: where other geometries start
+            ms = MassSweep.build(base.model, t, g, P)
+            ms0 = MassSweep.build(result.stages[0].model, t, g, P)
         base_key, base_name = (ms.key, ms0.key), base.name
     except (SpecFieldError, AnalysisError, ValueError) as exc:  # no fast path: every design in full
-        ms, ms0, base_key, base_name = None, None, (None, None), p.stage or "last"
+        ms, ms0, base_key, base_name, anchors = None, None, (None, None), p.stage or "last", None
         notes = [f"the base spec's stage cannot be analysed ({_error_text(exc)}): no fast path"]
     else:
         notes = []
-    total = len(p.designs)
-    done = 0
-    rows: list[dict] = []
+    with warm_start(anchors):  # every design evaluated here (probes, chunks, confirmations) starts from them
+        total = len(p.designs)
+        done = 0
+        rows: list[dict] = []
 
-    def take(part: list[dict]) -> None:
-        """Collect a chunk's rows and report the progress."""
-        nonlocal done
-        rows.extend(part)
-        done += len(part)
-        if progress:
-            progress(done, total)
+        def take(part: list[dict]) -> None:
+            """Collect a chunk's rows and report the progress."""
+            nonlocal done
+            rows.extend(part)
+            done += len(part)
+            if progress:
+                progress(done, total)
 
-    route, pre, pre_rows = None, {}, []
-    if ms is not None and affine:
-        from .sweep_affine import build_route
+        route, pre, pre_rows = None, {}, []
+        if ms is not None and affine:
+            from .sweep_affine import build_route
 
-        route = build_route(p, base_key, (ms.names, ms0.names))
-    if route is not None:
-        notes.append(f"Mass-only sweep: every design's masses and inertias are affine in the varied values "
-                     f"(found and checked on {route.probes} designs built in full); the others were not built "
-                     f"one by one but evaluated as matrix products.")  # mass-only: designs as matrix products, no spec built per design
-        rows, F = route.rows(p.designs)
-        pre = dict(zip(("", "unbalanced_"), route.parameters(F)))
-        flagged = set(np.flatnonzero(route.unbuildable(F)).tolist())
-        for i in sorted(flagged):  # a design that cannot be built: its own error, as built in full
-            rows[i] = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, base_key)[0]
-        if flagged:
-            keep = np.array([i not in flagged for i in range(total)])
-            pre = {tag: P[keep] for tag, P in pre.items()}
-        pre_rows = [r for r in rows if r["design"] not in flagged]
-        if progress:
-            progress(total, total)
-    elif scheduler:
-        from distributed import Client, as_completed
+            route = build_route(p, base_key, (ms.names, ms0.names))
+        if route is not None:
+            notes.append(f"Mass-only sweep: every design's masses and inertias are affine in the varied values "
+                         f"(found and checked on {route.probes} designs built in full); the others were not built "
+                         f"one by one but evaluated as matrix products.")  # mass-only: designs as matrix products, no spec built per design
+            rows, F = route.rows(p.designs)
+            pre = dict(zip(("", "unbalanced_"), route.parameters(F)))
+            flagged = set(np.flatnonzero(route.unbuildable(F)).tolist())
+            for i in sorted(flagged):  # a design that cannot be built: its own error, as built in full
+                rows[i] = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, base_key, anchors)[0]
+            if flagged:
+                keep = np.array([i not in flagged for i in range(total)])
+                pre = {tag: P[keep] for tag, P in pre.items()}
+            pre_rows = [r for r in rows if r["design"] not in flagged]
+            if progress:
+                progress(total, total)
+        elif scheduler:
+            from distributed import Client, as_completed
 
-        with Client(scheduler) as client:
-            workers = max(1, len(client.scheduler_info()["workers"]))
-            chunks = _chunks(p.designs, workers)
-            [fdata] = client.scatter([p.data], broadcast=True)
-            futures = [client.submit(evaluate_chunk, fdata, paths, c, p.stage, base_key, pure=False) for c in chunks]
-            for fut in as_completed(futures):
-                take(fut.result())
-    else:
-        workers = jobs or os.cpu_count() or 1
-        chunks = _chunks(p.designs, workers)
-        if jobs == 0 and len(chunks) > 1:  # all cores only when the work outweighs starting them
-            t0 = time.perf_counter()
-            part = evaluate_chunk(p.data, paths, chunks[0], p.stage, base_key)
-            take(part)
-            per_design = (time.perf_counter() - t0) / len(part)
-            chunks = chunks[1:]
-            if per_design * (total - done) < POOL_WORTH:
-                workers = 1
-        if workers == 1 or len(chunks) <= 1:
-            for c in chunks:
-                take(evaluate_chunk(p.data, paths, c, p.stage, base_key))
-        else:
-            from concurrent.futures import ProcessPoolExecutor, as_completed as done_futures
-
-            with ProcessPoolExecutor(max_workers=workers) as pool:
-                futs = [pool.submit(evaluate_chunk, p.data, paths, c, p.stage, base_key) for c in chunks]
-                for fut in done_futures(futs):
+            with Client(scheduler) as client:
+                workers = max(1, len(client.scheduler_info()["workers"]))
+                chunks = _chunks(p.designs, workers)
+                [fdata, fanchors] = client.scatter([p.data, anchors], broadcast=True)
+                futures = [client.submit(evaluate_chunk, fdata, paths, c, p.stage, base_key, fanchors, pure=False)
+                           for c in chunks]
+                for fut in as_completed(futures):
                     take(fut.result())
-    rows.sort(key=lambda r: r["design"])
-    for tag, sweep in (("", ms), ("unbalanced_", ms0)):  # the fast path, in blocks of matrix products
-        fast = [r for r in rows if tag + "p" in r]
-        Pm = np.array([r.pop(tag + "p") for r in fast])
-        if tag in pre:  # the affine route's designs: their parameters as one matrix
-            fast, Pm = pre_rows + fast, np.concatenate([pre[tag], Pm.reshape(-1, pre[tag].shape[1])])
-        if not fast:
-            continue
-        bad = check_parameters(sweep.names, Pm)
-        peaks = sweep.peaks(Pm)
-        for k, r in enumerate(fast):
-            if bad[k]:
-                for key in list(r):
-                    if key not in ("design", "values", "route"):
-                        r.pop(key)
-                r["error"] = bad[k]
+        else:
+            workers = jobs or os.cpu_count() or 1
+            chunks = _chunks(p.designs, workers)
+            if jobs == 0 and len(chunks) > 1:  # all cores only when the work outweighs starting them
+                t0 = time.perf_counter()
+                part = evaluate_chunk(p.data, paths, chunks[0], p.stage, base_key, anchors)
+                take(part)
+                per_design = (time.perf_counter() - t0) / len(part)
+                chunks = chunks[1:]
+                if per_design * (total - done) < POOL_WORTH:
+                    workers = 1
+            if workers == 1 or len(chunks) <= 1:
+                for c in chunks:
+                    take(evaluate_chunk(p.data, paths, c, p.stage, base_key, anchors))
             else:
-                for key, arr in peaks.items():
-                    r[tag + key] = float(arr[k])
-    for r in rows:
-        if "error" not in r:
-            for q in ("force", "moment"):
-                ref = r[f"unbalanced_max_shaking_{q}"]
-                r[f"{q}_ratio"] = r[f"max_shaking_{q}"] / ref if ref > 0 else 0.0
-    res = SweepResult(p, rows, base_name, notes=notes)
-    res.fast = sum(r.get("route") == "mass" and "error" not in r for r in rows)
-    res.full = sum(r.get("route") == "full" and "error" not in r for r in rows)
-    res.failed = sum("error" in r for r in rows)
-    mark_pareto(rows)
-    if route is not None and not _front_confirmed(p, paths, rows, F, route, base_key):
-        return run(p, jobs, scheduler, progress, affine=False)
-    return res
+                from concurrent.futures import ProcessPoolExecutor, as_completed as done_futures
+
+                with ProcessPoolExecutor(max_workers=workers) as pool:
+                    futs = [pool.submit(evaluate_chunk, p.data, paths, c, p.stage, base_key, anchors) for c in chunks]
+                    for fut in done_futures(futs):
+                        take(fut.result())
+        rows.sort(key=lambda r: r["design"])
+        for tag, sweep in (("", ms), ("unbalanced_", ms0)):  # the fast path, in blocks of matrix products
+            fast = [r for r in rows if tag + "p" in r]
+            Pm = np.array([r.pop(tag + "p") for r in fast])
+            if tag in pre:  # the affine route's designs: their parameters as one matrix
+                fast, Pm = pre_rows + fast, np.concatenate([pre[tag], Pm.reshape(-1, pre[tag].shape[1])])
+            if not fast:
+                continue
+            bad = check_parameters(sweep.names, Pm)
+            peaks = sweep.peaks(Pm)
+            for k, r in enumerate(fast):
+                if bad[k]:
+                    for key in list(r):
+                        if key not in ("design", "values", "route"):
+                            r.pop(key)
+                    r["error"] = bad[k]
+                else:
+                    for key, arr in peaks.items():
+                        r[tag + key] = float(arr[k])
+        for r in rows:
+            if "error" not in r:
+                for q in ("force", "moment"):
+                    ref = r[f"unbalanced_max_shaking_{q}"]
+                    r[f"{q}_ratio"] = r[f"max_shaking_{q}"] / ref if ref > 0 else 0.0
+        res = SweepResult(p, rows, base_name, notes=notes)
+        res.fast = sum(r.get("route") == "mass" and "error" not in r for r in rows)
+        res.full = sum(r.get("route") == "full" and "error" not in r for r in rows)
+        res.failed = sum("error" in r for r in rows)
+        mark_pareto(rows)
+        if route is not None and not _front_confirmed(p, paths, rows, F, route, base_key):
+            return run(p, jobs, scheduler, progress, affine=False)
+        return res
 
 
 def _front_confirmed(p: Plan, paths: list[tuple], rows: list[dict], F: np.ndarray, route, keys: tuple) -> bool:

@@ -138,11 +138,11 @@ def compiled(model: Model) -> Compiled:
 
 
 def clear_cache() -> None:
-    """Forget compiled models and block structures (for benchmarks of cold calls)."""
+    """Forget compiled models, block structures and solved motions (for benchmarks of cold
+    calls); the anchors of :mod:`.warmstart` are the caller's."""
     _COMPILED.clear()
     structure._CACHE.clear()
     fastpath._MOTIONS.clear()
-    fastpath._WARM.clear()
 
 
 def analyse(

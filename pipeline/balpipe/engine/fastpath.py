@@ -5,16 +5,15 @@ substitution on the decomposed Jacobian (:mod:`.structure`), the constraints eva
 * Positions: when every block is 1 x 1 and linear in its unknown (open chains with driven
   joints, guides fixed to the frame, ...) Phi(q, t) = 0 is solved level by level, each unknown
   by one division, with no Newton iteration, continuation or branch to follow (the solution is
-  unique); the residual is checked at the end. Otherwise (closed loops) the general
-  continuation and batched Newton-Raphson of :mod:`.positions`, followed by one Newton step
-  by blocks (its residual 1e-12 becomes ~1e-16); the motion of the bodies' frames is kept and
-  reused by the next model with the same joints, drivers, initial poses and grid (a balancing
-  stage, a mass design), which then needs no continuation. A new geometry of the same structure
-  (a sweep's next design: other lengths, the same joints, drivers, point names and grid) starts
-  a Newton-Raphson by blocks on all samples at once from the motion of the nearest design solved
-  before, accepted when it converges everywhere on the branch of its own initial pose, else the
-  continuation runs (:func:`_warm_start`; counts in :data:`STATS`). Opt-in, within
-  :func:`warm_designs` (the last digits would otherwise depend on the history).
+  unique); the residual is checked at the end. Otherwise (closed loops) the motion of the
+  bodies' frames is solved on the frame model (every centre of mass at its frame's origin, so
+  that it depends on the geometry alone) by the general continuation and batched
+  Newton-Raphson of :mod:`.positions`, followed by one Newton step by blocks (its residual
+  1e-12 becomes ~1e-16); it is kept and reused by every model with the same joints, drivers,
+  points, initial poses and grid (a balancing stage, a mass design: no continuation), which
+  places its centres of mass in it. Within :func:`.warmstart.warm_start` a new geometry of the
+  same structure (a sweep's next design) starts from the nearest anchor instead
+  (:mod:`.warmstart`).
 * Velocities Phi_q q' = nu, accelerations Phi_q q'' = gamma: forward substitution.
 * Multipliers Phi_q^T lambda = Q - M q'': backward substitution on the same values.
 * Regularity: cond(Phi_q) >= max|entry| / sigma_min(block) for every diagonal block; samples
@@ -30,15 +29,15 @@ the general dense path.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 
-from .compile import Compiled
-from .positions import _COND_LIMIT, _JUMP, _MAX_ITER, _TOL, _check_regular, _condition, follow_motion, redundancy
+from ..model import Model
+from . import warmstart
+from .compile import Compiled, compile_model
+from .positions import _COND_LIMIT, _TOL, _check_regular, _condition, follow_motion, redundancy
 from .constraints import _extend, jacobian
 from .structure import Decomposition, block_sigma_min, decompose, invert_blocks, solve
 from .vectorised import State, Vectorised, acceleration_rhs, jacobian_values, law_table, residual, velocity_rhs, vectorise
@@ -130,62 +129,75 @@ def _explicit_positions(vz: Vectorised, dec: Decomposition, f: np.ndarray, N: in
 _MOTIONS: dict[tuple, tuple[list, np.ndarray]] = {}
 
 
-def _motion_key(c: Compiled, t: np.ndarray) -> tuple:
-    """Everything the motion of the bodies' own frames depends on: the joints, the drivers (their
-    laws by identity, kept alive by the cache), the bodies' named points, the initial poses
-    (the branch) and the time grid; not the mass properties, which move only the centres of
-    mass within the bodies (a balancing stage, a mass design). Numbers enter exactly."""
-    m = c.model
-    joints = tuple((type(j).__name__, *(_exact(getattr(j, f.name)) for f in dataclasses.fields(j))) for j in m.joints)
-    return (joints, tuple((d.name, _exact(d.target), id(d.law)) for d in m.drivers),
-            tuple((b.name, _exact(sorted(b.points.items()))) for b in m.bodies),
-            _exact(sorted(m.initial.items())), t.tobytes())
-
-
-def _exact(v):
-    """A hashable, exact image of nested tuples, lists, arrays and numbers."""
-    if isinstance(v, (str, type(None))):
-        return v
-    if isinstance(v, (tuple, list, np.ndarray)):
-        return tuple(_exact(x) for x in v)
-    return float(v).hex()
-
-
 def _closed_loop_positions(c: Compiled, vz: Vectorised, dec: Decomposition, t: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """Positions (N, 3 nb) by the general continuation, or from the motion of the bodies' frames
-    solved before for the same mechanism and grid (another stage or mass design): the centres
-    of mass are placed in the bodies' frames, and the residual is checked. A new geometry of a
-    mechanism solved before (same structure, other lengths or poses) starts from that motion
-    (:func:`_warm_start`); the continuation runs when it is rejected."""
-    key = _motion_key(c, t)
-    hit = _MOTIONS.get(key)
-    com = c.com_local
-    if hit is not None:
-        q = _place(hit[1], com)
+    """Positions (N, 3 nb) of a closed loop: the centres of mass placed in the frame motion of its
+    geometry (:func:`frame_motion`), the residual checked; where that motion cannot be solved on
+    the frame model (its pattern has no block form), the continuation on ``c`` itself."""
+    frame = frame_motion(c, t, f)
+    if frame is not None and c.frame is c:  # solved on c itself, to 1e-14
+        return frame
+    if frame is not None:
+        q = _place(frame, c.com_local)
         X = np.zeros((vz.ncol, len(t)))
         X[3:] = q.T
         if np.all(np.abs(residual(vz, State(vz, X), f)) < _TOL):
-            STATS["reused"] += 1
             return q
-    skey, numbers = _structure_key(c, t) if _WARM_ENABLED else (None, None)
-    q = _warm_start(c, vz, dec, f, skey, numbers) if _WARM_ENABLED else None
-    if q is None:
-        STATS["continuation"] += 1
-        q = _polish(vz, dec, follow_motion(c, t), f)
-    frame = _place(q, -com)
-    if len(_MOTIONS) >= 16:
-        _MOTIONS.clear()
-    _MOTIONS[key] = ([d.law for d in c.model.drivers], frame)
-    if skey is None:
-        return q
-    designs = _WARM.setdefault(skey, [])
-    if len(designs) >= 8:
-        del designs[0]
-    designs.append((numbers, frame))
-    if len(_WARM) >= 16:
-        _WARM.clear()
-        _WARM[skey] = designs
-    return q
+    return _polish(vz, dec, follow_motion(c, t), f)
+
+
+def frame_motion(c: Compiled, t: np.ndarray, f: np.ndarray) -> np.ndarray | None:
+    """The motion (N, 3 nb) of the bodies' own frames along ``t``, solved on the frame model
+    (:func:`frame_model`) so that it depends on the geometry alone, not on the mass properties
+    (every balancing stage and mass design of a mechanism shares it, whatever ran first):
+
+    1. known: solved before in this process for the same joints, drivers, points, initial poses
+       and grid (:func:`_motion_key`), or warm-started before from the active anchors;
+    2. within :func:`.warmstart.warm_start`: from the nearest anchor, if accepted;
+    3. the continuation (:func:`.positions.follow_motion`) and one Newton step by blocks.
+
+    None when the frame model's pattern has no block form (the caller solves ``c`` itself)."""
+    key = warmstart.motion_key(c, t)
+    hit = _MOTIONS.get(key)
+    frame = hit[1] if hit is not None else warmstart.solved(key)
+    if frame is not None:
+        warmstart.STATS["reused"] += 1
+    else:
+        fc = _frame_compiled(c)
+        fp = fc.fast
+        if fp.dec is None:
+            return None
+        frame = warmstart.start(fc, fp.vz, fp.dec, t, f, key)
+        if frame is None:
+            warmstart.STATS["continuation"] += 1
+            frame = _polish(fp.vz, fp.dec, follow_motion(fc, t), f)
+            if len(_MOTIONS) >= 16:
+                _MOTIONS.clear()
+            _MOTIONS[key] = ([d.law for d in c.model.drivers], frame)
+    warmstart.note(c, t, frame)
+    return frame
+
+
+def frame_model(model: Model) -> Model:
+    """``model`` with every body's centre of mass at its frame origin (mass 1 kg, inertia
+    1 kg m^2, attachments massless): the same geometry, whose coordinates are the bodies' frames."""
+    bodies = tuple(dataclasses.replace(b, mass=1.0, com=(0.0, 0.0), inertia=1.0,
+                                       attachments=tuple(dataclasses.replace(a, mass=0.0, inertia=0.0)
+                                                         for a in b.attachments))
+                   for b in model.bodies)
+    return dataclasses.replace(model, bodies=bodies)
+
+
+def _frame_compiled(c: Compiled) -> Compiled:
+    """The compiled frame model of ``c`` (``c`` itself when its centres of mass are at the
+    frames' origins), prepared for the block path; kept on ``c``."""
+    if c.frame is None:
+        if not np.any(c.com_local):
+            c.frame = c
+        else:
+            c.frame = compile_model(frame_model(c.model))
+        if c.frame.fast is None:
+            c.frame.fast = prepare(c.frame)
+    return c.frame
 
 
 def _place(frame: np.ndarray, com: np.ndarray) -> np.ndarray:
@@ -196,134 +208,6 @@ def _place(frame: np.ndarray, com: np.ndarray) -> np.ndarray:
     q[:, 0::3] += cos * com[:, 0] - sin * com[:, 1]
     q[:, 1::3] += sin * com[:, 0] + cos * com[:, 1]
     return q
-
-
-# Warm start across geometry: per structure (:func:`_structure_key`), the frame motions of the
-# designs solved last, with their numbers; on within :func:`warm_designs` only.
-_WARM: dict[tuple, list[tuple[np.ndarray, np.ndarray]]] = {}
-_WARM_ENABLED = False
-STATS = {"reused": 0, "warm": 0, "warm_rejected": 0, "continuation": 0}
-_SAME_POSE = 1e-8  # warm start: the first sample against the assembled initial pose (relative)
-_STEP_CHANGE = 0.5  # warm start: a step's angle change against the start's, in its largest step
-_CHORD = 0.1  # warm start: a new Jacobian after a step that reduced the residual less than this factor
-
-
-@contextlib.contextmanager
-def warm_designs() -> Iterator[None]:
-    """Within this block, :func:`balpipe.engine.analyse` of a closed loop with a new geometry
-    (other lengths or poses; the same joints, drivers, point names and time grid) starts from the
-    motion of the nearest design analysed before in the block's process instead of the
-    sequential continuation (:func:`_warm_start`).
-
-    Off by default: a warm-started motion equals the continuation's only to round-off (~1e-15 of
-    each quantity's peak), so with it a design's numbers would depend, in their last digits, on
-    which designs ran before in the same process (a build must give the same bytes for the same
-    spec; a sweep the same table for any chunking). A caller that accepts that (an optimiser, an
-    interactive sweep) opts in here."""
-    global _WARM_ENABLED
-    previous = _WARM_ENABLED
-    _WARM_ENABLED = True
-    try:
-        yield
-    finally:
-        _WARM_ENABLED = previous
-
-
-def _structure_key(c: Compiled, t: np.ndarray) -> tuple[tuple, np.ndarray]:
-    """:func:`_motion_key` with the numbers taken out: the names and types of the joints,
-    drivers (the laws by type), bodies' points and initial poses, and the time grid exactly;
-    the numbers (lengths, offsets, poses) separately, to pick the nearest design."""
-    m = c.model
-    numbers: list[float] = []
-    joints = tuple((type(j).__name__, *(_shape(getattr(j, f.name), numbers) for f in dataclasses.fields(j)))
-                   for j in m.joints)
-    drivers = tuple((d.name, _shape(d.target, numbers), type(d.law).__name__) for d in m.drivers)
-    bodies = tuple((b.name, _shape(sorted(b.points.items()), numbers)) for b in m.bodies)
-    initial = _shape(sorted(m.initial.items()), numbers)
-    return (joints, drivers, bodies, initial, t.tobytes()), np.array(numbers, dtype=float)
-
-
-def _shape(v, numbers: list[float]):
-    """:func:`_exact` with every number replaced by "#" and appended to ``numbers``."""
-    if isinstance(v, (str, type(None))):
-        return v
-    if isinstance(v, (tuple, list, np.ndarray)):
-        return tuple(_shape(x, numbers) for x in v)
-    numbers.append(float(v))
-    return "#"
-
-
-def _warm_start(c: Compiled, vz: Vectorised, dec: Decomposition, f: np.ndarray, skey: tuple,
-                numbers: np.ndarray) -> np.ndarray | None:
-    """Positions (N, 3 nb) by Newton-Raphson on all samples at once (block by block) from the
-    motion of the nearest design with the same structure, or None (take the continuation).
-
-    Accepted only when every sample converges (residual below 1e-14, or no longer decreasing
-    below 1e-12) and the motion stays on the branch of the model's own initial pose: the first
-    sample is the pose assembled from ``model.initial`` by Newton's method (as the continuation
-    starts; by blocks here), no angle is more than 0.2 rad from its start (the continuation's
-    branch guard, :data:`.positions._JUMP`) and no step between samples changes its angles by
-    more than half the start's largest step (no jump between samples)."""
-    designs = _WARM.get(skey)
-    if not designs:
-        return None
-    start = _place(min(designs, key=lambda d: float(np.abs(d[0] - numbers).max()))[1], c.com_local)
-    q = _block_newton(vz, dec, start, f)
-    if q is None or not _same_branch(c, vz, dec, f, q, start):
-        STATS["warm_rejected"] += 1
-        return None
-    STATS["warm"] += 1
-    return q
-
-
-def _block_newton(vz: Vectorised, dec: Decomposition, q: np.ndarray, f: np.ndarray, max_iter: int = _MAX_ITER,
-                  chord: bool = True) -> np.ndarray | None:
-    """Newton-Raphson by blocks on all samples from ``q`` (N, 3 nb); None if it does not converge.
-
-    ``chord``: the Jacobian (its values and block inverses) is evaluated again only when the
-    last step reduced the residual less than tenfold (:data:`_CHORD`; from a nearby start the first one serves
-    several steps); the iteration stops at the same residual as Newton's method. ``chord=False``:
-    Newton's method itself (the assembly of the first sample, as :func:`.positions._newton`)."""
-    X = np.zeros((vz.ncol + 1, q.shape[0]))
-    X[3:-1] = q.T
-    last, fresh, jac = np.inf, False, None
-    with np.errstate(all="ignore"):
-        for _ in range(max_iter):
-            state = State(vz, X[:-1])
-            phi = residual(vz, state, f)
-            err = float(np.abs(phi).max())
-            if not np.isfinite(err) or err <= _POLISH or (err < _TOL and err > 0.1 * last and fresh):
-                break
-            if jac is None or not chord or err > _CHORD * last:
-                vals = jacobian_values(vz, state)
-                try:
-                    jac = (vals, invert_blocks(dec, vals))
-                except np.linalg.LinAlgError:
-                    return None
-                fresh = True
-            else:
-                fresh = False
-            last = err
-            X += solve(dec.forward, jac[0], -phi, jac[1], offset=3)
-    if not err < _TOL or not np.all(np.isfinite(X)):
-        return None
-    return X[3:-1].T.copy()
-
-
-def _same_branch(c: Compiled, vz: Vectorised, dec: Decomposition, f: np.ndarray, q: np.ndarray,
-                 start: np.ndarray) -> bool:
-    """The branch guard of the warm start (see :func:`_warm_start`)."""
-    q0 = _block_newton(vz, dec, c.q0[None, :], f[:, :1], max_iter=50, chord=False)
-    if q0 is None or np.abs(q[0] - q0[0]).max() > _SAME_POSE * max(1.0, float(np.abs(q0[0]).max())):
-        return False
-    th, th0 = q[:, 2::3], start[:, 2::3]
-    if np.abs(th - th0).max() > _JUMP:
-        return False
-    if len(q) > 1:
-        step, step0 = np.diff(th, axis=0), np.diff(th0, axis=0)
-        if np.abs(step - step0).max() > _STEP_CHANGE * float(np.abs(step0).max()):
-            return False
-    return True
 
 
 def _polish(vz: Vectorised, dec: Decomposition, q: np.ndarray, f: np.ndarray) -> np.ndarray:
