@@ -538,6 +538,8 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
             from .sweep_affine import build_route
 
             route = build_route(p, base_key, (ms.names, ms0.names))
+        if route is None and anchors is not None:  # designs one by one: where their motions start
+            _corner_anchors(p, paths, anchors)
         if route is not None:
             notes.append(f"Mass-only sweep: every design's masses and inertias are affine in the varied values "
                          f"(found and checked on {route.probes} designs built in full); the others were not built "
@@ -617,6 +619,33 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
         if route is not None and not _front_confirmed(p, paths, rows, F, route, base_key):
             return run(p, jobs, scheduler, progress, affine=False)
         return res
+
+
+MAX_CORNERS = 16  # corner designs solved up front as anchors (2^k for k varied fields)
+
+
+def _corner_anchors(p: Plan, paths: list[tuple], anchors) -> None:
+    """Add to ``anchors`` the closed-loop motions of the sweep's corner designs (the first and
+    last value of every varied field, at most :data:`MAX_CORNERS`), solved here by the
+    continuation: every design then starts from the nearest of the base and the corners, which
+    covers sweeps that reach far from the base spec. Fixed before any design is evaluated, so
+    the numbers do not depend on chunks or workers. A corner that cannot be built or analysed is
+    left out (its design reports the error)."""
+    from .engine import analyse, record_anchors
+
+    ends = [(v.values[0], v.values[-1]) if v.values else (v.raw(v.lo), v.raw(v.hi)) for v in p.varies]
+    corners = list(dict.fromkeys(itertools.product(*ends)))
+    if len(corners) > MAX_CORNERS:
+        return
+    with record_anchors(into=anchors):
+        for values in corners:
+            try:
+                spec, sr, base = build_design(p.data, paths, values, p.stage)
+                t, g, P = _settings(spec)
+                for model in (sr.model, base.model):
+                    analyse(canonical(model), t, g, P)
+            except Exception:  # noqa: BLE001 - the design's own row says why
+                continue
 
 
 def _front_confirmed(p: Plan, paths: list[tuple], rows: list[dict], F: np.ndarray, route, keys: tuple) -> bool:

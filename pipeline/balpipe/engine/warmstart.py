@@ -70,10 +70,10 @@ _ACTIVE: list[Anchors] = []
 
 
 @contextlib.contextmanager
-def record() -> Iterator[Anchors]:
+def record(into: Anchors | None = None) -> Iterator[Anchors]:
     """Within this block every closed-loop frame motion the engine solves or reuses becomes an
-    anchor of the :class:`Anchors` yielded."""
-    anchors = Anchors()
+    anchor of the :class:`Anchors` yielded (``into``, or new ones)."""
+    anchors = Anchors() if into is None else into
     _RECORDING.append(anchors)
     try:
         yield anchors
