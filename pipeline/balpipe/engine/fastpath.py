@@ -134,7 +134,7 @@ def _closed_loop_positions(c: Compiled, vz: Vectorised, dec: Decomposition, t: n
     geometry (:func:`frame_motion`), the residual checked; where that motion cannot be solved on
     the frame model (its pattern has no block form), the continuation on ``c`` itself."""
     frame = frame_motion(c, t, f)
-    if frame is not None and c.frame is c:  # solved on c itself, to 1e-14
+    if frame is not None and not np.any(c.com_local):  # c is its own frame model
         return frame
     if frame is not None:
         q = _place(frame, c.com_local)
@@ -151,7 +151,7 @@ def frame_motion(c: Compiled, t: np.ndarray, f: np.ndarray) -> np.ndarray | None
     (every balancing stage and mass design of a mechanism shares it, whatever ran first):
 
     1. known: solved before in this process for the same joints, drivers, points, initial poses
-       and grid (:func:`_motion_key`), or warm-started before from the active anchors;
+       and grid (:func:`.warmstart.motion_key`), or warm-started before from the active anchors;
     2. within :func:`.warmstart.warm_start`: from the nearest anchor, if accepted;
     3. the continuation (:func:`.positions.follow_motion`) and one Newton step by blocks.
 
