@@ -440,9 +440,9 @@ def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]
     """Rows of one chunk of designs. For the chosen stage and the design's unbalanced stage
     (``keys``: their base geometries, or None), a design with the base geometry returns its
     parameter vector for the parent's fast path; any other is analysed here by the engine, once
-    per geometry (:func:`_stage_loads`), a closed loop starting from the base spec's motions
-    (``anchors``, :mod:`balpipe.engine.warmstart`: no sequential continuation, and the same
-    numbers in any chunk or worker)."""
+    per geometry (:func:`_stage_loads`), a closed loop starting from the fixed motions
+    ``anchors`` (:func:`run`; :mod:`balpipe.engine.warmstart`: no sequential continuation, and
+    the same numbers in any chunk or worker)."""
     from .engine import warm_start
 
     with warm_start(anchors):
@@ -499,7 +499,7 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     processes; 1 = in this process; 0 = all cores, after timing the first chunk in this process,
     if the rest would take more than :data:`POOL_WORTH` seconds) or on the dask.distributed
     scheduler at ``scheduler``."""
-    from .engine import AnalysisError, record_anchors, warm_start
+    from .engine import AnalysisError, record_anchors
     from .mass_sweep import MassSweep, check_parameters
     from .spec_parts import SpecFieldError
 
@@ -511,7 +511,7 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
         result = registry.balance_designs(base_spec)
         base = _pick_stage(result, p.stage)
         t, g, P = _settings(base_spec)
-        with record_anchors() as anchors:  # the base's motions: where other geometries start
+        with record_anchors() as anchors:  # the base's motions: where the other geometries start
             ms = MassSweep.build(base.model, t, g, P)
             ms0 = MassSweep.build(result.stages[0].model, t, g, P)
         base_key, base_name = (ms.key, ms0.key), base.name
@@ -520,105 +520,104 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
         notes = [f"the base spec's stage cannot be analysed ({_error_text(exc)}): no fast path"]
     else:
         notes = []
-    with warm_start(anchors):  # every design evaluated here (probes, chunks, confirmations) starts from them
-        total = len(p.designs)
-        done = 0
-        rows: list[dict] = []
+    total = len(p.designs)
+    done = 0
+    rows: list[dict] = []
 
-        def take(part: list[dict]) -> None:
-            """Collect a chunk's rows and report the progress."""
-            nonlocal done
-            rows.extend(part)
-            done += len(part)
-            if progress:
-                progress(done, total)
+    def take(part: list[dict]) -> None:
+        """Collect a chunk's rows and report the progress."""
+        nonlocal done
+        rows.extend(part)
+        done += len(part)
+        if progress:
+            progress(done, total)
 
-        route, pre, pre_rows = None, {}, []
-        if ms is not None and affine:
-            from .sweep_affine import build_route
+    route, pre, pre_rows = None, {}, []
+    if ms is not None and affine:
+        from .sweep_affine import build_route
 
-            route = build_route(p, base_key, (ms.names, ms0.names))
-        if route is None and anchors is not None:  # designs one by one: where their motions start
-            _corner_anchors(p, paths, anchors)
-        if route is not None:
-            notes.append(f"Mass-only sweep: every design's masses and inertias are affine in the varied values "
-                         f"(found and checked on {route.probes} designs built in full); the others were not built "
-                         f"one by one but evaluated as matrix products.")  # mass-only: designs as matrix products, no spec built per design
-            rows, F = route.rows(p.designs)
-            pre = dict(zip(("", "unbalanced_"), route.parameters(F)))
-            flagged = set(np.flatnonzero(route.unbuildable(F)).tolist())
-            for i in sorted(flagged):  # a design that cannot be built: its own error, as built in full
-                rows[i] = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, base_key, anchors)[0]
-            if flagged:
-                keep = np.array([i not in flagged for i in range(total)])
-                pre = {tag: P[keep] for tag, P in pre.items()}
-            pre_rows = [r for r in rows if r["design"] not in flagged]
-            if progress:
-                progress(total, total)
-        elif scheduler:
-            from distributed import Client, as_completed
+        route = build_route(p, base_key, (ms.names, ms0.names), anchors)
+    if route is None and anchors is not None:  # designs one by one: more places to start from
+        _corner_anchors(p, paths, anchors)
+    if route is not None:
+        notes.append(f"Mass-only sweep: every design's masses and inertias are affine in the varied values "
+                     f"(found and checked on {route.probes} designs built in full); the others were not built "
+                     f"one by one but evaluated as matrix products.")  # mass-only: designs as matrix products, no spec built per design
+        rows, F = route.rows(p.designs)
+        pre = dict(zip(("", "unbalanced_"), route.parameters(F)))
+        flagged = set(np.flatnonzero(route.unbuildable(F)).tolist())
+        for i in sorted(flagged):  # a design that cannot be built: its own error, as built in full
+            rows[i] = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, base_key, anchors)[0]
+        if flagged:
+            keep = np.array([i not in flagged for i in range(total)])
+            pre = {tag: P[keep] for tag, P in pre.items()}
+        pre_rows = [r for r in rows if r["design"] not in flagged]
+        if progress:
+            progress(total, total)
+    elif scheduler:
+        from distributed import Client, as_completed
 
-            with Client(scheduler) as client:
-                workers = max(1, len(client.scheduler_info()["workers"]))
-                chunks = _chunks(p.designs, workers)
-                [fdata, fanchors] = client.scatter([p.data, anchors], broadcast=True)
-                futures = [client.submit(evaluate_chunk, fdata, paths, c, p.stage, base_key, fanchors, pure=False)
-                           for c in chunks]
-                for fut in as_completed(futures):
-                    take(fut.result())
-        else:
-            workers = jobs or os.cpu_count() or 1
+        with Client(scheduler) as client:
+            workers = max(1, len(client.scheduler_info()["workers"]))
             chunks = _chunks(p.designs, workers)
-            if jobs == 0 and len(chunks) > 1:  # all cores only when the work outweighs starting them
-                t0 = time.perf_counter()
-                part = evaluate_chunk(p.data, paths, chunks[0], p.stage, base_key, anchors)
-                take(part)
-                per_design = (time.perf_counter() - t0) / len(part)
-                chunks = chunks[1:]
-                if per_design * (total - done) < POOL_WORTH:
-                    workers = 1
-            if workers == 1 or len(chunks) <= 1:
-                for c in chunks:
-                    take(evaluate_chunk(p.data, paths, c, p.stage, base_key, anchors))
-            else:
-                from concurrent.futures import ProcessPoolExecutor, as_completed as done_futures
+            [fdata, fanchors] = client.scatter([p.data, anchors], broadcast=True)
+            futures = [client.submit(evaluate_chunk, fdata, paths, c, p.stage, base_key, fanchors, pure=False)
+                       for c in chunks]
+            for fut in as_completed(futures):
+                take(fut.result())
+    else:
+        workers = jobs or os.cpu_count() or 1
+        chunks = _chunks(p.designs, workers)
+        if jobs == 0 and len(chunks) > 1:  # all cores only when the work outweighs starting them
+            t0 = time.perf_counter()
+            part = evaluate_chunk(p.data, paths, chunks[0], p.stage, base_key, anchors)
+            take(part)
+            per_design = (time.perf_counter() - t0) / len(part)
+            chunks = chunks[1:]
+            if per_design * (total - done) < POOL_WORTH:
+                workers = 1
+        if workers == 1 or len(chunks) <= 1:
+            for c in chunks:
+                take(evaluate_chunk(p.data, paths, c, p.stage, base_key, anchors))
+        else:
+            from concurrent.futures import ProcessPoolExecutor, as_completed as done_futures
 
-                with ProcessPoolExecutor(max_workers=workers) as pool:
-                    futs = [pool.submit(evaluate_chunk, p.data, paths, c, p.stage, base_key, anchors) for c in chunks]
-                    for fut in done_futures(futs):
-                        take(fut.result())
-        rows.sort(key=lambda r: r["design"])
-        for tag, sweep in (("", ms), ("unbalanced_", ms0)):  # the fast path, in blocks of matrix products
-            fast = [r for r in rows if tag + "p" in r]
-            Pm = np.array([r.pop(tag + "p") for r in fast])
-            if tag in pre:  # the affine route's designs: their parameters as one matrix
-                fast, Pm = pre_rows + fast, np.concatenate([pre[tag], Pm.reshape(-1, pre[tag].shape[1])])
-            if not fast:
-                continue
-            bad = check_parameters(sweep.names, Pm)
-            peaks = sweep.peaks(Pm)
-            for k, r in enumerate(fast):
-                if bad[k]:
-                    for key in list(r):
-                        if key not in ("design", "values", "route"):
-                            r.pop(key)
-                    r["error"] = bad[k]
-                else:
-                    for key, arr in peaks.items():
-                        r[tag + key] = float(arr[k])
-        for r in rows:
-            if "error" not in r:
-                for q in ("force", "moment"):
-                    ref = r[f"unbalanced_max_shaking_{q}"]
-                    r[f"{q}_ratio"] = r[f"max_shaking_{q}"] / ref if ref > 0 else 0.0
-        res = SweepResult(p, rows, base_name, notes=notes)
-        res.fast = sum(r.get("route") == "mass" and "error" not in r for r in rows)
-        res.full = sum(r.get("route") == "full" and "error" not in r for r in rows)
-        res.failed = sum("error" in r for r in rows)
-        mark_pareto(rows)
-        if route is not None and not _front_confirmed(p, paths, rows, F, route, base_key):
-            return run(p, jobs, scheduler, progress, affine=False)
-        return res
+            with ProcessPoolExecutor(max_workers=workers) as pool:
+                futs = [pool.submit(evaluate_chunk, p.data, paths, c, p.stage, base_key, anchors) for c in chunks]
+                for fut in done_futures(futs):
+                    take(fut.result())
+    rows.sort(key=lambda r: r["design"])
+    for tag, sweep in (("", ms), ("unbalanced_", ms0)):  # the fast path, in blocks of matrix products
+        fast = [r for r in rows if tag + "p" in r]
+        Pm = np.array([r.pop(tag + "p") for r in fast])
+        if tag in pre:  # the affine route's designs: their parameters as one matrix
+            fast, Pm = pre_rows + fast, np.concatenate([pre[tag], Pm.reshape(-1, pre[tag].shape[1])])
+        if not fast:
+            continue
+        bad = check_parameters(sweep.names, Pm)
+        peaks = sweep.peaks(Pm)
+        for k, r in enumerate(fast):
+            if bad[k]:
+                for key in list(r):
+                    if key not in ("design", "values", "route"):
+                        r.pop(key)
+                r["error"] = bad[k]
+            else:
+                for key, arr in peaks.items():
+                    r[tag + key] = float(arr[k])
+    for r in rows:
+        if "error" not in r:
+            for q in ("force", "moment"):
+                ref = r[f"unbalanced_max_shaking_{q}"]
+                r[f"{q}_ratio"] = r[f"max_shaking_{q}"] / ref if ref > 0 else 0.0
+    res = SweepResult(p, rows, base_name, notes=notes)
+    res.fast = sum(r.get("route") == "mass" and "error" not in r for r in rows)
+    res.full = sum(r.get("route") == "full" and "error" not in r for r in rows)
+    res.failed = sum("error" in r for r in rows)
+    mark_pareto(rows)
+    if route is not None and not _front_confirmed(p, paths, rows, F, route, base_key, anchors):
+        return run(p, jobs, scheduler, progress, affine=False)
+    return res
 
 
 MAX_CORNERS = 16  # corner designs solved up front as anchors (2^k for k varied fields)
@@ -648,7 +647,8 @@ def _corner_anchors(p: Plan, paths: list[tuple], anchors) -> None:
                 continue
 
 
-def _front_confirmed(p: Plan, paths: list[tuple], rows: list[dict], F: np.ndarray, route, keys: tuple) -> bool:
+def _front_confirmed(p: Plan, paths: list[tuple], rows: list[dict], F: np.ndarray, route, keys: tuple,
+                     anchors=None) -> bool:
     """The affine route's designs on a Pareto front (at most 64), built in full, have the
     predicted parameters (to the route's tolerance); else the sweep is run design by design."""
     from .sweep_affine import TOL
@@ -656,7 +656,7 @@ def _front_confirmed(p: Plan, paths: list[tuple], rows: list[dict], F: np.ndarra
     front = [r["design"] for r in rows if "error" not in r and (r["pareto_moment"] or r["pareto_effort"])][:64]
     scale = np.maximum(np.abs(F).max(axis=0), 1e-300)
     for i in front:
-        full = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, keys)[0]
+        full = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, keys, anchors)[0]
         if "error" in full or "unbalanced_p" not in full:
             return False
         got = np.concatenate([full["p"], full["unbalanced_p"]])
