@@ -88,18 +88,23 @@ _RNG = np.random.default_rng(13)
 FACTORS = {
     "slider-crank": [0.99, 0.97, *_RNG.uniform(0.9, 1.0, 2), 0.995],
     "four-bar": [1.01, 1.05, *_RNG.uniform(0.9, 1.1, 2), 0.95],
+    "3-RPR with idler loop": [1.01, 0.98, *_RNG.uniform(0.97, 1.03, 2)],  # prismatic legs, gears
+    "five-bar with meshes": [1.01, 0.98, *_RNG.uniform(0.97, 1.03, 2)],  # gear meshes
 }
+STRETCHED = {"slider-crank": "crank", "four-bar": "crank", "3-RPR with idler loop": "platform",
+             "five-bar with meshes": "link3"}
 
 
 @pytest.mark.parametrize("samples", [None, 3])
 @pytest.mark.parametrize("case", list(FACTORS))
 def test_designs_started_from_the_anchors_equal_cold_analyses(case, samples):
-    """Every stage of every design equals its cold analysis; each design's geometry is solved
-    once (a warm start per topology; its other stages reuse the motion), with no continuation."""
+    """Every stage of every design (a link longer or shorter) equals its cold analysis; each
+    design's geometry is solved once (a warm start per topology; its other stages reuse the
+    motion), with no continuation."""
     stages, t, g, mp = _setting(case)
     if samples is not None:
         t = np.linspace(t[0], t[-1], samples)
-    designs = [[_stretched(s.model, "crank", f) for s in stages] for f in FACTORS[case]]
+    designs = [[_stretched(s.model, STRETCHED[case], f) for s in stages] for f in FACTORS[case]]
     cold = [[_cold(m, t, g, mp) for m in models] for models in designs]
     anchors = _anchors(stages, t, g, mp)
     topologies = len({repr([type(j).__name__ for j in s.model.joints]) for s in stages})
