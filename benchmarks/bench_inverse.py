@@ -6,20 +6,15 @@ microseconds (best of repeats) and the ratio; asserts nothing about speed."""
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
 from balpipe.engine.structure import _LAPACK_SAMPLES, _gauss_jordan, inverse
+from bench import best_of
 
 
-def best(fn, repeats: int = 30) -> float:
-    out = float("inf")
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        out = min(out, time.perf_counter() - t0)
-    return out * 1e6
+def best(fn) -> float:
+    """Microseconds, best of 30 calls."""
+    return best_of(fn, 30) * 1e6
 
 
 def main() -> None:

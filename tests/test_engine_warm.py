@@ -185,6 +185,16 @@ def test_another_duration_starts_from_the_anchor():
     assert an.max_force == pytest.approx(analyse(base, t, g, mp).max_force / 0.8**2, rel=1e-9)
 
 
+def _assert_rejected(model, anchors, t, g, mp, ref, label: str) -> None:
+    """Within the anchors' block the warm start of ``model`` is rejected, the continuation runs
+    once and the result is the cold one, ``ref``."""
+    before = dict(warmstart.STATS)
+    with engine.warm_start(anchors):
+        an = analyse(model, t, g, mp)
+    assert _counts(before) == {"reused": 0, "warm": 0, "warm_rejected": 1, "continuation": 1}
+    _assert_close(an, ref, label)
+
+
 def _flipped(model: Model) -> Model:
     """The four-bar assembled on its other branch: coupler and rocker mirrored about the line
     through the crank pin and the rocker's pivot (the x axis at the spec's crank angle 0)."""
@@ -211,11 +221,7 @@ def test_a_design_on_the_other_branch_falls_back_to_the_continuation():
     f = fastpath.law_table(fc.fast.vz, t)[0]
     unguarded = warmstart.newton(fc.fast.vz, fc.fast.dec, anchor, f)
     assert unguarded is not None and np.abs(unguarded[:, 8] - ref.extra["frame_pose"][:, 2, 2]).max() > 0.5
-    before = dict(warmstart.STATS)
-    with engine.warm_start(anchors):
-        an = analyse(other, t, g, mp)
-    assert _counts(before) == {"reused": 0, "warm": 0, "warm_rejected": 1, "continuation": 1}
-    _assert_close(an, ref, "flipped four-bar")
+    _assert_rejected(other, anchors, t, g, mp, ref, "flipped four-bar")
 
 
 def test_a_very_different_design_falls_back_to_the_continuation():
@@ -225,11 +231,7 @@ def test_a_very_different_design_falls_back_to_the_continuation():
     other = _stretched(stages[0].model, "crank", 0.6)
     ref = _cold(other, t, g, mp)
     anchors = _anchors(stages[:1], t, g, mp)
-    before = dict(warmstart.STATS)
-    with engine.warm_start(anchors):
-        an = analyse(other, t, g, mp)
-    assert _counts(before) == {"reused": 0, "warm": 0, "warm_rejected": 1, "continuation": 1}
-    _assert_close(an, ref, "slider-crank x0.6")
+    _assert_rejected(other, anchors, t, g, mp, ref, "slider-crank x0.6")
 
 
 def test_a_design_that_cannot_move_still_raises_the_located_error():
