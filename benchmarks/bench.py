@@ -365,6 +365,41 @@ def slider_crank_stages() -> tuple[list[tuple[str, Model]], tuple, tuple, float]
             spec.motion.duration)
 
 
+def slider_crank_new_geometry() -> Model:
+    """The unbalanced Scott-Russell slider-crank with a crank 1 % shorter (a sweep's next design:
+    built from the spec's data as ``balpipe sweep`` builds it)."""
+    import yaml
+
+    from balpipe.spec import Spec
+
+    data = yaml.safe_load((ROOT / "specs" / "scott_russell.yaml").read_text())
+    data["mechanism"]["crank"]["length"] = "0.198 m"
+    return registry.unbalanced_model(Spec.model_validate(data))
+
+
+def new_geometry_time(base: Model, other: Model, t: np.ndarray, grav, mpt, repeats: int,
+                      warm_start: bool = True) -> float:
+    """Best time of analyse() on a new geometry, as a sweep runs it: the base design's motion
+    recorded as the anchor (:func:`balpipe.engine.record_anchors`), each call on a fresh copy of
+    ``other`` (compiled again, its motion not known) within :func:`balpipe.engine.warm_start`.
+    ``warm_start=False``: without the anchors (the sequential continuation, as before them)."""
+    from balpipe.engine import fastpath
+
+    engine.clear_cache()
+    with engine.record_anchors() as anchors:
+        analyse(base, t, grav, mpt)
+    motions = dict(fastpath._MOTIONS)
+
+    def call():
+        fastpath._MOTIONS.clear()
+        fastpath._MOTIONS.update(motions)
+        anchors.solved.clear()
+        analyse(dataclasses.replace(other), t, grav, mpt)
+
+    with engine.warm_start(anchors if warm_start else None):
+        return best_of(call, repeats, min_total=MIN_TOTAL)
+
+
 def bench_engine(counts: list[int], repeats: int) -> dict:
     print("\n== 2. engine throughput: analyse() = compile + positions + velocities/accelerations"
           " + inverse dynamics + both shaking-load routes ==")
@@ -402,12 +437,20 @@ def bench_engine(counts: list[int], repeats: int) -> dict:
             b = model.bodies[0]
             analyse(model.replace_body(dataclasses.replace(b, mass=b.mass * 1.01)), t, grav, mpt)
 
+        geometry = ["-"] * 4
+        if label.startswith("slider-crank"):
+            other = slider_crank_new_geometry()
+            geometry = [f"{new_geometry_time(model, other, np.linspace(0.0, dur, n), grav, mpt, repeats, w) * 1e3:.3f}"
+                        for n in (3, 100) for w in (True, False)]
         fixed.append([label, f"{warm * 1e3:.3f}", f"{best_of(new_design, repeats, min_total=MIN_TOTAL) * 1e3:.3f}",
-                      f"{best_of(cold, repeats, min_total=MIN_TOTAL) * 1e3:.3f}"])
+                      *geometry, f"{best_of(cold, repeats, min_total=MIN_TOTAL) * 1e3:.3f}"])
         times.setdefault(label, {})[3] = warm
-    table(["model", "same model ms", "new mass design ms", "cold ms"], fixed,
-          "fixed cost per analyse() call (3 samples, best of repeats): the same model again; a new model "
-          "differing in one mass; cold (engine.clear_cache() before each call):")
+    table(["model", "same model ms", "new mass design ms", "new geometry ms", "(continuation)",
+           "new geometry 100 samples ms", "(continuation)", "cold ms"], fixed,
+          "fixed cost per analyse() call (3 samples unless said, best of repeats): the same model again; a new "
+          "model differing in one mass; a new geometry (the crank 1 % shorter, after the spec's design: the warm "
+          "start from its motion, and in brackets the sequential continuation it replaces); cold "
+          "(engine.clear_cache() before each call):")
     return times
 
 

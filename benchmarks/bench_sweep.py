@@ -17,6 +17,8 @@
    on a local process pool of two and on a local two-worker dask.distributed cluster (if installed).
 4. A geometry sweep (a length and a mass): two engine analyses per design before, one per
    geometry after.
+5. A length-only sweep: every design a new geometry of a closed loop, solved from the base
+   spec's motion (warm start) against the sequential continuation.
 
 On a machine shared with other jobs, OpenBLAS threads fight for the cores; set
 ``OPENBLAS_NUM_THREADS=1`` for steadier numbers (the matrix products have 12 columns).
@@ -209,6 +211,36 @@ def geometry_sweep(lengths: int = 5, masses: int = 20) -> None:
           f"{res.failed} failed); {old * n / t1:.1f}x")
 
 
+def geometry_only_sweep(lengths: int = 40) -> None:
+    """5. A sweep of one length only (every design a new geometry of a closed loop, 501
+    samples), jobs=1: each geometry's motion from the base spec's (the anchors of
+    :mod:`balpipe.engine.warmstart`), against the sequential continuation per geometry."""
+    from balpipe import sweep
+    from balpipe.engine import warmstart
+    from balpipe.sweep import plan, run
+
+    spec = ROOT / "specs" / "offset_slider_crank.yaml"
+    p = plan(str(spec), [f"mechanism.crank.length=0.15:0.25:{lengths}"])
+    times, counts = {}, {}
+    saved = warmstart.start
+    for label in ("continuation", "warm start"):
+        if label == "continuation":
+            warmstart.start = lambda *args: None
+        sweep._GEOMETRIES.clear()
+        before = dict(warmstart.STATS)
+        t0 = time.perf_counter()
+        res = run(p, jobs=1)
+        times[label] = time.perf_counter() - t0
+        counts[label] = {k: warmstart.STATS[k] - before[k] for k in before}
+        warmstart.start = saved
+        assert res.failed == 0
+    n = len(p.designs)
+    print(f"5. length-only sweep, offset slider-crank, {n} crank lengths (every design a new geometry), jobs=1")
+    for label in times:
+        print(f"   {label}: {times[label]:.2f} s = {n / times[label]:,.1f} designs/s  (engine: {counts[label]})")
+    print(f"   warm start / continuation: {times['continuation'] / times['warm start']:.2f}x designs/s")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--designs", type=int, default=10_000)
@@ -220,6 +252,7 @@ def main() -> None:
     if anchor:
         print(f"   mass sweep / Pinocchio per-sample RNEA: {rate / anchor:.1f}x (target 10x)")
     end_to_end(args.e2e, not args.no_dask)
+    geometry_only_sweep()
 
 
 if __name__ == "__main__":

@@ -389,14 +389,12 @@ MAX_GEOMETRIES = 32
 
 def canonical(model):
     """The model with every body's mass 1 kg, centre of mass at its frame origin, inertia
-    1 kg m^2, and massless attachments: its :class:`balpipe.mass_sweep.MassSweep` depends on the
-    geometry alone, so every design of that geometry gets the same numbers, in any chunk or worker."""
-    from dataclasses import replace
+    1 kg m^2, and massless attachments (:func:`balpipe.engine.fastpath.frame_model`): its
+    :class:`balpipe.mass_sweep.MassSweep` depends on the geometry alone, so every design of that
+    geometry gets the same numbers, in any chunk or worker."""
+    from .engine.fastpath import frame_model
 
-    bodies = tuple(replace(b, mass=1.0, com=(0.0, 0.0), inertia=1.0,
-                           attachments=tuple(replace(a, mass=0.0, inertia=0.0) for a in b.attachments))
-                   for b in model.bodies)
-    return replace(model, bodies=bodies)
+    return frame_model(model)
 
 
 def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
@@ -438,11 +436,21 @@ def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
 
 
 def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]], stage: str | None,
-                   keys: tuple) -> list[dict]:
+                   keys: tuple, anchors=None) -> list[dict]:
     """Rows of one chunk of designs. For the chosen stage and the design's unbalanced stage
     (``keys``: their base geometries, or None), a design with the base geometry returns its
     parameter vector for the parent's fast path; any other is analysed here by the engine, once
-    per geometry (:func:`_stage_loads`)."""
+    per geometry (:func:`_stage_loads`), a closed loop starting from the fixed motions
+    ``anchors`` (:func:`run`; :mod:`balpipe.engine.warmstart`: no sequential continuation, and
+    the same numbers in any chunk or worker)."""
+    from .engine import warm_start
+
+    with warm_start(anchors):
+        return _evaluate(data, paths, chunk, stage, keys)
+
+
+def _evaluate(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]], stage: str | None,
+              keys: tuple) -> list[dict]:
     from .study import _total_inertia
 
     rows = []
@@ -491,7 +499,7 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     processes; 1 = in this process; 0 = all cores, after timing the first chunk in this process,
     if the rest would take more than :data:`POOL_WORTH` seconds) or on the dask.distributed
     scheduler at ``scheduler``."""
-    from .engine import AnalysisError
+    from .engine import AnalysisError, record_anchors
     from .mass_sweep import MassSweep, check_parameters
     from .spec_parts import SpecFieldError
 
@@ -503,11 +511,12 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
         result = registry.balance_designs(base_spec)
         base = _pick_stage(result, p.stage)
         t, g, P = _settings(base_spec)
-        ms = MassSweep.build(base.model, t, g, P)
-        ms0 = MassSweep.build(result.stages[0].model, t, g, P)
+        with record_anchors() as anchors:  # the base's motions: where the other geometries start
+            ms = MassSweep.build(base.model, t, g, P)
+            ms0 = MassSweep.build(result.stages[0].model, t, g, P)
         base_key, base_name = (ms.key, ms0.key), base.name
     except (SpecFieldError, AnalysisError, ValueError) as exc:  # no fast path: every design in full
-        ms, ms0, base_key, base_name = None, None, (None, None), p.stage or "last"
+        ms, ms0, base_key, base_name, anchors = None, None, (None, None), p.stage or "last", None
         notes = [f"the base spec's stage cannot be analysed ({_error_text(exc)}): no fast path"]
     else:
         notes = []
@@ -527,7 +536,9 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     if ms is not None and affine:
         from .sweep_affine import build_route
 
-        route = build_route(p, base_key, (ms.names, ms0.names))
+        route = build_route(p, base_key, (ms.names, ms0.names), anchors)
+    if route is None and anchors is not None:  # designs one by one: more places to start from
+        _corner_anchors(p, paths, anchors)
     if route is not None:
         notes.append(f"Mass-only sweep: every design's masses and inertias are affine in the varied values "
                      f"(found and checked on {route.probes} designs built in full); the others were not built "
@@ -536,7 +547,7 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
         pre = dict(zip(("", "unbalanced_"), route.parameters(F)))
         flagged = set(np.flatnonzero(route.unbuildable(F)).tolist())
         for i in sorted(flagged):  # a design that cannot be built: its own error, as built in full
-            rows[i] = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, base_key)[0]
+            rows[i] = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, base_key, anchors)[0]
         if flagged:
             keep = np.array([i not in flagged for i in range(total)])
             pre = {tag: P[keep] for tag, P in pre.items()}
@@ -549,8 +560,9 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
         with Client(scheduler) as client:
             workers = max(1, len(client.scheduler_info()["workers"]))
             chunks = _chunks(p.designs, workers)
-            [fdata] = client.scatter([p.data], broadcast=True)
-            futures = [client.submit(evaluate_chunk, fdata, paths, c, p.stage, base_key, pure=False) for c in chunks]
+            [fdata, fanchors] = client.scatter([p.data, anchors], broadcast=True)
+            futures = [client.submit(evaluate_chunk, fdata, paths, c, p.stage, base_key, fanchors, pure=False)
+                       for c in chunks]
             for fut in as_completed(futures):
                 take(fut.result())
     else:
@@ -558,7 +570,7 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
         chunks = _chunks(p.designs, workers)
         if jobs == 0 and len(chunks) > 1:  # all cores only when the work outweighs starting them
             t0 = time.perf_counter()
-            part = evaluate_chunk(p.data, paths, chunks[0], p.stage, base_key)
+            part = evaluate_chunk(p.data, paths, chunks[0], p.stage, base_key, anchors)
             take(part)
             per_design = (time.perf_counter() - t0) / len(part)
             chunks = chunks[1:]
@@ -566,12 +578,12 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
                 workers = 1
         if workers == 1 or len(chunks) <= 1:
             for c in chunks:
-                take(evaluate_chunk(p.data, paths, c, p.stage, base_key))
+                take(evaluate_chunk(p.data, paths, c, p.stage, base_key, anchors))
         else:
             from concurrent.futures import ProcessPoolExecutor, as_completed as done_futures
 
             with ProcessPoolExecutor(max_workers=workers) as pool:
-                futs = [pool.submit(evaluate_chunk, p.data, paths, c, p.stage, base_key) for c in chunks]
+                futs = [pool.submit(evaluate_chunk, p.data, paths, c, p.stage, base_key, anchors) for c in chunks]
                 for fut in done_futures(futs):
                     take(fut.result())
     rows.sort(key=lambda r: r["design"])
@@ -603,12 +615,40 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     res.full = sum(r.get("route") == "full" and "error" not in r for r in rows)
     res.failed = sum("error" in r for r in rows)
     mark_pareto(rows)
-    if route is not None and not _front_confirmed(p, paths, rows, F, route, base_key):
+    if route is not None and not _front_confirmed(p, paths, rows, F, route, base_key, anchors):
         return run(p, jobs, scheduler, progress, affine=False)
     return res
 
 
-def _front_confirmed(p: Plan, paths: list[tuple], rows: list[dict], F: np.ndarray, route, keys: tuple) -> bool:
+MAX_CORNERS = 16  # corner designs solved up front as anchors (2^k for k varied fields)
+
+
+def _corner_anchors(p: Plan, paths: list[tuple], anchors) -> None:
+    """Add to ``anchors`` the closed-loop motions of the sweep's corner designs (the first and
+    last value of every varied field, at most :data:`MAX_CORNERS`), solved here by the
+    continuation: every design then starts from the nearest of the base and the corners, which
+    covers sweeps that reach far from the base spec. Fixed before any design is evaluated, so
+    the numbers do not depend on chunks or workers. A corner that cannot be built or analysed is
+    left out (its design reports the error)."""
+    from .engine import analyse, record_anchors
+
+    ends = [(v.values[0], v.values[-1]) if v.values else (v.raw(v.lo), v.raw(v.hi)) for v in p.varies]
+    corners = list(dict.fromkeys(itertools.product(*ends)))
+    if len(corners) > MAX_CORNERS:
+        return
+    with record_anchors(into=anchors):
+        for values in corners:
+            try:
+                spec, sr, base = build_design(p.data, paths, values, p.stage)
+                t, g, P = _settings(spec)
+                for model in (sr.model, base.model):
+                    analyse(canonical(model), t, g, P)
+            except Exception:  # noqa: BLE001 - the design's own row says why
+                continue
+
+
+def _front_confirmed(p: Plan, paths: list[tuple], rows: list[dict], F: np.ndarray, route, keys: tuple,
+                     anchors=None) -> bool:
     """The affine route's designs on a Pareto front (at most 64), built in full, have the
     predicted parameters (to the route's tolerance); else the sweep is run design by design."""
     from .sweep_affine import TOL
@@ -616,7 +656,7 @@ def _front_confirmed(p: Plan, paths: list[tuple], rows: list[dict], F: np.ndarra
     front = [r["design"] for r in rows if "error" not in r and (r["pareto_moment"] or r["pareto_effort"])][:64]
     scale = np.maximum(np.abs(F).max(axis=0), 1e-300)
     for i in front:
-        full = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, keys)[0]
+        full = evaluate_chunk(p.data, paths, [(i, p.designs[i])], p.stage, keys, anchors)[0]
         if "error" in full or "unbalanced_p" not in full:
             return False
         got = np.concatenate([full["p"], full["unbalanced_p"]])

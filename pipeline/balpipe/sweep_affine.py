@@ -133,10 +133,11 @@ def _box(p) -> tuple[np.ndarray, np.ndarray]:
     return np.array(lo), np.array(hi)
 
 
-def build_route(p, keys: tuple, names: tuple[list[str], list[str]]) -> AffineRoute | None:
+def build_route(p, keys: tuple, names: tuple[list[str], list[str]], anchors=None) -> AffineRoute | None:
     """Probe the plan's sweep (k + 1 full designs, then the checks); the route, or None when the
     designs are not affine in the varied values at the base geometry. ``keys``: the geometry keys
-    of the base design's chosen and unbalanced stages; ``names``: their bodies' names."""
+    of the base design's chosen and unbalanced stages; ``names``: their bodies' names;
+    ``anchors``: where the probes' closed-loop motions start (:func:`balpipe.sweep.run`)."""
     from .sweep import build_design, evaluate_chunk
 
     if keys[0] is None or keys[1] is None or not p.designs:
@@ -150,7 +151,7 @@ def build_route(p, keys: tuple, names: tuple[list[str], list[str]]) -> AffineRou
 
     def full(x: np.ndarray) -> tuple[np.ndarray | None, dict]:
         values = tuple(v.raw(xj) for v, xj in zip(p.varies, x))
-        row = evaluate_chunk(p.data, paths, [(0, values)], p.stage, keys)[0]
+        row = evaluate_chunk(p.data, paths, [(0, values)], p.stage, keys, anchors)[0]
         if "error" in row:
             return None, row
         _, sr, base = build_design(p.data, paths, values, p.stage)

@@ -34,7 +34,9 @@ loads are computed twice, independently:
 Modules, one job each: :mod:`.compile` (primitives, :func:`compile_model`), :mod:`.constraints`
 (Phi, Phi_q, nu, gamma), :mod:`.positions`, :mod:`.kinematics` (velocities, accelerations),
 :mod:`.dynamics` (multipliers, tooth loads, reactions), :mod:`.analysis` (:class:`Analysis`,
-:func:`analyse`).
+:func:`analyse`), :mod:`.structure` and :mod:`.fastpath` (the block-triangular path),
+:mod:`.warmstart` (a new geometry of a closed loop solved from fixed anchors:
+:func:`record_anchors`, :func:`warm_start`).
 """
 
 from .analysis import Analysis, analyse, clear_cache, compiled
@@ -43,12 +45,13 @@ from .constraints import _extend, _law_values, _split, acceleration_rhs, jacobia
 from .dynamics import _joint_reactions, _multipliers, _radial_tooth_loads, _tooth_rows
 from .errors import AnalysisError
 from .kinematics import _solve_rect, _vel_acc
+from .warmstart import Anchors, record as record_anchors, warm_start
 from .positions import (
     _COARSE, _COND_LIMIT, _JUMP, _MAX_ITER, _TOL, _check_regular, _check_redundancy, _check_square,
     _fail_position, _newton, _substep, _worst_rows, condition_numbers, follow_motion, redundancy, solve_positions,
 )
 
 __all__ = [
-    "Analysis", "AnalysisError", "Compiled", "acceleration_rhs", "analyse", "clear_cache", "compile_model", "compiled", "jacobian",
-    "redundancy", "residual", "solve_positions", "velocity_rhs",
+    "Analysis", "AnalysisError", "Anchors", "Compiled", "acceleration_rhs", "analyse", "clear_cache", "compile_model", "compiled", "jacobian",
+    "record_anchors", "redundancy", "residual", "solve_positions", "velocity_rhs", "warm_start",
 ]

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..model import Model
 from . import fastpath, structure
-from .compile import Compiled, _rotate, compile_model
+from .compile import Compiled, compile_model
 from .constraints import _extend, jacobian
 from .dynamics import _joint_reactions, _multipliers, _radial_tooth_loads, _tooth_rows
 from .kinematics import _vel_acc
@@ -138,7 +138,8 @@ def compiled(model: Model) -> Compiled:
 
 
 def clear_cache() -> None:
-    """Forget compiled models and block structures (for benchmarks of cold calls)."""
+    """Forget compiled models, block structures and solved motions (for benchmarks of cold
+    calls); the anchors of :mod:`.warmstart` are the caller's."""
     _COMPILED.clear()
     structure._CACHE.clear()
     fastpath._MOTIONS.clear()
@@ -227,11 +228,7 @@ def analyse(
     efforts = {name: -lam[:, row] for name, row in c.driver_rows.items()}
     reactions = _joint_reactions(model, c, lam, mesh_geo)
     # frame poses for drawing: frame origin = com - A(theta) com_local
-    frame_pose = np.zeros_like(qb)
-    for k, b in enumerate(model.bodies):
-        _, cl, _ = b.mass_properties()
-        frame_pose[:, k, :2] = qb[:, k, :2] - _rotate(qb[:, k, 2], np.asarray(cl))
-        frame_pose[:, k, 2] = qb[:, k, 2]
+    frame_pose = fastpath._place(q, -c.com_local).reshape(qb.shape)
     return Analysis(
         t=t, names=c.names, q=qb, v=vb, a=ab,
         force=force, moment=about_P(moment_O, force),

@@ -77,6 +77,8 @@ class Compiled:
     meshes: list = field(default_factory=list)  # _Mesh: gear pairs that pass tooth forces
     fast: object = None  # the block-triangular path's data (:func:`.fastpath.prepare`), made once
     com_local: np.ndarray | None = None  # (nb, 2) centres of mass in the bodies' own frames
+    frame: "Compiled | None" = None  # the frame model's (:func:`.fastpath.frame_motion`), made once
+    keys: tuple | None = None  # (shape, numbers, law ids) of the model (:func:`.warmstart.model_keys`), made once
 
     @property
     def nb(self) -> int:

@@ -5,11 +5,15 @@ substitution on the decomposed Jacobian (:mod:`.structure`), the constraints eva
 * Positions: when every block is 1 x 1 and linear in its unknown (open chains with driven
   joints, guides fixed to the frame, ...) Phi(q, t) = 0 is solved level by level, each unknown
   by one division, with no Newton iteration, continuation or branch to follow (the solution is
-  unique); the residual is checked at the end. Otherwise (closed loops) the general
-  continuation and batched Newton-Raphson of :mod:`.positions`, followed by one Newton step
-  by blocks (its residual 1e-12 becomes ~1e-16); the motion of the bodies' frames is kept and
-  reused by the next model with the same joints, drivers, initial poses and grid (a balancing
-  stage, a mass design), which then needs no continuation.
+  unique); the residual is checked at the end. Otherwise (closed loops) the motion of the
+  bodies' frames is solved on the frame model (every centre of mass at its frame's origin, so
+  that it depends on the geometry alone) by the general continuation and batched
+  Newton-Raphson of :mod:`.positions`, followed by one Newton step by blocks (its residual
+  1e-12 becomes ~1e-16); it is kept and reused by every model with the same joints, drivers,
+  points, initial poses and grid (a balancing stage, a mass design: no continuation), which
+  places its centres of mass in it. Within :func:`.warmstart.warm_start` a new geometry of the
+  same structure (a sweep's next design) starts from the nearest anchor instead
+  (:mod:`.warmstart`).
 * Velocities Phi_q q' = nu, accelerations Phi_q q'' = gamma: forward substitution.
 * Multipliers Phi_q^T lambda = Q - M q'': backward substitution on the same values.
 * Regularity: cond(Phi_q) >= max|entry| / sigma_min(block) for every diagonal block; samples
@@ -30,7 +34,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .compile import Compiled
+from ..model import Model
+from . import warmstart
+from .compile import Compiled, compile_model
 from .positions import _COND_LIMIT, _TOL, _check_regular, _condition, follow_motion, redundancy
 from .constraints import _extend, jacobian
 from .structure import Decomposition, block_sigma_min, decompose, invert_blocks, solve
@@ -123,54 +129,84 @@ def _explicit_positions(vz: Vectorised, dec: Decomposition, f: np.ndarray, N: in
 _MOTIONS: dict[tuple, tuple[list, np.ndarray]] = {}
 
 
-def _motion_key(c: Compiled, t: np.ndarray) -> tuple:
-    """Everything the motion of the bodies' own frames depends on: the joints, the drivers (their
-    laws by identity, kept alive by the cache), the bodies' named points, the initial poses
-    (the branch) and the time grid; not the mass properties, which move only the centres of
-    mass within the bodies (a balancing stage, a mass design). Numbers enter exactly."""
-    m = c.model
-    joints = tuple((type(j).__name__, *(_exact(getattr(j, f.name)) for f in dataclasses.fields(j))) for j in m.joints)
-    return (joints, tuple((d.name, _exact(d.target), id(d.law)) for d in m.drivers),
-            tuple((b.name, _exact(sorted(b.points.items()))) for b in m.bodies),
-            _exact(sorted(m.initial.items())), t.tobytes())
-
-
-def _exact(v):
-    """A hashable, exact image of nested tuples, lists, arrays and numbers."""
-    if isinstance(v, (str, type(None))):
-        return v
-    if isinstance(v, (tuple, list, np.ndarray)):
-        return tuple(_exact(x) for x in v)
-    return float(v).hex()
-
-
 def _closed_loop_positions(c: Compiled, vz: Vectorised, dec: Decomposition, t: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """Positions (N, 3 nb) by the general continuation, or from the motion of the bodies' frames
-    solved before for the same mechanism and grid (another stage or mass design): the centres
-    of mass are placed in the bodies' frames, and the residual is checked."""
-    key = _motion_key(c, t)
-    hit = _MOTIONS.get(key)
-    com = c.com_local
-    if hit is not None:
-        frame = hit[1]
-        th = frame[:, 2::3]
-        cos, sin = np.cos(th), np.sin(th)
-        q = frame.copy()
-        q[:, 0::3] += cos * com[:, 0] - sin * com[:, 1]
-        q[:, 1::3] += sin * com[:, 0] + cos * com[:, 1]
+    """Positions (N, 3 nb) of a closed loop: the centres of mass placed in the frame motion of its
+    geometry (:func:`frame_motion`), the residual checked; where that motion cannot be solved on
+    the frame model (its pattern has no block form), the continuation on ``c`` itself."""
+    frame = frame_motion(c, t, f)
+    if frame is not None and not np.any(c.com_local):  # c is its own frame model
+        return frame
+    if frame is not None:
+        q = _place(frame, c.com_local)
         X = np.zeros((vz.ncol, len(t)))
         X[3:] = q.T
         if np.all(np.abs(residual(vz, State(vz, X), f)) < _TOL):
             return q
-    q = _polish(vz, dec, follow_motion(c, t), f)
-    th = q[:, 2::3]
+    return _polish(vz, dec, follow_motion(c, t), f)
+
+
+def frame_motion(c: Compiled, t: np.ndarray, f: np.ndarray) -> np.ndarray | None:
+    """The motion (N, 3 nb) of the bodies' own frames along ``t``, solved on the frame model
+    (:func:`frame_model`) so that it depends on the geometry alone, not on the mass properties
+    (every balancing stage and mass design of a mechanism shares it, whatever ran first):
+
+    1. known: solved before in this process for the same joints, drivers, points, initial poses
+       and grid (:func:`.warmstart.motion_key`), or warm-started before from the active anchors;
+    2. within :func:`.warmstart.warm_start`: from the nearest anchor, if accepted;
+    3. the continuation (:func:`.positions.follow_motion`) and one Newton step by blocks.
+
+    None when the frame model's pattern has no block form (the caller solves ``c`` itself)."""
+    key = warmstart.motion_key(c, t)
+    hit = _MOTIONS.get(key)
+    frame = hit[1] if hit is not None else warmstart.solved(key)
+    if frame is not None:
+        warmstart.STATS["reused"] += 1
+    else:
+        fc = _frame_compiled(c)
+        fp = fc.fast
+        if fp.dec is None:
+            return None
+        frame = warmstart.start(fc, fp.vz, fp.dec, t, f, key)
+        if frame is None:
+            warmstart.STATS["continuation"] += 1
+            frame = _polish(fp.vz, fp.dec, follow_motion(fc, t), f)
+            if len(_MOTIONS) >= 16:
+                _MOTIONS.clear()
+            _MOTIONS[key] = ([d.law for d in c.model.drivers], frame)
+    warmstart.note(c, t, frame)
+    return frame
+
+
+def frame_model(model: Model) -> Model:
+    """``model`` with every body's centre of mass at its frame origin (mass 1 kg, inertia
+    1 kg m^2, attachments massless): the same geometry, whose coordinates are the bodies' frames."""
+    bodies = tuple(dataclasses.replace(b, mass=1.0, com=(0.0, 0.0), inertia=1.0,
+                                       attachments=tuple(dataclasses.replace(a, mass=0.0, inertia=0.0)
+                                                         for a in b.attachments))
+                   for b in model.bodies)
+    return dataclasses.replace(model, bodies=bodies)
+
+
+def _frame_compiled(c: Compiled) -> Compiled:
+    """The compiled frame model of ``c`` (``c`` itself when its centres of mass are at the
+    frames' origins), prepared for the block path; kept on ``c``."""
+    if c.frame is None:
+        if not np.any(c.com_local):
+            c.frame = c
+        else:
+            c.frame = compile_model(frame_model(c.model))
+        if c.frame.fast is None:
+            c.frame.fast = prepare(c.frame)
+    return c.frame
+
+
+def _place(frame: np.ndarray, com: np.ndarray) -> np.ndarray:
+    """Coordinates (N, 3 nb) of the points at ``com`` (nb, 2) in the bodies' frames ``frame``."""
+    th = frame[:, 2::3]
     cos, sin = np.cos(th), np.sin(th)
-    frame = q.copy()
-    frame[:, 0::3] -= cos * com[:, 0] - sin * com[:, 1]
-    frame[:, 1::3] -= sin * com[:, 0] + cos * com[:, 1]
-    if len(_MOTIONS) >= 16:
-        _MOTIONS.clear()
-    _MOTIONS[key] = ([d.law for d in c.model.drivers], frame)
+    q = frame.copy()
+    q[:, 0::3] += cos * com[:, 0] - sin * com[:, 1]
+    q[:, 1::3] += sin * com[:, 0] + cos * com[:, 1]
     return q
 
 

@@ -244,10 +244,27 @@ def solve(plan: Plan, vals: np.ndarray, rhs: np.ndarray, inverses: dict[int, np.
     return U
 
 
+_LAPACK_SAMPLES = 300  # below this many samples (or from k = 7) LAPACK per matrix is faster
+
+
 def inverse(A: np.ndarray) -> np.ndarray:
-    """Inverses of a stack of small matrices laid out (k, k, N), by Gauss-Jordan elimination with
-    partial pivoting, vectorised over the N samples (for k of a few units much faster than
-    LAPACK called per matrix). A singular matrix gives non-finite values."""
+    """Inverses of a stack of small matrices laid out (k, k, N). Few samples or larger blocks:
+    LAPACK's LU per matrix (:func:`numpy.linalg.inv`; its fixed cost is a few microseconds);
+    otherwise Gauss-Jordan elimination with partial pivoting, vectorised over the N samples (for
+    k of a few units and thousands of samples much faster than LAPACK called per matrix;
+    ``benchmarks/bench_inverse.py`` measures the crossing). A singular matrix gives non-finite
+    values."""
+    k, _, N = A.shape
+    if N <= _LAPACK_SAMPLES or k >= 7:
+        try:
+            return np.linalg.inv(A.transpose(2, 0, 1)).transpose(1, 2, 0)
+        except np.linalg.LinAlgError:  # an exactly singular sample: non-finite values, as below
+            pass
+    return _gauss_jordan(A)
+
+
+def _gauss_jordan(A: np.ndarray) -> np.ndarray:
+    """:func:`inverse` by Gauss-Jordan elimination vectorised over the samples."""
     k, _, N = A.shape
     M = np.empty((k, 2 * k, N))
     M[:, :k] = A
