@@ -36,12 +36,13 @@ _DENSE_ENTRIES = 20_000  # samples x n^2 up to which the dense scattered Jacobia
 class BlockOps:
     """The continuation's solves for a model with a square, structurally regular Jacobian."""
 
-    def __init__(self, c: Compiled, vz: Vectorised, dec: Decomposition):
+    def __init__(self, c: Compiled, vz: Vectorised, dec: Decomposition, t: np.ndarray | None = None):
+        """``t``: the time grid of the motion, whose law values are then evaluated once."""
         self.c, self.vz, self.dec = c, vz, dec
+        self._grid = None if t is None else (t, law_table(vz, t), {x: k for k, x in enumerate(t.tolist())})
         free = np.flatnonzero(vz.cols >= 3)
         self._free, self._frow, self._fcol = free, vz.rows[free], vz.cols[free] - 3
         self.n = vz.ncol - 3
-        self._last_t = None  # (t, law table) of the last single time
         self._last_state = None  # (q, State) where the last single-sample Newton stopped
 
     def _X(self, q: np.ndarray) -> np.ndarray:
@@ -59,14 +60,17 @@ class BlockOps:
         return N * self.n * self.n <= _DENSE_ENTRIES
 
     def _laws(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:func:`.vectorised.law_table`, kept for the last single time (a coarse step's Newton
-        iteration and its velocities ask for the same one)."""
-        if len(t) == 1 and self._last_t is not None and self._last_t[0] == t[0]:
-            return self._last_t[1]
-        F = law_table(self.vz, t)
-        if len(t) == 1:
-            self._last_t = (float(t[0]), F)
-        return F
+        """:func:`.vectorised.law_table` at times t: taken from the table of the whole grid
+        (made once) for the grid itself and for single times on it (the coarse steps)."""
+        if self._grid is not None:
+            grid, table, where = self._grid
+            if t is grid:
+                return table
+            if len(t) == 1:
+                k = where.get(float(t[0]))
+                if k is not None:
+                    return table[0][:, k : k + 1], table[1][:, k : k + 1], table[2][:, k : k + 1]
+        return law_table(self.vz, t)
 
     def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = 25):
         """Batched Newton-Raphson from q (N, n) at times t (N,). Returns (q, converged mask,

@@ -143,7 +143,7 @@ class DenseOps:
         return _vel_acc(self.c, q, t)
 
 
-def _ops(c: Compiled):
+def _ops(c: Compiled, t: np.ndarray):
     """The solves for the continuation of ``c``: by the constraints evaluated by type
     (:class:`.newton_blocks.BlockOps`) when the block path has decomposed its Jacobian
     (``c.fast``, :func:`.fastpath.prepare`), else the general path's."""
@@ -151,7 +151,7 @@ def _ops(c: Compiled):
     if p is not None and getattr(p, "dec", None) is not None and redundancy(c) == 0:
         from .newton_blocks import BlockOps
 
-        return BlockOps(c, p.vz, p.dec)
+        return BlockOps(c, p.vz, p.dec, t)
     return DenseOps(c)
 
 
@@ -175,7 +175,7 @@ def follow_motion(c: Compiled, t: np.ndarray, ops=None) -> np.ndarray:
     :class:`.newton_blocks.BlockOps`); by default the block ones where ``c`` has been decomposed
     (:func:`_ops`). Either gives the same motion (same branch, to the Newton tolerance)."""
     if ops is None:
-        ops = _ops(c)
+        ops = _ops(c, t)
     _check_square(c)
     N = len(t)
     q, ok, _ = ops.newton(c.q0[None, :], t[:1], max_iter=50)
