@@ -117,7 +117,7 @@ def _decompose(vz: Vectorised) -> Decomposition | None:
             col_entries[c].append((r, s))
     adj = [[c for c, _ in e] for e in row_entries]
     match = maximum_matching(adj, n)  # column matched to each row
-    if match is None:
+    if -1 in match:
         return None  # structurally singular
     row_of_col = [0] * n
     for r, c in enumerate(match):
@@ -226,11 +226,13 @@ def _step(eqs, unks, diag, offs, pad: int, n: int, square: bool, block: int = -1
                 np.array(off_unk, dtype=np.intp).reshape(len(offs), w), square, block)
 
 
-def maximum_matching(adj: list[list[int]], n: int) -> list[int] | None:
-    """A perfect matching of the rows of a pattern to its ``n`` columns (``adj[r]``: the columns
-    of row r), as the column matched to each row, or None when there is none (the pattern is
-    structurally singular). Augmenting paths (Kuhn 1955; Duff 1981, algorithm MC21) by a depth-
-    first search without recursion, columns tried in the order given: deterministic."""
+def maximum_matching(adj: list[list[int]], n: int) -> list[int]:
+    """A maximum matching of the rows of a pattern to its ``n`` columns (``adj[r]``: the columns
+    of row r), as the column matched to each row (-1 for a row left unmatched: the pattern is
+    then structurally singular, its structural rank the number of matched rows). Augmenting
+    paths (Kuhn 1955; Duff 1981, algorithm MC21) by a depth-first search without recursion,
+    after a cheap greedy assignment; rows and columns tried in the order given: deterministic.
+    O(rows x entries), nothing for the patterns of planar mechanisms."""
     m = len(adj)
     row_col = [-1] * m
     col_row = [-1] * n
@@ -265,8 +267,7 @@ def maximum_matching(adj: list[list[int]], n: int) -> list[int] | None:
                     row_col[u2], col_row[c2] = c2, u2
                 break
             path.append(w), pos.append(0)
-        else:
-            return None  # no augmenting path from r: no perfect matching
+        # no augmenting path from r: r stays unmatched (Kuhn: it never gets one later)
     return row_col
 
 

@@ -11,6 +11,7 @@ are written once. The driver laws are evaluated once per call (:func:`law_table`
 
 from __future__ import annotations
 
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -166,7 +167,7 @@ def _aux(vz: Vectorised) -> _Aux:
     src = (vz.ci, vz.cj, vz.pi, vz.pj, vz.csi, vz.csj, vz.pa, vz.psi, vz.psj, vz.crow, vz.aconst, vz.pconst,
            vz.const)
     hit = vz.__dict__.get("_aux")
-    if hit is None or any(a is not b for a, b in zip(hit.src, src)):
+    if hit is None or not all(map(operator.is_, hit.src, src)):
         hit = vz.__dict__["_aux"] = _Aux(vz, src)
     return hit
 
