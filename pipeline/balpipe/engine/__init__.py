@@ -32,7 +32,8 @@ loads are computed twice, independently:
 (b) momentum: F_sh = sum m g - dP/dt, M_O = sum r x m g - dH_O/dt.
 
 Modules, one job each: :mod:`.compile` (primitives, :func:`compile_model`), :mod:`.constraints`
-(Phi, Phi_q, nu, gamma), :mod:`.positions`, :mod:`.kinematics` (velocities, accelerations),
+(Phi, Phi_q, nu, gamma), :mod:`.positions` (continuation; its solves on the block path in
+:mod:`.newton_blocks`), :mod:`.kinematics` (velocities, accelerations),
 :mod:`.dynamics` (multipliers, tooth loads, reactions), :mod:`.analysis` (:class:`Analysis`,
 :func:`analyse`), :mod:`.structure` and :mod:`.fastpath` (the block-triangular path),
 :mod:`.warmstart` (a new geometry of a closed loop solved from fixed anchors:

@@ -8,7 +8,7 @@ import numpy as np
 from .compile import Compiled
 from .constraints import _extend, jacobian, residual
 from .errors import AnalysisError
-from .kinematics import _solve_rect, _vel_acc, _vel_acc_safe
+from .kinematics import _solve_rect, _vel_acc
 
 _TOL = 1e-12
 _MAX_ITER = 25
@@ -129,24 +129,56 @@ def _check_regular(c: Compiled, q: np.ndarray, t: np.ndarray) -> np.ndarray:
     return cond
 
 
+class DenseOps:
+    """The general path's solves: :func:`_newton` and :func:`.kinematics._vel_acc` on every
+    sample's full Jacobian (:func:`.constraints.jacobian`)."""
+
+    def __init__(self, c: Compiled):
+        self.c = c
+
+    def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER):
+        return _newton(self.c, q, t, max_iter)
+
+    def vel_acc(self, q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return _vel_acc(self.c, q, t)
+
+
+def _ops(c: Compiled, t: np.ndarray):
+    """The solves for the continuation of ``c``: by the constraints evaluated by type
+    (:class:`.newton_blocks.BlockOps`) when the block path has decomposed its Jacobian
+    (``c.fast``, :func:`.fastpath.prepare`), else the general path's."""
+    p = c.fast
+    if p is not None and getattr(p, "dec", None) is not None and redundancy(c) == 0:
+        from .newton_blocks import BlockOps
+
+        return BlockOps(c, p.vz, p.dec, t)
+    return DenseOps(c)
+
+
 def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
     """Positions (N, 3 nb) along the motion.
 
     The first sample is assembled from the model's initial pose; a coarse grid is then followed
     by continuation (second-order predictor), and all samples are refined at once by batched
     Newton-Raphson from a cubic Hermite interpolation of the coarse solution. A singular
-    configuration on the way is an error (:func:`_check_regular`).
+    configuration on the way is an error (:func:`_check_regular`). Always the general path's
+    dense solves (:class:`DenseOps`): the reference the block path is tested against.
     """
-    qall = follow_motion(c, t)
+    qall = follow_motion(c, t, DenseOps(c))
     c.condition = _check_regular(c, qall, t)
     return qall
 
 
-def follow_motion(c: Compiled, t: np.ndarray) -> np.ndarray:
-    """:func:`solve_positions` without the regularity check (the caller makes it)."""
+def follow_motion(c: Compiled, t: np.ndarray, ops=None) -> np.ndarray:
+    """:func:`solve_positions` without the regularity check (the caller makes it). ``ops``: the
+    Newton-Raphson and velocity solves (:class:`DenseOps`, or
+    :class:`.newton_blocks.BlockOps`); by default the block ones where ``c`` has been decomposed
+    (:func:`_ops`). Either gives the same motion (same branch, to the Newton tolerance)."""
+    if ops is None:
+        ops = _ops(c, t)
     _check_square(c)
     N = len(t)
-    q, ok, _ = _newton(c, c.q0[None, :], t[:1], max_iter=50)
+    q, ok, _ = ops.newton(c.q0[None, :], t[:1], max_iter=50)
     if not ok[0]:
         raise AnalysisError(
             "cannot assemble the mechanism at t = 0: " + str(_fail_position(c, q[0], float(t[0]))).split(": ", 1)[1],
@@ -163,12 +195,12 @@ def follow_motion(c: Compiled, t: np.ndarray) -> np.ndarray:
         if k > 0:
             h = tc[k] - tc[k - 1]
             guess = qc[k - 1] + vc[k - 1] * h + 0.5 * ac * h * h
-            sol, ok_k, _ = _newton(c, guess[None, :], tc[k : k + 1])
+            sol, ok_k, _ = ops.newton(guess[None, :], tc[k : k + 1])
             if not ok_k[0]:
                 # substep the continuation before giving up
-                sol = _substep(c, qc[k - 1], tc[k - 1], tc[k])
+                sol = _substep(c, qc[k - 1], tc[k - 1], tc[k], ops=ops)
             qc[k] = sol[0]
-        v, ac = _vel_acc(c, qc[k : k + 1], tc[k : k + 1])
+        v, ac = ops.vel_acc(qc[k : k + 1], tc[k : k + 1])
         vc[k], ac = v[0], ac[0]
     # Hermite interpolation to the full grid
     seg = np.clip(np.searchsorted(tc, t, side="right") - 1, 0, len(tc) - 2) if len(tc) > 1 else np.zeros(N, int)
@@ -180,22 +212,27 @@ def follow_motion(c: Compiled, t: np.ndarray) -> np.ndarray:
         guess = h00 * qc[seg] + h10 * h * vc[seg] + h01 * qc[seg + 1] + h11 * h * vc[seg + 1]
     else:
         guess = np.repeat(qc[:1], N, axis=0)
-    qall, ok, _ = _newton(c, guess, t)
+    qall, ok, _ = ops.newton(guess, t)
     jumped = np.abs(qall[:, 2::3] - guess[:, 2::3]).max(axis=1) > _JUMP
     for k in np.flatnonzero(~ok | jumped):  # rare: refine sequentially from the previous sample
         prev = k - 1
-        qall[k] = _substep(c, qall[prev], t[prev], t[k])[0]
+        qall[k] = _substep(c, qall[prev], t[prev], t[k], ops=ops)[0]
     return qall
 
 
-def _substep(c: Compiled, q: np.ndarray, ta: float, tb: float, depth: int = 0) -> np.ndarray:
+def _substep(c: Compiled, q: np.ndarray, ta: float, tb: float, depth: int = 0, ops=None) -> np.ndarray:
+    ops = ops if ops is not None else DenseOps(c)
     for n in (4, 16, 64):
         cur = q.copy()
         good = True
         for tt in np.linspace(ta, tb, n + 1)[1:]:
-            v, a = _vel_acc_safe(c, cur, tt)
+            try:
+                v, a = ops.vel_acc(cur[None, :], np.array([tt]))
+                v, a = v[0], a[0]
+            except np.linalg.LinAlgError:
+                v, a = np.zeros_like(cur), np.zeros_like(cur)
             h = (tb - ta) / n
-            sol, ok, _ = _newton(c, (cur + v * h + 0.5 * a * h * h)[None, :], np.array([tt]))
+            sol, ok, _ = ops.newton((cur + v * h + 0.5 * a * h * h)[None, :], np.array([tt]))
             if not ok[0]:
                 good = False
                 break

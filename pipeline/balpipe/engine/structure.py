@@ -1,10 +1,13 @@
 """Structural decomposition of the constraint Jacobian and the triangular solves it allows.
 
 The sparsity pattern of Phi_q (free coordinates only) is put in block lower-triangular form
-(Dulmage-Mendelsohn fine decomposition, Duff and Reid 1978; Pothen and Fan 1990): a maximum
-bipartite matching of rows to columns (:func:`scipy.sparse.csgraph.maximum_bipartite_matching`),
-then the strongly connected components of the graph "row r uses the column matched to row s"
-(:func:`scipy.sparse.csgraph.connected_components`), in topological order. A square system
+(Dulmage-Mendelsohn fine decomposition, Duff and Reid 1978; Pothen and Fan 1990): a perfect
+matching of rows to columns by augmenting paths (:func:`maximum_matching`; Duff's MC21), then
+the strongly connected components of the graph "row r uses the column matched to row s" in
+topological order (:func:`strong_components`; Tarjan 1972). Both run in pure Python over lists:
+for the patterns of planar mechanisms (tens of rows) that is far cheaper than building sparse
+matrices for scipy's csgraph, and the result does not depend on which matching is found (the
+blocks are unique as sets; each block's columns are taken in ascending order). A square system
 Phi_q x = b is then solved block by block by forward substitution, and Phi_q^T lambda = c by
 backward substitution; det Phi_q is the product of the diagonal blocks' determinants, so Phi_q
 is regular exactly when every diagonal block is.
@@ -18,8 +21,8 @@ The decomposition depends only on the pattern, so it is cached by pattern
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
@@ -97,111 +100,118 @@ def _decompose_cached(key: tuple, vz: Vectorised) -> Decomposition | None:
 
 
 def _decompose(vz: Vectorised) -> Decomposition | None:
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import connected_components, maximum_bipartite_matching
-
     m, n = vz.m, vz.ncol - 3
     if m != n or m == 0:
         return None
-    free = vz.structural & (vz.cols >= 3)
-    slots = np.flatnonzero(free)
-    R, Cl = vz.rows[slots], vz.cols[slots] - 3
-    slot_of = {(int(r), int(c)): int(s) for r, c, s in zip(R, Cl, slots)}
-    if len(slot_of) != len(slots):  # two entries on one (row, column): not expected
-        return None
-    P = csr_matrix((np.ones(len(R)), (R, Cl)), shape=(m, n))
-    match = maximum_bipartite_matching(P, perm_type="column")  # column matched to each row
-    if np.any(match < 0):
+    rows_l, cols_l, struct_l = vz.rows.tolist(), vz.cols.tolist(), vz.structural.tolist()
+    row_entries: list[list[tuple[int, int]]] = [[] for _ in range(m)]  # (column, slot) per row
+    col_entries: list[list[tuple[int, int]]] = [[] for _ in range(n)]  # (row, slot) per column
+    slot_of: dict[tuple[int, int], int] = {}
+    for s, (r, c, st) in enumerate(zip(rows_l, cols_l, struct_l)):
+        if st and c >= 3:
+            c -= 3
+            if (r, c) in slot_of:  # two entries on one (row, column): not expected
+                return None
+            slot_of[r, c] = s
+            row_entries[r].append((c, s))
+            col_entries[c].append((r, s))
+    adj = [[c for c, _ in e] for e in row_entries]
+    match = maximum_matching(adj, n)  # column matched to each row
+    if -1 in match:
         return None  # structurally singular
-    row_of_col = np.empty(n, dtype=np.intp)
-    row_of_col[match] = np.arange(m)
-    # row r -> row s when r uses the column matched to s
-    G = csr_matrix((np.ones(len(R)), (R, row_of_col[Cl])), shape=(m, m))
-    nblk, label = connected_components(G, directed=True, connection="strong")
-    members = [sorted(np.flatnonzero(label == b).tolist()) for b in range(nblk)]
-    row_entries: dict[int, list[tuple[int, int]]] = {r: [] for r in range(m)}
-    col_entries: dict[int, list[tuple[int, int]]] = {c: [] for c in range(n)}
-    for r, c, s in zip(R.tolist(), Cl.tolist(), slots.tolist()):
-        row_entries[r].append((c, s))
-        col_entries[c].append((r, s))
-    deps = [set() for _ in range(nblk)]  # blocks whose unknowns a block uses
+    row_of_col = [0] * n
+    for r, c in enumerate(match):
+        row_of_col[c] = r
+    # row r -> row s when r uses the column matched to s; components in topological order
+    members = strong_components([[row_of_col[c] for c in a] for a in adj])
+    nblk = len(members)
+    label = [0] * m
+    for b, rows in enumerate(members):
+        for r in rows:
+            label[r] = b
+    deps: list[set[int]] = [set() for _ in range(nblk)]  # blocks whose unknowns a block uses
     for r in range(m):
-        for c, _ in row_entries[r]:
+        lr = label[r]
+        for c in adj[r]:
             b2 = label[row_of_col[c]]
-            if b2 != label[r]:
-                deps[label[r]].add(int(b2))
-    order = _topological(deps)
-    blocks = [(members[b], [int(match[r]) for r in members[b]]) for b in order]
+            if b2 != lr:
+                deps[lr].add(b2)
+    # each block's columns in ascending order: the decomposition does not depend on which
+    # maximum matching was found (the blocks, as sets, are unique)
+    bcols = [sorted(match[r] for r in rows) for rows in members]
+    blocks = [(members[b], bcols[b]) for b in range(nblk)]
     pad = vz.nnz
-    kind = _row_kind(vz)
+    kind = _row_kind(vz).tolist()
+    rdeps: list[list[int]] = [[] for _ in range(nblk)]
+    for b in range(nblk):
+        for b2 in sorted(deps[b]):
+            rdeps[b2].append(b)
 
     def build(transposed: bool) -> Plan:
         # forward: equations = rows, unknowns = columns; backward: the other way round
-        level: dict[int, int] = {}
-        seq = order if not transposed else order[::-1]
-        rdeps = [set() for _ in range(nblk)]
-        for b in range(nblk):
-            for b2 in deps[b]:
-                rdeps[b2].add(b)
-        dep = deps if not transposed else rdeps
-        for b in seq:
-            level[b] = 1 + max((level[d] for d in dep[b]), default=-1)
+        level = [0] * nblk
+        if not transposed:
+            for b in range(nblk):
+                level[b] = 1 + max((level[d] for d in deps[b]), default=-1)
+            seq = range(nblk)
+        else:
+            for b in range(nblk - 1, -1, -1):
+                level[b] = 1 + max((level[d] for d in rdeps[b]), default=-1)
+            seq = range(nblk - 1, -1, -1)
         groups: dict[int, list[int]] = {}
         for b in seq:
             groups.setdefault(level[b], []).append(b)
         steps = []
         for lev in sorted(groups):
-            singles = [b for b in groups[lev] if len(members[b]) == 1]
-            if singles:
-                eqs, unks, piv, offs = [], [], [], []
-                for b in singles:
-                    r = members[b][0]
-                    c = int(match[r])
-                    if not transposed:
-                        eqs.append(r), unks.append(c)
-                        offs.append([(s, cc) for cc, s in row_entries[r] if cc != c])
-                    else:
-                        eqs.append(c), unks.append(r)
-                        offs.append([(s, rr) for rr, s in col_entries[c] if rr != r])
-                    piv.append(slot_of[(r, c)])
+            eqs, unks, piv, offs = [], [], [], []
+            for b in groups[lev]:
+                if len(members[b]) != 1:
+                    continue
+                r = members[b][0]
+                c = match[r]
+                if not transposed:
+                    eqs.append(r), unks.append(c)
+                    offs.append([(s, cc) for cc, s in row_entries[r] if cc != c])
+                else:
+                    eqs.append(c), unks.append(r)
+                    offs.append([(s, rr) for rr, s in col_entries[c] if rr != r])
+                piv.append(slot_of[r, c])
+            if eqs:
                 steps.append(_step(eqs, unks, np.array(piv, dtype=np.intp), offs, pad, n, False))
             for b in groups[lev]:
                 if len(members[b]) == 1:
                     continue
-                rows, cols = members[b], [int(match[r]) for r in members[b]]
-                k = len(rows)
-                diag = np.full((k, k), pad, dtype=np.intp)
-                for a, r in enumerate(rows):
-                    for bb, c in enumerate(cols):
-                        diag[a, bb] = slot_of.get((r, c), pad)
+                rows, cols = members[b], bcols[b]
+                rset, cset = set(rows), set(cols)
+                diag = square_diag[b]
                 if not transposed:
-                    offs = [[(s, cc) for cc, s in row_entries[r] if cc not in cols] for r in rows]
-                    steps.append(_step(rows, cols, diag, offs, pad, n, True, position[b]))
+                    offs = [[(s, cc) for cc, s in row_entries[r] if cc not in cset] for r in rows]
+                    steps.append(_step(rows, cols, diag, offs, pad, n, True, b))
                 else:
-                    offs = [[(s, rr) for rr, s in col_entries[c] if rr not in rows] for c in cols]
-                    steps.append(_step(cols, rows, diag.T.copy(), offs, pad, n, True, position[b]))
+                    offs = [[(s, rr) for rr, s in col_entries[c] if rr not in rset] for c in cols]
+                    steps.append(_step(cols, rows, diag.T.copy(), offs, pad, n, True, b))
         return Plan(steps, n, transposed)
 
-    position = {b: k for k, b in enumerate(order)}
+    square_diag: dict[int, np.ndarray] = {}
     square_blocks = []
-    for k, (rows, cols) in enumerate(blocks):
+    for b, (rows, cols) in enumerate(blocks):
         if len(rows) > 1:
-            square_blocks.append((k, np.array([[slot_of.get((r, c), pad) for c in cols] for r in rows], dtype=np.intp)))
+            square_diag[b] = np.array([[slot_of.get((r, c), pad) for c in cols] for r in rows], dtype=np.intp)
+            square_blocks.append((b, square_diag[b]))
 
     explicit = all(len(rows) == 1 and (kind[rows[0]] == 1 or cols[0] % 3 != 2) for rows, cols in blocks)
-    pivots_constant = all(
-        len(rows) > 1 or not np.isnan(vz.const[slot_of[(rows[0], cols[0])]]) for rows, cols in blocks
-    )
+    const = vz.const
+    pivots_constant = all(len(rows) > 1 or not math.isnan(const[slot_of[rows[0], cols[0]]]) for rows, cols in blocks)
     forward = build(False)
     angle_steps, position_steps = [], []
     if explicit:
-        where = {int(r): k for k, r in enumerate(vz.arow)}
+        where = {r: k for k, r in enumerate(vz.arow.tolist())}
         for st in forward.steps:
             ang = st.unk % 3 == 2
             if ang.any():
-                eq = np.array([where[int(r)] for r in st.eq[ang]], dtype=np.intp)
+                eq = np.array([where[r] for r in st.eq[ang].tolist()], dtype=np.intp)
                 angle_steps.append((eq, st.unk[ang], st.diag[ang]))
-            if (~ang).any():
+            if not ang.all():
                 position_steps.append((st.eq[~ang], st.unk[~ang], st.diag[~ang]))
     return Decomposition(forward, build(True), explicit, pivots_constant, blocks, pad, square_blocks,
                          angle_steps, position_steps)
@@ -209,20 +219,109 @@ def _decompose(vz: Vectorised) -> Decomposition | None:
 
 def _step(eqs, unks, diag, offs, pad: int, n: int, square: bool, block: int = -1) -> Step:
     w = max((len(o) for o in offs), default=0)
-    off_slots = np.full((len(offs), w), pad, dtype=np.intp)
-    off_unk = np.full((len(offs), w), n, dtype=np.intp)
-    for a, o in enumerate(offs):
-        for b, (s, u) in enumerate(o):
-            off_slots[a, b] = s
-            off_unk[a, b] = u
-    return Step(np.array(eqs, dtype=np.intp), np.array(unks, dtype=np.intp), diag, off_slots, off_unk, square, block)
+    off_slots = [[s for s, _ in o] + [pad] * (w - len(o)) for o in offs]
+    off_unk = [[u for _, u in o] + [n] * (w - len(o)) for o in offs]
+    return Step(np.array(eqs, dtype=np.intp), np.array(unks, dtype=np.intp), diag,
+                np.array(off_slots, dtype=np.intp).reshape(len(offs), w),
+                np.array(off_unk, dtype=np.intp).reshape(len(offs), w), square, block)
 
 
-def _topological(deps: list[set[int]]) -> list[int]:
-    """Blocks ordered so that every block comes after those it depends on."""
-    from graphlib import TopologicalSorter
+def maximum_matching(adj: list[list[int]], n: int) -> list[int]:
+    """A maximum matching of the rows of a pattern to its ``n`` columns (``adj[r]``: the columns
+    of row r), as the column matched to each row (-1 for a row left unmatched: the pattern is
+    then structurally singular, its structural rank the number of matched rows). Augmenting
+    paths (Kuhn 1955; Duff 1981, algorithm MC21) by a depth-first search without recursion,
+    after a cheap greedy assignment; rows and columns tried in the order given: deterministic.
+    O(rows x entries), nothing for the patterns of planar mechanisms."""
+    m = len(adj)
+    row_col = [-1] * m
+    col_row = [-1] * n
+    for r, a in enumerate(adj):  # cheap assignment first
+        for c in a:
+            if col_row[c] < 0:
+                col_row[c], row_col[r] = r, c
+                break
+    for r in range(m):
+        if row_col[r] >= 0:
+            continue
+        seen = [False] * n
+        path, pos, via = [r], [0], []  # rows on the path, next column to try, columns taken
+        while path:
+            u = path[-1]
+            a = adj[u]
+            p = pos[-1]
+            if p == len(a):
+                path.pop(), pos.pop()
+                if via:
+                    via.pop()
+                continue
+            c = a[p]
+            pos[-1] = p + 1
+            if seen[c]:
+                continue
+            seen[c] = True
+            via.append(c)
+            w = col_row[c]
+            if w < 0:  # a free column: augment along the path
+                for u2, c2 in zip(path, via):
+                    row_col[u2], col_row[c2] = c2, u2
+                break
+            path.append(w), pos.append(0)
+        # no augmenting path from r: r stays unmatched (Kuhn: it never gets one later)
+    return row_col
 
-    return list(TopologicalSorter({b: deps[b] for b in range(len(deps))}).static_order())
+
+def strong_components(succ: list[list[int]]) -> list[list[int]]:
+    """Strongly connected components of the graph with successors ``succ[v]`` (Tarjan 1972,
+    without recursion), each as a sorted list, every component after those it reaches: for
+    "row r uses the unknown of row s" an order in which each block comes after those it needs.
+    Deterministic (vertices and successors taken in the order given)."""
+    nv = len(succ)
+    index = [-1] * nv
+    low = [0] * nv
+    on = [False] * nv
+    stack: list[int] = []
+    comps: list[list[int]] = []
+    counter = 0
+    for s in range(nv):
+        if index[s] >= 0:
+            continue
+        index[s] = low[s] = counter
+        counter += 1
+        stack.append(s)
+        on[s] = True
+        work = [[s, 0]]
+        while work:
+            frame = work[-1]
+            v, p = frame
+            nb = succ[v]
+            if p < len(nb):
+                frame[1] = p + 1
+                w = nb[p]
+                if index[w] < 0:
+                    index[w] = low[w] = counter
+                    counter += 1
+                    stack.append(w)
+                    on[w] = True
+                    work.append([w, 0])
+                elif on[w] and index[w] < low[v]:
+                    low[v] = index[w]
+                continue
+            work.pop()
+            if work:
+                u = work[-1][0]
+                if low[v] < low[u]:
+                    low[u] = low[v]
+            if low[v] == index[v]:
+                comp = []
+                while True:
+                    w = stack.pop()
+                    on[w] = False
+                    comp.append(w)
+                    if w == v:
+                        break
+                comps.append(sorted(comp))
+    return comps
 
 
 def solve(plan: Plan, vals: np.ndarray, rhs: np.ndarray, inverses: dict[int, np.ndarray], offset: int = 0) -> np.ndarray:

@@ -11,6 +11,7 @@ are written once. The driver laws are evaluated once per call (:func:`law_table`
 
 from __future__ import annotations
 
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -145,6 +146,32 @@ def _rot(C: np.ndarray, S: np.ndarray, b: np.ndarray, s: np.ndarray) -> tuple[np
     return cb * s[:, :1] - sb * s[:, 1:], sb * s[:, :1] + cb * s[:, 1:]
 
 
+class _Aux:
+    """Index arrays and stacks derived from a :class:`Vectorised`, made once: the rows of the
+    coordinates each primitive reads, and every local vector :class:`State` rotates (the
+    revolutes' s_i, s_j, then the projections' a, s_i, s_j) with its body."""
+
+    def __init__(self, vz: Vectorised, src: tuple):
+        self.src = src
+        self.cix, self.ciy, self.cjx, self.cjy = 3 * vz.ci, 3 * vz.ci + 1, 3 * vz.cj, 3 * vz.cj + 1
+        self.pix, self.piy, self.pjx, self.pjy = 3 * vz.pi, 3 * vz.pi + 1, 3 * vz.pj, 3 * vz.pj + 1
+        self.crow1 = vz.crow + 1
+        self.aconst, self.pconst = vz.aconst[:, None], vz.pconst[:, None]
+        self.const = np.append(vz.const, 0.0)[:, None]
+        self.bodies = np.concatenate([vz.ci, vz.cj, vz.pi, vz.pi, vz.pj]).astype(np.intp)
+        self.local = np.concatenate([vz.csi, vz.csj, vz.pa, vz.psi, vz.psj]).reshape(-1, 2)
+
+
+def _aux(vz: Vectorised) -> _Aux:
+    """:class:`_Aux` of ``vz``, kept on it while its arrays are the same objects."""
+    src = (vz.ci, vz.cj, vz.pi, vz.pj, vz.csi, vz.csj, vz.pa, vz.psi, vz.psj, vz.crow, vz.aconst, vz.pconst,
+           vz.const)
+    hit = vz.__dict__.get("_aux")
+    if hit is None or not all(map(operator.is_, hit.src, src)):
+        hit = vz.__dict__["_aux"] = _Aux(vz, src)
+    return hit
+
+
 class State:
     """Trigonometry and rotated local vectors at the angles of X (3 nb + 3, N). They depend on
     the angles only: the positions in X may change afterwards (:func:`residual` and the others
@@ -155,32 +182,37 @@ class State:
         self.vz = vz
         self.X = X
         self.C, self.S = np.cos(th), np.sin(th)
-        self.AIx, self.AIy = _rot(self.C, self.S, vz.ci, vz.csi)
-        self.AJx, self.AJy = _rot(self.C, self.S, vz.cj, vz.csj)
-        if len(vz.pi):
-            self.ex, self.ey = _rot(self.C, self.S, vz.pi, vz.pa)
-            self.PIx, self.PIy = _rot(self.C, self.S, vz.pi, vz.psi)
-            self.PJx, self.PJy = _rot(self.C, self.S, vz.pj, vz.psj)
+        # every rotated local vector at once (fewer numpy calls; the same operations per entry)
+        self.aux = aux = _aux(vz)
+        x, y = _rot(self.C, self.S, aux.bodies, aux.local)
+        nc, npj = len(vz.ci), len(vz.pi)
+        self.AIx, self.AIy = x[:nc], y[:nc]
+        self.AJx, self.AJy = x[nc : 2 * nc], y[nc : 2 * nc]
+        if npj:
+            b = 2 * nc
+            self.ex, self.ey = x[b : b + npj], y[b : b + npj]
+            self.PIx, self.PIy = x[b + npj : b + 2 * npj], y[b + npj : b + 2 * npj]
+            self.PJx, self.PJy = x[b + 2 * npj :], y[b + 2 * npj :]
 
     def d(self) -> tuple[np.ndarray, np.ndarray]:
         """The projections' vectors d = r_j + A_j s_j - r_i - A_i s_i, x and y (np, N)."""
-        X, vz = self.X, self.vz
-        return (X[3 * vz.pj] + self.PJx - X[3 * vz.pi] - self.PIx,
-                X[3 * vz.pj + 1] + self.PJy - X[3 * vz.pi + 1] - self.PIy)
+        X, ax = self.X, self.aux
+        return (X[ax.pjx] + self.PJx - X[ax.pix] - self.PIx,
+                X[ax.pjy] + self.PJy - X[ax.piy] - self.PIy)
 
 
 def residual(vz: Vectorised, s: State, f: np.ndarray) -> np.ndarray:
     """Phi (m, N) at the state ``s``; ``f`` the law values of the driven rows."""
-    X = s.X
+    X, ax = s.X, s.aux
     out = np.empty((vz.m, X.shape[1]))
     if len(vz.ci):
-        out[vz.crow] = X[3 * vz.ci] + s.AIx - X[3 * vz.cj] - s.AJx
-        out[vz.crow + 1] = X[3 * vz.ci + 1] + s.AIy - X[3 * vz.cj + 1] - s.AJy
+        out[vz.crow] = X[ax.cix] + s.AIx - X[ax.cjx] - s.AJx
+        out[ax.crow1] = X[ax.ciy] + s.AIy - X[ax.cjy] - s.AJy
     if len(vz.arow):
-        out[vz.arow] = vz.akoef @ X[2::3] - vz.aconst[:, None]
+        out[vz.arow] = vz.akoef @ X[2::3] - ax.aconst
     if len(vz.prow):
         dx, dy = s.d()
-        out[vz.prow] = s.ex * dx + s.ey * dy - vz.pconst[:, None]
+        out[vz.prow] = s.ex * dx + s.ey * dy - ax.pconst
     if len(vz.law_rows):
         out[vz.law_rows] -= f
     return out
@@ -191,7 +223,7 @@ def jacobian_values(vz: Vectorised, s: State) -> np.ndarray:
     row is zero (a padding slot for the triangular solves)."""
     N = s.X.shape[1]
     J = np.empty((vz.nnz + 1, N))
-    J[:] = np.append(vz.const, 0.0)[:, None]
+    J[:] = s.aux.const
     nc, npj = len(vz.ci), len(vz.pi)
     if nc:
         b = vz.c_base + 4 * nc
@@ -228,12 +260,13 @@ def acceleration_rhs(vz: Vectorised, s: State, V: np.ndarray, fdd: np.ndarray) -
     if len(vz.ci):
         wi2, wj2 = W[vz.ci] ** 2, W[vz.cj] ** 2
         out[vz.crow] = wi2 * s.AIx - wj2 * s.AJx
-        out[vz.crow + 1] = wi2 * s.AIy - wj2 * s.AJy
+        out[s.aux.crow1] = wi2 * s.AIy - wj2 * s.AJy
     if len(vz.prow):
         wi, wj = W[vz.pi], W[vz.pj]
         dx, dy = s.d()
-        ddx = V[3 * vz.pj] - wj * s.PJy - V[3 * vz.pi] + wi * s.PIy
-        ddy = V[3 * vz.pj + 1] + wj * s.PJx - V[3 * vz.pi + 1] - wi * s.PIx
+        ax = s.aux
+        ddx = V[ax.pjx] - wj * s.PJy - V[ax.pix] + wi * s.PIy
+        ddy = V[ax.pjy] + wj * s.PJx - V[ax.piy] - wi * s.PIx
         wi2, wj2 = wi**2, wj**2
         quad = (
             -wi2 * (s.ex * dx + s.ey * dy)
