@@ -242,11 +242,12 @@ LABEL_STYLES = {  # kind -> font size, colour, style, weight
 
 
 def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float,
-                  numbers: dict[str, str]) -> tuple[list, list, list]:
+                  numbers: dict[str, str], disc: float = 0.035) -> tuple[list, list, list]:
     """What to label at one instant, in placing order (frame pivots, joints, gears,
     counterweights, links), in model coordinates: (text, anchor, kind) triples, the links'
     segments, and the joint markers, pivots, slider blocks and counterweight discs to keep clear,
-    as (centre, radius), radius None for a joint's marker and -1 for a pivot's triangle."""
+    as (centre, radius), radius None for a joint's marker and -1 for a pivot's triangle.
+    ``disc``: a counterweight's disc radius / ``span`` for the heaviest (``max_cw``), as drawn."""
     out: list[tuple[str, np.ndarray, str]] = []
     keep: list[tuple[np.ndarray, float | None]] = []
     segs: list[tuple[np.ndarray, np.ndarray]] = []
@@ -278,7 +279,7 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
             c = _global_point(pose, a.position)
             if a.kind == "counterweight":
                 cws.append((a.name, c, "counterweight"))
-                keep.append((c, 0.035 * span * math.sqrt(a.mass / max_cw)))
+                keep.append((c, disc * span * math.sqrt(a.mass / max_cw)))
                 root = _global_point(pose, b.points[b.outline[0]] if b.outline else (0, 0))
                 segs.append((root, c))
             elif a.radius:
@@ -296,16 +297,23 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
 
 
 def _place_names(fig, ax, model: Model, pose_row: np.ndarray, span: float, max_cw: float,
-                 numbers: dict[str, str] | None) -> list:
+                 numbers: dict[str, str] | None, disc: float = 0.035, kinds: tuple[str, ...] | None = None,
+                 marks: list | tuple = (), texts: dict[str, str] | None = None) -> list:
     """Names of the spec at one instant (every body point once per place, every link, every
     counterweight, every gear's number), placed in display pixels by :func:`labels.place` so
-    that no two overlap, avoiding the links and markers; a displaced name gets a leader line."""
+    that no two overlap, avoiding the links and markers; a displaced name gets a leader line.
+    Call it once the figure's layout is final. ``disc``: as :func:`name_requests`; ``kinds``: only
+    these kinds of names (``LABEL_STYLES``' keys; all when None); ``marks``: further points drawn
+    (model coordinates) to keep clear, e.g. centres of mass; ``texts``: name -> the text drawn
+    (a paper's notation)."""
     from matplotlib.font_manager import FontProperties
 
     from . import labels as lb
 
     numbers = numbers if numbers is not None else lb.gear_numbers([model])
-    items, segs, keep = name_requests(model, pose_row, span, max_cw, numbers)
+    items, segs, keep = name_requests(model, pose_row, span, max_cw, numbers, disc)
+    items = [((texts or {}).get(t, t), a, k) for t, a, k in items if kinds is None or k in kinds]
+    keep = keep + [(np.asarray(p, dtype=float), None) for p in marks]
     ax.apply_aspect()
     to_px = ax.transData.transform
     renderer = fig.canvas.get_renderer()
@@ -340,6 +348,9 @@ def _place_names(fig, ax, model: Model, pose_row: np.ndarray, span: float, max_c
                     arrowprops={"arrowstyle": "-", "color": "0.45", "linewidth": 0.6, "shrinkA": 0, "shrinkB": 0}
                     if pl.displaced else None)
     return placed
+
+
+place_names = _place_names  # public: the report's other drawings (paper 001's 4-RRR) name their parts with it
 
 
 def common_limits(items: list[tuple[Model, np.ndarray]], pad: float = 0.08) -> tuple[float, float, float, float]:
