@@ -406,14 +406,20 @@ def drift_figure(runs: list, prefix: str = "drift") -> str:
 
 def residual_figure(stages: list, prefix: str = "residuals") -> str:
     """|F_sim - F_analytic| / F0 and |M_sim - M_analytic| / M0 over time, every stage.
-    ``stages``: (label, t, force_error, moment_error, F0, M0)."""
+    ``stages``: (label, t, force_error, moment_error, F0, M0), F0 and M0 the stage's own reference
+    loads (N, N m); the titles give them when every stage has the same, else the legend does."""
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 2.8))
+    one = len({(F0, M0) for *_, F0, M0 in stages}) == 1  # one reference for every stage: in the titles
     for k, (label, t, fe, me, F0, M0) in enumerate(stages):
         c = SIM_COLORS[k % len(SIM_COLORS)]
-        a1.plot(t, fe / F0 if F0 > 0 else fe, color=c, label=literal(label), linewidth=1.0)
-        a2.plot(t, me / M0 if M0 > 0 else me, color=c, label=literal(label), linewidth=1.0)
-    a1.set_title("|F_sim - F_analytic| / reference force", fontsize=9)
-    a2.set_title("|M_sim - M_analytic| / reference moment", fontsize=9)
+        name = label if one else f"{label} (F_ref {F0:.4g} N, M_ref {M0:.4g} N m)"
+        a1.plot(t, fe / F0 if F0 > 0 else fe, color=c, label=literal(name), linewidth=1.0)
+        a2.plot(t, me / M0 if M0 > 0 else me, color=c, label=literal(name), linewidth=1.0)
+    F0, M0 = stages[0][4], stages[0][5]
+    a1.set_title("Force residual" + (f", F_ref = {F0:.4g} N" if one else ", F_ref per stage (legend)"), fontsize=9)
+    a2.set_title("Moment residual" + (f", M_ref = {M0:.4g} N m" if one else ", M_ref per stage (legend)"), fontsize=9)
+    a1.set_ylabel("|F_sim − F_analytic| / F_ref" if F0 > 0 or not one else "|F_sim − F_analytic| (N)", fontsize=8)
+    a2.set_ylabel("|M_sim − M_analytic| / M_ref" if M0 > 0 or not one else "|M_sim − M_analytic| (N m)", fontsize=8)
     for a in (a1, a2):
         a.set_xlabel("time (s)")
         a.set_yscale("log")

@@ -1,0 +1,71 @@
+"""What a reader of the report pages sees: every relative figure names its reference, axes carry
+their units (the review of the pages, after issue 11)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from balpipe import loader
+from balpipe import study as study_mod
+from balpipe.report import figures, page, results
+from balpipe.study import ratio_reference
+
+SPECS = Path(__file__).resolve().parents[1] / "specs"
+
+
+@pytest.fixture(scope="module")
+def paper003():
+    """Paper 003's eight trajectories in one spec, each stage given a stand-in simulation whose
+    load errors are 1e-3 N and 1e-3 N m at every sample (no pymunk run)."""
+    st = study_mod.run(loader.load(SPECS / "paper003_com_planning.yaml").spec)
+    for s in st.stages:
+        t = s.analysis.t
+        s.validation = SimpleNamespace(t=t, force=s.analysis.force, moment=s.analysis.moment,
+                                       force_error=np.full(len(t), 1e-3), moment_error=np.full(len(t), 1e-3),
+                                       to_json=dict)
+    return st
+
+
+def test_residuals_are_relative_to_each_stages_own_reference(paper003):
+    st = paper003
+    rows, caption = page.residual_rows(st, st.stages)
+    recorded = {m["name"]: m["reference"] for m in results.results_dict(st, "x", "h", False)["stages"]}
+    by_name = {s.stage.name: s for s in st.stages}
+    firsts = {}
+    for s in st.stages:  # the unbalanced stage of each motion: the first of its group
+        firsts.setdefault(s.stage.group, s)
+    refs = set()
+    for s, (label, t, fe, me, F0, M0) in zip(st.stages, rows):
+        own = firsts[s.stage.group]
+        assert recorded[s.stage.name] == own.stage.name  # what results.json states
+        expected = ratio_reference(by_name[recorded[s.stage.name]])
+        assert (F0, M0) == (expected.force, expected.moment), s.stage.name
+        refs.add((F0, M0))
+        assert f"{F0:.4g} N" in caption and f"{M0:.4g} N m" in caption
+    assert len(refs) == len(firsts) > 1  # eight motions, eight references: the test can tell them apart
+    assert (rows[0][4], rows[0][5]) == (st.checks["reference"]["force"], st.checks["reference"]["moment"])
+    # several references in one figure: the legend names each; one reference: the titles do
+    groups = list(firsts)
+    first = [r for r, s in zip(rows, st.stages) if s.stage.group == groups[0]]
+    two = first + [r for r, s in zip(rows, st.stages) if s.stage.group == groups[1]]
+    svg = figures.residual_figure(two)
+    assert "F_ref per stage" in svg and "M_ref per stage" in svg
+    for r in two:
+        assert f"F_ref {r[4]:.4g} N, M_ref {r[5]:.4g} N m" in svg
+    svg1 = figures.residual_figure(first)
+    F0, M0 = first[0][4], first[0][5]
+    assert f"F_ref = {F0:.4g} N" in svg1 and f"M_ref = {M0:.4g} N m" in svg1
+    assert "|F_sim − F_analytic| / F_ref" in svg1 and "time (s)" in svg1
+
+
+def test_the_pages_residual_figure_says_what_it_divides_by(paper003):
+    figs = page.study_figures(paper003)
+    [(title, svg, caption)] = figs["residuals"]
+    ref = paper003.reference
+    assert f"F_ref = {ref.force:.4g} N" in svg and f"F_ref = {ref.force:.4g} N" in caption
+    assert f"M_ref = {ref.moment:.4g} N m" in caption and "'" + paper003.stages[0].stage.label + "'" in caption
