@@ -69,3 +69,43 @@ def test_the_pages_residual_figure_says_what_it_divides_by(paper003):
     ref = paper003.reference
     assert f"F_ref = {ref.force:.4g} N" in svg and f"F_ref = {ref.force:.4g} N" in caption
     assert f"M_ref = {ref.moment:.4g} N m" in caption and "'" + paper003.stages[0].stage.label + "'" in caption
+
+
+def _fits(fig) -> list[str]:
+    """The axis labels of ``fig`` that leave the figure (cut off in the SVG)."""
+    fig.canvas.draw()
+    r = fig.canvas.get_renderer()
+    W, H = fig.bbox.width, fig.bbox.height
+    out = []
+    for ax in fig.axes:
+        for lab in (ax.xaxis.label, ax.yaxis.label, ax.title):
+            x0, y0, x1, y1 = lab.get_window_extent(r).extents
+            if lab.get_text() and (x0 < -0.5 or y0 < -0.5 or x1 > W + 0.5 or y1 > H + 0.5):
+                out.append(lab.get_text())
+    return out
+
+
+def test_sweep_page_units_round_off_and_labels_that_fit(tmp_path, monkeypatch):
+    from balpipe.report import sweep_page
+    from balpipe.sweep import plan, run, write
+
+    p = plan(str(Path(__file__).parent / "fixtures" / "sweep_block.yaml"))
+    res = run(p, jobs=1)
+    write(res, str(tmp_path))
+    html = (tmp_path / "index.html").read_text(encoding="utf-8")
+    # the varied fields' SI values carry their unit, the effort its unit (a crank: N m)
+    assert "mechanism.crank.mass (kg)" in html and "mechanism.slider.mass (kg)" in html and "(SI)" not in html
+    assert "Peak effort (N m)" in html and "peak actuator effort (N m)" in html
+    # the counterweight stage cancels the force: round-off, shown as such, not as 1e-13 N
+    front = [r for r in res.rows if r.get("pareto_moment") or r.get("pareto_effort")]
+    assert front and all(r["max_shaking_force"] <= 1e-9 * r["unbalanced_max_shaking_force"] for r in front)
+    assert "0 (&lt; 1e-9 of unbalanced)" in html or "0 (< 1e-9 of unbalanced)" in html
+    assert not re.search(r"<td class=\"num\">\d\.\d+e-1\d</td>", html)
+    # every axis label of the Pareto figures lies inside its figure
+    drawn = []
+    monkeypatch.setattr(sweep_page, "to_svg", lambda fig, prefix: drawn.append(fig) or "<svg/>")
+    sweep_page.render(res, set())
+    assert len(drawn) == 2
+    for fig in drawn:
+        assert _fits(fig) == []
+        figures.plt.close(fig)
