@@ -109,3 +109,42 @@ def test_sweep_page_units_round_off_and_labels_that_fit(tmp_path, monkeypatch):
     for fig in drawn:
         assert _fits(fig) == []
         figures.plt.close(fig)
+
+
+def _legends_clear_of_the_data(fig) -> list[str]:
+    """Legends (of the figure or of an axes) that cover part of an axes' plotting area."""
+    fig.canvas.draw()
+    r = fig.canvas.get_renderer()
+    legends = list(fig.legends) + [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None]
+    out = []
+    for leg in legends:
+        lb = leg.get_window_extent(r)
+        for ax in fig.axes:
+            if lb.overlaps(ax.get_window_extent(r)):
+                out.append(", ".join(t.get_text() for t in leg.get_texts()))
+    return out
+
+
+def test_legends_never_cover_the_curves(monkeypatch):
+    """The time plots with one curve per stage (efforts, residuals, tracking, drift) keep their
+    legend under the axes, in as many columns as fit, with long stage names (paper 001's)."""
+    drawn = []
+    monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.append((prefix, fig)) or "<svg/>")
+    t = np.linspace(0.0, 0.5, 101)
+    names = ["unbalanced", "counterweights", "counterweights + counter-rotations",
+             "force balance only: least-mass counterweights", "crank counterweight only: 1 kg at 80 mm behind O2"]
+    an = [SimpleNamespace(t=t, efforts={"crank": (k + 1) * np.sin(9 * t)}) for k in range(len(names))]
+    figures.efforts_figure(list(zip(names, an)), units={"crank": "N m"})
+    err = 1e-6 * (1 + np.abs(np.sin(20 * t)))
+    figures.residual_figure([(n, t, err, err, 10.0, 2.0) for n in names])
+    figures.series_figure(t, [(n + ": crank", err) for n in names], "|q_sim − q_plan| / travel", "torque")
+    figures.drift_figure([(n, t, np.stack([err, err], 1), err) for n in names])
+    assert len(drawn) == 4
+    for prefix, fig in drawn:
+        assert _legends_clear_of_the_data(fig) == [], prefix
+        assert _fits(fig) == [], prefix
+        W = fig.bbox.width
+        for leg in fig.legends:
+            box = leg.get_window_extent(fig.canvas.get_renderer())
+            assert box.x0 >= 0 and box.x1 <= W and box.y0 >= 0, prefix
+        figures.plt.close(fig)

@@ -94,6 +94,27 @@ def to_svg(fig, prefix: str) -> str:
     return svg
 
 
+def legend_below(fig, ax, fontsize: float = 8.5) -> None:
+    """``ax``'s legend under the figure's axes, never over a curve: as many columns (at most 3) as
+    the figure's width holds, the figure made taller by the legend's height, the layout above it.
+    Call it instead of ``fig.tight_layout()``."""
+    handles, labels = ax.get_legend_handles_labels()
+    if not labels:
+        fig.tight_layout()
+        return
+    renderer = fig.canvas.get_renderer()
+    W, H = fig.get_size_inches()
+    for ncol in range(min(len(labels), 3), 0, -1):
+        leg = fig.legend(handles, labels, loc="lower center", bbox_to_anchor=(0.5, 0.0), ncol=ncol,
+                         fontsize=fontsize, frameon=False)
+        if ncol == 1 or leg.get_window_extent(renderer).width <= 0.98 * W * fig.dpi:
+            break
+        leg.remove()
+    h = leg.get_window_extent(renderer).height / fig.dpi + 0.05
+    fig.set_size_inches(W, H + h)
+    fig.tight_layout(rect=(0, h / (H + h), 1, 1))
+
+
 def loads_figure(stages: list, prefix: str = "loads") -> str:
     """Fx, Fy, |F| and M over time, every stage on the same axes (paper 000 Fig. 4 style).
     ``stages``: list of (label, Analysis, simulated or None) with simulated = (t, F, M)."""
@@ -144,8 +165,7 @@ def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = N
         ax.set_title(literal(f"Actuator effort: {name}" + (f" ({u})" if u else "")), fontsize=9)
         ax.set_ylabel({"N m": "torque (N m)", "N": "force (N)"}.get(u, "effort"))
         ax.set_xlabel("time (s)")
-    axes[0][0].legend(fontsize=8.5)
-    fig.tight_layout()
+    legend_below(fig, axes[0][0])
     return to_svg(fig, prefix)
 
 
@@ -380,8 +400,7 @@ def series_figure(t: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel: s
     ax.set_ylabel(ylabel)
     if title:
         ax.set_title(literal(title), fontsize=9)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
+    legend_below(fig, ax, fontsize=8)
     return to_svg(fig, prefix)
 
 
@@ -399,8 +418,7 @@ def drift_figure(runs: list, prefix: str = "drift") -> str:
     a2.set_title("Rotation of the free frame (deg)", fontsize=9)
     for a in (a1, a2):
         a.set_xlabel("time (s)")
-    a1.legend(fontsize=8.5)
-    fig.tight_layout()
+    legend_below(fig, a1)
     return to_svg(fig, prefix)
 
 
@@ -423,8 +441,7 @@ def residual_figure(stages: list, prefix: str = "residuals") -> str:
     for a in (a1, a2):
         a.set_xlabel("time (s)")
         a.set_yscale("log")
-    a1.legend(fontsize=8.5)
-    fig.tight_layout()
+    legend_below(fig, a1)
     return to_svg(fig, prefix)
 
 
