@@ -148,3 +148,13 @@ def test_legends_never_cover_the_curves(monkeypatch):
             box = leg.get_window_extent(fig.canvas.get_renderer())
             assert box.x0 >= 0 and box.x1 <= W and box.y0 >= 0, prefix
         figures.plt.close(fig)
+
+
+def test_rpr3_factor_table_gives_the_effort_unit_and_one_full_stop():
+    from balpipe.mechanisms import rpr3
+
+    st = study_mod.run(loader.load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
+    table = rpr3._factor_table(st, st.spec.balancing.method)
+    assert "peak actuator effort (N m)</th>" in table  # revolute actuators A_i
+    caption = rpr3._factor_caption(st, st.spec.balancing.method)
+    assert caption.endswith("3-RPR).") and ".." not in caption
