@@ -158,3 +158,17 @@ def test_rpr3_factor_table_gives_the_effort_unit_and_one_full_stop():
     assert "peak actuator effort (N m)</th>" in table  # revolute actuators A_i
     caption = rpr3._factor_caption(st, st.spec.balancing.method)
     assert caption.endswith("3-RPR).") and ".." not in caption
+
+
+def test_index_lead_agrees_in_number():
+    from balpipe.report import site_filter
+    from balpipe.report.render import environment
+
+    def lead(flagged: int) -> str:
+        html = environment().get_template("index.html").render(
+            entries=[], n_ok=12, n_failed=0, n_flagged=flagged, n_invalid=0, n_ok_cli=12 + flagged,
+            filters=site_filter.options([]))
+        return html[html.index('class="lead"'):][:600]
+
+    assert "12 pass and 1 has stages that cannot be built" in lead(1)
+    assert "12 pass and 2 have stages that cannot be built" in lead(2)
