@@ -19,16 +19,23 @@ SPECS = Path(__file__).resolve().parents[1] / "specs"
 
 
 @pytest.fixture(scope="module")
-def paper003():
-    """Paper 003's eight trajectories in one spec, each stage given a stand-in simulation whose
-    load errors are 1e-3 N and 1e-3 N m at every sample (no pymunk run)."""
-    st = study_mod.run(loader.load(SPECS / "paper003_com_planning.yaml").spec)
-    for s in st.stages:
+def study003():
+    """Paper 003's eight trajectories in one spec (no simulation)."""
+    return study_mod.run(loader.load(SPECS / "paper003_com_planning.yaml").spec)
+
+
+@pytest.fixture
+def paper003(study003):
+    """The same, each stage given a stand-in simulation whose load errors are 1e-3 N and
+    1e-3 N m at every sample (no pymunk run), taken away afterwards."""
+    for s in study003.stages:
         t = s.analysis.t
         s.validation = SimpleNamespace(t=t, force=s.analysis.force, moment=s.analysis.moment,
                                        force_error=np.full(len(t), 1e-3), moment_error=np.full(len(t), 1e-3),
                                        to_json=dict)
-    return st
+    yield study003
+    for s in study003.stages:
+        s.validation = None
 
 
 def test_residuals_are_relative_to_each_stages_own_reference(paper003):
@@ -172,3 +179,41 @@ def test_index_lead_agrees_in_number():
 
     assert "12 pass and 1 has stages that cannot be built" in lead(1)
     assert "12 pass and 2 have stages that cannot be built" in lead(2)
+
+
+def _stage_rows(html: str) -> dict:
+    """Stage table of a page: label -> the row's HTML."""
+    table = html[html.index('<h2 id="balancing-stages"'):]
+    table = table[:table.index("</table>")]
+    rows = {}
+    for row in table.split("<tr>")[2:]:
+        m = re.search(r"<strong>(.*?)</strong>", row)
+        rows[m.group(1)] = row
+    return rows
+
+
+def test_stage_table_names_each_ratios_reference_and_claims_only_what_is_claimed(study003):
+    st = study003
+    html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+    rows = _stage_rows(html)
+    by_name = {s.stage.name: s.stage.label for s in st.stages}
+    for s in st.stages:
+        row = rows[s.stage.label]
+        ref = st.reference_stage(s)
+        if ref is s:
+            assert ">reference</span>" in row  # its own reference: the claim column says so
+            if s is not st.stages[0]:
+                assert "reference of the ratios of its motion" in row
+        else:
+            assert "— (no claim)" in row and ">reference</span>" not in row, s.stage.name
+            if ref is not st.stages[0]:
+                assert f"ratios vs {by_name[ref.stage.name]}" in row, s.stage.name
+    assert "for the stages of the first motion (" + st.stages[0].stage.label + ")" in html
+
+
+def test_single_motion_page_keeps_one_reference_sentence():
+    st = study_mod.run(loader.load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
+    html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+    rows = _stage_rows(html)
+    assert ">reference</span>" in rows["unbalanced"] and "— (no claim)" in rows["idler loop"]
+    assert "first motion" not in html and "ratios vs" not in html
