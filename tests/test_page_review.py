@@ -217,3 +217,13 @@ def test_single_motion_page_keeps_one_reference_sentence():
     rows = _stage_rows(html)
     assert ">reference</span>" in rows["unbalanced"] and "— (no claim)" in rows["idler loop"]
     assert "first motion" not in html and "ratios vs" not in html
+
+
+def test_tracking_error_caption_gives_each_travel():
+    st = study_mod.run(loader.load(SPECS / "offset_slider_crank.yaml").spec)
+    for s in st.stages:
+        t = s.analysis.t
+        s.torque = SimpleNamespace(t=t, travel={"crank": 2.5}, tracking={"crank": np.full(len(t), 1e-6)})
+    [(title, svg, caption)] = page.study_figures(st)["torque"]
+    assert "relative to its travel" in caption and "crank 2.5 rad" in caption
+    assert "|q_sim − q_plan| / travel" in svg and "time (s)" in svg

@@ -62,10 +62,18 @@ def study_figures(study: Study) -> dict:
             "Tracking error of the torque-driven run",
             figures.series_figure(runs[0].torque.t, curves, "|q_sim − q_plan| / travel", prefix="torque"),
             "Each driven coordinate of the simulation driven by the engine's efforts (no position drive), "
-            "minus its planned motion, relative to its travel.",
+            "minus its planned motion, relative to its travel (largest excursion from its start): "
+            + travel_text(runs[0]) + ".",
         ))
     return {"loads": loads, "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
+
+
+def travel_text(s) -> str:
+    """'crank 2.793 rad' per driver of a stage's torque-driven run: the tracking error's reference."""
+    model = s.stage.model
+    return ", ".join(f"{d} {v:.4g} {'m' if present.driver_unit(model, d) == 'N' else 'rad'}"
+                     for d, v in sorted(s.torque.travel.items()))
 
 
 def residual_rows(study: Study, stages: list) -> tuple[list, str]:
