@@ -300,6 +300,8 @@ def test_names_on_paper001_drawings_never_overlap(studies, name, monkeypatch):
     for prefix, fig in drawn:
         fig.canvas.draw()  # annotations find their positions when drawn
         renderer = fig.canvas.get_renderer()
+        # at most three panels a row (four: 2 x 2), each as large as the others' (4.2 in)
+        assert fig.get_size_inches()[0] <= 3 * 4.2 + 1e-9, (name, prefix, fig.get_size_inches())
         for ax in fig.axes:
             if not ax.axison:
                 continue

@@ -152,6 +152,12 @@ def _counter_masses(model) -> list[float]:
     return [a.mass for b in model.bodies for a in b.attachments if a.kind == "counterweight"]
 
 
+def grid_columns(n: int) -> int:
+    """Panels per row: at most three, two for four panels (2 x 2, not 3 + 1 or a row of four too
+    small to read on a page)."""
+    return 2 if n == 4 else min(3, n)
+
+
 def topology_figure(study):
     """The balanced stages at t = 0, one panel each: links, joints, pivots, each link's centre of
     mass (cross), counter-masses as red discs of area proportional to mass, and the fixed total
@@ -161,10 +167,14 @@ def topology_figure(study):
     shown = [s for s in study.stages if s.stage.name in FIGURE_OF_STAGE]
     if not shown:
         return None
-    fig, axes = plt.subplots(1, len(shown), figsize=(4.2 * len(shown), 4.2), squeeze=False)
+    cols = grid_columns(len(shown))
+    rows = (len(shown) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
     max_cw = max([m for s in shown for m in _counter_masses(s.stage.model)] + [1e-12])
     panels = []
-    for ax, s in zip(axes[0], shown):
+    for ax in list(axes.flat)[len(shown):]:
+        ax.axis("off")
+    for ax, s in zip(axes.flat, shown):
         model = s.stage.model
         poses = s.analysis.extra["frame_pose"][0]
         marks = _draw(ax, model, poses, _span(model), max_cw, f"{s.stage.label}\nadded {s.added_mass:.3g} kg")
@@ -204,7 +214,7 @@ def designs_figure(study, checked, figures: tuple[str, ...]):
     shown = [c for c in checked if c[0].figure in figures]
     if not shown:
         return None
-    cols = min(3, len(shown))
+    cols = grid_columns(len(shown))
     rows = (len(shown) + cols - 1) // cols
     fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
     poses = study.stages[0].analysis.extra["frame_pose"][0]
