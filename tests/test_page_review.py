@@ -3,6 +3,7 @@ their units (the review of the pages, after issue 11)."""
 
 from __future__ import annotations
 
+import html as html_mod
 import re
 from pathlib import Path
 from types import SimpleNamespace
@@ -227,3 +228,21 @@ def test_tracking_error_caption_gives_each_travel():
     [(title, svg, caption)] = page.study_figures(st)["torque"]
     assert "relative to its travel" in caption and "crank 2.5 rad" in caption
     assert "|q_sim − q_plan| / travel" in svg and "time (s)" in svg
+
+
+def test_no_two_stages_look_alike_and_the_caption_names_each_style(monkeypatch):
+    """A spec with compared designs has seven stages: the loads figure draws each in its own
+    line, colour and marker, and its caption says which is which (it named only four)."""
+    looks = [(str(figures.style(k)["color"]), figures.style(k)["linestyle"], figures.marked(k, 100)["marker"])
+             for k in range(10)]
+    assert len(set(looks)) == len(looks)
+    assert len({figures.style_text(k) for k in range(10)}) == 10
+    st = study_mod.run(loader.load(SPECS / "paper000_rpr3_scott_russell_corrected.yaml").spec)
+    shown = page.shown_stages(st)
+    assert len(shown) == 7
+    html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+    cap = html[html.index('<figure class="wide">'):]
+    cap = cap[cap.index("<figcaption>"):cap.index("</figcaption>")]
+    cap = html_mod.unescape(cap).lower()
+    for k, s in enumerate(shown):
+        assert f"{figures.style_text(k)}: {s.stage.label}".lower() in cap, (k, cap)

@@ -50,17 +50,44 @@ SIM_COLORS = ["tab:orange", "tab:blue", "tab:green", "tab:purple", "tab:brown"]
 
 
 MARKERS = ["o", "s", "^", "D", "v"]
+# from the sixth stage on (a spec with compared designs): the five line styles again, in colours
+# and with markers of their own, so that no two stages of a figure look alike
+MORE_COLORS = ["tab:green", "tab:purple", "tab:brown", "tab:olive", "tab:cyan"]
+MORE_MARKERS = ["P", "X", "h", "<", ">"]
+STYLE_WORDS = ["solid black", "dashed black", "grey", "blue dash-dot", "red dotted"]
+LINE_WORDS = ["solid", "dashed", "thick solid", "dash-dot", "dotted"]
+MARKER_WORDS = ["circles", "squares", "triangles", "diamonds", "down-triangles",
+                "plus signs", "crosses", "hexagons", "left-triangles", "right-triangles"]
 
 
 def style(k: int) -> dict:
-    return STAGE_STYLES[k % len(STAGE_STYLES)]
+    n = len(STAGE_STYLES)
+    base = STAGE_STYLES[k % n]
+    if k < n:
+        return base
+    return {**base, "color": MORE_COLORS[(k // n - 1 + k) % len(MORE_COLORS)]}
+
+
+def _marker(k: int) -> str:
+    return (MARKERS + MORE_MARKERS)[k % (len(MARKERS) + len(MORE_MARKERS))]
+
+
+def style_text(k: int, markers: bool = True) -> str:
+    """Words for stage ``k``'s line (and marker, as :func:`marked` draws it): 'solid black,
+    circles'; 'dashed purple, crosses' from the sixth stage on."""
+    n = len(STAGE_STYLES)
+    if k < n:
+        line = STYLE_WORDS[k]
+    else:
+        line = LINE_WORDS[k % n] + " " + style(k)["color"].removeprefix("tab:")
+    return line + (f", {MARKER_WORDS[k % len(MARKER_WORDS)]}" if markers else "")
 
 
 def marked(k: int, n: int) -> dict:
     """A stage's line style with its own marker, placed at staggered samples (offset per stage)
     so that curves that coincide stay distinguishable."""
     every = max(1, n // 12)
-    return {**style(k), "marker": MARKERS[k % len(MARKERS)], "markersize": 4.5, "markerfacecolor": "none",
+    return {**style(k), "marker": _marker(k), "markersize": 4.5, "markerfacecolor": "none",
             "markevery": (min(n - 1, (k * every) // max(1, len(MARKERS))), every)}
 
 

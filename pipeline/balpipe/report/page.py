@@ -65,7 +65,8 @@ def study_figures(study: Study) -> dict:
             "minus its planned motion, relative to its travel (largest excursion from its start): "
             + travel_text(runs[0]) + ".",
         ))
-    return {"loads": loads, "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
+    key = "; ".join(f"{figures.style_text(k)}: {s.stage.label}" for k, s in enumerate(shown_stages(study)))
+    return {"loads": loads, "loads_key": key[:1].upper() + key[1:], "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
