@@ -246,3 +246,17 @@ def test_no_two_stages_look_alike_and_the_caption_names_each_style(monkeypatch):
     cap = html_mod.unescape(cap).lower()
     for k, s in enumerate(shown):
         assert f"{figures.style_text(k)}: {s.stage.label}".lower() in cap, (k, cap)
+
+
+def test_dimensionless_parameters_say_so_and_round_off_before_counter_rotations_is_zero():
+    st = study_mod.run(loader.load(SPECS / "scott_russell.yaml").spec)
+    html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+    params = html[html.index("Computed parameters</h2>"):]
+    params = params[:params.index("</table>")]
+    row = next(r for r in params.split("<tr>") if "<td>rcp1</td>" in r)
+    assert '<td class="unit">1</td>' in row  # rcp1 = position / L1: a ratio, unit 1
+    side = html[html.index("Designs side by side</h2>"):]
+    side = side[:side.index("</table>")]
+    last = side.split("<tr>")[-1]  # the fully balanced stage: its moment before counter-rotations is round-off
+    cells = re.findall(r"<td[^>]*>(.*?)</td>", last, re.S)
+    assert html_mod.unescape(cells[-1]).startswith("0 (< 1e-9 of reference)"), cells
