@@ -260,3 +260,26 @@ def test_dimensionless_parameters_say_so_and_round_off_before_counter_rotations_
     last = side.split("<tr>")[-1]  # the fully balanced stage: its moment before counter-rotations is round-off
     cells = re.findall(r"<td[^>]*>(.*?)</td>", last, re.S)
     assert html_mod.unescape(cells[-1]).startswith("0 (< 1e-9 of reference)"), cells
+
+
+def test_player_writes_no_negative_zero():
+    """The player's frame readout ('frame: (0.00, 0.00) mm, 0.000 deg') never shows -0.000 for a
+    balanced stage's round-off rotation: its fixed() helper, run by node."""
+    import shutil
+    import subprocess
+
+    from balpipe.report import player
+
+    node = shutil.which("node")
+    if node is None:
+        pytest.skip("node is not installed")
+    st = study_mod.run(loader.load(SPECS / "scott_russell.yaml").spec)
+    stages = [{"label": s.stage.label, "model": s.stage.model, "t": s.analysis.t, "base": np.zeros((len(s.analysis.t), 3)),
+               "poses": np.asarray(s.analysis.extra["frame_pose"])} for s in st.stages]
+    html = player.player_html(stages)
+    fn = re.search(r"^function fixed\(v, d\) \{.*?\}  // no \"-0.000\"$", html, re.M)
+    assert fn, "fixed() not in the player"
+    assert "${fixed(rot, 3)} deg" in html and "rot.toFixed" not in html
+    js = fn.group(0) + "\nconsole.log([fixed(-1e-6, 3), fixed(-0.0, 2), fixed(-0.004, 2), fixed(-0.5, 3), fixed(2.25, 1)].join('|'))"
+    out = subprocess.run([node, "-e", js], capture_output=True, text=True, check=True).stdout.strip()
+    assert out == "0.000|0.00|0.00|-0.500|2.3" or out == "0.000|0.00|0.00|-0.500|2.2", out
