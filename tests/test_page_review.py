@@ -283,3 +283,37 @@ def test_player_writes_no_negative_zero():
     js = fn.group(0) + "\nconsole.log([fixed(-1e-6, 3), fixed(-0.0, 2), fixed(-0.004, 2), fixed(-0.5, 3), fixed(2.25, 1)].join('|'))"
     out = subprocess.run([node, "-e", js], capture_output=True, text=True, check=True).stdout.strip()
     assert out == "0.000|0.00|0.00|-0.500|2.3" or out == "0.000|0.00|0.00|-0.500|2.2", out
+
+
+def test_paper003_square_and_phi_figures_keep_names_and_legends_off_the_paths(study003, monkeypatch):
+    from matplotlib.text import Text
+
+    from balpipe.report import labels
+
+    drawn = {}
+    monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.setdefault(prefix, fig) and "<svg/>")
+    list(study003.extra_figures())
+    for prefix in ("com-square", "com-phi"):
+        assert _legends_clear_of_the_data(drawn[prefix]) == [], prefix
+        assert _fits(drawn[prefix]) == [], prefix
+    fig = drawn["com-square"]
+    ax = fig.axes[0]
+    fig.canvas.draw()
+    r = fig.canvas.get_renderer()
+    px = ax.transData.transform
+    segs = []
+    for t in ax.texts:  # the tip's paths: arrows from the start to the end point
+        if not t.get_text() and getattr(t, "arrow_patch", None) is not None:
+            segs.append((tuple(px(t.xyann)), tuple(px(t.xy))))
+    for line in ax.lines:
+        if line.get_linestyle() not in ("None", "", " ") and len(line.get_xydata()) >= 2:
+            xy = px(line.get_xydata())
+            segs += [(tuple(a), tuple(b)) for a, b in zip(xy[:-1], xy[1:])]
+    names = [t for t in ax.texts if t.get_text()]
+    assert len(names) == 17  # P1-P16 and E
+    for t in names:
+        box = Text.get_window_extent(t, r).extents
+        hits = [sg for sg in segs if labels.segment_hits_box(sg, box)]
+        assert not hits, (t.get_text(), hits[:2])
+    for prefix, f in drawn.items():
+        figures.plt.close(f)

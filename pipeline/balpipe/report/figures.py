@@ -353,14 +353,25 @@ def _place_names(fig, ax, model: Model, pose_row: np.ndarray, span: float, max_c
     these kinds of names (``LABEL_STYLES``' keys; all when None); ``marks``: further points drawn
     (model coordinates) to keep clear, e.g. centres of mass; ``texts``: name -> the text drawn
     (a paper's notation)."""
-    from matplotlib.font_manager import FontProperties
-
     from . import labels as lb
 
     numbers = numbers if numbers is not None else lb.gear_numbers([model])
     items, segs, keep = name_requests(model, pose_row, span, max_cw, numbers, disc)
     items = [((texts or {}).get(t, t), a, k) for t, a, k in items if kinds is None or k in kinds]
     keep = keep + [(np.asarray(p, dtype=float), None) for p in marks]
+    return place_items(fig, ax, items, segs, keep)
+
+
+def place_items(fig, ax, items: list, segs: list, keep: list) -> list:
+    """Names placed by :func:`labels.place` and drawn (a displaced one with a leader line):
+    ``items`` (text, anchor, kind) in data coordinates, ``kind`` a key of ``LABEL_STYLES``, in
+    placing order; ``segs``: lines to keep clear ((x, y), (x, y)); ``keep``: markers and discs as
+    (centre, radius), radius None for a point marker, -1 for a pivot's triangle. Call it once
+    the figure's layout is final; returns the :class:`labels.Placed` (display pixels)."""
+    from matplotlib.font_manager import FontProperties
+
+    from . import labels as lb
+
     ax.apply_aspect()
     to_px = ax.transData.transform
     renderer = fig.canvas.get_renderer()
