@@ -241,7 +241,7 @@ def test_player_grid_and_names_in_the_html(studies):
 
 # -- paper 001's 4-RRR drawings (Figs. 2a, 3a-f, 4a, 4b, 6) -------------------------------------
 
-PAPER001 = ["paper001_4rrr.yaml", "paper001_4rrr_fig6b.yaml"]
+PAPER001 = ["paper001_4rrr.yaml", "paper001_4rrr_fig6a.yaml", "paper001_4rrr_fig6b.yaml"]
 
 
 def _drawn_geometry(ax, renderer):
