@@ -317,3 +317,12 @@ def test_paper003_square_and_phi_figures_keep_names_and_legends_off_the_paths(st
         assert not hits, (t.get_text(), hits[:2])
     for prefix, f in drawn.items():
         figures.plt.close(f)
+
+
+def test_history_table_shows_round_off_as_zero():
+    from balpipe.report import history_page
+
+    c = {"stages": [{"max_shaking_force": 3.661, "max_shaking_moment": 1.328},
+                    {"max_shaking_force": 3.178e-14, "max_shaking_moment": 0.5}]}
+    assert history_page._peaks(c, "max_shaking_force") == "3.661 → 0 (< 1e-9 of unbalanced)"
+    assert history_page._peaks(c, "max_shaking_moment") == "1.328 → 0.5"  # a real peak stays
