@@ -326,3 +326,11 @@ def test_history_table_shows_round_off_as_zero():
                     {"max_shaking_force": 3.178e-14, "max_shaking_moment": 0.5}]}
     assert history_page._peaks(c, "max_shaking_force") == "3.661 → 0 (< 1e-9 of unbalanced)"
     assert history_page._peaks(c, "max_shaking_moment") == "1.328 → 0.5"  # a real peak stays
+
+
+def test_unrealisable_parts_write_their_units_as_the_page_does():
+    st = study_mod.run(loader.load(SPECS / "paper004_five_bar.yaml").spec)
+    html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+    table = html[html.index('<h2 id="balancing-stages"'):]
+    table = table[:table.index("</table>")]
+    assert "centroidal inertia" in table and "kg m²" in table and "kg m^2" not in table
