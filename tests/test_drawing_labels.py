@@ -237,3 +237,86 @@ def test_player_grid_and_names_in_the_html(studies):
     names = d["stages"][2]["names"]
     assert sorted(g[-1] for g in names["gears"]) == ["1'", "2'", "3'", "4'", "5", "6", "7"]
     assert html == player.player_html(_stages(st, False))  # same bytes
+
+
+# -- paper 001's 4-RRR drawings (Figs. 2a, 3a-f, 4a, 4b, 6) -------------------------------------
+
+PAPER001 = ["paper001_4rrr.yaml", "paper001_4rrr_fig6a.yaml", "paper001_4rrr_fig6b.yaml"]
+
+
+def _drawn_geometry(ax, renderer):
+    """What a panel shows, read back from the figure in display pixels: the boxes of its texts
+    (not the title), its discs (centre, radius), and its links and counter-mass rods as segments
+    (solid lines and the platform's outline; leader lines are not lines of the axes)."""
+    from matplotlib.patches import Circle, Polygon
+    from matplotlib.text import Text
+
+    # Text's own extent: an Annotation's would include its leader line
+    texts = [(t.get_text(), Text.get_window_extent(t, renderer).extents) for t in ax.texts if t.get_text()]
+    to_px = ax.transData.transform
+    discs, segs = [], []
+    for p in ax.patches:
+        if isinstance(p, Circle):
+            c = to_px(p.center)
+            discs.append((c, abs(to_px((p.center[0] + p.radius, p.center[1]))[0] - c[0])))
+        elif isinstance(p, Polygon):
+            xy = to_px(p.get_xy())
+            segs += [(tuple(xy[k]), tuple(xy[(k + 1) % len(xy)])) for k in range(len(xy))]
+    for line in ax.lines:
+        if line.get_linestyle() in ("-", "solid") and len(line.get_xydata()) >= 2 and line.get_linewidth() >= 1.0:
+            xy = to_px(line.get_xydata())
+            segs += [(tuple(a), tuple(b)) for a, b in zip(xy[:-1], xy[1:])]
+    return texts, discs, segs
+
+
+def _disc_hits_box(centre, r, box) -> bool:
+    qx = min(max(centre[0], box[0]), box[2])
+    qy = min(max(centre[1], box[1]), box[3])
+    return math.hypot(qx - centre[0], qy - centre[1]) < r
+
+
+@pytest.mark.parametrize("name", PAPER001)
+def test_names_on_paper001_drawings_never_overlap(studies, name, monkeypatch):
+    """Every 4-RRR drawing of paper 001 (the balanced stages; Figs. 3a-f; Fig. 4b): the names drawn
+    (pivots A1-A4 at least) overlap no other name, no counter-mass disc and no link, read back
+    from the figures themselves."""
+    from balpipe.report import rrr4
+
+    drawn = []
+
+    def keep(fig, prefix):
+        drawn.append((prefix, fig))
+        return "<svg/>"
+
+    monkeypatch.setattr(figures, "to_svg", keep)
+    st = studies(name)
+    rrr4.topology_figure(st)
+    checked = rrr4.designs_checked(st)
+    if checked:
+        rrr4.designs_figure(st, checked, rrr4.FIG3)
+        rrr4.designs_figure(st, checked, ("Fig. 4b",))
+    assert len(drawn) == (3 if checked else 1)
+    panels = 0
+    for prefix, fig in drawn:
+        fig.canvas.draw()  # annotations find their positions when drawn
+        renderer = fig.canvas.get_renderer()
+        # at most three panels a row (four: 2 x 2), each as large as the others' (4.2 in)
+        assert fig.get_size_inches()[0] <= 3 * 4.2 + 1e-9, (name, prefix, fig.get_size_inches())
+        for ax in fig.axes:
+            if not ax.axison:
+                continue
+            panels += 1
+            texts, discs, segs = _drawn_geometry(ax, renderer)
+            where = f"{name} {prefix} {ax.get_title()!r}"
+            names = [t for t, _ in texts]
+            assert {"A1", "A2", "A3", "A4"} <= set(names), (where, names)
+            assert discs and segs, where
+            for (ta, a), (tb, b) in itertools.combinations(texts, 2):
+                assert not labels.overlaps(a, b), f"{where}: {ta!r} over {tb!r}"
+            for t, box in texts:
+                for c, r in discs:
+                    assert not _disc_hits_box(c, r, box), f"{where}: {t!r} over a disc at {c}"
+                for sg in segs:
+                    assert not labels.segment_hits_box(sg, box), f"{where}: {t!r} over a link {sg}"
+        figures.plt.close(fig)
+    assert panels >= 4

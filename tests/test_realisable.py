@@ -118,5 +118,5 @@ def test_simulated_build_flags_the_page_and_the_index_and_validates_the_point_ma
     assert page.count('<span class="badge warn">simulation agrees</span>') == 2
     assert page.count('<span class="badge ok">balanced</span>') == 1  # the point-mass stage
     index = (out / "index.html").read_text()
-    assert "not realisable: negative inertia" in index and "of the ok, 0 pass and 1 have stages that cannot be built" in index
+    assert "not realisable: negative inertia" in index and "of the ok, 0 pass and 1 has stages that cannot be built" in index
     assert '<span class="badge warn">built</span>' in index

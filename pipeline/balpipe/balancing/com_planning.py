@@ -574,7 +574,7 @@ def _pct(x: float) -> str:
 
 
 def figures(study, info: dict):
-    from ..report.figures import plt, style, to_svg
+    from ..report.figures import legend_below, plt, style, to_svg
 
     plans: list[Plan] = info["plans"]
     method: ComMotionPlanning = info["method"]
@@ -643,8 +643,7 @@ def figures(study, info: dict):
     axes.plot(info["planner"].t, np.degrees(phi5(info["planner"].t)[0]), color="black", linestyle="--", linewidth=1.4, label="3-4-5 law")
     axes.set_xlabel("time (s)")
     axes.set_ylabel("phi (deg)")
-    axes.legend(fontsize=6, ncol=3)
-    fig.tight_layout()
+    legend_below(fig, axes, fontsize=7)  # under the axes: never over a curve
     yield ("Optimised end-effector orientation", to_svg(fig, "com-phi"),
            f"phi(t) of case 2 per trajectory (degree {method.phi.degree}, ends fixed), and the 3-4-5 law it starts from.")
 
@@ -665,6 +664,8 @@ def _square_figure(study, info, plt, to_svg):
     method: ComMotionPlanning = info["method"]
     planner: Planner = info["planner"]
     fig, ax = plt.subplots(figsize=(6.0, 5.4))
+    names: list = []  # (text, point, kind): placed last, clear of the paths (report.figures.place_items)
+    segs: list = []
     if method.test_square is not None:
         sq = method.test_square
         h = sq.side / 2
@@ -672,17 +673,15 @@ def _square_figure(study, info, plt, to_svg):
         ax.fill([cx - h, cx + h, cx + h, cx - h], [cy - h, cy - h, cy + h, cy + h], color="0.88", zorder=0)
         for name, (x, y) in sq.points().items():
             ax.plot(x, y, "o", color="black", markersize=2.5)
-            dx, dy = x - cx, y - cy
-            ax.annotate(name, (x, y), textcoords="offset points", fontsize=7,
-                        xytext=(8 * np.sign(dx) if abs(dx) > 1e-12 else 0, 8 * np.sign(dy) if abs(dy) > 1e-12 else 0),
-                        ha="center", va="center")
+            names.append((name, (x, y), "joint"))
         ax.plot([cx], [cy], "+", color="black")
-        ax.annotate("E", (cx, cy), textcoords="offset points", xytext=(4, 4), fontsize=7)
+        names.append(("E", (cx, cy), "joint"))
     for k, p in enumerate(plans):
         c = f"C{k % 10}"
         ax.annotate("", xy=p.end[:2], xytext=p.start[:2], arrowprops={"arrowstyle": "->", "color": c, "lw": 1.2})
         ax.plot([p.com_start[0], p.com_end[0]], [p.com_start[1], p.com_end[1]], color=c, linestyle="--", linewidth=1.0,
                 label=f"{p.name}: tip → (solid), centre of mass (dashed)")
+        segs += [(tuple(p.start[:2]), tuple(p.end[:2])), (tuple(p.com_start[:2]), tuple(p.com_end[:2]))]
     # the arm at the start of the first trajectory
     p0 = plans[0]
     th = np.cumsum(p0.q_start)
@@ -691,12 +690,16 @@ def _square_figure(study, info, plt, to_svg):
         pts.append(pts[-1] + L * np.array([math.cos(a), math.sin(a)]))
     pts = np.array(pts)
     ax.plot(pts[:, 0], pts[:, 1], "-o", color="0.3", linewidth=2.0, markersize=3, label=f"arm at the start of {p0.name}")
+    segs += [(tuple(a), tuple(b)) for a, b in zip(pts[:-1], pts[1:])]
     ax.plot([planner.arm.base[0]], [planner.arm.base[1]], "^", color="black", markersize=8)
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.legend(fontsize=6, loc="lower left")
-    fig.tight_layout()
+    from ..report.figures import legend_below, place_items
+
+    legend_below(fig, ax, fontsize=7)  # under the drawing: never over the arm or the paths
+    place_items(fig, ax, names, segs, [(np.asarray(q, dtype=float), None) for _, q, _ in names]
+                + [(np.asarray(planner.arm.base, dtype=float), -1.0)])
     yield ("The test square and the trajectories (Fig. 2)", to_svg(fig, "com-square"),
            "Grey: the tested zone (side " + (f"{method.test_square.side:g} m, centre ({method.test_square.centre[0]:g}, "
            f"{method.test_square.centre[1]:g}) m" if method.test_square else "—") + "), points P1.. numbered "

@@ -420,8 +420,12 @@ def _factor_table(study, method: str) -> str:
             f"<tr><td>{s.stage.label}</td><td>{an.max_force:.6g}</td><td>{an.max_moment:.6g}</td>"
             f"<td>{s.max_effort:.6g}</td><td>{s.added_mass:.6g}</td><td>{s.added_inertia:.6g}</td></tr>"
         )
+    from ..report.present import driver_unit
+
+    model = study.unbalanced.stage.model
+    units = sorted({driver_unit(model, d.name) for d in model.drivers}) or ["N m or N"]
     head = ("<table><thead><tr><th>stage</th><th>max |F| (N)</th><th>max |M| (N m)</th>"
-            "<th>peak actuator effort (N m or N)</th><th>added mass (kg)</th><th>added inertia (kg m²)</th>"
+            f"<th>peak actuator effort ({' or '.join(units)})</th><th>added mass (kg)</th><th>added inertia (kg m²)</th>"
             "</tr></thead><tbody>")
     out = head + "".join(rows) + "</tbody></table>"
     cw, un, added = _stage(study, "counterweights"), study.unbalanced, _stage(study, ADDED_LINKAGE.get(method, ""))
@@ -440,7 +444,7 @@ def _factor_caption(study, method: str) -> str:
     text = ("Peaks over the motion of every stage. The factor is the counterweights stage's peak shaking "
             "moment divided by the reference stage's")
     if paper:
-        text += f"; the paper reports {paper} (the reference `counterweights.moment_ratio` compares it with the unbalanced 3-RPR)."
+        text += f"; the paper reports {paper} (the reference `counterweights.moment_ratio` compares it with the unbalanced 3-RPR)"
     return text + "."
 
 

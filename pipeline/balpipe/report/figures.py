@@ -50,17 +50,44 @@ SIM_COLORS = ["tab:orange", "tab:blue", "tab:green", "tab:purple", "tab:brown"]
 
 
 MARKERS = ["o", "s", "^", "D", "v"]
+# from the sixth stage on (a spec with compared designs): the five line styles again, in colours
+# and with markers of their own, so that no two stages of a figure look alike
+MORE_COLORS = ["tab:green", "tab:purple", "tab:brown", "tab:olive", "tab:cyan"]
+MORE_MARKERS = ["P", "X", "h", "<", ">"]
+STYLE_WORDS = ["solid black", "dashed black", "grey", "blue dash-dot", "red dotted"]
+LINE_WORDS = ["solid", "dashed", "thick solid", "dash-dot", "dotted"]
+MARKER_WORDS = ["circles", "squares", "triangles", "diamonds", "down-triangles",
+                "plus signs", "crosses", "hexagons", "left-triangles", "right-triangles"]
 
 
 def style(k: int) -> dict:
-    return STAGE_STYLES[k % len(STAGE_STYLES)]
+    n = len(STAGE_STYLES)
+    base = STAGE_STYLES[k % n]
+    if k < n:
+        return base
+    return {**base, "color": MORE_COLORS[(k // n - 1 + k) % len(MORE_COLORS)]}
+
+
+def _marker(k: int) -> str:
+    return (MARKERS + MORE_MARKERS)[k % (len(MARKERS) + len(MORE_MARKERS))]
+
+
+def style_text(k: int, markers: bool = True) -> str:
+    """Words for stage ``k``'s line (and marker, as :func:`marked` draws it): 'solid black,
+    circles'; 'dashed purple, crosses' from the sixth stage on."""
+    n = len(STAGE_STYLES)
+    if k < n:
+        line = STYLE_WORDS[k]
+    else:
+        line = LINE_WORDS[k % n] + " " + style(k)["color"].removeprefix("tab:")
+    return line + (f", {MARKER_WORDS[k % len(MARKER_WORDS)]}" if markers else "")
 
 
 def marked(k: int, n: int) -> dict:
     """A stage's line style with its own marker, placed at staggered samples (offset per stage)
     so that curves that coincide stay distinguishable."""
     every = max(1, n // 12)
-    return {**style(k), "marker": MARKERS[k % len(MARKERS)], "markersize": 4.5, "markerfacecolor": "none",
+    return {**style(k), "marker": _marker(k), "markersize": 4.5, "markerfacecolor": "none",
             "markevery": (min(n - 1, (k * every) // max(1, len(MARKERS))), every)}
 
 
@@ -92,6 +119,27 @@ def to_svg(fig, prefix: str) -> str:
     svg = re.sub(r"url\(#([^)]+)\)", lambda m: f"url(#{prefix}-{m.group(1)})", svg)
     svg = re.sub(r'xlink:href="#([^"]+)"', lambda m: f'xlink:href="#{prefix}-{m.group(1)}"', svg)
     return svg
+
+
+def legend_below(fig, ax, fontsize: float = 8.5) -> None:
+    """``ax``'s legend under the figure's axes, never over a curve: as many columns (at most 3) as
+    the figure's width holds, the figure made taller by the legend's height, the layout above it.
+    Call it instead of ``fig.tight_layout()``."""
+    handles, labels = ax.get_legend_handles_labels()
+    if not labels:
+        fig.tight_layout()
+        return
+    renderer = fig.canvas.get_renderer()
+    W, H = fig.get_size_inches()
+    for ncol in range(min(len(labels), 3), 0, -1):
+        leg = fig.legend(handles, labels, loc="lower center", bbox_to_anchor=(0.5, 0.0), ncol=ncol,
+                         fontsize=fontsize, frameon=False)
+        if ncol == 1 or leg.get_window_extent(renderer).width <= 0.98 * W * fig.dpi:
+            break
+        leg.remove()
+    h = leg.get_window_extent(renderer).height / fig.dpi + 0.05
+    fig.set_size_inches(W, H + h)
+    fig.tight_layout(rect=(0, h / (H + h), 1, 1))
 
 
 def loads_figure(stages: list, prefix: str = "loads") -> str:
@@ -144,8 +192,7 @@ def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = N
         ax.set_title(literal(f"Actuator effort: {name}" + (f" ({u})" if u else "")), fontsize=9)
         ax.set_ylabel({"N m": "torque (N m)", "N": "force (N)"}.get(u, "effort"))
         ax.set_xlabel("time (s)")
-    axes[0][0].legend(fontsize=8.5)
-    fig.tight_layout()
+    legend_below(fig, axes[0][0])
     return to_svg(fig, prefix)
 
 
@@ -242,11 +289,12 @@ LABEL_STYLES = {  # kind -> font size, colour, style, weight
 
 
 def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float,
-                  numbers: dict[str, str]) -> tuple[list, list, list]:
+                  numbers: dict[str, str], disc: float = 0.035) -> tuple[list, list, list]:
     """What to label at one instant, in placing order (frame pivots, joints, gears,
     counterweights, links), in model coordinates: (text, anchor, kind) triples, the links'
     segments, and the joint markers, pivots, slider blocks and counterweight discs to keep clear,
-    as (centre, radius), radius None for a joint's marker and -1 for a pivot's triangle."""
+    as (centre, radius), radius None for a joint's marker and -1 for a pivot's triangle.
+    ``disc``: a counterweight's disc radius / ``span`` for the heaviest (``max_cw``), as drawn."""
     out: list[tuple[str, np.ndarray, str]] = []
     keep: list[tuple[np.ndarray, float | None]] = []
     segs: list[tuple[np.ndarray, np.ndarray]] = []
@@ -278,7 +326,7 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
             c = _global_point(pose, a.position)
             if a.kind == "counterweight":
                 cws.append((a.name, c, "counterweight"))
-                keep.append((c, 0.035 * span * math.sqrt(a.mass / max_cw)))
+                keep.append((c, disc * span * math.sqrt(a.mass / max_cw)))
                 root = _global_point(pose, b.points[b.outline[0]] if b.outline else (0, 0))
                 segs.append((root, c))
             elif a.radius:
@@ -296,16 +344,34 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
 
 
 def _place_names(fig, ax, model: Model, pose_row: np.ndarray, span: float, max_cw: float,
-                 numbers: dict[str, str] | None) -> list:
+                 numbers: dict[str, str] | None, disc: float = 0.035, kinds: tuple[str, ...] | None = None,
+                 marks: list | tuple = (), texts: dict[str, str] | None = None) -> list:
     """Names of the spec at one instant (every body point once per place, every link, every
     counterweight, every gear's number), placed in display pixels by :func:`labels.place` so
-    that no two overlap, avoiding the links and markers; a displaced name gets a leader line."""
+    that no two overlap, avoiding the links and markers; a displaced name gets a leader line.
+    Call it once the figure's layout is final. ``disc``: as :func:`name_requests`; ``kinds``: only
+    these kinds of names (``LABEL_STYLES``' keys; all when None); ``marks``: further points drawn
+    (model coordinates) to keep clear, e.g. centres of mass; ``texts``: name -> the text drawn
+    (a paper's notation)."""
+    from . import labels as lb
+
+    numbers = numbers if numbers is not None else lb.gear_numbers([model])
+    items, segs, keep = name_requests(model, pose_row, span, max_cw, numbers, disc)
+    items = [((texts or {}).get(t, t), a, k) for t, a, k in items if kinds is None or k in kinds]
+    keep = keep + [(np.asarray(p, dtype=float), None) for p in marks]
+    return place_items(fig, ax, items, segs, keep)
+
+
+def place_items(fig, ax, items: list, segs: list, keep: list) -> list:
+    """Names placed by :func:`labels.place` and drawn (a displaced one with a leader line):
+    ``items`` (text, anchor, kind) in data coordinates, ``kind`` a key of ``LABEL_STYLES``, in
+    placing order; ``segs``: lines to keep clear ((x, y), (x, y)); ``keep``: markers and discs as
+    (centre, radius), radius None for a point marker, -1 for a pivot's triangle. Call it once
+    the figure's layout is final; returns the :class:`labels.Placed` (display pixels)."""
     from matplotlib.font_manager import FontProperties
 
     from . import labels as lb
 
-    numbers = numbers if numbers is not None else lb.gear_numbers([model])
-    items, segs, keep = name_requests(model, pose_row, span, max_cw, numbers)
     ax.apply_aspect()
     to_px = ax.transData.transform
     renderer = fig.canvas.get_renderer()
@@ -342,6 +408,9 @@ def _place_names(fig, ax, model: Model, pose_row: np.ndarray, span: float, max_c
     return placed
 
 
+place_names = _place_names  # public: the report's other drawings (paper 001's 4-RRR) name their parts with it
+
+
 def common_limits(items: list[tuple[Model, np.ndarray]], pad: float = 0.08) -> tuple[float, float, float, float]:
     """One box for every panel: every point, attachment and disc rim of every (model, poses)."""
     from .player import _extent_points
@@ -369,8 +438,7 @@ def series_figure(t: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel: s
     ax.set_ylabel(ylabel)
     if title:
         ax.set_title(literal(title), fontsize=9)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
+    legend_below(fig, ax, fontsize=8)
     return to_svg(fig, prefix)
 
 
@@ -388,26 +456,30 @@ def drift_figure(runs: list, prefix: str = "drift") -> str:
     a2.set_title("Rotation of the free frame (deg)", fontsize=9)
     for a in (a1, a2):
         a.set_xlabel("time (s)")
-    a1.legend(fontsize=8.5)
-    fig.tight_layout()
+    legend_below(fig, a1)
     return to_svg(fig, prefix)
 
 
 def residual_figure(stages: list, prefix: str = "residuals") -> str:
     """|F_sim - F_analytic| / F0 and |M_sim - M_analytic| / M0 over time, every stage.
-    ``stages``: (label, t, force_error, moment_error, F0, M0)."""
+    ``stages``: (label, t, force_error, moment_error, F0, M0), F0 and M0 the stage's own reference
+    loads (N, N m); the titles give them when every stage has the same, else the legend does."""
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 2.8))
+    one = len({(F0, M0) for *_, F0, M0 in stages}) == 1  # one reference for every stage: in the titles
     for k, (label, t, fe, me, F0, M0) in enumerate(stages):
         c = SIM_COLORS[k % len(SIM_COLORS)]
-        a1.plot(t, fe / F0 if F0 > 0 else fe, color=c, label=literal(label), linewidth=1.0)
-        a2.plot(t, me / M0 if M0 > 0 else me, color=c, label=literal(label), linewidth=1.0)
-    a1.set_title("|F_sim - F_analytic| / reference force", fontsize=9)
-    a2.set_title("|M_sim - M_analytic| / reference moment", fontsize=9)
+        name = label if one else f"{label} (F_ref {F0:.4g} N, M_ref {M0:.4g} N m)"
+        a1.plot(t, fe / F0 if F0 > 0 else fe, color=c, label=literal(name), linewidth=1.0)
+        a2.plot(t, me / M0 if M0 > 0 else me, color=c, label=literal(name), linewidth=1.0)
+    F0, M0 = stages[0][4], stages[0][5]
+    a1.set_title("Force residual" + (f", F_ref = {F0:.4g} N" if one else ", F_ref per stage (legend)"), fontsize=9)
+    a2.set_title("Moment residual" + (f", M_ref = {M0:.4g} N m" if one else ", M_ref per stage (legend)"), fontsize=9)
+    a1.set_ylabel("|F_sim − F_analytic| / F_ref" if F0 > 0 or not one else "|F_sim − F_analytic| (N)", fontsize=8)
+    a2.set_ylabel("|M_sim − M_analytic| / M_ref" if M0 > 0 or not one else "|M_sim − M_analytic| (N m)", fontsize=8)
     for a in (a1, a2):
         a.set_xlabel("time (s)")
         a.set_yscale("log")
-    a1.legend(fontsize=8.5)
-    fig.tight_layout()
+    legend_below(fig, a1)
     return to_svg(fig, prefix)
 
 

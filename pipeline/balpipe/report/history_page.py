@@ -18,6 +18,7 @@ from pathlib import Path
 from .history_figures import (added_history_figure, changing_parameters, flagged, loads_history_figure,
                               parameters_history_figure)
 from .render import environment, num
+from .render import load as peak_text
 
 HISTORY_FILE = "history.json"
 HISTORY_PAGE = "history.html"
@@ -42,7 +43,8 @@ def _peaks(c: dict, key: str) -> str:
     if not st:
         return "—"
     a, b = st[0].get(key), st[-1].get(key)
-    return num(a) if len(st) == 1 else f"{num(a)} → {num(b)}"
+    # a last stage's round-off (at most 1e-9 of the unbalanced peak) reads as 0, as on the stage table
+    return num(a) if len(st) == 1 else f"{num(a)} → {peak_text(b, a, 1e-9, of='unbalanced')}"
 
 
 def view(history: dict, prefix: str = "hist") -> dict:

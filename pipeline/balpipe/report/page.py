@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import realisable
-from ..study import Study
+from ..study import Study, ratio_reference
 from . import figures, labels, present, toc
 from .notation_table import notation_groups
 from .render import environment
@@ -49,15 +49,8 @@ def study_figures(study: Study) -> dict:
     residuals, drift = [], []
     vals = [s for s in shown_stages(study) if s.validation is not None]
     if vals:
-        ref = study.reference
-        F0, M0 = ref.force, ref.moment
-        residuals.append((
-            "Residuals of the simulation",
-            figures.residual_figure([(s.stage.label, s.validation.t, s.validation.force_error,
-                                      s.validation.moment_error, F0, M0) for s in vals]),
-            "Difference between the pymunk simulation and the analytic engine, relative to "
-            + study.reference.describe("force") + " and " + study.reference.describe("moment") + ".",
-        ))
+        rows, caption = residual_rows(study, vals)
+        residuals.append(("Residuals of the simulation", figures.residual_figure(rows), caption))
     if study.reactionless is not None:
         drift = list(study.reactionless.figures())
     torque = []
@@ -69,10 +62,53 @@ def study_figures(study: Study) -> dict:
             "Tracking error of the torque-driven run",
             figures.series_figure(runs[0].torque.t, curves, "|q_sim − q_plan| / travel", prefix="torque"),
             "Each driven coordinate of the simulation driven by the engine's efforts (no position drive), "
-            "minus its planned motion, relative to its travel.",
+            "minus its planned motion, relative to its travel (largest excursion from its start): "
+            + travel_text(runs[0]) + ".",
         ))
-    return {"loads": loads, "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
+    key = "; ".join(f"{figures.style_text(k)}: {s.stage.label}" for k, s in enumerate(shown_stages(study)))
+    return {"loads": loads, "loads_key": key[:1].upper() + key[1:], "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
+
+
+def travel_text(s) -> str:
+    """'crank 2.793 rad' per driver of a stage's torque-driven run: the tracking error's reference."""
+    model = s.stage.model
+    return ", ".join(f"{d} {v:.4g} {'m' if present.driver_unit(model, d) == 'N' else 'rad'}"
+                     for d, v in sorted(s.torque.travel.items()))
+
+
+def residual_rows(study: Study, stages: list) -> tuple[list, str]:
+    """The residual figure's rows (:func:`figures.residual_figure`) for ``stages`` (simulated), each
+    divided by its own reference: the loads of ``study.reference_stage`` (with several motions, the
+    unbalanced stage of its own motion; results.json's ``stages[].reference``, whose loads are
+    ``checks.reference`` for the first motion), as the validation table's residuals; and the
+    caption naming each reference."""
+    refs = {}
+    rows = []
+    for s in stages:
+        rs = study.reference_stage(s)
+        ref = ratio_reference(rs)
+        refs.setdefault(rs.stage.name, (rs.stage.label, ref, []))[2].append(s.stage.label)
+        rows.append((s.stage.label, s.validation.t, s.validation.force_error, s.validation.moment_error,
+                     ref.force, ref.moment))
+    parts = []
+    for name, (label, ref, of) in refs.items():
+        whose = "" if len(refs) == 1 else f"for {', '.join(of)}, "
+        parts.append(whose + _reference_phrase(ref, label, "force") + " and " + _reference_phrase(ref, label, "moment"))
+    caption = ("Difference between the pymunk simulation and the analytic engine (force |F_sim − F_analytic|, "
+               "moment |M_sim − M_analytic|), divided by the reference loads F_ref, M_ref of the ratios "
+               "and of the validation table: " + "; ".join(parts) + ".")
+    return rows, caption
+
+
+def _reference_phrase(ref, label: str, which: str) -> str:
+    """'F_ref = 237.7 N, the peak inertial force of the unbalanced stage 'unbalanced'' (or its floor)."""
+    value, basis, peak, unit, sym = ((ref.force, ref.force_basis, ref.force_peak, "N", "F_ref") if which == "force"
+                                     else (ref.moment, ref.moment_basis, ref.moment_peak, "N m", "M_ref"))
+    if basis == "unbalanced peak":
+        return f"{sym} = {value:.4g} {unit}, the peak inertial {which} of the unbalanced stage '{label}'"
+    return (f"{sym} = {value:.4g} {unit}, {ref.floor_fraction:g} of the gross inertial {which} of the unbalanced "
+            f"stage '{label}' (larger than its peak, {peak:.3g} {unit})")
 
 
 def render_page(study: Study, results: dict, spec_text: str, history: dict | None = None,

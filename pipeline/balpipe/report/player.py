@@ -229,6 +229,7 @@ const L = D.layout, PW = L.width, PH = L.height;
 const T0 = D.stages[0].t[0], T1 = D.stages[0].t[D.stages[0].t.length - 1], span = Math.max(T1 - T0, 1e-9);
 function T(pose, p) {{ const c = Math.cos(pose[2]), si = Math.sin(pose[2]);
   return [pose[0] + c * p[0] - si * p[1], pose[1] + si * p[0] + c * p[1]]; }}
+function fixed(v, d) {{ const t = v.toFixed(d); return /^-0(\\.0*)?$/.test(t) ? t.slice(1) : t; }}  // no "-0.000"
 function frameAt(st, time) {{ let i = 0; while (i + 1 < st.t.length && st.t[i + 1] <= time + 1e-12) i++; return i; }}
 function hit(a, b) {{ return a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3]; }}
 function segHit(p, q, b) {{ // Liang-Barsky: does segment p-q cross box b (x0, y0, x1, y1)?
@@ -323,7 +324,7 @@ function draw() {{
     g.fillStyle = "#1d232b"; g.font = "12px sans-serif";
     g.fillText(st.label, O[0] + 8, O[1] + 15);
     const dx = base[0] * 1000, dy = base[1] * 1000, rot = base[2] * 180 / Math.PI;
-    g.fillText(`frame: (${{dx.toFixed(2)}}, ${{dy.toFixed(2)}}) mm, ${{rot.toFixed(3)}} deg`, O[0] + 8, O[1] + PH - 8);
+    g.fillText(`frame: (${{fixed(dx, 2)}}, ${{fixed(dy, 2)}}) mm, ${{fixed(rot, 3)}} deg`, O[0] + 8, O[1] + PH - 8);
     // scale bar, bottom right of the panel: this panel's own scale
     const bl = st.bar[0] * s, bx = O[0] + PW - 12 - bl, by = O[1] + PH - 26;
     g.strokeStyle = "#1d232b"; g.lineWidth = 2; g.beginPath(); g.moveTo(bx, by - 4); g.lineTo(bx, by); g.lineTo(bx + bl, by);

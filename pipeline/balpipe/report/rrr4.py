@@ -84,13 +84,18 @@ def finder_table(study) -> str | None:
     return out
 
 
-def _draw(ax, model, poses, span: float, max_cw: float, title: str) -> None:
+DISC = 0.05  # the heaviest counter-mass's disc radius / the span of the base pivots
+NAMED = ("pivot", "link")  # the names a panel carries: base pivots A1-A4 and links, as the paper: l11 for link11
+
+
+def _draw(ax, model, poses, span: float, max_cw: float, title: str) -> list:
     """One panel: ``model`` at the body poses ``poses`` (the engine's frame poses at t = 0): links,
     joints, pivots, each body's centre of mass (cross), counter-masses as red discs of area
-    proportional to mass (``max_cw`` has the largest), the total centre of mass (star)."""
+    proportional to mass (``max_cw`` has the largest), the total centre of mass (star). Returns the
+    points marked (centres of mass) for :func:`_name` to keep clear."""
     from matplotlib.patches import Circle, Polygon
 
-    total, weighted = 0.0, np.zeros(2)
+    total, weighted, marks = 0.0, np.zeros(2), []
     for k, b in enumerate(model.bodies):
         x, y, th = poses[k]
         R = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
@@ -107,21 +112,35 @@ def _draw(ax, model, poses, span: float, max_cw: float, title: str) -> None:
             root = g(b.points[b.outline[0]])
             pos = g(a.position)
             ax.plot([root[0], pos[0]], [root[1], pos[1]], color="tab:red", linewidth=1.2)
-            ax.add_patch(Circle(pos, 0.05 * span * math.sqrt(a.mass / max_cw), color="tab:red", alpha=0.6))
+            ax.add_patch(Circle(pos, DISC * span * math.sqrt(a.mass / max_cw), color="tab:red", alpha=0.6))
         m, c, _ = b.mass_properties()
         gc = g(c)
         total, weighted = total + m, weighted + m * gc
         ax.plot(gc[0], gc[1], "x", color="tab:blue", markersize=5)
+        marks.append(gc)
     for name, p in model.frame_points.items():
         ax.plot(p[0], p[1], marker="^", color="black", markersize=8)
-        ax.annotate(name, p, textcoords="offset points", xytext=(4, -12), fontsize=7)
     com = weighted / max(total, 1e-300)
+    marks.append(com)
     ax.plot(com[0], com[1], "*", color="tab:purple", markersize=11)
     ax.set_title(title, fontsize=8)
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)", fontsize=7)
     ax.set_ylabel("y (m)", fontsize=7)
     ax.tick_params(labelsize=7)
+    return marks
+
+
+def _name(fig, ax, model, poses, span: float, max_cw: float, marks: list) -> list:
+    """The panel's names (:data:`NAMED`), placed by the report's label placer
+    (:func:`balpipe.report.figures.place_names`, :func:`balpipe.report.labels.place`): no two
+    overlap, and each keeps clear of the links, counter-mass discs, pivots, joints and the centres
+    of mass ``marks`` where the panel leaves room. Call once the figure's layout is final."""
+    from .figures import place_names
+
+    paper = {b.name: "l" + b.name[4:] for b in model.bodies if b.name.startswith("link")}
+    return place_names(fig, ax, model, np.asarray(poses, dtype=float), span, max_cw, {}, disc=DISC, kinds=NAMED,
+                       marks=marks, texts=paper)
 
 
 def _span(model) -> float:
@@ -133,6 +152,12 @@ def _counter_masses(model) -> list[float]:
     return [a.mass for b in model.bodies for a in b.attachments if a.kind == "counterweight"]
 
 
+def grid_columns(n: int) -> int:
+    """Panels per row: at most three, two for four panels (2 x 2, not 3 + 1 or a row of four too
+    small to read on a page)."""
+    return 2 if n == 4 else min(3, n)
+
+
 def topology_figure(study):
     """The balanced stages at t = 0, one panel each: links, joints, pivots, each link's centre of
     mass (cross), counter-masses as red discs of area proportional to mass, and the fixed total
@@ -142,13 +167,21 @@ def topology_figure(study):
     shown = [s for s in study.stages if s.stage.name in FIGURE_OF_STAGE]
     if not shown:
         return None
-    fig, axes = plt.subplots(1, len(shown), figsize=(4.2 * len(shown), 4.2), squeeze=False)
+    cols = grid_columns(len(shown))
+    rows = (len(shown) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
     max_cw = max([m for s in shown for m in _counter_masses(s.stage.model)] + [1e-12])
-    for ax, s in zip(axes[0], shown):
+    panels = []
+    for ax in list(axes.flat)[len(shown):]:
+        ax.axis("off")
+    for ax, s in zip(axes.flat, shown):
         model = s.stage.model
-        _draw(ax, model, s.analysis.extra["frame_pose"][0], _span(model), max_cw,
-              f"{s.stage.label}\nadded {s.added_mass:.3g} kg")
+        poses = s.analysis.extra["frame_pose"][0]
+        marks = _draw(ax, model, poses, _span(model), max_cw, f"{s.stage.label}\nadded {s.added_mass:.3g} kg")
+        panels.append((ax, model, poses, marks))
     fig.tight_layout()
+    for ax, model, poses, marks in panels:
+        _name(fig, ax, model, poses, _span(model), max_cw, marks)
     return to_svg(fig, "rrr4-topology")
 
 
@@ -181,18 +214,22 @@ def designs_figure(study, checked, figures: tuple[str, ...]):
     shown = [c for c in checked if c[0].figure in figures]
     if not shown:
         return None
-    cols = min(3, len(shown))
+    cols = grid_columns(len(shown))
     rows = (len(shown) + cols - 1) // cols
     fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
     poses = study.stages[0].analysis.extra["frame_pose"][0]
     max_cw = max([m for d, _, _ in shown for m in _counter_masses(d.model)] + [1e-12])
+    panels = []
     for ax, (d, added, ratio) in zip(axes.flat, shown):
         kept = ", ".join(f"l{b}" if b != "5" else "platform" for b in d.kept)
-        _draw(ax, d.model, poses, _span(d.model), max_cw,
-              f"{d.figure}: {kept} as built\nadded {added:.3g} kg, peak |F| / unbalanced {ratio:.1e}")
+        marks = _draw(ax, d.model, poses, _span(d.model), max_cw,
+                      f"{d.figure}: {kept} as built\nadded {added:.3g} kg, peak |F| / unbalanced {ratio:.1e}")
+        panels.append((ax, d.model, marks))
     for ax in list(axes.flat)[len(shown):]:
         ax.axis("off")
     fig.tight_layout()
+    for ax, model, marks in panels:
+        _name(fig, ax, model, poses, _span(model), max_cw, marks)
     return to_svg(fig, "rrr4-" + figures[0].replace("Fig. ", "fig").lower())
 
 
@@ -238,7 +275,8 @@ def figures(study):
                                                                  for s in study.stages if s.stage.name == "special"}))
             + "; least mass)",
             svg,
-            "Each force-balanced stage at t = 0: links (black), joints (circles), base pivots (triangles), each "
+            "Each force-balanced stage at t = 0: links (black; named l11 to l42 as in the paper, the spec's link11 to "
+            "link42), joints (circles), base pivots (triangles, A1 to A4), each "
             "body's centre of mass (blue cross), counter-masses as red discs (area proportional to mass, the "
             "largest over the panels has the largest disc) on a line from the link's proximal joint, and the "
             "total centre of mass (purple star), which stays fixed during the motion in every panel.",

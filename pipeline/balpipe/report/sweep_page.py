@@ -33,21 +33,51 @@ def front_figure(rows: list[dict], metric: str, flag: str, ylabel: str, prefix: 
     return to_svg(fig, prefix)
 
 
+def effort_unit(plan) -> str:
+    """The unit of the sweep's actuator efforts: 'N m' when every driver of the base spec is a
+    torque (revolute joint, angle), 'N' when every one is a force, else 'N m or N'. The varied
+    fields are values, so every design has the base spec's drivers."""
+    from .. import registry
+    from ..sweep import _validate
+    from .present import driver_unit
+
+    try:
+        model = registry.unbalanced_model(_validate(plan.data))
+    except Exception:  # noqa: BLE001  (the base spec was checked; a unit is not worth a failed page)
+        return "N m or N"
+    units = {driver_unit(model, d.name) for d in model.drivers}
+    return units.pop() if len(units) == 1 else "N m or N"
+
+
+def si_unit(vary) -> str:
+    """The SI unit of a varied field's values in the table (the CSV's SI numbers): from the unit
+    the vary is written in ('500 g:2 kg' -> kg); 'SI' when it is written without one."""
+    from ..units import SI, UNITS, _normalise_unit
+
+    if vary.unit:
+        u = _normalise_unit(vary.unit)
+        for kind, table in UNITS.items():
+            if u in table and SI.get(kind):
+                return SI[kind]
+    return "SI"
+
+
 def render(res, linked: set[int]) -> str:
     rows = res.rows
+    unit = effort_unit(res.plan)
     fronts = [
         ("Added mass against peak shaking moment",
          front_figure(rows, "max_shaking_moment", "pareto_moment",
-                      "peak shaking moment |M| about the spec's moment point (N m)", "front-m"),
+                      "peak shaking moment |M| (N m)\nabout the spec's moment point", "front-m"),
          "pareto_moment"),
         ("Added mass against peak actuator effort",
          front_figure(rows, "max_actuator_effort", "pareto_effort",
-                      "peak actuator effort, largest over the drivers (N m or N)", "front-e"),
+                      f"peak actuator effort ({unit})\nlargest over the drivers", "front-e"),
          "pareto_effort"),
     ]
     front_rows = [r for r in rows if r.get("pareto_moment") or r.get("pareto_effort")]
     errors = [r for r in rows if "error" in r]
     return environment().get_template("sweep.html").render(
         res=res, plan=res.plan, fronts=fronts, front_rows=front_rows, errors=errors[:200],
-        n_errors=len(errors), linked=linked,
+        n_errors=len(errors), linked=linked, effort_unit=unit, var_units=[si_unit(v) for v in res.plan.varies],
     )
