@@ -28,6 +28,7 @@ def test_a_wide_geometry_sweep_starts_from_the_base_and_corners_with_the_same_ta
     one = run(p, jobs=1)
     counts = {k: warmstart.STATS[k] - before[k] for k in before}
     assert one.failed == 0 and one.full == 8
+    assert any("start from 3 fixed motions" in n for n in one.notes)  # the base and two corners
     # base (+ its balancing) and the two corners by the continuation, the designs warm
     assert counts["warm"] >= 5 and counts["continuation"] <= 3 + counts["warm_rejected"]
     sweep._GEOMETRIES.clear()

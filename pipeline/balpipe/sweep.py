@@ -539,6 +539,12 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
         route = build_route(p, base_key, (ms.names, ms0.names), anchors)
     if route is None and anchors is not None:  # designs one by one: more places to start from
         _corner_anchors(p, paths, anchors)
+        if len(anchors):
+            notes.append(f"Closed loops of a new geometry start from {len(anchors)} fixed motions (the base spec's "
+                         f"and the sweep's corner designs'), not from the sequential continuation: each design's "
+                         f"numbers depend only on them and on the design, in any chunk or worker; a design whose "
+                         f"motion is more than 0.2 rad from all of them, or on another branch, takes the "
+                         f"continuation.")
     if route is not None:
         notes.append(f"Mass-only sweep: every design's masses and inertias are affine in the varied values "
                      f"(found and checked on {route.probes} designs built in full); the others were not built "
