@@ -101,10 +101,7 @@ class MassSweep:
             col = 3 * (k + 1)
             J[:, :, col + 2] += -J[:, :, col] * s[:, 1, None] + J[:, :, col + 1] * s[:, 0, None]
         Jf = J[:, :, 3:]
-        if Jf.shape[1] == Jf.shape[2]:  # square: one LU per sample for every parameter's column
-            Lam = np.linalg.solve(np.transpose(Jf, (0, 2, 1)), -YD)
-        else:
-            Lam = np.stack([_multipliers(c, Jf, -YD[:, :, j]) for j in range(YD.shape[2])], axis=2)
+        Lam = _multipliers(c, Jf, -YD)  # every parameter's column at once
         drivers = list(c.driver_rows)
         G = -Lam[:, [c.driver_rows[d] for d in drivers], :]
         key = geometry_key(model, t, gravity, moment_point)

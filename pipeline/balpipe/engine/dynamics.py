@@ -101,7 +101,8 @@ def _joint_reactions(
 
 
 def _multipliers(c: Compiled, Jf: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """Lagrange multipliers from Phi_q^T lambda = Q - M q'' (N samples).
+    """Lagrange multipliers from Phi_q^T lambda = Q - M q'' (N samples): ``rhs`` (N, n) gives
+    (N, m); (N, n, k), k right-hand sides at once (a regressor's columns), gives (N, m, k).
 
     Square Jacobian: the unique solution. Redundant actuation (r more rows than coordinates):
     Phi_q^T has an r-dimensional null space, the internal (antagonistic) loads that the
@@ -115,13 +116,15 @@ def _multipliers(c: Compiled, Jf: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """
     A = np.transpose(Jf, (0, 2, 1))  # (N, n, m)
     n, m = A.shape[1], A.shape[2]
+    B = rhs[..., None] if rhs.ndim == 2 else rhs  # (N, n, k)
     if m == n:
-        return np.linalg.solve(A, rhs[..., None])[..., 0]
-    Q, R = np.linalg.qr(Jf, mode="complete")  # Jf = [Q1 Q2] [R1; 0]: Q2 spans the null space of A
-    y = np.linalg.solve(np.transpose(R[:, :n, :], (0, 2, 1)), rhs[..., None])[..., 0]  # R1^T y = rhs
-    lam_p = np.einsum("nmk,nk->nm", Q[:, :, :n], y)  # the least-norm solution, Q1 R1^-T rhs
-    null = Q[:, :, n:]  # (N, m, r)
-    drv = sorted(c.driver_rows.values())
-    S_null = null[:, drv, :]  # (N, d, r)
-    z = -np.einsum("nij,nj->ni", np.linalg.pinv(S_null), lam_p[:, drv])
-    return lam_p + np.einsum("nmr,nr->nm", null, z)
+        lam = np.linalg.solve(A, B)
+    else:
+        Q, R = np.linalg.qr(Jf, mode="complete")  # Jf = [Q1 Q2] [R1; 0]: Q2 spans the null space of A
+        y = np.linalg.solve(np.transpose(R[:, :n, :], (0, 2, 1)), B)  # R1^T y = rhs
+        lam_p = Q[:, :, :n] @ y  # the least-norm solution, Q1 R1^-T rhs
+        null = Q[:, :, n:]  # (N, m, r)
+        drv = sorted(c.driver_rows.values())
+        z = -np.linalg.pinv(null[:, drv, :]) @ lam_p[:, drv]  # (N, r, k)
+        lam = lam_p + null @ z
+    return lam[..., 0] if rhs.ndim == 2 else lam

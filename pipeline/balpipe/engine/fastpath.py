@@ -39,12 +39,12 @@ from . import warmstart
 from .compile import Compiled, compile_model
 from .positions import _COND_LIMIT, _TOL, _check_regular, _condition, follow_motion, redundancy
 from .constraints import _extend, jacobian
+from .newton_blocks import polish
 from .structure import Decomposition, block_sigma_min, decompose, invert_blocks, solve
 from .vectorised import State, Vectorised, acceleration_rhs, jacobian_values, law_table, residual, velocity_rhs, vectorise
 
 _SCREEN = 1e-4  # exact condition numbers where the lower bound exceeds this fraction of the limit
 _RESIDUAL = 1e-9  # the general path's convergence test (:func:`.positions._newton`)
-_POLISH = 1e-14  # closed loops: one more Newton step where the residual exceeds this
 
 
 class Fallback(Exception):
@@ -142,7 +142,7 @@ def _closed_loop_positions(c: Compiled, vz: Vectorised, dec: Decomposition, t: n
         X[3:] = q.T
         if np.all(np.abs(residual(vz, State(vz, X), f)) < _TOL):
             return q
-    return _polish(vz, dec, follow_motion(c, t), f)
+    return polish(vz, dec, follow_motion(c, t), f)
 
 
 def frame_motion(c: Compiled, t: np.ndarray, f: np.ndarray) -> np.ndarray | None:
@@ -169,7 +169,7 @@ def frame_motion(c: Compiled, t: np.ndarray, f: np.ndarray) -> np.ndarray | None
         frame = warmstart.start(fc, fp.vz, fp.dec, t, f, key)
         if frame is None:
             warmstart.STATS["continuation"] += 1
-            frame = _polish(fp.vz, fp.dec, follow_motion(fc, t), f)
+            frame = polish(fp.vz, fp.dec, follow_motion(fc, t), f)
             if len(_MOTIONS) >= 16:
                 _MOTIONS.clear()
             _MOTIONS[key] = ([d.law for d in c.model.drivers], frame)
@@ -208,22 +208,6 @@ def _place(frame: np.ndarray, com: np.ndarray) -> np.ndarray:
     q[:, 0::3] += cos * com[:, 0] - sin * com[:, 1]
     q[:, 1::3] += sin * com[:, 0] + cos * com[:, 1]
     return q
-
-
-def _polish(vz: Vectorised, dec: Decomposition, q: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """One more Newton step, block by block, where the residual exceeds 1e-14: the continuation
-    stops at a residual of 1e-12, where joint points still miss each other by up to ~1e-12 and
-    the two routes to the shaking moment (reactions, momentum) disagree by that times the
-    forces."""
-    X = np.zeros((vz.ncol + 1, q.shape[0]))
-    X[3:-1] = q.T
-    state = State(vz, X[:-1])
-    phi = residual(vz, state, f)
-    if np.all(np.abs(phi) <= _POLISH):
-        return q
-    vals = jacobian_values(vz, state)
-    X += solve(dec.forward, vals, -phi, invert_blocks(dec, vals), offset=3)
-    return X[3:-1].T.copy()
 
 
 def _screen(c: Compiled, p: Prepared, vals: np.ndarray, inverses: dict, X: np.ndarray, t: np.ndarray) -> None:

@@ -17,14 +17,6 @@ def _solve_rect(J: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.linalg.solve(R, np.einsum("nji,nj->ni", Q, b)[..., None])[..., 0]
 
 
-def _vel_acc_safe(c: Compiled, q: np.ndarray, t: float):
-    try:
-        v, a = _vel_acc(c, q[None, :], np.array([t]))
-        return v[0], a[0]
-    except np.linalg.LinAlgError:
-        return np.zeros_like(q), np.zeros_like(q)
-
-
 def _vel_acc(c: Compiled, q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     qx = _extend(q)
     J = jacobian(c, qx)[:, :, 3:]

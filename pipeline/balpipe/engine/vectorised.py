@@ -11,7 +11,6 @@ are written once. The driver laws are evaluated once per call (:func:`law_table`
 
 from __future__ import annotations
 
-import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,6 +56,9 @@ class Vectorised:
     @property
     def nnz(self) -> int:
         return len(self.rows)
+
+    def __post_init__(self) -> None:
+        self.aux = _Aux(self)  # derived index arrays and stacks, made once (not a field)
 
 
 def vectorise(c: Compiled) -> Vectorised:
@@ -147,12 +149,11 @@ def _rot(C: np.ndarray, S: np.ndarray, b: np.ndarray, s: np.ndarray) -> tuple[np
 
 
 class _Aux:
-    """Index arrays and stacks derived from a :class:`Vectorised`, made once: the rows of the
-    coordinates each primitive reads, and every local vector :class:`State` rotates (the
+    """Index arrays and stacks derived from a :class:`Vectorised`, made once with it: the rows of
+    the coordinates each primitive reads, and every local vector :class:`State` rotates (the
     revolutes' s_i, s_j, then the projections' a, s_i, s_j) with its body."""
 
-    def __init__(self, vz: Vectorised, src: tuple):
-        self.src = src
+    def __init__(self, vz: Vectorised):
         self.cix, self.ciy, self.cjx, self.cjy = 3 * vz.ci, 3 * vz.ci + 1, 3 * vz.cj, 3 * vz.cj + 1
         self.pix, self.piy, self.pjx, self.pjy = 3 * vz.pi, 3 * vz.pi + 1, 3 * vz.pj, 3 * vz.pj + 1
         self.crow1 = vz.crow + 1
@@ -160,16 +161,6 @@ class _Aux:
         self.const = np.append(vz.const, 0.0)[:, None]
         self.bodies = np.concatenate([vz.ci, vz.cj, vz.pi, vz.pi, vz.pj]).astype(np.intp)
         self.local = np.concatenate([vz.csi, vz.csj, vz.pa, vz.psi, vz.psj]).reshape(-1, 2)
-
-
-def _aux(vz: Vectorised) -> _Aux:
-    """:class:`_Aux` of ``vz``, kept on it while its arrays are the same objects."""
-    src = (vz.ci, vz.cj, vz.pi, vz.pj, vz.csi, vz.csj, vz.pa, vz.psi, vz.psj, vz.crow, vz.aconst, vz.pconst,
-           vz.const)
-    hit = vz.__dict__.get("_aux")
-    if hit is None or not all(map(operator.is_, hit.src, src)):
-        hit = vz.__dict__["_aux"] = _Aux(vz, src)
-    return hit
 
 
 class State:
@@ -183,7 +174,7 @@ class State:
         self.X = X
         self.C, self.S = np.cos(th), np.sin(th)
         # every rotated local vector at once (fewer numpy calls; the same operations per entry)
-        self.aux = aux = _aux(vz)
+        self.aux = aux = vz.aux
         x, y = _rot(self.C, self.S, aux.bodies, aux.local)
         nc, npj = len(vz.ci), len(vz.pi)
         self.AIx, self.AIy = x[:nc], y[:nc]

@@ -32,11 +32,11 @@ import numpy as np
 
 from .compile import Compiled
 from .positions import _JUMP, _TOL
-from .structure import Decomposition, invert_blocks, solve
-from .vectorised import State, Vectorised, jacobian_values, residual
+from .newton_blocks import BlockOps, polish
+from .structure import Decomposition
+from .vectorised import Vectorised
 
 STATS = {"reused": 0, "warm": 0, "warm_rejected": 0, "continuation": 0}
-_POLISH = 1e-14  # Newton-Raphson stops at this residual (or where it stops decreasing below _TOL)
 _MAX_ITER = 50  # the assembly's iteration limit (:func:`.positions.follow_motion`)
 _SAME_POSE = 1e-8  # the first sample against the assembled initial pose (relative)
 _STEP_CHANGE = 0.5  # a step's angle change against the anchor's, in the anchor's largest step
@@ -157,10 +157,10 @@ def start(c: Compiled, vz: Vectorised, dec: Decomposition, t: np.ndarray, f: np.
     anchor, or None (no anchor block, no anchor of this structure, or rejected: take the
     continuation).
 
-    Newton-Raphson by blocks runs on all samples at once from the anchor's motion, together with
-    one more column: the model's initial pose at the first time, which Newton's method assembles
-    as the continuation starts. Accepted only when every column converges (residual 1e-14, or
-    below 1e-12 where it stops decreasing) and the motion is on the branch of the design's own
+    Newton-Raphson by blocks (:func:`newton`) runs on all samples at once from the anchor's
+    motion, together with one more column: the model's initial pose at the first time, which
+    Newton's method assembles as the continuation starts. Accepted only when every column
+    converges and the motion is on the branch of the design's own
     initial pose: its first sample is that assembled pose (to 1e-8), no angle is more than 0.2 rad
     from the anchor's (the continuation's branch guard, :data:`.positions._JUMP`), and no step
     between samples changes its angles by more than half the anchor's largest step."""
@@ -173,7 +173,7 @@ def start(c: Compiled, vz: Vectorised, dec: Decomposition, t: np.ndarray, f: np.
         return None
     anchor = min(candidates, key=lambda d: float(np.abs(d[0] - numbers).max()))[1]
     guess = np.concatenate([c.q0[None, :], anchor])
-    q = newton(vz, dec, guess, np.concatenate([f[:, :1], f], axis=1))
+    q = newton(c, vz, dec, guess, np.concatenate([t[:1], t]), np.concatenate([f[:, :1], f], axis=1))
     if q is None or not _same_branch(q[0], q[1:], anchor):
         STATS["warm_rejected"] += 1
         return None
@@ -185,30 +185,17 @@ def start(c: Compiled, vz: Vectorised, dec: Decomposition, t: np.ndarray, f: np.
     return frame
 
 
-def newton(vz: Vectorised, dec: Decomposition, q: np.ndarray, f: np.ndarray,
-           max_iter: int = _MAX_ITER) -> np.ndarray | None:
-    """Newton-Raphson by blocks (:func:`.structure.solve`) on all columns of ``q`` (N, 3 nb) at
-    once; None when it does not converge to 1e-12."""
-    X = np.zeros((vz.ncol + 1, q.shape[0]))
-    X[3:-1] = q.T
-    last = err = np.inf
+def newton(c: Compiled, vz: Vectorised, dec: Decomposition, q: np.ndarray, t: np.ndarray,
+           f: np.ndarray) -> np.ndarray | None:
+    """Newton-Raphson by blocks on all columns of ``q`` (N, 3 nb) at times ``t`` (law values
+    ``f``) at once, as the continuation's batched refinement (:class:`.newton_blocks.BlockOps`),
+    then its polishing step to ~1e-16 (:func:`.newton_blocks.polish`); None when a column does not
+    converge to 1e-12."""
     with np.errstate(all="ignore"):
-        for _ in range(max_iter):
-            state = State(vz, X[:-1])
-            phi = residual(vz, state, f)
-            err = float(np.abs(phi).max())
-            if not np.isfinite(err) or err <= _POLISH or (err < _TOL and err > 0.1 * last):
-                break
-            vals = jacobian_values(vz, state)
-            try:
-                inverses = invert_blocks(dec, vals)
-            except np.linalg.LinAlgError:
-                return None
-            last = err
-            X += solve(dec.forward, vals, -phi, inverses, offset=3)
-    if not err < _TOL or not np.all(np.isfinite(X)):
+        q, _, norms = BlockOps(c, vz, dec, t).newton(q, t, max_iter=_MAX_ITER)
+    if not (np.all(norms < _TOL) and np.all(np.isfinite(q))):
         return None
-    return X[3:-1].T.copy()
+    return polish(vz, dec, q, f)
 
 
 def _same_branch(assembled: np.ndarray, q: np.ndarray, anchor: np.ndarray) -> bool:

@@ -275,7 +275,7 @@ def mechanism_drawing(model: Model, analysis, instants: int = 5, title: str = ""
     if title:
         ax.set_title(literal(title), fontsize=9)
     fig.tight_layout()
-    placed = _place_names(fig, ax, model, poses[ks[-1]], span, max_cw, numbers)
+    placed = place_names(fig, ax, model, poses[ks[-1]], span, max_cw, numbers)
     return fig, placed
 
 
@@ -343,7 +343,7 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
     return out + gears + cws + links, segs, keep
 
 
-def _place_names(fig, ax, model: Model, pose_row: np.ndarray, span: float, max_cw: float,
+def place_names(fig, ax, model: Model, pose_row: np.ndarray, span: float, max_cw: float,
                  numbers: dict[str, str] | None, disc: float = 0.035, kinds: tuple[str, ...] | None = None,
                  marks: list | tuple = (), texts: dict[str, str] | None = None) -> list:
     """Names of the spec at one instant (every body point once per place, every link, every
@@ -406,9 +406,6 @@ def place_items(fig, ax, items: list, segs: list, keep: list) -> list:
                     arrowprops={"arrowstyle": "-", "color": "0.45", "linewidth": 0.6, "shrinkA": 0, "shrinkB": 0}
                     if pl.displaced else None)
     return placed
-
-
-place_names = _place_names  # public: the report's other drawings (paper 001's 4-RRR) name their parts with it
 
 
 def common_limits(items: list[tuple[Model, np.ndarray]], pad: float = 0.08) -> tuple[float, float, float, float]:
