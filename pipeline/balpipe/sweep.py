@@ -88,12 +88,12 @@ def _number(text: str, arg: str) -> tuple[float, str]:
 
 def _conversion(frm: str, to: str, arg: str) -> float:
     """Factor from unit ``frm`` to unit ``to`` of the same dimension (HI given in another unit)."""
-    from .units import UNITS, _normalise_unit
+    from .units import kinds_of
 
-    a, b = _normalise_unit(frm), _normalise_unit(to)
-    for table in UNITS.values():
-        if a in table and b in table:
-            return table[a] / table[b]
+    a, b = kinds_of(frm), kinds_of(to)
+    for kind in a:
+        if kind in b:
+            return a[kind] / b[kind]
     raise SweepError(f"{arg}: LO and HI have units of different kinds ({to!r}, {frm!r})")
 
 

@@ -59,6 +59,13 @@ def _normalise_unit(unit: str) -> str:
     return u.replace(" ^2", "^2")
 
 
+def kinds_of(unit: str) -> dict[str, float]:
+    """The dimensions whose unit tables hold ``unit`` (after normalising its spelling), in the
+    order of :data:`UNITS`, each with the unit's factor to SI ({} for an unknown unit)."""
+    u = _normalise_unit(unit)
+    return {kind: table[u] for kind, table in UNITS.items() if u in table}
+
+
 def parse(value: Any, dimension: str) -> float:
     """Convert a number or a ``"<number> <unit>"`` string of ``dimension`` to SI.
 

@@ -43,10 +43,10 @@ def _written_to_si(raw: Any, dimension: str | None) -> tuple[str, str] | None:
     if isinstance(raw, str):
         m = units._QTY.match(raw)
         if m:
-            u = units._normalise_unit(m.group(2))
-            for dim, table in units.UNITS.items():
-                if u and u in table:
-                    return num(float(m.group(1)) * table[u]), units.SI[dim]
+            kinds = units.kinds_of(m.group(2)) if units._normalise_unit(m.group(2)) else {}
+            if kinds:
+                dim, factor = next(iter(kinds.items()))  # the first table holding the unit, as before
+                return num(float(m.group(1)) * factor), units.SI[dim]
     return None
 
 

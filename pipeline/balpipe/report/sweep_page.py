@@ -52,13 +52,11 @@ def effort_unit(plan) -> str:
 def si_unit(vary) -> str:
     """The SI unit of a varied field's values in the table (the CSV's SI numbers): from the unit
     the vary is written in ('500 g:2 kg' -> kg); 'SI' when it is written without one."""
-    from ..units import SI, UNITS, _normalise_unit
+    from ..units import SI, kinds_of
 
-    if vary.unit:
-        u = _normalise_unit(vary.unit)
-        for kind, table in UNITS.items():
-            if u in table and SI.get(kind):
-                return SI[kind]
+    for kind in kinds_of(vary.unit) if vary.unit else ():
+        if SI.get(kind):
+            return SI[kind]
     return "SI"
 
 
