@@ -98,6 +98,7 @@ import pymunk
 
 from ..engine import Analysis
 from ..model import Model
+from .extend import continued, settling_steps
 from .run import SimulationRun, _model_scale, _relative_poses, _run_adaptive
 from .settings import MAX_ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings
 from .verdict import Verdict
@@ -278,6 +279,7 @@ def validate(
     """
     settings = settings or ValidationSettings()
     wall0 = time.perf_counter()
+    model = continued(model, analysis)
     dt_default, it_default = default_settings(model, analysis)
     dt_target = settings.dt or dt_default
     iterations = settings.iterations or it_default
@@ -296,7 +298,8 @@ def validate(
         settings.tolerance / 10.0 * (M0 if M0 > 0 else 1.0),
     )
     run, notes, change = _run_adaptive(
-        model, analysis, dt, iterations, settings, scale, idx, limit=limit, mass_floor=settings.mass_floor
+        model, analysis, dt, iterations, settings, scale, idx, limit=limit, mass_floor=settings.mass_floor,
+        settle=settling_steps(model, analysis, nsteps),
     )
     fden = F0 if F0 > 0 else 1.0
     mden = M0 if M0 > 0 else 1.0

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..engine import Analysis
 from ..model import FRAME, Gear, Model, Prismatic, Revolute
+from .extend import start_state
 from .settings import HEALTH_LIMIT, MAX_ITERATIONS, _jumps
 from .space import SimModel, build_space
 
@@ -88,6 +89,7 @@ def simulate(
     efforts: dict[str, np.ndarray] | None = None,
     measure_with: Model | None = None,
     abort: tuple[float, float] | None = None,
+    settle: int = 0,
     **build_options,
 ) -> SimulationRun:
     """Simulate ``model`` along ``analysis``' motion and measure the loads on the frame.
@@ -112,12 +114,15 @@ def simulate(
     ``abort`` = (limit, scale): stop with FloatingPointError as soon as a body, in the frame's
     coordinates, is more than ``limit`` (rad, or ``limit * scale`` m) from the analysed motion
     at an analysis sample (checked every tenth step): a run that came apart ends early.
+    ``settle``: steps run before t0 and not recorded (:func:`balpipe.validate.extend.settling_steps`:
+    a settling cycle of a periodic motion, a run-in of a motion moving at t0), from
+    :func:`balpipe.validate.extend.start_state`, so that the recorded steps are in steady state.
     """
     t = np.asarray(analysis.t, dtype=float)
     t0 = float(t[0])
     n = int(round((float(t[-1]) - t0) / dt))
     times = t0 + dt * np.arange(n + 1)
-    q0, v0, a0 = analysis.q[0], analysis.v[0], analysis.a[0]
+    q0, v0, a0 = start_state(model, analysis, settle, dt)
     vh = v0 - 0.5 * dt * a0
     qs = q0 - dt * vh
     gravity = (0.0, 0.0) if floating_base is not None else analysis.gravity
@@ -139,10 +144,11 @@ def simulate(
     names = [b.name for b in model.bodies]
     com = {FRAME: (0.0, 0.0), **{b.name: b.mass_properties()[1] for b in model.bodies}}
 
-    target_t = times + dt  # the step landing on times[k] starts at times[k] - dt: target t + 2 dt
+    every = t0 + dt * np.arange(-settle, n + 1)  # settling steps, then the recorded ones
+    target_t = every + dt  # the step landing on every[k] starts at every[k] - dt: target t + 2 dt
     targets = {d.name: np.asarray(d.law(target_t)[0], dtype=float) for d in model.drivers}
     laws_now = {d.name: np.asarray(d.law(times)[0], dtype=float) for d in model.drivers}
-    boost = np.zeros(n + 1, dtype=bool)
+    boost = np.zeros(settle + n + 1, dtype=bool)
     boost[:startup_steps] = True
     for k in _jumps(model, target_t):  # the solver restarts where a law's acceleration jumps
         boost[max(k - 1, 0) : k + startup_steps] = True
@@ -172,13 +178,18 @@ def simulate(
         on = np.abs(t0 + steps * dt - t) <= 1e-9 * max(float(t[-1] - t0), 1e-12)
         check = {int(k): i for i, k in enumerate(steps) if on[i] and k % 10 == 0}
     start = time.perf_counter()
-    for k in range(n + 1):
-        space.iterations = startup_iterations if boost[k] else iterations
-        sim.prepare({name: v[k] for name, v in targets.items()}, dt)
+    for step in range(settle + n + 1):
+        space.iterations = startup_iterations if boost[step] else iterations
+        sim.prepare({name: v[step] for name, v in targets.items()}, dt)
+        k = step - settle
         if efforts is not None:
             for act in sim.actuators:
-                act.apply(float(efforts[act.name][k]), dt)
+                act.apply(float(efforts[act.name][max(k, 0)]), dt)
         space.step(dt)
+        if k < 0:
+            if k == -1:
+                px0, py0, h0 = momenta(bodies, m, inertia)
+            continue
         px, py, h = momenta(bodies, m, inertia)
         gm = 0.0
         if g.any():

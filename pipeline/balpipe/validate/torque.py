@@ -48,6 +48,7 @@ from ..engine import Analysis, analyse
 from ..model import Attachment, Model
 from .loads import _on_grid  # the same sampling of the loads as the position-driven check
 from .run import SimulationRun, simulate
+from .extend import continued
 from .settings import ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings
 from .space import build_space
 from .verdict import Verdict
@@ -175,7 +176,9 @@ def torque_driven(
     """
     settings = settings or ValidationSettings()
     wall0 = time.perf_counter()
-    analytic_model = analytic_model or model
+    distinct = analytic_model is not None and analytic_model is not model
+    model = continued(model, analysis)
+    analytic_model = continued(analytic_model, analysis) if distinct else model
     t = np.asarray(analysis.t, dtype=float)
     dt_default, it_default = default_settings(model, analysis)
     dt, nsteps, idx = _step_grid(t, dt or settings.dt or dt_default)
@@ -184,7 +187,7 @@ def torque_driven(
     times = float(t[0]) + dt * np.arange(n + 1)
     sim_model, floored = floored_model(model, settings.mass_floor)
     effort_model = sim_model
-    if analytic_model is not model:  # the analytic model with the simulated mechanism's floor parts
+    if distinct:  # the analytic model with the simulated mechanism's floor parts
         effort_model = analytic_model
         for b in sim_model.bodies:
             extra = [a for a in b.attachments if a.name == "pymunk floor"]
