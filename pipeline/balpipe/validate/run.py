@@ -284,7 +284,8 @@ def _gear_models(model: Model, floating: bool) -> list[str | None]:
 
 
 def _run_adaptive(
-    model, analysis, dt, iterations, settings, scale, idx, limit=None, max_iterations=None, accept=None, **kw
+    model, analysis, dt, iterations, settings, scale, idx, limit=None, max_iterations=None, accept=None, passes=None,
+    **kw,
 ) -> tuple[SimulationRun | None, list[str], tuple[float, float]]:
     """Run with solver iterations doubled until the measured loads stop changing.
 
@@ -300,7 +301,10 @@ def _run_adaptive(
     balance claims hold, since more solver iterations move the loads towards the exact solution
     and cannot turn it into a failure (see :mod:`balpipe.validate.loads`). Returns the run (None
     if none held together), notes and the last change (force, moment) between doublings (NaN
-    when a run was accepted without one)."""
+    when a run was accepted without one). ``passes(run) -> bool``: when a gear model's best run
+    passes the verdict without having converged, the next gear model (the explicit carrier, which
+    lags where the carrier's acceleration jumps) is not tried: it could only replace a passing
+    run by its own."""
     notes: list[str] = []
     t = np.asarray(analysis.t, dtype=float)
     floating = kw.get("floating_base") is not None
@@ -351,6 +355,10 @@ def _run_adaptive(
                 break
             prev = run if healthy else None
             it *= 2
+        if passes is not None and best is not None and best[3] == gm and gm != models[-1] and passes(best[1]):
+            # another gear model could only replace a passing run by its own (less accurate) one
+            notes.append(f"the best run{label} passes: no other gear model tried")
+            break
     if best is None:
         return None, notes, (math.inf, math.inf)
     _, run, change, gm = best
