@@ -23,7 +23,9 @@ from balpipe import registry
 from balpipe.engine import analyse
 from balpipe.loader import load
 from balpipe.validate import ValidationSettings, validate
-from test_validate import GRID, arm_2r, reactionless_arm
+from balpipe.validate.settings import ITERATIONS
+from balpipe.validate.torque import torque_driven_economic
+from test_validate import GRID, arm_2r, force_balanced_arm, reactionless_arm
 
 IDLER = Path(__file__).resolve().parents[1] / "specs" / "paper000_rpr3_idler_loop.yaml"
 
@@ -72,3 +74,33 @@ def test_one_percent_inertia_error_on_the_idler_loop_fails():
     off = _inertia_scaled(full, heaviest.name, 1.01)
     v, effect = _check_power(off, claimed, (first.max_force, first.max_moment), t, ValidationSettings(dt=2.5e-4))
     assert not v.passed
+
+
+def test_early_acceptance_keeps_the_verdict_with_fewer_iterations():
+    model = reactionless_arm()
+    a = analyse(model, GRID)
+    un = analyse(arm_2r(), GRID)
+    peaks = (un.max_force, un.max_moment)
+    fast = validate(model, a, peaks, expect=("force", "moment"))
+    full = validate(model, a, peaks, ValidationSettings(early_accept=False), expect=("force", "moment"))
+    assert fast.passed and full.passed
+    assert fast.iterations < full.iterations  # one run instead of a doubling chain
+    assert max(fast.force_residual, fast.moment_residual) <= 1e-3  # kept because it passes ten times over
+    # a design 10 % off is never accepted early: the same converged run as without early acceptance
+    off = force_balanced_arm(1.1)
+    claimed = analyse(force_balanced_arm(), GRID)
+    v1 = validate(off, claimed, peaks)
+    v2 = validate(off, claimed, peaks, ValidationSettings(early_accept=False))
+    assert not v1.passed and not v2.passed
+    assert v1.iterations == v2.iterations and v1.force_residual == v2.force_residual
+
+
+def test_torque_driven_run_tries_the_cheap_solver_effort_first():
+    model = reactionless_arm()
+    a = analyse(model, GRID)
+    settings = ValidationSettings()
+    cheap = torque_driven_economic(model, a, settings, dt=1e-3, iterations=800)
+    assert cheap.passed and cheap.iterations == ITERATIONS
+    assert cheap.tracking_error_max <= settings.tracking_tolerance / 10
+    full = torque_driven_economic(model, a, ValidationSettings(early_accept=False), dt=1e-3, iterations=800)
+    assert full.passed and full.iterations == 800
