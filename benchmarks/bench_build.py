@@ -49,7 +49,6 @@ WRAPS = [
     ("balpipe.study", "run_stage_analyses", "analyse"),
     ("balpipe.validation_stage", "validate", "validate"),
     ("balpipe.validation_stage", "torque_driven", "torque"),
-    ("balpipe.validation_stage", "torque_driven_economic", "torque"),
     ("balpipe.validation_stage", "free_floating", "reactionless"),
     ("balpipe.report.page", "study_figures", "figures"),
     ("balpipe.build", "render_page", "page"),

@@ -24,7 +24,7 @@ from balpipe.engine import analyse
 from balpipe.loader import load
 from balpipe.validate import ValidationSettings, validate
 from balpipe.validate.settings import ITERATIONS
-from balpipe.validate.torque import torque_driven_economic
+from balpipe.validate.torque import torque_driven
 from test_validate import GRID, arm_2r, force_balanced_arm, reactionless_arm
 
 IDLER = Path(__file__).resolve().parents[1] / "specs" / "paper000_rpr3_idler_loop.yaml"
@@ -99,8 +99,8 @@ def test_torque_driven_run_tries_the_cheap_solver_effort_first():
     model = reactionless_arm()
     a = analyse(model, GRID)
     settings = ValidationSettings()
-    cheap = torque_driven_economic(model, a, settings, dt=1e-3, iterations=800)
+    cheap = torque_driven(model, a, settings, economic=True, dt=1e-3, iterations=800)
     assert cheap.passed and cheap.iterations == ITERATIONS
     assert cheap.tracking_error_max <= settings.tracking_tolerance / 10
-    full = torque_driven_economic(model, a, ValidationSettings(early_accept=False), dt=1e-3, iterations=800)
+    full = torque_driven(model, a, ValidationSettings(early_accept=False), economic=True, dt=1e-3, iterations=800)
     assert full.passed and full.iterations == 800

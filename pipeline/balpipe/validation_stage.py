@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from .study import Study, ratio_reference
 from .validate import FreeFloating, ValidationSettings, free_floating, validate
 from .validate.run import _model_scale
-from .validate.torque import torque_driven_economic
+from .validate.torque import torque_driven
 
 #: mass of the free-floating frame (kg)
 BASE_MASS = 10.0
@@ -107,8 +107,8 @@ def simulate_study(study: Study) -> None:
                 f"pymunk validation of stage {s.stage.name!r} fails: {'; '.join(s.validation.reasons)}"
             )
         # the inverse dynamics: the engine's efforts drive the mechanism (same step and solver effort)
-        s.torque = torque_driven_economic(
-            s.stage.model, s.analysis, settings, reference=(ref.force, ref.moment),
+        s.torque = torque_driven(
+            s.stage.model, s.analysis, settings, economic=True, reference=(ref.force, ref.moment),
             dt=s.validation.dt, iterations=s.validation.iterations,
         )
         if not s.torque.passed:

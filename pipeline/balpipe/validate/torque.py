@@ -154,7 +154,7 @@ def _travel(model: Model, t: np.ndarray) -> dict[str, float]:
     return out
 
 
-def torque_driven(
+def _torque_driven_once(
     model: Model,
     analysis: Analysis,
     settings: ValidationSettings | None = None,
@@ -273,28 +273,33 @@ def torque_driven(
     )
 
 
-def torque_driven_economic(
+
+def torque_driven(
     model: Model,
     analysis: Analysis,
-    settings: ValidationSettings,
+    settings: ValidationSettings | None = None,
     *,
-    reference: tuple[float, float] | None = None,
-    dt: float | None = None,
-    iterations: int | None = None,
+    economic: bool = False,
+    **kw,
 ) -> TorqueDriven:
-    """:func:`torque_driven` first with :data:`ITERATIONS` solver iterations, kept when it passes
-    by ten times over (tracking error at most a tenth of ``tracking_tolerance``, resolution at
-    least ten times :data:`MIN_RESOLUTION`); otherwise, or without ``settings.early_accept``,
-    the run with ``iterations`` (the position-driven validation's), as before. On the idler
-    loop's counterweights stage both give a tracking error of 6.2e-6 of the travel; 100
-    iterations take a sixth of the time of 3200."""
+    """The torque-driven run (:func:`_torque_driven_once`, whose keywords it takes).
+
+    ``economic``: first with :data:`ITERATIONS` solver iterations, kept when it passes by ten
+    times over (tracking error at most a tenth of ``tracking_tolerance``, resolution at least
+    ten times :data:`MIN_RESOLUTION`); otherwise the run with ``iterations`` (the position-driven
+    validation's), as without. Tried only with ``settings.early_accept`` and when ``iterations``
+    is at least four times :data:`ITERATIONS` (a failed try adds its cost). On the idler loop's
+    counterweights stage both give a tracking error of 6.2e-6 of the travel; 100 iterations take
+    a sixth of the time of 3200."""
+    settings = settings or ValidationSettings()
+    iterations = kw.get("iterations")
     first = None
-    if settings.early_accept and iterations is not None and iterations > ITERATIONS:
-        first = torque_driven(model, analysis, settings, reference=reference, dt=dt, iterations=ITERATIONS)
+    if economic and settings.early_accept and iterations is not None and iterations >= 4 * ITERATIONS:
+        first = _torque_driven_once(model, analysis, settings, **{**kw, "iterations": ITERATIONS})
         if (first.passed and first.tracking_error_max <= settings.tracking_tolerance / 10.0
                 and first.resolution >= 10.0 * MIN_RESOLUTION):
             return first
-    r = torque_driven(model, analysis, settings, reference=reference, dt=dt, iterations=iterations)
+    r = _torque_driven_once(model, analysis, settings, **kw)
     if first is not None:
         r.timing["total_s"] = r.timing.get("total_s", 0.0) + first.timing.get("total_s", 0.0)
     return r
