@@ -1,0 +1,51 @@
+"""benchmarks/bench_build.py: phases of a cold build, per spec and in total, against a revision."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _bench():
+    spec = importlib.util.spec_from_file_location("bench_build", ROOT / "benchmarks" / "bench_build.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_table_sums_the_phases_and_gives_ratios():
+    b = _bench()
+    res = {
+        "a": {"this": {"rc": 0, "times": {"validate": 1.0, "figures": 2.0, "total": 4.0}},
+              "old": {"rc": 0, "times": {"validate": 4.0, "figures": 2.0, "total": 8.0}}},
+        "b": {"this": {"rc": 0, "times": {"validate": 1.0, "total": 2.0}},
+              "old": {"rc": 1, "times": {"validate": 1.0, "total": 2.0}}},
+    }
+    out = b.table(res, ["this", "old"])
+    rows = {tuple(line.split()[:2]): line.split()[2:] for line in out.splitlines()[1:] if line.strip()}
+    assert rows[("a", "validate")] == ["1.000", "4.000", "0.250"]
+    assert rows[("TOTAL", "validate")] == ["2.000", "5.000", "0.400"]
+    assert rows[("TOTAL", "total")] == ["6.000", "10.000", "0.600"]
+    assert ("a", "torque") not in rows  # phases that took no time in either version are left out
+    assert any(line.split()[-2:] == ["0", "1"] for line in out.splitlines() if "status" in line)
+
+
+def test_specs_by_name_or_path():
+    b = _bench()
+    assert b.resolve_specs(["scott_russell"], ROOT) == [ROOT / "specs" / "scott_russell.yaml"]
+    assert ROOT / "specs" / "six_bar_constant_speed.yaml" in b.resolve_specs(None, ROOT)
+
+
+def test_one_cold_build_is_timed_by_phase(tmp_path):
+    b = _bench()
+    res = b.run_one(sys.executable, ROOT / "pipeline", ROOT / "specs" / "scott_russell.yaml", tmp_path / "site",
+                    ["--no-sim"])
+    t = res["times"]
+    assert res["rc"] == 0 and (tmp_path / "site" / "scott_russell" / "results.json").exists()
+    assert t["load"] > 0 and t["analyse"] > 0 and t["figures"] > 0 and t["write"] > 0
+    assert "validate" not in t  # --no-sim
+    parts = sum(v for k, v in t.items() if k != "total")
+    assert abs(parts - t["total"]) < 1e-6 * t["total"]  # the phases and `other` make up the total
