@@ -12,6 +12,7 @@ still fails.
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 from pathlib import Path
 
@@ -153,3 +154,21 @@ def test_periodic_continuation_repeats_with_the_travel():
     t = np.array([-0.4, 0.6, 1.3])
     q, v, _ = c(t)
     assert np.allclose(q, w * t, rtol=1e-12) and np.allclose(v, w)
+
+
+def test_stages_simulated_in_parallel_give_the_same_results(tmp_path):
+    from balpipe.validation_stage import simulate_study
+
+    text = SIX_BAR.read_text().replace("analysis:", "validation:\n  reactionless: true\nanalysis:")
+    p = tmp_path / "six.yaml"
+    p.write_text(text)
+    one, two = _study(p), _study(p)
+    simulate_study(one)
+    simulate_study(two, workers=2)
+    assert one.problems == two.problems
+    for a, b in zip(one.stages, two.stages):
+        assert a.validation.to_json() == b.validation.to_json()
+        assert a.torque.to_json() == b.torque.to_json()
+        assert np.array_equal(a.validation.force, b.validation.force)
+    # (json: NaN fields compare equal as text)
+    assert json.dumps(one.reactionless.to_json(), sort_keys=True) == json.dumps(two.reactionless.to_json(), sort_keys=True)

@@ -90,42 +90,77 @@ class Reactionless:
         ])
 
 
-def simulate_study(study: Study) -> None:
-    """Validate every stage; failures become problems of the study (the build exits 1)."""
+#: the study being simulated, for forked workers (:func:`_parallel`): inherited, not pickled
+_FORKED: Study | None = None
+
+
+def _stage_runs(k: int, study: Study | None = None):
+    """Validation and torque-driven run of stage ``k`` (relative to the unbalanced inertial peaks
+    (the shaking loads' peaks without gravity) of the stage's own reference (Stage.reference: with
+    several trajectories, that trajectory's unbalanced stage; else the first stage), floored by
+    that model's gross inertial loads (balpipe.load_reference): the same denominators as the
+    stage's ratios)."""
+    study = study or _FORKED
     settings = settings_for(study)
-    for s in study.stages:
-        # relative to the unbalanced inertial peaks (the shaking loads' peaks without gravity) of
-        # the stage's own reference (Stage.reference: with several trajectories, that trajectory's
-        # unbalanced stage; else the first stage), floored by that model's gross inertial loads
-        # (balpipe.load_reference): the same denominators as the stage's ratios
-        ref = ratio_reference(study.reference_stage(s))
-        F0, M0 = ref.force_peak, ref.moment_peak
-        expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
-        s.validation = validate(s.stage.model, s.analysis, (F0, M0), settings, expect, reference=ref)
-        if not s.validation.passed:
-            study.problems.append(
-                f"pymunk validation of stage {s.stage.name!r} fails: {'; '.join(s.validation.reasons)}"
-            )
-        # the inverse dynamics: the engine's efforts drive the mechanism (same step and solver effort)
-        s.torque = torque_driven(
-            s.stage.model, s.analysis, settings, economic=True, reference=(ref.force, ref.moment),
-            dt=s.validation.dt, iterations=s.validation.iterations,
-        )
-        if not s.torque.passed:
-            study.problems.append(
-                f"torque-driven run of stage {s.stage.name!r} fails: {'; '.join(s.torque.reasons)}"
-            )
+    s = study.stages[k]
+    ref = ratio_reference(study.reference_stage(s))
+    F0, M0 = ref.force_peak, ref.moment_peak
+    expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
+    v = validate(s.stage.model, s.analysis, (F0, M0), settings, expect, reference=ref)
+    # the inverse dynamics: the engine's efforts drive the mechanism (same step and solver effort)
+    tq = torque_driven(
+        s.stage.model, s.analysis, settings, economic=True, reference=(ref.force, ref.moment),
+        dt=v.dt, iterations=v.iterations,
+    )
+    return v, tq
+
+
+def _floating_run(k: int, base_inertia: float, settings: ValidationSettings | None,
+                  study: Study | None = None) -> FreeFloating:
+    s = (study or _FORKED).stages[k]
+    return free_floating(s.stage.model, s.analysis, BASE_MASS, base_inertia, settings=settings)
+
+
+def _parallel(study: Study, workers: int, fn, args: list[tuple]) -> list:
+    """``fn(*a)`` for every ``a`` of ``args``, in that order; in ``workers`` forked processes
+    when more than one (each runs whole simulations, which are deterministic: the results do
+    not depend on ``workers``)."""
+    if workers <= 1 or len(args) <= 1:
+        return [fn(*a, study) for a in args]
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    global _FORKED
+    _FORKED = study
+    try:
+        ctx = multiprocessing.get_context("fork")
+        with ProcessPoolExecutor(max_workers=min(workers, len(args)), mp_context=ctx) as pool:
+            return list(pool.map(fn, *zip(*args)))
+    finally:
+        _FORKED = None
+
+
+def simulate_study(study: Study, workers: int = 1) -> None:
+    """Validate every stage; failures become problems of the study (the build exits 1).
+    ``workers`` > 1: the stages' simulations run in that many forked processes (for a build that
+    leaves cores free); the results, and the order of the problems, are the same."""
+    runs = _parallel(study, workers, _stage_runs, [(k,) for k in range(len(study.stages))])
+    for s, (v, tq) in zip(study.stages, runs):
+        s.validation, s.torque = v, tq
+        if not v.passed:
+            study.problems.append(f"pymunk validation of stage {s.stage.name!r} fails: {'; '.join(v.reasons)}")
+        if not tq.passed:
+            study.problems.append(f"torque-driven run of stage {s.stage.name!r} fails: {'; '.join(tq.reasons)}")
     if reactionless_enabled(study):
-        study.reactionless = reactionless_runs(study, settings)
+        study.reactionless = reactionless_runs(study, settings_for(study), workers=workers)
 
 
-def reactionless_runs(study: Study, settings: ValidationSettings | None = None) -> Reactionless:
+def reactionless_runs(study: Study, settings: ValidationSettings | None = None, workers: int = 1) -> Reactionless:
     """Every stage on the same free-floating frame: mass BASE_MASS, the inertia of a square
     plate reaching the farthest centre of mass of any stage."""
     reach = max(_model_scale(s.analysis) for s in study.stages)
     base_inertia = (2.0 / 3.0) * BASE_MASS * reach**2
-    runs = [free_floating(s.stage.model, s.analysis, BASE_MASS, base_inertia, settings=settings)
-            for s in study.stages]
+    runs = _parallel(study, workers, _floating_run, [(k, base_inertia, settings) for k in range(len(study.stages))])
     return Reactionless(
         [s.stage.label for s in study.stages], [s.stage.name for s in study.stages], runs,
         [s.stage.model for s in study.stages],
