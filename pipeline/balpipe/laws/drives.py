@@ -452,13 +452,16 @@ def drive_laws(name: str, drive: Any, dims: dict[str, str], motion: Any) -> dict
     return {name: scalar_law(drive, dims[name], path, motion.duration)}
 
 
-def point_laws(name: str, drive: Any, motion: Any) -> tuple[Law, Law] | None:
-    """x and y laws of a template's point drive (a five-bar's gripper) on a path, or None when
-    the drive is not a path."""
+def path_laws(name: str, drive: Any, motion: Any, n: int) -> tuple[Law, ...] | None:
+    """The first ``n`` component laws (x, y and, for n = 3, the angle) of a template's point or
+    pose drive (a five-bar's gripper, a serial arm's tip) on a path, or None when the drive is not
+    a path."""
     if not isinstance(drive, PathDrive):
         return None
+    if drive.components is not None:
+        raise SpecFieldError(("motion", "drive", name, "components"), f"{name!r} is the point itself: leave out components")
     pm = path_motion(drive, ("motion", "drive", name), motion.duration)
-    return geometry.PathComponent(pm, 0), geometry.PathComponent(pm, 1)
+    return tuple(geometry.PathComponent(pm, k) for k in range(n))
 
 
 def read_tables(spec: Any, folder: FilePath) -> None:
