@@ -122,6 +122,9 @@ class AnalysisSettings(Strict):
         1e-9,
         description="a stage counts as balanced when its peak is below this fraction of the reference load (the unbalanced peak, floored by 1 % of the gross inertial load)",
     )
+    claim_tolerance: dict[str, number(gt=0, lt=1)] = Field(
+        {}, description="the tolerance of a stage's claims by stage name (default: balance_tolerance for computed "
+        "designs; for stages typed by hand, balance_tolerance plus what the rounding of their numbers allows)")
 
 
 class ValidationSpec(Strict):

@@ -40,7 +40,7 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     tol = spec.analysis.balance_tolerance
     stages = []
     for s in study.stages:
-        m = stage_metrics(s, study.reference_stage(s), tol)
+        m = stage_metrics(s, study.reference_stage(s), tol, spec.analysis.claim_tolerance)
         stages.append(m)
     validation = {}
     for s in study.stages:
