@@ -209,3 +209,18 @@ validation: {enabled: false}
     assert tip[0] == pytest.approx([0.2, 0.3], abs=1e-9) and tip[-1] == pytest.approx([0.35, 0.15], abs=1e-9)
     # the corner is cut by the fillet: the tip never reaches (0.35, 0.3)
     assert np.min(np.hypot(tip[:, 0] - 0.35, tip[:, 1] - 0.3)) > 0.005
+
+
+def test_a_changed_table_rebuilds_the_page(tmp_path, capsys):
+    spec = write(tmp_path, """\
+        duration: 2 s
+        drive:
+          crank: {law: table, file: crank.csv, ends: periodic}
+    """, _csv())
+    out = str(tmp_path / "site")
+    assert main(["build", str(spec), "-o", out, "--no-sim", "-j", "1"]) == 0
+    assert main(["build", str(spec), "-o", out, "--no-sim", "-j", "1"]) == 0
+    assert "unchanged" in capsys.readouterr().err
+    (tmp_path / "crank.csv").write_text(_csv(n=101))
+    assert main(["build", str(spec), "-o", out, "--no-sim", "-j", "1"]) == 0
+    assert "unchanged" not in capsys.readouterr().err

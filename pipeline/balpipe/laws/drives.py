@@ -477,6 +477,13 @@ def read_tables(spec: Any, folder: FilePath) -> None:
                 raise SpecFieldError(sub + ("file",), f"cannot read the table {d.file!r}: {reason}") from None
 
 
+def table_texts(spec: Any) -> str:
+    """The text of every table the spec reads, for the build's input hash ("" without tables, so
+    the hash of a spec without tables is unchanged): a changed CSV rebuilds the page."""
+    return "".join(f"\0table {d.file}\0{d._text}" for name, drive in spec.motion.drive.items()
+                   for _, d in _tables(drive, ()))
+
+
 def _tables(drive: Any, path: tuple):
     if isinstance(drive, TableDrive):
         yield path, drive
