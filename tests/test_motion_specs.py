@@ -10,6 +10,7 @@ from pathlib import Path
 import balpipe  # noqa: F401
 import numpy as np
 import pytest
+import yaml
 
 from balpipe import registry
 from balpipe.cli import main
@@ -224,3 +225,24 @@ def test_a_changed_table_rebuilds_the_page(tmp_path, capsys):
     (tmp_path / "crank.csv").write_text(_csv(n=101))
     assert main(["build", str(spec), "-o", out, "--no-sim", "-j", "1"]) == 0
     assert "unchanged" not in capsys.readouterr().err
+
+
+def test_a_path_on_the_3rpr_platform_pose(tmp_path):
+    """The 3-RPR's platform x, y, phi fed by one path with heading: the platform's angle follows
+    the tangent of an arc (plus an offset), and the engine's platform pose follows the path."""
+    text = (ROOT / "specs" / "paper000_rpr3_idler_loop.yaml").read_text()
+    data = yaml.safe_load(text)
+    data["motion"] = {"duration": 0.5, "drive": {"platform": {
+        "law": "path", "components": ["x", "y", "phi"], "heading": True, "angle": "-80 deg",
+        "path": {"type": "arc", "centre": [-0.1, 0.0], "radius": 0.05, "from": "-90 deg", "to": "0 deg"},
+        "timing": {"law": "cycloidal"}}}}
+    data["validation"] = {"enabled": False}
+    data.pop("references", None)
+    p = tmp_path / "rpr3.yaml"
+    p.write_text(yaml.safe_dump(data))
+    study = run(load(p).spec)
+    an = study.unbalanced.analysis
+    pose = an.extra["frame_pose"][:, an.names.index("platform")]
+    assert pose[0, :2] == pytest.approx([-0.1, -0.05], abs=1e-9) and pose[-1, :2] == pytest.approx([-0.05, 0.0], abs=1e-9)
+    # heading: tangent of a counter-clockwise arc at angle a is a + 90 deg, plus the -80 deg offset
+    assert pose[0, 2] == pytest.approx(math.radians(-90 + 90 - 80)) and pose[-1, 2] == pytest.approx(math.radians(0 + 90 - 80))
