@@ -246,3 +246,32 @@ def test_a_path_on_the_3rpr_platform_pose(tmp_path):
     assert pose[0, :2] == pytest.approx([-0.1, -0.05], abs=1e-9) and pose[-1, :2] == pytest.approx([-0.05, 0.0], abs=1e-9)
     # heading: tangent of a counter-clockwise arc at angle a is a + 90 deg, plus the -80 deg offset
     assert pose[0, 2] == pytest.approx(math.radians(-90 + 90 - 80)) and pose[-1, 2] == pytest.approx(math.radians(0 + 90 - 80))
+
+
+def test_point_and_pose_drives_of_templates(tmp_path, capsys):
+    """The n-RRR's platform on a path (pose with heading); a five-bar's gripper on a law that is
+    not a path, and a path on the gear-coupled five-bar: located errors."""
+    data = yaml.safe_load((ROOT / "specs" / "paper001_4rrr.yaml").read_text())
+    start = data["motion"]["drive"]["platform"]["from"]
+    data["motion"] = {"duration": 1, "drive": {"platform": {
+        "law": "path", "path": {"type": "line", "from": start[:2], "to": [0.02, 0.02]}, "timing": {"law": "quintic"},
+        "angle": start[2]}}}
+    data["validation"] = {"enabled": False}
+    data.pop("references", None)
+    data["balancing"] = {"method": "none"}
+    p = tmp_path / "rrr4.yaml"
+    p.write_text(yaml.safe_dump(data))
+    an = run(load(p).spec).unbalanced.analysis
+    assert np.isfinite(an.max_force) and an.max_force > 0
+    five = yaml.safe_load((ROOT / "specs" / "paper004_five_bar.yaml").read_text())
+    five["motion"] = {"duration": 1, "drive": {"gripper": {"law": "constant_speed", "speed": 1}}}
+    five.pop("references", None)
+    p = tmp_path / "five.yaml"
+    p.write_text(yaml.safe_dump(five))
+    assert main(["check", str(p)]) == 2
+    assert "motion.drive.gripper.law: 'gripper' is a point or a pose" in capsys.readouterr().err
+    five["motion"]["drive"]["gripper"] = {"law": "path", "path": {"type": "circle", "centre": [0, 0.45], "radius": 0.05},
+                                          "timing": {"law": "quintic"}}
+    p.write_text(yaml.safe_dump(five))
+    assert main(["check", str(p)]) == 2
+    assert "a path needs the plain five-bar" in capsys.readouterr().err

@@ -454,10 +454,13 @@ def drive_laws(name: str, drive: Any, dims: dict[str, str], motion: Any) -> dict
 
 def path_laws(name: str, drive: Any, motion: Any, n: int) -> tuple[Law, ...] | None:
     """The first ``n`` component laws (x, y and, for n = 3, the angle) of a template's point or
-    pose drive (a five-bar's gripper, a serial arm's tip) on a path, or None when the drive is not
-    a path."""
-    if not isinstance(drive, PathDrive):
+    pose drive (a five-bar's gripper, a serial arm's tip, an n-RRR's platform) on a path, or None
+    for a point-to-point drive (from, to); another law is a located error."""
+    if drive is None or isinstance(drive, DriveSpec):
         return None
+    if not isinstance(drive, PathDrive):
+        raise SpecFieldError(("motion", "drive", name, "law"), f"{name!r} is a point or a pose: give from and to "
+                             f"(a point-to-point law) or law: path, not law: {drive.law}")
     if drive.components is not None:
         raise SpecFieldError(("motion", "drive", name, "components"), f"{name!r} is the point itself: leave out components")
     pm = path_motion(drive, ("motion", "drive", name), motion.duration)

@@ -109,8 +109,11 @@ class FiveBarMechanism(Strict):
     def laws(self, motion) -> dict[str, Law]:
         """Fixed-sequence: {"theta1": CoupledInput}; plain: {"gripper_x", "gripper_y"} (on a
         path when motion.drive.gripper has law: path, see balpipe.laws)."""
-        on_path = path_laws("gripper", motion.drive.get("gripper"), motion, 2) if self.coupling is None else None
+        on_path = path_laws("gripper", motion.drive.get("gripper"), motion, 2)
         if on_path is not None:
+            if self.coupling is not None:
+                raise SpecFieldError(GRIPPER_PATH + ("law",), "the fixed-sequence five-bar moves its gripper between "
+                                     "two positions (from, to); a path needs the plain five-bar (no coupling)")
             return {"gripper_x": on_path[0], "gripper_y": on_path[1]}
         start, end = gripper_positions(motion)
         if self.coupling is None:
