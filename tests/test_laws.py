@@ -9,12 +9,16 @@ import math
 import balpipe  # noqa: F401
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from balpipe.laws import paths
 from balpipe.laws.cycle import Cycle, joins
 from balpipe.laws.periodic import Cam, ConstantSpeed, Fourier, cam_jumps
 from balpipe.laws.table import Table, TableError, Tabulated, parse_table
+from balpipe.laws.drives import CycleDrive, cycle_law
 from balpipe.motion import PROFILES, PointToPoint, Polynomial
+from balpipe.spec_parts import SpecFieldError
 
 
 def assert_derivatives(law, t0: float, t1: float, n: int = 40001, skip_jumps: bool = False):
@@ -183,3 +187,34 @@ def test_path_motion_derivatives_and_circle_laps(seed):
     timed = paths.PathMotion(g, PointToPoint(0.0, g.length, 1.0, PROFILES["quintic"]))
     for k in range(2):  # the acceleration jumps where the curvature does: skip those samples
         assert_derivatives(paths.PathComponent(timed, k), 0.0, 1.0, n=80001, skip_jumps=True)
+
+
+SEGMENT = st.one_of(
+    st.builds(lambda law, T, by: {"law": law, "duration": T, "by": by},
+              st.sampled_from(["quintic", "cycloidal", "bang_bang", "trapezoidal"]), st.floats(0.05, 1), st.floats(-3, 3)),
+    st.builds(lambda T: {"law": "dwell", "duration": T}, st.floats(0.05, 1)),
+    st.builds(lambda T, w: {"law": "constant_speed", "duration": T, "speed": w}, st.floats(0.05, 1), st.floats(-5, 5)),
+    st.builds(lambda T, by: {"law": "polynomial", "duration": T, "by": by}, st.floats(0.05, 1), st.floats(-3, 3)),
+)
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(st.lists(SEGMENT, min_size=1, max_size=5), st.floats(-3, 3))
+def test_random_cycles_join_or_are_refused(segments, start):
+    """A cycle of random segments either joins up in position and velocity at every join (the
+    wrap-around included) or is refused at the segment after a velocity jump."""
+    drive = CycleDrive.model_validate({"law": "cycle", "from": start, "segments": segments})
+    try:
+        cyc = cycle_law(drive, "angle", ("motion", "drive", "q"))
+    except SpecFieldError as exc:
+        assert "velocity jumps" in exc.message and exc.path[-2] == "segments"
+        return
+    P = cyc.period
+    t = np.linspace(0, P, 4001)
+    q, qd, _ = cyc(t)
+    vs = max(float(np.max(np.abs(qd))), 1e-12)
+    for dq, dv, _ in joins(cyc):
+        assert abs(dq) <= 1e-9 * max(1.0, float(np.ptp(q))) and abs(dv) <= 1e-9 * vs
+    # the next cycle starts where this one ends, shifted by the displacement
+    a, b = cyc(np.array([P])), cyc(np.array([P * (1 + 1e-12) + 1e-12]))
+    assert abs(b[0][0] - a[0][0]) < 1e-6 * max(1.0, vs) and abs(b[1][0] - a[1][0]) < 1e-6 * vs
