@@ -110,3 +110,4 @@ def test_build_exit_0_and_results_state_the_tolerance(tmp_path, capsys):
     assert cw["force_balanced"] and cw["force_ratio"] <= cw["force_tolerance"] and math.isfinite(cw["force_tolerance"])
     page = (tmp_path / "site" / "crank" / "index.html").read_text()
     assert "judged at the tolerance" in page and "achieved" in page
+    assert "<dd>cycloidal law over 0.5 s" in page  # the drives' own law in the page's summary

@@ -256,6 +256,12 @@ Drive = Annotated[
 ]
 
 
+def law_names(motion: Any) -> str:
+    """The laws the drives use, for a page's summary ("quintic", "constant_speed and cam")."""
+    names = list(dict.fromkeys((getattr(d, "law", None) or motion.law) for d in motion.drive.values())) or [motion.law]
+    return " and ".join([", ".join(names[:-1]), names[-1]] if len(names) > 1 else names)
+
+
 def period(drive: Any) -> float | None:
     """The period of a periodic drive (None for a point-to-point or aperiodic one)."""
     if isinstance(drive, ConstantSpeedDrive):
