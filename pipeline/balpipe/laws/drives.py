@@ -26,6 +26,8 @@ from . import paths as geometry
 from .periodic import Cam, ConstantSpeed, Fourier, cam_jumps
 from .table import Tabulated, TableError, parse_table
 
+#: largest CSV table read (bytes)
+MAX_TABLE_BYTES = 20_000_000
 #: relative size of a state jump at a join that counts as a jump (of the segment's own scale)
 JOIN_TOLERANCE = 1e-9
 
@@ -480,6 +482,8 @@ def read_tables(spec: Any, folder: FilePath) -> None:
         for sub, d in _tables(drive, ("motion", "drive", name)):
             f = folder / d.file
             try:
+                if f.stat().st_size > MAX_TABLE_BYTES:
+                    raise SpecFieldError(sub + ("file",), f"the table {d.file!r} is larger than {MAX_TABLE_BYTES // 10**6} MB")
                 d._text = f.read_text(encoding="utf-8")
             except (OSError, UnicodeDecodeError) as exc:
                 reason = getattr(exc, "strerror", None) or str(exc)

@@ -88,7 +88,7 @@ def parse_table(text: str, dimension: str, time_column: str | None = None,
             tv, qv = float(cells[it]), float(cells[iv])
         except (ValueError, IndexError):
             raise TableError(f"expected numbers in the columns {header[it].strip()!r} and {header[iv].strip()!r}, "
-                             f"got {', '.join(cells)!r}", row) from None
+                             f"got {', '.join(cells)[:60]!r}", row) from None
         if not (np.isfinite(tv) and np.isfinite(qv)):
             raise TableError("not a finite number", row)
         if ts and not tv * factors[0] > ts[-1]:
