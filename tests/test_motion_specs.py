@@ -275,3 +275,25 @@ def test_point_and_pose_drives_of_templates(tmp_path, capsys):
     p.write_text(yaml.safe_dump(five))
     assert main(["check", str(p)]) == 2
     assert "a path needs the plain five-bar" in capsys.readouterr().err
+
+
+def test_a_serial_arms_tip_on_a_circle(tmp_path):
+    """The 2R arm's tip drive takes a path: the analysed tip follows the circle at its speed."""
+    data = {
+        "name": "2R tip on a circle",
+        "mechanism": {"template": "serial_arm", "links": [
+            {"length": 0.35, "mass": 1.6, "com": 0.175, "inertia": 0.0163},
+            {"length": 0.30, "mass": 0.9, "com": 0.15, "inertia": 0.00675}]},
+        "motion": {"cycles": 1, "drive": {"tip": {"law": "path", "timing": {"law": "constant_speed", "speed": "0.5 m/s"},
+                                                   "path": {"type": "circle", "centre": [0.3, 0.25], "radius": 0.08}}}},
+        "analysis": {"samples": 201}, "validation": {"enabled": False},
+    }
+    p = tmp_path / "arm.yaml"
+    p.write_text(yaml.safe_dump(data))
+    spec = load(p).spec
+    assert spec.motion.duration == pytest.approx(2 * math.pi * 0.08 / 0.5)
+    an = run(spec).unbalanced.analysis
+    pose = an.extra["frame_pose"][:, an.names.index("link2")]
+    tip = pose[:, :2] + 0.30 * np.stack([np.cos(pose[:, 2]), np.sin(pose[:, 2])], axis=1)
+    assert np.allclose(np.hypot(tip[:, 0] - 0.3, tip[:, 1] - 0.25), 0.08, atol=1e-9)
+    assert tip[0] == pytest.approx([0.38, 0.25], abs=1e-9) and tip[-1] == pytest.approx([0.38, 0.25], abs=1e-9)
