@@ -28,6 +28,7 @@ from importlib import resources
 from pathlib import Path
 
 from . import study as study_mod
+from .laws.drives import table_texts
 from .limits import check_finite, check_simulation
 from .loader import LoadedSpec, SpecError, SpecErrors, load, schema
 from .report import history_page
@@ -243,7 +244,7 @@ def build_one(path: Path, opts: Options) -> Outcome:
         loaded = load(path)
     except SpecErrors as exc:
         return Outcome(source, slug, "error", str(exc), spec_error=True, seconds=time.perf_counter() - start)
-    h = input_hash(loaded.text, opts)
+    h = input_hash(loaded.text + table_texts(loaded.spec), opts)  # the CSV tables it reads count too
     target = opts.out / slug
     h = history_page.mix_hash(h, target)  # a new history.json re-renders the page
     if not opts.force:

@@ -138,8 +138,8 @@ def compare(a: Side, b: Side) -> dict:
         row.update({"name": name, "unit": (x or y).unit, "source": (x or y).source})
         params.append(row)
     tol_a, tol_b = a.loaded.spec.analysis.balance_tolerance, b.loaded.spec.analysis.balance_tolerance
-    ma = {s.stage.name: stage_metrics(s, a.study.reference_stage(s), tol_a) for s in a.study.stages}
-    mb = {s.stage.name: stage_metrics(s, b.study.reference_stage(s), tol_b) for s in b.study.stages}
+    ma = {s.stage.name: stage_metrics(s, a.study.reference_stage(s), tol_a, a.loaded.spec.analysis.claim_tolerance) for s in a.study.stages}
+    mb = {s.stage.name: stage_metrics(s, b.study.reference_stage(s), tol_b, b.loaded.spec.analysis.claim_tolerance) for s in b.study.stages}
     stages = []
     for name in list(ma) + [n for n in mb if n not in ma]:
         row: dict[str, Any] = {"name": name}

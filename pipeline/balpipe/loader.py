@@ -17,6 +17,7 @@ from typing import Any
 import yaml
 from pydantic import ValidationError
 
+from .laws.drives import read_tables
 from .limits import check_limits
 from .spec import Spec
 from .spec_parts import SpecFieldError
@@ -382,6 +383,7 @@ def load_text(text: str, file: str) -> tuple[Spec, yaml.Node]:
         raise SpecErrors(sorted(unique, key=lambda e: (e.line or 0, e.column or 0))) from None
     try:
         check_limits(spec)
+        read_tables(spec, Path(file).parent)
     except SpecFieldError as exc:
         raise SpecErrors([_located(file, node, exc.path, exc.message)]) from None
     return spec, node

@@ -20,8 +20,9 @@ from .balancing import stages as generic_stages
 from .balancing.base import BalanceResult, Stage
 from .mechanisms import custom, five_bar, rpr3, rrr4, serial_arm, slider_crank
 from .model import Law, Model
+from .laws.drives import drive_laws
 from .motion import law_for
-from .spec_parts import SpecFieldError
+from .spec_parts import DriveSpec, SpecFieldError
 
 
 @dataclass(frozen=True)
@@ -109,6 +110,9 @@ def scalar_laws(motion: Any, dims: dict[str, str]) -> dict[str, Law]:
     out = {}
     for name, drive in motion.drive.items():
         path = ("motion", "drive", name)
+        if not isinstance(drive, DriveSpec):  # constant speed, cam, fourier, table, cycle, path
+            out.update(drive_laws(name, drive, dims, motion))
+            continue
         if name not in dims:
             raise SpecFieldError(path, f"unknown drive {name!r}; this mechanism drives: {', '.join(dims)}")
         values = []

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal, Union
 
-from pydantic import Field
+from pydantic import Field, PrivateAttr, model_validator
 
 from .balancing.com_planning import ComMotionPlanning
 from .balancing.decoupling import GearDecoupling
@@ -28,7 +28,8 @@ from .mechanisms.rpr3 import Rpr3Mechanism
 from .mechanisms.rrr4 import RRR4Mechanism
 from .mechanisms.serial_arm import SerialArmMechanism
 from .mechanisms.slider_crank import SliderCrankMechanism
-from .spec_parts import DriveSpec, Strict
+from .laws.drives import Drive, common_period, period
+from .spec_parts import Strict
 from .sweep_spec import SweepSpec
 from .units import Duration, Length, count, number, quantity
 
@@ -61,7 +62,9 @@ class Design(Strict):
 
 
 class Motion(Strict):
-    """Point-to-point motion of the driven coordinates, all on the same law and duration."""
+    """The motion of the driven coordinates: point-to-point laws on one duration, or the laws of
+    real machines (constant speed, cam, Fourier, table, cycle of segments, path; docs/motion.md)
+    over a duration or a number of cycles."""
 
     law: Literal["quintic", "cycloidal", "bang_bang", "trapezoidal", "polynomial"] = Field(
         "quintic",
@@ -69,14 +72,43 @@ class Motion(Strict):
         "trapezoidal: constant acceleration, cruise, deceleration; polynomial: the lowest-degree "
         "polynomial meeting the drives' boundary velocities and accelerations",
     )
-    duration: Duration = Field(description="duration of the motion")
+    duration: Duration | None = Field(None, description="duration of the motion (or give cycles)")
+    cycles: number(gt=0, le=10_000) | None = Field(
+        None, description="instead of duration: this many periods of the periodic drives (constant speed "
+        "in rpm or rad/s: one turn; cam, fourier: their period; cycle: the sum of its segments)")
     accel_fraction: number(gt=0, le=0.5) = Field(
         1 / 3, description="trapezoidal law: fraction of the duration spent accelerating"
     )
-    drive: dict[str, DriveSpec] = Field(
+    drive: dict[str, Drive] = Field(
         description="driven coordinates by name (the template lists them: e.g. crank, slider, "
-        "gripper) with their start and end"
+        "gripper) with their law: from/to on the point-to-point laws, or law: constant_speed, cam, "
+        "fourier, table, cycle, path"
     )
+    _period: float | None = PrivateAttr(None)
+
+    @model_validator(mode="after")
+    def _duration_from_cycles(self) -> "Motion":
+        periods = [p for p in (period(d) for d in self.drive.values()) if p is not None]
+        self._period = common_period(periods)
+        if self.cycles is not None and self.duration is not None:
+            raise ValueError("give either duration or cycles, not both")
+        if self.cycles is None and self.duration is None:
+            raise ValueError("give the duration of the motion (duration: 1 s) or a number of cycles of its periodic drives (cycles: 2)")
+        if self.cycles is not None:
+            if self._period is None:
+                raise ValueError(
+                    "cycles needs a periodic drive (constant speed in rpm or rad/s, cam, fourier, cycle, a closed "
+                    "path at constant speed)" if not periods else
+                    f"the periodic drives' periods ({', '.join(f'{p:.6g} s' for p in periods)}) have no common multiple "
+                    "among them: give the duration instead")
+            object.__setattr__(self, "duration", float(self.cycles * self._period))
+        return self
+
+    @property
+    def period(self) -> float | None:
+        """The common period of the periodic drives (s), None when no drive is periodic: a
+        motion of whole cycles lasts a multiple of it and is in steady state."""
+        return self._period
 
 
 class AnalysisSettings(Strict):
@@ -90,6 +122,9 @@ class AnalysisSettings(Strict):
         1e-9,
         description="a stage counts as balanced when its peak is below this fraction of the reference load (the unbalanced peak, floored by 1 % of the gross inertial load)",
     )
+    claim_tolerance: dict[str, number(gt=0, lt=1)] = Field(
+        {}, description="the tolerance of a stage's claims by stage name (default: balance_tolerance for computed "
+        "designs; for stages typed by hand, balance_tolerance plus what the rounding of their numbers allows)")
 
 
 class ValidationSpec(Strict):

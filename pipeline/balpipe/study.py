@@ -11,6 +11,7 @@ import numpy as np
 
 from . import realisable, registry
 from .balancing.base import BalanceResult, Stage
+from .claim_precision import claim_tolerances
 from .engine import Analysis, AnalysisError, analyse
 from .load_reference import LoadReference, load_reference
 from .spec import Spec
@@ -117,12 +118,16 @@ def ratio_reference(unbalanced: StageResult) -> LoadReference:
     return load_reference(unbalanced.stage.model, unbalanced.analysis)
 
 
-def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float) -> dict:
+def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float, overrides: dict | None = None) -> dict:
     """Peaks, ratios and balance of one stage. Ratios and the balance criterion use the inertial
     part of the loads (the shaking loads less the moving links' weight and its moment, which a
     force-balanced mechanism keeps constant); without gravity that is the loads themselves.
-    They divide by :func:`ratio_reference` (the unbalanced peaks, or their floor)."""
+    They divide by :func:`ratio_reference` (the unbalanced peaks, or their floor). The claims
+    are judged at the stage's own tolerances (:func:`balpipe.claim_precision.claim_tolerances`:
+    ``tol`` for computed designs, the precision of the entered numbers for designs typed by
+    hand, or ``overrides[stage]``)."""
     ref = ratio_reference(unbalanced)
+    claim = claim_tolerances(sr.stage, sr.stage.model, sr.analysis, ref, tol, overrides)
     F0, M0 = ref.force, ref.moment
     F, M = sr.analysis.max_inertial_force, sr.analysis.max_inertial_moment
     df, dm = sr.analysis.route_difference()
@@ -138,8 +143,11 @@ def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float) -> dict:
         "max_inertial_moment": M,
         "force_ratio": F / F0 if F0 > 0 else 0.0,
         "moment_ratio": M / M0 if M0 > 0 else 0.0,
-        "force_balanced": F <= tol * F0,
-        "moment_balanced": M <= tol * M0,
+        "force_balanced": F <= claim["force"] * F0,
+        "moment_balanced": M <= claim["moment"] * M0,
+        "force_tolerance": claim["force"],
+        "moment_tolerance": claim["moment"],
+        "tolerance_source": claim["source"],
         "max_actuator_effort": sr.max_effort,
         "added_mass": sr.added_mass,
         "added_inertia": sr.added_inertia,
@@ -205,7 +213,12 @@ def run(spec: Spec) -> Study:
     balance = registry.balance_designs(spec)
     stages = run_stage_analyses(spec, balance)
     tol = spec.analysis.balance_tolerance
-    metrics = [stage_metrics(s, reference_of(stages, s), tol) for s in stages]
+    overrides = spec.analysis.claim_tolerance
+    for name in overrides:
+        if name not in {s.stage.name for s in stages}:
+            raise SpecFieldError(("analysis", "claim_tolerance", name),
+                                 f"no stage {name!r} (stages: {', '.join(s.stage.name for s in stages)})")
+    metrics = [stage_metrics(s, reference_of(stages, s), tol, overrides) for s in stages]
     if balance.derived is not None:
         balance.parameters.extend(balance.derived(stages))
     problems = []
@@ -213,10 +226,16 @@ def run(spec: Spec) -> Study:
     if not rvm <= 1e-9 or not math.isfinite(rvm):
         problems.append(f"reactions and momentum disagree by {rvm:.3g} of the reference load (limit 1e-9)")
     for m in metrics:
-        if "force" in m["balances"] and not m["force_balanced"]:
-            problems.append(f"stage {m['name']!r} should cancel the shaking force but keeps {m['force_ratio']:.3g} of it")
-        if "moment" in m["balances"] and not m["moment_balanced"]:
-            problems.append(f"stage {m['name']!r} should cancel the shaking moment but keeps {m['moment_ratio']:.3g} of it")
+        for what in ("force", "moment"):
+            if what in m["balances"] and not m[f"{what}_balanced"]:
+                problems.append(f"stage {m['name']!r} should cancel the shaking {what} but keeps {m[f'{what}_ratio']:.3g} "
+                                f"of it (tolerance {m[f'{what}_tolerance']:.3g}: {m['tolerance_source']})")
+        claimed = [w for w in ("force", "moment") if w in m["balances"]]
+        if claimed and m["tolerance_source"] != "analysis.balance_tolerance":
+            balance.notes.append(f"Stage {m['label']!r}: its claim is judged at the tolerance " + ", ".join(
+                f"{m[f'{w}_tolerance']:.3g} of the reference {w} (achieved {m[f'{w}_ratio']:.3g})" for w in claimed)
+                + f", set by the {m['tolerance_source']}" + ("" if m["tolerance_source"] == "spec" else
+                " (each rounded at its last digit, the worst case carried through the loads)") + ".")
     worst = max(stages, key=lambda s: float(np.max(s.analysis.extra["condition"])))
     cond = worst.analysis.extra["condition"]
     k = int(np.argmax(cond))

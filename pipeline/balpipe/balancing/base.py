@@ -34,6 +34,8 @@ class Stage:
     balances: str = ""
     reference: str | None = None  # the stage its ratios refer to (default: the first stage)
     group: str = ""  # stages of one motion (a spec with several motions groups them, e.g. per trajectory)
+    tolerance: float | None = None  # the claims' tolerance set by the spec (default: balpipe.claim_precision)
+    rounding: tuple = ()  # balpipe.claim_precision.Rounding of the numbers entered by hand
 
 
 @dataclass(frozen=True)

@@ -10,9 +10,10 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
+from ..claim_precision import Rounding, half_unit
 from ..model import Attachment, Model
 from ..spec_parts import SpecFieldError, Strict
-from ..units import Inertia, Length, Mass, PositiveLength
+from ..units import Inertia, Length, Mass, PositiveLength, number
 from .base import BalanceResult, Stage
 from .force_balance import Point, _point
 from .moment_balance import CounterRotationSpec, add_discs, set_disc_inertias
@@ -48,6 +49,10 @@ class StageStep(Strict):
     parts: list[PartSpec] = Field([], description="parts added (or changed, by body and name)")
     remove: list[str] = Field([], description="parts removed, as body.name")
     counter_rotations: list[GivenCounterRotation] = Field([], description="counter-rotating discs added")
+    tolerance: number(gt=0, lt=1) | None = Field(
+        None, description="tolerance of the stage's claims, a fraction of the reference load; default: "
+        "analysis.balance_tolerance plus what the rounding of the entered numbers allows (numbers of "
+        "four or more significant digits are taken as rounded at their last digit)")
 
 
 class Stages(Strict):
@@ -80,10 +85,22 @@ def detach(model: Model, ref: str, path: tuple) -> Model:
     return model.replace_body(replace(body, attachments=tuple(a for a in body.attachments if a.name != name)))
 
 
+def part_rounding(part: PartSpec) -> Rounding:
+    """Half-units of the numbers of a part as entered (a named point is exact)."""
+    x, y = (0.0, 0.0) if isinstance(part.position, str) else (half_unit(part.position[0]), half_unit(part.position[1]))
+    dm, dI = half_unit(part.mass), half_unit(part.inertia)
+    text = ", ".join(f"{part.name}.{k} = {v:.12g} {u}" for k, v, u, h in (
+        ("mass", part.mass, "kg", dm), ("inertia", part.inertia, "kg m^2", dI)) if h)
+    if x or y:
+        text += (", " if text else "") + f"{part.name}.position = ({part.position[0]:.12g}, {part.position[1]:.12g}) m"
+    return Rounding(part.body, part.name, dm, x, y, dI, text)
+
+
 def balance(mech, method: Stages, model: Model, t: np.ndarray | None = None) -> BalanceResult:
     stages = [Stage("unbalanced", "unbalanced", model, "the mechanism as given")]
     current = model
     seen = {"unbalanced"}
+    entered: dict[tuple[str, str | None], Rounding] = {}  # the precision of the parts on the model
     for k, step in enumerate(method.stages):
         path = ("balancing", "stages", k)
         if step.name in seen:
@@ -91,12 +108,18 @@ def balance(mech, method: Stages, model: Model, t: np.ndarray | None = None) -> 
         seen.add(step.name)
         for i, ref in enumerate(step.remove):
             current = detach(current, ref, path + ("remove", i))
+            entered.pop(tuple(ref.split(".", 1)), None)  # type: ignore[arg-type]
         for i, part in enumerate(step.parts):
             current = attach(current, part, path + ("parts", i))
+            entered[(part.body, part.name)] = part_rounding(part)
         if step.counter_rotations:
             current = add_discs(current, step.counter_rotations, path + ("counter_rotations",))
             current = set_disc_inertias(current, {c.name: c.inertia for c in step.counter_rotations})
-        stages.append(Stage(step.name, step.label or step.name, current, step.description, step.balances))
+            for c in step.counter_rotations:
+                entered[(c.name, None)] = Rounding(c.name, None, inertia=half_unit(c.inertia),
+                                                   text=f"{c.name}.inertia = {c.inertia:.12g} kg m^2")
+        stages.append(Stage(step.name, step.label or step.name, current, step.description, step.balances,
+                            tolerance=step.tolerance, rounding=tuple(entered.values())))
     return BalanceResult([], stages, [])
 
 

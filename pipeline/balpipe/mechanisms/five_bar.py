@@ -37,6 +37,7 @@ from pydantic import Field
 from .. import units
 from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
 from ..model import FRAME, Attachment, Body, Driver, Gear, Law, Model, Revolute
+from ..laws.drives import path_laws
 from ..motion import law_for
 from ..spec_parts import LinkSpec, SpecFieldError, Strict
 from ..units import Inertia, Length, Mass, PositiveLength, Sign
@@ -106,7 +107,14 @@ class FiveBarMechanism(Strict):
         return (lk.proximal, lk.distal), (lk.proximal_2 or lk.proximal, lk.distal_2 or lk.distal)
 
     def laws(self, motion) -> dict[str, Law]:
-        """Fixed-sequence: {"theta1": CoupledInput}; plain: {"gripper_x", "gripper_y"}."""
+        """Fixed-sequence: {"theta1": CoupledInput}; plain: {"gripper_x", "gripper_y"} (on a
+        path when motion.drive.gripper has law: path, see balpipe.laws)."""
+        on_path = path_laws("gripper", motion.drive.get("gripper"), motion, 2)
+        if on_path is not None:
+            if self.coupling is not None:
+                raise SpecFieldError(GRIPPER_PATH + ("law",), "the fixed-sequence five-bar moves its gripper between "
+                                     "two positions (from, to); a path needs the plain five-bar (no coupling)")
+            return {"gripper_x": on_path[0], "gripper_y": on_path[1]}
         start, end = gripper_positions(motion)
         if self.coupling is None:
             return {
@@ -337,7 +345,7 @@ def synthesise(mech: FiveBarMechanism, start, end) -> Synthesis:
 def segment_distance(P: np.ndarray, S: np.ndarray, E: np.ndarray) -> np.ndarray:
     """Distance of points P (..., 2) from the segment SE."""
     v = E - S
-    u = np.clip(((P - S) @ v) / float(v @ v), 0.0, 1.0)
+    u = np.clip(((P - S) @ v) / float(v @ v), 0.0, 1.0) if float(v @ v) > 0 else np.zeros(P.shape[:-1])
     return np.hypot(*(P - S - u[..., None] * v).T)
 
 
@@ -488,9 +496,11 @@ def figures(study):
     an, model = first.analysis, first.stage.model
     C = gripper_path(an, model)
     S, E = C[0], C[-1]
+    on_path = getattr(study.spec.motion.drive.get("gripper"), "law", None) == "path"  # balpipe.laws.paths
     fig, ax = plt.subplots(figsize=(5.6, 3.6))
     ax.plot(C[:, 0], C[:, 1], color="black", linewidth=1.4, label="gripper path")
-    ax.plot([S[0], E[0]], [S[1], E[1]], color="0.6", linestyle="--", linewidth=1.0, label="straight segment")
+    if not on_path:
+        ax.plot([S[0], E[0]], [S[1], E[1]], color="0.6", linestyle="--", linewidth=1.0, label="straight segment")
     ax.plot([S[0]], [S[1]], "o", color="black", markersize=4)
     ax.plot([E[0]], [E[1]], "s", color="black", markersize=4)
     ax.set_xlabel("x (m)")
@@ -503,9 +513,9 @@ def figures(study):
     yield (
         "Gripper path (Fig. 7)",
         to_svg(fig, "fivebar-path"),
-        f"C(t) from the analysis, from ({S[0]:.4g}, {S[1]:.4g}) to ({E[0]:.4g}, {E[1]:.4g}) m; largest "
-        f"distance from the straight segment {1000 * dev:.3g} mm"
-        + (" (the gear-coupled inputs do not keep the gripper on the segment)." if coupled else "."),
+        f"C(t) from the analysis, from ({S[0]:.4g}, {S[1]:.4g}) to ({E[0]:.4g}, {E[1]:.4g}) m; " + (
+            "the path of motion.drive.gripper." if on_path else f"largest distance from the straight segment {1000 * dev:.3g} mm"
+            + (" (the gear-coupled inputs do not keep the gripper on the segment)." if coupled else ".")),
     )
     th1, th2 = input_angles(an)
     fig, axes = plt.subplots(1, 2, figsize=(8.4, 2.8))
@@ -518,7 +528,7 @@ def figures(study):
         "Input angles (Figs. 8-9)",
         to_svg(fig, "fivebar-angles"),
         "theta1 follows the motion law; theta2 follows it through gears 1', 5, 2' (theta2 - theta2i = "
-        "U21 (theta1 - theta1i))." if coupled else "Both inputs follow the inverse kinematics of the straight path.",
+        "U21 (theta1 - theta1i))." if coupled else f"Both inputs follow the inverse kinematics of the {'given' if on_path else 'straight'} path.",
     )
 
 

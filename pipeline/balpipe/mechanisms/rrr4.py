@@ -37,6 +37,7 @@ from pydantic import Field
 from .. import units
 from ..joint_laws import PoseJointLaw, body_point, dyad_rates
 from ..model import FRAME, Body, Driver, Law, Model, Revolute
+from ..laws.drives import path_laws
 from ..motion import law_for
 from ..spec_parts import SpecFieldError, Strict
 from ..units import Inertia, Length, Mass, PositiveLength, Sign
@@ -104,7 +105,11 @@ class RRR4Mechanism(Strict):
         return {"platform": "pose"}
 
     def laws(self, motion) -> dict[str, Law]:
-        """The platform pose's three laws: {"x", "y", "angle"}."""
+        """The platform pose's three laws: {"x", "y", "angle"} (on a path with law: path, see
+        balpipe.laws)."""
+        on_path = path_laws("platform", motion.drive.get("platform"), motion, 3)
+        if on_path is not None:
+            return dict(zip(("x", "y", "angle"), on_path))
         start, end = platform_poses(motion)
         return {k: law_for(motion, start[n], end[n]) for n, k in enumerate(("x", "y", "angle"))}
 

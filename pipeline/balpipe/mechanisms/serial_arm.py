@@ -30,8 +30,9 @@ from pydantic import Field
 from .. import units
 from ..joint_laws import PoseJointLaw, body_point, dyad_rates
 from ..model import FRAME, Attachment, Body, Driver, Law, Model, Revolute
+from ..laws.drives import drive_laws, path_laws
 from ..motion import law_for
-from ..spec_parts import LinkSpec, SpecFieldError, Strict
+from ..spec_parts import DriveSpec, LinkSpec, SpecFieldError, Strict
 from ..units import Angle, Inertia, Length, Mass, Sign
 
 DRIVE = ("motion", "drive")
@@ -81,12 +82,18 @@ class SerialArmMechanism(Strict):
         if "tip" in names:
             if len(names) > 1:
                 raise SpecFieldError(DRIVE + ("tip",), "drive either the tip or the joints, not both")
+            on_path = path_laws("tip", motion.drive["tip"], motion, 2 if n == 2 else 3)
+            if on_path is not None:  # the tip on a path (balpipe.laws.paths), its angle with it for n = 3
+                return {"tip": TaskMotion(on_path, "tip", DRIVE + ("tip",))}
             start, end = tip_poses(self, motion.drive["tip"])
             task = [law_for(motion, a, b) for a, b in zip(start, end)]
             return {"tip": TaskMotion(tuple(task), "tip", DRIVE + ("tip",))}
         out: dict[str, Law] = {}
         for name in names:
             d = motion.drive[name]
+            if not isinstance(d, DriveSpec):  # constant speed, cam, fourier, table, cycle (balpipe.laws)
+                out.update(drive_laws(name, d, known, motion))
+                continue
             vals = []
             for key, raw in (("from", d.start), ("to", d.end)):
                 try:

@@ -56,6 +56,15 @@ def _drive_values(spec: Any) -> dict[str, tuple[str, str]]:
     mech = spec.mechanism
     dims = mech.drives() if hasattr(mech, "drives") else {}
     for name, drive in spec.motion.drive.items():
+        if not hasattr(drive, "start_velocity"):  # the laws of balpipe.laws: values and speed in SI
+            for base, law, dim in ((name, drive, dims.get(name)), (f"{name}.timing", getattr(drive, "timing", None), "length")):
+                for key in ("start", "end", "mean", "speed"):
+                    raw = getattr(law, key, None)
+                    conv = _written_to_si(raw, dim) if key != "speed" else (
+                        (num(float(raw)), _RATE_UNITS.get(dim or "", ("SI",))[0]) if raw is not None else None)
+                    if conv:
+                        out[f"motion.drive.{base}.{key}"] = conv
+            continue
         dim = dims.get(name)
         for key, raw in (("start", drive.start), ("end", drive.end)):
             path = f"motion.drive.{name}.{key}"

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import realisable
+from ..laws.drives import law_names
 from ..study import Study, ratio_reference
 from . import figures, labels, present, toc
 from .notation_table import notation_groups
@@ -144,7 +145,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         r=results,
         paper=spec.paper,
         description=spec.description,
-        law=spec.motion.law,
+        law=law_names(spec.motion),  # the drives' own laws (balpipe.laws)
         figures=study_figures(study),
         validation=validation_rows,
         torque=torque_rows,

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
+from ..motion_outputs import motion_columns
 from ..study import Study, stage_metrics
 from . import present
 
@@ -39,7 +40,7 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     tol = spec.analysis.balance_tolerance
     stages = []
     for s in study.stages:
-        m = stage_metrics(s, study.reference_stage(s), tol)
+        m = stage_metrics(s, study.reference_stage(s), tol, spec.analysis.claim_tolerance)
         stages.append(m)
     validation = {}
     for s in study.stages:
@@ -148,8 +149,9 @@ def joint_load_table(study: Study) -> list[dict]:
 
 def timeseries_csv(study: Study) -> str:
     """One row per sample: t, then per stage Fx, Fy, |F|, M (about the moment point), every
-    actuator effort and every joint reaction (see :func:`balpipe.engine._joint_reactions`);
-    SI units, 12 significant digits."""
+    actuator effort, every joint reaction (see :func:`balpipe.engine._joint_reactions`), the
+    total centre of mass, every body's pose and every named point's path with their velocities
+    (:func:`balpipe.motion_outputs.motion_columns`); SI units, 12 significant digits."""
     cols: list[tuple[str, np.ndarray]] = [("t_s", study.unbalanced.analysis.t)]
     for s in study.stages:
         an, n = s.analysis, s.stage.name
@@ -164,6 +166,7 @@ def timeseries_csv(study: Study) -> str:
         for j in sorted(an.reactions):
             for comp, values in an.reactions[j].items():
                 cols.append((f"{n}.reaction.{j}.{comp}", values))
+        cols += [(f"{n}.{name}", values) for name, values in motion_columns(s.stage.model, an)]
     buf = io.StringIO()
     buf.write(",".join(c for c, _ in cols) + "\n")
     data = np.column_stack([v for _, v in cols])
