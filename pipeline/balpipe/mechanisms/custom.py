@@ -11,6 +11,7 @@ from typing import Annotated, Literal, Union
 import numpy as np
 from pydantic import Field
 
+from .. import actuation
 from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle, mesh_geometry
 from ..model import FRAME, Attachment, Body, Driver, Gear, Model, Prismatic, Revolute
 from ..spec_parts import SpecFieldError, Strict
@@ -106,7 +107,8 @@ class CustomMechanism(Strict):
     frame_points: dict[str, tuple[Length, Length]] = Field({}, description="named fixed points")
     bodies: list[CustomBody] = Field(min_length=1, description="the moving bodies")
     joints: list[JointSpec] = Field(min_length=1, description="revolute, prismatic and gear joints")
-    drivers: list[DriverSpec] = Field(min_length=1, description="the actuated coordinates")
+    drivers: list[DriverSpec] = Field(min_length=1, description="the prescribed coordinates (their motion is motion.drive)")
+    actuators: list[str] | None = Field(None, description=actuation.DESCRIPTION)
 
     def drives(self) -> dict[str, str]:
         out = {}
@@ -199,7 +201,10 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
         drivers=tuple(drivers),
         initial={b.name: tuple(b.pose) for b in mech.bodies},
         frame_points={k: tuple(v) for k, v in mech.frame_points.items()},
+        sources={**{b.name: root + ("bodies", k) for k, b in enumerate(mech.bodies)},
+                 **{j.name: root + ("joints", k) for k, j in enumerate(mech.joints)}},
     )
+    model = actuation.with_actuators(model, mech.actuators, root + ("actuators",))
     for k, (j, jt) in enumerate(zip(mech.joints, joints)):
         if isinstance(jt, Gear):
             try:

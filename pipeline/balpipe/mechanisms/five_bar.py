@@ -34,7 +34,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .. import units
+from .. import actuation, units
 from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
 from ..model import FRAME, Attachment, Body, Driver, Gear, Law, Model, Revolute
 from ..motion import law_for
@@ -91,6 +91,10 @@ class FiveBarMechanism(Strict):
         (1, -1),
         description="sigma1, sigma2: +1 puts B_j on the counter-clockwise side of A_jC (the sign "
         "of the root in eq. 2; the paper's Fig. 3 is [+1, -1])",
+    )
+    actuators: list[str] | None = Field(
+        None, description="the motors' joints: default A1 and A2 for the plain 5R (their torques "
+        "are reported), the driven A1 when coupled; [] reports the virtual gripper forces instead",
     )
     coupling: CouplingSpec | None = Field(
         None,
@@ -414,10 +418,12 @@ def build(mech: FiveBarMechanism, laws: dict, t: np.ndarray) -> Model:
             Driver("gripper_y", ("y", "link3", "C"), laws["gripper_y"]),
         )
         name = "five-bar"
-    return Model(
+    model = Model(
         name=name, bodies=tuple(bodies), joints=tuple(joints), drivers=drivers,
         initial=initial, frame_points=frame_points,
     )
+    motors = mech.actuators if mech.actuators is not None else (["A1", "A2"] if mech.coupling is None else None)
+    return actuation.with_actuators(model, motors, ("mechanism", "actuators"))
 
 
 def _check_straight_path(mech: FiveBarMechanism, C: np.ndarray, t: np.ndarray) -> None:
