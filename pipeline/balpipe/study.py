@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from . import realisable, registry
+from . import loop_closure, realisable, registry
 from .balancing.base import BalanceResult, Stage
 from .engine import Analysis, AnalysisError, analyse
 from .load_reference import LoadReference, load_reference
@@ -94,7 +94,7 @@ def run_stage_analyses(spec: Spec, result: BalanceResult) -> list[StageResult]:
         try:
             an = analyse(stage.model, t, gravity_vector(spec), tuple(spec.analysis.moment_point))
         except AnalysisError as exc:
-            raise SpecFieldError(("motion",), f"stage {stage.name!r}: {exc}") from None
+            raise loop_closure.located(base, t, exc, stage.name) from None
         out.append(
             StageResult(
                 stage, an,
@@ -202,7 +202,10 @@ def _decimals(x: float) -> int:
 
 def run(spec: Spec) -> Study:
     """Balance and analyse every stage; collect checks and problems (no simulation)."""
-    balance = registry.balance_designs(spec)
+    try:
+        balance = registry.balance_designs(spec)
+    except AnalysisError as exc:  # a balancing method analysed a motion that cannot be followed
+        raise loop_closure.located(registry.unbalanced_model(spec), registry.time_grid(spec), exc) from None
     stages = run_stage_analyses(spec, balance)
     tol = spec.analysis.balance_tolerance
     metrics = [stage_metrics(s, reference_of(stages, s), tol) for s in stages]
