@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from . import loop_closure, realisable, registry
+from . import actuation, dead_centres, loop_closure, realisable, registry
 from .balancing.base import BalanceResult, Stage
 from .engine import Analysis, AnalysisError, analyse
 from .load_reference import LoadReference, load_reference
@@ -42,6 +42,7 @@ class Study:
     checks: dict
     problems: list[str] = field(default_factory=list)
     reactionless: Any = None
+    warnings: list[dict] = field(default_factory=list)  # dead centres and singularities (balpipe.dead_centres)
 
     @property
     def unbalanced(self) -> StageResult:
@@ -239,7 +240,11 @@ def run(spec: Spec) -> Study:
             "the least sum of squares, no internal preload), and the joint reactions follow from the same "
             "multipliers. The shaking force and moment do not depend on how the actuators share the load."
         )
+    warnings = [w for s in stages for w in dead_centres.find(s.stage.model, s.analysis, s.stage.name)]
+    virtual = actuation.virtual_note(stages[0].stage.model)
+    if virtual:
+        balance.notes.append(virtual)
     refs = compare_references(spec, balance, metrics)
     checks = {"reactions_vs_momentum": rvm, "balance_tolerance": tol, "max_condition_number": float(cond[k]),
               "reference": ratio_reference(stages[0]).to_json()}
-    return Study(spec, balance, stages, refs, checks, problems)
+    return Study(spec, balance, stages, refs, checks, problems, warnings=warnings)

@@ -11,7 +11,7 @@ from typing import Annotated, Literal, Union
 import numpy as np
 from pydantic import Field
 
-from .. import actuation
+from .. import actuation, assembly
 from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle, mesh_geometry
 from ..model import FRAME, Attachment, Body, Driver, Gear, Model, Prismatic, Revolute
 from ..spec_parts import SpecFieldError, Strict
@@ -205,6 +205,7 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
                  **{j.name: root + ("joints", k) for k, j in enumerate(mech.joints)}},
     )
     model = actuation.with_actuators(model, mech.actuators, root + ("actuators",))
+    assembly.check(model, float(t[0]))
     for k, (j, jt) in enumerate(zip(mech.joints, joints)):
         if isinstance(jt, Gear):
             try:
