@@ -90,7 +90,7 @@ def test_loop_that_cannot_close_at_the_start_is_located():
 
             raise SpecErrors([_located("x.yaml", node, exc.path, exc.message)]) from None
     e = err.value.errors[0]
-    assert e.line is not None and "cannot close at t = 0 s" in e.message
+    assert e.line is not None and "cannot be closed at t = 0 s" in e.message
     assert "coupler needs at most 0.44 m (has 0.5 m)" in e.message
     assert e.path.startswith("mechanism.bodies[")
 
@@ -106,7 +106,7 @@ def test_cli_loop_and_far_pose_exit_2_no_traceback_site_untouched(tmp_path):
     assert r.returncode == 2
     assert "Traceback" not in r.stderr and "Traceback" not in r.stdout
     lines = r.stderr.splitlines()
-    loop = next(line for line in lines if "cannot close" in line)
+    loop = next(line for line in lines if "cannot be closed" in line)
     assert loop.strip().startswith("good.yaml:") and "mechanism.bodies[" in loop and ".points.B" in loop
     assert "needs at least" in loop and "(has 0.12 m)" in loop or "(has 0.22 m)" in loop
     pose = next(line for line in lines if "far from every assembly" in line)

@@ -55,7 +55,7 @@ def _length_field(model: Model, body: str, d: dyads.Dyad) -> tuple:
 
 def _dyad_message(model: Model, d: dyads.Dyad, dist: float, t: float) -> tuple[tuple, str] | None:
     li, lj = d.length_i, d.length_j
-    head = (f"the loop through joints {d.joints} cannot close at t = {t:.6g} s: the dyad {d.body_i}-{d.body_j} "
+    head = (f"the loop through joints {d.joints} cannot be closed at t = {t:.6g} s: the dyad {d.body_i}-{d.body_j} "
             f"must span {dist:.6g} m between joints {d.end_i.name} and {d.end_j.name}, but {d.body_i} "
             f"({d.end_i.name} to {d.middle.name}) is {li:.6g} m long and {d.body_j} ({d.end_j.name} to "
             f"{d.middle.name}) {lj:.6g} m")
@@ -123,7 +123,7 @@ def explain(model: Model, c: Compiled, exc: AnalysisError) -> SpecFieldError:
         first = next((model.sources[o] for o in joints if o in model.sources), where)
         return SpecFieldError(
             first, f"the loop through joints {', '.join(joints) or ', '.join(b.owners)} (bodies "
-            f"{', '.join(b.bodies)}) cannot close at t = {tf:.6g} s (residual {phi:.3g}): "
+            f"{', '.join(b.bodies)}) cannot be closed at t = {tf:.6g} s (residual {phi:.3g}): "
             "its links are too short or too long for the positions the motion prescribes")
     return SpecFieldError(where, str(exc))
 

@@ -204,8 +204,6 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
         sources={**{b.name: root + ("bodies", k) for k, b in enumerate(mech.bodies)},
                  **{j.name: root + ("joints", k) for k, j in enumerate(mech.joints)}},
     )
-    model = actuation.with_actuators(model, mech.actuators, root + ("actuators",))
-    assembly.check(model, float(t[0]))
     for k, (j, jt) in enumerate(zip(mech.joints, joints)):
         if isinstance(jt, Gear):
             try:
@@ -213,6 +211,8 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
             except ValueError as exc:
                 key = "radius_b" if j.radius_a is not None and j.radius_b is None else "radius_a"
                 raise SpecFieldError(root + ("joints", k, key), str(exc)) from None
+    model = actuation.with_actuators(model, mech.actuators, root + ("actuators",))
+    assembly.check(model, float(t[0]))
     return model
 
 
@@ -265,6 +265,8 @@ def notation(mech: CustomMechanism) -> dict:
             f"{p}.radius_b": ours(f"r_{{{j.name},b}}", f"pitch radius of the driven gear of `{j.name}`"),
             f"{p}.pressure_angle": ours(f"α_{{{j.name}}}", f"pressure angle of gear pair `{j.name}`"),
         })
+    for k, a in enumerate(mech.actuators or []):
+        table[f"mechanism.actuators[{k}]"] = ours(f"τ_{{{a}}}", f"motor at joint `{a}`: its torque (revolute) or force (prismatic)")
     for k, d in enumerate(mech.drivers):
         p = f"mechanism.drivers[{k}]"
         for field, what in (("joint", "joint it drives"), ("body", "body whose coordinate it drives"),

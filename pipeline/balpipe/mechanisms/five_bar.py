@@ -555,6 +555,8 @@ def _notation() -> dict:
         "mechanism.links.distal_2.com": Sym("r_4", "centre of mass of link 4 from B_2"),
         "mechanism.links.distal_2.com_offset": ours("e_4", "offset of S_4 normal to link 4"),
         "mechanism.links.distal_2.inertia": Sym("I_4", "axial moment of inertia of link 4"),
+        "mechanism.actuators[0]": ours("τ_1", "first motor's joint (default A1): its torque is reported"),
+        "mechanism.actuators[1]": ours("τ_2", "second motor's joint (default A2): its torque is reported"),
         "mechanism.working_modes": Sym("(σ_1, σ_2)", "working modes: +1 puts B_j on the counter-clockwise side of A_jP (eq. 2)"),
         "mechanism.coupling.r1p": Sym("r_{1'}", "pitch radius of gear 1' on input link 1"),
         "mechanism.coupling.gear_1p.mass": Sym("m_{1'}", "mass of gear 1' (on link 1 at A_1)"),
