@@ -10,6 +10,10 @@ far from every assembly (or between two branches), and the spec is refused at th
 ``pose``, with the pose that was reached. A loop that cannot close at all is named by
 :mod:`balpipe.loop_closure`. The branch then stays the same along the motion (the analysis
 follows it continuously and refuses a singular configuration, where it could switch).
+
+The check runs when a spec is built or checked (:func:`balpipe.study.run`), not in design
+sweeps, whose new geometries start from the base spec's motions instead
+(:mod:`balpipe.engine.warmstart`).
 """
 
 from __future__ import annotations

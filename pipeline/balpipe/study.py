@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from . import actuation, dead_centres, loop_closure, realisable, registry
+from . import actuation, assembly, dead_centres, loop_closure, realisable, registry
 from .balancing.base import BalanceResult, Stage
 from .engine import Analysis, AnalysisError, analyse
 from .load_reference import LoadReference, load_reference
@@ -203,10 +203,13 @@ def _decimals(x: float) -> int:
 
 def run(spec: Spec) -> Study:
     """Balance and analyse every stage; collect checks and problems (no simulation)."""
+    model = registry.unbalanced_model(spec)
+    if model.sources:  # a spec that gives its own poses (custom): the assembly must confirm them
+        assembly.check(model, float(registry.time_grid(spec)[0]))
     try:
         balance = registry.balance_designs(spec)
     except AnalysisError as exc:  # a balancing method analysed a motion that cannot be followed
-        raise loop_closure.located(registry.unbalanced_model(spec), registry.time_grid(spec), exc) from None
+        raise loop_closure.located(model, registry.time_grid(spec), exc) from None
     stages = run_stage_analyses(spec, balance)
     tol = spec.analysis.balance_tolerance
     metrics = [stage_metrics(s, reference_of(stages, s), tol) for s in stages]
