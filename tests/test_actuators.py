@@ -360,3 +360,44 @@ def test_actuator_errors_are_located(tmp_path, acts, expect):
     text = path.read_text().splitlines()
     line = int(msg.split(":")[1])
     assert "actuators" in text[line - 1] or "- A" in text[line - 1] or "- Z9" in text[line - 1]
+
+
+def test_prismatic_motor_force_in_newtons_by_power_balance():
+    """A slider-crank whose crank angle is prescribed and whose motor pushes the slider: the
+    motor's force F (N) satisfies F x' = sum_k (m_k (a_k - g) . v_k + I_k alpha_k w_k) (power)."""
+    spec = {
+        "name": "slider-crank, crank prescribed, linear motor on the slider",
+        "mechanism": {
+            "template": "custom",
+            "bodies": [
+                {"name": "crank", "mass": 1.3, "com": [0.04, 0.01], "inertia": 0.002, "pose": [0, 0, 0.3],
+                 "points": {"A": [0, 0], "B": [0.1, 0]}},
+                {"name": "coupler", "mass": 0.9, "com": [0.12, -0.005], "inertia": 0.006, "pose": [0.0955, 0.0296, -0.1],
+                 "points": {"B": [0, 0], "C": [0.3, 0]}},
+                {"name": "slider", "mass": 0.7, "com": [0.01, 0.0], "inertia": 0.001, "pose": [0.394, 0, 0], "points": {"C": [0, 0]}},
+            ],
+            "joints": [
+                {"type": "revolute", "name": "A", "a": "frame", "b": "crank", "point_a": [0, 0], "point_b": "A"},
+                {"type": "revolute", "name": "B", "a": "crank", "b": "coupler", "point_a": "B", "point_b": "B"},
+                {"type": "revolute", "name": "C", "a": "coupler", "b": "slider", "point_a": "C", "point_b": "C"},
+                {"type": "prismatic", "name": "guide", "guide": "frame", "slider": "slider", "point_guide": [0, 0], "axis": [1, 0]},
+            ],
+            "drivers": [{"name": "crank", "joint": "A"}],
+            "actuators": ["guide"],
+        },
+        "motion": {"law": "quintic", "duration": 0.3, "drive": {"crank": {"from": 0.3, "to": 2.5}}},
+        "analysis": {"samples": 301, "gravity": True},
+    }
+    s, model = model_of(spec)
+    t = registry.time_grid(s)
+    an = analyse(model, t, (0.0, -G0))
+    F = an.efforts["guide"]
+    power = np.zeros(len(t))
+    for k, b in enumerate(model.bodies):
+        m, _, inertia = b.mass_properties()
+        power += m * np.sum((an.a[:, k, :2] - np.array([0.0, -G0])) * an.v[:, k, :2], axis=1) + inertia * an.a[:, k, 2] * an.v[:, k, 2]
+    xdot = an.v[:, an.names.index("slider"), 0]
+    assert np.max(np.abs(F * xdot - power)) < 1e-9 * np.max(np.abs(power))
+    from balpipe.report.present import driver_unit
+
+    assert driver_unit(model, "guide") == "N"
