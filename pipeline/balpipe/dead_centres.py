@@ -93,3 +93,16 @@ def find(model: Model, an: Analysis, stage: str = "") -> list[dict]:
                            f"{cond[k]:.3g}, warned above {CONDITION_LIMIT:.0e})" + _spike_text(spike),
             })
     return out
+
+
+def unique(warnings: list[dict]) -> list[dict]:
+    """One warning per kind, place and time: the stages of a spec share their motion, so a dead
+    centre of the first stage is that of every stage (the first stage's warning, with its
+    effort spike, is kept)."""
+    seen, out = set(), []
+    for w in warnings:
+        key = (w["kind"], w.get("dyad"), round(w["time"], 12))
+        if key not in seen:
+            seen.add(key)
+            out.append(w)
+    return out

@@ -243,7 +243,7 @@ def run(spec: Spec) -> Study:
             "the least sum of squares, no internal preload), and the joint reactions follow from the same "
             "multipliers. The shaking force and moment do not depend on how the actuators share the load."
         )
-    warnings = [w for s in stages for w in dead_centres.find(s.stage.model, s.analysis, s.stage.name)]
+    warnings = dead_centres.unique([w for s in stages for w in dead_centres.find(s.stage.model, s.analysis, s.stage.name)])
     virtual = actuation.virtual_note(stages[0].stage.model)
     if virtual:
         balance.notes.append(virtual)
