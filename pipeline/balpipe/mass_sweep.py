@@ -91,6 +91,7 @@ class MassSweep:
         YF, YM = shaking_regressor(states, gravity, moment_point)
         YD = dynamics_regressor(states, gravity)
         c = compile_model(model)
+        c = c.dynamics or c  # with actuators: their rows, not the drivers' (engine.compile._actuated)
         N = len(t)
         qx = _extend(an.q.reshape(N, -1))
         J = jacobian(c, qx)

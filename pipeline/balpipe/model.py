@@ -175,12 +175,31 @@ class Driver:
 
 
 @dataclass(frozen=True)
+class Actuator:
+    """A motor at a joint: a torque (N m) about a revolute's axis, applied to body b and
+    reacted on body a, or a force (N) along a prismatic pair's axis, on the slider and reacted
+    on the guide. Its effort is the generalized force conjugate to the joint coordinate (the
+    revolute's theta_b - theta_a, the prismatic's displacement), so the virtual work of the
+    effort is tau d(coordinate) (DESIGN.md, "What moves and what drives are two lists":
+    M q'' + h = B tau + Phi_q^T lambda, B the coordinates' gradients)."""
+
+    name: str
+    joint: str
+
+
+@dataclass(frozen=True)
 class Model:
     """A planar mechanism: bodies, joints, drivers and an initial pose for assembly.
 
     ``initial`` maps each body to an approximate pose (x, y, theta) of its frame at t = 0; the
     engine refines it by Newton-Raphson. ``frame_points`` are named fixed points (pivots) drawn
     on the frame; ``guides`` are fixed line segments drawn on the frame (slider guides).
+
+    ``actuators``: the motors, distinct from the drivers. Empty (the default): each driver is
+    its own actuator and the efforts are the drivers' (virtual ones when a driver prescribes a
+    point or a pose). Given: the drivers only prescribe the motion, and the efforts are the
+    actuators' (:mod:`balpipe.engine.dynamics`). ``sources`` maps body, joint, driver and
+    actuator names to the spec field that defines them, for located errors.
     """
 
     name: str
@@ -190,6 +209,8 @@ class Model:
     initial: dict[str, tuple[float, float, float]]
     frame_points: dict[str, Vec2] = field(default_factory=dict)
     guides: tuple[tuple[Vec2, Vec2], ...] = ()
+    actuators: tuple[Actuator, ...] = ()
+    sources: dict[str, tuple] = field(default_factory=dict, compare=False)
 
     def body(self, name: str) -> Body:
         for b in self.bodies:

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from . import realisable, registry
+from . import actuation, assembly, dead_centres, loop_closure, realisable, registry
 from .balancing.base import BalanceResult, Stage
 from .claim_precision import claim_tolerances
 from .engine import Analysis, AnalysisError, analyse
@@ -43,6 +43,7 @@ class Study:
     checks: dict
     problems: list[str] = field(default_factory=list)
     reactionless: Any = None
+    warnings: list[dict] = field(default_factory=list)  # dead centres and singularities (balpipe.dead_centres)
 
     @property
     def unbalanced(self) -> StageResult:
@@ -95,7 +96,7 @@ def run_stage_analyses(spec: Spec, result: BalanceResult) -> list[StageResult]:
         try:
             an = analyse(stage.model, t, gravity_vector(spec), tuple(spec.analysis.moment_point))
         except AnalysisError as exc:
-            raise SpecFieldError(("motion",), f"stage {stage.name!r}: {exc}") from None
+            raise loop_closure.located(base, t, exc, stage.name) from None
         out.append(
             StageResult(
                 stage, an,
@@ -210,7 +211,13 @@ def _decimals(x: float) -> int:
 
 def run(spec: Spec) -> Study:
     """Balance and analyse every stage; collect checks and problems (no simulation)."""
-    balance = registry.balance_designs(spec)
+    model = registry.unbalanced_model(spec)
+    if model.sources:  # a spec that gives its own poses (custom): the assembly must confirm them
+        assembly.check(model, float(registry.time_grid(spec)[0]))
+    try:
+        balance = registry.balance_designs(spec)
+    except AnalysisError as exc:  # a balancing method analysed a motion that cannot be followed
+        raise loop_closure.located(model, registry.time_grid(spec), exc) from None
     stages = run_stage_analyses(spec, balance)
     tol = spec.analysis.balance_tolerance
     overrides = spec.analysis.claim_tolerance
@@ -255,7 +262,11 @@ def run(spec: Spec) -> Study:
             "the least sum of squares, no internal preload), and the joint reactions follow from the same "
             "multipliers. The shaking force and moment do not depend on how the actuators share the load."
         )
+    warnings = dead_centres.unique([w for s in stages for w in dead_centres.find(s.stage.model, s.analysis, s.stage.name)])
+    virtual = actuation.virtual_note(stages[0].stage.model)
+    if virtual:
+        balance.notes.append(virtual)
     refs = compare_references(spec, balance, metrics)
     checks = {"reactions_vs_momentum": rvm, "balance_tolerance": tol, "max_condition_number": float(cond[k]),
               "reference": ratio_reference(stages[0]).to_json()}
-    return Study(spec, balance, stages, refs, checks, problems)
+    return Study(spec, balance, stages, refs, checks, problems, warnings=warnings)

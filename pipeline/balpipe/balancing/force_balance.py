@@ -136,6 +136,7 @@ def force_stage(model: Model, specs: list[CounterweightRegionSpec], settings: Fi
         "polygon_sides": sol.polygon_sides,
         "disc_accuracy": sol.disc_accuracy,
         "residual_after": sol.residual,
+        "least_mass_unique": sol.unique,
     })
     gap = "no singular value dropped" if not np.isfinite(cond.gap) else f"gap between the last kept and the first dropped singular value {cond.gap:.3g}"
     notes = [
@@ -145,7 +146,7 @@ def force_stage(model: Model, specs: list[CounterweightRegionSpec], settings: Fi
         + (f"; disc regions are replaced by inscribed {sol.polygon_sides}-gons (within "
            f"{sol.disc_accuracy:.1e} of their radius)" if any(r.kind == "disc" for r in regions) else "")
         + "."
-    ]
+    ] + LM.tie_note(sol)
     return out, params, details, notes
 
 

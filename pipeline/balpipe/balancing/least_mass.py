@@ -32,6 +32,7 @@ from scipy.optimize import linprog
 from ..model import Model, Vec2
 from .conditions import ForceConditions, scale_of
 from . import regressor as R
+from . import tie_break
 
 POLYGON_SIDES = 128
 
@@ -72,6 +73,7 @@ class Solution:
     polygon_sides: int
     residual: float  # max |C p| / (total mass x model size) after the counterweights
     disc_inertias: list[float] = None  # with the moment: the counter-rotating discs' inertias
+    unique: bool = True  # the least-mass design was unique; else the tie-break chose it (tie_break.RULE)
 
     @property
     def disc_accuracy(self) -> float:
@@ -151,10 +153,12 @@ def solve(model: Model, cond: ForceConditions, regions: list[Region], sides: int
         raise _infeasible(labels, A, b, regions)
     if res.status != 0:
         raise ValueError(f"least-mass counterweights: the solver stopped: {res.message}")
-    z = res.x.copy()
+    D = _design_map(G4, len(cost) - G.shape[1], moment is not None, R.model_size(model))
+    z, unique = tie_break.least_norm(A_lp, b_lp, np.array(cost), D, res.x.copy())
     active = z > 1e-12 * max(1.0, float(np.max(z, initial=0.0)))
     for _ in range(3 if active.any() else 0):  # polish: conditions to round-off
-        dz = np.linalg.lstsq(A_lp[:, active], b_lp - A_lp @ z, rcond=None)[0]
+        # rcond: directions of the optimal face (singular values at round-off) are not corrections
+        dz = np.linalg.lstsq(A_lp[:, active], b_lp - A_lp @ z, rcond=1e-10)[0]
         z[active] += dz
     z = np.maximum(z, 0.0)
     placed = []
@@ -171,7 +175,27 @@ def solve(model: Model, cond: ForceConditions, regions: list[Region], sides: int
     p = p0 + G @ z[: G.shape[1]]
     total = float(sum(c.mass for c in placed))
     discs = z[G.shape[1]:] if moment is not None else np.zeros(0)
-    return Solution(placed, total, sides, cond.contains(p, scale_of(model)), [float(x) for x in discs])
+    return Solution(placed, total, sides, cond.contains(p, scale_of(model)), [float(x) for x in discs], unique)
+
+
+def tie_note(sol: Solution) -> list[str]:
+    """The page's note when the least-mass optimum was not unique (and the rule that chose)."""
+    if sol.unique:
+        return []
+    return [f"The least added mass ({sol.total_mass:.6g} kg) is reached by more than one design: "
+            f"balpipe takes, {tie_break.RULE} (a unique choice, symmetric when the mechanism is)."]
+
+
+def _design_map(G4: np.ndarray, n_discs: int, moment: bool, size: float) -> np.ndarray:
+    """Rows (m, mx / L, my / L[, J / L^2]) of the bodies that carry counterweights, as functions
+    of the generator weights z (the discs' inertias appended when the moment is balanced): the
+    design whose sum of squares :mod:`.tie_break` minimises."""
+    w = np.tile(np.array([1.0, 1 / size, 1 / size, 1 / size**2 if moment else 0.0]), G4.shape[0] // 4)
+    D = w[:, None] * G4
+    D = D[np.any(D != 0, axis=1)]
+    if n_discs:
+        D = np.block([[D, np.zeros((D.shape[0], n_discs))], [np.zeros((n_discs, G4.shape[1])), np.eye(n_discs) / size**2]])
+    return D
 
 
 EQUATION_TOLERANCE = 1e-9  # relative singular value / right-hand side left outside the kept equations

@@ -213,7 +213,7 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
         f"Counter-rotation inertias re-solved by least squares over {samples} sampled states: relative residual "
         f"{residual:.2g}" + (" (the moment is cancelled for every motion)." if cancelled else
                              f", above {MOMENT_TOLERANCE:g}: the stage claims only the force."),
-    ]
+    ] + LM.tie_note(sol)
     details = {
         "force_balance": cond.to_json(R.parameters(model.add(tuple(b for b in with_discs.bodies if b.name in discs)))),
         "moment_balance": {

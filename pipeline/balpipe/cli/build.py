@@ -38,6 +38,8 @@ def run(args) -> int:
         print(f"[{k}/{total}] {o.source}: {tag} ({o.seconds:.2f} s)", file=sys.stderr)
         if o.status != "ok" and o.message and not o.skipped:
             print("    " + o.message.replace("\n", "\n    "), file=sys.stderr)
+        for w in ((o.results or {}).get("warnings") or []) if not o.skipped else []:
+            print("    warning: " + w["message"], file=sys.stderr)
 
     try:
         outcomes = build(args.paths, opts, jobs=args.jobs, progress=progress)

@@ -13,7 +13,7 @@ from ..model import Model
 from . import fastpath, structure
 from .compile import Compiled, compile_model
 from .constraints import _extend, jacobian
-from .dynamics import _joint_reactions, _multipliers, _radial_tooth_loads, _tooth_rows
+from .dynamics import _joint_reactions, _multipliers, _radial_tooth_loads, _tooth_rows, actuation_condition
 from .kinematics import _vel_acc
 from .positions import condition_numbers, redundancy, solve_positions
 
@@ -167,6 +167,7 @@ def analyse(
     g = np.asarray(gravity, dtype=float)
     Mdiag = np.stack([c.mass, c.mass, c.inertia], axis=1).reshape(1, -1)
     kin = None
+    actuation = rates = None
     if method == "auto":
         if c.fast is None:
             c.fast = fastpath.prepare(c)
@@ -183,7 +184,8 @@ def analyse(
         q, v, a = kin.X[3:-1].T, kin.V[3:-1].T, kin.A[3:-1].T
         cond = None
         condition = functools.partial(condition_numbers, c, q)
-    if kin is not None and not c.meshes:
+    cd = c.dynamics or c  # the system of the inverse dynamics: the actuators' rows, or the drivers'
+    if kin is not None and not c.meshes and c.dynamics is None:
         rhsT = -Mdiag.T * kin.A[3:-1]
         rhsT[0::3] += (c.mass * g[0])[:, None]
         rhsT[1::3] += (c.mass * g[1])[:, None]
@@ -193,15 +195,18 @@ def analyse(
         gen0 = fastpath.frame_load(c.fast, kin.vals, lamT)
     else:
         qx = _extend(q)
-        J = jacobian(c, qx)
-        mesh_geo = _tooth_rows(c, qx, J)  # gear meshes with pitch radii act by tooth forces
+        J = jacobian(cd, qx)
+        mesh_geo = _tooth_rows(cd, qx, J)  # gear meshes with pitch radii act by tooth forces
         Jf, J0 = J[:, :, 3:], J[:, :, :3]
         Q = np.zeros_like(q)
         Q[:, 0::3] = c.mass * g[0]
         Q[:, 1::3] = c.mass * g[1]
         rhs = Q - Mdiag * a
-        lam = _multipliers(c, Jf, rhs)
-        lam, radial_on_frame = _radial_tooth_loads(c, mesh_geo, lam)
+        if c.dynamics is not None:
+            actuation = actuation_condition(cd, Jf, t)
+            rates = {name: np.einsum("nk,nk->n", Jf[:, row, :], v) for name, row in cd.driver_rows.items()}
+        lam = _multipliers(cd, Jf, rhs)
+        lam, radial_on_frame = _radial_tooth_loads(cd, mesh_geo, lam)
         gen0 = -np.einsum("nmk,nm->nk", J0, lam) + radial_on_frame  # load on the frame: Fx, Fy, M_O
     P = np.asarray(moment_point, dtype=float)
     force = gen0[:, :2]
@@ -225,8 +230,8 @@ def analyse(
     def about_P(M: np.ndarray, F: np.ndarray) -> np.ndarray:
         return M - (P[0] * F[:, 1] - P[1] * F[:, 0])
 
-    efforts = {name: -lam[:, row] for name, row in c.driver_rows.items()}
-    reactions = _joint_reactions(model, c, lam, mesh_geo)
+    efforts = {name: -lam[:, row] for name, row in cd.driver_rows.items()}
+    reactions = _joint_reactions(model, cd, lam, mesh_geo)
     # frame poses for drawing: frame origin = com - A(theta) com_local
     frame_pose = fastpath._place(q, -c.com_local).reshape(qb.shape)
     return Analysis(
@@ -236,6 +241,8 @@ def analyse(
         efforts=efforts, reactions=reactions, com=com, momentum=momentum, angular_momentum=ang,
         moment_point=(float(P[0]), float(P[1])), gravity=(float(g[0]), float(g[1])),
         extra=_Extra({"frame_pose": frame_pose, "total_mass": float(m.sum()),
-                      "redundant_actuators": redundancy(c), **({"condition": cond} if cond is not None else {})},
+                      "redundant_actuators": redundancy(cd),
+                      "actuated": c.dynamics is not None,
+                      **({"actuation_condition": actuation, "actuator_rates": rates} if actuation is not None else {}), **({"condition": cond} if cond is not None else {})},
                      condition),
     )

@@ -3,7 +3,7 @@ docstring): body indices, joint points relative to each centre of mass, constrai
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -79,6 +79,7 @@ class Compiled:
     com_local: np.ndarray | None = None  # (nb, 2) centres of mass in the bodies' own frames
     frame: "Compiled | None" = None  # the frame model's (:func:`.fastpath.frame_motion`), made once
     keys: tuple | None = None  # (shape, numbers, law ids) of the model (:func:`.warmstart.model_keys`), made once
+    dynamics: "Compiled | None" = None  # with actuators: the joints' rows and the actuators' (:func:`_actuated`)
 
     @property
     def nb(self) -> int:
@@ -172,7 +173,37 @@ def compile_model(model: Model) -> Compiled:
     )
     compiled.meshes = _compile_meshes(model, idx, local, joint_rows)
     compiled.com_local = np.array([com[n] for n in names], dtype=float).reshape(-1, 2)
+    compiled.dynamics = _actuated(compiled, joints_by_name, idx, local)
     return compiled
+
+
+def _actuated(c: Compiled, joints: dict, idx, local) -> Compiled | None:
+    """The system of the inverse dynamics when the model names actuators: the joints' own rows
+    (same indices as in ``c``) followed by one row per actuator, the gradient of its joint
+    coordinate (the primitive a driver of that joint would have). The drivers' rows are left
+    out: they prescribe the motion but apply nothing. With B the actuators' rows,
+    M q'' + Phi_j^T lambda_j - B^T tau = Q, i.e. the multipliers of this system with the
+    actuators' multipliers -tau (DESIGN.md, "Real machines"). None without actuators."""
+    model = c.model
+    if not model.actuators:
+        return None
+    nd = len(model.drivers)
+    joint_prims = c.prims[: len(c.prims) - nd]
+    rows = sum(p.rows for p in joint_prims)
+    prims, actuator_rows = list(joint_prims), {}
+    for a in model.actuators:
+        jt = joints.get(a.joint)
+        if jt is None or isinstance(jt, Gear):
+            what = "unknown joint" if jt is None else "a gear pair, not a revolute or prismatic joint"
+            raise ValueError(f"actuator {a.name!r}: {a.joint!r} is {what}")
+        if a.name in actuator_rows:
+            raise ValueError(f"actuator name {a.name!r} is used twice")
+        prims.append(_driver_primitive(Driver(a.name, ("joint", a.joint), None), joints, idx, local, model))
+        actuator_rows[a.name] = rows + len(actuator_rows)
+    owner = c.row_owner[:rows] + list(actuator_rows)
+    joint_rows = {n: [r for r in rs if r < rows] for n, rs in c.joint_rows.items() if n in joints}
+    return replace(c, prims=prims, row_owner=owner, driver_rows=actuator_rows, joint_rows=joint_rows,
+                   fast=None, frame=None, keys=None, condition=None)
 
 
 @dataclass

@@ -8,6 +8,7 @@ import numpy as np
 from ..model import Model, Prismatic, Revolute
 from .compile import Compiled, _perp, _rotate
 from .constraints import _split
+from .errors import AnalysisError
 
 
 def _tooth_rows(c: Compiled, qx: np.ndarray, J: np.ndarray) -> list[dict[str, np.ndarray]]:
@@ -98,6 +99,41 @@ def _joint_reactions(
         else:
             out[jt.name] = {"T": -lam[:, rows[0]]}
     return out
+
+
+ACTUATION_LIMIT = 1e11  # condition number of the actuated system beyond which the efforts are lost
+
+
+def actuation_condition(c: Compiled, Jf: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Condition numbers (N,) of the actuated system [Phi_joints; B^T] (``Jf``: its free
+    columns) along the motion, checked: fewer rows than coordinates (fewer actuators than
+    degrees of freedom), or a configuration where the actuators lose control of the mechanism
+    (condition above :data:`ACTUATION_LIMIT`: an effort there would be infinite), is an
+    :class:`AnalysisError` naming the actuators. ``c``: the system of :func:`.compile._actuated`."""
+    m, n = Jf.shape[1], Jf.shape[2]
+    names = ", ".join(repr(a) for a in c.driver_rows)
+    if m < n:
+        dof = n - (m - len(c.driver_rows))
+        raise AnalysisError(
+            f"not realisable: the mechanism has {dof} degree{'s' if dof != 1 else ''} of freedom but "
+            f"{len(c.driver_rows)} actuator{'s are' if len(c.driver_rows) != 1 else ' is'} named ({names}): "
+            f"name at least {dof} actuated joints", float(t[0]), joint=None,
+        )
+    s = np.linalg.svd(Jf, compute_uv=False)
+    cond = s[:, 0] / np.maximum(s[:, -1], 1e-300)
+    bad = np.flatnonzero(~(cond <= ACTUATION_LIMIT))
+    if bad.size:
+        k = int(bad[0])
+        always = bad.size == len(t)
+        raise AnalysisError(
+            f"not realisable: the actuators {names} cannot produce the prescribed motion "
+            + ("anywhere on it (their joint coordinates leave the mechanism free to move; choose other "
+               "actuated joints)" if always else
+               f"at t = {t[k]:.6g} s (condition number {cond[k]:.2g}: they lose control of the mechanism "
+               "there, a dead centre of the actuation; keep the motion away from it or actuate other joints)"),
+            float(t[k]),
+        )
+    return cond
 
 
 def _multipliers(c: Compiled, Jf: np.ndarray, rhs: np.ndarray) -> np.ndarray:

@@ -10,3 +10,4 @@ class AnalysisError(Exception):
         super().__init__(message)
         self.time = time
         self.joint = joint
+        self.q = None  # positions (3 nb,) where the position analysis stopped, when it did

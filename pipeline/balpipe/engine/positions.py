@@ -92,12 +92,14 @@ def _fail_position(c: Compiled, q: np.ndarray, t: float) -> AnalysisError:
     qx = _extend(q[None, :])
     phi = residual(c, qx, np.array([t]))[0]
     worst = int(np.argmax(np.abs(phi)))
-    return AnalysisError(
+    err = AnalysisError(
         f"position analysis did not converge at t = {t:.6g} s: joint {c.row_owner[worst]!r} cannot "
         f"be closed (residual {abs(phi[worst]):.3g}); the motion leaves the mechanism's workspace",
         t,
         c.row_owner[worst],
     )
+    err.q = q  # the configuration reached, for a diagnosis of the loop (balpipe.loop_closure)
+    return err
 
 
 def condition_numbers(c: Compiled, q: np.ndarray) -> np.ndarray:
@@ -180,10 +182,12 @@ def follow_motion(c: Compiled, t: np.ndarray, ops=None) -> np.ndarray:
     N = len(t)
     q, ok, _ = ops.newton(c.q0[None, :], t[:1], max_iter=50)
     if not ok[0]:
-        raise AnalysisError(
+        err = AnalysisError(
             "cannot assemble the mechanism at t = 0: " + str(_fail_position(c, q[0], float(t[0]))).split(": ", 1)[1],
             float(t[0]),
         )
+        err.q = q[0]
+        raise err
     _check_redundancy(c, q[0], float(t[0]))
     coarse_idx = np.unique(np.linspace(0, N - 1, min(N, _COARSE)).round().astype(int))
     tc = t[coarse_idx]

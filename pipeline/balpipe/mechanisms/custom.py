@@ -11,6 +11,7 @@ from typing import Annotated, Literal, Union
 import numpy as np
 from pydantic import Field
 
+from .. import actuation
 from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle, mesh_geometry
 from ..model import FRAME, Attachment, Body, Driver, Gear, Model, Prismatic, Revolute
 from ..spec_parts import SpecFieldError, Strict
@@ -106,7 +107,8 @@ class CustomMechanism(Strict):
     frame_points: dict[str, tuple[Length, Length]] = Field({}, description="named fixed points")
     bodies: list[CustomBody] = Field(min_length=1, description="the moving bodies")
     joints: list[JointSpec] = Field(min_length=1, description="revolute, prismatic and gear joints")
-    drivers: list[DriverSpec] = Field(min_length=1, description="the actuated coordinates")
+    drivers: list[DriverSpec] = Field(min_length=1, description="the prescribed coordinates (their motion is motion.drive)")
+    actuators: list[str] | None = Field(None, description=actuation.DESCRIPTION)
 
     def drives(self) -> dict[str, str]:
         out = {}
@@ -199,6 +201,8 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
         drivers=tuple(drivers),
         initial={b.name: tuple(b.pose) for b in mech.bodies},
         frame_points={k: tuple(v) for k, v in mech.frame_points.items()},
+        sources={**{b.name: root + ("bodies", k) for k, b in enumerate(mech.bodies)},
+                 **{j.name: root + ("joints", k) for k, j in enumerate(mech.joints)}},
     )
     for k, (j, jt) in enumerate(zip(mech.joints, joints)):
         if isinstance(jt, Gear):
@@ -207,6 +211,7 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
             except ValueError as exc:
                 key = "radius_b" if j.radius_a is not None and j.radius_b is None else "radius_a"
                 raise SpecFieldError(root + ("joints", k, key), str(exc)) from None
+    model = actuation.with_actuators(model, mech.actuators, root + ("actuators",))
     return model
 
 
@@ -259,6 +264,8 @@ def notation(mech: CustomMechanism) -> dict:
             f"{p}.radius_b": ours(f"r_{{{j.name},b}}", f"pitch radius of the driven gear of `{j.name}`"),
             f"{p}.pressure_angle": ours(f"α_{{{j.name}}}", f"pressure angle of gear pair `{j.name}`"),
         })
+    for k, a in enumerate(mech.actuators or []):
+        table[f"mechanism.actuators[{k}]"] = ours(f"τ_{{{a}}}", f"motor at joint `{a}`: its torque (revolute) or force (prismatic)")
     for k, d in enumerate(mech.drivers):
         p = f"mechanism.drivers[{k}]"
         for field, what in (("joint", "joint it drives"), ("body", "body whose coordinate it drives"),

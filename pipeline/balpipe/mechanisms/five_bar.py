@@ -34,7 +34,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .. import units
+from .. import actuation, units
 from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
 from ..model import FRAME, Attachment, Body, Driver, Gear, Law, Model, Revolute
 from ..laws.drives import path_laws
@@ -92,6 +92,10 @@ class FiveBarMechanism(Strict):
         (1, -1),
         description="sigma1, sigma2: +1 puts B_j on the counter-clockwise side of A_jC (the sign "
         "of the root in eq. 2; the paper's Fig. 3 is [+1, -1])",
+    )
+    actuators: list[str] | None = Field(
+        None, description="the motors' joints: default A1 and A2 for the plain 5R (their torques "
+        "are reported), the driven A1 when coupled; [] reports the virtual gripper forces instead",
     )
     coupling: CouplingSpec | None = Field(
         None,
@@ -422,10 +426,12 @@ def build(mech: FiveBarMechanism, laws: dict, t: np.ndarray) -> Model:
             Driver("gripper_y", ("y", "link3", "C"), laws["gripper_y"]),
         )
         name = "five-bar"
-    return Model(
+    model = Model(
         name=name, bodies=tuple(bodies), joints=tuple(joints), drivers=drivers,
         initial=initial, frame_points=frame_points,
     )
+    motors = mech.actuators if mech.actuators is not None else (["A1", "A2"] if mech.coupling is None else None)
+    return actuation.with_actuators(model, motors, ("mechanism", "actuators"))
 
 
 def _check_straight_path(mech: FiveBarMechanism, C: np.ndarray, t: np.ndarray) -> None:
@@ -559,6 +565,8 @@ def _notation() -> dict:
         "mechanism.links.distal_2.com": Sym("r_4", "centre of mass of link 4 from B_2"),
         "mechanism.links.distal_2.com_offset": ours("e_4", "offset of S_4 normal to link 4"),
         "mechanism.links.distal_2.inertia": Sym("I_4", "axial moment of inertia of link 4"),
+        "mechanism.actuators[0]": ours("τ_1", "first motor's joint (default A1): its torque is reported"),
+        "mechanism.actuators[1]": ours("τ_2", "second motor's joint (default A2): its torque is reported"),
         "mechanism.working_modes": Sym("(σ_1, σ_2)", "working modes: +1 puts B_j on the counter-clockwise side of A_jP (eq. 2)"),
         "mechanism.coupling.r1p": Sym("r_{1'}", "pitch radius of gear 1' on input link 1"),
         "mechanism.coupling.gear_1p.mass": Sym("m_{1'}", "mass of gear 1' (on link 1 at A_1)"),

@@ -179,8 +179,10 @@ def loads_figure(stages: list, prefix: str = "loads") -> str:
     return to_svg(fig, prefix)
 
 
-def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = None) -> str:
-    """Actuator torque (or force) of every driver, every stage; ``units``: driver -> 'N m' or 'N'."""
+def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = None,
+                   marks: list | None = None) -> str:
+    """Actuator torque (or force) of every driver, every stage; ``units``: driver -> 'N m' or 'N';
+    ``marks``: (time, label) of kinematic warnings (balpipe.dead_centres), drawn as dotted lines."""
     units = units or {}
     names = sorted({n for _, an in stages for n in an.efforts})
     fig, axes = plt.subplots(1, max(1, len(names)), figsize=(4.6 * max(1, len(names)), 2.8), squeeze=False)
@@ -192,6 +194,9 @@ def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = N
         ax.set_title(literal(f"Actuator effort: {name}" + (f" ({u})" if u else "")), fontsize=9)
         ax.set_ylabel({"N m": "torque (N m)", "N": "force (N)"}.get(u, "effort"))
         ax.set_xlabel("time (s)")
+        for tm, text in sorted(set(marks or [])):
+            ax.axvline(tm, color="0.4", linestyle=":", linewidth=0.9)
+            ax.annotate(literal(text), (tm, 1.0), xycoords=("data", "axes fraction"), fontsize=7, ha="right", va="top", rotation=90)
     legend_below(fig, axes[0][0])
     return to_svg(fig, prefix)
 

@@ -38,7 +38,8 @@ def study_figures(study: Study) -> dict:
     )
     efforts = figures.efforts_figure([(s.stage.label, s.analysis) for s in shown_stages(study)], prefix="efforts",
                                      units={d.name: present.driver_unit(s.stage.model, d.name)
-                                            for s in shown_stages(study) for d in s.stage.model.drivers})
+                                            for s in shown_stages(study) for d in (*s.stage.model.drivers, *s.stage.model.actuators)},
+                                     marks=[(w["time"], w["kind"].replace("_", " ")) for w in study.warnings])
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
     numbers = labels.gear_numbers([s.stage.model for s in shown_stages(study)])
     mech = [

@@ -9,12 +9,16 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..actuation import effort_unit
 from ..model import Model, Prismatic, Revolute
 
 
 def driver_unit(model: Model, name: str) -> str:
     """'N m' for a driver of a revolute joint or of an absolute angle, 'N' for a prismatic
-    joint or a point coordinate (x, y)."""
+    joint or a point coordinate (x, y); an actuator's by its joint."""
+    unit = effort_unit(model, name)
+    if unit is not None:
+        return unit
     for d in model.drivers:
         if d.name != name:
             continue
@@ -31,7 +35,10 @@ def driver_unit(model: Model, name: str) -> str:
 
 
 def driver_rate(analysis, model: Model, name: str) -> np.ndarray | None:
-    """The rate of the driven coordinate (rad/s or m/s) from the driver's law q(t), q'(t), q''(t)."""
+    """The rate of the driven coordinate (rad/s or m/s) from the driver's law q(t), q'(t), q''(t);
+    an actuator's joint rate from the analysis."""
+    if name in analysis.extra.get("actuator_rates", {}):
+        return analysis.extra["actuator_rates"][name]
     for d in model.drivers:
         if d.name == name:
             t = np.asarray(analysis.t, dtype=float)

@@ -68,6 +68,7 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
         "checks": study.checks,
         "references": study.references,
         "notes": study.balance.notes,
+        "warnings": study.warnings,  # dead centres and singularities (balpipe.dead_centres)
         "validation": validation if simulated else None,
         "reactionless": study.reactionless.to_json() if study.reactionless is not None else None,
         "torque_driven": {s.stage.name: s.torque.to_json() for s in study.stages if s.torque is not None}

@@ -473,7 +473,8 @@ def build_space(
 
     for d in model.drivers:
         if not drive:
-            sim.actuators.append(_actuator(model, d, pb, local))
+            if not model.actuators:  # named actuators apply the efforts instead (below)
+                sim.actuators.append(_actuator(model, d, pb, local))
             continue
         kind = d.target[0]
         if kind == "joint":
@@ -498,6 +499,8 @@ def build_space(
             sim.drives.append(dr)
         else:
             raise ValueError(f"driver {d.name!r}: unknown target {d.target!r}")
+    if not drive:  # motors at named joints (Model.actuators): their efforts, the engine's
+        sim.actuators += [_actuator(model, Driver(a.name, ("joint", a.joint), None), pb, local) for a in model.actuators]
     return sim
 
 
