@@ -108,7 +108,11 @@ def _infeasible(program: Program, caps: list, method: PartialBalance) -> SpecFie
     cp = program.cp
     masses = sum((program.z[p.col] for p in program.maps.parts), start=0.0)
     program.mass_budget.value = PF.UNBOUNDED
-    prob = cp.Problem(cp.Minimize(masses), program.base + [program.expression(t) <= b for t, b in caps])
+    cons = list(program.base)
+    for t, b in caps:
+        e, c = program.expression(t)
+        cons += c + [e <= b]
+    prob = cp.Problem(cp.Minimize(masses), cons)
     out = program.solve(prob)
     what = "; ".join(f"{t.label} <= {b:g} x unbalanced" for t, b in caps)
     if out.z is None:

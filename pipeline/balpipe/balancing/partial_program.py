@@ -111,31 +111,46 @@ class Program:
             cons.append(self.inertia_budget)
         self.base = cons
 
-    def expression(self, term: Term):
-        """The term's measure divided by its unbalanced value (a convex expression of z)."""
+    def expression(self, term: Term) -> tuple:
+        """The term's measure divided by its unbalanced value: (convex expression of z, the
+        constraints that define it). A peak is an epigraph variable u with one cone per sample
+        (|load_i| <= u); an RMS one cone over all the samples."""
         cp = self.cp
-        out = []
+        out, cons = [], []
         for L in term.maps:
             A, b = L.A / term.scale, L.b / term.scale
             comps = [A[:, k, :] @ self.z + b[:, k] for k in range(A.shape[1])]
             if term.kind == "rms":
                 out.append(cp.norm(cp.hstack(comps), 2) / math.sqrt(A.shape[0]))
-            elif len(comps) == 1:
-                out.append(cp.max(cp.abs(comps[0])))
+                continue
+            u = cp.Variable()
+            if len(comps) == 1:
+                cons += [comps[0] <= u, -u <= comps[0]]
             else:
-                out.append(cp.max(cp.norm(cp.vstack(comps), 2, axis=0)))
-        return out[0] if len(out) == 1 else cp.maximum(*out)
+                cons.append(cp.SOC(u * np.ones(A.shape[0]), cp.vstack(comps), axis=0))
+            out.append(u)
+        return (out[0] if len(out) == 1 else cp.maximum(*out)), cons
 
     def problem(self, objective: list[Term], caps: list[tuple[Term, float]] = (), eps: list[Term] = ()):
         """min sum w_i term_i s.t. the parts' constraints, the budget, ``caps`` (term <= bound, in
         units of the unbalanced value) and ``eps`` (term <= a parameter, for epsilon-constraint
         fronts). Returns (problem, cap constraints, eps parameters)."""
         cp = self.cp
-        obj = sum((t.weight * self.expression(t) for t in objective), start=0.0)
-        cap_cons = [self.expression(t) <= bound for t, bound in caps]
+        cons = list(self.base)
+        obj = 0.0
+        for t in objective:
+            e, c = self.expression(t)
+            obj, cons = obj + t.weight * e, cons + c
+        cap_cons = []
+        for t, bound in caps:
+            e, c = self.expression(t)
+            cap_cons.append(e <= bound)
+            cons += c
         params = [cp.Parameter(nonneg=True) for _ in eps]
-        eps_cons = [self.expression(t) <= p for t, p in zip(eps, params)]
-        return cp.Problem(cp.Minimize(obj), self.base + cap_cons + eps_cons), cap_cons, params
+        for t, p in zip(eps, params):
+            e, c = self.expression(t)
+            cons += c + [e <= p]
+        return cp.Problem(cp.Minimize(obj), cons + cap_cons), cap_cons, params
 
     def solve(self, problem, polish: list[Term] = ()) -> Outcome:
         """Solve; the terms of ``polish`` that come out below :data:`ZERO` of their unbalanced
