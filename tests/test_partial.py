@@ -27,6 +27,9 @@ SEGMENTS = [
     {"body": "crank", "name": "cw_crank", "segment": [[0, 0], [-0.08, 0]], "max_mass": 2.0},
     {"body": "rocker", "name": "cw_rocker", "segment": [[0, 0], [-0.12, 0]], "max_mass": 2.0},
 ]
+DISCS = [{"body": "crank", "name": "cw_crank", "disc": {"centre": [-0.05, 0], "radius": 0.05}},
+         {"body": "coupler", "name": "cw_coupler", "disc": {"centre": [0.15, 0], "radius": 0.3}},
+         {"body": "rocker", "name": "cw_rocker", "disc": {"centre": [-0.15, 0], "radius": 0.15}}]
 DISC = {"body": "coupler", "name": "cw_coupler", "disc": {"centre": [0.1, 0.02], "radius": 0.1}}
 POLYGON = {"body": "coupler", "name": "cw_poly", "polygon": [[0, -0.03], [0.2, -0.03], [0.2, 0.03], [0, 0.03]]}
 
@@ -185,9 +188,7 @@ def test_no_random_design_dominates_the_front():
 
 def test_force_front_reaches_zero_at_or_below_the_complete_design():
     rng = np.random.default_rng(5)
-    regions = [{"body": "crank", "name": "cw_crank", "disc": {"centre": [-0.05, 0], "radius": 0.05}},
-               {"body": "coupler", "name": "cw_coupler", "disc": {"centre": [0.15, 0], "radius": 0.3}},
-               {"body": "rocker", "name": "cw_rocker", "disc": {"centre": [-0.15, 0], "radius": 0.15}}]
+    regions = DISCS
     d = four_bar(rng, {"method": "force_balance", "counterweights": regions})
     complete = registry.balance(Spec.model_validate(d)).details["force_balance"]["total_mass"]
     d["balancing"] = method(regions, budget=complete, fronts={"points": 30})
@@ -309,3 +310,25 @@ def test_documented_example_runs():
     spec = Spec.model_validate(yaml.safe_load(block))
     det = registry.balance(spec).details["partial_balance"]
     assert det["terms"][0]["ratio"] < 1 and len(det["fronts"]["force_vs_mass"]) == spec.balancing.fronts.points
+
+
+def test_page_draws_the_fronts_and_results_hold_them():
+    import json
+
+    from balpipe.report.page import render_page
+    from balpipe.report.results import results_dict
+
+    rng = np.random.default_rng(5)
+    d = four_bar(rng, method(DISCS, budget=0.8, fronts={"points": 30}))
+    d["compare"] = [{"name": "complete", "label": "complete force balance",
+                     "balancing": {"method": "force_balance", "counterweights": DISCS}}]
+    st = study.run(Spec.model_validate(d))
+    res = results_dict(st, "x.yaml", "h", simulated=False)
+    fronts = json.loads(json.dumps(res))["balancing_details"]["partial_balance"]["fronts"]
+    for key in ("force_vs_mass", "moment_vs_mass", "force_vs_moment", "effort_vs_force"):
+        assert len(fronts[key]) >= 30, key
+    html = render_page(st, res, "text")
+    for title in ("Shaking force against added mass", "Shaking moment against added mass",
+                  "Shaking force against shaking moment", "Actuator effort against shaking force"):
+        assert title in html
+    assert "complete force balance" in html and "The chosen design removes" in html

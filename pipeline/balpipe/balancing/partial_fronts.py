@@ -20,6 +20,7 @@ from .partial_maps import Maps
 from .partial_program import Program, Term
 
 UNBOUNDED = 1e9  # kg: the mass budget when a programme should not be limited by it
+RELAX = (1e-9, 1e-7, 1e-5)  # relative slack on an epsilon-constraint, tried in turn
 
 
 def point(maps: Maps, z: np.ndarray, terms: dict[str, Term]) -> dict:
@@ -76,8 +77,11 @@ def tradeoff_front(program: Program, first: Term, second: Term, budget: float, n
     prob, _, (eps,) = program.problem([first], eps=[second])
     pts = []
     for e in np.linspace(a, max(a, b), n):
-        eps.value = float(e) * (1 + 1e-9) + 1e-12
-        out = program.solve(prob, polish=[first])
+        for slack in RELAX:  # the first cap is the least value itself: feasible only to the solver's tolerance
+            eps.value = float(e) * (1 + slack) + slack
+            out = program.solve(prob, polish=[first])
+            if out.z is not None:
+                break
         if out.z is not None:
             pts.append({"cap": float(e) * second.scale, **point(program.maps, out.z, terms)})
     return pts
