@@ -2,7 +2,7 @@
 
     python benchmarks/bench_partial.py [--designs 400] [--points 30]
 
-On specs/partial_custom_four_bar.yaml (401 samples, three counterweights):
+On specs/custom_four_bar_partial.yaml (401 samples, three counterweights):
 
 1. the force front (least peak shaking force against added mass, ``--points`` budgets) by the cone
    programme: one engine analysis for the affine maps, cvxpy's compilation, then one Clarabel
@@ -27,7 +27,7 @@ import numpy as np
 import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
-SPEC = ROOT / "specs" / "partial_custom_four_bar.yaml"
+SPEC = ROOT / "specs" / "custom_four_bar_partial.yaml"
 
 
 def cone_front(points: int) -> tuple[list[dict], dict]:

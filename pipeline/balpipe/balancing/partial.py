@@ -20,6 +20,7 @@ import math
 import numpy as np
 
 from ..model import Model
+from ..notation import ours, setting
 from ..spec_parts import SpecFieldError
 from . import partial_fronts as PF
 from .base import BalanceResult, Parameter, Stage
@@ -235,7 +236,39 @@ def design_table(maps: Maps, z: np.ndarray) -> list[dict]:
     return rows
 
 
+def _term_notation(root: str, terms: list, what: str) -> dict:
+    table = {}
+    for k, t in enumerate(terms):
+        p, name = f"{root}[{k}]", f"{t.measure} {t.load}" + (f" {t.actuator}" if t.actuator else "") + (f" {t.joint}" if t.joint else "")
+        table.update({
+            f"{p}.load": ours(f"{what} {k + 1}", f"the load of {what} {k + 1} ({name})"),
+            f"{p}.measure": ours(f"{what} {k + 1}", f"peak or RMS over the samples ({name})"),
+            f"{p}.actuator": ours(f"{what} {k + 1}", f"the actuator whose effort is meant ({name})"),
+            f"{p}.joint": ours(f"{what} {k + 1}", f"the joint whose load is meant ({name})"),
+            f"{p}.weight": ours(f"w_{{{k + 1}}}", f"weight of objective term {k + 1} ({name}, divided by its unbalanced value)"),
+            f"{p}.at_most": ours(f"c_{{{k + 1}}}", f"cap {k + 1}: {name} at most this"),
+            f"{p}.relative": ours(f"c_{{{k + 1}}}", f"cap {k + 1} is a multiple of the unbalanced value"),
+        })
+    return table
+
+
 def notation(method: PartialBalance) -> dict:
-    """Symbols of this method's inputs, named after its parts."""
-    return {**counterweight_notation(method.counterweights),
-            **counter_rotation_notation(method.counter_rotations, "balancing.counter_rotations")}
+    """Symbols of this method's inputs, named after its parts and terms."""
+    table = {**counterweight_notation(method.counterweights),
+             **counter_rotation_notation(method.counter_rotations, "balancing.counter_rotations"),
+             **_term_notation("balancing.objective", method.objective, "objective term"),
+             **_term_notation("balancing.caps", method.caps, "cap")}
+    for k, c in enumerate(method.counterweights):
+        n = c.name or f"cw_{c.body}"
+        table[f"balancing.counterweights[{k}].max_mass"] = ours(f"m_{{{n},max}}", f"upper bound on the mass of `{n}`")
+        table[f"balancing.counterweights[{k}].polygon"] = ours(f"`{n}`", f"`{n}` anywhere in a polygon on `{c.body}`")
+    for k, d in enumerate(method.counter_rotations):
+        table[f"balancing.counter_rotations[{k}].max_inertia"] = ours(f"I_{{{d.name},max}}", f"upper bound on the inertia of `{d.name}`")
+    table.update({
+        "balancing.budget.mass": ours("M_{max}", "added mass at most (counterweights and discs)"),
+        "balancing.budget.inertia": ours("I_{max}", "added inertia at most (discs, counterweights' second moments)"),
+        "balancing.fronts.points": setting("points", "points of each Pareto front"),
+        "balancing.fronts.max_mass": ours("M_{front}", "the mass fronts' largest budget"),
+        "balancing.label": setting("label", "label of the optimised stage"),
+    })
+    return table
