@@ -332,3 +332,65 @@ def test_page_draws_the_fronts_and_results_hold_them():
                   "Shaking force against shaking moment", "Actuator effort against shaking force"):
         assert title in html
     assert "complete force balance" in html and "The chosen design removes" in html
+
+
+def test_no_design_of_a_real_sweep_dominates_the_front(tmp_path):
+    """The same check through ``balpipe sweep`` (every design built as a spec of hand-placed parts)."""
+    import yaml
+
+    from balpipe import sweep
+
+    rng = np.random.default_rng(11)
+    d = four_bar(rng, method(SEGMENTS, budget=1.5, fronts={"points": 30, "max_mass": 4.0}))
+    front = registry.balance(Spec.model_validate(d)).details["partial_balance"]["fronts"]["force_vs_mass"]
+    d["balancing"] = {"method": "stages", "stages": [{"name": "cw", "parts": [
+        {"body": s["body"], "name": s["name"], "mass": 1.0, "position": s["segment"][1]} for s in SEGMENTS]}]}
+    d["sweep"] = {"vary": {"balancing.stages.0.parts.0.mass": "0:2", "balancing.stages.0.parts.0.position.0": "-0.08:0",
+                           "balancing.stages.0.parts.1.mass": "0:2", "balancing.stages.0.parts.1.position.0": "-0.12:0"},
+                  "sample": "random", "designs": 300, "seed": 3}
+    path = tmp_path / "sweep.yaml"
+    path.write_text(yaml.safe_dump(d, sort_keys=False))
+    rows = [r for r in sweep.run(sweep.plan(str(path)), jobs=1).rows if "error" not in r]
+    assert len(rows) == 300
+    mass = np.array([r["added_mass"] for r in rows])
+    force = np.array([r["max_shaking_force"] for r in rows])
+    for pt in front:
+        ok = mass <= pt["budget"]
+        if ok.any():
+            assert force[ok].min() >= pt["shaking_force"] * (1 - 1e-6)
+
+
+def test_cone_optimum_with_a_disc_and_spread_mass_equals_differential_evolution():
+    """Peak shaking moment, where the counterweights' inertias matter: a crank counterweight on a
+    segment (a point mass, J = m |c|^2 at the optimum or spread between the ends) and a coupler
+    counterweight anywhere in a disc with any realisable spread: centroidal inertia f m (r^2 -
+    |c - c0|^2), f in [0, 1] (a ring through c's chord at f = 1)."""
+    from scipy.optimize import LinearConstraint, differential_evolution
+
+    rng = np.random.default_rng(8)
+    budget = 0.5
+    disc = {"body": "coupler", "name": "cw_coupler", "disc": {"centre": [0.1, 0.0], "radius": 0.08}}
+    spec = Spec.model_validate(four_bar(rng, method([SEGMENTS[0], disc], [{"load": "shaking_moment"}], budget=budget)))
+    maps = setup(spec)
+    _, out, terms, *_ = P.solve(maps, spec.balancing)
+    best = terms[0].value(out.z)
+    seg, dsc = maps.parts
+    c0, r = np.asarray(dsc.points[0]), dsc.radius
+
+    def z_of(x):
+        z = np.zeros(maps.nz)
+        m, u, f = x[0], x[1], x[2]
+        c = np.asarray(seg.points[0]) + u * (np.asarray(seg.points[1]) - np.asarray(seg.points[0]))
+        L = float(np.linalg.norm(np.asarray(seg.points[1]) - np.asarray(seg.points[0])))
+        z[0:4] = m, m * c[0], m * c[1], m * float(c @ c) + f * m * u * (1 - u) * L * L  # spread between the ends
+        m2, rho, phi, f2 = x[3], x[4], x[5], x[6]
+        c = c0 + rho * r * np.array([math.cos(phi), math.sin(phi)])
+        z[4:8] = m2, m2 * c[0], m2 * c[1], m2 * float(c @ c) + f2 * m2 * r * r * (1 - rho * rho)
+        return z
+
+    f = lambda x: terms[0].value(z_of(x))  # noqa: E731
+    bounds = [(0, 2), (0, 1), (0, 1), (0, 2), (0, 1), (-math.pi, math.pi), (0, 1)]
+    res = differential_evolution(f, bounds, seed=2, tol=1e-14, atol=0, maxiter=4000, popsize=40,
+                                 constraints=LinearConstraint([[1, 0, 0, 1, 0, 0, 0]], 0, budget), polish=False)
+    assert best <= res.fun * (1 + 1e-9)
+    assert abs(res.fun - best) <= 1e-6 * best
