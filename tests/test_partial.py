@@ -13,9 +13,7 @@ import pytest
 
 from balpipe import registry, study
 from balpipe.balancing import partial as P
-from balpipe.balancing import partial_fronts as PF
 from balpipe.balancing import partial_maps as PM
-from balpipe.balancing.partial_program import Program
 from balpipe.engine import analyse
 from balpipe.spec import Spec
 from balpipe.spec_parts import SpecFieldError

@@ -27,7 +27,7 @@ import numpy as np
 
 from .partial_maps import Load, Maps
 
-SOLVER_SETTINGS: dict = {}  # Clarabel's defaults (1e-8 gaps and feasibility); zeros are polished
+SOLVER_SETTINGS: dict = {"max_iter": 80}  # Clarabel's tolerances (1e-8); zeros are polished; a front point at a boundary may stall
 ZERO = 1e-7  # a term whose optimum is below this fraction of its unbalanced value is polished to zero
 
 
