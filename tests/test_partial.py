@@ -160,7 +160,7 @@ def test_cone_optimum_equals_differential_evolution(objective):
     f = lambda x: terms[0].value(_physical(maps, x))  # noqa: E731
     res = differential_evolution(f, [(0, 2), (0, 1), (0, 2), (0, 1)], seed=1, tol=1e-14, atol=0, maxiter=3000,
                                  popsize=30, constraints=LinearConstraint([[1, 0, 1, 0]], 0, budget), polish=False)
-    assert best <= res.fun * (1 + 1e-9)
+    assert best <= res.fun * (1 + 1e-7)  # DE cannot beat it beyond the solver's tolerance (gaps 1e-8)
     assert abs(res.fun - best) <= 1e-6 * best
 
 
@@ -390,5 +390,28 @@ def test_cone_optimum_with_a_disc_and_spread_mass_equals_differential_evolution(
     bounds = [(0, 2), (0, 1), (0, 1), (0, 2), (0, 1), (-math.pi, math.pi), (0, 1)]
     res = differential_evolution(f, bounds, seed=2, tol=1e-14, atol=0, maxiter=4000, popsize=40,
                                  constraints=LinearConstraint([[1, 0, 0, 1, 0, 0, 0]], 0, budget), polish=False)
-    assert best <= res.fun * (1 + 1e-9)
+    assert best <= res.fun * (1 + 1e-7)  # DE cannot beat it beyond the solver's tolerance (gaps 1e-8)
     assert abs(res.fun - best) <= 1e-6 * best
+
+
+def test_joint_load_objective_and_inertia_budget_reach_the_analysed_stage():
+    """Minimise the peak load of the crank's bearing with a polygon counterweight on the coupler
+    and a counter-rotating disc under an inertia budget: the engine's analysis of the stage gives
+    the predicted peak, the budget is reported active and not exceeded."""
+    rng = np.random.default_rng(4)
+    cr = [{"name": "disc_crank", "carrier": "frame", "at": [0, 0], "geared_to": "crank", "ratio": -1}]
+    d = four_bar(rng, method([SEGMENTS[0], POLYGON], [{"load": "joint", "joint": "O2"},
+                                                      {"load": "shaking_moment", "measure": "rms"}],
+                             budget=0.6, counter_rotations=cr))
+    d["balancing"]["budget"]["inertia"] = 2e-4
+    st = study.run(Spec.model_validate(d))
+    det = st.balance.details["partial_balance"]
+    load = det["terms"][0]
+    assert load["ratio"] < 1
+    an = st.stages[1].analysis
+    assert np.hypot(an.reactions["O2"]["Fx"], an.reactions["O2"]["Fy"]).max() == pytest.approx(load["value"], rel=1e-9)
+    assert any(a.startswith("inertia budget") for a in det["active"])
+    model = st.stages[1].stage.model
+    second = model.body("disc_crank").inertia + sum(
+        a.mass * (a.position[0] ** 2 + a.position[1] ** 2) + a.inertia for b in model.bodies for a in b.attachments)
+    assert second <= 2e-4 * (1 + 1e-6)

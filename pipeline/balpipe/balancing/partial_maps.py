@@ -114,6 +114,21 @@ class Maps:
     def added_mass(self, z: np.ndarray) -> float:
         return float(sum(z[p.col] for p in self.parts)) + self.fixed_mass
 
+    def realised(self, z: np.ndarray, tiny: float = 1e-12) -> np.ndarray:
+        """z as :meth:`design` builds it: no part below ``tiny`` x the largest mass, every
+        J >= |s|^2 / m and every disc inertia >= 0 exactly (a solver meets them to its tolerance)."""
+        z = np.asarray(z, dtype=float).copy()
+        big = max([abs(z[p.col]) for p in self.parts] + [1e-300])
+        for p in self.parts:
+            m, sx, sy, J = z[p.col : p.col + 4]
+            if m <= tiny * big:
+                z[p.col : p.col + 4] = 0.0
+            else:
+                z[p.col + 3] = max(J, (sx * sx + sy * sy) / m)
+        for d in self.discs:
+            z[d.col] = max(0.0, z[d.col])
+        return z
+
     def design(self, z: np.ndarray, tiny: float = 1e-12) -> Model:
         """The model with the parts of design z: each counterweight of mass m at s / m with
         centroidal inertia J - |s|^2 / m (none below ``tiny`` x the largest mass), each disc's

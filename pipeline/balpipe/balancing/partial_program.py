@@ -61,6 +61,21 @@ class Outcome:
     budget_dual: float
 
 
+def variable_scale(maps: Maps) -> np.ndarray:
+    """Units of the unknowns, so that the solver's tolerances are relative: per counterweight
+    (1, L, L, L^2) with L the farthest point of its region from its body's origin, per disc the
+    largest L^2 (kg, kg m, kg m^2)."""
+    d = np.ones(maps.nz)
+    Ls = [1e-3]
+    for p in maps.parts:
+        L = max([float(np.hypot(*v)) for v in p.points] + [1e-3]) + p.radius
+        d[p.col : p.col + 4] = (1.0, L, L, L * L)
+        Ls.append(L)
+    for disc in maps.discs:
+        d[disc.col] = max(Ls) ** 2
+    return d
+
+
 class Program:
     """Variables and realisability constraints of ``maps``' parts, the mass budget (a parameter,
     for fronts) and optional inertia budget; problems built on them share the variables."""
@@ -70,7 +85,7 @@ class Program:
 
         self.cp = cp
         self.maps = maps
-        self.z = cp.Variable(maps.nz, name="z")
+        self.z = cp.multiply(variable_scale(maps), cp.Variable(maps.nz, name="z_scaled"))  # O(1) unknowns
         self.mass_budget = cp.Parameter(nonneg=True, name="mass_budget")
         z = self.z
         cons = []
@@ -107,7 +122,8 @@ class Program:
         self.inertia_budget = None
         if inertia_budget is not None:
             second = [z[p.col + 3] for p in maps.parts] + [z[d.col] for d in maps.discs]
-            self.inertia_budget = sum(second, start=0.0) <= inertia_budget
+            scale = inertia_budget if inertia_budget > 0 else 1.0  # the solver's tolerance relative to the budget
+            self.inertia_budget = sum(second, start=0.0) / scale <= inertia_budget / scale
             cons.append(self.inertia_budget)
         self.base = cons
 
@@ -170,6 +186,7 @@ class Program:
         for t in polish:
             if t.value(z) <= ZERO * t.scale:
                 z = polish_zero(self.maps, t, z)
+        z = self.maps.realised(z)
         dual = self.budget.dual_value
         return Outcome(z, status, float(problem.value), -float(dual) if dual is not None else 0.0)
 
