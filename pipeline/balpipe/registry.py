@@ -15,6 +15,7 @@ from .balancing import rpr3_idler, rpr3_scott_russell
 from .balancing import rrr4 as rrr4_balancing
 from .balancing import force_balance as generic_force
 from .balancing import moment_balance as generic_moment
+from .balancing import partial as generic_partial
 from .balancing import slider_crank as sc_balancing
 from .balancing import stages as generic_stages
 from .balancing.base import BalanceResult, Stage
@@ -89,6 +90,8 @@ METHODS.update({
         generic_moment.balance, (), "least-mass counterweights + counter-rotations from the angular momentum", generic=True
     ),
     "stages": Method(generic_stages.balance, (), "stages written by hand, each adding parts", generic=True),
+    "partial_balance": Method(generic_partial.balance, (), "optimal partial balancing (cone programme)", generic=True,
+                              uses_spec=True, notation=generic_partial.notation),
 })
 
 # the papers' symbols of each template's and method's inputs (balpipe.notation, the inputs table)
@@ -154,7 +157,7 @@ def balance(spec: Any, balancing: Any = None) -> BalanceResult:
         return BalanceResult([], [Stage("unbalanced", "unbalanced", model, "the mechanism as given")])
     method = METHODS[name]
     if method.generic:
-        return method.balance(spec.mechanism, balancing, model, t=time_grid(spec))
+        return method.balance(spec.mechanism, balancing, model, t=time_grid(spec), **({"spec": spec} if method.uses_spec else {}))
     if spec.mechanism.template not in method.templates:
         raise SpecFieldError(
             ("balancing", "method"),

@@ -17,6 +17,7 @@ from .balancing.decoupling import GearDecoupling
 from .balancing.five_bar import FiveBarGearBalancing
 from .balancing.force_balance import ForceBalance
 from .balancing.moment_balance import MomentBalance
+from .balancing.partial_spec import PartialBalance
 from .balancing.rpr3_idler import Rpr3IdlerLoop
 from .balancing.rpr3_scott_russell import Rpr3ScottRussell
 from .balancing.rrr4 import RRR4Balancing
@@ -47,7 +48,7 @@ Mechanism = Annotated[
 Balancing = Annotated[
     Union[
         NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing, RRR4Balancing, Rpr3IdlerLoop, Rpr3ScottRussell,
-        GearDecoupling, ComMotionPlanning, ForceBalance, MomentBalance, Stages,
+        GearDecoupling, ComMotionPlanning, ForceBalance, MomentBalance, Stages, PartialBalance,
     ],
     Field(discriminator="method", description="the balancing method and its design choices"),
 ]

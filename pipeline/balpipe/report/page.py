@@ -7,7 +7,7 @@ import numpy as np
 from .. import realisable
 from ..laws.drives import law_names
 from ..study import Study, ratio_reference
-from . import figures, labels, present, toc
+from . import figures, labels, partial_figures, present, toc
 from .notation_table import notation_groups
 from .render import environment
 from .results import joint_load_table
@@ -48,6 +48,7 @@ def study_figures(study: Study) -> dict:
         for k, s in enumerate(shown_stages(study))
     ]
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
+    extra += partial_figures.figures(study)  # the fronts of an optimal partial balancing, if any
     residuals, drift = [], []
     vals = [s for s in shown_stages(study) if s.validation is not None]
     if vals:

@@ -1,0 +1,274 @@
+"""The ``partial_balance`` method, for any model (``custom`` included): counterweights in regions
+of named links and counter-rotating discs chosen by a second-order cone programme
+(:mod:`.partial_program`) on the affine maps of the loads (:mod:`.partial_maps`), to global
+optimality at the analysed motion; Pareto fronts (:mod:`.partial_fronts`) for the page.
+
+Stages: ``unbalanced``, ``partial`` (the optimum's parts added). The details for results.json hold
+the objective achieved, each term, the active constraints, the budget's sensitivity (the dual
+value: d objective / d mass budget) and the fronts.
+
+Requests that cannot be met are located errors before any stage is analysed: a region outside
+its link (farther than :data:`REACH` x the link's size from the link's frame origin), a non-convex
+polygon, a part on a body that neither accelerates nor turns, a name that is not an actuator or a
+joint, and caps that no design within the budget meets (the error gives the least mass that does).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..model import Model
+from ..notation import ours, setting
+from ..spec_parts import SpecFieldError
+from . import partial_fronts as PF
+from .base import BalanceResult, Parameter, Stage
+from .force_balance import _point, counterweight_notation, regions_from_spec
+from .moment_balance import add_discs, counter_rotation_notation
+from .partial_maps import DiscVars, Maps, PartVars, build
+from .partial_program import Program, Term
+from .partial_spec import PartialBalance, PartialCounterweightSpec
+from .regressor import model_size
+
+REACH = 2.0  # a region must lie within this multiple of its link's size from the link's origin
+ACTIVE = 1e-6  # relative slack below which a constraint is reported active
+ROOT = ("balancing",)
+
+
+def _link_size(model: Model, body: str) -> float:
+    b = model.body(body)
+    r = [math.hypot(*p) for p in b.points.values()] + [math.hypot(*b.com)]
+    return max(r + [1e-3 * model_size(model)])
+
+
+def _polygon(model: Model, s: PartialCounterweightSpec, path: tuple) -> tuple:
+    V = np.array([_point(model, s.body, p, path + ("polygon", i)) for i, p in enumerate(s.polygon)])
+    e = np.roll(V, -1, axis=0) - V
+    turn = e[:, 0] * np.roll(e, -1, axis=0)[:, 1] - e[:, 1] * np.roll(e, -1, axis=0)[:, 0]
+    if not (np.all(turn > 0) or np.all(turn < 0)):
+        raise SpecFieldError(path + ("polygon",), "the polygon must be convex with its vertices in order (no three collinear)")
+    return tuple(map(tuple, V))
+
+
+def parts_from_spec(model: Model, method: PartialBalance) -> tuple[Model, list[PartVars], list[DiscVars]]:
+    """The model with the discs (zero inertia) and the design variables, every region checked
+    (bodies, names and points as :func:`.force_balance.regions_from_spec` checks them; a polygon
+    stands there as its first vertex)."""
+    root = ROOT + ("counterweights",)
+    specs = method.counterweights
+    polygons = {k: _polygon(model, s, root + (k,)) for k, s in enumerate(specs) if s.polygon is not None}
+    proxies = [s if s.polygon is None else s.model_copy(update={"polygon": None, "at": s.polygon[0]}) for s in specs]
+    parts = []
+    for k, r in enumerate(regions_from_spec(model, proxies, root)):
+        kind, pts = ("polygon", polygons[k]) if k in polygons else (r.kind, r.points)
+        far = max(math.hypot(*p) for p in pts) + r.radius
+        size = _link_size(model, r.body)
+        if far > REACH * size:
+            raise SpecFieldError(root + (k, kind if kind != "point" else "at"),
+                                 f"the region reaches {far:.4g} m from {r.body!r}'s frame origin, outside the link "
+                                 f"(at most {REACH:g} x its size {size:.4g} m)")
+        parts.append(PartVars(r.name, r.body, kind, pts, r.radius, specs[k].max_mass, 4 * len(parts)))
+    with_discs = add_discs(model, method.counter_rotations, ROOT + ("counter_rotations",))
+    discs = [DiscVars(s.name, float(s.mass), s.max_inertia, 4 * len(parts) + k) for k, s in enumerate(method.counter_rotations)]
+    return with_discs, parts, discs
+
+
+def _check_names(maps: Maps, method: PartialBalance) -> None:
+    joints = [j.name for j in maps.model.joints]
+    for key, terms in (("objective", method.objective), ("caps", method.caps)):
+        for k, t in enumerate(terms):
+            if t.load == "effort" and t.actuator and t.actuator not in maps.drivers:
+                raise SpecFieldError(ROOT + (key, k, "actuator"), f"no actuator {t.actuator!r} (actuators: {', '.join(maps.drivers) or 'none'})")
+            if t.load == "effort" and not maps.drivers:
+                raise SpecFieldError(ROOT + (key, k, "load"), "the mechanism has no actuator")
+            if t.load == "joint" and t.joint not in joints:
+                raise SpecFieldError(ROOT + (key, k, "joint"), f"no joint {t.joint!r} (joints: {', '.join(joints)})")
+    for k, p in enumerate(maps.parts):
+        if not maps.moving[p.body]:
+            raise SpecFieldError(ROOT + ("counterweights", k, "body"),
+                                 f"{p.body!r} neither accelerates nor turns during the motion: a part on it changes no load")
+
+
+def term_of(maps: Maps, t, weight: float = 1.0) -> Term:
+    label = t.load + (f" {t.actuator}" if t.actuator else "") + (f" {t.joint}" if t.joint else "")
+    return Term(tuple(maps.load(t.load, t.actuator, t.joint)), t.measure, weight, f"{t.measure} {label}")
+
+
+def standard_terms(maps: Maps) -> dict[str, Term]:
+    """The peaks the fronts and the tables report: force, moment, effort (all actuators)."""
+    out = {"shaking_force": Term((maps.loads["shaking_force"],), "peak", 1.0, "peak shaking_force"),
+           "shaking_moment": Term((maps.loads["shaking_moment"],), "peak", 1.0, "peak shaking_moment")}
+    if maps.drivers:
+        out["effort"] = Term(tuple(maps.load("effort")), "peak", 1.0, "peak effort")
+    return out
+
+
+def _infeasible(program: Program, caps: list, method: PartialBalance) -> SpecFieldError:
+    """Why nothing meets the caps within the budget: the least mass that does, if any."""
+    cp = program.cp
+    masses = sum((program.z[p.col] for p in program.maps.parts), start=0.0)
+    program.mass_budget.value = PF.UNBOUNDED
+    cons = list(program.base)
+    for t, b in caps:
+        e, c = program.expression(t)
+        cons += c + [e <= b]
+    prob = cp.Problem(cp.Minimize(masses), cons)
+    out = program.solve(prob)
+    what = "; ".join(f"{t.label} <= {b:g} x unbalanced" for t, b in caps)
+    if out.z is None:
+        return SpecFieldError(ROOT + ("caps",), f"no design of these parts (within their bounds) meets the caps ({what}) at any added mass")
+    return SpecFieldError(ROOT + ("budget", "mass"),
+                          f"a budget of {method.budget.mass:.6g} kg is too small for the caps ({what}): "
+                          f"they need at least {program.maps.added_mass(out.z):.6g} kg")
+
+
+def solve(maps: Maps, method: PartialBalance):
+    """The optimum: (program, outcome, objective terms, caps as (term, bound))."""
+    program = Program(maps, method.budget.inertia)
+    objective = [term_of(maps, t, t.weight) for t in method.objective]
+    caps = []
+    for c in method.caps:
+        t = term_of(maps, c)
+        caps.append((t, c.at_most if c.relative else c.at_most / t.scale))
+    prob, cap_cons, _ = program.problem(objective, caps)
+    program.mass_budget.value = float(method.budget.mass)
+    out = program.solve(prob, polish=objective)
+    if out.z is None:
+        raise _infeasible(program, caps, method) if caps else SpecFieldError(
+            ROOT + ("budget", "mass"), f"no design within the budget ({out.status})")
+    return program, out, objective, caps, cap_cons
+
+
+def active_constraints(program: Program, z: np.ndarray, method: PartialBalance, caps: list) -> list[str]:
+    maps = program.maps
+    out = []
+    if maps.added_mass(z) >= method.budget.mass * (1 - ACTIVE) - 1e-12:
+        out.append(f"mass budget ({method.budget.mass:.6g} kg)")
+    if program.inertia_budget is not None:
+        used = sum(z[p.col + 3] for p in maps.parts) + sum(z[d.col] for d in maps.discs)
+        if used >= method.budget.inertia * (1 - ACTIVE) - 1e-15:
+            out.append(f"inertia budget ({method.budget.inertia:.6g} kg m^2)")
+    for name, _, bound in program.part_caps:
+        col = next((p.col for p in maps.parts if p.name == name), None)
+        col = col if col is not None else next(d.col for d in maps.discs if d.name == name)
+        if z[col] >= bound * (1 - ACTIVE):
+            out.append(f"{name} at its bound ({bound:.6g})")
+    for t, bound in caps:
+        if t.value(z) / t.scale >= bound * (1 - ACTIVE):
+            out.append(f"cap: {t.label} = {bound:g} x unbalanced")
+    for p in maps.parts:
+        m = z[p.col]
+        if p.kind == "disc" and m > 0:
+            c = z[p.col + 1 : p.col + 3] / m
+            if math.hypot(*(c - np.asarray(p.points[0]))) >= p.radius * (1 - ACTIVE):
+                out.append(f"{p.name} on the edge of its disc")
+    return out
+
+
+def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None) -> BalanceResult:
+    with_discs, parts, discs = parts_from_spec(model, method)
+    gravity = (0.0, -spec.analysis.g) if spec is not None and spec.analysis.gravity else (0.0, 0.0)
+    point = tuple(spec.analysis.moment_point) if spec is not None else (0.0, 0.0)
+    maps = build(with_discs, model, t, parts, discs, gravity, point)
+    _check_names(maps, method)
+    program, out, objective, caps, _ = solve(maps, method)
+    z = out.z
+    std = standard_terms(maps)
+    design = maps.design(z)
+    active = active_constraints(program, z, method, caps)
+    terms = [{"term": t.label, "weight": t.weight, "value": t.value(z), "unbalanced": t.scale,
+              "ratio": t.value(z) / t.scale} for t in objective]
+    details = {
+        "objective": float(sum(t.weight * t.value(z) / t.scale for t in objective)),
+        "terms": terms,
+        "caps": [{"term": t.label, "at_most": b, "value": t.value(z) / t.scale} for t, b in caps],
+        "active": active,
+        "budget": {"mass": method.budget.mass, "inertia": method.budget.inertia},
+        "sensitivity": out.budget_dual,
+        "added_mass": maps.added_mass(z),
+        "peaks": {k: v.value(z) for k, v in std.items()},
+        "unbalanced": {k: v.scale for k, v in std.items()},
+        "status": out.status,
+        "solver": "cvxpy + Clarabel",
+        "design": design_table(maps, z),
+    }
+    if method.fronts is not None:
+        details["fronts"] = PF.compute(program, std, method.budget.mass, method.fronts.points, method.fronts.max_mass)
+    params = [Parameter(f"{r['name']}.{k}", r[k], u, "cone programme (Clarabel)", f"{r['name']} on {r['body']}")
+              for r in details["design"] for k, u in (("mass", "kg"), ("x", "m"), ("y", "m"), ("inertia", "kg m^2"))
+              if k in r]
+    params += [
+        Parameter("added_mass", details["added_mass"], "kg", "cone programme (Clarabel)", "mass of the parts"),
+        Parameter("objective", details["objective"], "", "cone programme (Clarabel)",
+                  "sum of weight x term / unbalanced term at the optimum"),
+        Parameter("budget_sensitivity", out.budget_dual, "1/kg", "dual value of the mass budget",
+                  "change of the objective per kg more budget"),
+    ]
+    notes = [
+        "Optimal partial balancing by a second-order cone programme (cvxpy, Clarabel) over the "
+        f"{len(t)} time samples: objective {' + '.join(f'{x.weight:g} x {x.label}' for x in objective)} "
+        f"(each divided by its unbalanced value) = {details['objective']:.6g} with {details['added_mass']:.6g} kg added; "
+        f"active: {', '.join(active) or 'none'}; d objective / d budget = {out.budget_dual:.4g} per kg."
+    ]
+    label = method.label or "partial balance"
+    stages = [Stage("unbalanced", "unbalanced", model, "the mechanism as given"),
+              Stage("partial", label, design, "parts chosen by the cone programme (global optimum at this motion)")]
+    return BalanceResult(params, stages, notes, details={"partial_balance": details})
+
+
+def design_table(maps: Maps, z: np.ndarray) -> list[dict]:
+    """Each part of design z: mass, centre of mass, centroidal inertia (counterweights), inertia (discs)."""
+    rows = []
+    big = max([abs(z[p.col]) for p in maps.parts] + [1e-300])
+    for p in maps.parts:
+        m, sx, sy, J = (float(v) for v in z[p.col : p.col + 4])
+        if m <= 1e-12 * big:  # no part (as Maps.design): its position is undefined, show the region's first point
+            m, (sx, sy), J = 0.0, p.points[0], 0.0
+            x, y = sx, sy
+        else:
+            x, y = sx / m, sy / m
+        rows.append({"name": p.name, "body": p.body, "region": p.kind, "mass": m, "x": x, "y": y,
+                     "inertia": max(0.0, J - m * (x * x + y * y))})
+    for d in maps.discs:
+        rows.append({"name": d.name, "body": d.name, "region": "counter-rotation", "mass": d.mass,
+                     "inertia": max(0.0, float(z[d.col]))})
+    return rows
+
+
+def _term_notation(root: str, terms: list, what: str) -> dict:
+    table = {}
+    for k, t in enumerate(terms):
+        p, name = f"{root}[{k}]", f"{t.measure} {t.load}" + (f" {t.actuator}" if t.actuator else "") + (f" {t.joint}" if t.joint else "")
+        table.update({
+            f"{p}.load": ours(f"{what} {k + 1}", f"the load of {what} {k + 1} ({name})"),
+            f"{p}.measure": ours(f"{what} {k + 1}", f"peak or RMS over the samples ({name})"),
+            f"{p}.actuator": ours(f"{what} {k + 1}", f"the actuator whose effort is meant ({name})"),
+            f"{p}.joint": ours(f"{what} {k + 1}", f"the joint whose load is meant ({name})"),
+            f"{p}.weight": ours(f"w_{{{k + 1}}}", f"weight of objective term {k + 1} ({name}, divided by its unbalanced value)"),
+            f"{p}.at_most": ours(f"c_{{{k + 1}}}", f"cap {k + 1}: {name} at most this"),
+            f"{p}.relative": ours(f"c_{{{k + 1}}}", f"cap {k + 1} is a multiple of the unbalanced value"),
+        })
+    return table
+
+
+def notation(method: PartialBalance) -> dict:
+    """Symbols of this method's inputs, named after its parts and terms."""
+    table = {**counterweight_notation(method.counterweights),
+             **counter_rotation_notation(method.counter_rotations, "balancing.counter_rotations"),
+             **_term_notation("balancing.objective", method.objective, "objective term"),
+             **_term_notation("balancing.caps", method.caps, "cap")}
+    for k, c in enumerate(method.counterweights):
+        n = c.name or f"cw_{c.body}"
+        table[f"balancing.counterweights[{k}].max_mass"] = ours(f"m_{{{n},max}}", f"upper bound on the mass of `{n}`")
+        table[f"balancing.counterweights[{k}].polygon"] = ours(f"`{n}`", f"`{n}` anywhere in a polygon on `{c.body}`")
+    for k, d in enumerate(method.counter_rotations):
+        table[f"balancing.counter_rotations[{k}].max_inertia"] = ours(f"I_{{{d.name},max}}", f"upper bound on the inertia of `{d.name}`")
+    table.update({
+        "balancing.budget.mass": ours("M_{max}", "added mass at most (counterweights and discs)"),
+        "balancing.budget.inertia": ours("I_{max}", "added inertia at most (discs, counterweights' second moments)"),
+        "balancing.fronts.points": setting("points", "points of each Pareto front"),
+        "balancing.fronts.max_mass": ours("M_{front}", "the mass fronts' largest budget"),
+        "balancing.label": setting("label", "label of the optimised stage"),
+    })
+    return table

@@ -1,0 +1,115 @@
+"""Pareto fronts of a partial balancing, each a sequence of cone programmes on one compiled problem
+(epsilon-constraint: the mass budget or a cap on the other load is a cvxpy parameter, so each
+point re-solves without re-compiling):
+
+* shaking force against added mass, and shaking moment against added mass (budget 0 .. max);
+* shaking force against shaking moment, and actuator effort against shaking force, at the spec's
+  budget (a cap on the second load from its least to its value at the first load's optimum);
+
+and the least added mass of complete balancing in the same regions along the analysed motion
+(the force, and the force and the moment together), where it exists: the loads set to zero as
+linear equations (:func:`.least_mass.independent_equations`), the added mass minimised.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .least_mass import independent_equations
+from .partial_maps import Maps
+from .partial_program import Program, Term
+
+UNBOUNDED = 1e9  # kg: the mass budget when a programme should not be limited by it
+RELAX = (1e-9, 1e-7, 1e-5)  # relative slack on an epsilon-constraint, tried in turn
+
+
+def point(maps: Maps, z: np.ndarray, terms: dict[str, Term]) -> dict:
+    """The loads (SI) and added mass of design z."""
+    out = {"added_mass": maps.added_mass(z)}
+    out.update({name: t.value(z) for name, t in terms.items()})
+    return out
+
+
+def least_complete_mass(program: Program, terms: list[Term]) -> tuple[float, np.ndarray] | None:
+    """(least added mass, design) with every load of ``terms`` zero at every sample, or None."""
+    cp = program.cp
+    maps = program.maps
+    A = np.concatenate([L.A.reshape(-1, maps.nz) for t in terms for L in t.maps])
+    b = np.concatenate([L.b.reshape(-1) for t in terms for L in t.maps])
+    Ar, br, inconsistent = independent_equations(A, -b)
+    if inconsistent:
+        return None
+    scale = max(float(np.max(np.abs(Ar))), 1e-300)
+    masses = sum((program.z[p.col] for p in maps.parts), start=0.0)
+    prob = cp.Problem(cp.Minimize(masses), program.base + [(Ar / scale) @ program.z == br / scale])
+    program.mass_budget.value = UNBOUNDED
+    out = program.solve(prob, polish=[Term(tuple(L for t in terms for L in t.maps), "peak")])
+    if out.z is None:
+        return None
+    worst = max(t.value(out.z) / t.scale for t in terms)
+    if worst > 1e-6:  # the equations are met only up to the solver's tolerance: not a complete balance
+        return None
+    return maps.added_mass(out.z), out.z
+
+
+def mass_front(program: Program, term: Term, masses: np.ndarray, terms: dict[str, Term]) -> list[dict]:
+    """min ``term`` for each mass budget."""
+    prob, _, _ = program.problem([term])
+    pts = []
+    for M in masses:
+        program.mass_budget.value = float(M)
+        out = program.solve(prob, polish=[term])
+        if out.z is not None:
+            pts.append({"budget": float(M), **point(program.maps, out.z, terms), "sensitivity": out.budget_dual * term.scale})
+    return pts
+
+
+def tradeoff_front(program: Program, first: Term, second: Term, budget: float, n: int,
+                   terms: dict[str, Term]) -> list[dict]:
+    """min ``first`` s.t. ``second`` <= eps, eps from the least ``second`` to its value where
+    ``first`` is least, at the mass ``budget``."""
+    program.mass_budget.value = float(budget)
+    lo = program.solve(program.problem([second])[0], polish=[second])
+    hi = program.solve(program.problem([first])[0], polish=[first])
+    if lo.z is None or hi.z is None:
+        return []
+    a, b = second.value(lo.z) / second.scale, second.value(hi.z) / second.scale
+    prob, _, (eps,) = program.problem([first], eps=[second])
+    pts = []
+    for e in np.linspace(a, max(a, b), n):
+        for slack in RELAX:  # the first cap is the least value itself: feasible only to the solver's tolerance
+            eps.value = float(e) * (1 + slack) + slack
+            out = program.solve(prob, polish=[first])
+            if out.z is not None:
+                break
+        if out.z is not None:
+            pts.append({"cap": float(e) * second.scale, **point(program.maps, out.z, terms)})
+    return pts
+
+
+def compute(program: Program, terms: dict[str, Term], budget: float, n: int, max_mass: float | None) -> dict:
+    """Every front and the complete balances' least masses (None where infeasible)."""
+    force, moment = terms["shaking_force"], terms["shaking_moment"]
+    complete_f = least_complete_mass(program, [force])
+    complete_fm = least_complete_mass(program, [force, moment])
+    top = max_mass
+    if top is None:
+        top = max(budget, 1.25 * complete_f[0]) if complete_f is not None else budget
+    masses = np.linspace(program.maps.fixed_mass, max(top, program.maps.fixed_mass), n)
+    if complete_f is not None and complete_f[0] <= masses[-1]:  # the front's zero lands on a point
+        masses[int(np.argmin(np.abs(masses[1:] - complete_f[0]))) + 1] = complete_f[0]
+        masses.sort()
+    out = {
+        "points": n,
+        "max_mass": float(top),
+        "budget": float(budget),
+        "complete_force": None if complete_f is None else point(program.maps, complete_f[1], terms),
+        "complete_force_moment": None if complete_fm is None else point(program.maps, complete_fm[1], terms),
+        "force_vs_mass": mass_front(program, force, masses, terms),
+        "moment_vs_mass": mass_front(program, moment, masses, terms),
+        "force_vs_moment": tradeoff_front(program, force, moment, budget, n, terms),
+    }
+    if "effort" in terms:
+        out["effort_vs_force"] = tradeoff_front(program, terms["effort"], force, budget, n, terms)
+    program.mass_budget.value = float(budget)
+    return out

@@ -1,0 +1,115 @@
+"""The spec of the ``partial_balance`` method (DESIGN.md, "Partial balancing is a cone program"):
+the parts the optimiser may add, what it minimises, and under which budget and caps.
+
+This module only describes the input; :mod:`.partial` solves it (cvxpy is not imported here)."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field, model_validator
+
+from ..spec_parts import Strict
+from ..units import Inertia, Mass, count, number
+from .force_balance import CounterweightRegionSpec, Point
+from .moment_balance import CounterRotationSpec
+
+LOADS = ("shaking_force", "shaking_moment", "effort", "joint")
+
+
+class PartialCounterweightSpec(CounterweightRegionSpec):
+    """A counterweight of free mass on a body, its centre of mass within one region of the body's
+    frame (``at`` a point, a ``segment``, a ``disc`` or a convex ``polygon``) and its mass spread
+    within that region (any realisable inertia)."""
+
+    polygon: list[Point] | None = Field(None, min_length=3, description="anywhere in this convex polygon (vertices in order)")
+    max_mass: Mass | None = Field(None, description="upper bound on this counterweight's mass")
+
+    @model_validator(mode="after")
+    def _one_region(self):
+        given = [k for k in ("at", "segment", "disc", "polygon") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError(f"give exactly one of at, segment, disc, polygon (got {', '.join(given) or 'none'})")
+        return self
+
+
+class PartialCounterRotationSpec(CounterRotationSpec):
+    """A counter-rotating disc whose inertia (>= 0) the optimiser chooses."""
+
+    max_inertia: Inertia | None = Field(None, description="upper bound on the disc's inertia")
+
+
+class LoadTerm(Strict):
+    """One load over the motion's time samples, measured by its peak or its RMS."""
+
+    load: Literal["shaking_force", "shaking_moment", "effort", "joint"] = Field(
+        description="shaking_force |F|, shaking_moment |M| (about the analysis' moment point), effort |tau| of "
+        "an actuator, joint: the load a joint carries (|F| of a revolute, |N| of a prismatic pair, |T| of a gear)"
+    )
+    measure: Literal["peak", "rms"] = Field("peak", description="peak over the samples, or root mean square")
+    actuator: str | None = Field(None, description="effort: the driver's name (default: every actuator, the largest)")
+    joint: str | None = Field(None, description="joint: the joint's name")
+
+    @model_validator(mode="after")
+    def _names(self):
+        if self.load == "joint" and not self.joint:
+            raise ValueError("a joint load names its joint (joint: NAME)")
+        if self.load != "joint" and self.joint:
+            raise ValueError("joint: only with load: joint")
+        if self.load != "effort" and self.actuator:
+            raise ValueError("actuator: only with load: effort")
+        return self
+
+
+class WeightedTerm(LoadTerm):
+    """An objective term: ``weight`` x the load's measure / the unbalanced mechanism's."""
+
+    weight: number(gt=0) = Field(1.0, description="weight of this term (terms are divided by their unbalanced values)")
+
+
+class Cap(LoadTerm):
+    """A cap on a load: at most ``at_most`` (x the unbalanced value when ``relative``)."""
+
+    at_most: number(ge=0) = Field(description="the cap")
+    relative: bool = Field(True, description="at_most is a multiple of the unbalanced mechanism's value")
+
+
+class Budget(Strict):
+    """What the parts may add."""
+
+    mass: Mass = Field(description="added mass at most (counterweights and the discs' own masses)")
+    inertia: Inertia | None = Field(
+        None, description="added inertia at most: the discs' inertias plus the counterweights' second moments "
+        "about their bodies' frame origins (a bound on their centroidal inertias)"
+    )
+
+
+class FrontSettings(Strict):
+    """Pareto fronts drawn on the page, each a sequence of cone programmes."""
+
+    points: count(ge=2, le=1000) = Field(30, description="points per front")
+    max_mass: Mass | None = Field(
+        None, description="the mass fronts' range [0, max_mass] (default: 1.25 x the complete force balance's "
+        "least mass in the allowed regions, or the budget when larger)"
+    )
+
+
+class PartialBalance(Strict):
+    """Optimal partial balancing: counterweights and counter-rotating discs chosen by a convex
+    (second-order cone) programme that minimises peaks or RMS of the loads under a mass budget and
+    caps, globally optimal at the analysed motion."""
+
+    method: Literal["partial_balance"] = Field(description="balancing method")
+    counterweights: list[PartialCounterweightSpec] = Field([], description="counterweights the optimiser may add")
+    counter_rotations: list[PartialCounterRotationSpec] = Field([], description="counter-rotating discs the optimiser may add")
+    objective: list[WeightedTerm] = Field(min_length=1, description="terms minimised (their weighted sum)")
+    budget: Budget
+    caps: list[Cap] = Field([], description="caps on loads (e.g. peak effort at most 1.2 x the unbalanced)")
+    fronts: FrontSettings | None = Field(FrontSettings(), description="Pareto fronts for the page (null: none)")
+    label: str = Field("", description="label of the optimised stage (default: 'partial balance')")
+
+    @model_validator(mode="after")
+    def _parts(self):
+        if not self.counterweights and not self.counter_rotations:
+            raise ValueError("give counterweights or counter_rotations: the parts the optimiser may add")
+        return self

@@ -1,0 +1,87 @@
+"""Figures of an optimal partial balancing (:mod:`balpipe.balancing.partial`): its Pareto fronts,
+with the chosen design, the least-mass complete balancing in the same regions and every analysed
+stage of the study (the compared designs, e.g. the paper's complete balancing) marked."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from .figures import _marker, legend_below, style, to_svg  # noqa: E402
+
+AXES = {
+    "added_mass": "added mass (kg)",
+    "shaking_force": "peak shaking force (N)",
+    "shaking_moment": "peak shaking moment (N m)",
+    "effort": "peak actuator effort (N m or N)",
+}
+STAGE_KEYS = {"added_mass": lambda s: s.added_mass, "shaking_force": lambda s: s.analysis.max_force,
+              "shaking_moment": lambda s: s.analysis.max_moment, "effort": lambda s: s.max_effort}
+FRONTS = (
+    ("force_vs_mass", "added_mass", "shaking_force", "Shaking force against added mass",
+     "the least peak shaking force for each mass budget"),
+    ("moment_vs_mass", "added_mass", "shaking_moment", "Shaking moment against added mass",
+     "the least peak shaking moment for each mass budget"),
+    ("force_vs_moment", "shaking_moment", "shaking_force", "Shaking force against shaking moment",
+     "the least peak shaking force for each cap on the peak moment, at the spec's mass budget"),
+    ("effort_vs_force", "shaking_force", "effort", "Actuator effort against shaking force",
+     "the least peak actuator effort for each cap on the peak shaking force, at the spec's mass budget"),
+)
+
+
+def _front_figure(points: list[dict], x: str, y: str, marks: list[tuple[str, float, float]], prefix: str) -> str:
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    ax.plot([p[x] for p in points], [p[y] for p in points], "-o", ms=3, color="black", lw=1.2,
+            label="optimal front (cone programme)")
+    for k, (label, vx, vy) in enumerate(marks):
+        ax.plot([vx], [vy], linestyle="none", marker=_marker(k), color=style(k + 1)["color"], ms=8,
+                markerfacecolor="none", mew=1.5, label=label)
+    ax.set_xlabel(AXES[x])
+    ax.set_ylabel(AXES[y])
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    legend_below(fig, ax)
+    return to_svg(fig, prefix)
+
+
+def _marks(study, det: dict, x: str, y: str) -> list[tuple[str, float, float]]:
+    out = []
+    fr = det["fronts"]
+    for key, label in (("complete_force", "least-mass complete force balance (these regions)"),
+                       ("complete_force_moment", "least-mass complete force and moment balance (these regions)")):
+        c = fr.get(key)
+        if c is not None and x in c and y in c:
+            out.append((label, c[x], c[y]))
+    for s in study.stages:
+        out.append((s.stage.label, STAGE_KEYS[x](s), STAGE_KEYS[y](s)))
+    return out
+
+
+def headline(study, det: dict) -> str:
+    """'removes 80 % of the peak force for 25 % of the complete balance's mass' for the chosen design."""
+    c = det["fronts"].get("complete_force") if det.get("fronts") else None
+    F, F0 = det["peaks"]["shaking_force"], det["unbalanced"]["shaking_force"]
+    text = f"The chosen design removes {100 * (1 - F / F0):.0f} % of the unbalanced peak shaking force"
+    if c is not None and c["added_mass"] > 0:
+        text += f" for {100 * det['added_mass'] / c['added_mass']:.0f} % of the mass of the complete force balance"
+    return text + "."
+
+
+def figures(study) -> list[tuple[str, str, str]]:
+    """(title, svg, caption) of each front the study's partial balancing computed; [] otherwise."""
+    det = study.balance.details.get("partial_balance")
+    if not det or not det.get("fronts"):
+        return []
+    out = []
+    for key, x, y, title, what in FRONTS:
+        pts = det["fronts"].get(key) or []
+        if len(pts) < 2:
+            continue
+        svg = _front_figure(pts, x, y, _marks(study, det, x, y), prefix=f"partial_{key}")
+        caption = (f"{len(pts)} points, each {what}, solved to global optimality at the analysed motion "
+                   "(second-order cone programme, Clarabel). Markers: the least-mass complete balances in the same "
+                   "regions along this motion, where they exist, and every analysed stage. " + headline(study, det))
+        out.append((title, svg, caption))
+    return out
