@@ -36,7 +36,7 @@ def test_table_sums_the_phases_and_gives_ratios():
 def test_specs_by_name_or_path():
     b = _bench()
     assert b.resolve_specs(["scott_russell"], ROOT) == [ROOT / "specs" / "scott_russell.yaml"]
-    assert ROOT / "specs" / "six_bar_constant_speed.yaml" in b.resolve_specs(None, ROOT)
+    assert ROOT / "specs" / "custom_stephenson_six_bar_120rpm.yaml" in b.resolve_specs(None, ROOT)
 
 
 def test_one_cold_build_is_timed_by_phase(tmp_path):

@@ -1,6 +1,6 @@
 """The pymunk validation of motions that are already moving at t0 (issue 20, item 3).
 
-A Stephenson six-bar whose crank turns at a constant 120 rpm (specs/six_bar_constant_speed.yaml,
+A Stephenson six-bar whose crank turns at a constant 120 rpm (tests/fixtures/six_bar_polynomial_speed.yaml,
 a ``polynomial`` law with equal start and end speeds: exactly linear) failed every stage before
 (force residual ~150 of the unbalanced peak: the laws held their end values outside [0, T], so
 the simulated crank stopped dead after t = T). The laws are now continued (periodically for a
@@ -29,7 +29,7 @@ from balpipe.validate.extend import ContinuedLaw, continued, is_periodic_moving,
 from balpipe.validation_stage import settings_for
 
 ROOT = Path(__file__).resolve().parents[1]
-SIX_BAR = ROOT / "specs" / "six_bar_constant_speed.yaml"
+SIX_BAR = ROOT / "tests" / "fixtures" / "six_bar_polynomial_speed.yaml"
 SLIDER = ROOT / "specs" / "offset_slider_crank.yaml"
 
 

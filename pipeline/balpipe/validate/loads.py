@@ -59,7 +59,7 @@ Moving starts
     The drivers' laws are continued outside [t0, T] (:mod:`balpipe.validate.extend`): a periodic
     motion moving at t0 is simulated from one cycle earlier (a settling cycle) and checked over
     the next, in steady state; another motion moving at t0 gets a 20-step run-in. Stephenson
-    six-bar at 120 rpm (specs/six_bar_constant_speed.yaml): force / moment residuals 4.2e-5 /
+    six-bar at 120 rpm (tests/fixtures/six_bar_polynomial_speed.yaml): force / moment residuals 4.2e-5 /
     9.7e-5 unbalanced, 7.2e-8 / 6.1e-5 with counterweights (150 / 15 before: spikes at 0 and T).
 
 Measured residuals (max |sim - analytic| / unbalanced peak) at the defaults, 0.5 s motions,
