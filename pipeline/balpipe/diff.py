@@ -266,7 +266,7 @@ def to_json(data: dict) -> str:
 def to_html(data: dict, a: Side, b: Side, site: str = "") -> str:
     """The HTML page; a stage whose loads are round-off in both designs is drawn on the
     unbalanced stage's scale (flat at zero) and said so, not plotted as a signal."""
-    from .report.figures import overlay_figure
+    from .draw.figures import overlay_figure
     from .report.render import environment
 
     figs = []

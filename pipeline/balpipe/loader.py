@@ -424,7 +424,22 @@ def load(path: str | Path) -> LoadedSpec:
 
 def schema() -> dict[str, Any]:
     """The JSON Schema of a spec (``balpipe schema``)."""
-    s = Spec.model_json_schema(by_alias=True)
+    s = _stable_def_names(Spec.model_json_schema(by_alias=True))
     s["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     s["title"] = "balpipe spec"
     return s
+
+
+def _stable_def_names(node: Any) -> Any:
+    """pydantic names a definition whose class name is not unique by its module path; a family's
+    template module ``balpipe.families.X.template`` keeps the name it had as
+    ``balpipe.mechanisms.X``, so the schema does not change when code moves."""
+    if isinstance(node, dict):
+        return {_stable_name(k): _stable_def_names(v) for k, v in node.items()}
+    if isinstance(node, list):
+        return [_stable_def_names(v) for v in node]
+    return _stable_name(node) if isinstance(node, str) else node
+
+
+def _stable_name(text: str) -> str:
+    return re.sub(r"balpipe__families__([A-Za-z0-9_]+?)__template__", r"balpipe__mechanisms__\1__", text)

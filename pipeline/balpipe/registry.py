@@ -9,16 +9,21 @@ from typing import Any, Callable
 import numpy as np
 
 from . import units
-from .balancing import com_planning, decoupling
-from .balancing import five_bar as fb_balancing
-from .balancing import rpr3_idler, rpr3_scott_russell
-from .balancing import rrr4 as rrr4_balancing
+from .families.serial_arm import com_planning, decoupling
+from .families.five_bar import gear_balancing as fb_balancing
+from .families.rpr3 import idler_loop as rpr3_idler, scott_russell as rpr3_scott_russell
+from .families.rrr4 import counter_masses as rrr4_balancing
 from .balancing import force_balance as generic_force
 from .balancing import moment_balance as generic_moment
-from .balancing import slider_crank as sc_balancing
+from .families.slider_crank import counterweights as sc_balancing
 from .balancing import stages as generic_stages
 from .balancing.base import BalanceResult, Stage
-from .mechanisms import custom, five_bar, rpr3, rrr4, serial_arm, slider_crank
+from .families.custom import template as custom
+from .families.five_bar import template as five_bar
+from .families.rpr3 import template as rpr3
+from .families.rrr4 import template as rrr4
+from .families.serial_arm import template as serial_arm
+from .families.slider_crank import template as slider_crank
 from .model import Law, Model
 from .motion import law_for
 from .spec_parts import SpecFieldError

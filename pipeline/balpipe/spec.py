@@ -12,22 +12,22 @@ from typing import Annotated, Literal, Union
 
 from pydantic import Field
 
-from .balancing.com_planning import ComMotionPlanning
-from .balancing.decoupling import GearDecoupling
-from .balancing.five_bar import FiveBarGearBalancing
+from .families.serial_arm.com_planning import ComMotionPlanning
+from .families.serial_arm.decoupling import GearDecoupling
+from .families.five_bar.gear_balancing import FiveBarGearBalancing
 from .balancing.force_balance import ForceBalance
 from .balancing.moment_balance import MomentBalance
-from .balancing.rpr3_idler import Rpr3IdlerLoop
-from .balancing.rpr3_scott_russell import Rpr3ScottRussell
-from .balancing.rrr4 import RRR4Balancing
-from .balancing.slider_crank import SliderCrankCounterweights
+from .families.rpr3.idler_loop import Rpr3IdlerLoop
+from .families.rpr3.scott_russell import Rpr3ScottRussell
+from .families.rrr4.counter_masses import RRR4Balancing
+from .families.slider_crank.counterweights import SliderCrankCounterweights
 from .balancing.stages import Stages
-from .mechanisms.custom import CustomMechanism
-from .mechanisms.five_bar import FiveBarMechanism
-from .mechanisms.rpr3 import Rpr3Mechanism
-from .mechanisms.rrr4 import RRR4Mechanism
-from .mechanisms.serial_arm import SerialArmMechanism
-from .mechanisms.slider_crank import SliderCrankMechanism
+from .families.custom.template import CustomMechanism
+from .families.five_bar.template import FiveBarMechanism
+from .families.rpr3.template import Rpr3Mechanism
+from .families.rrr4.template import RRR4Mechanism
+from .families.serial_arm.template import SerialArmMechanism
+from .families.slider_crank.template import SliderCrankMechanism
 from .spec_parts import DriveSpec, Strict
 from .sweep_spec import SweepSpec
 from .units import Duration, Length, count, number, quantity

@@ -12,7 +12,7 @@ import numpy as np
 from . import realisable, registry
 from .balancing.base import BalanceResult, Stage
 from .engine import Analysis, AnalysisError, analyse
-from .load_reference import LoadReference, load_reference
+from .engine.load_reference import LoadReference, load_reference
 from .spec import Spec
 from .spec_parts import SpecFieldError
 

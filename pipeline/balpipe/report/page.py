@@ -6,7 +6,8 @@ import numpy as np
 
 from .. import realisable
 from ..study import Study, ratio_reference
-from . import figures, labels, present, toc
+from ..draw import figures, labels
+from . import present, toc
 from .notation_table import notation_groups
 from .render import environment
 from .results import joint_load_table

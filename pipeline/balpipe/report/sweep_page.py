@@ -9,7 +9,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .figures import to_svg  # noqa: E402
+from ..draw.figures import to_svg  # noqa: E402
 from .render import environment  # noqa: E402
 
 

@@ -37,9 +37,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..mechanisms.rrr4 import mass_parameters
-from ..model import Model
-from . import rrr4_conditions as cond
+from .template import mass_parameters
+from ...model import Model
+from . import conditions as cond
 
 LEGS = (1, 2, 3, 4)
 SOLVE_CONDITION = 1e8  # a kept triple whose 12 x 12 system is worse conditioned counts as singular
@@ -118,7 +118,7 @@ def realise_all(model: Model, targets: dict[str, tuple[float, float]], proximal:
     """``model`` with one counter-mass per link of ``targets`` (paper name -> first moments (m p,
     m q) wanted), at the spec's distance from the link's proximal joint, in the direction the
     missing first moment needs (:func:`balpipe.balancing.rrr4.realise`)."""
-    from .rrr4 import realise
+    from .counter_masses import realise
 
     out = model
     for ij, (P, Q) in targets.items():

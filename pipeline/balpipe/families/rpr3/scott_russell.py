@@ -28,13 +28,13 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ..mechanisms import rpr3
-from ..model import FRAME, Body, Model, Revolute
-from ..spec_parts import LinkSpec, SpecFieldError, Strict
-from ..units import Length, Sign
-from .base import BalanceResult, Parameter, Stage
-from .parts import add_counter_rotation, add_counterweight
-from .slider_crank import eq20_lhs
+from . import template as rpr3
+from ...model import FRAME, Body, Model, Revolute
+from ...spec_parts import LinkSpec, SpecFieldError, Strict
+from ...units import Length, Sign
+from ...balancing.base import BalanceResult, Parameter, Stage
+from ...balancing.parts import add_counter_rotation, add_counterweight
+from ..slider_crank.counterweights import eq20_lhs
 
 PATH = ("balancing",)
 
@@ -283,7 +283,7 @@ def balance(mech: rpr3.Rpr3Mechanism, method: Rpr3ScottRussell, model: Model) ->
 
 
 def _notation() -> dict:
-    from ..notation import Sym, ours, setting
+    from ...notation import Sym, ours, setting
 
     return {
         # Sec. 3 renumbers the leg: the piston is link 3, the cylinder link 4 (Fig. 6)

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .engine import _extend, compile_model, jacobian, solve_positions
-from .model import Model
+from . import _extend, compile_model, jacobian, solve_positions
+from ..model import Model
 
 
 def mass_matrix(model: Model, t: np.ndarray) -> tuple[list[str], np.ndarray]:

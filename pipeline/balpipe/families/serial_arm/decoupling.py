@@ -37,12 +37,12 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ..mechanisms.serial_arm import SerialArmMechanism
-from ..model import FRAME, Attachment, Model
-from ..spec_parts import SpecFieldError, Strict
-from ..units import Inertia, Length, Mass, PositiveLength, number
-from .base import BalanceResult, Parameter, Stage
-from .parts import add_counter_rotation, add_counterweight
+from .template import SerialArmMechanism
+from ...model import FRAME, Attachment, Model
+from ...spec_parts import SpecFieldError, Strict
+from ...units import Inertia, Length, Mass, PositiveLength, number
+from ...balancing.base import BalanceResult, Parameter, Stage
+from ...balancing.parts import add_counter_rotation, add_counterweight
 
 ROOT = ("balancing",)
 
@@ -234,8 +234,8 @@ def balance(mech: SerialArmMechanism, method: GearDecoupling, model: Model) -> B
 
 def figures(study, info: dict):
     """Mass matrix before and after (symbolic and along the motion), torque against acceleration."""
-    from ..joint_space import mass_matrix
-    from ..report.figures import plt, style, to_svg
+    from ...engine.joint_space import mass_matrix
+    from ...draw.figures import plt, style, to_svg
 
     before, after = info["before"], info["after"]
     J1, J2 = info["J"]
@@ -292,7 +292,7 @@ def figures(study, info: dict):
 def _notation() -> dict:
     """Paper 002's symbols (Figs. 1, 3-4, eqs. 3-16): joints A, B, centres of mass S_1, S_2,
     angles θ_1, θ_2; they replace the serial arm's generic ones for the 2R arm."""
-    from ..notation import Sym, drive_table, ours
+    from ...notation import Sym, drive_table, ours
 
     table = drive_table({"q1": Sym("θ_1", "angle of link 1 relative to the base"),
                          "q2": Sym("θ_2", "angle of link 2 relative to link 1")}, end_time="T")

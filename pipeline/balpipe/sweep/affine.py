@@ -69,7 +69,7 @@ def _features(row: dict, extra: list[float]) -> np.ndarray | None:
 def _si_factor(vary, probes: list[tuple[float, float]]) -> float | None:
     """The factor from the vary's unit to SI, as :func:`balpipe.units.parse` applies it, checked
     on the probes' (number, validated SI value) pairs."""
-    from .units import _normalise_unit, kinds_of
+    from ..units import _normalise_unit, kinds_of
 
     factors = {1.0} if not _normalise_unit(vary.unit) else set(kinds_of(vary.unit).values())
     fits = [f for f in factors if all(x * f == si for x, si in probes)]
@@ -101,7 +101,7 @@ class AffineRoute:
         """Per row of F: a negative declared mass or inertia, or a body with a negative mass or
         centroidal inertia (:func:`balpipe.mass_sweep.check_parameters`); such designs are built
         in full for their own error."""
-        from .mass_sweep import check_parameters
+        from .mass import check_parameters
 
         p, p0 = self.parameters(F)
         dec = F[:, 2 + self.n_p + self.n_p0 :]
@@ -137,7 +137,7 @@ def build_route(p, keys: tuple, names: tuple[list[str], list[str]], anchors=None
     designs are not affine in the varied values at the base geometry. ``keys``: the geometry keys
     of the base design's chosen and unbalanced stages; ``names``: their bodies' names;
     ``anchors``: where the probes' closed-loop motions start (:func:`balpipe.sweep.run`)."""
-    from .sweep import build_design, evaluate_chunk
+    from . import build_design, evaluate_chunk
 
     if keys[0] is None or keys[1] is None or not p.designs:
         return None

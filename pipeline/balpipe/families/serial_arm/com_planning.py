@@ -36,7 +36,7 @@ from typing import Literal, Union
 import numpy as np
 from pydantic import Field
 
-from ..mechanisms.serial_arm import (
+from .template import (
     ArmGeometry,
     Chain,
     JointLaw,
@@ -53,11 +53,11 @@ from ..mechanisms.serial_arm import (
     tip_chain,
     with_joint_laws,
 )
-from ..model import Law, Model
-from ..motion import PointToPoint, bang_bang, law_for, quintic
-from ..spec_parts import SpecFieldError, Strict
-from ..units import Angle, Length, PositiveLength, count, number, quantity
-from .base import BalanceResult, Parameter, Stage
+from ...model import Law, Model
+from ...motion import PointToPoint, bang_bang, law_for, quintic
+from ...spec_parts import SpecFieldError, Strict
+from ...units import Angle, Length, PositiveLength, count, number, quantity
+from ...balancing.base import BalanceResult, Parameter, Stage
 
 ROOT = ("balancing",)
 CASES = (
@@ -456,8 +456,8 @@ def trajectories_of(method: ComMotionPlanning, model: Model) -> list[tuple[str, 
 def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, spec) -> BalanceResult:
     if len(mech.links) != 3:
         raise SpecFieldError(("mechanism", "links"), f"com_motion_planning plans a 3R arm (eqs. 8-10); got {len(mech.links)} links")
-    from ..registry import time_grid
-    from ..study import gravity_vector
+    from ...registry import time_grid
+    from ...study import gravity_vector
 
     T = spec.motion.duration
     t = time_grid(spec)
@@ -574,7 +574,7 @@ def _pct(x: float) -> str:
 
 
 def figures(study, info: dict):
-    from ..report.figures import legend_below, plt, style, to_svg
+    from ...draw.figures import legend_below, plt, style, to_svg
 
     plans: list[Plan] = info["plans"]
     method: ComMotionPlanning = info["method"]
@@ -695,7 +695,7 @@ def _square_figure(study, info, plt, to_svg):
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    from ..report.figures import legend_below, place_items
+    from ...draw.figures import legend_below, place_items
 
     legend_below(fig, ax, fontsize=7)  # under the drawing: never over the arm or the paths
     place_items(fig, ax, names, segs, [(np.asarray(q, dtype=float), None) for _, q, _ in names]
@@ -709,7 +709,7 @@ def _square_figure(study, info, plt, to_svg):
 
 
 def _notation() -> dict:
-    from ..notation import Sym, ours, setting
+    from ...notation import Sym, ours, setting
 
     return {
         "balancing.test_square.centre": Sym("E", "centre of the tested square (Fig. 2)"),

@@ -32,15 +32,15 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ..mechanisms.rrr4 import RRR4Mechanism, corner, mass_parameters, resolve_legs
-from ..model import Model
-from ..spec_parts import SpecFieldError, Strict
-from ..units import Mass, PositiveLength
-from . import rrr4_conditions as cond
-from . import rrr4_generic as generic
-from . import rrr4_topologies as topologies
-from .base import BalanceResult, Parameter, Stage
-from .parts import add_counterweight
+from .template import RRR4Mechanism, corner, mass_parameters, resolve_legs
+from ...model import Model
+from ...spec_parts import SpecFieldError, Strict
+from ...units import Mass, PositiveLength
+from . import conditions as cond
+from . import finder as generic
+from . import topologies as topologies
+from ...balancing.base import BalanceResult, Parameter, Stage
+from ...balancing.parts import add_counterweight
 
 
 class CounterMassDistances(Strict):
@@ -430,7 +430,7 @@ def eq17_residuals(mech: RRR4Mechanism, model: Model) -> list[tuple[cond.LinearC
 
 
 def _notation() -> dict:
-    from ..notation import Sym, ours, setting
+    from ...notation import Sym, ours, setting
 
     return {
         "balancing.counterweights.proximal": ours("d_{i1}", "distance of the counter-mass on each link l_{i1} from A_i (Fig. 2a)"),

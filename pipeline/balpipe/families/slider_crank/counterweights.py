@@ -8,11 +8,11 @@ from typing import Literal
 
 from pydantic import Field
 
-from ..mechanisms.slider_crank import SliderCrankMechanism
-from ..model import Attachment, Model
-from ..spec_parts import SpecFieldError, Strict
-from ..units import Length, Mass
-from .base import BalanceResult, Parameter, Stage
+from .template import SliderCrankMechanism
+from ...model import Attachment, Model
+from ...spec_parts import SpecFieldError, Strict
+from ...units import Length, Mass
+from ...balancing.base import BalanceResult, Parameter, Stage
 
 
 class SliderCrankCounterweights(Strict):
@@ -176,7 +176,7 @@ def balance(mech: SliderCrankMechanism, method: SliderCrankCounterweights, model
 
 
 def _notation() -> dict:
-    from ..notation import Sym, setting
+    from ...notation import Sym, setting
 
     return {
         "balancing.crank_counterweight": Sym(

@@ -35,7 +35,7 @@ import numpy as np
 import yaml
 from pydantic import ValidationError
 
-from .sweep_spec import MAX_DESIGNS  # noqa: E402  (one limit for --max-designs and sweep.max_designs)
+from ..sweep_spec import MAX_DESIGNS  # noqa: E402  (one limit for --max-designs and sweep.max_designs)
 POOL_WORTH = 3.0  # s: estimated remaining in-process work above which jobs=0 starts a process pool
 METRICS = ("added_mass", "added_inertia", "max_shaking_force", "max_shaking_moment", "max_actuator_effort",
            "unbalanced_max_shaking_force", "unbalanced_max_shaking_moment", "force_ratio", "moment_ratio")
@@ -88,7 +88,7 @@ def _number(text: str, arg: str) -> tuple[float, str]:
 
 def _conversion(frm: str, to: str, arg: str) -> float:
     """Factor from unit ``frm`` to unit ``to`` of the same dimension (HI given in another unit)."""
-    from .units import kinds_of
+    from ..units import kinds_of
 
     a, b = kinds_of(frm), kinds_of(to)
     for kind in a:
@@ -197,7 +197,7 @@ def _located(loaded, path: tuple, message: str, vary: Vary | None = None) -> str
     """A problem at the spec field ``path``, named after its vary: ``file:line:col: field:
     message (--vary PATH=RANGE)``, or for a vary of the spec's ``sweep:`` block, at that entry:
     ``file:line:col: sweep.vary.PATH: field: message``."""
-    from .loader import _format_path, _located as locate
+    from ..loader import _format_path, _located as locate
 
     if vary is not None and vary.origin != "--vary":
         key = vary.arg.split("=", 1)[0]
@@ -215,13 +215,13 @@ def _vary_problem(loaded, v: Vary, message: str) -> str:
 
 
 def _validate(data: dict):
-    from .spec import Spec
+    from ..spec import Spec
 
     return Spec.model_validate(data)
 
 
 def _errors_at(loaded, data: dict, exc: ValidationError, vary: Vary) -> list[str]:
-    from .loader import _clean_loc, _message
+    from ..loader import _clean_loc, _message
 
     out = []
     for err in exc.errors():
@@ -265,7 +265,7 @@ def plan(spec_file: str, vary_args: list[str] | None = None, sample: str | None 
     loader's ``SpecErrors`` for an invalid base spec. What is not given (None, or no
     ``vary_args``) comes from the spec's ``sweep:`` block (:class:`balpipe.sweep_spec.SweepSpec`),
     else the defaults (grid, seed 0, :data:`MAX_DESIGNS`, the method's last stage)."""
-    from .loader import load
+    from ..loader import load
 
     loaded = load(spec_file)
     data = yaml.safe_load(loaded.text)
@@ -326,7 +326,7 @@ def plan(spec_file: str, vary_args: list[str] | None = None, sample: str | None 
     if size > max_designs:
         msg = f"the sweep has {size} designs, above the limit of {max_designs}"
         if limit_from_block:
-            from .loader import _located as locate
+            from ..loader import _located as locate
 
             at = ("sweep", "max_designs") if "max_designs" in block.model_fields_set else ("sweep",)
             raise SweepError(str(locate(str(loaded.path), loaded.node, at, msg + " (sweep.max_designs)")))
@@ -356,15 +356,15 @@ def _pick_stage(result, stage: str | None):
 
 
 def _settings(spec) -> tuple[np.ndarray, tuple, tuple]:
-    from . import registry
-    from .study import gravity_vector
+    from .. import registry
+    from ..study import gravity_vector
 
     return registry.time_grid(spec), gravity_vector(spec), tuple(spec.analysis.moment_point)
 
 
 def build_design(data: dict, paths: list[tuple], values: tuple, stage: str | None):
     """Spec, chosen stage and unbalanced model of one design (raises on an invalid design)."""
-    from . import registry
+    from .. import registry
 
     spec = _validate(with_values(data, paths, values))
     result = registry.balance_designs(spec)
@@ -372,10 +372,10 @@ def build_design(data: dict, paths: list[tuple], values: tuple, stage: str | Non
 
 
 def _error_text(exc: BaseException) -> str:
-    from .spec_parts import SpecFieldError
+    from ..spec_parts import SpecFieldError
 
     if isinstance(exc, ValidationError):
-        from .loader import _format_path, _message
+        from ..loader import _format_path, _message
 
         return "; ".join(f"{_format_path(tuple(e['loc']))}: {_message(e)}" for e in exc.errors())
     if isinstance(exc, SpecFieldError):
@@ -392,7 +392,7 @@ def canonical(model):
     1 kg m^2, and massless attachments (:func:`balpipe.engine.fastpath.frame_model`): its
     :class:`balpipe.mass_sweep.MassSweep` depends on the geometry alone, so every design of that
     geometry gets the same numbers, in any chunk or worker."""
-    from .engine.fastpath import frame_model
+    from ..engine.fastpath import frame_model
 
     return frame_model(model)
 
@@ -403,8 +403,8 @@ def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
     canonical model, cached in this process: the design's other stage and the other designs of
     that geometry reuse it) and the design's peaks through its regressors, in ``row``. Returns the
     route taken."""
-    from .balancing.regressor import parameters
-    from .mass_sweep import MassSweep, geometry_key
+    from ..balancing.regressor import parameters
+    from .mass import MassSweep, geometry_key
 
     gkey = geometry_key(model, t, g, P)
     if key is not None and gkey == key:
@@ -419,7 +419,7 @@ def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
         try:
             ms = MassSweep.build(canonical(model), t, g, P)
         except Exception:  # the design's own analysis says why (or succeeds)
-            from .engine import analyse
+            from ..engine import analyse
 
             an = analyse(model, t, g, P)
             row[tag + "max_shaking_force"] = an.max_force
@@ -443,7 +443,7 @@ def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]
     per geometry (:func:`_stage_loads`), a closed loop starting from the fixed motions
     ``anchors`` (:func:`run`; :mod:`balpipe.engine.warmstart`: no sequential continuation, and
     the same numbers in any chunk or worker)."""
-    from .engine import warm_start
+    from ..engine import warm_start
 
     with warm_start(anchors):
         return _evaluate(data, paths, chunk, stage, keys)
@@ -451,7 +451,7 @@ def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]
 
 def _evaluate(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]], stage: str | None,
               keys: tuple) -> list[dict]:
-    from .study import _total_inertia
+    from ..study import _total_inertia
 
     rows = []
     for index, values in chunk:
@@ -499,14 +499,14 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     processes; 1 = in this process; 0 = all cores, after timing the first chunk in this process,
     if the rest would take more than :data:`POOL_WORTH` seconds) or on the dask.distributed
     scheduler at ``scheduler``."""
-    from .engine import AnalysisError, record_anchors
-    from .mass_sweep import MassSweep, check_parameters
-    from .spec_parts import SpecFieldError
+    from ..engine import AnalysisError, record_anchors
+    from .mass import MassSweep, check_parameters
+    from ..spec_parts import SpecFieldError
 
     paths = [v.path for v in p.varies]
     base_spec = _validate(p.data)
     try:
-        from . import registry
+        from .. import registry
 
         result = registry.balance_designs(base_spec)
         base = _pick_stage(result, p.stage)
@@ -534,7 +534,7 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
 
     route, pre, pre_rows = None, {}, []
     if ms is not None and affine:
-        from .sweep_affine import build_route
+        from .affine import build_route
 
         route = build_route(p, base_key, (ms.names, ms0.names), anchors)
     if route is None and anchors is not None:  # designs one by one: more places to start from
@@ -636,7 +636,7 @@ def _corner_anchors(p: Plan, paths: list[tuple], anchors) -> None:
     covers sweeps that reach far from the base spec. Fixed before any design is evaluated, so
     the numbers do not depend on chunks or workers. A corner that cannot be built or analysed is
     left out (its design reports the error)."""
-    from .engine import analyse, record_anchors
+    from ..engine import analyse, record_anchors
 
     ends = [(v.values[0], v.values[-1]) if v.values else (v.raw(v.lo), v.raw(v.hi)) for v in p.varies]
     corners = list(dict.fromkeys(itertools.product(*ends)))
@@ -657,7 +657,7 @@ def _front_confirmed(p: Plan, paths: list[tuple], rows: list[dict], F: np.ndarra
                      anchors=None) -> bool:
     """The affine route's designs on a Pareto front (at most 64), built in full, have the
     predicted parameters (to the route's tolerance); else the sweep is run design by design."""
-    from .sweep_affine import TOL
+    from .affine import TOL
 
     front = [r["design"] for r in rows if "error" not in r and (r["pareto_moment"] or r["pareto_effort"])][:64]
     scale = np.maximum(np.abs(F).max(axis=0), 1e-300)
@@ -739,7 +739,7 @@ def write(res: SweepResult, out: str, specs: str = "pareto", parquet: bool = Fal
     """Write sweep.csv, index.html and the designs' specs (``pareto``, ``all`` or ``none``)."""
     from pathlib import Path
 
-    from .report.sweep_page import render
+    from ..report.sweep_page import render
 
     o = Path(out)
     (o / "designs").mkdir(parents=True, exist_ok=True)

@@ -34,14 +34,14 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..engine import analyse
-from ..model import Model
-from ..motion import PROFILES, PointToPoint
-from . import conditions as C
-from . import least_mass as LM
-from . import regressor as R
-from .parts import add_counterweight
-from .rrr4_conditions import LinearCondition
+from ...engine import analyse
+from ...model import Model
+from ...motion import PROFILES, PointToPoint
+from ...balancing import conditions as C
+from ...balancing import least_mass as LM
+from ...balancing import regressor as R
+from ...balancing.parts import add_counterweight
+from .conditions import LinearCondition
 
 TRANSLATING_MOVES = 8  # translating-platform motions sampled for the special-kinematics count
 MOVE_SAMPLES = 21  # states per move

@@ -13,9 +13,9 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ..model import FRAME, Body, Driver, Model, Prismatic, Revolute
-from ..spec_parts import BodySpec, LinkSpec, SpecFieldError, Strict
-from ..units import Length, Sign
+from ...model import FRAME, Body, Driver, Model, Prismatic, Revolute
+from ...spec_parts import BodySpec, LinkSpec, SpecFieldError, Strict
+from ...units import Length, Sign
 
 
 class SliderCrankMechanism(Strict):
@@ -113,7 +113,7 @@ def build(mech: SliderCrankMechanism, laws: dict, t: np.ndarray) -> Model:
 
 
 def _notation() -> dict:
-    from ..notation import Sym, drive_table, ours
+    from ...notation import Sym, drive_table, ours
 
     table = {
         "mechanism.pivot": Sym("A", "the crank's pivot on the frame"),

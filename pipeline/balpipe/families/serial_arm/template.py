@@ -27,12 +27,12 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .. import units
-from ..joint_laws import PoseJointLaw, body_point, dyad_rates
-from ..model import FRAME, Attachment, Body, Driver, Law, Model, Revolute
-from ..motion import law_for
-from ..spec_parts import LinkSpec, SpecFieldError, Strict
-from ..units import Angle, Inertia, Length, Mass, Sign
+from ... import units
+from ...joint_laws import PoseJointLaw, body_point, dyad_rates
+from ...model import FRAME, Attachment, Body, Driver, Law, Model, Revolute
+from ...motion import law_for
+from ...spec_parts import LinkSpec, SpecFieldError, Strict
+from ...units import Angle, Inertia, Length, Mass, Sign
 
 DRIVE = ("motion", "drive")
 
@@ -514,7 +514,7 @@ def notation(mech: SerialArmMechanism) -> dict:
     """Symbols of an n-link arm's inputs: paper 003's for the 3R arm (joints O, A, B, tip C:
     l_OA, l_AB, l_BC; r_i, m_i, I_i; q_i), the same pattern with l_i for other arms (paper 002's
     method renames them as that paper does)."""
-    from ..notation import Sym, drive_table, ours
+    from ...notation import Sym, drive_table, ours
 
     n = len(mech.links)
     joints = "OABC" if n == 3 else None

@@ -26,8 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .engine import Analysis
-from .model import Model
+from . import Analysis
+from ..model import Model
 
 #: fraction of the gross inertial load that is the smallest denominator of a relative figure
 FLOOR_FRACTION = 0.01

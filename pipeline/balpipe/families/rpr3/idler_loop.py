@@ -25,12 +25,12 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ..mechanisms import rpr3
-from ..model import FRAME, Body, Model, Revolute
-from ..spec_parts import LinkSpec, SpecFieldError, Strict
-from ..units import Length, Sign
-from .base import BalanceResult, Parameter, Stage
-from .parts import add_counter_rotation, add_counterweight
+from . import template as rpr3
+from ...model import FRAME, Body, Model, Revolute
+from ...spec_parts import LinkSpec, SpecFieldError, Strict
+from ...units import Length, Sign
+from ...balancing.base import BalanceResult, Parameter, Stage
+from ...balancing.parts import add_counter_rotation, add_counterweight
 
 PATH = ("balancing",)
 
@@ -240,7 +240,7 @@ def balance(mech: rpr3.Rpr3Mechanism, method: Rpr3IdlerLoop, model: Model, t: np
 
 
 def _notation() -> dict:
-    from ..notation import Sym, ours
+    from ...notation import Sym, ours
 
     return {
         "balancing.E": Sym("E", "base pivot of the idler loop E-F-P (the paper: E = O)"),

@@ -39,12 +39,12 @@ from typing import Literal
 
 from pydantic import Field
 
-from ..mechanisms.five_bar import FiveBarMechanism, GearPart, Synthesis
-from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
-from ..model import Attachment, Body, Gear, Model, Revolute
-from ..spec_parts import SpecFieldError, Strict
-from ..units import Inertia, Length, Mass, number
-from .base import BalanceResult, Parameter, Stage
+from .template import FiveBarMechanism, GearPart, Synthesis
+from ...meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
+from ...model import Attachment, Body, Gear, Model, Revolute
+from ...spec_parts import SpecFieldError, Strict
+from ...units import Inertia, Length, Mass, number
+from ...balancing.base import BalanceResult, Parameter, Stage
 
 
 class CounterweightPositions(Strict):
@@ -373,7 +373,7 @@ def _full_stage(model: Model, links: dict[str, Body], I: dict[str, float], mech:
 
 
 def _notation() -> dict:
-    from ..notation import Sym, ours, setting
+    from ...notation import Sym, ours, setting
 
     return {
         "balancing.counterweights.proximal": Sym(

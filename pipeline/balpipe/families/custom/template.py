@@ -11,10 +11,10 @@ from typing import Annotated, Literal, Union
 import numpy as np
 from pydantic import Field
 
-from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle, mesh_geometry
-from ..model import FRAME, Attachment, Body, Driver, Gear, Model, Prismatic, Revolute
-from ..spec_parts import SpecFieldError, Strict
-from ..units import Angle, Inertia, Length, Mass, Number, PositiveLength
+from ...meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle, mesh_geometry
+from ...model import FRAME, Attachment, Body, Driver, Gear, Model, Prismatic, Revolute
+from ...spec_parts import SpecFieldError, Strict
+from ...units import Angle, Inertia, Length, Mass, Number, PositiveLength
 
 Point = Union[str, tuple[Length, Length]]
 
@@ -213,7 +213,7 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
 def notation(mech: CustomMechanism) -> dict:
     """Symbols named after the spec's own bodies, points, joints and drivers: m_<body>,
     I_<body>, S_<body> (centre of mass), m_<part> of an attachment, U_<gear pair>, q_<driver>."""
-    from ..notation import drive_table, ours
+    from ...notation import drive_table, ours
 
     table = drive_table({d.name: ours(f"q_{{{d.name}}}", f"coordinate driven by `{d.name}`") for d in mech.drivers}, end_time="T")
     for name in mech.frame_points:

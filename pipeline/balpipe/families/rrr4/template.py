@@ -34,12 +34,12 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .. import units
-from ..joint_laws import PoseJointLaw, body_point, dyad_rates
-from ..model import FRAME, Body, Driver, Law, Model, Revolute
-from ..motion import law_for
-from ..spec_parts import SpecFieldError, Strict
-from ..units import Inertia, Length, Mass, PositiveLength, Sign
+from ... import units
+from ...joint_laws import PoseJointLaw, body_point, dyad_rates
+from ...model import FRAME, Body, Driver, Law, Model, Revolute
+from ...motion import law_for
+from ...spec_parts import SpecFieldError, Strict
+from ...units import Inertia, Length, Mass, PositiveLength, Sign
 
 PLATFORM_PATH = ("motion", "drive", "platform")
 LEGS = (1, 2, 3, 4)
@@ -397,7 +397,7 @@ def mass_parameters(model: Model) -> dict[str, float]:
 def figures(study):
     """The template's figures: the balance topologies (paper 001, Figs. 2-4 and 6) and eq. 17's
     conditions with their residuals, when the study's method provides them."""
-    from ..report.rrr4 import figures as report_figures  # matplotlib only when a report is drawn
+    from .figures import figures as report_figures  # matplotlib only when a report is drawn
 
     yield from report_figures(study)
 
@@ -407,7 +407,7 @@ __all__ = ["RRR4Mechanism", "LegSpec", "RRRLink", "PlatformSpec", "build", "reso
 
 
 def _notation() -> dict:
-    from ..notation import Sym, drive_table, ours, setting
+    from ...notation import Sym, drive_table, ours, setting
 
     table = drive_table({"platform": Sym("(x, y, θ_5)", "platform pose: position of its centre and orientation θ_5")}, end_time="T")
     table.update({

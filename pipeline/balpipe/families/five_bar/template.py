@@ -34,12 +34,12 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from .. import units
-from ..meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
-from ..model import FRAME, Attachment, Body, Driver, Gear, Law, Model, Revolute
-from ..motion import law_for
-from ..spec_parts import LinkSpec, SpecFieldError, Strict
-from ..units import Inertia, Length, Mass, PositiveLength, Sign
+from ... import units
+from ...meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
+from ...model import FRAME, Attachment, Body, Driver, Gear, Law, Model, Revolute
+from ...motion import law_for
+from ...spec_parts import LinkSpec, SpecFieldError, Strict
+from ...units import Inertia, Length, Mass, PositiveLength, Sign
 
 GRIPPER_PATH = ("motion", "drive", "gripper")
 
@@ -482,7 +482,7 @@ __all__ = [
 
 def figures(study):
     """Report figures of the template: the gripper path (Fig. 7) and the input angles (Figs. 8-9)."""
-    from ..report.figures import plt, to_svg  # matplotlib only when a report is drawn
+    from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
 
     first = study.stages[0]
     an, model = first.analysis, first.stage.model
@@ -523,7 +523,7 @@ def figures(study):
 
 
 def _notation() -> dict:
-    from ..notation import Sym, drive_table, ours
+    from ...notation import Sym, drive_table, ours
 
     table = drive_table({"gripper": Sym("P", "gripper position (x, y)")}, end_time="T")
     table.update({

@@ -8,9 +8,9 @@ import math
 
 import numpy as np
 
-from ..balancing import rrr4 as recipe
-from ..balancing import rrr4_conditions as cond
-from ..mechanisms.rrr4 import mass_parameters, resolve_legs
+from . import counter_masses as recipe
+from . import conditions as cond
+from .template import mass_parameters, resolve_legs
 
 FIGURE_OF_STAGE = {"leg_by_leg": "Fig. 2a", "least_mass": "least mass", "general": "Fig. 4a", "special": "Fig. 6"}
 FIG3 = tuple(f"Fig. 3{c}" for c in "abcdef")
@@ -136,7 +136,7 @@ def _name(fig, ax, model, poses, span: float, max_cw: float, marks: list) -> lis
     (:func:`balpipe.report.figures.place_names`, :func:`balpipe.report.labels.place`): no two
     overlap, and each keeps clear of the links, counter-mass discs, pivots, joints and the centres
     of mass ``marks`` where the panel leaves room. Call once the figure's layout is final."""
-    from .figures import place_names
+    from ...draw.figures import place_names
 
     paper = {b.name: "l" + b.name[4:] for b in model.bodies if b.name.startswith("link")}
     return place_names(fig, ax, model, np.asarray(poses, dtype=float), span, max_cw, {}, disc=DISC, kinds=NAMED,
@@ -162,7 +162,7 @@ def topology_figure(study):
     """The balanced stages at t = 0, one panel each: links, joints, pivots, each link's centre of
     mass (cross), counter-masses as red discs of area proportional to mass, and the fixed total
     centre of mass (star)."""
-    from .figures import plt, to_svg
+    from ...draw.figures import plt, to_svg
 
     shown = [s for s in study.stages if s.stage.name in FIGURE_OF_STAGE]
     if not shown:
@@ -189,8 +189,8 @@ def designs_checked(study):
     """Figs. 3 and 4b's designs (:mod:`balpipe.balancing.rrr4_topologies`) rebuilt from the spec,
     each with its shaking force analysed by the engine on the study's time grid: (design, added
     mass, peak |F| / the unbalanced stage's peak)."""
-    from ..balancing import rrr4_topologies as topo
-    from ..engine import analyse
+    from . import topologies as topo
+    from ...engine import analyse
 
     if "topologies" not in study.balance.details:
         return []
@@ -209,7 +209,7 @@ def designs_checked(study):
 def designs_figure(study, checked, figures: tuple[str, ...]):
     """The designs of ``figures`` (e.g. Fig. 3a..f), one panel each, at the unbalanced stage's
     pose at t = 0 (the kinematics are the same)."""
-    from .figures import plt, to_svg
+    from ...draw.figures import plt, to_svg
 
     shown = [c for c in checked if c[0].figure in figures]
     if not shown:

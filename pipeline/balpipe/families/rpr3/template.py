@@ -33,10 +33,10 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ..joint_laws import PoseJointLaw, body_point
-from ..model import FRAME, Body, Driver, Law, Model, Prismatic, Revolute
-from ..spec_parts import SpecFieldError, Strict
-from ..units import Inertia, Length, Mass, PositiveLength
+from ...joint_laws import PoseJointLaw, body_point
+from ...model import FRAME, Body, Driver, Law, Model, Prismatic, Revolute
+from ...spec_parts import SpecFieldError, Strict
+from ...units import Inertia, Length, Mass, PositiveLength
 
 ANGLES_DEG = (-150.0, -30.0, 90.0)
 DRIVE_PATH = ("motion", "drive")
@@ -336,7 +336,7 @@ def figures(study):
     loop, Fig. 8 for the Scott-Russell legs: unbalanced solid, counterweights dashed,
     counter-rotations grey; the added-linkage stage, which the paper does not plot, dotted), and
     a table of the peaks and of the factor by which the counterweights raise the peak moment."""
-    from ..report.figures import plt, to_svg  # matplotlib only when a report is drawn
+    from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
 
     method = study.spec.balancing.method
     styles = {
@@ -420,7 +420,7 @@ def _factor_table(study, method: str) -> str:
             f"<tr><td>{s.stage.label}</td><td>{an.max_force:.6g}</td><td>{an.max_moment:.6g}</td>"
             f"<td>{s.max_effort:.6g}</td><td>{s.added_mass:.6g}</td><td>{s.added_inertia:.6g}</td></tr>"
         )
-    from ..report.present import driver_unit
+    from ...report.present import driver_unit
 
     model = study.unbalanced.stage.model
     units = sorted({driver_unit(model, d.name) for d in model.drivers}) or ["N m or N"]
@@ -449,7 +449,7 @@ def _factor_caption(study, method: str) -> str:
 
 
 def _notation() -> dict:
-    from ..notation import Sym, drive_table, ours, setting
+    from ...notation import Sym, drive_table, ours, setting
 
     table = drive_table({"x": Sym("x", "x of the platform's point P"), "y": Sym("y", "y of P"),
                          "phi": Sym("φ", "platform angle, C_1C_2 to A_1A_2")})
