@@ -1,9 +1,9 @@
 """The spec: one YAML file describing a mechanism, its motion, the balancing method and the
 analysis. ``balpipe schema`` prints its JSON Schema.
 
-Mechanism templates and balancing methods register here: each is a pydantic model with a
-``template`` (``method``) literal that discriminates the union, a builder and a balancer (see
-:mod:`balpipe.registry`).
+The mechanism and balancing sections are unions of the templates and methods the registry
+discovered (:mod:`balpipe.plugins`, :mod:`balpipe.registry`): each is a pydantic model with a
+``template`` (``method``) literal that discriminates the union.
 """
 
 from __future__ import annotations
@@ -12,22 +12,7 @@ from typing import Annotated, Literal, Union
 
 from pydantic import Field
 
-from .families.serial_arm.com_planning import ComMotionPlanning
-from .families.serial_arm.decoupling import GearDecoupling
-from .families.five_bar.gear_balancing import FiveBarGearBalancing
-from .balancing.force_balance import ForceBalance
-from .balancing.moment_balance import MomentBalance
-from .families.rpr3.idler_loop import Rpr3IdlerLoop
-from .families.rpr3.scott_russell import Rpr3ScottRussell
-from .families.rrr4.counter_masses import RRR4Balancing
-from .families.slider_crank.counterweights import SliderCrankCounterweights
-from .balancing.stages import Stages
-from .families.custom.template import CustomMechanism
-from .families.five_bar.template import FiveBarMechanism
-from .families.rpr3.template import Rpr3Mechanism
-from .families.rrr4.template import RRR4Mechanism
-from .families.serial_arm.template import SerialArmMechanism
-from .families.slider_crank.template import SliderCrankMechanism
+from . import registry
 from .spec_parts import DriveSpec, Strict
 from .sweep_spec import SweepSpec
 from .units import Duration, Length, count, number, quantity
@@ -40,14 +25,11 @@ class NoBalancing(Strict):
 
 
 Mechanism = Annotated[
-    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism, RRR4Mechanism, Rpr3Mechanism, SerialArmMechanism],
+    Union[registry.template_specs()],
     Field(discriminator="template", description="the mechanism: a template with its parameters"),
 ]
 Balancing = Annotated[
-    Union[
-        NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing, RRR4Balancing, Rpr3IdlerLoop, Rpr3ScottRussell,
-        GearDecoupling, ComMotionPlanning, ForceBalance, MomentBalance, Stages,
-    ],
+    Union[(NoBalancing, *registry.method_specs())],
     Field(discriminator="method", description="the balancing method and its design choices"),
 ]
 

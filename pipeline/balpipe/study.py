@@ -13,6 +13,7 @@ from . import realisable, registry
 from .balancing.base import BalanceResult, Stage
 from .engine import Analysis, AnalysisError, analyse
 from .engine.load_reference import LoadReference, load_reference
+from .sampling import gravity_vector  # noqa: F401  (balpipe.study.gravity_vector, as before)
 from .spec import Spec
 from .spec_parts import SpecFieldError
 
@@ -80,10 +81,6 @@ def reference_of(stages: list[StageResult], sr: StageResult) -> StageResult:
 
 
 NEAR_SINGULAR = 1e3  # condition number above which the page warns of lost accuracy
-
-
-def gravity_vector(spec: Spec) -> tuple[float, float]:
-    return (0.0, -spec.analysis.g) if spec.analysis.gravity else (0.0, 0.0)
 
 
 def run_stage_analyses(spec: Spec, result: BalanceResult) -> list[StageResult]:

@@ -58,6 +58,7 @@ from ...motion import PointToPoint, bang_bang, law_for, quintic
 from ...spec_parts import SpecFieldError, Strict
 from ...units import Angle, Length, PositiveLength, count, number, quantity
 from ...balancing.base import BalanceResult, Parameter, Stage
+from ...sampling import gravity_vector, time_grid
 
 ROOT = ("balancing",)
 CASES = (
@@ -456,9 +457,6 @@ def trajectories_of(method: ComMotionPlanning, model: Model) -> list[tuple[str, 
 def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, spec) -> BalanceResult:
     if len(mech.links) != 3:
         raise SpecFieldError(("mechanism", "links"), f"com_motion_planning plans a 3R arm (eqs. 8-10); got {len(mech.links)} links")
-    from ...registry import time_grid
-    from ...study import gravity_vector
-
     T = spec.motion.duration
     t = time_grid(spec)
     planner = Planner(model, mech, method, T, t, gravity_vector(spec), spec.analysis.moment_point)
