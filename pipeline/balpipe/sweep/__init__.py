@@ -25,7 +25,6 @@ import copy
 import itertools
 import math
 import os
-import re
 import sys
 import time
 from dataclasses import dataclass, field
@@ -43,136 +42,11 @@ UNITS_OF = {"added_mass": "kg", "added_inertia": "kg m^2", "max_shaking_force": 
             "max_actuator_effort": "N m or N", "unbalanced_max_shaking_force": "N",
             "unbalanced_max_shaking_moment": "N m", "force_ratio": "1", "moment_ratio": "1"}
 
-_NUM = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
-
-
-class SweepError(Exception):
-    """Bad sweep input, located (spec file, line, field, and the --vary argument)."""
-
-
-@dataclass(frozen=True)
-class Vary:
-    """One ``--vary PATH=RANGE``: ``values`` for a grid, or ``lo``/``hi`` (numbers in ``unit``)."""
-
-    arg: str
-    path: tuple[str | int, ...]
-    values: tuple = ()
-    lo: float | None = None
-    hi: float | None = None
-    unit: str = ""
-    origin: str = "--vary"  # or "sweep.vary": the spec's sweep block
-
-    @property
-    def where(self) -> str:
-        """How messages name this vary: ``--vary PATH=RANGE``, or ``sweep.vary`` (the spec's block)."""
-        return f"{self.origin} {self.arg}" if self.origin == "--vary" else self.origin
-
-    @property
-    def name(self) -> str:
-        return ".".join(map(str, self.path))
-
-    def raw(self, x: float) -> Any:
-        """The spec value for the number x in this vary's unit."""
-        return f"{float(x)!r} {self.unit}" if self.unit else float(x)
-
-    def extremes(self) -> list:
-        return list(self.values) if self.values else [self.raw(self.lo), self.raw(self.hi)]
-
-
-def _number(text: str, arg: str) -> tuple[float, str]:
-    m = _NUM.match(text)
-    if not m:
-        raise SweepError(f"{arg}: {text.strip()!r} is not a number with an optional unit")
-    return float(m.group(1)), m.group(2)
-
-
-def _conversion(frm: str, to: str, arg: str) -> float:
-    """Factor from unit ``frm`` to unit ``to`` of the same dimension (HI given in another unit)."""
-    from ..units import kinds_of
-
-    a, b = kinds_of(frm), kinds_of(to)
-    for kind in a:
-        if kind in b:
-            return a[kind] / b[kind]
-    raise SweepError(f"{arg}: LO and HI have units of different kinds ({to!r}, {frm!r})")
-
-
-def parse_vary(arg: str, origin: str = "--vary") -> Vary:
-    """``PATH=RANGE`` -> :class:`Vary` (syntax only; :func:`plan` validates against the spec).
-    Messages start with ``origin arg`` (``--vary PATH=RANGE``)."""
-    tag = f"{origin} {arg}" if origin else arg
-    if "=" not in arg:
-        raise SweepError(f"{tag}: expected PATH=RANGE, e.g. mechanism.crank.mass=0.5kg:2kg:7")
-    path_text, rng = arg.split("=", 1)
-    path = tuple(int(p) if p.isdigit() else p for p in path_text.strip().split("."))
-    if not path or any(p == "" for p in path):
-        raise SweepError(f"{tag}: empty field in the path {path_text!r}")
-    if "," in rng:
-        vals = []
-        unit0 = ""
-        for part in rng.split(","):
-            x, u = _number(part, tag)
-            unit0 = u or unit0
-            vals.append(x)
-        return Vary(arg, path, tuple(f"{x!r} {unit0}" if unit0 else x for x in vals), unit=unit0, origin=origin)
-    parts = rng.split(":")
-    if len(parts) not in (2, 3):
-        raise SweepError(f"{tag}: the range must be LO:HI:N, LO:HI or a,b,c")
-    lo, ulo = _number(parts[0], tag)
-    hi, uhi = _number(parts[1], tag)
-    if ulo and uhi and ulo != uhi:
-        hi = hi * _conversion(uhi, ulo, tag)
-    unit = ulo or uhi
-    if len(parts) == 3:
-        try:
-            n = int(parts[2])
-        except ValueError:
-            raise SweepError(f"{tag}: N must be an integer (got {parts[2]!r})") from None
-        if n < 1:
-            raise SweepError(f"{tag}: N must be at least 1")
-        xs = np.linspace(lo, hi, n) if n > 1 else np.array([lo])
-        return Vary(arg, path, tuple(f"{float(x)!r} {unit}" if unit else float(x) for x in xs), unit=unit, origin=origin)
-    return Vary(arg, path, (), lo, hi, unit, origin)
-
-
-def set_path(data: Any, path: tuple, value: Any) -> None:
-    """Set ``data[p0][p1]...`` = value; the last key may be new (an optional field)."""
-    cur = data
-    for k, p in enumerate(path[:-1]):
-        try:
-            cur = cur[p]
-        except (KeyError, IndexError, TypeError):
-            raise KeyError(path[: k + 1]) from None
-    if isinstance(cur, dict):
-        cur[path[-1]] = value
-    elif isinstance(cur, list) and isinstance(path[-1], int) and path[-1] < len(cur):
-        cur[path[-1]] = value
-    else:
-        raise KeyError(path)
-
-
-def with_values(data: dict, paths: list[tuple], values: tuple) -> dict:
-    """A copy of ``data`` with the values set, copying only the containers along the paths (the
-    rest is shared with ``data``, which is never modified)."""
-    d = dict(data)
-    for path, value in zip(paths, values):
-        cur = d
-        for p in path[:-1]:
-            try:
-                nxt = cur[p]
-            except (KeyError, IndexError, TypeError):
-                break  # set_path reports it
-            nxt = dict(nxt) if isinstance(nxt, dict) else list(nxt) if isinstance(nxt, list) else nxt
-            cur[p] = nxt
-            cur = nxt
-        set_path(d, path, value)
-    return d
-
-
-def get_attr_path(obj: Any, path: tuple) -> Any:
-    for p in path:
-        obj = obj[p] if isinstance(p, int) or isinstance(obj, dict) else getattr(obj, p)
-    return obj
+from ..vary import SweepError, Vary, get_attr_path, parse_vary, set_path, with_values  # noqa: E402,F401  (public here too)
+from .evaluate import (  # noqa: E402,F401  (balpipe.sweep.build_design etc., as before)
+    _GEOMETRIES, MAX_GEOMETRIES, _error_text, _pick_stage, _settings, _validate, build_design, canonical,
+    evaluate_chunk,
+)
 
 
 # ------------------------------------------------------------------------------------------
@@ -212,12 +86,6 @@ def _vary_problem(loaded, v: Vary, message: str) -> str:
     if v.origin == "--vary":
         return f"{v.where}: {message}"
     return _located(loaded, v.path, message, v)
-
-
-def _validate(data: dict):
-    from ..spec import Spec
-
-    return Spec.model_validate(data)
 
 
 def _errors_at(loaded, data: dict, exc: ValidationError, vary: Vary) -> list[str]:
@@ -340,134 +208,6 @@ def _has(data: Any, path: tuple) -> bool:
         return True
     except (KeyError, IndexError, TypeError, AttributeError):
         return False
-
-
-# ------------------------------------------------------------------------------------------
-# Evaluating designs (in worker processes or dask workers)
-
-
-def _pick_stage(result, stage: str | None):
-    if stage is None:  # the main method's last stage (compared designs prefix theirs with "name:")
-        return [s for s in result.stages if ":" not in s.name][-1]
-    for s in result.stages:
-        if s.name == stage:
-            return s
-    raise ValueError(f"no stage {stage!r}; stages: {', '.join(s.name for s in result.stages)}")
-
-
-def _settings(spec) -> tuple[np.ndarray, tuple, tuple]:
-    from .. import registry
-    from ..study import gravity_vector
-
-    return registry.time_grid(spec), gravity_vector(spec), tuple(spec.analysis.moment_point)
-
-
-def build_design(data: dict, paths: list[tuple], values: tuple, stage: str | None):
-    """Spec, chosen stage and unbalanced model of one design (raises on an invalid design)."""
-    from .. import registry
-
-    spec = _validate(with_values(data, paths, values))
-    result = registry.balance_designs(spec)
-    return spec, _pick_stage(result, stage), result.stages[0]
-
-
-def _error_text(exc: BaseException) -> str:
-    from ..spec_parts import SpecFieldError
-
-    if isinstance(exc, ValidationError):
-        from ..loader import _format_path, _message
-
-        return "; ".join(f"{_format_path(tuple(e['loc']))}: {_message(e)}" for e in exc.errors())
-    if isinstance(exc, SpecFieldError):
-        return f"{'.'.join(map(str, exc.path))}: {exc.message}"
-    return f"{type(exc).__name__}: {exc}" if not str(exc) else str(exc)
-
-
-_GEOMETRIES: dict[tuple, Any] = {}  # geometry key -> MassSweep of the canonical model (per process)
-MAX_GEOMETRIES = 32
-
-
-def canonical(model):
-    """The model with every body's mass 1 kg, centre of mass at its frame origin, inertia
-    1 kg m^2, and massless attachments (:func:`balpipe.engine.fastpath.frame_model`): its
-    :class:`balpipe.mass_sweep.MassSweep` depends on the geometry alone, so every design of that
-    geometry gets the same numbers, in any chunk or worker."""
-    from ..engine.fastpath import frame_model
-
-    return frame_model(model)
-
-
-def _stage_loads(model, key: tuple | None, t, g, P, tag: str, row: dict) -> str:
-    """Fast path: the design's parameter vector ``row[tag + 'p']`` (the parent does the product).
-    Otherwise one engine analysis per geometry (a :class:`balpipe.mass_sweep.MassSweep` of the
-    canonical model, cached in this process: the design's other stage and the other designs of
-    that geometry reuse it) and the design's peaks through its regressors, in ``row``. Returns the
-    route taken."""
-    from ..balancing.regressor import parameters
-    from .mass import MassSweep, geometry_key
-
-    gkey = geometry_key(model, t, g, P)
-    if key is not None and gkey == key:
-        row[tag + "p"] = parameters(model, angular=True)
-        return "mass"
-    for b in model.bodies:  # as the engine refuses it (compile_model)
-        m, _, i = b.mass_properties()
-        if m < 0 or i < 0:
-            raise ValueError(f"body {b.name!r} has a negative mass or inertia")
-    ms = _GEOMETRIES.get(gkey)
-    if ms is None:
-        try:
-            ms = MassSweep.build(canonical(model), t, g, P)
-        except Exception:  # the design's own analysis says why (or succeeds)
-            from ..engine import analyse
-
-            an = analyse(model, t, g, P)
-            row[tag + "max_shaking_force"] = an.max_force
-            row[tag + "max_shaking_moment"] = an.max_moment
-            row[tag + "max_actuator_effort"] = max((float(np.max(np.abs(e))) for e in an.efforts.values()), default=0.0)
-            return "full"
-        if len(_GEOMETRIES) >= MAX_GEOMETRIES:
-            _GEOMETRIES.clear()
-        _GEOMETRIES[gkey] = ms
-    peaks = ms.peaks(parameters(model, angular=True)[None, :])
-    for name, arr in peaks.items():
-        row[tag + name] = float(arr[0])
-    return "full"
-
-
-def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]], stage: str | None,
-                   keys: tuple, anchors=None) -> list[dict]:
-    """Rows of one chunk of designs. For the chosen stage and the design's unbalanced stage
-    (``keys``: their base geometries, or None), a design with the base geometry returns its
-    parameter vector for the parent's fast path; any other is analysed here by the engine, once
-    per geometry (:func:`_stage_loads`), a closed loop starting from the fixed motions
-    ``anchors`` (:func:`run`; :mod:`balpipe.engine.warmstart`: no sequential continuation, and
-    the same numbers in any chunk or worker)."""
-    from ..engine import warm_start
-
-    with warm_start(anchors):
-        return _evaluate(data, paths, chunk, stage, keys)
-
-
-def _evaluate(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]], stage: str | None,
-              keys: tuple) -> list[dict]:
-    from ..study import _total_inertia
-
-    rows = []
-    for index, values in chunk:
-        row: dict[str, Any] = {"design": index, "values": values}
-        try:
-            spec, sr, base = build_design(data, paths, values, stage)
-            row["si"] = [float(get_attr_path(spec, p)) for p in paths]
-            row["added_mass"] = sr.model.total_mass() - base.model.total_mass()
-            row["added_inertia"] = _total_inertia(sr.model) - _total_inertia(base.model)
-            t, g, P = _settings(spec)
-            row["route"] = _stage_loads(sr.model, keys[0], t, g, P, "", row)
-            _stage_loads(base.model, keys[1], t, g, P, "unbalanced_", row)
-        except Exception as exc:  # a failing design is a row with its error, not a crashed sweep
-            row = {"design": index, "values": values, "error": _error_text(exc)}
-        rows.append(row)
-    return rows
 
 
 # ------------------------------------------------------------------------------------------

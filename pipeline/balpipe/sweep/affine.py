@@ -137,7 +137,7 @@ def build_route(p, keys: tuple, names: tuple[list[str], list[str]], anchors=None
     designs are not affine in the varied values at the base geometry. ``keys``: the geometry keys
     of the base design's chosen and unbalanced stages; ``names``: their bodies' names;
     ``anchors``: where the probes' closed-loop motions start (:func:`balpipe.sweep.run`)."""
-    from . import build_design, evaluate_chunk
+    from .evaluate import build_design, evaluate_chunk
 
     if keys[0] is None or keys[1] is None or not p.designs:
         return None

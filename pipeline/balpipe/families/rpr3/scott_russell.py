@@ -34,7 +34,7 @@ from ...spec_parts import LinkSpec, SpecFieldError, Strict
 from ...units import Length, Sign
 from ...balancing.base import BalanceResult, Parameter, Stage
 from ...balancing.parts import add_counter_rotation, add_counterweight
-from ..slider_crank.counterweights import eq20_lhs
+from ...balancing.scott_russell import eq20_lhs
 
 PATH = ("balancing",)
 

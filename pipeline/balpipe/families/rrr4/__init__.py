@@ -1,7 +1,7 @@
 """The n-RRR family (paper 001): the planar parallel manipulator and its counter-masses."""
 
 from ...plugins import Family, Method, Template
-from . import counter_masses, template
+from . import counter_masses, figures, template
 
 FAMILY = Family(
     name="rrr4",
@@ -9,7 +9,7 @@ FAMILY = Family(
     package=__name__,
     templates=(
         Template("rrr4", template.RRR4Mechanism, template.build,
-                 "planar n-RRR parallel manipulator (4-RRR of paper 001, legs removable)", template.figures,
+                 "planar n-RRR parallel manipulator (4-RRR of paper 001, legs removable)", figures.figures,
                  notation=template.NOTATION),
     ),
     methods=(

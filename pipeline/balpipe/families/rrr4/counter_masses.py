@@ -39,8 +39,8 @@ from ...units import Mass, PositiveLength
 from . import conditions as cond
 from . import finder as generic
 from . import topologies as topologies
+from .placement import realise
 from ...balancing.base import BalanceResult, Parameter, Stage
-from ...balancing.parts import add_counterweight
 
 
 class CounterMassDistances(Strict):
@@ -128,19 +128,6 @@ def platform_split(mech: RRR4Mechanism, legs: list[int], given: list[float] | No
             + "; balance with the general conditions (four legs) instead",
         )
     return mu
-
-
-def realise(model: Model, body: str, P: float, Q: float, distance: float, name: str) -> tuple[Model, float, tuple[float, float]]:
-    """``model`` with a counter-mass on ``body`` bringing its first moments (m c_x, m c_y) to
-    (P, Q); returns the model, the counter-mass and its position (0 and None when not needed)."""
-    m, c, _ = model.body(body).mass_properties()
-    s = np.array([P - m * c[0], Q - m * c[1]])
-    norm = float(np.hypot(*s))
-    if norm <= 1e-14 * max(abs(P), abs(Q), m * distance, 1e-300):
-        return model, 0.0, (0.0, 0.0)
-    pos = (float(s[0] / norm * distance), float(s[1] / norm * distance))
-    mass = norm / distance
-    return add_counterweight(model, body, name, mass, pos, radius=None), mass, pos
 
 
 def leg_by_leg(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> tuple[Model, list[Parameter]]:

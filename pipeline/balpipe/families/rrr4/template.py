@@ -390,20 +390,8 @@ def mass_parameters(model: Model) -> dict[str, float]:
     return out
 
 
-# --------------------------------------------------------------------------------------------
-# Report figures
-
-
-def figures(study):
-    """The template's figures: the balance topologies (paper 001, Figs. 2-4 and 6) and eq. 17's
-    conditions with their residuals, when the study's method provides them."""
-    from .figures import figures as report_figures  # matplotlib only when a report is drawn
-
-    yield from report_figures(study)
-
-
 __all__ = ["RRR4Mechanism", "LegSpec", "RRRLink", "PlatformSpec", "build", "resolve_legs",
-           "mass_parameters", "leg_motion", "corner", "figures"]
+           "mass_parameters", "leg_motion", "corner"]
 
 
 def _notation() -> dict:

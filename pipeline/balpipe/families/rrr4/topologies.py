@@ -40,6 +40,7 @@ import numpy as np
 from .template import mass_parameters
 from ...model import Model
 from . import conditions as cond
+from .placement import realise
 
 LEGS = (1, 2, 3, 4)
 SOLVE_CONDITION = 1e8  # a kept triple whose 12 x 12 system is worse conditioned counts as singular
@@ -117,9 +118,7 @@ def realise_all(model: Model, targets: dict[str, tuple[float, float]], proximal:
                 tag: str) -> Model:
     """``model`` with one counter-mass per link of ``targets`` (paper name -> first moments (m p,
     m q) wanted), at the spec's distance from the link's proximal joint, in the direction the
-    missing first moment needs (:func:`balpipe.balancing.rrr4.realise`)."""
-    from .counter_masses import realise
-
+    missing first moment needs (:func:`balpipe.families.rrr4.placement.realise`)."""
     out = model
     for ij, (P, Q) in targets.items():
         out, _, _ = realise(out, f"link{ij}", P, Q, _distance(ij, proximal, distal), f"counter-mass {ij} ({tag})")

@@ -13,6 +13,7 @@ from ...model import Attachment, Model
 from ...spec_parts import SpecFieldError, Strict
 from ...units import Length, Mass
 from ...balancing.base import BalanceResult, Parameter, Stage
+from ...balancing.scott_russell import eq20_lhs
 
 
 class SliderCrankCounterweights(Strict):
@@ -56,15 +57,6 @@ def _counterweight_masses(mech: SliderCrankMechanism, c1: float, c2: float) -> t
     mcp2 = -(m2 * mech.coupler.com + m3 * L2) / c2
     mcp1 = -(m1 * mech.crank.com + (m2 + mcp2 + m3) * L1) / c1
     return mcp1, mcp2
-
-
-def eq20_lhs(I1: float, m1: float, p1: float, mcp1: float, c1: float, L1: float,
-             I2: float, m2: float, p2: float, mcp2: float, c2: float) -> float:
-    """Left-hand side of eq. 20 (= eq. 28's Ieq2 and eq. 30e for a 3-RPR leg) in lengths:
-    I1 + m1 p1^2 + mcp1 c1^2 + (m2 + mcp2) L1^2 - I2 - m2 p2^2 - mcp2 c2^2, the coefficient of the
-    crank's rotation relative to the guide in the angular momentum of a force-balanced
-    Scott-Russell mechanism (p: centres of mass, c: counterweights, from A and from B)."""
-    return I1 + m1 * p1**2 + mcp1 * c1**2 + (m2 + mcp2) * L1**2 - I2 - m2 * p2**2 - mcp2 * c2**2
 
 
 def is_scott_russell(mech: SliderCrankMechanism) -> bool:
