@@ -169,7 +169,7 @@ def compute(text: str, source: str, simulate: bool, input_hash: str) -> dict:
     try:
         spec, node = load_text(text, source)
         loaded = LoadedSpec(Path(source), text, spec, node)
-        st = runner.run(loaded, simulate, checks=False)
+        st = runner.run(loaded, simulate)  # the checks of build: a revision build rejects is invalid here too
     except SpecErrors as exc:
         return {"status": "invalid", "problems": str(exc).splitlines(), "parameters": [], "stages": [],
                 "validation": "skipped", "references": []}

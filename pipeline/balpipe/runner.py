@@ -4,7 +4,7 @@ of them rejects is rejected by the others with the same located errors."""
 
 from __future__ import annotations
 
-from contextlib import contextmanager, nullcontext
+from contextlib import contextmanager
 
 from . import study as study_mod
 from .limits import check_finite, check_simulation
@@ -12,23 +12,20 @@ from .loader import LoadedSpec, SpecError, SpecErrors
 from .spec_parts import SpecFieldError
 
 
-def analyse(loaded: LoadedSpec, simulate: bool = True, checks: bool = True):
+def analyse(loaded: LoadedSpec, simulate: bool = True):
     """Balance and analyse one loaded spec (no simulation, nothing written): the study, or
-    :class:`SpecErrors` for every problem of the spec, located. With ``checks``, the results must
-    be finite and, with ``simulate``, within the simulation's limits."""
+    :class:`SpecErrors` for every problem of the spec, located. The results must be finite and,
+    with ``simulate``, within the simulation's limits."""
     try:
-        with _quiet_numpy() if checks else nullcontext():
+        with _quiet_numpy():
             st = study_mod.run(loaded.spec)
-            if checks:
-                check_finite(st)
-                if simulate:
-                    check_simulation(st)
+            check_finite(st)
+            if simulate:
+                check_simulation(st)
         return st
     except SpecFieldError as exc:
         raise loaded.error(exc) from None
     except ArithmeticError as exc:  # overflow, division by zero from extreme input
-        if not checks:
-            raise
         raise SpecErrors([SpecError(str(loaded.path), None, None, "",
                                     f"the computation failed on this spec's numbers ({type(exc).__name__}: {exc}); "
                                     "check the magnitudes of masses, lengths and the duration")]) from None
@@ -47,9 +44,9 @@ def simulate(loaded: LoadedSpec, st) -> bool:
     return True
 
 
-def run(loaded: LoadedSpec, simulate_it: bool = True, checks: bool = True):
+def run(loaded: LoadedSpec, simulate_it: bool = True):
     """:func:`analyse`, then :func:`simulate` when ``simulate_it``: the study with its validation."""
-    st = analyse(loaded, simulate=simulate_it, checks=checks)
+    st = analyse(loaded, simulate=simulate_it)
     if simulate_it:
         simulate(loaded, st)
     return st
