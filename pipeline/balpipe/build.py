@@ -227,17 +227,23 @@ def prepare_output(out: Path) -> None:
                           "the site there was left as it was") from None
 
 
+LOCK_NAME = ".balpipe.lock"
+
+
 @contextmanager
 def locked(out: Path):
     """Hold an exclusive lock on ``out/.balpipe.lock`` for the build: a second build of the same
-    folder waits, so pages and the index of two builds never interleave."""
+    folder waits, so pages and the index of two builds never interleave. The lock file is removed
+    when the build ends, so it is never published with the site; a build that waited on a removed
+    file locks the current one instead."""
     try:
         import fcntl
     except ImportError:  # pragma: no cover - not POSIX
         yield
         return
-    fd = os.open(out / ".balpipe.lock", os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o666)
-    try:
+    lock = out / LOCK_NAME
+    while True:
+        fd = os.open(lock, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o666)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
@@ -245,8 +251,20 @@ def locked(out: Path):
 
             print(f"balpipe: waiting for another build of {out} to finish", file=sys.stderr)
             fcntl.flock(fd, fcntl.LOCK_EX)
+        try:
+            current = os.stat(lock, follow_symlinks=False).st_ino == os.fstat(fd).st_ino
+        except FileNotFoundError:
+            current = False
+        if current:
+            break
+        os.close(fd)
+    try:
         yield
     finally:
+        try:
+            os.unlink(lock)
+        except OSError:
+            pass
         os.close(fd)
 
 
@@ -257,19 +275,34 @@ def _worker_init() -> None:
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
-def _clashes(specs: list[Path]) -> dict[Path, str]:
+def _clash_groups(specs: list[Path]) -> list[list[Path]]:
     """Specs whose page folders would be the same (x.yaml and x.yml, 'a b' and 'a-b', names that
-    differ only in case): each gets a message naming the others."""
+    differ only in case), each group in sorted order."""
     groups: dict[str, list[Path]] = {}
     for p in specs:
         groups.setdefault(slug_for(p).lower(), []).append(p)
+    return [sorted(g, key=str) for g in groups.values() if len(g) > 1]
+
+
+def _clashes(specs: list[Path]) -> dict[Path, str]:
+    """The specs refused for a page-name clash: every one after the first of its group in sorted
+    order (the first is built), each with a message naming the others."""
     out = {}
-    for group in groups.values():
-        if len(group) > 1:
-            for p in group:
-                others = ", ".join(str(q) for q in group if q is not p)
-                out[p] = (f"{p}: its page {slug_for(p)}/ would be the same as that of {others}; "
-                          "rename one of these files")
+    for first, *rest in _clash_groups(specs):
+        for p in rest:
+            others = ", ".join(str(q) for q in [first, *rest] if q is not p)
+            out[p] = (f"{p}: its page {slug_for(p)}/ would be the same as that of {others}; "
+                      f"{first} (the first in sorted order) is built, not this file; rename one of these files")
+    return out
+
+
+def _clash_notes(specs: list[Path]) -> dict[Path, str]:
+    """For the spec built from each clashing group: a note naming the files refused beside it."""
+    out = {}
+    for first, *rest in _clash_groups(specs):
+        others = ", ".join(map(str, rest))
+        out[first] = (f"{first}: its page {slug_for(first)}/ would be the same as that of {others}; "
+                      f"built from this file, the first in sorted order ({others} refused); rename one of these files")
     return out
 
 
@@ -315,6 +348,8 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
     if progress:
         for o in outcomes:  # refused before any work: k = 0
             progress(0, len(todo), o)
+        for p, note in _clash_notes(specs).items():  # said before any work too; built as usual
+            progress(0, len(todo), Outcome(str(p), slug_for(p), "ok", note))
     if jobs is None:
         jobs = default_jobs(len(todo))
     with locked(opts.out):

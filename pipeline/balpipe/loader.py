@@ -193,19 +193,26 @@ def _describe(value: Any) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def _check_duplicates(node: yaml.Node, file: str, path: tuple = ()) -> list[SpecError]:
+def _check_duplicates(node: yaml.Node, file: str, path: tuple = (), done: set | None = None) -> list[SpecError]:
+    """Keys written twice in one mapping, on the composed document (before the constructor
+    flattens merge keys): a key that overrides one merged in with ``<<: *anchor`` is not a
+    duplicate. A node reached through several aliases is checked once."""
+    done = set() if done is None else done
+    if id(node) in done:
+        return []
+    done.add(id(node))
     errors = []
     if isinstance(node, yaml.MappingNode):
         seen = set()
         for k, v in node.value:
-            if k.value in seen:
+            if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
                 m = k.start_mark
                 errors.append(SpecError(file, m.line + 1, m.column + 1, _format_path(path + (k.value,)), "duplicate key"))
             seen.add(k.value)
-            errors += _check_duplicates(v, file, path + (k.value,))
+            errors += _check_duplicates(v, file, path + (k.value,), done)
     elif isinstance(node, yaml.SequenceNode):
         for i, v in enumerate(node.value):
-            errors += _check_duplicates(v, file, path + (i,))
+            errors += _check_duplicates(v, file, path + (i,), done)
     return errors
 
 
@@ -352,6 +359,7 @@ def load_text(text: str, file: str) -> tuple[Spec, yaml.Node]:
             node = loader.get_single_node()
             if node is not None:
                 _check_aliases(node, file)
+            dup = _check_duplicates(node, file) if node is not None else []  # before merge keys are flattened
             data = loader.construct_document(node) if node is not None else None
         finally:
             loader.dispose()
@@ -365,7 +373,6 @@ def load_text(text: str, file: str) -> tuple[Spec, yaml.Node]:
             raise SpecErrors(bad)
     if node is None or not isinstance(data, dict):
         raise SpecErrors([SpecError(file, 1, 1, "", "the spec must be a YAML mapping (name:, mechanism:, motion:, ...)")])
-    dup = _check_duplicates(node, file)
     if dup:
         raise SpecErrors(dup)
     try:
