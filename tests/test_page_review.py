@@ -160,7 +160,7 @@ def test_legends_never_cover_the_curves(monkeypatch):
 
 
 def test_rpr3_factor_table_gives_the_effort_unit_and_one_full_stop():
-    from balpipe.families.rpr3 import template as rpr3
+    from balpipe.families.rpr3 import figures as rpr3
 
     st = study_mod.run(loader.load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
     table = rpr3._factor_table(st, st.spec.balancing.method)

@@ -1,7 +1,7 @@
 """The five-bar family: the fixed-sequence 5R with gear-coupled inputs and its gear balancing."""
 
 from ...plugins import Family, Method, Template
-from . import gear_balancing, template
+from . import figures, gear_balancing, template
 
 FAMILY = Family(
     name="five_bar",
@@ -9,7 +9,7 @@ FAMILY = Family(
     package=__name__,
     templates=(
         Template("five_bar", template.FiveBarMechanism, template.build,
-                 "five-bar (5R), fixed-sequence with gear-coupled inputs", template.figures, notation=template.NOTATION),
+                 "five-bar (5R), fixed-sequence with gear-coupled inputs", figures.figures, notation=template.NOTATION),
     ),
     methods=(
         Method("five_bar_gear_balancing", gear_balancing.FiveBarGearBalancing, gear_balancing.balance, ("five_bar",),

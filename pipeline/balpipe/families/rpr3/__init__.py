@@ -1,14 +1,14 @@
 """The 3-RPR family: the parallel manipulator, its idler-loop and Scott-Russell balancings."""
 
 from ...plugins import Family, Method, Template
-from . import idler_loop, scott_russell, template
+from . import figures, idler_loop, scott_russell, template
 
 FAMILY = Family(
     name="rpr3",
     order=4,
     package=__name__,
     templates=(
-        Template("rpr3", template.Rpr3Mechanism, template.build, "3-RPR parallel manipulator", template.figures,
+        Template("rpr3", template.Rpr3Mechanism, template.build, "3-RPR parallel manipulator", figures.figures,
                  notation=template.NOTATION),
     ),
     methods=(
