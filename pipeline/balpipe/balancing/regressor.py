@@ -29,7 +29,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..engine import Compiled, _extend, _newton, compile_model, jacobian, solve_positions
+from ..engine import Compiled, compile_model, jacobian, solve_positions
+from ..engine.constraints import _extend
+from ..engine.positions import _newton
 from ..model import Law, Model
 
 MIN_CONDITION = 1e-7  # smallest / largest singular value of a kept configuration's Jacobian

@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _extend, compile_model, jacobian, solve_positions
+from .compile import compile_model
+from .constraints import _extend, jacobian
+from .positions import solve_positions
 from ..model import Model
 
 

@@ -26,10 +26,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..balancing.regressor import dynamics_regressor, parameters, shaking_regressor, states_from_analysis
-from ..engine import (
-    _extend, _joint_reactions, _multipliers, _radial_tooth_loads, _rotate, _tooth_rows, analyse,
-    compile_model, jacobian,
-)
+from ..engine import analyse, compile_model, jacobian
+from ..engine.compile import _rotate
+from ..engine.constraints import _extend
+from ..engine.dynamics import _joint_reactions, _multipliers, _radial_tooth_loads, _tooth_rows
 from ..model import Model
 
 CHUNK = 512  # designs per block of the batched products (bounds the memory: CHUNK x N x rows)
