@@ -61,10 +61,10 @@ class LoadedSpec:
 
     def error(self, exc: SpecFieldError) -> SpecErrors:
         """Locate a semantic error raised while building or balancing this spec."""
-        return SpecErrors([_located(str(self.path), self.node, exc.path, exc.message)])
+        return SpecErrors([located(str(self.path), self.node, exc.path, exc.message)])
 
 
-def _format_path(path: tuple) -> str:
+def format_path(path: tuple) -> str:
     out = ""
     for p in path:
         if not isinstance(p, int):
@@ -107,20 +107,20 @@ def _key_node(node: yaml.Node | None, path: tuple) -> yaml.Node | None:
     return None
 
 
-def _located(file: str, root: yaml.Node | None, path: tuple, message: str, at_key: bool = False) -> SpecError:
+def located(file: str, root: yaml.Node | None, path: tuple, message: str, at_key: bool = False) -> SpecError:
     target = _key_node(root, path) if at_key else None
     if target is None:
         target, _ = _find(root, path)
     if target is None:
-        return SpecError(file, None, None, _format_path(path), message)
+        return SpecError(file, None, None, format_path(path), message)
     mark = target.start_mark
-    return SpecError(file, mark.line + 1, mark.column + 1, _format_path(path), message)
+    return SpecError(file, mark.line + 1, mark.column + 1, format_path(path), message)
 
 
 _DISCRIMINATORS = ("template", "method", "type")
 
 
-def _clean_loc(loc: tuple, data: Any) -> tuple:
+def clean_loc(loc: tuple, data: Any) -> tuple:
     """Drop the parts of pydantic's error location that are not in the document: the tags of
     discriminated unions (e.g. 'slider_crank') and validator names ('function-after[...]')."""
     out: list = []
@@ -141,7 +141,7 @@ def _clean_loc(loc: tuple, data: Any) -> tuple:
     return tuple(out)
 
 
-def _message(err: dict) -> str:
+def error_message(err: dict) -> str:
     msg = err["msg"]
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
@@ -207,7 +207,7 @@ def _check_duplicates(node: yaml.Node, file: str, path: tuple = (), done: set | 
         for k, v in node.value:
             if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
                 m = k.start_mark
-                errors.append(SpecError(file, m.line + 1, m.column + 1, _format_path(path + (k.value,)), "duplicate key"))
+                errors.append(SpecError(file, m.line + 1, m.column + 1, format_path(path + (k.value,)), "duplicate key"))
             seen.add(k.value)
             errors += _check_duplicates(v, file, path + (k.value,), done)
     elif isinstance(node, yaml.SequenceNode):
@@ -338,7 +338,7 @@ def _check_strings(node: yaml.Node, file: str, path: tuple = ()) -> list[SpecErr
             m = _CONTROL.search(n.value) if isinstance(n.value, str) else None
             if m:
                 mk = n.start_mark
-                errors.append(SpecError(file, mk.line + 1, mk.column + 1, _format_path(p), _control_message(m.group())))
+                errors.append(SpecError(file, mk.line + 1, mk.column + 1, format_path(p), _control_message(m.group())))
         elif isinstance(n, yaml.MappingNode):
             for k, v in n.value:
                 stack.append((k, p))
@@ -380,17 +380,17 @@ def load_text(text: str, file: str) -> tuple[Spec, yaml.Node]:
     except ValidationError as exc:
         errors = []
         for err in exc.errors():
-            loc = _clean_loc(err["loc"], data)
+            loc = clean_loc(err["loc"], data)
             if err["type"] in ("union_tag_invalid", "union_tag_not_found"):
                 loc = loc + (err.get("ctx", {}).get("discriminator", "").strip("'"),)
-            errors.append(_located(file, node, loc, _message(err), at_key=err["type"] == "extra_forbidden"))
+            errors.append(located(file, node, loc, error_message(err), at_key=err["type"] == "extra_forbidden"))
         # one line per place: a union may report the same field several times
         unique = list(dict.fromkeys(errors))
         raise SpecErrors(sorted(unique, key=lambda e: (e.line or 0, e.column or 0))) from None
     try:
         check_limits(spec)
     except SpecFieldError as exc:
-        raise SpecErrors([_located(file, node, exc.path, exc.message)]) from None
+        raise SpecErrors([located(file, node, exc.path, exc.message)]) from None
     return spec, node
 
 

@@ -71,7 +71,7 @@ def _located(loaded, path: tuple, message: str, vary: Vary | None = None) -> str
     """A problem at the spec field ``path``, named after its vary: ``file:line:col: field:
     message (--vary PATH=RANGE)``, or for a vary of the spec's ``sweep:`` block, at that entry:
     ``file:line:col: sweep.vary.PATH: field: message``."""
-    from ..loader import _format_path, _located as locate
+    from ..loader import format_path as _format_path, located as locate
 
     if vary is not None and vary.origin != "--vary":
         key = vary.arg.split("=", 1)[0]
@@ -89,7 +89,7 @@ def _vary_problem(loaded, v: Vary, message: str) -> str:
 
 
 def _errors_at(loaded, data: dict, exc: ValidationError, vary: Vary) -> list[str]:
-    from ..loader import _clean_loc, _message
+    from ..loader import clean_loc as _clean_loc, error_message as _message
 
     out = []
     for err in exc.errors():
@@ -194,7 +194,7 @@ def plan(spec_file: str, vary_args: list[str] | None = None, sample: str | None 
     if size > max_designs:
         msg = f"the sweep has {size} designs, above the limit of {max_designs}"
         if limit_from_block:
-            from ..loader import _located as locate
+            from ..loader import located as locate
 
             at = ("sweep", "max_designs") if "max_designs" in block.model_fields_set else ("sweep",)
             raise SweepError(str(locate(str(loaded.path), loaded.node, at, msg + " (sweep.max_designs)")))

@@ -46,7 +46,7 @@ def _error_text(exc: BaseException) -> str:
     from ..spec_parts import SpecFieldError
 
     if isinstance(exc, ValidationError):
-        from ..loader import _format_path, _message
+        from ..loader import error_message as _message, format_path as _format_path
 
         return "; ".join(f"{_format_path(tuple(e['loc']))}: {_message(e)}" for e in exc.errors())
     if isinstance(exc, SpecFieldError):
