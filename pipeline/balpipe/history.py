@@ -14,7 +14,7 @@ folder. A spec text already seen, in any commit of any spec, is never recomputed
 version recomputes everything, as ``build`` does. When ``<out>/<slug>/results.json`` was built
 from the same text and options (same input hash), its figures are taken from there.
 
-Output, per spec: ``<out>/<slug>/history.json`` (documented in the README, deterministic: sorted
+Output, per spec: ``<out>/<slug>/history.json`` (documented in docs/history.md, deterministic: sorted
 keys, commits oldest first, no time of the run) and ``<out>/<slug>/history.html``, a page of
 plots against the commits. ``balpipe build`` reads ``history.json`` and puts the same section
 in the study page (see :mod:`balpipe.report.history_page`).

@@ -216,7 +216,7 @@ def _check_duplicates(node: yaml.Node, file: str, path: tuple = (), done: set | 
     return errors
 
 
-#: Limits of a spec file, checked before any work (README, "Limits").
+#: Limits of a spec file, checked before any work (docs/limits.md).
 MAX_FILE_BYTES = 1_000_000
 MAX_DEPTH = 64
 MAX_VALUES = 200_000  # values after alias expansion (an alias bomb multiplies them)
