@@ -122,7 +122,7 @@ _DISCRIMINATORS = ("template", "method", "type")
 
 def clean_loc(loc: tuple, data: Any) -> tuple:
     """Drop the parts of pydantic's error location that are not in the document: the tags of
-    discriminated unions (e.g. 'slider_crank') and validator names ('function-after[...]')."""
+    discriminated unions (a template's or method's name) and validator names ('function-after[...]')."""
     out: list = []
     cur = data
     for part in loc:
