@@ -201,3 +201,38 @@ def test_a_planted_family_import_in_the_core_fails(tree_copy: Path):
     study = tree_copy / "balpipe" / "study.py"
     study.write_text(study.read_text(encoding="utf-8") + "\nfrom .families.rrr4 import template  # noqa\n")
     assert any(b.startswith("balpipe.study:") for b in family_imports_outside_families(tree_copy))
+
+
+def _family_words() -> set[str]:
+    from balpipe import plugins
+
+    return {w for f in plugins.discover() for w in (f.name, *(t.name for t in f.templates), *(m.name for m in f.methods))}
+
+
+def names_of_families(src: Path, words: set[str]) -> list[str]:
+    """String constants (docstrings aside) and identifiers equal to a family's, a template's or a
+    method's name, in modules outside ``balpipe.families``."""
+    found = []
+    for m, p in modules(src).items():
+        if m.startswith("balpipe.families"):
+            continue
+        tree = ast.parse(p.read_text(encoding="utf-8"))
+        docs = {id(n.body[0].value) for n in ast.walk(tree)
+                if isinstance(n, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and n.body
+                and isinstance(n.body[0], ast.Expr) and isinstance(n.body[0].value, ast.Constant)}
+        for n in ast.walk(tree):
+            text = (n.value if isinstance(n, ast.Constant) and isinstance(n.value, str) and id(n) not in docs
+                    else n.id if isinstance(n, ast.Name) else n.attr if isinstance(n, ast.Attribute) else None)
+            if text in words:
+                found.append(f"{m}:{n.lineno} names {text!r}")
+    return found
+
+
+def test_no_core_module_names_a_family():
+    assert names_of_families(SRC, _family_words()) == []
+
+
+def test_a_planted_family_name_in_the_core_fails(tree_copy: Path):
+    study = tree_copy / "balpipe" / "study.py"
+    study.write_text(study.read_text(encoding="utf-8") + '\n\ndef _planted(spec):\n    return spec.mechanism.template == "rrr4"\n')
+    assert any(b.startswith("balpipe.study:") for b in names_of_families(tree_copy, _family_words()))
