@@ -4,7 +4,7 @@ A sweep varies fields of one spec (dotted paths, e.g. ``mechanism.crank.mass``),
 design's model and balancing, and analyses the chosen stage (default: the last stage of the
 spec's method). Designs whose model has the base spec's geometry (only masses, inertias,
 counterweights differ) take the fast path: one engine analysis of the base design and a matrix
-product per design (:mod:`balpipe.mass_sweep`); the others a full engine analysis. Designs are
+product per design (:mod:`balpipe.sweep.mass`); the others a full engine analysis. Designs are
 evaluated locally on a process pool, or on a dask.distributed cluster.
 
 Ranges (units as in the spec; the first value's unit applies to a second without one):
@@ -21,208 +21,31 @@ no balancing solution, cannot assemble, negative counterweight) is a row with it
 
 from __future__ import annotations
 
-import copy
 import itertools
 import math
 import os
 import sys
 import time
-from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
-import yaml
-from pydantic import ValidationError
 
 from ..sweep_spec import MAX_DESIGNS  # noqa: E402  (one limit for --max-designs and sweep.max_designs)
 POOL_WORTH = 3.0  # s: estimated remaining in-process work above which jobs=0 starts a process pool
-METRICS = ("added_mass", "added_inertia", "max_shaking_force", "max_shaking_moment", "max_actuator_effort",
-           "unbalanced_max_shaking_force", "unbalanced_max_shaking_moment", "force_ratio", "moment_ratio")
-UNITS_OF = {"added_mass": "kg", "added_inertia": "kg m^2", "max_shaking_force": "N", "max_shaking_moment": "N m",
-            "max_actuator_effort": "N m or N", "unbalanced_max_shaking_force": "N",
-            "unbalanced_max_shaking_moment": "N m", "force_ratio": "1", "moment_ratio": "1"}
 
 from ..vary import SweepError, Vary, get_attr_path, parse_vary, set_path, with_values  # noqa: E402,F401  (public here too)
 from .evaluate import (  # noqa: E402,F401  (balpipe.sweep.build_design etc., as before)
     _GEOMETRIES, MAX_GEOMETRIES, _error_text, _pick_stage, _settings, _validate, build_design, canonical,
     evaluate_chunk,
 )
-
-
-# ------------------------------------------------------------------------------------------
-# Checking the sweep against the spec, before any work
-
-
-@dataclass
-class Plan:
-    """A checked sweep: the base spec, the varies and the designs (each a tuple of raw values)."""
-
-    file: str
-    text: str
-    data: dict
-    varies: list[Vary]
-    designs: list[tuple]
-    stage: str | None = None
-    sample: str = "grid"
-    seed: int = 0
-
-
-def _located(loaded, path: tuple, message: str, vary: Vary | None = None) -> str:
-    """A problem at the spec field ``path``, named after its vary: ``file:line:col: field:
-    message (--vary PATH=RANGE)``, or for a vary of the spec's ``sweep:`` block, at that entry:
-    ``file:line:col: sweep.vary.PATH: field: message``."""
-    from ..loader import format_path as _format_path, located as locate
-
-    if vary is not None and vary.origin != "--vary":
-        key = vary.arg.split("=", 1)[0]
-        text = message if tuple(path) == vary.path else f"{_format_path(tuple(path))}: {message}"
-        return str(locate(str(loaded.path), loaded.node, ("sweep", "vary", key), text, at_key=True))
-    where = str(locate(str(loaded.path), loaded.node, path, message))
-    return where + (f" ({vary.where})" if vary else "")
-
-
-def _vary_problem(loaded, v: Vary, message: str) -> str:
-    """A problem of the vary itself (not of the field it names)."""
-    if v.origin == "--vary":
-        return f"{v.where}: {message}"
-    return _located(loaded, v.path, message, v)
-
-
-def _errors_at(loaded, data: dict, exc: ValidationError, vary: Vary) -> list[str]:
-    from ..loader import clean_loc as _clean_loc, error_message as _message
-
-    out = []
-    for err in exc.errors():
-        loc = _clean_loc(err["loc"], data)
-        if err["type"] == "extra_forbidden" and loc == vary.path:
-            out.append(_located(loaded, vary.path, "unknown path: not a field of the spec schema", vary))
-        else:
-            out.append(_located(loaded, loc, _message(err), vary))
-    return out
-
-
-def designs_of(varies: list[Vary], sample: str, n: int, seed: int) -> list[tuple]:
-    """The designs: the grid's Cartesian product, or n seeded random / Latin-hypercube points."""
-    if sample == "grid":
-        return list(itertools.product(*[v.values for v in varies]))
-    if n < 1:
-        raise SweepError(f"--sample {sample} needs -n N >= 1 designs")
-    if sample == "random":
-        u = np.random.default_rng(seed).uniform(size=(n, len(varies)))
-    elif sample == "lhs":
-        from scipy.stats import qmc
-
-        u = qmc.LatinHypercube(d=len(varies), seed=seed).random(n)
-    else:
-        raise SweepError(f"unknown --sample {sample!r} (grid, random, lhs)")
-    out = []
-    for row in u:
-        vals = []
-        for v, x in zip(varies, row):
-            if v.values:  # a list: pick one of its values
-                vals.append(v.values[min(int(x * len(v.values)), len(v.values) - 1)])
-            else:
-                vals.append(v.raw(v.lo + x * (v.hi - v.lo)))
-        out.append(tuple(vals))
-    return out
-
-
-def plan(spec_file: str, vary_args: list[str] | None = None, sample: str | None = None, n: int | None = None,
-         seed: int | None = None, max_designs: int | None = None, stage: str | None = None) -> Plan:
-    """Parse and check everything; raises :class:`SweepError` (all problems, located) or the
-    loader's ``SpecErrors`` for an invalid base spec. What is not given (None, or no
-    ``vary_args``) comes from the spec's ``sweep:`` block (:class:`balpipe.sweep_spec.SweepSpec`),
-    else the defaults (grid, seed 0, :data:`MAX_DESIGNS`, the method's last stage)."""
-    from ..loader import load
-
-    loaded = load(spec_file)
-    data = yaml.safe_load(loaded.text)
-    data.pop("sweep", None)  # the designs are specs without the block (validated once, above)
-    block = loaded.spec.sweep
-    if vary_args:
-        varies = [parse_vary(a) for a in vary_args]
-    elif block is not None:
-        varies = [parse_vary(f"{k}={v}", origin="sweep.vary") for k, v in block.vary.items()]
-    else:
-        raise SweepError("nothing to vary: give at least one --vary PATH=RANGE, or a sweep: block in the spec")
-    limit_from_block = max_designs is None and block is not None
-    if block is not None:
-        sample = sample if sample is not None else block.sample
-        n = n if n is not None else block.designs
-        seed = seed if seed is not None else block.seed
-        max_designs = max_designs if max_designs is not None else block.max_designs
-        stage = stage if stage is not None else block.stage
-    sample = sample or "grid"
-    n, seed = n or 0, seed or 0
-    max_designs = MAX_DESIGNS if max_designs is None else max_designs
-    problems: list[str] = []
-    seen = set()
-    for v in varies:
-        if v.path in seen:
-            problems.append(_vary_problem(loaded, v, f"{v.name} is varied twice"))
-        seen.add(v.path)
-        if sample == "grid" and not v.values:
-            problems.append(_vary_problem(loaded, v, "a grid needs LO:HI:N or a,b,c (LO:HI is for random and lhs samples)"))
-            continue
-        for raw in v.extremes():
-            trial = copy.deepcopy(data)
-            try:
-                set_path(trial, v.path, raw)
-            except KeyError as exc:
-                bad = exc.args[0]
-                problems.append(_located(loaded, bad, f"unknown path: {'.'.join(map(str, bad))} is not in the spec", v))
-                break
-            old = get_attr_path(data, v.path) if _has(data, v.path) else None
-            if isinstance(old, (dict, list, bool)):
-                problems.append(_located(loaded, v.path, "not a numeric field", v))
-                break
-            try:
-                spec = _validate(trial)
-                value = get_attr_path(spec, v.path)
-                if isinstance(value, bool) or not isinstance(value, (int, float)):
-                    problems.append(_located(loaded, v.path, "not a numeric field", v))
-                    break
-            except ValidationError as exc:
-                problems.extend(_errors_at(loaded, trial, exc, v))
-                break
-            except (AttributeError, KeyError, IndexError, TypeError):
-                problems.append(_located(loaded, v.path, "not a numeric field", v))
-                break
-    if problems:
-        raise SweepError("\n".join(dict.fromkeys(problems)))
-    size = math.prod(len(v.values) for v in varies) if sample == "grid" else n
-    if size > max_designs:
-        msg = f"the sweep has {size} designs, above the limit of {max_designs}"
-        if limit_from_block:
-            from ..loader import located as locate
-
-            at = ("sweep", "max_designs") if "max_designs" in block.model_fields_set else ("sweep",)
-            raise SweepError(str(locate(str(loaded.path), loaded.node, at, msg + " (sweep.max_designs)")))
-        raise SweepError(msg + " (--max-designs)")
-    return Plan(str(loaded.path), loaded.text, data, varies, designs_of(varies, sample, n, seed), stage, sample, seed)
-
-
-def _has(data: Any, path: tuple) -> bool:
-    try:
-        get_attr_path(data, path)
-        return True
-    except (KeyError, IndexError, TypeError, AttributeError):
-        return False
+from .output import (  # noqa: E402,F401  (balpipe.sweep.csv_text etc., as before)
+    METRICS, UNITS_OF, SweepResult, csv_text, design_spec_text, mark_pareto, pareto, write,
+)
+from .plan import Plan, designs_of, plan  # noqa: E402,F401  (balpipe.sweep.plan, as before)
 
 
 # ------------------------------------------------------------------------------------------
 # Running
-
-
-@dataclass
-class SweepResult:
-    plan: Plan
-    rows: list[dict]
-    base_stage: str
-    fast: int = 0
-    full: int = 0
-    failed: int = 0
-    notes: list[str] = field(default_factory=list)
 
 
 def _chunks(designs: list[tuple], workers: int) -> list[list[tuple[int, tuple]]]:
@@ -410,97 +233,6 @@ def _front_confirmed(p: Plan, paths: list[tuple], rows: list[dict], F: np.ndarra
         if np.any(np.abs(got - want) > 1e-9 * scale[2 : 2 + got.size]):
             return False
     return True
-
-
-def pareto(points: np.ndarray) -> np.ndarray:
-    """Mask of the non-dominated rows of ``points`` (D, 2), both objectives minimised."""
-    D = len(points)
-    keep = np.ones(D, dtype=bool)
-    if D == 0:
-        return keep
-    order = np.lexsort((points[:, 1], points[:, 0]))
-    y = points[order, 1]
-    best_before = np.concatenate([[math.inf], np.minimum.accumulate(y)[:-1]])  # the best of the designs before
-    keep[order] = y < best_before
-    return keep
-
-
-def mark_pareto(rows: list[dict]) -> None:
-    """``pareto_moment`` / ``pareto_effort``: on the front of added mass against peak shaking
-    moment / peak actuator effort (designs with errors are on neither)."""
-    ok = [r for r in rows if "error" not in r]
-    for key, metric in (("pareto_moment", "max_shaking_moment"), ("pareto_effort", "max_actuator_effort")):
-        for r in rows:
-            r[key] = False
-        if ok:
-            pts = np.array([[r["added_mass"], r[metric]] for r in ok])
-            for r, k in zip(ok, pareto(pts)):
-                r[key] = bool(k)
-
-
-# ------------------------------------------------------------------------------------------
-# Output
-
-
-def csv_text(res: SweepResult) -> str:
-    """The table: one row per design, varied fields in SI units, metrics in SI units."""
-    import csv
-    import io
-
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    names = [v.name for v in res.plan.varies]
-    w.writerow(["design", "status", "route", *names, *[f"{m} [{UNITS_OF[m]}]" for m in METRICS],
-                "pareto_moment", "pareto_effort", "error"])
-    for r in res.rows:
-        si = r.get("si") or [""] * len(names)
-        vals = [repr(x) if isinstance(x, float) else x for x in si]
-        if "error" in r:
-            w.writerow([r["design"], "error", r.get("route", ""), *(vals if r.get("si") else list(map(str, r["values"]))),
-                        *[""] * len(METRICS), False, False, r["error"]])
-        else:
-            w.writerow([r["design"], "ok", r["route"], *vals, *[repr(float(r[m])) for m in METRICS],
-                        r["pareto_moment"], r["pareto_effort"], ""])
-    return buf.getvalue()
-
-
-def design_spec_text(res: SweepResult, index: int) -> str:
-    """The spec of design ``index``: the base spec's YAML with the varied fields set, so that
-    ``balpipe build`` gives its full report."""
-    row = res.rows[index]
-    d = copy.deepcopy(with_values(res.plan.data, [v.path for v in res.plan.varies], row["values"]))  # no sweep block
-    d["name"] = f"{d.get('name', 'design')} — sweep design {index}"
-    head = (f"# Design {index} of the sweep of {res.plan.file}: "
-            + ", ".join(f"{v.name} = {raw}" for v, raw in zip(res.plan.varies, row["values"])) + "\n")
-    return head + yaml.safe_dump(d, sort_keys=False, allow_unicode=True)
-
-
-def write(res: SweepResult, out: str, specs: str = "pareto", parquet: bool = False) -> list[str]:
-    """Write sweep.csv, index.html and the designs' specs (``pareto``, ``all`` or ``none``)."""
-    from pathlib import Path
-
-    from ..report.sweep_page import render
-
-    o = Path(out)
-    (o / "designs").mkdir(parents=True, exist_ok=True)
-    written = []
-    (o / "sweep.csv").write_text(csv_text(res), encoding="utf-8")
-    written.append(str(o / "sweep.csv"))
-    if parquet:
-        import pyarrow.csv as pacsv
-        import pyarrow.parquet as pq
-
-        pq.write_table(pacsv.read_csv(str(o / "sweep.csv")), str(o / "sweep.parquet"))
-        written.append(str(o / "sweep.parquet"))
-    linked = set()
-    for r in res.rows:
-        if specs == "all" or (specs == "pareto" and (r.get("pareto_moment") or r.get("pareto_effort"))):
-            linked.add(r["design"])
-    for i in sorted(linked):
-        (o / "designs" / f"design_{i:06d}.yaml").write_text(design_spec_text(res, i), encoding="utf-8")
-    (o / "index.html").write_text(render(res, linked), encoding="utf-8")
-    written.append(str(o / "index.html"))
-    return written
 
 
 def progress_printer(quiet: bool) -> Callable[[int, int], None]:
