@@ -20,7 +20,8 @@ ROOT = Path(__file__).resolve().parent.parent
 CASE = r'''
 import time, numpy as np
 from balpipe import registry
-from balpipe.balancing import conditions as C, rrr4 as recipe
+from balpipe.balancing import conditions as C
+from balpipe.families.rrr4 import counter_masses as recipe
 from balpipe.loader import load_text
 a = np.random.default_rng(0).normal(size=(328, 72, 75))
 c0, w0 = time.process_time(), time.perf_counter(); np.linalg.svd(a)

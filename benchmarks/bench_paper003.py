@@ -46,7 +46,7 @@ def breakdown() -> None:
     import numpy as np
 
     from balpipe import engine, registry, study
-    from balpipe.balancing import com_planning as cp
+    from balpipe.families.serial_arm import com_planning as cp
     from balpipe.loader import load
     from balpipe.report.page import render_page
     from balpipe.report.results import results_dict

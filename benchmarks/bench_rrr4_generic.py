@@ -22,8 +22,8 @@ from pathlib import Path
 from balpipe import registry
 from balpipe.balancing import conditions as C
 from balpipe.balancing import least_mass as LM
-from balpipe.balancing import rrr4 as recipe
-from balpipe.balancing import rrr4_generic as G
+from balpipe.families.rrr4 import counter_masses as recipe
+from balpipe.families.rrr4 import finder as G
 from balpipe.loader import load
 from bench_generic import best  # noqa: E402  (benchmarks/ is on sys.path when run as a script)
 

@@ -51,7 +51,7 @@ def mass_sweep(designs: int) -> tuple[float, int]:
     from balpipe import registry
     from balpipe.engine import analyse
     from balpipe.loader import load
-    from balpipe.mass_sweep import MassSweep
+    from balpipe.balancing.mass_sweep import MassSweep
     from balpipe.study import gravity_vector
 
     spec = load(SPEC).spec

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from balpipe import registry, study
-from balpipe.balancing import rrr4 as recipe
+from balpipe.families.rrr4 import counter_masses as recipe
 from balpipe.engine import analyse
 from balpipe.loader import load
 from balpipe.model import Driver

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from balpipe import registry, study
-from balpipe.balancing import com_planning as cp
+from balpipe.families.serial_arm import com_planning as cp
 from balpipe.engine import analyse
 from balpipe.loader import load
-from balpipe.mechanisms.serial_arm import ArmGeometry, TaskMotion, com_chain, joint_laws, with_joint_laws
+from balpipe.families.serial_arm.template import ArmGeometry, TaskMotion, com_chain, joint_laws, with_joint_laws
 from balpipe.motion import PointToPoint, bang_bang, quintic
 from test_serial_arm import arm_spec
 from _edits import replaced
@@ -95,7 +95,7 @@ def test_trapezoidal_case_respects_the_torque_rate_limit(paper):
     plan = pl.plan(name, start, end, path)
     phi = cp.PhiPolynomial(start[2], end[2], T, tuple(p[f"phi_c{k}_{name}"] for k in range(3)))
     tt = np.linspace(0, T, 400001)
-    from balpipe.mechanisms.serial_arm import joint_torques
+    from balpipe.families.serial_arm.template import joint_torques
 
     def rate(f):
         _, _, _, state = pl.loads(cp._com_motion(plan, cp.trapezoidal_acceleration(f), T, phi, path), plan.com_mode, tt)
@@ -133,7 +133,7 @@ def test_bang_bang_on_the_com_never_exceeds_the_quintic(rng):
             for name, prof in (("bang_bang", bang_bang), ("quintic", quintic)):
                 motion = TaskMotion((PointToPoint(c0[0], c1[0], T, prof), PointToPoint(c0[1], c1[1], T, prof),
                                      PointToPoint(q0.sum(), q1.sum(), T, quintic)), "com", (), "random")
-                from balpipe.mechanisms.serial_arm import JointSolution
+                from balpipe.families.serial_arm.template import JointSolution
 
                 mode = cp._elbow_sign(chain, q0)
                 JointSolution(chain, motion, mode, t)

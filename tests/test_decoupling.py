@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from balpipe import study
-from balpipe.balancing.decoupling import mass_matrix_2r
+from balpipe.families.serial_arm.decoupling import mass_matrix_2r
 from balpipe.engine import analyse
-from balpipe.joint_space import mass_matrix
+from balpipe.engine.joint_space import mass_matrix
 from balpipe.loader import load
-from balpipe.mechanisms.serial_arm import with_joint_laws
+from balpipe.families.serial_arm.template import with_joint_laws
 from balpipe.motion import Polynomial
 from balpipe.spec import Spec
 

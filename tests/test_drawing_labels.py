@@ -13,7 +13,9 @@ import pytest
 from balpipe import loader
 from balpipe import study as study_mod
 from balpipe.build import Options, build
-from balpipe.report import figures, labels, page, player
+from balpipe.draw import figures, labels
+from balpipe.report import page
+from balpipe.draw import player
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
 DRAWN = ["paper000_rpr3_idler_loop.yaml", "paper001_4rrr.yaml", "paper002_decoupling.yaml",
@@ -280,7 +282,7 @@ def test_names_on_paper001_drawings_never_overlap(studies, name, monkeypatch):
     """Every 4-RRR drawing of paper 001 (the balanced stages; Figs. 3a-f; Fig. 4b): the names drawn
     (pivots A1-A4 at least) overlap no other name, no counter-mass disc and no link, read back
     from the figures themselves."""
-    from balpipe.report import rrr4
+    from balpipe.families.rrr4 import figures as rrr4
 
     drawn = []
 

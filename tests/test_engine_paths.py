@@ -18,7 +18,10 @@ import numpy as np
 import pytest
 
 from balpipe import engine, registry
-from balpipe.engine import _extend, _multipliers, _vel_acc, analyse, compiled, fastpath, jacobian
+from balpipe.engine import analyse, compiled, fastpath, jacobian
+from balpipe.engine.constraints import _extend
+from balpipe.engine.dynamics import _multipliers
+from balpipe.engine.kinematics import _vel_acc
 from balpipe.engine.structure import decompose
 from balpipe.engine import AnalysisError
 from balpipe.loader import load

@@ -11,7 +11,7 @@ import pytest
 from balpipe import registry
 from balpipe.engine import analyse
 from balpipe.loader import load, load_text
-from balpipe.mechanisms.five_bar import (
+from balpipe.families.five_bar.template import (
     FiveBarMechanism,
     elbows,
     forward_kinematics,

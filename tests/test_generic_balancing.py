@@ -14,7 +14,7 @@ from balpipe import registry, study
 from balpipe.balancing import conditions as C
 from balpipe.balancing import least_mass as LM
 from balpipe.balancing import regressor as R
-from balpipe.balancing.slider_crank import _counterweight_masses
+from balpipe.families.slider_crank.counterweights import _counterweight_masses
 from balpipe.engine import analyse
 from balpipe.loader import load
 from balpipe.report.results import results_dict

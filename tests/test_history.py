@@ -257,3 +257,19 @@ def test_with_the_simulation_the_validation_status_is_recorded(tmp_path, monkeyp
     o = history.run(["specs"], Path("nosim"), Path("cache"), simulate=False)[0]
     assert o.computed == 1
     assert json.loads(Path("nosim/osc/history.json").read_text())["commits"][0]["validation"] == "skipped"
+
+
+def test_a_spec_that_build_rejects_is_rejected_by_history(tmp_path):
+    """One path (balpipe.runner): a revision whose loads overflow fails build's finite-value
+    check, and history records it as invalid with the same located problem, not as a point."""
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "specs" / "offset_slider_crank.yaml").read_text(encoding="utf-8")
+    text = edit(text, "duration: 0.5 s", "duration: 1.0e-100 s")
+    (tmp_path / "specs").mkdir()
+    p = tmp_path / "specs" / "fast.yaml"
+    p.write_text(text, encoding="utf-8")
+    outcome = build([str(p)], Options(out=tmp_path / "out", simulate=False))[0]
+    assert outcome.status == "error" and "motion.duration" in outcome.message and "overflows" in outcome.message
+    point = history.compute(text, str(p), False, "h")
+    assert point["status"] == "invalid" and point["stages"] == []
+    assert point["problems"] == outcome.message.splitlines()

@@ -8,7 +8,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from balpipe.joint_laws import KEEP, PoseJointLaw, body_point
-from balpipe.mechanisms import rpr3, rrr4, serial_arm
+from balpipe.families.rpr3 import template as rpr3
+from balpipe.families.rrr4 import template as rrr4
+from balpipe.families.serial_arm import template as serial_arm
 from balpipe.motion import PointToPoint, quintic
 
 

@@ -13,7 +13,8 @@ import pytest
 
 from balpipe import loader
 from balpipe import study as study_mod
-from balpipe.report import figures, page, results
+from balpipe.draw import figures
+from balpipe.report import page, results
 from balpipe.study import ratio_reference
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
@@ -159,7 +160,7 @@ def test_legends_never_cover_the_curves(monkeypatch):
 
 
 def test_rpr3_factor_table_gives_the_effort_unit_and_one_full_stop():
-    from balpipe.mechanisms import rpr3
+    from balpipe.families.rpr3 import figures as rpr3
 
     st = study_mod.run(loader.load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
     table = rpr3._factor_table(st, st.spec.balancing.method)
@@ -268,7 +269,7 @@ def test_player_writes_no_negative_zero():
     import shutil
     import subprocess
 
-    from balpipe.report import player
+    from balpipe.draw import player
 
     node = shutil.which("node")
     if node is None:
@@ -288,7 +289,7 @@ def test_player_writes_no_negative_zero():
 def test_paper003_square_and_phi_figures_keep_names_and_legends_off_the_paths(study003, monkeypatch):
     from matplotlib.text import Text
 
-    from balpipe.report import labels
+    from balpipe.draw import labels
 
     drawn = {}
     monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.setdefault(prefix, fig) and "<svg/>")

@@ -13,7 +13,7 @@ import pytest
 
 from balpipe import loader, study
 from balpipe.engine import analyse
-from balpipe.load_reference import FLOOR_FRACTION, gross_inertial_loads, load_reference
+from balpipe.engine.load_reference import FLOOR_FRACTION, gross_inertial_loads, load_reference
 
 ROOT = Path(__file__).resolve().parents[1]
 FIXTURE = ROOT / "tests" / "fixtures" / "reactionless_arm.yaml"

@@ -11,7 +11,7 @@ import pytest
 from balpipe import registry, study
 from balpipe.engine import analyse
 from balpipe.loader import load
-from balpipe.mechanisms import rpr3
+from balpipe.families.rpr3 import template as rpr3
 from balpipe.spec import Spec
 from balpipe.spec_parts import SpecFieldError
 from _edits import replaced

@@ -12,11 +12,11 @@ import pytest
 import yaml
 
 from balpipe import registry, study
-from balpipe.balancing import rrr4 as recipe
-from balpipe.balancing import rrr4_conditions as cond
+from balpipe.families.rrr4 import counter_masses as recipe
+from balpipe.families.rrr4 import conditions as cond
 from balpipe.engine import AnalysisError, analyse
 from balpipe.loader import SpecErrors, load_text
-from balpipe.mechanisms.rrr4 import corner_motion, leg_motion, mass_parameters, resolve_legs
+from balpipe.families.rrr4.template import corner_motion, leg_motion, mass_parameters, resolve_legs
 from balpipe.model import FRAME, Driver, Model, Revolute
 from balpipe.motion import PROFILES, PointToPoint
 from balpipe.spec import Spec

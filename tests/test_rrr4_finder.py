@@ -11,11 +11,11 @@ from balpipe import registry, study
 from balpipe.balancing import conditions as C
 from balpipe.balancing import least_mass as LM
 from balpipe.balancing import regressor as R
-from balpipe.balancing import rrr4 as recipe
-from balpipe.balancing import rrr4_conditions as cond
-from balpipe.balancing import rrr4_generic as G
+from balpipe.families.rrr4 import counter_masses as recipe
+from balpipe.families.rrr4 import conditions as cond
+from balpipe.families.rrr4 import finder as G
 from balpipe.engine import analyse
-from balpipe.mechanisms.rrr4 import mass_parameters
+from balpipe.families.rrr4.template import mass_parameters
 from balpipe.balancing.parts import add_counterweight
 from test_rrr4 import paper_data, regular_random, spec_of, special_data
 

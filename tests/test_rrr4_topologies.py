@@ -12,11 +12,11 @@ import pytest
 import yaml
 
 from balpipe import registry, study
-from balpipe.balancing import rrr4 as recipe
-from balpipe.balancing import rrr4_generic as generic
-from balpipe.balancing import rrr4_topologies as topo
+from balpipe.families.rrr4 import counter_masses as recipe
+from balpipe.families.rrr4 import finder as generic
+from balpipe.families.rrr4 import topologies as topo
 from balpipe.engine import analyse
-from balpipe.mechanisms.rrr4 import mass_parameters
+from balpipe.families.rrr4.template import mass_parameters
 from test_rrr4 import random_data, spec_of
 
 TOL = 1e-9
@@ -145,7 +145,7 @@ def test_fig6_label():
 
 
 def test_page_draws_fig3_and_fig4b_with_what_was_assumed():
-    from balpipe.report import rrr4 as page
+    from balpipe.families.rrr4 import figures as page
 
     spec = load(PAPER, samples=41, simulate=False)
     st = study.run(spec)

@@ -11,7 +11,7 @@ import pytest
 from balpipe import registry
 from balpipe.engine import analyse
 
-from balpipe.mechanisms.serial_arm import (
+from balpipe.families.serial_arm.template import (
     ArmGeometry,
     TaskMotion,
     JointSolution,
@@ -151,7 +151,7 @@ def test_com_motion_moves_the_total_centre_of_mass_on_its_law(rng):
     q1 = np.array([1.7, -0.7, 1.2])
     c0, c1 = chain.point(q0[None])[0], chain.point(q1[None])[0]
     T = 0.4
-    from balpipe.mechanisms.serial_arm import joint_laws, with_joint_laws
+    from balpipe.families.serial_arm.template import joint_laws, with_joint_laws
     from balpipe.motion import bang_bang
 
     motion = TaskMotion((PointToPoint(c0[0], c1[0], T, bang_bang), PointToPoint(c0[1], c1[1], T, bang_bang),

@@ -16,7 +16,7 @@ import pytest
 from balpipe import registry
 from balpipe.engine import analyse
 from balpipe.loader import load
-from balpipe.mass_sweep import MassSweep, check_parameters, geometry_key
+from balpipe.balancing.mass_sweep import MassSweep, check_parameters, geometry_key
 from balpipe.model import Attachment
 from balpipe.study import gravity_vector
 

@@ -12,7 +12,7 @@ import pytest
 from balpipe.engine import analyse
 from balpipe.model import FRAME, Attachment, Body, Driver, Gear, Model, Prismatic, Revolute
 from balpipe.motion import PointToPoint, bang_bang, cycloidal, quintic
-from balpipe.pymunk_model import build_space
+from balpipe.validate.space import build_space
 from balpipe.validate import ValidationSettings, free_floating, simulate, validate
 
 T = 0.5

@@ -58,15 +58,6 @@ def with_actuators(model: Model, names: list[str] | tuple[str, ...] | None, path
     return replace(model, actuators=tuple(Actuator(n, n) for n in names))
 
 
-def effort_unit(model: Model, name: str) -> str | None:
-    """'N' for an actuator at a prismatic joint, 'N m' at a revolute, None when ``name`` is not
-    one of the model's actuators."""
-    for a in model.actuators:
-        if a.name == name:
-            return "N" if isinstance(model.joint(a.joint), Prismatic) else "N m"
-    return None
-
-
 def virtual_note(model: Model) -> str | None:
     """The page's note when the efforts are not motors': drivers of a point or a pose and no
     actuator named. None when every effort is a motor's."""

@@ -15,8 +15,6 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import secrets
-import shutil
 import signal
 import time
 import traceback
@@ -25,16 +23,17 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
+from importlib.util import find_spec
 from pathlib import Path
 
-from . import study as study_mod
+from . import plugins, runner
 from .laws.drives import table_texts
-from .limits import check_finite, check_simulation
-from .loader import LoadedSpec, SpecError, SpecErrors, load, schema
+from .loader import SpecErrors, load, schema
 from .report import history_page
 from .report.page import render_page
 from .report.results import dumps, results_dict, timeseries_csv
 from .spec_parts import SpecFieldError
+from .fsutil import remove_path, remove_temporaries, tmp_name, write_atomic_dir, write_file_atomic, write_new
 
 
 @dataclass
@@ -113,7 +112,27 @@ def code_hash() -> str:
     for f in files:
         h.update(f.name.encode())
         h.update(f.read_bytes())
+    for name, f in _family_files():  # families from packages of their own: their code is part of the result
+        h.update(name.encode())
+        h.update(f.read_bytes())
     return h.hexdigest()
+
+
+def _family_files() -> list[tuple[str, Path]]:
+    """(name, path) of the Python files of the discovered families that are not part of balpipe:
+    a package's files by their path in it, a single module by its file name."""
+    out = set()
+    for fam in plugins.discover():
+        top = (fam.package or "").split(".")[0]
+        spec = find_spec(top) if top and top != "balpipe" else None
+        if spec is None or not spec.origin:
+            continue
+        origin = Path(spec.origin)
+        if spec.submodule_search_locations:
+            out.update((f.relative_to(origin.parent.parent).as_posix(), f) for f in origin.parent.rglob("*.py"))
+        else:
+            out.add((origin.name, origin))
+    return sorted(out)
 
 
 def input_hash(text: str, opts: Options) -> str:
@@ -122,117 +141,6 @@ def input_hash(text: str, opts: Options) -> str:
     h.update(f"sim={opts.simulate}".encode())
     h.update(code_hash().encode())
     return h.hexdigest()[:16]
-
-
-TMP_MARK = ".balpipe-tmp-"  # temporary files and folders in the output folder carry this
-
-
-def _tmp_name(name: str) -> str:
-    return f".{name[:100]}{TMP_MARK}{os.getpid()}-{secrets.token_hex(4)}"
-
-
-def _write_new(path: Path, content: str) -> None:
-    """Create ``path`` (it must not exist: never writes through a planted symlink); mode from
-    the umask."""
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o666)
-    with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
-        f.write(content)
-
-
-def _remove(path: Path) -> None:
-    """Remove a file, a symlink (not its target) or a folder tree (rmtree does not follow links)."""
-    if path.is_symlink() or path.is_file():
-        path.unlink()
-    elif path.is_dir():
-        shutil.rmtree(path, ignore_errors=True)
-
-
-def write_file_atomic(path: Path, content: str) -> None:
-    """Replace ``path`` in one step: a reader sees the old or the new file, never a part; a
-    symlink at ``path`` is replaced by the file, its target is left alone."""
-    tmp = path.with_name(_tmp_name(path.name))
-    try:
-        _write_new(tmp, content)
-        os.replace(tmp, path)
-    except BaseException:
-        if tmp.exists():
-            tmp.unlink()
-        raise
-
-
-def _write_atomic_dir(target: Path, files: dict[str, str]) -> None:
-    """Write a page folder next to ``target`` and move it into place when complete. Modes follow
-    the umask (os.mkdir(0o777)), not tempfile's 0700."""
-    target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = target.with_name(_tmp_name(target.name))
-    os.mkdir(tmp, 0o777)
-    try:
-        for name, content in files.items():
-            _write_new(tmp / name, content)
-        old = None
-        if target.is_symlink() or target.is_file():
-            target.unlink()  # planted: replace the link itself
-        elif target.exists():
-            old = target.with_name(_tmp_name(target.name + ".old"))
-            target.rename(old)
-        tmp.rename(target)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-
-
-def remove_temporaries(out: Path) -> None:
-    """Remove what an interrupted build left: temporaries of balpipe's own naming only."""
-    try:
-        entries = list(out.iterdir())
-    except OSError:
-        return
-    for e in entries:
-        if e.name.startswith(".") and TMP_MARK in e.name:
-            try:
-                _remove(e)
-            except OSError:
-                pass
-        elif e.is_dir() and not e.is_symlink():  # a page folder: its failed/ is written inside
-            try:
-                inner = [f for f in e.iterdir() if f.name.startswith(".") and TMP_MARK in f.name]
-            except OSError:
-                continue
-            for f in inner:
-                try:
-                    _remove(f)
-                except OSError:
-                    pass
-
-
-def analyse(loaded: LoadedSpec, simulate: bool = True):
-    """Balance and analyse one loaded spec (no simulation, nothing written): the study, or
-    :class:`SpecErrors` for every problem of the spec, located. ``check`` and ``build`` share it,
-    so a spec that passes ``check`` does not fail ``build`` for its input. With ``simulate`` the
-    simulation's limits are checked too."""
-    try:
-        with _quiet_numpy():
-            st = study_mod.run(loaded.spec)
-            check_finite(st)
-            if simulate:
-                check_simulation(st)
-        return st
-    except SpecFieldError as exc:
-        raise loaded.error(exc) from None
-    except ArithmeticError as exc:  # overflow, division by zero from extreme input
-        raise SpecErrors([SpecError(str(loaded.path), None, None, "",
-                                    f"the computation failed on this spec's numbers ({type(exc).__name__}: {exc}); "
-                                    "check the magnitudes of masses, lengths and the duration")]) from None
-
-
-@contextmanager
-def _quiet_numpy():
-    import numpy as np
-
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        yield
 
 
 def build_one(path: Path, opts: Options) -> Outcome:
@@ -252,19 +160,18 @@ def build_one(path: Path, opts: Options) -> Outcome:
         if previous is not None and previous.get("input_hash") == h:
             stale_failed = target / "failed"
             if stale_failed.exists() or stale_failed.is_symlink():  # the spec is back to its good page
-                _remove(stale_failed)
+                remove_path(stale_failed)
             return Outcome(source, slug, previous.get("status", "ok"), "unchanged", previous, skipped=True,
                            seconds=time.perf_counter() - start)
     try:
         try:
-            st = analyse(loaded, simulate=opts.simulate)
+            st = runner.analyse(loaded, simulate=opts.simulate)
         except SpecErrors as exc:
             return Outcome(source, slug, "error", str(exc), spec_error=True, seconds=time.perf_counter() - start)
         extra: dict[str, str] = {}
-        if opts.simulate and loaded.spec.validation.enabled:
-            from .validation_stage import simulate_study, timing, timing_script
+        if opts.simulate and runner.simulate(loaded, st):
+            from .validation_stage import timing, timing_script
 
-            simulate_study(st)
             times = timing(st)
             extra = {"timing.json": json.dumps(times, indent=2, sort_keys=True) + "\n",
                      "timing.js": timing_script(times)}
@@ -282,10 +189,10 @@ def build_one(path: Path, opts: Options) -> Outcome:
         if status == "failed" and previous is not None and previous.get("status") == "ok":
             # the README's promise: a failing spec never replaces a good page; its own page goes
             # beside it, in failed/
-            _write_atomic_dir(target / "failed", files)
+            write_atomic_dir(target / "failed", files)
             return Outcome(source, slug, status, "; ".join(st.problems), results, seconds=time.perf_counter() - start,
                            kept_previous=True)
-        _write_atomic_dir(target, files)
+        write_atomic_dir(target, files)
         return Outcome(source, slug, status, "; ".join(st.problems), results, seconds=time.perf_counter() - start)
     except SpecFieldError as exc:
         return Outcome(source, slug, "error", str(loaded.error(exc)), spec_error=True, seconds=time.perf_counter() - start)
@@ -312,26 +219,32 @@ def prepare_output(out: Path) -> None:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"cannot create the output folder {out}: {exc.strerror or exc}") from None
-    probe = out / _tmp_name("probe")
+    probe = out / tmp_name("probe")
     try:
-        _write_new(probe, "")
+        write_new(probe, "")
         probe.unlink()
     except OSError as exc:
         raise OutputError(f"cannot write to the output folder {out}: {exc.strerror or exc}; "
                           "the site there was left as it was") from None
 
 
+LOCK_NAME = ".balpipe.lock"
+
+
 @contextmanager
 def locked(out: Path):
     """Hold an exclusive lock on ``out/.balpipe.lock`` for the build: a second build of the same
-    folder waits, so pages and the index of two builds never interleave."""
+    folder waits, so pages and the index of two builds never interleave. The lock file is removed
+    when the build ends, so it is never published with the site; a build that waited on a removed
+    file locks the current one instead."""
     try:
         import fcntl
     except ImportError:  # pragma: no cover - not POSIX
         yield
         return
-    fd = os.open(out / ".balpipe.lock", os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o666)
-    try:
+    lock = out / LOCK_NAME
+    while True:
+        fd = os.open(lock, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o666)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
@@ -339,8 +252,20 @@ def locked(out: Path):
 
             print(f"balpipe: waiting for another build of {out} to finish", file=sys.stderr)
             fcntl.flock(fd, fcntl.LOCK_EX)
+        try:
+            current = os.stat(lock, follow_symlinks=False).st_ino == os.fstat(fd).st_ino
+        except FileNotFoundError:
+            current = False
+        if current:
+            break
+        os.close(fd)
+    try:
         yield
     finally:
+        try:
+            os.unlink(lock)
+        except OSError:
+            pass
         os.close(fd)
 
 
@@ -351,19 +276,34 @@ def _worker_init() -> None:
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
-def _clashes(specs: list[Path]) -> dict[Path, str]:
+def _clash_groups(specs: list[Path]) -> list[list[Path]]:
     """Specs whose page folders would be the same (x.yaml and x.yml, 'a b' and 'a-b', names that
-    differ only in case): each gets a message naming the others."""
+    differ only in case), each group in sorted order."""
     groups: dict[str, list[Path]] = {}
     for p in specs:
         groups.setdefault(slug_for(p).lower(), []).append(p)
+    return [sorted(g, key=str) for g in groups.values() if len(g) > 1]
+
+
+def _clashes(specs: list[Path]) -> dict[Path, str]:
+    """The specs refused for a page-name clash: every one after the first of its group in sorted
+    order (the first is built), each with a message naming the others."""
     out = {}
-    for group in groups.values():
-        if len(group) > 1:
-            for p in group:
-                others = ", ".join(str(q) for q in group if q is not p)
-                out[p] = (f"{p}: its page {slug_for(p)}/ would be the same as that of {others}; "
-                          "rename one of these files")
+    for first, *rest in _clash_groups(specs):
+        for p in rest:
+            others = ", ".join(str(q) for q in [first, *rest] if q is not p)
+            out[p] = (f"{p}: its page {slug_for(p)}/ would be the same as that of {others}; "
+                      f"{first} (the first in sorted order) is built, not this file; rename one of these files")
+    return out
+
+
+def _clash_notes(specs: list[Path]) -> dict[Path, str]:
+    """For the spec built from each clashing group: a note naming the files refused beside it."""
+    out = {}
+    for first, *rest in _clash_groups(specs):
+        others = ", ".join(map(str, rest))
+        out[first] = (f"{first}: its page {slug_for(first)}/ would be the same as that of {others}; "
+                      f"built from this file, the first in sorted order ({others} refused); rename one of these files")
     return out
 
 
@@ -409,6 +349,8 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
     if progress:
         for o in outcomes:  # refused before any work: k = 0
             progress(0, len(todo), o)
+        for p, note in _clash_notes(specs).items():  # said before any work too; built as usual
+            progress(0, len(todo), Outcome(str(p), slug_for(p), "ok", note))
     if jobs is None:
         jobs = default_jobs(len(todo))
     with locked(opts.out):

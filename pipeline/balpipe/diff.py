@@ -17,9 +17,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from . import runner
 from .loader import LoadedSpec, SpecError, SpecErrors, load, load_text
 from .report.results import _clean
-from .spec_parts import SpecFieldError
 from .study import Study, stage_metrics
 
 ROUND_OFF = 1e-9  # ratios to the unbalanced peak below this are cancelled loads
@@ -63,16 +63,7 @@ def read_side(ref: str) -> LoadedSpec:
 
 def run_side(ref: str, simulate: bool) -> Side:
     loaded = read_side(ref)
-    from .build import analyse  # the checks and limits of check and build, errors located
-
-    st = analyse(loaded, simulate=simulate)
-    try:
-        if simulate and loaded.spec.validation.enabled:
-            from .validation_stage import simulate_study
-
-            simulate_study(st)
-    except SpecFieldError as exc:
-        raise loaded.error(exc) from None
+    st = runner.run(loaded, simulate)  # the checks and limits of check and build, errors located
     return Side(ref, loaded, st)
 
 
@@ -266,7 +257,7 @@ def to_json(data: dict) -> str:
 def to_html(data: dict, a: Side, b: Side, site: str = "") -> str:
     """The HTML page; a stage whose loads are round-off in both designs is drawn on the
     unbalanced stage's scale (flat at zero) and said so, not plotted as a signal."""
-    from .report.figures import overlay_figure
+    from .draw.figures import overlay_figure
     from .report.render import environment
 
     figs = []

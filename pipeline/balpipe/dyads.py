@@ -19,7 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .engine import Compiled, _extend, jacobian
+from .engine import Compiled, jacobian
+from .engine.constraints import _extend
 from .engine.structure import maximum_matching, strong_components
 from .model import FRAME, Model, Revolute
 

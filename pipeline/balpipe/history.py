@@ -14,7 +14,7 @@ folder. A spec text already seen, in any commit of any spec, is never recomputed
 version recomputes everything, as ``build`` does. When ``<out>/<slug>/results.json`` was built
 from the same text and options (same input hash), its figures are taken from there.
 
-Output, per spec: ``<out>/<slug>/history.json`` (documented in the README, deterministic: sorted
+Output, per spec: ``<out>/<slug>/history.json`` (documented in docs/history.md, deterministic: sorted
 keys, commits oldest first, no time of the run) and ``<out>/<slug>/history.html``, a page of
 plots against the commits. ``balpipe build`` reads ``history.json`` and puts the same section
 in the study page (see :mod:`balpipe.report.history_page`).
@@ -162,22 +162,14 @@ def figures_from_results(results: dict) -> dict:
 def compute(text: str, source: str, simulate: bool, input_hash: str) -> dict:
     """Run one revision of a spec (study, and the simulation when asked) and return its figures;
     an invalid revision gives ``status: invalid`` and the located errors."""
-    from . import study as study_mod
+    from . import runner
     from .loader import LoadedSpec, SpecErrors, load_text
     from .report.results import results_dict
-    from .spec_parts import SpecFieldError
 
     try:
         spec, node = load_text(text, source)
         loaded = LoadedSpec(Path(source), text, spec, node)
-        try:
-            st = study_mod.run(spec)
-            if simulate and spec.validation.enabled:
-                from .validation_stage import simulate_study
-
-                simulate_study(st)
-        except SpecFieldError as exc:
-            raise loaded.error(exc) from None
+        st = runner.run(loaded, simulate)  # the checks of build: a revision build rejects is invalid here too
     except SpecErrors as exc:
         return {"status": "invalid", "problems": str(exc).splitlines(), "parameters": [], "stages": [],
                 "validation": "skipped", "references": []}

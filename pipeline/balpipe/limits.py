@@ -4,7 +4,7 @@ loads are finite.
 Per-field magnitudes are bounded by :data:`balpipe.units.MAX_ABS` and by the fields' own bounds
 (``analysis.samples`` <= 200 000, ``validation.iterations`` <= 10 000, file size and nesting in
 :mod:`balpipe.loader`); the limits here involve several fields. Each refusal names the field and
-the limit (README, "Limits").
+the limit (docs/limits.md).
 """
 
 from __future__ import annotations

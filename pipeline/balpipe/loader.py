@@ -62,10 +62,10 @@ class LoadedSpec:
 
     def error(self, exc: SpecFieldError) -> SpecErrors:
         """Locate a semantic error raised while building or balancing this spec."""
-        return SpecErrors([_located(str(self.path), self.node, exc.path, exc.message)])
+        return SpecErrors([located(str(self.path), self.node, exc.path, exc.message)])
 
 
-def _format_path(path: tuple) -> str:
+def format_path(path: tuple) -> str:
     out = ""
     for p in path:
         if not isinstance(p, int):
@@ -108,22 +108,22 @@ def _key_node(node: yaml.Node | None, path: tuple) -> yaml.Node | None:
     return None
 
 
-def _located(file: str, root: yaml.Node | None, path: tuple, message: str, at_key: bool = False) -> SpecError:
+def located(file: str, root: yaml.Node | None, path: tuple, message: str, at_key: bool = False) -> SpecError:
     target = _key_node(root, path) if at_key else None
     if target is None:
         target, _ = _find(root, path)
     if target is None:
-        return SpecError(file, None, None, _format_path(path), message)
+        return SpecError(file, None, None, format_path(path), message)
     mark = target.start_mark
-    return SpecError(file, mark.line + 1, mark.column + 1, _format_path(path), message)
+    return SpecError(file, mark.line + 1, mark.column + 1, format_path(path), message)
 
 
 _DISCRIMINATORS = ("template", "method", "type")
 
 
-def _clean_loc(loc: tuple, data: Any) -> tuple:
+def clean_loc(loc: tuple, data: Any) -> tuple:
     """Drop the parts of pydantic's error location that are not in the document: the tags of
-    discriminated unions (e.g. 'slider_crank') and validator names ('function-after[...]')."""
+    discriminated unions (a template's or method's name) and validator names ('function-after[...]')."""
     out: list = []
     cur = data
     for part in loc:
@@ -142,7 +142,7 @@ def _clean_loc(loc: tuple, data: Any) -> tuple:
     return tuple(out)
 
 
-def _message(err: dict) -> str:
+def error_message(err: dict) -> str:
     msg = err["msg"]
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
@@ -194,23 +194,30 @@ def _describe(value: Any) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def _check_duplicates(node: yaml.Node, file: str, path: tuple = ()) -> list[SpecError]:
+def _check_duplicates(node: yaml.Node, file: str, path: tuple = (), done: set | None = None) -> list[SpecError]:
+    """Keys written twice in one mapping, on the composed document (before the constructor
+    flattens merge keys): a key that overrides one merged in with ``<<: *anchor`` is not a
+    duplicate. A node reached through several aliases is checked once."""
+    done = set() if done is None else done
+    if id(node) in done:
+        return []
+    done.add(id(node))
     errors = []
     if isinstance(node, yaml.MappingNode):
         seen = set()
         for k, v in node.value:
-            if k.value in seen:
+            if k.value in seen and k.tag != "tag:yaml.org,2002:merge":
                 m = k.start_mark
-                errors.append(SpecError(file, m.line + 1, m.column + 1, _format_path(path + (k.value,)), "duplicate key"))
+                errors.append(SpecError(file, m.line + 1, m.column + 1, format_path(path + (k.value,)), "duplicate key"))
             seen.add(k.value)
-            errors += _check_duplicates(v, file, path + (k.value,))
+            errors += _check_duplicates(v, file, path + (k.value,), done)
     elif isinstance(node, yaml.SequenceNode):
         for i, v in enumerate(node.value):
-            errors += _check_duplicates(v, file, path + (i,))
+            errors += _check_duplicates(v, file, path + (i,), done)
     return errors
 
 
-#: Limits of a spec file, checked before any work (README, "Limits").
+#: Limits of a spec file, checked before any work (docs/limits.md).
 MAX_FILE_BYTES = 1_000_000
 MAX_DEPTH = 64
 MAX_VALUES = 200_000  # values after alias expansion (an alias bomb multiplies them)
@@ -332,7 +339,7 @@ def _check_strings(node: yaml.Node, file: str, path: tuple = ()) -> list[SpecErr
             m = _CONTROL.search(n.value) if isinstance(n.value, str) else None
             if m:
                 mk = n.start_mark
-                errors.append(SpecError(file, mk.line + 1, mk.column + 1, _format_path(p), _control_message(m.group())))
+                errors.append(SpecError(file, mk.line + 1, mk.column + 1, format_path(p), _control_message(m.group())))
         elif isinstance(n, yaml.MappingNode):
             for k, v in n.value:
                 stack.append((k, p))
@@ -353,6 +360,7 @@ def load_text(text: str, file: str) -> tuple[Spec, yaml.Node]:
             node = loader.get_single_node()
             if node is not None:
                 _check_aliases(node, file)
+            dup = _check_duplicates(node, file) if node is not None else []  # before merge keys are flattened
             data = loader.construct_document(node) if node is not None else None
         finally:
             loader.dispose()
@@ -366,7 +374,6 @@ def load_text(text: str, file: str) -> tuple[Spec, yaml.Node]:
             raise SpecErrors(bad)
     if node is None or not isinstance(data, dict):
         raise SpecErrors([SpecError(file, 1, 1, "", "the spec must be a YAML mapping (name:, mechanism:, motion:, ...)")])
-    dup = _check_duplicates(node, file)
     if dup:
         raise SpecErrors(dup)
     try:
@@ -374,10 +381,10 @@ def load_text(text: str, file: str) -> tuple[Spec, yaml.Node]:
     except ValidationError as exc:
         errors = []
         for err in exc.errors():
-            loc = _clean_loc(err["loc"], data)
+            loc = clean_loc(err["loc"], data)
             if err["type"] in ("union_tag_invalid", "union_tag_not_found"):
                 loc = loc + (err.get("ctx", {}).get("discriminator", "").strip("'"),)
-            errors.append(_located(file, node, loc, _message(err), at_key=err["type"] == "extra_forbidden"))
+            errors.append(located(file, node, loc, error_message(err), at_key=err["type"] == "extra_forbidden"))
         # one line per place: a union may report the same field several times
         unique = list(dict.fromkeys(errors))
         raise SpecErrors(sorted(unique, key=lambda e: (e.line or 0, e.column or 0))) from None
@@ -385,7 +392,7 @@ def load_text(text: str, file: str) -> tuple[Spec, yaml.Node]:
         check_limits(spec)
         read_tables(spec, Path(file).parent)
     except SpecFieldError as exc:
-        raise SpecErrors([_located(file, node, exc.path, exc.message)]) from None
+        raise SpecErrors([located(file, node, exc.path, exc.message)]) from None
     return spec, node
 
 
@@ -426,7 +433,22 @@ def load(path: str | Path) -> LoadedSpec:
 
 def schema() -> dict[str, Any]:
     """The JSON Schema of a spec (``balpipe schema``)."""
-    s = Spec.model_json_schema(by_alias=True)
+    s = _stable_def_names(Spec.model_json_schema(by_alias=True))
     s["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     s["title"] = "balpipe spec"
     return s
+
+
+def _stable_def_names(node: Any) -> Any:
+    """pydantic names a definition whose class name is not unique by its module path; a family's
+    template module ``balpipe.families.X.template`` keeps the name it had as
+    ``balpipe.mechanisms.X``, so the schema does not change when code moves."""
+    if isinstance(node, dict):
+        return {_stable_name(k): _stable_def_names(v) for k, v in node.items()}
+    if isinstance(node, list):
+        return [_stable_def_names(v) for v in node]
+    return _stable_name(node) if isinstance(node, str) else node
+
+
+def _stable_name(text: str) -> str:
+    return re.sub(r"balpipe__families__([A-Za-z0-9_]+?)__template__", r"balpipe__mechanisms__\1__", text)

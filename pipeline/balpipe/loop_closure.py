@@ -16,7 +16,8 @@ import math
 import numpy as np
 
 from . import dyads
-from .engine import AnalysisError, Compiled, _extend, compile_model, jacobian, residual
+from .engine import AnalysisError, Compiled, compile_model, jacobian, residual
+from .engine.constraints import _extend
 from .engine.positions import follow_motion
 from .model import Model
 from .spec_parts import SpecFieldError

@@ -3,109 +3,71 @@ unbalanced model and its balancing stages."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
-from typing import Any, Callable
-
-import numpy as np
+from dataclasses import replace
+from typing import Any
 
 from . import units
-from .balancing import com_planning, decoupling
-from .balancing import five_bar as fb_balancing
-from .balancing import rpr3_idler, rpr3_scott_russell
-from .balancing import rrr4 as rrr4_balancing
 from .balancing import force_balance as generic_force
 from .balancing import moment_balance as generic_moment
 from .balancing import partial as generic_partial
-from .balancing import slider_crank as sc_balancing
 from .balancing import stages as generic_stages
 from .balancing.base import BalanceResult, Stage
-from .mechanisms import custom, five_bar, rpr3, rrr4, serial_arm, slider_crank
+from .balancing.partial_spec import PartialBalance
 from .model import Law, Model
 from .laws.drives import drive_laws
 from .motion import law_for
+from .plugins import Method, Template, discover
+from .sampling import time_grid
 from .spec_parts import DriveSpec, SpecFieldError
 
+__all__ = [
+    "METHODS", "TEMPLATES", "Method", "Template", "balance", "balance_designs", "method_specs", "scalar_laws",
+    "template_specs", "time_grid", "unbalanced_model",
+]
 
-@dataclass(frozen=True)
-class Template:
-    """``build(mechanism_spec, laws, t) -> Model``; ``laws`` maps drive names to laws.
-    ``figures(study)`` optionally yields extra report figures as (title, svg, caption)."""
-
-    build: Callable[..., Model]
-    label: str
-    figures: Callable[..., Any] | None = None
-    notation: Any = None  # the papers' symbols of the inputs: a table or table(mechanism_spec) (balpipe.notation)
-
-
-@dataclass(frozen=True)
-class Method:
-    """``balance(mechanism_spec, method_spec, model) -> BalanceResult`` for ``templates``."""
-
-    balance: Callable[..., BalanceResult]
-    templates: tuple[str, ...]
-    label: str
-    uses_spec: bool = False  # balance(..., spec): the method also reads the motion and analysis settings
-    generic: bool = False  # applies to every template; balance() also receives the time grid t
-    notation: Any = None  # the papers' symbols of the inputs: a table or table(method_spec) (balpipe.notation)
+# methods for every template (they read only the model); "none" is the spec's own default
+GENERIC: tuple[Method, ...] = (
+    Method("force_balance", generic_force.ForceBalance, generic_force.balance, (),
+           "force-balance conditions from the momentum + least-mass counterweights", generic=True,
+           notation=generic_force.notation),
+    Method("moment_balance", generic_moment.MomentBalance, generic_moment.balance, (),
+           "least-mass counterweights + counter-rotations from the angular momentum", generic=True,
+           notation=generic_moment.notation),
+    Method("stages", generic_stages.Stages, generic_stages.balance, (), "stages written by hand, each adding parts",
+           generic=True, notation=generic_stages.notation),
+    Method("partial_balance", PartialBalance, generic_partial.balance, (),
+           "optimal partial balancing (cone programme)", uses_spec=True, generic=True, notation=generic_partial.notation),
+)
 
 
-TEMPLATES: dict[str, Template] = {
-    "slider_crank": Template(slider_crank.build, "slider-crank"),
-    "custom": Template(custom.build, "custom mechanism"),
-    "five_bar": Template(five_bar.build, "five-bar (5R), fixed-sequence with gear-coupled inputs", five_bar.figures),
-    "rrr4": Template(rrr4.build, "planar n-RRR parallel manipulator (4-RRR of paper 001, legs removable)", rrr4.figures),
-    "rpr3": Template(rpr3.build, "3-RPR parallel manipulator", rpr3.figures),
-    "serial_arm": Template(serial_arm.build, "serial nR arm"),
-}
-METHODS: dict[str, Method] = {
-    "slider_crank_counterweights": Method(
-        sc_balancing.balance, ("slider_crank",), "counterweights (+ eq. 20 inertia for Scott-Russell)"
-    ),
-    "five_bar_gear_balancing": Method(
-        fb_balancing.balance, ("five_bar",), "counterweights + counter-rotating gears 5, 6, 7 (eqs. 9-21)"
-    ),
-    "rrr4_counter_masses": Method(
-        rrr4_balancing.balance, ("rrr4",), "counter-masses: leg by leg (eqs. 8-11), from eq. 17 (Fig. 4a) and eqs. 19/21 (Fig. 6)"
-    ),
-    "rpr3_idler_loop": Method(
-        rpr3_idler.balance, ("rpr3",), "idler loop E-F-P, counterweights (eqs. 5a-d), chained counter-rotations (eqs. 9a-d)"
-    ),
-    "rpr3_scott_russell": Method(
-        rpr3_scott_russell.balance, ("rpr3",),
-        "Scott-Russell legs, counterweights (eqs. 30a-d), eq. 30e, one counter-rotation per leg (eq. 30f)",
-    ),
-    "gear_decoupling": Method(
-        decoupling.balance, ("serial_arm",), "decoupling by gears 1'-2' and mass redistribution, counter-rotating gear 3 (paper 002)"
-    ),
-    "com_motion_planning": Method(
-        com_planning.balance, ("serial_arm",), "centre-of-mass motion planning, phi optimised (paper 003)", uses_spec=True
-    ),
-}
-# methods for every template (they read only the model)
-METHODS.update({
-    "force_balance": Method(
-        generic_force.balance, (), "force-balance conditions from the momentum + least-mass counterweights", generic=True
-    ),
-    "moment_balance": Method(
-        generic_moment.balance, (), "least-mass counterweights + counter-rotations from the angular momentum", generic=True
-    ),
-    "stages": Method(generic_stages.balance, (), "stages written by hand, each adding parts", generic=True),
-    "partial_balance": Method(generic_partial.balance, (), "optimal partial balancing (cone programme)", generic=True,
-                              uses_spec=True, notation=generic_partial.notation),
-})
+def _tables() -> tuple[dict[str, Template], dict[str, Method]]:
+    """Templates and methods of the discovered families in their order, then the generic methods."""
+    templates: dict[str, Template] = {}
+    methods: dict[str, Method] = {}
+    for family in discover():
+        for kind, table, items in (("template", templates, family.templates), ("method", methods, family.methods)):
+            for item in items:
+                if item.name in table or (kind == "method" and item.name == "none"):
+                    raise ValueError(f"family {family.name!r}: {kind} {item.name!r} is already defined")
+                table[item.name] = item
+    for item in GENERIC:
+        if item.name in methods:
+            raise ValueError(f"method {item.name!r} is already defined")
+        methods[item.name] = item
+    return templates, methods
 
-# the papers' symbols of each template's and method's inputs (balpipe.notation, the inputs table)
-for _name, _table in (("slider_crank", slider_crank.NOTATION), ("custom", custom.notation),
-                      ("five_bar", five_bar.NOTATION), ("rrr4", rrr4.NOTATION), ("rpr3", rpr3.NOTATION),
-                      ("serial_arm", serial_arm.notation)):
-    TEMPLATES[_name] = replace(TEMPLATES[_name], notation=_table)
-for _name, _table in (("slider_crank_counterweights", sc_balancing.NOTATION),
-                      ("five_bar_gear_balancing", fb_balancing.NOTATION),
-                      ("rrr4_counter_masses", rrr4_balancing.NOTATION), ("rpr3_idler_loop", rpr3_idler.NOTATION),
-                      ("rpr3_scott_russell", rpr3_scott_russell.NOTATION), ("gear_decoupling", decoupling.NOTATION),
-                      ("com_motion_planning", com_planning.NOTATION), ("force_balance", generic_force.notation),
-                      ("moment_balance", generic_moment.notation), ("stages", generic_stages.notation)):
-    METHODS[_name] = replace(METHODS[_name], notation=_table)
+
+TEMPLATES, METHODS = _tables()
+
+
+def template_specs() -> tuple[type, ...]:
+    """The templates' spec sections, in union order."""
+    return tuple(t.spec for t in TEMPLATES.values())
+
+
+def method_specs() -> tuple[type, ...]:
+    """The methods' spec sections, in union order (after the spec's own "none")."""
+    return tuple(m.spec for m in METHODS.values())
 
 
 def scalar_laws(motion: Any, dims: dict[str, str]) -> dict[str, Law]:
@@ -131,10 +93,6 @@ def scalar_laws(motion: Any, dims: dict[str, str]) -> dict[str, Law]:
                 raise SpecFieldError(path + (key,), f"{exc} ({name})") from None
         out[name] = law_for(motion, values[0], values[1], drive)
     return out
-
-
-def time_grid(spec: Any) -> np.ndarray:
-    return np.linspace(0.0, spec.motion.duration, spec.analysis.samples)
 
 
 def unbalanced_model(spec: Any) -> Model:

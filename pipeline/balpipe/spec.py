@@ -1,9 +1,9 @@
 """The spec: one YAML file describing a mechanism, its motion, the balancing method and the
 analysis. ``balpipe schema`` prints its JSON Schema.
 
-Mechanism templates and balancing methods register here: each is a pydantic model with a
-``template`` (``method``) literal that discriminates the union, a builder and a balancer (see
-:mod:`balpipe.registry`).
+The mechanism and balancing sections are unions of the templates and methods the registry
+discovered (:mod:`balpipe.plugins`, :mod:`balpipe.registry`): each is a pydantic model with a
+``template`` (``method``) literal that discriminates the union.
 """
 
 from __future__ import annotations
@@ -12,23 +12,7 @@ from typing import Annotated, Literal, Union
 
 from pydantic import Field, PrivateAttr, model_validator
 
-from .balancing.com_planning import ComMotionPlanning
-from .balancing.decoupling import GearDecoupling
-from .balancing.five_bar import FiveBarGearBalancing
-from .balancing.force_balance import ForceBalance
-from .balancing.moment_balance import MomentBalance
-from .balancing.partial_spec import PartialBalance
-from .balancing.rpr3_idler import Rpr3IdlerLoop
-from .balancing.rpr3_scott_russell import Rpr3ScottRussell
-from .balancing.rrr4 import RRR4Balancing
-from .balancing.slider_crank import SliderCrankCounterweights
-from .balancing.stages import Stages
-from .mechanisms.custom import CustomMechanism
-from .mechanisms.five_bar import FiveBarMechanism
-from .mechanisms.rpr3 import Rpr3Mechanism
-from .mechanisms.rrr4 import RRR4Mechanism
-from .mechanisms.serial_arm import SerialArmMechanism
-from .mechanisms.slider_crank import SliderCrankMechanism
+from . import registry
 from .laws.drives import Drive, common_period, period
 from .spec_parts import Strict
 from .sweep_spec import SweepSpec
@@ -42,14 +26,11 @@ class NoBalancing(Strict):
 
 
 Mechanism = Annotated[
-    Union[SliderCrankMechanism, CustomMechanism, FiveBarMechanism, RRR4Mechanism, Rpr3Mechanism, SerialArmMechanism],
+    Union[registry.template_specs()],
     Field(discriminator="template", description="the mechanism: a template with its parameters"),
 ]
 Balancing = Annotated[
-    Union[
-        NoBalancing, SliderCrankCounterweights, FiveBarGearBalancing, RRR4Balancing, Rpr3IdlerLoop, Rpr3ScottRussell,
-        GearDecoupling, ComMotionPlanning, ForceBalance, MomentBalance, Stages, PartialBalance,
-    ],
+    Union[(NoBalancing, *registry.method_specs())],
     Field(discriminator="method", description="the balancing method and its design choices"),
 ]
 

@@ -13,7 +13,8 @@ from . import actuation, assembly, dead_centres, loop_closure, realisable, regis
 from .balancing.base import BalanceResult, Stage
 from .claim_precision import claim_tolerances
 from .engine import Analysis, AnalysisError, analyse
-from .load_reference import LoadReference, load_reference
+from .engine.load_reference import LoadReference, load_reference
+from .sampling import gravity_vector  # noqa: F401  (balpipe.study.gravity_vector, as before)
 from .spec import Spec
 from .spec_parts import SpecFieldError
 
@@ -82,10 +83,6 @@ def reference_of(stages: list[StageResult], sr: StageResult) -> StageResult:
 
 
 NEAR_SINGULAR = 1e3  # condition number above which the page warns of lost accuracy
-
-
-def gravity_vector(spec: Spec) -> tuple[float, float]:
-    return (0.0, -spec.analysis.g) if spec.analysis.gravity else (0.0, 0.0)
 
 
 def run_stage_analyses(spec: Spec, result: BalanceResult) -> list[StageResult]:

@@ -28,6 +28,7 @@ from pydantic import AfterValidator, BeforeValidator, Field, WithJsonSchema, mod
 
 from .spec_parts import Strict
 from .units import count
+from .vary import SweepError, parse_vary
 
 MAX_DESIGNS = 100_000
 
@@ -57,8 +58,6 @@ def _range_text(value: Any) -> str:
 
 
 def _range_syntax(text: str) -> str:
-    from .sweep import SweepError, parse_vary
-
     try:
         parse_vary("x=" + text, origin="")
     except SweepError as exc:

@@ -64,7 +64,7 @@ class Reactionless:
         return len({(r.base_mass, r.base_inertia) for r in self.runs}) == 1
 
     def figures(self):
-        from .report.figures import drift_figure
+        from .draw.figures import drift_figure
 
         yield (
             "Frame drift and rotation",
@@ -73,7 +73,7 @@ class Reactionless:
         )
 
     def player(self) -> str:
-        from .report.player import player_html
+        from .draw.player import player_html
 
         return player_html([
             {"label": lab, "model": m, "t": r.t, "base": r.base, "poses": r.poses}
@@ -82,7 +82,7 @@ class Reactionless:
 
     def player_note(self) -> str:
         """The player caption's sentence on the panels' scales and the gears' numbers."""
-        from .report.player import scale_note
+        from .draw.player import scale_note
 
         return scale_note([
             {"label": lab, "model": m, "t": r.t, "base": r.base, "poses": r.poses}

@@ -27,7 +27,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linprog
 
 from ..model import Model, Vec2
 from .conditions import ForceConditions, scale_of
@@ -148,6 +147,8 @@ def solve(model: Model, cond: ForceConditions, regions: list[Region], sides: int
     A_lp, b_lp, inconsistent = independent_equations(A, b)
     if inconsistent:
         raise _infeasible(labels, A, b, regions)
+    from scipy.optimize import linprog  # scipy only when a programme is solved (import balpipe.spec stays light)
+
     res = linprog(np.array(cost), A_eq=A_lp, b_eq=b_lp, bounds=(0, None), method="highs")
     if res.status == 2 or res.x is None:
         raise _infeasible(labels, A, b, regions)
@@ -241,6 +242,8 @@ def _infeasible(labels: list[str], A, b, regions: list[Region]) -> Infeasible:
     r, nz = A.shape
     Aeq = np.hstack([A, np.eye(r), -np.eye(r)])
     c = np.concatenate([np.zeros(nz), np.ones(2 * r)])
+    from scipy.optimize import linprog  # see above
+
     res = linprog(c, A_eq=Aeq, b_eq=b, bounds=(0, None), method="highs")
     slack = res.x[nz : nz + r] - res.x[nz + r :] if res.x is not None else b
     scale = max(float(np.max(np.abs(b))), 1e-300)

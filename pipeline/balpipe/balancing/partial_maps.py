@@ -4,7 +4,7 @@
 At fixed geometry and motion every load is linear in each body's parameters p = (m, mx, my, J)
 (mass, first moment and second moment about the body frame's origin;
 :func:`.regressor.parameters` with ``angular=True``), and one engine analysis gives the matrices
-(:class:`balpipe.mass_sweep.MassSweep`: shaking force and moment from the momentum regressors,
+(:class:`balpipe.balancing.mass_sweep.MassSweep`: shaking force and moment from the momentum regressors,
 efforts and multipliers from the dynamics regressor). A counterweight k on body b adds its own
 (m_k, s_k, J_k) to b's parameters (s_k = m_k c_k its first moment, J_k its second moment about b's
 origin); a counter-rotating disc d adds its inertia I_d to its own body's J. So with the design
@@ -25,8 +25,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..engine import _joint_reactions
-from ..mass_sweep import MassSweep
+from ..engine.dynamics import _joint_reactions
+from .mass_sweep import MassSweep
 from ..model import Model, Prismatic, Revolute
 from .parts import add_counterweight
 from .regressor import parameters

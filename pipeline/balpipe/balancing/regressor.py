@@ -29,7 +29,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..engine import Compiled, _extend, _newton, compile_model, jacobian, solve_positions
+from ..engine import Compiled, compile_model, jacobian, solve_positions
+from ..engine.constraints import _extend
+from ..engine.positions import _newton
 from ..model import Law, Model
 
 MIN_CONDITION = 1e-7  # smallest / largest singular value of a kept configuration's Jacobian
@@ -331,7 +333,7 @@ def dynamics_regressor(states: States, gravity: tuple[float, float] = (0.0, 0.0)
         theta: mx e1 x (r_o'' - g) + my e2 x (r_o'' - g) + J alpha
 
     (Newton-Euler about the frame origin: J = I + m |c|^2). The dynamics read
-    Phi_q^T lambda = -Y_D p in these coordinates (:mod:`balpipe.mass_sweep`)."""
+    Phi_q^T lambda = -Y_D p in these coordinates (:mod:`balpipe.balancing.mass_sweep`)."""
     rdd, e1, e2, dde1, dde2, al = _accelerations(states)
     a = rdd - np.asarray(gravity, dtype=float)
     S, nb = al.shape

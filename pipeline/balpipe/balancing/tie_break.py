@@ -24,7 +24,6 @@ maximising a fixed generic combination of the design parameters.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linprog, minimize
 
 MASS_SLACK = 1e-9  # relative: the tie-broken design's mass may exceed the least mass by this
 UNIQUE_TOLERANCE = 1e-5
@@ -39,6 +38,8 @@ def least_norm(A: np.ndarray, b: np.ndarray, cost: np.ndarray, D: np.ndarray, z0
     """The tie-broken design on the face of least ``cost . z`` (``z0``: an optimal vertex) and
     whether the least-mass design was unique already. ``D`` maps z to the weighted design
     parameters."""
+    from scipy.optimize import linprog  # scipy only when a tie is broken
+
     if D.shape[0] == 0 or z0.size == 0:
         return z0, True
     lp = linprog(cost, A_eq=A, b_eq=b, bounds=(0, None), method="highs")
@@ -68,6 +69,8 @@ def least_norm(A: np.ndarray, b: np.ndarray, cost: np.ndarray, D: np.ndarray, z0
 def _least_distance(Aeq: np.ndarray, beq: np.ndarray, D: np.ndarray, z0: np.ndarray) -> np.ndarray:
     """min |D z|^2 + eps |z|^2 s.t. Aeq z = beq, z >= 0 (SLSQP with exact gradients, scaled, from
     the feasible z0; a few variables once the face is pruned)."""
+    from scipy.optimize import minimize  # scipy only when a tie is broken
+
     U, sv, _ = np.linalg.svd(Aeq, full_matrices=False)  # independent rows only (SLSQP needs them)
     rank = int(np.sum(sv > 1e-9 * sv[0])) if sv.size and sv[0] > 0 else 0
     Aeq, beq = U[:, :rank].T @ Aeq, U[:, :rank].T @ beq

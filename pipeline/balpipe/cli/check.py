@@ -17,7 +17,8 @@ def run(args) -> int:
     """Everything ``build`` checks before simulating: schema, units, limits, geometry, the
     balancing, the analysis of every stage (singular motions), the references, and the paths and
     values of a ``sweep:`` block. Keeps going past a spec that fails."""
-    from ..build import _clashes, analyse, find_specs
+    from ..build import _clashes, find_specs
+    from ..runner import analyse
     from ..loader import SpecErrors, load
     from ..sweep import SweepError, plan
 

@@ -41,16 +41,11 @@ Modules, one job each: :mod:`.compile` (primitives, :func:`compile_model`), :mod
 """
 
 from .analysis import Analysis, analyse, clear_cache, compiled
-from .compile import Compiled, _Angle, _Coincident, _Mesh, _perp, _Projection, _rotate, compile_model
-from .constraints import _extend, _law_values, _split, acceleration_rhs, jacobian, residual, velocity_rhs
-from .dynamics import _joint_reactions, _multipliers, _radial_tooth_loads, _tooth_rows
+from .compile import Compiled, compile_model
+from .constraints import acceleration_rhs, jacobian, residual, velocity_rhs
 from .errors import AnalysisError
-from .kinematics import _solve_rect, _vel_acc
 from .warmstart import Anchors, record as record_anchors, warm_start
-from .positions import (
-    _COARSE, _COND_LIMIT, _JUMP, _MAX_ITER, _TOL, _check_regular, _check_redundancy, _check_square,
-    _fail_position, _newton, _substep, _worst_rows, condition_numbers, follow_motion, redundancy, solve_positions,
-)
+from .positions import condition_numbers, follow_motion, redundancy, solve_positions
 
 __all__ = [
     "Analysis", "AnalysisError", "Anchors", "Compiled", "acceleration_rhs", "analyse", "clear_cache", "compile_model", "compiled", "jacobian",

@@ -16,7 +16,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .figures import style, to_svg  # noqa: E402
+from ..draw.figures import style, to_svg  # noqa: E402
 
 MAX_LABELS = 16
 

@@ -7,7 +7,8 @@ import numpy as np
 from .. import realisable
 from ..laws.drives import law_names
 from ..study import Study, ratio_reference
-from . import figures, labels, partial_figures, present, toc
+from ..draw import figures, labels
+from . import partial_figures, present, toc
 from .notation_table import notation_groups
 from .render import environment
 from .results import joint_load_table

@@ -9,7 +9,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from .figures import _marker, legend_below, style, to_svg  # noqa: E402
+from ..draw.figures import _marker, legend_below, style, to_svg  # noqa: E402
 
 AXES = {
     "added_mass": "added mass (kg)",

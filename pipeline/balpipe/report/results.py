@@ -1,4 +1,4 @@
-"""``results.json`` (a public interface, documented in the README) and the CSV time series."""
+"""``results.json`` (a public interface, documented in docs/site.md) and the CSV time series."""
 
 from __future__ import annotations
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from ..fsutil import write_file_atomic  # replaced in one step, never through a planted symlink
 from . import site_filter
 from .render import environment, load, num, printable, ratio
 
@@ -116,8 +117,6 @@ def write_site(out: Path, outcomes: list) -> None:
         n_invalid=n_invalid, n_ok_cli=n_ok,
         filters=site_filter.options(entries),
     )
-    from ..build import write_file_atomic  # replaced in one step, never through a planted symlink
-
     write_file_atomic(out / "index.html", html)
     write_file_atomic(out / "site_nav.js", site_nav_script(entries))
 

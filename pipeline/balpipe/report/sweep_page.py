@@ -9,7 +9,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .figures import to_svg  # noqa: E402
+from ..draw.figures import to_svg  # noqa: E402
 from .render import environment  # noqa: E402
 
 
@@ -38,11 +38,11 @@ def effort_unit(plan) -> str:
     torque (revolute joint, angle), 'N' when every one is a force, else 'N m or N'. The varied
     fields are values, so every design has the base spec's drivers."""
     from .. import registry
-    from ..sweep import _validate
+    from ..spec import Spec
     from .present import driver_unit
 
     try:
-        model = registry.unbalanced_model(_validate(plan.data))
+        model = registry.unbalanced_model(Spec.model_validate(plan.data))
     except Exception:  # noqa: BLE001  (the base spec was checked; a unit is not worth a failed page)
         return "N m or N"
     units = {driver_unit(model, d.name) for d in model.drivers}

@@ -1,0 +1,1 @@
+"""Mechanism families shipped with balpipe, one package each (see :mod:`balpipe.plugins`)."""

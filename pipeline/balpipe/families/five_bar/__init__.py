@@ -1,0 +1,18 @@
+"""The five-bar family: the fixed-sequence 5R with gear-coupled inputs and its gear balancing."""
+
+from ...plugins import Family, Method, Template
+from . import figures, gear_balancing, template
+
+FAMILY = Family(
+    name="five_bar",
+    order=2,
+    package=__name__,
+    templates=(
+        Template("five_bar", template.FiveBarMechanism, template.build,
+                 "five-bar (5R), fixed-sequence with gear-coupled inputs", figures.figures, notation=template.NOTATION),
+    ),
+    methods=(
+        Method("five_bar_gear_balancing", gear_balancing.FiveBarGearBalancing, gear_balancing.balance, ("five_bar",),
+               "counterweights + counter-rotating gears 5, 6, 7 (eqs. 9-21)", notation=gear_balancing.NOTATION),
+    ),
+)

@@ -1,0 +1,53 @@
+"""The five-bar's report figures (paper 004): the gripper path (Fig. 7) and the input angles
+(Figs. 8-9), drawn from the study's analyses."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .template import gripper_path, input_angles, segment_distance
+
+
+def figures(study):
+    """Report figures of the template: the gripper path (Fig. 7) and the input angles (Figs. 8-9)."""
+    from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
+
+    first = study.stages[0]
+    an, model = first.analysis, first.stage.model
+    C = gripper_path(an, model)
+    S, E = C[0], C[-1]
+    on_path = getattr(study.spec.motion.drive.get("gripper"), "law", None) == "path"  # balpipe.laws.paths
+    fig, ax = plt.subplots(figsize=(5.6, 3.6))
+    ax.plot(C[:, 0], C[:, 1], color="black", linewidth=1.4, label="gripper path")
+    if not on_path:
+        ax.plot([S[0], E[0]], [S[1], E[1]], color="0.6", linestyle="--", linewidth=1.0, label="straight segment")
+    ax.plot([S[0]], [S[1]], "o", color="black", markersize=4)
+    ax.plot([E[0]], [E[1]], "s", color="black", markersize=4)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    dev = float(np.max(segment_distance(C, S, E)))
+    coupled = model.name.startswith("fixed-sequence")
+    yield (
+        "Gripper path (Fig. 7)",
+        to_svg(fig, "fivebar-path"),
+        f"C(t) from the analysis, from ({S[0]:.4g}, {S[1]:.4g}) to ({E[0]:.4g}, {E[1]:.4g}) m; " + (
+            "the path of motion.drive.gripper." if on_path else f"largest distance from the straight segment {1000 * dev:.3g} mm"
+            + (" (the gear-coupled inputs do not keep the gripper on the segment)." if coupled else ".")),
+    )
+    th1, th2 = input_angles(an)
+    fig, axes = plt.subplots(1, 2, figsize=(8.4, 2.8))
+    for ax, th, name in ((axes[0], th1, "theta1"), (axes[1], th2, "theta2")):
+        ax.plot(an.t, th, color="black", linewidth=1.4)
+        ax.set_title(f"{name} (rad)", fontsize=9)
+        ax.set_xlabel("time (s)")
+    fig.tight_layout()
+    yield (
+        "Input angles (Figs. 8-9)",
+        to_svg(fig, "fivebar-angles"),
+        "theta1 follows the motion law; theta2 follows it through gears 1', 5, 2' (theta2 - theta2i = "
+        "U21 (theta1 - theta1i))." if coupled
+        else f"Both inputs follow the inverse kinematics of the {'given' if on_path else 'straight'} path.",
+    )

@@ -1,0 +1,126 @@
+"""The 3-RPR's report figures (paper 000): the shaking force and moment of every stage in the
+paper's line styles (Figs. 4 and 8), the peaks and the moment factor, and the axial forces that
+prismatic actuators would need."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .template import pose_of, prismatic_equivalent
+
+PAPER_FIGURES = {"rpr3_idler_loop": "Fig. 4", "rpr3_scott_russell": "Fig. 8"}
+ADDED_LINKAGE = {"rpr3_idler_loop": "idler_loop", "rpr3_scott_russell": "scott_russell"}
+
+
+def _own(study) -> list:
+    """The main design's stages (those of ``compare`` designs are named design:stage and shown in
+    the generic "Designs side by side" table, not in the paper's figures)."""
+    return [s for s in study.stages if ":" not in s.stage.name]
+
+
+def _stage(study, name: str):
+    for s in _own(study):
+        if s.stage.name == name:
+            return s
+    return None
+
+
+def figures(study):
+    """The paper's shaking force x, y and moment figure with its line styles (Fig. 4 for the idler
+    loop, Fig. 8 for the Scott-Russell legs: unbalanced solid, counterweights dashed,
+    counter-rotations grey; the added-linkage stage, which the paper does not plot, dotted), and
+    a table of the peaks and of the factor by which the counterweights raise the peak moment."""
+    from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
+
+    method = study.spec.balancing.method
+    styles = {
+        "unbalanced": {"color": "black", "linestyle": "-", "linewidth": 1.3},
+        ADDED_LINKAGE.get(method, ""): {"color": "tab:blue", "linestyle": ":", "linewidth": 1.2},
+        "counterweights": {"color": "black", "linestyle": "--", "linewidth": 1.3},
+        "counter_rotations": {"color": "0.6", "linestyle": "-", "linewidth": 2.4},
+    }
+    fig, axes = plt.subplots(1, 3, figsize=(10.5, 3.2))
+    panels = (("(a) shaking force along x (N)", lambda a: a.force[:, 0]),
+              ("(b) shaking force along y (N)", lambda a: a.force[:, 1]),
+              ("(c) shaking moment about O (N m)", lambda a: a.moment))
+    for ax, (title, fn) in zip(axes, panels):
+        for s in _own(study):
+            st = styles.get(s.stage.name, {"color": "tab:red", "linestyle": "-.", "linewidth": 1.0})
+            ax.plot(s.analysis.t, fn(s.analysis), label=s.stage.label, **st)
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("time (s)")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
+    number = PAPER_FIGURES.get(method, "")
+    yield (
+        f"Shaking force and moment, every stage ({number} of paper 000)" if number else "Shaking force and moment",
+        to_svg(fig, "rpr3-loads"),
+        "The paper's line styles: before (solid) and after (dashed) the counterweights, after the "
+        "counter-rotations (grey); the stage with the added linkage but no counterweights, which the "
+        "paper does not plot, is dotted. Moments about O, the base's circumcentre; loads that the "
+        "moving links exert on the base.",
+    )
+    yield ("Peak loads and the moment factor", _factor_table(study, method), _factor_caption(study, method))
+    if study.spec.mechanism.actuation == "revolute":
+        yield _prismatic_forces_figure(study, plt, to_svg)
+
+
+def _prismatic_forces_figure(study, plt, to_svg):
+    mech = study.spec.mechanism
+    pose = pose_of(study.unbalanced.stage.model)
+    fig, axes = plt.subplots(1, 3, figsize=(10.5, 2.9), sharey=True)
+    for k, s in enumerate((study.stages[0], _own(study)[-1])):
+        an = s.analysis
+        tau = np.stack([an.efforts[f"theta{i}"] for i in (1, 2, 3)], axis=1)
+        f = prismatic_equivalent(mech, pose, an.t, tau)
+        for i, ax in enumerate(axes):
+            ax.semilogy(an.t, np.abs(f[:, i]), color=("black", "0.6")[k], linewidth=(1.3, 2.2)[k], label=s.stage.label)
+            ax.set_title(f"|axial force| of leg {i + 1} (N)", fontsize=9)
+            ax.set_xlabel("time (s)")
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    return (
+        "Axial forces that prismatic actuators would need",
+        to_svg(fig, "rpr3-prismatic"),
+        "The same motion driven by actuators at the prismatic pairs B_i instead of the revolutes A_i: "
+        "J_p^T f = J_r^T tau (the same generalised force on the platform). Where the three leg lines meet "
+        "in one point (a parallel singularity of prismatic actuation, at phi = 0 for a platform homothetic "
+        "to the base) the forces are unbounded; samples there are left out.",
+    )
+
+
+def _factor_table(study, method: str) -> str:
+    rows = []
+    for s in _own(study):
+        an = s.analysis
+        rows.append(
+            f"<tr><td>{s.stage.label}</td><td>{an.max_force:.6g}</td><td>{an.max_moment:.6g}</td>"
+            f"<td>{s.max_effort:.6g}</td><td>{s.added_mass:.6g}</td><td>{s.added_inertia:.6g}</td></tr>"
+        )
+    from ...drivers import driver_unit
+
+    model = study.unbalanced.stage.model
+    units = sorted({driver_unit(model, d.name) for d in model.drivers}) or ["N m or N"]
+    head = ("<table><thead><tr><th>stage</th><th>max |F| (N)</th><th>max |M| (N m)</th>"
+            f"<th>peak actuator effort ({' or '.join(units)})</th><th>added mass (kg)</th><th>added inertia (kg m²)</th>"
+            "</tr></thead><tbody>")
+    out = head + "".join(rows) + "</tbody></table>"
+    cw, un, added = _stage(study, "counterweights"), study.unbalanced, _stage(study, ADDED_LINKAGE.get(method, ""))
+    if cw is not None:
+        out += "<table><thead><tr><th>peak moment with counterweights relative to</th><th>factor</th></tr></thead><tbody>"
+        for ref in (un, added):
+            if ref is not None and ref.analysis.max_moment > 0:
+                out += (f"<tr><td>{ref.stage.label} ({ref.analysis.max_moment:.6g} N m)</td>"
+                        f"<td>{cw.analysis.max_moment / ref.analysis.max_moment:.4g}</td></tr>")
+        out += "</tbody></table>"
+    return out
+
+
+def _factor_caption(study, method: str) -> str:
+    paper = {"rpr3_idler_loop": 17, "rpr3_scott_russell": 28}.get(method)
+    text = ("Peaks over the motion of every stage. The factor is the counterweights stage's peak shaking "
+            "moment divided by the reference stage's")
+    if paper:
+        text += f"; the paper reports {paper} (the reference `counterweights.moment_ratio` compares it with the unbalanced 3-RPR)"
+    return text + "."

@@ -1,0 +1,326 @@
+"""Report figures of the n-RRR (paper 001): eq. 17's conditions with their residuals per stage,
+and the balance topologies (Figs. 2a, 3, 4a, 4b, 6) with their counter-masses drawn."""
+
+from __future__ import annotations
+
+import html
+import math
+
+import numpy as np
+
+from . import counter_masses as recipe
+from . import conditions as cond
+from .template import mass_parameters, resolve_legs
+
+FIGURE_OF_STAGE = {"leg_by_leg": "Fig. 2a", "least_mass": "least mass", "general": "Fig. 4a", "special": "Fig. 6"}
+FIG3 = tuple(f"Fig. 3{c}" for c in "abcdef")
+TOL = 1e-9
+
+
+def conditions_table(study) -> str | None:
+    """An HTML table: each printed condition and its residual (kg m) for every stage."""
+    mech = study.spec.mechanism
+    if len(resolve_legs(mech)) != 4:
+        return None
+    rows = cond.eq17(recipe.geometry(mech))
+    if mech.kinematics != "general":
+        rows = rows + cond.special(recipe.geometry(mech), mech.kinematics)
+    params = [(s.stage.label, mass_parameters(s.stage.model)) for s in study.stages]
+    head = "".join(f"<th>{html.escape(lbl)}</th>" for lbl, _ in params)
+    body = []
+    for r in rows:
+        cells = []
+        for _, p in params:
+            res, scale = r.residual(p), r.scale(p)
+            ok = abs(res) <= TOL * max(scale, 1e-300)
+            cells.append(f'<td class="num">{res:.3e}{" ✓" if ok else ""}</td>')
+        body.append(f"<tr><td>{html.escape(r.name)}</td><td><code>{html.escape(r.text())}</code></td>{''.join(cells)}</tr>")
+    return (f"<table><tr><th>Condition</th><th>Linear equation (kg m; masses in kg)</th>{head}</tr>"
+            + "".join(body) + "</table>")
+
+
+def finder_table(study) -> str | None:
+    """An HTML table: the generic condition finder's counts beside the paper's, eq. 17's rows in
+    its space, the leg-by-leg and least-mass counter-masses side by side (issue 8)."""
+    det = study.balance.details
+    if "finder" not in det:
+        return None
+    p = {x.name: x.value for x in study.balance.parameters}
+    mech = study.spec.mechanism
+    four = len(resolve_legs(mech)) == 4
+    rows = [("force-balance conditions, every motion", f"{int(p['finder_conditions'])}",
+             "12 (eq. 17)" if four else "", f"singular-value gap {p['finder_gap']:.3g}")]
+    if four:
+        rows.append(("eq. 17's printed rows: largest distance from the computed space", f"{p['eq17_in_finder_space']:.1e}",
+                     "0", "relative, scaled columns; at most 1e-9: in the space"))
+    rows.append(("leg-by-leg design (eqs. 8-11): largest residual", f"{p['leg_by_leg_in_finder_space']:.1e}", "0",
+                 "/ (total mass x model size)"))
+    if "translating_conditions" in p:
+        eq = cond.SPECIAL_EQ[mech.kinematics]
+        rows += [
+            ("conditions, translating platform (Fig. 5" + mech.kinematics[-1] + ")", f"{int(p['translating_conditions'])}",
+             f"8 ({eq})", f"singular-value gap {p['translating_gap']:.3g}"),
+            ("computed translating conditions: largest distance from the span of the printed eight",
+             f"{p['translating_in_printed_span']:.1e}", "", "the printed eight are sufficient"),
+            (f"{eq}'s rows with m5 p5, m5 q5 eliminated: independent combinations", f"{int(p['printed_reduced_conditions'])}",
+             "", f"largest distance from the computed space {p['printed_reduced_in_translating']:.1e}"),
+        ]
+    body = "".join(f"<tr><td>{html.escape(a)}</td><td class=\"num\">{b}</td><td class=\"num\">{html.escape(c)}</td>"
+                   f"<td>{html.escape(d)}</td></tr>" for a, b, c, d in rows)
+    out = ("<table><tr><th>Generic condition finder</th><th>computed</th><th>paper</th><th></th></tr>" + body + "</table>")
+    lm = det.get("least_mass")
+    if lm:
+        stage = next((s for s in study.stages if s.stage.name == "leg_by_leg"), None)
+        lbl = {b.name: a for b in stage.stage.model.bodies for a in b.attachments if a.kind == "counterweight"} if stage else {}
+        cells = []
+        for c in lm["counter_masses"]:
+            a = lbl.get(c["body"])
+            lb = f"{a.mass:.4g} kg at ({a.position[0]:.4g}, {a.position[1]:.4g}) m" if a else "none"
+            pos = f"{c['mass']:.4g} kg at ({c['position'][0]:.4g}, {c['position'][1]:.4g}) m" if c["mass"] > 0 else "none"
+            cells.append(f"<tr><td>l{c['body'][4:]}</td><td>{lb}</td><td>{pos}</td></tr>")
+        out += ("<table><tr><th>Link</th><th>leg-by-leg counter-mass (eqs. 8-11)</th><th>least-mass counter-mass "
+                "(linprog, same allowed positions)</th></tr>" + "".join(cells)
+                + f"<tr><th>added mass</th><th>{lm['leg_by_leg_mass']:.6g} kg</th><th>{lm['total_mass']:.6g} kg</th></tr></table>")
+    return out
+
+
+DISC = 0.05  # the heaviest counter-mass's disc radius / the span of the base pivots
+NAMED = ("pivot", "link")  # the names a panel carries: base pivots A1-A4 and links, as the paper: l11 for link11
+
+
+def _draw(ax, model, poses, span: float, max_cw: float, title: str) -> list:
+    """One panel: ``model`` at the body poses ``poses`` (the engine's frame poses at t = 0): links,
+    joints, pivots, each body's centre of mass (cross), counter-masses as red discs of area
+    proportional to mass (``max_cw`` has the largest), the total centre of mass (star). Returns the
+    points marked (centres of mass) for :func:`_name` to keep clear."""
+    from matplotlib.patches import Circle, Polygon
+
+    total, weighted, marks = 0.0, np.zeros(2), []
+    for k, b in enumerate(model.bodies):
+        x, y, th = poses[k]
+        R = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+        g = lambda p: np.array([x, y]) + R @ np.asarray(p, dtype=float)  # noqa: E731
+        pts = np.array([g(b.points[n]) for n in b.outline])
+        if b.kind == "platform":
+            ax.add_patch(Polygon(pts[:-1], closed=True, facecolor="0.9", edgecolor="black", linewidth=1.5))
+        else:
+            ax.plot(pts[:, 0], pts[:, 1], color="black", linewidth=2.0, solid_capstyle="round")
+        ax.plot(pts[:, 0], pts[:, 1], "o", color="white", markeredgecolor="black", markersize=4)
+        for a in b.attachments:
+            if a.kind != "counterweight":
+                continue
+            root = g(b.points[b.outline[0]])
+            pos = g(a.position)
+            ax.plot([root[0], pos[0]], [root[1], pos[1]], color="tab:red", linewidth=1.2)
+            ax.add_patch(Circle(pos, DISC * span * math.sqrt(a.mass / max_cw), color="tab:red", alpha=0.6))
+        m, c, _ = b.mass_properties()
+        gc = g(c)
+        total, weighted = total + m, weighted + m * gc
+        ax.plot(gc[0], gc[1], "x", color="tab:blue", markersize=5)
+        marks.append(gc)
+    for name, p in model.frame_points.items():
+        ax.plot(p[0], p[1], marker="^", color="black", markersize=8)
+    com = weighted / max(total, 1e-300)
+    marks.append(com)
+    ax.plot(com[0], com[1], "*", color="tab:purple", markersize=11)
+    ax.set_title(title, fontsize=8)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)", fontsize=7)
+    ax.set_ylabel("y (m)", fontsize=7)
+    ax.tick_params(labelsize=7)
+    return marks
+
+
+def _name(fig, ax, model, poses, span: float, max_cw: float, marks: list) -> list:
+    """The panel's names (:data:`NAMED`), placed by the report's label placer
+    (:func:`balpipe.report.figures.place_names`, :func:`balpipe.report.labels.place`): no two
+    overlap, and each keeps clear of the links, counter-mass discs, pivots, joints and the centres
+    of mass ``marks`` where the panel leaves room. Call once the figure's layout is final."""
+    from ...draw.figures import place_names
+
+    paper = {b.name: "l" + b.name[4:] for b in model.bodies if b.name.startswith("link")}
+    return place_names(fig, ax, model, np.asarray(poses, dtype=float), span, max_cw, {}, disc=DISC, kinds=NAMED,
+                       marks=marks, texts=paper)
+
+
+def _span(model) -> float:
+    return max(np.ptp([p[0] for p in model.frame_points.values()] + [0.0]),
+               np.ptp([p[1] for p in model.frame_points.values()] + [0.0]), 0.1)
+
+
+def _counter_masses(model) -> list[float]:
+    return [a.mass for b in model.bodies for a in b.attachments if a.kind == "counterweight"]
+
+
+def grid_columns(n: int) -> int:
+    """Panels per row: at most three, two for four panels (2 x 2, not 3 + 1 or a row of four too
+    small to read on a page)."""
+    return 2 if n == 4 else min(3, n)
+
+
+def topology_figure(study):
+    """The balanced stages at t = 0, one panel each: links, joints, pivots, each link's centre of
+    mass (cross), counter-masses as red discs of area proportional to mass, and the fixed total
+    centre of mass (star)."""
+    from ...draw.figures import plt, to_svg
+
+    shown = [s for s in study.stages if s.stage.name in FIGURE_OF_STAGE]
+    if not shown:
+        return None
+    cols = grid_columns(len(shown))
+    rows = (len(shown) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
+    max_cw = max([m for s in shown for m in _counter_masses(s.stage.model)] + [1e-12])
+    panels = []
+    for ax in list(axes.flat)[len(shown):]:
+        ax.axis("off")
+    for ax, s in zip(axes.flat, shown):
+        model = s.stage.model
+        poses = s.analysis.extra["frame_pose"][0]
+        marks = _draw(ax, model, poses, _span(model), max_cw, f"{s.stage.label}\nadded {s.added_mass:.3g} kg")
+        panels.append((ax, model, poses, marks))
+    fig.tight_layout()
+    for ax, model, poses, marks in panels:
+        _name(fig, ax, model, poses, _span(model), max_cw, marks)
+    return to_svg(fig, "rrr4-topology")
+
+
+def designs_checked(study):
+    """Figs. 3 and 4b's designs (:mod:`balpipe.balancing.rrr4_topologies`) rebuilt from the spec,
+    each with its shaking force analysed by the engine on the study's time grid: (design, added
+    mass, peak |F| / the unbalanced stage's peak)."""
+    from . import topologies as topo
+    from ...engine import analyse
+
+    if "topologies" not in study.balance.details:
+        return []
+    base = study.stages[0]
+    model, an0 = base.stage.model, base.analysis
+    g = recipe.geometry(study.spec.mechanism)
+    cw = study.spec.balancing.counterweights
+    designs = topo.fig3_designs(model, g, cw.proximal, cw.distal) + [topo.fig4b_design(model, g, cw.proximal, cw.distal)]
+    out = []
+    for d in designs:
+        an = analyse(d.model, an0.t)
+        out.append((d, d.model.total_mass() - model.total_mass(), an.max_force / max(an0.max_force, 1e-300)))
+    return out
+
+
+def designs_figure(study, checked, figures: tuple[str, ...]):
+    """The designs of ``figures`` (e.g. Fig. 3a..f), one panel each, at the unbalanced stage's
+    pose at t = 0 (the kinematics are the same)."""
+    from ...draw.figures import plt, to_svg
+
+    shown = [c for c in checked if c[0].figure in figures]
+    if not shown:
+        return None
+    cols = grid_columns(len(shown))
+    rows = (len(shown) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
+    poses = study.stages[0].analysis.extra["frame_pose"][0]
+    max_cw = max([m for d, _, _ in shown for m in _counter_masses(d.model)] + [1e-12])
+    panels = []
+    for ax, (d, added, ratio) in zip(axes.flat, shown):
+        kept = ", ".join(f"l{b}" if b != "5" else "platform" for b in d.kept)
+        marks = _draw(ax, d.model, poses, _span(d.model), max_cw,
+                      f"{d.figure}: {kept} as built\nadded {added:.3g} kg, peak |F| / unbalanced {ratio:.1e}")
+        panels.append((ax, d.model, marks))
+    for ax in list(axes.flat)[len(shown):]:
+        ax.axis("off")
+    fig.tight_layout()
+    for ax, model, marks in panels:
+        _name(fig, ax, model, poses, _span(model), max_cw, marks)
+    return to_svg(fig, "rrr4-" + figures[0].replace("Fig. ", "fig").lower())
+
+
+def figures(study):
+    """(title, html or svg, caption) for the page."""
+    if study.spec.balancing.method != "rrr4_counter_masses":
+        return
+    table = conditions_table(study)
+    if table is not None:
+        mech = study.spec.mechanism
+        n_special = 0 if mech.kinematics == "general" else 8
+        yield (
+            "Force-balance conditions (paper 001, eq. 17" + (", " + cond.SPECIAL_EQ[mech.kinematics] if n_special else "") + ")",
+            table,
+            f"The twelve general conditions of eq. 17" + (f" and the eight of {cond.SPECIAL_EQ[mech.kinematics]} "
+                                                          "(non-rotating platform)" if n_special else "")
+            + " as printed, as linear equations in the named mass parameters (m_ij p_ij and m_ij q_ij: first "
+            "moments of link l_ij in its frame, origin at its proximal joint, x along the link; m5 p5, m5 q5: the "
+            "platform's about its centre). Residual per stage in kg m; ✓ where it is at most 1e-9 of the "
+            "condition's largest term. Count: 12 printed conditions, independent (each holds one dependent "
+            "first moment with coefficient 1).",
+        )
+    finder = finder_table(study)
+    if finder is not None:
+        yield (
+            "Generic condition finder against the printed conditions; least-mass counter-masses",
+            finder,
+            "The force-balance conditions computed from the linear-momentum regressor of the model (any mechanism's "
+            "route, no loop algebra), counted by the rank of the regressor over sampled states, against the paper's "
+            "printed ones mapped onto the finder's parameters (m_ij p_ij = mx[link ij], m_ij q_ij = my[link ij], "
+            "m5 p5 = mx[platform]: the body frames are the paper's). A printed row lies in the computed space when "
+            "its distance from it (relative, in columns scaled to one unit) is at most 1e-9. With special kinematics "
+            "the finder is also run on states of translating-platform motions only (eight random straight moves at "
+            "the start angle). Second table: the counter-masses of the leg-by-leg design and of least total mass "
+            "(linear programme over the same allowed positions: within the leg-by-leg distance of each link's "
+            "proximal joint), link frames as in the paper (x along the link from its proximal joint).",
+        )
+    svg = topology_figure(study)
+    if svg is not None:
+        yield (
+            "Balance topologies (paper 001, Figs. 2a, 4a" + "".join(
+                ", " + fig.replace("Fig. ", "") for fig in sorted({s.stage.label.split("(")[1].split(",")[0]
+                                                                 for s in study.stages if s.stage.name == "special"}))
+            + "; least mass)",
+            svg,
+            "Each force-balanced stage at t = 0: links (black; named l11 to l42 as in the paper, the spec's link11 to "
+            "link42), joints (circles), base pivots (triangles, A1 to A4), each "
+            "body's centre of mass (blue cross), counter-masses as red discs (area proportional to mass, the "
+            "largest over the panels has the largest disc) on a line from the link's proximal joint, and the "
+            "total centre of mass (purple star), which stays fixed during the motion in every panel.",
+        )
+    checked = designs_checked(study)
+    if checked:
+        top = study.balance.details["topologies"]
+        fr = top["freedoms"]
+        worst = max(r for _, _, r in checked)
+        svg = designs_figure(study, checked, FIG3)
+        if svg is not None:
+            yield (
+                "Force balance topologies from the general conditions (paper 001, Fig. 3: a selection of ours)",
+                svg,
+                "Designs from eq. 17 whose link centres of mass may leave the lines through the joints. What the "
+                f"paper's text fixes: with the masses given, eq. 17 leaves {fr['eq17']} mass-position parameters free "
+                f"(the paper's six, two per loop equation) where the leg-by-leg conditions of Fig. 2 leave {fr['leg_by_leg']}; "
+                f"keeping three bodies as built fixes the other twelve first moments for {top['admissible_kept']} of the "
+                "84 triples (computed: exactly those with no two links of one leg). The paper's six panels cannot be read "
+                "from its text, so the six drawn here are our selection, not the paper's: for each pair of legs (a, b) "
+                "the distal links l_a2, l_b2 and the platform as built, one counter-mass on each of the six other links "
+                "at the spec's distance from its proximal joint, in the direction eq. 17 needs (Fig. 3b is the design "
+                "of Fig. 4a). Each panel: added mass, and the peak shaking force over the spec's motion (engine) "
+                f"relative to the unbalanced stage's peak; largest over the panels {worst:.1e}. Drawn as the stage "
+                "panels above (red discs: counter-masses, area proportional to mass, the largest in this figure has "
+                "the largest disc; blue crosses: body centres of mass; purple star: total centre of mass).",
+            )
+        svg = designs_figure(study, checked, ("Fig. 4b",))
+        if svg is not None:
+            ranks = top["same_kind_per_leg_ranks"]
+            yield (
+                "Symmetric balance topology (paper 001, Fig. 4b: reconstructed)",
+                svg,
+                "The paper's text says Fig. 4b is fully symmetric and has more design freedom than Fig. 2a. Read here "
+                "as: a counter-mass on every link, as in Fig. 2a, but from eq. 17 instead of eqs. 8-11, the platform "
+                f"as built. That family has {fr['eq17_links']} free first moments where the leg-by-leg family has "
+                f"{fr['leg_by_leg_links']} (mu_54), and its link centres of mass may leave the link lines. No leg may "
+                "be privileged, but keeping the same first moment in every leg (all p_i1, q_i1, p_i2 or q_i2) never "
+                "fixes the design (eq. 17's 12 x 12 system then has rank "
+                + ", ".join(f"{ranks[k]}" for k in ("p1", "q1", "p2", "q2"))
+                + "), so the free parameters are fixed by the least Euclidean norm of the sixteen first-moment "
+                "changes (every link treated alike; when that least-norm design is unique it has every symmetry of the "
+                "mechanism and its mass data). That "
+                "choice is ours: the paper's drawing is not in its text. Counter-masses at the spec's distances from "
+                "the proximal joints; the panel gives the added mass and the peak shaking force over the spec's motion "
+                "relative to the unbalanced stage's peak.",
+            )

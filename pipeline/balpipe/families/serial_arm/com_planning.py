@@ -1,0 +1,735 @@
+"""Shaking-force reduction by planning the motion of the total centre of mass (paper 003).
+
+The shaking force of an arm is F = -m x_S'' (eq. 1, horizontal plane): over a fixed duration T
+the straight line between the centre of mass' end positions on the bang-bang law (eqs. 3-6)
+has the least peak acceleration, 4 d / T^2, hence the least peak force 4 m d / T^2. For a 3R arm
+the centre of mass fixes two of the three joint angles' combinations: the third, the
+end-effector orientation phi, is free between its end values and is used against the shaking
+moment. The joint angles follow from (x_S, y_S, phi) by the inverse kinematics of eqs. 8-10
+(the centre of mass as a chain of equivalent links, :func:`balpipe.mechanisms.serial_arm.com_chain`),
+with exact derivatives by the chain rule, so every stage is an ordinary joint-driven arm for the
+engine.
+
+Cases (Sec. 3), per trajectory of the tip from P_i (phi0) to P_j (phif), duration T:
+
+1. ``end-effector quintic``: the tip on the straight line and phi, both on the 3-4-5 law;
+2. ``CoM bang-bang``: the centre of mass on the straight line between the same end
+   configurations' centres of mass, bang-bang; phi on the 3-4-5 law;
+   ``CoM bang-bang + phi optimised``: phi a polynomial of degree d (default 8) with its ends
+   fixed in position, velocity and acceleration (d - 5 free coefficients), optimised to minimise
+   the peak shaking moment (multi-start Nelder-Mead, fixed seed);
+3. ``CoM trapezoidal``: the centre of mass on a trapezoidal acceleration profile (linear ramps
+   of duration f T) with the shortest ramps for which no actuator torque changes faster than the
+   limit (the paper's 3.10^4 N m/s), phi as optimised in case 2.
+
+The optimiser evaluates the shaking moment with the explicit serial dynamics
+(:func:`balpipe.mechanisms.serial_arm.shaking_loads`), vectorised over the analysis grid; the
+engine analyses only the final stages (tests check that both agree to 1e-9).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Literal, Union
+
+import numpy as np
+from pydantic import Field
+
+from .template import (
+    ArmGeometry,
+    Chain,
+    JointLaw,
+    JointSolution,
+    SerialArmMechanism,
+    TaskMotion,
+    absolute_motion,
+    absolute_state,
+    com_chain,
+    joint_laws,
+    joint_torques,
+    shaking_loads,
+    shaking_moment,
+    tip_chain,
+    with_joint_laws,
+)
+from ...model import Law, Model
+from ...motion import PointToPoint, bang_bang, law_for, quintic
+from ...spec_parts import SpecFieldError, Strict
+from ...units import Angle, Length, PositiveLength, count, number, quantity
+from ...balancing.base import BalanceResult, Parameter, Stage
+from ...sampling import gravity_vector, time_grid
+
+ROOT = ("balancing",)
+CASES = (
+    ("ee_quintic", "end-effector quintic"),
+    ("com_bang_bang", "CoM bang-bang"),
+    ("com_bang_bang_phi_opt", "CoM bang-bang + phi optimised"),
+    ("com_trapezoidal", "CoM trapezoidal"),
+)
+
+
+class TestSquare(Strict):
+    """The tested zone of Fig. 2: a square whose edges are divided into ``divisions`` segments by
+    the points P1 .. P(4 divisions), P1 at ``first_corner``, numbered counter-clockwise."""
+
+    centre: tuple[Length, Length] = Field(description="centre E of the square")
+    side: PositiveLength = Field(description="edge length")
+    divisions: count(ge=1, le=50) = Field(4, description="segments per edge")
+    first_corner: Literal["bottom-left", "bottom-right", "top-right", "top-left"] = Field(
+        "bottom-left", description="corner of P1 (the paper's figure is not legible: bottom-left reproduces its list)"
+    )
+
+    def points(self) -> dict[str, tuple[float, float]]:
+        cx, cy = self.centre
+        h = self.side / 2
+        corners = [(-h, -h), (h, -h), (h, h), (-h, h)]  # counter-clockwise from bottom-left
+        start = ("bottom-left", "bottom-right", "top-right", "top-left").index(self.first_corner)
+        corners = corners[start:] + corners[:start]
+        out = {}
+        k = 1
+        for e in range(4):
+            (x0, y0), (x1, y1) = corners[e], corners[(e + 1) % 4]
+            for j in range(self.divisions):
+                s = j / self.divisions
+                out[f"P{k}"] = (cx + x0 + s * (x1 - x0), cy + y0 + s * (y1 - y0))
+                k += 1
+        return out
+
+
+class TrajectorySpec(Strict):
+    """A tip trajectory between two points (names of the test square's points or [x, y])."""
+
+    name: str = Field(min_length=1, description="label of the trajectory")
+    start: Union[str, tuple[Length, Length]] = Field(alias="from", description="start point of the tip")
+    end: Union[str, tuple[Length, Length]] = Field(alias="to", description="end point of the tip")
+
+
+class Orientation(Strict):
+    start: Angle = Field(alias="from", description="phi at the start (the paper: 0 deg)")
+    end: Angle = Field(alias="to", description="phi at the end (the paper: 120 deg)")
+
+
+class PhiOptimisation(Strict):
+    """phi(tau) = phi0 + (phif - phi0) s5(tau) + sum_k c_k 64 tau^3 (1 - tau)^3 (2 tau - 1)^k,
+    k = 0 .. degree - 6: the degree-``degree`` polynomials with phi, phi', phi'' fixed at both ends."""
+
+    degree: count(ge=5, le=14) = Field(8, description="degree of the polynomial (5: the 3-4-5 law, nothing to optimise)")
+    starts: count(ge=1, le=50) = Field(4, description="multi-start: the 3-4-5 law plus starts - 1 random points")
+    seed: count(ge=0) = Field(0, description="seed of the random starting points (numpy default_rng)")
+    spread: quantity("angle", gt=0) = Field(0.5, description="standard deviation of the random starting coefficients (rad)")
+    max_evaluations: count(ge=10, le=100_000) = Field(300, description="objective evaluations per start (Nelder-Mead)")
+    tolerance: number(gt=0) = Field(1e-4, description="Nelder-Mead xatol (rad) and fatol (relative to the start's peak)")
+
+
+class ComMotionPlanning(Strict):
+    """Paper 003: the 3R arm's centre of mass on a bang-bang (and trapezoidal) law, phi optimised."""
+
+    method: Literal["com_motion_planning"] = Field(description="balancing method")
+    test_square: TestSquare | None = Field(None, description="the tested zone (Fig. 2), to name points P1..")
+    trajectories: list[Union[str, TrajectorySpec]] = Field(
+        [],
+        description="tip trajectories, 'PiPj' on the test square or {name, from, to}; empty: the "
+        "template's tip drive (motion.drive.tip)",
+    )
+    orientation: Orientation | None = Field(None, description="phi at both ends of every trajectory (with trajectories)")
+    phi: PhiOptimisation = Field(PhiOptimisation(), description="the law of phi in case 2 and its optimisation")
+    torque_rate_limit: number(gt=0) = Field(
+        3e4, description="case 3: largest rate of change of any actuator torque, N m/s (the paper: 3.10^4)"
+    )
+    rate_samples: count(ge=101, le=100_001) = Field(4001, description="case 3: samples on which torque rates are measured (central differences)")
+
+
+# --------------------------------------------------------------------------------------------
+# Laws
+
+
+@dataclass(frozen=True)
+class PhiPolynomial(Law):
+    """phi(t) of :class:`PhiOptimisation` (exact derivatives); held at the ends outside [0, T]."""
+
+    start: float
+    end: float
+    duration: float
+    coefficients: tuple[float, ...] = ()
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        T = self.duration
+        tau = np.clip(t / T, 0.0, 1.0)
+        s, ds, dds = quintic(tau)
+        h = self.end - self.start
+        p, dp, ddp = self.start + h * s, h * ds, h * dds
+        if self.coefficients:
+            # b_k = 64 w(tau) u^k, w = tau^3 (1 - tau)^3, u = 2 tau - 1
+            w = tau**3 * (1 - tau) ** 3
+            dw = 3 * tau**2 * (1 - tau) ** 2 * (1 - 2 * tau)
+            ddw = 6 * tau * (1 - tau) * (1 - 5 * tau + 5 * tau**2)
+            u = 2 * tau - 1
+            for k, c in enumerate(self.coefficients):
+                uk = u**k
+                duk = 2 * k * u ** (k - 1) if k >= 1 else 0.0
+                dduk = 4 * k * (k - 1) * u ** (k - 2) if k >= 2 else 0.0
+                p = p + 64 * c * w * uk
+                dp = dp + 64 * c * (dw * uk + w * duk)
+                ddp = ddp + 64 * c * (ddw * uk + 2 * dw * duk + w * dduk)
+        inside = (t >= 0) & (t <= T)
+        return p, np.where(inside, dp / T, 0.0), np.where(inside, ddp / T**2, 0.0)
+
+
+def trapezoidal_acceleration(f: float):
+    """Normalised profile s(tau) whose acceleration is trapezoidal: ramps of length f, plateaus
+    +A and -A, the sign change a ramp of length 2 f centred on tau = 1/2 (0 < f <= 1/4)."""
+    if not 0 < f <= 0.25:
+        raise ValueError("ramp fraction must be in (0, 1/4]")
+    knots = np.array([0.0, f, 0.5 - f, 0.5 + f, 1.0 - f, 1.0])
+    acc = np.array([0.0, 1.0, 1.0, -1.0, -1.0, 0.0])
+    jerk = np.diff(acc) / np.maximum(np.diff(knots), 1e-300)
+    v = np.zeros(6)
+    s = np.zeros(6)
+    for i in range(5):
+        h = knots[i + 1] - knots[i]
+        v[i + 1] = v[i] + acc[i] * h + jerk[i] * h * h / 2
+        s[i + 1] = s[i] + v[i] * h + acc[i] * h * h / 2 + jerk[i] * h**3 / 6
+    A = 1.0 / s[-1]
+
+    def profile(tau):
+        i = np.clip(np.searchsorted(knots, tau, side="right") - 1, 0, 4)
+        h = tau - knots[i]
+        a = acc[i] + jerk[i] * h
+        vv = v[i] + acc[i] * h + jerk[i] * h * h / 2
+        ss = s[i] + v[i] * h + acc[i] * h * h / 2 + jerk[i] * h**3 / 6
+        return A * ss, A * vv, A * a
+
+    return profile
+
+
+# --------------------------------------------------------------------------------------------
+# One trajectory
+
+
+@dataclass
+class Plan:
+    """Everything computed for one trajectory."""
+
+    name: str
+    start: tuple[float, float, float]
+    end: tuple[float, float, float]
+    q_start: np.ndarray
+    q_end: np.ndarray
+    com_start: np.ndarray
+    com_end: np.ndarray
+    com_mode: int
+    models: dict[str, Model] = field(default_factory=dict)
+    phi_coefficients: tuple[float, ...] = ()
+    phi_peak_start: float = 0.0
+    phi_peak_best: float = 0.0
+    evaluations: int = 0
+    ramp_fraction: float = 0.0
+    ramp_rate: float = 0.0
+    ramp_feasible: bool = True
+
+    @property
+    def com_distance(self) -> float:
+        return float(np.hypot(*(self.com_end - self.com_start)))
+
+
+def _com_motion(plan: Plan, profile, T: float, phi: Law, path: tuple) -> TaskMotion:
+    laws = (PointToPoint(float(plan.com_start[0]), float(plan.com_end[0]), T, profile),
+            PointToPoint(float(plan.com_start[1]), float(plan.com_end[1]), T, profile), phi)
+    return TaskMotion(laws, "com", path, plan.name)
+
+
+def _elbow_sign(chain: Chain, q: np.ndarray) -> int:
+    """Working mode of configuration q in ``chain``: +1 when the second equivalent link turns
+    clockwise from the first (the '+' root of eq. 8)."""
+    v = np.asarray(chain.vectors)
+    a1 = q[0] + math.atan2(v[0, 1], v[0, 0])
+    a2 = q[0] + q[1] + math.atan2(v[1, 1], v[1, 0])
+    return 1 if math.sin(a2 - a1) < 0 else -1
+
+
+class Planner:
+    """The method's computations for one arm model, duration and analysis grid."""
+
+    def __init__(self, model: Model, mech: SerialArmMechanism, method: ComMotionPlanning, T: float,
+                 t: np.ndarray, gravity, moment_point):
+        self.model, self.mech, self.method = model, mech, method
+        self.arm = ArmGeometry.of(model)
+        self.tip, self.com = tip_chain(self.arm), com_chain(self.arm)
+        self.T, self.t = T, np.asarray(t, dtype=float)
+        self.gravity, self.point = tuple(gravity), tuple(moment_point)
+        self.calls = 0
+
+    # -- fast path ---------------------------------------------------------------------------
+    def loads(self, motion: TaskMotion, mode: int, t: np.ndarray | None = None, check: bool = False):
+        """Shaking force (N, 2), moment (N,) and the joint solution along a centre-of-mass motion."""
+        sol = JointSolution(self.com, motion, mode, self.t if t is None else t, check=check)
+        st = absolute_state(self.arm, sol.th, sol.thd, sol.thdd)
+        F, M = shaking_loads(self.arm, st, self.gravity, self.point)
+        return F, M, sol, st
+
+    def objective(self, plan: Plan, path: tuple):
+        """The optimiser's objective c -> max |M| over the analysis grid with the CoM on the
+        bang-bang law and phi(c) (a penalty outside the workspace or at a singular
+        configuration). The CoM law and phi's basis are evaluated once; each call is a few
+        vectorised array operations (explicit serial kinematics and dynamics)."""
+        t, T = self.t, self.T
+        nfree = self.method.phi.degree - 5
+        com = _com_motion(plan, bang_bang, T, PhiPolynomial(plan.start[2], plan.end[2], T), path)
+        x0, xd0, xdd0 = com.values(t)
+        basis = [PhiPolynomial(0.0, 0.0, T, tuple(1.0 if j == k else 0.0 for j in range(k + 1)))(t) for k in range(nfree)]
+        B = [np.stack([b[d] for b in basis], axis=1) if nfree else np.zeros((len(t), 0)) for d in range(3)]
+        x, xd, xdd = x0.copy(), xd0.copy(), xdd0.copy()
+
+        def f(c) -> float:
+            self.calls += 1
+            c = np.asarray(c, dtype=float)
+            x[:, 2], xd[:, 2], xdd[:, 2] = x0[:, 2] + B[0] @ c, xd0[:, 2] + B[1] @ c, xdd0[:, 2] + B[2] @ c
+            th, thd, thdd, margin, sg = absolute_motion(self.com, x, xd, xdd, plan.com_mode)
+            bad = max(0.0, float(-margin.min())) + max(0.0, 1e-6 - float(np.abs(sg).min()))
+            if bad > 0:
+                return 1e6 * (1.0 + bad)
+            M = shaking_moment(self.arm, absolute_state(self.arm, th, thd, thdd), self.gravity, self.point)
+            peak = float(np.max(np.abs(M)))
+            return peak if math.isfinite(peak) else 1e6
+
+        return f
+
+    def peak_moment(self, plan: Plan, coeffs, path: tuple) -> float:
+        """max |M| of one phi (see :meth:`objective`)."""
+        return self.objective(plan, path)(coeffs)
+
+    # -- planning ----------------------------------------------------------------------------
+    def plan(self, name: str, start, end, path: tuple) -> Plan:
+        """End configurations by the tip's inverse kinematics, their centres of mass and the
+        working mode of the centre-of-mass chain (the same configurations, checked)."""
+        mode = self.mech.working_mode
+        q0 = self.tip.inverse(np.array([start[:2]]), np.array([start[2]]), mode)
+        q1 = self.tip.inverse(np.array([end[:2]]), np.array([end[2]]), mode)
+        for (q, margin), pose, key in ((q0, start, "from"), (q1, end, "to")):
+            if not margin[0] > 1e-9:
+                raise SpecFieldError(path + (key,), f"trajectory {name}: the tip pose ({pose[0]:.4g}, {pose[1]:.4g}) m, "
+                                     f"phi = {math.degrees(pose[2]):.4g} deg is out of reach")
+        qa, qb = q0[0][0], q1[0][0]
+        cmode = _elbow_sign(self.com, qa)
+        if _elbow_sign(self.com, qb) != cmode:
+            raise SpecFieldError(path, f"trajectory {name}: the end configurations are in different working "
+                                 "modes of the centre-of-mass chain; no motion of the centre of mass joins them")
+        return Plan(name, tuple(start), tuple(end), qa, qb, self.com.point(qa[None])[0], self.com.point(qb[None])[0], cmode)
+
+    def optimise_phi(self, plan: Plan, path: tuple) -> None:
+        from scipy.optimize import minimize
+
+        opt = self.method.phi
+        nfree = opt.degree - 5
+        f = self.objective(plan, path)
+        start_peak = f(np.zeros(nfree))
+        plan.phi_peak_start = start_peak
+        if nfree == 0:
+            plan.phi_peak_best = start_peak
+            return
+        rng = np.random.default_rng(opt.seed)
+        starts = [np.zeros(nfree)] + [rng.normal(0.0, opt.spread, nfree) for _ in range(opt.starts - 1)]
+        best_x, best_f = np.zeros(nfree), start_peak
+        calls0 = self.calls
+        for x0 in starts:
+            res = minimize(f, x0, method="Nelder-Mead",
+                           options={"maxfev": opt.max_evaluations, "xatol": opt.tolerance,
+                                    "fatol": opt.tolerance * start_peak, "initial_simplex": _simplex(x0, 0.2)})
+            if res.fun < best_f:
+                best_x, best_f = np.asarray(res.x, dtype=float), float(res.fun)
+        plan.phi_coefficients = tuple(float(c) for c in best_x)
+        plan.phi_peak_best = best_f
+        plan.evaluations = self.calls - calls0 + 1
+
+    def ramp(self, plan: Plan, phi: Law, path: tuple) -> None:
+        """Case 3: the shortest ramp fraction f whose torque rates stay within the limit
+        (bisection; rates by central differences on ``rate_samples`` uniform samples plus 64 in
+        each ramp, so that the shortest ramps are resolved)."""
+        limit = self.method.torque_rate_limit
+        uniform = np.linspace(0.0, self.T, self.method.rate_samples)
+
+        def rate(f: float) -> float:
+            ramps = [np.linspace(a, b, 64) for a, b in ((0.0, f), (0.5 - f, 0.5 + f), (1.0 - f, 1.0))]
+            tt = np.unique(np.concatenate([uniform, self.T * np.concatenate(ramps)]))
+            motion = _com_motion(plan, trapezoidal_acceleration(f), self.T, phi, path)
+            _, _, sol, st = self.loads(motion, plan.com_mode, tt)
+            tau = joint_torques(self.arm, st, self.gravity)
+            return float(np.max(np.abs(np.gradient(tau, tt, axis=0))))
+
+        lo, hi = 1e-4, 0.25
+        r_hi = rate(hi)
+        if r_hi > limit:
+            plan.ramp_fraction, plan.ramp_rate, plan.ramp_feasible = hi, r_hi, False
+            return
+        r_lo = rate(lo)
+        if r_lo <= limit:
+            plan.ramp_fraction, plan.ramp_rate = lo, r_lo
+            return
+        for _ in range(30):
+            mid = 0.5 * (lo + hi)
+            if rate(mid) <= limit:
+                hi = mid
+            else:
+                lo = mid
+            if hi - lo < 1e-5:
+                break
+        plan.ramp_fraction, plan.ramp_rate = hi, rate(hi)
+
+    def stages(self, plan: Plan, law_name: str, path: tuple) -> dict[str, Model]:
+        """The four stage models of one trajectory (case 1 on the spec's law)."""
+        T, mode = self.T, self.mech.working_mode
+        tip_laws = tuple(law_for(_Motion(law_name, T), a, b) for a, b in zip(plan.start, plan.end))
+        tip_motion = TaskMotion(tip_laws, "tip", path, plan.name)
+        JointSolution(self.tip, tip_motion, mode, self.t)  # located errors on the tip path
+        out = {"ee_quintic": with_joint_laws(self.model, joint_laws(self.tip, tip_motion, mode))}
+        phi5 = PhiPolynomial(plan.start[2], plan.end[2], T)
+        phio = PhiPolynomial(plan.start[2], plan.end[2], T, plan.phi_coefficients)
+        for key, profile, phi in (("com_bang_bang", bang_bang, phi5), ("com_bang_bang_phi_opt", bang_bang, phio),
+                                  ("com_trapezoidal", trapezoidal_acceleration(plan.ramp_fraction), phio)):
+            m = _com_motion(plan, profile, T, phi, path)
+            JointSolution(self.com, m, plan.com_mode, self.t)  # located errors on the centre-of-mass path
+            out[key] = with_joint_laws(self.model, joint_laws(self.com, m, plan.com_mode))
+        return out
+
+
+@dataclass(frozen=True)
+class _Motion:
+    """The two fields of the spec's motion that :func:`law_for` reads."""
+
+    law: str
+    duration: float
+    accel_fraction: float = 1 / 3
+
+
+def _simplex(x0: np.ndarray, step: float) -> np.ndarray:
+    n = len(x0)
+    return np.vstack([x0] + [x0 + step * np.eye(n)[k] for k in range(n)])
+
+
+# --------------------------------------------------------------------------------------------
+# The method
+
+
+def _point(square_points: dict, raw, path: tuple) -> tuple[float, float]:
+    if isinstance(raw, str):
+        if raw not in square_points:
+            raise SpecFieldError(path, f"unknown point {raw!r}" + (f" (the test square has P1..P{len(square_points)})" if square_points else " (no test_square)"))
+        return square_points[raw]
+    return (float(raw[0]), float(raw[1]))
+
+
+def trajectories_of(method: ComMotionPlanning, model: Model) -> list[tuple[str, tuple, tuple, tuple]]:
+    """(name, start pose, end pose, spec path) of every trajectory."""
+    pts = method.test_square.points() if method.test_square is not None else {}
+    if not method.trajectories:
+        for d in model.drivers:
+            if isinstance(d.law, JointLaw) and d.law.motion.point == "tip":
+                x0 = d.law.motion.values(np.array([0.0]))[0][0]
+                x1 = d.law.motion.values(np.array([np.inf]))[0][0]
+                return [("", tuple(map(float, x0)), tuple(map(float, x1)), ("motion", "drive", "tip"))]
+        raise SpecFieldError(ROOT + ("trajectories",), "give the trajectories, or drive the tip (motion.drive.tip)")
+    if model.drivers:
+        raise SpecFieldError(("motion", "drive"), "with balancing.trajectories the method plans every motion: leave motion.drive empty ({})")
+    if method.orientation is None:
+        raise SpecFieldError(ROOT + ("orientation",), "give phi at both ends of the trajectories: orientation: {from, to}")
+    o = method.orientation
+    out = []
+    for k, tr in enumerate(method.trajectories):
+        path = ROOT + ("trajectories", k)
+        if isinstance(tr, str):
+            names = [p for p in tr.split("P") if p]
+            if len(names) != 2 or not all(n.isdigit() for n in names):
+                raise SpecFieldError(path, f"expected 'PiPj' (two test-square points), got {tr!r}")
+            a, b = _point(pts, f"P{names[0]}", path), _point(pts, f"P{names[1]}", path)
+            name = tr
+        else:
+            a, b = _point(pts, tr.start, path + ("from",)), _point(pts, tr.end, path + ("to",))
+            name = tr.name
+        out.append((name, (a[0], a[1], o.start), (b[0], b[1], o.end), path))
+    names = [n for n, *_ in out]
+    if len(set(names)) != len(names):
+        raise SpecFieldError(ROOT + ("trajectories",), "trajectory names must be unique")
+    return out
+
+
+def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, spec) -> BalanceResult:
+    if len(mech.links) != 3:
+        raise SpecFieldError(("mechanism", "links"), f"com_motion_planning plans a 3R arm (eqs. 8-10); got {len(mech.links)} links")
+    T = spec.motion.duration
+    t = time_grid(spec)
+    planner = Planner(model, mech, method, T, t, gravity_vector(spec), spec.analysis.moment_point)
+    law_name = spec.motion.law if spec.motion.law != "polynomial" else "quintic"
+    plans: list[Plan] = []
+    stages: list[Stage] = []
+    params: list[Parameter] = []
+    P = lambda *a: params.append(Parameter(*a))  # noqa: E731
+    m_total = planner.arm.total_mass
+    for name, start, end, path in trajectories_of(method, model):
+        plan = planner.plan(name, start, end, path)
+        # located errors on every path before optimising (case 1 and the bang-bang line)
+        tip_laws = tuple(law_for(_Motion(law_name, T), a, b) for a, b in zip(plan.start, plan.end))
+        JointSolution(planner.tip, TaskMotion(tip_laws, "tip", path, name), mech.working_mode, t)
+        JointSolution(planner.com, _com_motion(plan, bang_bang, T, PhiPolynomial(start[2], end[2], T), path),
+                      plan.com_mode, t)
+        planner.optimise_phi(plan, path)
+        planner.ramp(plan, PhiPolynomial(start[2], end[2], T, plan.phi_coefficients), path)
+        plan.models = planner.stages(plan, law_name, path)
+        plans.append(plan)
+        prefix = f"{name}_" if name else ""
+        for key, label in CASES:
+            if key == "ee_quintic" and law_name != "quintic":
+                label = f"end-effector {law_name}"
+            stages.append(Stage(
+                prefix + key, f"{name} · {label}" if name else label, plan.models[key],
+                _description(key, plan, method), reference=prefix + "ee_quintic", group=name,
+            ))
+        sfx = f"_{name}" if name else ""
+        P(f"com_distance{sfx}", plan.com_distance, "m", "eq. 7", f"{name or 'the'} centre of mass displacement d (straight line)")
+        P(f"bang_bang_peak_force{sfx}", 4 * m_total * plan.com_distance / T**2, "N", "eqs. 1, 3-6: 4 m d / T^2",
+          "predicted peak shaking force of the bang-bang law on the centre of mass")
+        for k, c in enumerate(plan.phi_coefficients):
+            P(f"phi_c{k}{sfx}", c, "rad", "phi optimisation", f"coefficient of 64 tau^3 (1 - tau)^3 (2 tau - 1)^{k} in phi")
+        P(f"phi_peak_moment_start{sfx}", plan.phi_peak_start, "N m", "fast path", "peak |M| with phi on the 3-4-5 law (the optimisation's start)")
+        P(f"phi_peak_moment_best{sfx}", plan.phi_peak_best, "N m", "fast path", "peak |M| with the optimised phi")
+        P(f"phi_evaluations{sfx}", plan.evaluations, "", "phi optimisation", "objective evaluations, all starts")
+        P(f"ramp_fraction{sfx}", plan.ramp_fraction, "", "case 3", "ramp duration of the trapezoidal acceleration / T")
+        P(f"ramp_torque_rate{sfx}", plan.ramp_rate, "N m/s", "case 3", "largest actuator torque rate with that ramp")
+    notes = [_method_note(method, planner, plans, law_name)]
+    for p in plans:
+        if not p.ramp_feasible:
+            notes.append(f"Trajectory {p.name or ''}: even the longest ramps (f = 1/4) need a torque rate of "
+                         f"{p.ramp_rate:.4g} N m/s, above the limit {method.torque_rate_limit:.4g} N m/s: case 3 uses f = 1/4.")
+    info = {"plans": plans, "planner": planner, "method": method, "law": law_name}
+    return BalanceResult(params, stages, notes, figures=lambda study: figures(study, info),
+                         derived=lambda results: derived(results, plans, T, m_total))
+
+
+def _description(key: str, plan: Plan, method: ComMotionPlanning) -> str:
+    deg = method.phi.degree
+    return {
+        "ee_quintic": "tip on the straight line and phi on the 3-4-5 law (case 1)",
+        "com_bang_bang": "centre of mass on the straight line, bang-bang; phi on the 3-4-5 law",
+        "com_bang_bang_phi_opt": f"centre of mass bang-bang; phi a degree-{deg} polynomial minimising the peak moment (case 2)",
+        "com_trapezoidal": f"centre of mass on a trapezoidal acceleration, ramps {plan.ramp_fraction:.3g} T "
+                           f"(torque rate <= {method.torque_rate_limit:.3g} N m/s); phi as optimised (case 3)",
+    }[key]
+
+
+def _method_note(method: ComMotionPlanning, planner: Planner, plans: list[Plan], law: str) -> str:
+    o = method.phi
+    return (
+        f"phi optimisation: degree-{o.degree} polynomial, ends fixed in phi, phi', phi'' ({o.degree - 5} free "
+        f"coefficients); objective the peak |M| on the analysis grid ({len(planner.t)} samples), by the explicit "
+        f"serial dynamics; scipy.optimize.minimize Nelder-Mead from {o.starts} starts (the 3-4-5 law and "
+        f"{o.starts - 1} normal random points, sd {o.spread} rad, numpy default_rng({o.seed})), at most "
+        f"{o.max_evaluations} evaluations per start, xatol {o.tolerance}; {planner.calls} objective evaluations in "
+        f"all for {len(plans)} trajectories (benchmarks/bench_paper003.py times them). Case 3: the shortest ramps (bisection on "
+        f"f) for which every joint's torque rate, by central differences on {method.rate_samples} samples and 64 "
+        f"in each ramp, stays "
+        f"within {method.torque_rate_limit:.4g} N m/s."
+    )
+
+
+def derived(results, plans: list[Plan], T: float, m_total: float) -> list[Parameter]:
+    """Reductions per trajectory from the engine's analyses, and their ranges."""
+    by = {r.stage.name: r.analysis for r in results}
+    out: list[Parameter] = []
+    red = {"force": [], "moment": [], "force3": [], "moment3": []}
+    worst = 0.0
+    for p in plans:
+        pre, sfx = (f"{p.name}_", f"_{p.name}") if p.name else ("", "")
+        a1, a2, a3 = by[pre + "ee_quintic"], by[pre + "com_bang_bang_phi_opt"], by[pre + "com_trapezoidal"]
+        fr = 1 - a2.max_inertial_force / a1.max_inertial_force
+        mr = 1 - a2.max_inertial_moment / a1.max_inertial_moment
+        fr3 = 1 - a3.max_inertial_force / a1.max_inertial_force
+        mr3 = 1 - a3.max_inertial_moment / a1.max_inertial_moment
+        red["force"].append(fr), red["moment"].append(mr), red["force3"].append(fr3), red["moment3"].append(mr3)
+        predicted = 4 * m_total * p.com_distance / T**2
+        for key in ("com_bang_bang", "com_bang_bang_phi_opt"):
+            worst = max(worst, abs(by[pre + key].max_inertial_force - predicted) / predicted)
+        out += [
+            Parameter(f"force_reduction{sfx}", fr, "", "engine: 1 - F(case 2) / F(case 1)", "peak shaking force reduction, CoM bang-bang vs end-effector quintic"),
+            Parameter(f"moment_reduction{sfx}", mr, "", "engine: 1 - M(case 2) / M(case 1)", "peak shaking moment reduction, phi optimised vs end-effector quintic"),
+            Parameter(f"force_reduction_case3{sfx}", fr3, "", "engine", "peak shaking force reduction, CoM trapezoidal vs end-effector quintic"),
+            Parameter(f"moment_reduction_case3{sfx}", mr3, "", "engine", "peak shaking moment reduction, CoM trapezoidal vs end-effector quintic"),
+        ]
+    for key, label in (("force", "force"), ("moment", "moment")):
+        out.append(Parameter(f"{key}_reduction_min", min(red[key]), "", "engine, over the trajectories", f"smallest peak {label} reduction (case 2 vs 1)"))
+        out.append(Parameter(f"{key}_reduction_max", max(red[key]), "", "engine, over the trajectories", f"largest peak {label} reduction (case 2 vs 1)"))
+    out.append(Parameter("bang_bang_force_deviation", worst, "", "engine vs 4 m d / T^2",
+                         "largest relative difference of the bang-bang stages' peak force from 4 m d / T^2"))
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Page
+
+
+def _pct(x: float) -> str:
+    return f"{100 * x:.1f} %"
+
+
+def figures(study, info: dict):
+    from ...draw.figures import legend_below, plt, style, to_svg
+
+    plans: list[Plan] = info["plans"]
+    method: ComMotionPlanning = info["method"]
+    by = {s.stage.name: s for s in study.stages}
+    params = {p.name: p.value for p in study.balance.parameters}
+    # the table per trajectory
+    rows = []
+    for p in plans:
+        pre = f"{p.name}_" if p.name else ""
+        a1 = by[pre + "ee_quintic"].analysis
+        rows.append(f'<tr><th colspan="7">{p.name or "trajectory"}: tip ({p.start[0]:.4g}, {p.start[1]:.4g}) → '
+                    f'({p.end[0]:.4g}, {p.end[1]:.4g}) m, centre of mass moves {1000 * p.com_distance:.4g} mm</th></tr>')
+        for key, label in CASES:
+            s = by[pre + key]
+            an = s.analysis
+            tau = max(float(np.max(np.abs(e))) for e in an.efforts.values())
+            fr = 1 - an.max_inertial_force / a1.max_inertial_force
+            mr = 1 - an.max_inertial_moment / a1.max_inertial_moment
+            rows.append(
+                f"<tr><td>{s.stage.label.split(' · ')[-1]}</td><td class=\"num\">{an.max_force:.4g}</td>"
+                f"<td class=\"num\">{'—' if key == 'ee_quintic' else _pct(fr)}</td>"
+                f"<td class=\"num\">{an.max_moment:.4g}</td><td class=\"num\">{'—' if key == 'ee_quintic' else _pct(mr)}</td>"
+                f"<td class=\"num\">{tau:.4g}</td><td class=\"num\">{_rate_cell(key, an, p, method)}</td></tr>"
+            )
+    fmin, fmax = params["force_reduction_min"], params["force_reduction_max"]
+    mmin, mmax = params["moment_reduction_min"], params["moment_reduction_max"]
+    head = ("<table><tr><th>Case</th><th>Peak |F| (N)</th><th>|F| reduction vs case 1</th><th>Peak |M| (N m)</th>"
+            "<th>|M| reduction vs case 1</th><th>Peak |τ| (N m)</th><th>Peak |dτ/dt| (N m/s)</th></tr>")
+    summary = (f'<tr><th colspan="7">All trajectories, case 2 (CoM bang-bang + phi optimised) vs case 1: force '
+               f'reduction {_pct(fmin)} to {_pct(fmax)} (published 48 % to 62.2 %); moment reduction {_pct(mmin)} to '
+               f'{_pct(mmax)} (published 37.2 % to 61 %)</th></tr>')
+    yield ("Peak loads per trajectory (the paper's Sec. 3 results)", head + "".join(rows) + summary + "</table>",
+           "Computed by the engine for every stage; reductions are 1 − peak / peak of the same trajectory's case 1 "
+           "(end-effector quintic). The paper gives only the ranges over its eight trajectories; the duration "
+           f"({study.spec.motion.duration:g} s here) does not change the ratios (all loads scale with 1/T²) but does "
+           "change case 3 (the torque-rate limit). In a horizontal plane the shaking moment about the base joint is "
+           "minus joint 1's torque (paper 002, eq. 16), hence equal peaks. Torque rates: case 1 by central "
+           f"differences on the analysis grid, case 3 on {method.rate_samples} samples and 64 in each ramp (the ramp search).")
+    yield from _square_figure(study, info, plt, to_svg)
+    # Figs. 3-4 for every trajectory: |F| and M, the four cases
+    n = len(plans)
+    fig, axes = plt.subplots(n, 2, figsize=(9.0, 2.1 * n + 0.4), squeeze=False)
+    for r, p in enumerate(plans):
+        pre = f"{p.name}_" if p.name else ""
+        for k, (key, label) in enumerate(CASES):
+            an = by[pre + key].analysis
+            axes[r, 0].plot(an.t, np.hypot(an.force[:, 0], an.force[:, 1]), label=label, **style(k))
+            axes[r, 1].plot(an.t, an.moment, label=label, **style(k))
+        axes[r, 0].set_title(f"{p.name}: shaking force |F| (N)", fontsize=8)
+        axes[r, 1].set_title(f"{p.name}: shaking moment M (N m)", fontsize=8)
+    for ax in axes[-1]:
+        ax.set_xlabel("time (s)")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=7, frameon=False)
+    fig.tight_layout(rect=(0, 0.03 if n > 2 else 0.08, 1, 1))
+    yield ("Shaking force and moment per trajectory (Figs. 3-4)", to_svg(fig, "com-loads"),
+           "Solid black: case 1 (end-effector quintic); dashed: CoM bang-bang with phi on the 3-4-5 law; grey: "
+           "case 2 (CoM bang-bang, phi optimised); blue dash-dot: case 3 (CoM trapezoidal). The paper's Figs. 3-4 "
+           "show trajectory P15P7. Moment about the base joint, horizontal plane.")
+    fig, axes = plt.subplots(1, 1, figsize=(6.0, 3.0))
+    for k, p in enumerate(plans):
+        phi = PhiPolynomial(p.start[2], p.end[2], info["planner"].T, p.phi_coefficients)
+        tt = info["planner"].t
+        axes.plot(tt, np.degrees(phi(tt)[0]), label=p.name or "optimised", linewidth=1.0)
+    phi5 = PhiPolynomial(plans[0].start[2], plans[0].end[2], info["planner"].T)
+    axes.plot(info["planner"].t, np.degrees(phi5(info["planner"].t)[0]), color="black", linestyle="--", linewidth=1.4, label="3-4-5 law")
+    axes.set_xlabel("time (s)")
+    axes.set_ylabel("phi (deg)")
+    legend_below(fig, axes, fontsize=7)  # under the axes: never over a curve
+    yield ("Optimised end-effector orientation", to_svg(fig, "com-phi"),
+           f"phi(t) of case 2 per trajectory (degree {method.phi.degree}, ends fixed), and the 3-4-5 law it starts from.")
+
+
+def _rate_cell(key: str, an, plan: Plan, method: ComMotionPlanning) -> str:
+    """Peak actuator torque rate: unbounded where the bang-bang law makes the torques jump; case
+    3's as measured by the ramp search; case 1's by central differences on the analysis grid."""
+    if key.startswith("com_bang_bang"):
+        return "unbounded (torques jump)"
+    if key == "com_trapezoidal":
+        return f"{plan.ramp_rate:.4g} (limit {method.torque_rate_limit:.3g})"
+    return f"{max(float(np.max(np.abs(np.gradient(e, an.t)))) for e in an.efforts.values()):.4g}"
+
+
+def _square_figure(study, info, plt, to_svg):
+    """Fig. 2: the test square, its points and the trajectories of the tip and of the centre of mass."""
+    plans: list[Plan] = info["plans"]
+    method: ComMotionPlanning = info["method"]
+    planner: Planner = info["planner"]
+    fig, ax = plt.subplots(figsize=(6.0, 5.4))
+    names: list = []  # (text, point, kind): placed last, clear of the paths (report.figures.place_items)
+    segs: list = []
+    if method.test_square is not None:
+        sq = method.test_square
+        h = sq.side / 2
+        cx, cy = sq.centre
+        ax.fill([cx - h, cx + h, cx + h, cx - h], [cy - h, cy - h, cy + h, cy + h], color="0.88", zorder=0)
+        for name, (x, y) in sq.points().items():
+            ax.plot(x, y, "o", color="black", markersize=2.5)
+            names.append((name, (x, y), "joint"))
+        ax.plot([cx], [cy], "+", color="black")
+        names.append(("E", (cx, cy), "joint"))
+    for k, p in enumerate(plans):
+        c = f"C{k % 10}"
+        ax.annotate("", xy=p.end[:2], xytext=p.start[:2], arrowprops={"arrowstyle": "->", "color": c, "lw": 1.2})
+        ax.plot([p.com_start[0], p.com_end[0]], [p.com_start[1], p.com_end[1]], color=c, linestyle="--", linewidth=1.0,
+                label=f"{p.name}: tip → (solid), centre of mass (dashed)")
+        segs += [(tuple(p.start[:2]), tuple(p.end[:2])), (tuple(p.com_start[:2]), tuple(p.com_end[:2]))]
+    # the arm at the start of the first trajectory
+    p0 = plans[0]
+    th = np.cumsum(p0.q_start)
+    pts = [np.asarray(planner.arm.base)]
+    for L, a in zip(planner.arm.lengths, th):
+        pts.append(pts[-1] + L * np.array([math.cos(a), math.sin(a)]))
+    pts = np.array(pts)
+    ax.plot(pts[:, 0], pts[:, 1], "-o", color="0.3", linewidth=2.0, markersize=3, label=f"arm at the start of {p0.name}")
+    segs += [(tuple(a), tuple(b)) for a, b in zip(pts[:-1], pts[1:])]
+    ax.plot([planner.arm.base[0]], [planner.arm.base[1]], "^", color="black", markersize=8)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    from ...draw.figures import legend_below, place_items
+
+    legend_below(fig, ax, fontsize=7)  # under the drawing: never over the arm or the paths
+    place_items(fig, ax, names, segs, [(np.asarray(q, dtype=float), None) for _, q, _ in names]
+                + [(np.asarray(planner.arm.base, dtype=float), -1.0)])
+    yield ("The test square and the trajectories (Fig. 2)", to_svg(fig, "com-square"),
+           "Grey: the tested zone (side " + (f"{method.test_square.side:g} m, centre ({method.test_square.centre[0]:g}, "
+           f"{method.test_square.centre[1]:g}) m" if method.test_square else "—") + "), points P1.. numbered "
+           "counter-clockwise from P1 at the " + (method.test_square.first_corner if method.test_square else "—") +
+           " corner (our reading of the figure, which reproduces the paper's list of segments). Arrows: the tip's "
+           "straight paths of case 1; dashed: the centre of mass' straight paths of cases 2-3. Base joint: triangle.")
+
+
+def _notation() -> dict:
+    from ...notation import Sym, ours, setting
+
+    return {
+        "balancing.test_square.centre": Sym("E", "centre of the tested square (Fig. 2)"),
+        "balancing.test_square.side": ours("a", "edge length of the tested square"),
+        "balancing.test_square.divisions": ours("n_{div}", "segments per edge (points P_1, P_2, ...)"),
+        "balancing.test_square.first_corner": ours("P_1", "corner of P_1, points numbered counter-clockwise"),
+        "balancing.trajectories[<k>]": Sym("P_iP_j", "a tip trajectory between two points of the square"),
+        "balancing.trajectories[<k>].name": ours("name", "label of a tip trajectory"),
+        "balancing.trajectories[<k>].start": ours("x_0", "start point of a tip trajectory"),
+        "balancing.trajectories[<k>].end": ours("x_f", "end point of a tip trajectory"),
+        "balancing.orientation.start": Sym("φ_0", "orientation φ of the last link at the start of every trajectory"),
+        "balancing.orientation.end": Sym("φ_f", "orientation φ at the end"),
+        "balancing.phi.degree": ours("deg φ", "degree of the polynomial law of φ (ends fixed to second order)"),
+        "balancing.phi.starts": setting("starts", "multi-start: the 3-4-5 law plus random points"),
+        "balancing.phi.seed": setting("seed", "seed of the random starting points"),
+        "balancing.phi.spread": setting("σ_c", "spread of the random starting coefficients"),
+        "balancing.phi.max_evaluations": setting("evaluations", "objective evaluations per start (Nelder-Mead)"),
+        "balancing.phi.tolerance": setting("tol", "Nelder-Mead tolerance"),
+        "balancing.torque_rate_limit": ours("|τ̇|_{max}", "case 3: largest rate of change of any actuator torque (the paper: 3·10^4 N m/s)", unit="N m/s"),
+        "balancing.rate_samples": setting("N_{rate}", "case 3: samples on which torque rates are measured"),
+    }
+
+
+#: Paper 003's symbols (Sec. 3, Fig. 2) for this method's inputs.
+NOTATION = _notation()

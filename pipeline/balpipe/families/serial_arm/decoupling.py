@@ -1,0 +1,327 @@
+"""Decoupling a 2R arm by a gear pair and mass redistribution, then cancelling its shaking
+moment with one counter-rotating gear (paper 002, Sec. 4, eqs. 3-20).
+
+The parts (Fig. 3): gear 2' fixed on link 2 at joint B; gear 1' pivoted on link 1 at C (a
+revolute) and meshing with 2', so that w1' - w1 = rho (w2 - w1) (carrier link 1, rho = -1 for the
+paper's identical gears); counterweights on links 2 and 1. With link 1's assembly (link,
+attachments; mass m_a, centre of mass c_a from A, centroidal inertia I_a), gear 1' (m_g at C,
+inertia I_g) and link 2's assembly (link, gear 2', counterweight; m_b, centre of mass c_b from
+B, inertia I_b), the kinetic energy gives the mass matrix (eqs. 4-6 with the gear):
+
+    M11 = I_a + m_a |c_a|^2 + m_g |AC|^2 + I_g + I_b + m_b (l1^2 + |c_b|^2 + 2 l1 (c_bx cos q2 - c_by sin q2))
+    M12 = rho I_g + I_b + m_b (|c_b|^2 + l1 (c_bx cos q2 - c_by sin q2))
+    M22 = rho^2 I_g + I_b + m_b |c_b|^2
+
+and the gravity torques D1, D2 of eqs. 13-14 are those of the total centre of mass. Hence the
+three decoupling conditions:
+
+    (1) c_b = 0: link 2 with gear 2' has its centre of mass on B          (l_BS2 = 0)
+    (2) rho I_g + I_b = 0: I_S1' = I_S2 + I_S2' for rho = -1
+    (3) m_a c_a + m_g AC + m_b (l1, 0) = 0: the total centre of mass on A  (m1 l_AS1 = m1' l_AC + (m2 + m2') l1)
+
+and then tau1 = J1 q1'', tau2 = J2 q2'' (eqs. 17-18) with J1 = M11, J2 = M22 constant, the
+shaking force is the constant weight (eq. 19) and the shaking moment about A is -J1 q1''
+(eq. 20). Gear 1'' fixed on link 1 at A meshes with gear 3 on the frame (theta3 = -theta1): with
+I3 = J1 the total angular momentum J1 q1' + I3 (-q1') vanishes and so does the shaking moment.
+
+The counterweights' masses are solved from conditions (1) and (3) for the distances the spec
+chooses (each on the ray that cancels its link's first moment), gear 1''s inertia from (2).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from pydantic import Field
+
+from .template import SerialArmMechanism
+from ...model import FRAME, Attachment, Model
+from ...spec_parts import SpecFieldError, Strict
+from ...units import Inertia, Length, Mass, PositiveLength, number
+from ...balancing.base import BalanceResult, Parameter, Stage
+from ...balancing.parts import add_counter_rotation, add_counterweight
+
+ROOT = ("balancing",)
+
+
+class Gear1p(Strict):
+    """Gear 1', pivoted on link 1 at C."""
+
+    position: Length = Field(description="l_AC: position of C along link 1 from A (between A and B in the paper)")
+    mass: Mass = Field(0.0, description="m1'")
+    ratio: number(lt=0) = Field(-1.0, description="w1' - w1 = ratio (w2 - w1); -1 for identical gears (the paper)")
+
+
+class Gear2p(Strict):
+    """Gear 2', fixed on link 2 at B."""
+
+    mass: Mass = Field(0.0, description="m2'")
+    inertia: Inertia = Field(0.0, description="I_S2'")
+
+
+class Counterweight(Strict):
+    """A counterweight at ``distance`` from the link's proximal joint, on the ray that cancels the
+    first moment it must cancel; its mass is solved."""
+
+    distance: PositiveLength = Field(description="distance from the joint (A for link 1, B for link 2)")
+    inertia: Inertia = Field(0.0, description="centroidal inertia of the counterweight")
+
+
+class Counterweights(Strict):
+    link1: Counterweight = Field(description="puts the total centre of mass on A (condition 3)")
+    link2: Counterweight = Field(description="puts link 2 + gear 2' centre of mass on B (condition 1)")
+
+
+class FrameGear(Strict):
+    """Gear 3 on the frame meshing with gear 1'' (fixed on link 1 at A), identical: theta3 = -theta1."""
+
+    position: tuple[Length, Length] = Field(description="centre of gear 3 on the frame (its radius is half the distance to A)")
+
+
+class GearDecoupling(Strict):
+    """Paper 002: gear pair 1'-2' and mass redistribution (decoupled, linear dynamics), then gear 3."""
+
+    method: Literal["gear_decoupling"] = Field(description="balancing method")
+    gear_1p: Gear1p = Field(description="gear 1' on link 1 at C (its inertia is solved from condition 2)")
+    gear_2p: Gear2p = Field(Gear2p(), description="gear 2' fixed on link 2 at B")
+    counterweights: Counterweights = Field(description="counterweights whose masses conditions 1 and 3 give")
+    counter_rotation: FrameGear = Field(description="gear 3 on the frame (I3 = J1)")
+
+
+@dataclass(frozen=True)
+class MassMatrix2R:
+    """Closed form of the 2R (+ gear 1') mass matrix: M_ij = k0 + kc cos q2 + ks sin q2."""
+
+    M11: tuple[float, float, float]
+    M12: tuple[float, float, float]
+    M22: tuple[float, float, float]
+
+    def values(self, q2: np.ndarray) -> np.ndarray:
+        c, s = np.cos(q2), np.sin(q2)
+        ent = [np.asarray(k[0] + k[1] * c + k[2] * s, dtype=float) for k in (self.M11, self.M12, self.M22)]
+        return np.stack([np.stack([ent[0], ent[1]], -1), np.stack([ent[1], ent[2]], -1)], -2)
+
+    def text(self, entry: str) -> str:
+        k0, kc, ks = getattr(self, entry)
+        out = f"{k0:.6g}"
+        for v, f in ((kc, "cos q2"), (ks, "sin q2")):
+            if abs(v) > 1e-12 * max(1.0, abs(k0)):
+                out += f" {'+' if v > 0 else '-'} {abs(v):.6g} {f}"
+        return out
+
+
+def _assembly(model: Model, name: str) -> tuple[float, np.ndarray, float]:
+    m, c, i = model.body(name).mass_properties()
+    return m, np.asarray(c, dtype=float), i
+
+
+def mass_matrix_2r(model: Model, l1: float, gear: tuple[float, float, float, float] | None) -> MassMatrix2R:
+    """The closed form above for a model with bodies link1, link2 (and gear 1': (m_g, AC, I_g, rho))."""
+    ma, ca, Ia = _assembly(model, "link1")
+    mb, cb, Ib = _assembly(model, "link2")
+    mg, ac, Ig, rho = gear if gear is not None else (0.0, 0.0, 0.0, 0.0)
+    cb2 = float(cb @ cb)
+    k11 = Ia + ma * float(ca @ ca) + mg * ac**2 + Ig + Ib + mb * (l1**2 + cb2)
+    return MassMatrix2R(
+        (k11, 2 * mb * l1 * cb[0], -2 * mb * l1 * cb[1]),
+        (rho * Ig + Ib + mb * cb2, mb * l1 * cb[0], -mb * l1 * cb[1]),
+        (rho**2 * Ig + Ib + mb * cb2, 0.0, 0.0),
+    )
+
+
+def balance(mech: SerialArmMechanism, method: GearDecoupling, model: Model) -> BalanceResult:
+    if len(mech.links) != 2:
+        raise SpecFieldError(("mechanism", "links"), f"gear_decoupling balances a 2R arm (got {len(mech.links)} links)")
+    # a payload on link 2 is part of link 2's assembly: conditions (1)-(3) include it
+    l1 = mech.links[0].length
+    g1, g2, cw = method.gear_1p, method.gear_2p, method.counterweights
+    if not 0 <= g1.position < l1:
+        raise SpecFieldError(ROOT + ("gear_1p", "position"),
+                             f"C must lie on link 1 between A and B so that gears 1' and 2' can mesh (0 <= l_AC < l1 = {l1:g} m)")
+    params: list[Parameter] = []
+    P = lambda *a: params.append(Parameter(*a))  # noqa: E731
+    notes: list[str] = []
+
+    # gear 2' on link 2 at B, then the link 2 counterweight: condition (1)
+    r_mesh = l1 - g1.position  # |CB| = r1' + r2'
+    rho = g1.ratio
+    r1p = r_mesh / (1 - rho)  # r2' / r1' = -rho
+    r2p = r_mesh - r1p
+    dec = model.replace_body(model.body("link2").with_attachments(
+        Attachment("gear 2'", g2.mass, (0.0, 0.0), g2.inertia, "gear", r2p)))
+    m2, c2, _ = _assembly(dec, "link2")
+    first2 = m2 * c2
+    m_cw2 = float(np.hypot(*first2)) / cw.link2.distance
+    u2 = -first2 / np.hypot(*first2) if m_cw2 > 0 else np.array([-1.0, 0.0])
+    if m_cw2 > 0:
+        dec = add_counterweight(dec, "link2", "counterweight 2", m_cw2, tuple(cw.link2.distance * u2), cw.link2.inertia)
+    mb, cb, Ib = _assembly(dec, "link2")
+    # gear 1' inertia from condition (2)
+    Ig = -Ib / rho
+    # link 1 counterweight: condition (3), the total centre of mass on A
+    m1, c1, _ = _assembly(dec, "link1")
+    first1 = m1 * c1 + g1.mass * np.array([g1.position, 0.0]) + mb * np.array([l1, 0.0])
+    m_cw1 = float(np.hypot(*first1)) / cw.link1.distance
+    u1 = -first1 / np.hypot(*first1) if m_cw1 > 0 else np.array([-1.0, 0.0])
+    if m_cw1 > 0:
+        dec = add_counterweight(dec, "link1", "counterweight 1", m_cw1, tuple(cw.link1.distance * u1), cw.link1.inertia)
+    dec = add_counter_rotation(dec, "gear1p", carrier="link1", at=(g1.position, 0.0), geared_to="link2",
+                               ratio=rho, inertia=Ig, mass=g1.mass, radius=r1p, radius_geared=r2p)
+    ma, ca, Ia = _assembly(dec, "link1")
+
+    before = mass_matrix_2r(model, l1, None)
+    after = mass_matrix_2r(dec, l1, (g1.mass, g1.position, Ig, rho))
+    J1, J2 = after.M11[0], after.M22[0]
+    cond1 = float(np.hypot(*cb))
+    cond2 = rho * Ig + Ib
+    total_first = ma * ca + g1.mass * np.array([g1.position, 0.0]) + mb * np.array([l1, 0.0])
+    cond3 = float(np.hypot(*total_first))
+
+    # gear 3 on the frame, identical to gear 1'' on link 1 at A: theta3 = -theta1, I3 = J1
+    A = np.asarray(mech.base, dtype=float)
+    G3 = np.asarray(method.counter_rotation.position, dtype=float)
+    d3 = float(np.hypot(*(G3 - A)))
+    if d3 == 0:
+        raise SpecFieldError(ROOT + ("counter_rotation", "position"), "gear 3 cannot sit on joint A")
+    full = add_counter_rotation(dec, "gear3", carrier=FRAME, at=tuple(G3), geared_to="link1", ratio=-1.0,
+                                inertia=J1, radius=d3 / 2, radius_geared=d3 / 2)
+    full = full.replace_body(full.body("link1").with_attachments(
+        Attachment("gear 1''", 0.0, (0.0, 0.0), 0.0, "gear", d3 / 2)))
+
+    m_link1 = mech.links[0].mass + m_cw1
+    P("m_cw2", m_cw2, "kg", "condition (1): c_b = 0", "counterweight on link 2 (centre of mass of link 2 + gear 2' on B)")
+    P("cw2_angle", math.degrees(math.atan2(u2[1], u2[0])), "deg", "condition (1)", "direction of counterweight 2 in link 2's frame (180: beyond B)")
+    P("m_cw1", m_cw1, "kg", "condition (3): total centre of mass on A", "counterweight on link 1")
+    P("cw1_angle", math.degrees(math.atan2(u1[1], u1[0])), "deg", "condition (3)", "direction of counterweight 1 in link 1's frame (180: beyond A)")
+    P("m1", m_link1, "kg", "Sec. 4", "redistributed link 1: link + counterweight 1 (gear 1' excluded)")
+    bare1 = dec.body("link1")
+    mm1, cc1, ii1 = bare1.mass_properties()
+    P("l_AS1", float(np.hypot(*cc1)), "m", "Sec. 4", "distance of the redistributed link 1's centre of mass from A (on the side opposite B)")
+    P("I_S1", ii1, "kg m^2", "Sec. 4", "centroidal inertia of the redistributed link 1")
+    P("m2_plus_m2p", mb, "kg", "Sec. 4", "link 2 with gear 2' and counterweight 2")
+    P("l_BS2", cond1, "m", "condition (1)", "distance of link 2 + gear 2''s centre of mass from B")
+    P("I_S2_plus_I_S2p", Ib, "kg m^2", "Sec. 4", "centroidal inertia of link 2 with gear 2' and counterweight 2 (about B)")
+    P("I_S1p", Ig, "kg m^2", "condition (2): I_S1' = -(I_S2 + I_S2')/rho", "axial inertia of gear 1'")
+    P("r1p", r1p, "m", "|CB| = r1' + r2', r2' = -rho r1'", "pitch radius of gear 1'")
+    P("r2p", r2p, "m", "|CB| = r1' + r2'", "pitch radius of gear 2'")
+    P("J1", J1, "kg m^2", "eq. 17", "decoupled inertia of joint 1: tau1 = J1 q1''")
+    P("J2", J2, "kg m^2", "eq. 18", "decoupled inertia of joint 2: tau2 = J2 q2''")
+    P("I3", J1, "kg m^2", "Sec. 4: I3 = J1, theta3 = -theta1", "axial inertia of the counter-rotating gear 3 on the frame")
+    P("condition1_residual", cond1, "m", "condition (1)", "|c_b| after redistribution (0: satisfied)")
+    P("condition2_residual", cond2, "kg m^2", "condition (2)", "rho I_S1' + I_S2 + I_S2' (0: satisfied)")
+    P("condition3_residual", cond3, "kg m", "condition (3)", "|m_a c_a + m1' AC + m_b AB| (0: total centre of mass on A)")
+    P("M12_max_after", float(max(abs(v) for v in after.M12)), "kg m^2", "eq. 5", "largest coefficient of M12 after decoupling")
+    if cw.link1.inertia or cw.link2.inertia:
+        notes.append(
+            "The counterweights carry the centroidal inertias the spec gives (balancing.counterweights): "
+            "the paper lists only the redistributed links' inertias, so these are chosen to give them."
+        )
+
+    stages = [
+        Stage("unbalanced", "unbalanced", model, "the 2R arm as given"),
+        Stage("decoupled", "decoupled", dec,
+              "gear 2' on link 2 at B, gear 1' on link 1 at C, counterweights (conditions 1-3): "
+              "tau_i = J_i q_i'', constant shaking force", balances="force"),
+        Stage("decoupled_counter_rotation", "decoupled + counter-rotation", full,
+              "gear 1'' on link 1 at A meshing with gear 3 on the frame, I3 = J1", balances="force+moment"),
+    ]
+    info = {"before": before, "after": after, "J": (J1, J2)}
+    return BalanceResult(params, stages, notes, figures=lambda study: figures(study, info))
+
+
+def figures(study, info: dict):
+    """Mass matrix before and after (symbolic and along the motion), torque against acceleration."""
+    from ...engine.joint_space import mass_matrix
+    from ...draw.figures import plt, style, to_svg
+
+    before, after = info["before"], info["after"]
+    J1, J2 = info["J"]
+    rows = "".join(
+        f"<tr><td>{e}</td><td><code>{before.text(e)}</code></td><td><code>{after.text(e)}</code></td></tr>"
+        for e in ("M11", "M12", "M22")
+    )
+    table = (
+        "<table><tr><th>Entry (kg m²)</th><th>unbalanced</th><th>decoupled</th></tr>" + rows + "</table>"
+    )
+    yield (
+        "Mass matrix before and after decoupling (eqs. 4-6)",
+        table,
+        "M11 = I_a + m_a|c_a|² + m1'|AC|² + I_S1' + I_b + m_b (l1² + |c_b|² + 2 l1 (c_bx cos q2 − c_by sin q2)); "
+        "M12 = ρ I_S1' + I_b + m_b (|c_b|² + l1 (c_bx cos q2 − c_by sin q2)); M22 = ρ² I_S1' + I_b + m_b |c_b|², "
+        "with link 1's assembly (m_a, c_a, I_a), gear 1' on C (m1', I_S1', ratio ρ) and link 2's assembly "
+        "(m_b, c_b from B, I_b); the numbers are computed from the stages' models.",
+    )
+    stages = [s for s in study.stages if s.stage.name in ("unbalanced", "decoupled")]
+    fig, axes = plt.subplots(1, 3, figsize=(9.6, 2.8))
+    for k, s in enumerate(stages):
+        an = s.analysis
+        _, M = mass_matrix(s.stage.model, an.t)
+        for ax, (i, j, name) in zip(axes, ((0, 0, "M11"), (0, 1, "M12"), (1, 1, "M22"))):
+            ax.plot(an.t, M[:, i, j], label=s.stage.label, **style(k))
+            ax.set_title(f"{name} (kg m²)", fontsize=9)
+            ax.set_xlabel("time (s)")
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    yield ("Mass matrix along the motion", to_svg(fig, "decoupling-mass"),
+           "Entries of the joint-space mass matrix computed by the engine from each stage's model "
+           "(M = Vᵀ diag(m, m, I) V, V the body velocities per unit joint rate): the decoupled arm's is "
+           "constant and diagonal.")
+    fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.2))
+    for k, s in enumerate(stages):
+        an = s.analysis
+        for j, ax in enumerate(axes):
+            qdd = an.a[:, an.names.index(f"link{j + 1}"), 2] - (an.a[:, an.names.index("link1"), 2] if j else 0.0)
+            ax.plot(qdd, an.efforts[f"q{j + 1}"], ".", markersize=2.5, color=style(k)["color"],
+                    alpha=0.7 if k else 0.5, label=s.stage.label)
+    for j, (ax, Jj) in enumerate(zip(axes, (J1, J2))):
+        lim = np.array(ax.get_xlim())
+        ax.plot(lim, Jj * lim, color="tab:red", linewidth=1.0, label=f"J{j + 1} q{j + 1}'' (J{j + 1} = {Jj:.4g} kg m²)")
+        ax.set_xlabel(f"q{j + 1}'' (rad/s²)")
+        ax.set_title(f"Joint {j + 1} torque (N m)", fontsize=9)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    yield ("Torque against acceleration", to_svg(fig, "decoupling-torque"),
+           "Each joint's actuator torque against its own acceleration at every sample: coupled and "
+           "nonlinear before, on the line tau = J q'' after decoupling"
+           + (" (with gravity on, the decoupled arm's total centre of mass is on A: no gravity torque)." if study.spec.analysis.gravity else "."))
+
+
+def _notation() -> dict:
+    """Paper 002's symbols (Figs. 1, 3-4, eqs. 3-16): joints A, B, centres of mass S_1, S_2,
+    angles θ_1, θ_2; they replace the serial arm's generic ones for the 2R arm."""
+    from ...notation import Sym, drive_table, ours
+
+    table = drive_table({"q1": Sym("θ_1", "angle of link 1 relative to the base"),
+                         "q2": Sym("θ_2", "angle of link 2 relative to link 1")}, end_time="T")
+    table.update({
+        "mechanism.base": Sym("A", "joint A of link 1 on the frame"),
+        "mechanism.links[0].length": Sym("l_1", "length AB of link 1"),
+        "mechanism.links[0].mass": Sym("m_1", "mass of link 1"),
+        "mechanism.links[0].com": Sym("l_{AS1}", "distance of link 1's centre of mass S_1 from A"),
+        "mechanism.links[0].com_offset": ours("e_1", "offset of S_1 normal to AB"),
+        "mechanism.links[0].inertia": Sym("I_{S1}", "axial moment of inertia of link 1 about S_1"),
+        "mechanism.links[1].length": ours("l_2", "length of link 2 from B (its tip; the dynamics do not depend on it)"),
+        "mechanism.links[1].mass": Sym("m_2", "mass of link 2"),
+        "mechanism.links[1].com": Sym("l_{BS2}", "distance of link 2's centre of mass S_2 from B"),
+        "mechanism.links[1].com_offset": ours("e_2", "offset of S_2 normal to link 2"),
+        "mechanism.links[1].inertia": Sym("I_{S2}", "axial moment of inertia of link 2 about S_2"),
+        "motion.duration": ours("T", "duration of the motion"),
+        "balancing.gear_1p.position": Sym("l_{AC}", "position of gear 1''s axis C along link 1 from A"),
+        "balancing.gear_1p.mass": Sym("m_{1'}", "mass of gear 1'"),
+        "balancing.gear_1p.ratio": ours("U_{1'2}", "ω_1' − ω_1 = U (ω_2 − ω_1); −1 for identical gears"),
+        "balancing.gear_2p.mass": Sym("m_{2'}", "mass of gear 2', fixed on link 2 at B"),
+        "balancing.gear_2p.inertia": Sym("I_{S2'}", "axial moment of inertia of gear 2'"),
+        "balancing.counterweights.link1.distance": ours("l_{A,cw1}", "distance of link 1's counterweight from A (puts the total centre of mass on A)"),
+        "balancing.counterweights.link1.inertia": ours("I_{cw1}", "centroidal inertia of link 1's counterweight"),
+        "balancing.counterweights.link2.distance": ours("l_{B,cw2}", "distance of link 2's counterweight from B (puts link 2 + gear 2' centre of mass on B)"),
+        "balancing.counterweights.link2.inertia": ours("I_{cw2}", "centroidal inertia of link 2's counterweight"),
+        "balancing.counter_rotation.position": ours("O_3", "centre of the counter-rotating gear 3 on the frame (I_3 = J_1)"),
+    })
+    return table
+
+
+#: Paper 002's symbols for this method's inputs and for the 2R arm it balances.
+NOTATION = _notation()

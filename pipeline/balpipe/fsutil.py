@@ -1,0 +1,92 @@
+"""Writing the output folder safely: a file or a page folder replaced in one step (a reader sees
+the old or the new one, never a part), never through a planted symlink, and the temporaries of an
+interrupted build removed."""
+
+from __future__ import annotations
+
+import os
+import secrets
+import shutil
+from pathlib import Path
+
+TMP_MARK = ".balpipe-tmp-"  # temporary files and folders in the output folder carry this
+
+
+def tmp_name(name: str) -> str:
+    return f".{name[:100]}{TMP_MARK}{os.getpid()}-{secrets.token_hex(4)}"
+
+
+def write_new(path: Path, content: str) -> None:
+    """Create ``path`` (it must not exist: never writes through a planted symlink); mode from
+    the umask."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o666)
+    with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
+        f.write(content)
+
+
+def remove_path(path: Path) -> None:
+    """Remove a file, a symlink (not its target) or a folder tree (rmtree does not follow links)."""
+    if path.is_symlink() or path.is_file():
+        path.unlink()
+    elif path.is_dir():
+        shutil.rmtree(path, ignore_errors=True)
+
+
+def write_file_atomic(path: Path, content: str) -> None:
+    """Replace ``path`` in one step: a reader sees the old or the new file, never a part; a
+    symlink at ``path`` is replaced by the file, its target is left alone."""
+    tmp = path.with_name(tmp_name(path.name))
+    try:
+        write_new(tmp, content)
+        os.replace(tmp, path)
+    except BaseException:
+        if tmp.exists():
+            tmp.unlink()
+        raise
+
+
+def write_atomic_dir(target: Path, files: dict[str, str]) -> None:
+    """Write a page folder next to ``target`` and move it into place when complete. Modes follow
+    the umask (os.mkdir(0o777)), not tempfile's 0700."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    tmp = target.with_name(tmp_name(target.name))
+    os.mkdir(tmp, 0o777)
+    try:
+        for name, content in files.items():
+            write_new(tmp / name, content)
+        old = None
+        if target.is_symlink() or target.is_file():
+            target.unlink()  # planted: replace the link itself
+        elif target.exists():
+            old = target.with_name(tmp_name(target.name + ".old"))
+            target.rename(old)
+        tmp.rename(target)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def remove_temporaries(out: Path) -> None:
+    """Remove what an interrupted build left: temporaries of balpipe's own naming only."""
+    try:
+        entries = list(out.iterdir())
+    except OSError:
+        return
+    for e in entries:
+        if e.name.startswith(".") and TMP_MARK in e.name:
+            try:
+                remove_path(e)
+            except OSError:
+                pass
+        elif e.is_dir() and not e.is_symlink():  # a page folder: its failed/ is written inside
+            try:
+                inner = [f for f in e.iterdir() if f.name.startswith(".") and TMP_MARK in f.name]
+            except OSError:
+                continue
+            for f in inner:
+                try:
+                    remove_path(f)
+                except OSError:
+                    pass

@@ -1,0 +1,60 @@
+"""The one path from a loaded spec to its results: study (balancing and analysis), checks,
+simulation. ``check``, ``build``, ``diff`` and ``history`` all go through it, so a spec that one
+of them rejects is rejected by the others with the same located errors."""
+
+from __future__ import annotations
+
+from contextlib import contextmanager
+
+from . import study as study_mod
+from .limits import check_finite, check_simulation
+from .loader import LoadedSpec, SpecError, SpecErrors
+from .spec_parts import SpecFieldError
+
+
+def analyse(loaded: LoadedSpec, simulate: bool = True):
+    """Balance and analyse one loaded spec (no simulation, nothing written): the study, or
+    :class:`SpecErrors` for every problem of the spec, located. The results must be finite and,
+    with ``simulate``, within the simulation's limits."""
+    try:
+        with _quiet_numpy():
+            st = study_mod.run(loaded.spec)
+            check_finite(st)
+            if simulate:
+                check_simulation(st)
+        return st
+    except SpecFieldError as exc:
+        raise loaded.error(exc) from None
+    except ArithmeticError as exc:  # overflow, division by zero from extreme input
+        raise SpecErrors([SpecError(str(loaded.path), None, None, "",
+                                    f"the computation failed on this spec's numbers ({type(exc).__name__}: {exc}); "
+                                    "check the magnitudes of masses, lengths and the duration")]) from None
+
+
+def simulate(loaded: LoadedSpec, st) -> bool:
+    """The pymunk validation of every stage of ``st`` when the spec enables it; True when it ran."""
+    if not loaded.spec.validation.enabled:
+        return False
+    from .validation_stage import simulate_study  # pymunk only when a simulation runs
+
+    try:
+        simulate_study(st)
+    except SpecFieldError as exc:
+        raise loaded.error(exc) from None
+    return True
+
+
+def run(loaded: LoadedSpec, simulate_it: bool = True):
+    """:func:`analyse`, then :func:`simulate` when ``simulate_it``: the study with its validation."""
+    st = analyse(loaded, simulate=simulate_it)
+    if simulate_it:
+        simulate(loaded, st)
+    return st
+
+
+@contextmanager
+def _quiet_numpy():
+    import numpy as np
+
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        yield
