@@ -86,7 +86,7 @@ def test_cli_build_defaults_to_one_process_per_core_and_refuses_zero(tmp_path, m
     from balpipe.cli import main
 
     seen = []
-    monkeypatch.setattr(build_mod, "build", lambda paths, opts, jobs, progress: seen.append(jobs) or [])
+    monkeypatch.setattr(build_mod, "build", lambda paths, opts, jobs, progress, scheduler=None: seen.append(jobs) or [])
     spec = tmp_path / "s.yaml"
     spec.write_text("name: x\n")
     main(["build", str(spec), "-o", str(tmp_path / "o"), "-q"])

@@ -16,6 +16,7 @@ import hashlib
 import json
 import os
 import signal
+import sys
 import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor
@@ -28,7 +29,7 @@ from pathlib import Path
 
 from . import plugins, runner
 from .laws.drives import table_texts
-from .loader import SpecErrors, load, schema
+from .loader import LoadedSpec, SpecErrors, load, load_text, schema
 from .report import history_page
 from .report.page import render_page
 from .report.results import dumps, results_dict, timeseries_csv
@@ -56,6 +57,10 @@ class Options:
     out: Path
     simulate: bool = True
     force: bool = False
+
+
+class SchedulerError(Exception):
+    """``--scheduler``: the cluster cannot be reached, or its workers run another balpipe."""
 
 
 class OutputError(Exception):
@@ -143,17 +148,43 @@ def input_hash(text: str, opts: Options) -> str:
     return h.hexdigest()[:16]
 
 
-def build_one(path: Path, opts: Options) -> Outcome:
-    """Build one spec; never raises (errors become the outcome)."""
+@dataclass(frozen=True)
+class Job:
+    """One spec to compute, as read by the process that writes the site: the spec's text and
+    what its page folder holds that the page shows (the history), so that the computation
+    itself reads and writes nothing of the site and can run on another machine."""
+
+    path: Path
+    text: str
+    input_hash: str
+    simulate: bool
+    history: dict | None
+    history_files: dict[str, str]
+
+
+@dataclass
+class Computed:
+    """What :func:`compute` made of a :class:`Job`: the page's files and the study's status, or
+    the spec's located errors, or an internal error with its traceback."""
+
+    status: str  # "ok", "failed", "error", "crash"
+    message: str = ""
+    results: dict | None = None
+    files: dict[str, str] | None = None
+    seconds: float = 0.0
+
+
+def plan_one(path: Path, opts: Options) -> Job | Outcome:
+    """Read one spec and decide: an :class:`Outcome` when there is nothing to compute (invalid,
+    or unchanged since the last build), else the :class:`Job` that computes it."""
     start = time.perf_counter()
     slug = slug_for(path)
-    source = str(path)
     try:
         loaded = load(path)
     except SpecErrors as exc:
-        return Outcome(source, slug, "error", str(exc), spec_error=True, seconds=time.perf_counter() - start)
-    h = input_hash(loaded.text + table_texts(loaded.spec), opts)  # the CSV tables it reads count too
+        return Outcome(str(path), slug, "error", str(exc), spec_error=True, seconds=time.perf_counter() - start)
     target = opts.out / slug
+    h = input_hash(loaded.text + table_texts(loaded.spec), opts)  # the CSV tables it reads count too
     h = history_page.mix_hash(h, target)  # a new history.json re-renders the page
     if not opts.force:
         previous = _read_results(target)
@@ -161,44 +192,74 @@ def build_one(path: Path, opts: Options) -> Outcome:
             stale_failed = target / "failed"
             if stale_failed.exists() or stale_failed.is_symlink():  # the spec is back to its good page
                 remove_path(stale_failed)
-            return Outcome(source, slug, previous.get("status", "ok"), "unchanged", previous, skipped=True,
+            return Outcome(str(path), slug, previous.get("status", "ok"), "unchanged", previous, skipped=True,
                            seconds=time.perf_counter() - start)
+    return Job(path, loaded.text, h, opts.simulate, history_page.section(target), history_page.build_files(target))
+
+
+def compute(job: Job) -> Computed:
+    """Balance, analyse, validate and render one spec; never raises (errors become the result)."""
+    start = time.perf_counter()
+    source = str(job.path)
+    loaded = None
     try:
-        try:
-            st = runner.analyse(loaded, simulate=opts.simulate)
-        except SpecErrors as exc:
-            return Outcome(source, slug, "error", str(exc), spec_error=True, seconds=time.perf_counter() - start)
+        spec, node = load_text(job.text, source)
+        loaded = LoadedSpec(job.path, job.text, spec, node)
+        st = runner.analyse(loaded, simulate=job.simulate)
         extra: dict[str, str] = {}
-        if opts.simulate and runner.simulate(loaded, st):
+        if job.simulate and runner.simulate(loaded, st):
             from .validation_stage import timing, timing_script
 
             times = timing(st)
             extra = {"timing.json": json.dumps(times, indent=2, sort_keys=True) + "\n",
                      "timing.js": timing_script(times)}
-        results = results_dict(st, source, h, simulated=st.stages[0].validation is not None)
-        page = render_page(st, results, loaded.text, history=history_page.section(target))
+        results = results_dict(st, source, job.input_hash, simulated=st.stages[0].validation is not None)
         files = {
-            "index.html": page,
+            "index.html": render_page(st, results, job.text, history=job.history),
             "results.json": dumps(results),
             "timeseries.csv": timeseries_csv(st),
             **extra,
-            **history_page.build_files(target),
+            **job.history_files,
         }
-        status = "ok" if st.ok else "failed"
-        previous = _read_results(target) if not target.is_symlink() else None
-        if status == "failed" and previous is not None and previous.get("status") == "ok":
-            # the README's promise: a failing spec never replaces a good page; its own page goes
-            # beside it, in failed/
-            write_atomic_dir(target / "failed", files)
-            return Outcome(source, slug, status, "; ".join(st.problems), results, seconds=time.perf_counter() - start,
-                           kept_previous=True)
-        write_atomic_dir(target, files)
-        return Outcome(source, slug, status, "; ".join(st.problems), results, seconds=time.perf_counter() - start)
+        return Computed("ok" if st.ok else "failed", "; ".join(st.problems), results, files,
+                        time.perf_counter() - start)
+    except SpecErrors as exc:
+        return Computed("error", str(exc), seconds=time.perf_counter() - start)
     except SpecFieldError as exc:
-        return Outcome(source, slug, "error", str(loaded.error(exc)), spec_error=True, seconds=time.perf_counter() - start)
+        message = str(loaded.error(exc)) if loaded is not None else f"{source}: {exc}"
+        return Computed("error", message, seconds=time.perf_counter() - start)
     except Exception as exc:  # a bug in balpipe: keep going, report it with its traceback
         tb = traceback.format_exc(limit=6)
-        return Outcome(source, slug, "crash", f"{source}: internal error: {exc!r}\n{tb}", seconds=time.perf_counter() - start)
+        return Computed("crash", f"{source}: internal error: {exc!r}\n{tb}", seconds=time.perf_counter() - start)
+
+
+def finish(job: Job, done: Computed, opts: Options) -> Outcome:
+    """Write what :func:`compute` made into the site: the page folder, replaced whole; a build
+    that fails its checks after a good one goes beside it, in ``failed/``."""
+    source, slug = str(job.path), slug_for(job.path)
+    if done.status in ("error", "crash"):
+        return Outcome(source, slug, done.status, done.message, spec_error=done.status == "error", seconds=done.seconds)
+    target = opts.out / slug
+    previous = _read_results(target) if not target.is_symlink() else None
+    if done.status == "failed" and previous is not None and previous.get("status") == "ok":
+        # the README's promise: a failing spec never replaces a good page; its own page goes
+        # beside it, in failed/
+        write_atomic_dir(target / "failed", done.files)
+        return Outcome(source, slug, done.status, done.message, done.results, seconds=done.seconds, kept_previous=True)
+    write_atomic_dir(target, done.files)
+    return Outcome(source, slug, done.status, done.message, done.results, seconds=done.seconds)
+
+
+def build_one(path: Path, opts: Options) -> Outcome:
+    """Build one spec in this process (:func:`plan_one`, :func:`compute`, :func:`finish`);
+    never raises (errors become the outcome)."""
+    start = time.perf_counter()
+    job = plan_one(path, opts)
+    if isinstance(job, Outcome):
+        return job
+    out = finish(job, compute(job), opts)
+    out.seconds = time.perf_counter() - start
+    return out
 
 
 def _read_results(folder: Path) -> dict | None:
@@ -325,11 +386,14 @@ def default_jobs(specs: int) -> int:
     return max(1, min(usable_cores(), specs))
 
 
-def build(paths: list[str], opts: Options, jobs: int | None = None, progress=None) -> list[Outcome]:
+def build(paths: list[str], opts: Options, jobs: int | None = None, progress=None,
+          scheduler: str | None = None) -> list[Outcome]:
     """Build every spec (in parallel with ``jobs`` > 1; default, None: :func:`default_jobs`,
     one process per usable core, at most one per spec; 1: one after another in this process),
     then the site index and schema. The pages, the index and the order of the outcomes (and of
-    the ``progress`` calls: the specs' order) do not depend on ``jobs``.
+    the ``progress`` calls: the specs' order) do not depend on ``jobs``. With ``scheduler`` (the
+    address of a dask.distributed scheduler) the specs are computed on that cluster's workers and
+    written here: the same site byte for byte (:func:`compute` reads and writes nothing of the site).
 
     Raises :class:`OutputError` before any work when the output folder cannot be used. On
     KeyboardInterrupt (Ctrl-C, or SIGTERM turned into one by the CLI) the workers are stopped,
@@ -356,7 +420,10 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
     with locked(opts.out):
         remove_temporaries(opts.out)
         try:
-            _run(todo, opts, jobs, progress, outcomes)
+            if scheduler:
+                _run_on_cluster(scheduler, todo, opts, progress, outcomes)
+            else:
+                _run(todo, opts, jobs, progress, outcomes)
         except BaseException:
             remove_temporaries(opts.out)
             raise
@@ -391,6 +458,39 @@ def _run(todo: list[Path], opts: Options, jobs: int, progress, outcomes: list[Ou
     else:
         for k, p in enumerate(todo):
             o = build_one(p, opts)
+            outcomes.append(o)
+            if progress:
+                progress(k + 1, total, o)
+
+
+def _installed_code_hash() -> str:
+    """:func:`code_hash` of the balpipe installed where this runs (sent to workers by name)."""
+    return sys.modules[__name__].code_hash()
+
+
+def _run_on_cluster(address: str, todo: list[Path], opts: Options, progress, outcomes: list[Outcome]) -> None:
+    """Plan every spec here, compute the jobs on the dask.distributed cluster at ``address`` (all
+    submitted at once, so every worker is busy), write each result here in the specs' order."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise SchedulerError("--scheduler needs dask.distributed (pip install 'balpipe[sweep]')") from None
+    try:
+        client = Client(address, timeout="20s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise SchedulerError(f"cannot reach the dask scheduler at {address}: {exc}") from None
+    with client:
+        ours = code_hash()
+        theirs = client.run(_installed_code_hash)
+        other = sorted(w for w, h in theirs.items() if h != ours)
+        if other:
+            raise SchedulerError(f"the workers {', '.join(other)} run another balpipe than this one (its code hash "
+                                 f"differs): install the same version on every worker")
+        plans = [plan_one(p, opts) for p in todo]
+        futures = {k: client.submit(compute, job, pure=False) for k, job in enumerate(plans) if isinstance(job, Job)}
+        total = len(todo)
+        for k, job in enumerate(plans):
+            o = job if isinstance(job, Outcome) else finish(job, futures[k].result(), opts)
             outcomes.append(o)
             if progress:
                 progress(k + 1, total, o)

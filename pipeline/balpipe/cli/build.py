@@ -15,17 +15,22 @@ def add_parser(sub) -> None:
     b.add_argument("-o", "--out", default="reports", metavar="DIR", help="output folder (default: reports)")
     b.add_argument("-j", "--jobs", type=int, default=None, metavar="N",
                    help="build N specs in parallel (default: one per usable core, at most one per spec; 1: one after another)")
+    b.add_argument("--scheduler", metavar="ADDRESS",
+                   help="compute the specs on a dask.distributed cluster (tcp://host:port); the site is written here, "
+                   "the same byte for byte (the workers need this balpipe and read the specs' data files at the same paths)")
     b.add_argument("--no-sim", action="store_true", help="skip the pymunk validation (quick iterations)")
     b.add_argument("--force", action="store_true", help="rebuild specs even when unchanged")
     b.add_argument("-q", "--quiet", action="store_true", help="print only errors and the summary")
 
 
 def run(args) -> int:
-    from ..build import Options, OutputError, build
+    from ..build import Options, OutputError, SchedulerError, build
 
     problem = paths_jobs_problem(args.paths, args.jobs)
     if problem:
         return usage_error(problem)
+    if args.scheduler and args.jobs is not None:
+        return usage_error("--scheduler and -j exclude each other: the cluster's workers set the parallelism")
     opts = Options(out=Path(args.out), simulate=not args.no_sim, force=args.force)
 
     def progress(k: int, total: int, o) -> None:
@@ -42,8 +47,8 @@ def run(args) -> int:
             print("    warning: " + w["message"], file=sys.stderr)
 
     try:
-        outcomes = build(args.paths, opts, jobs=args.jobs, progress=progress)
-    except OutputError as exc:
+        outcomes = build(args.paths, opts, jobs=args.jobs, progress=progress, scheduler=args.scheduler)
+    except (OutputError, SchedulerError) as exc:
         return usage_error(str(exc))
     if not outcomes:
         return usage_error("no spec files (*.yaml) found")

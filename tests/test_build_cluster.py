@@ -1,0 +1,81 @@
+"""``balpipe build --scheduler``: the specs computed on a dask.distributed cluster give the same
+site, byte for byte, as a build in one process; a cluster that cannot be used is a usage error."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from balpipe.build import Options, SchedulerError, build
+
+ROOT = Path(__file__).resolve().parents[1]
+SPECS = ["scott_russell.yaml", "offset_slider_crank.yaml"]
+
+
+def tree(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def specs_with_a_broken_one(tmp_path: Path) -> Path:
+    """Two paper specs and one whose coupler cannot reach the guide: an error found by the
+    analysis, so on the workers, not when the spec is read."""
+    folder = tmp_path / "specs"
+    folder.mkdir()
+    for name in SPECS:
+        shutil.copy(ROOT / "specs" / name, folder / name)
+    text = (ROOT / "specs" / "offset_slider_crank.yaml").read_text()
+    (folder / "short_coupler.yaml").write_text(text.replace("coupler: {length: 0.3 m", "coupler: {length: 0.12 m"))
+    return folder
+
+
+def test_a_two_worker_cluster_builds_the_same_site_as_one_process(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    specs = specs_with_a_broken_one(tmp_path)
+    local, remote = tmp_path / "local", tmp_path / "remote"
+    here = build([str(specs)], Options(local, simulate=False), jobs=1)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
+        there = build([str(specs)], Options(remote, simulate=False), scheduler=cl.scheduler_address)
+    assert [(o.source, o.status, o.message) for o in there] == [(o.source, o.status, o.message) for o in here]
+    assert [o.status for o in here] == ["ok", "ok", "error"]  # offset, scott_russell, short_coupler
+    assert "short_coupler.yaml" in here[2].message and "coupler" in here[2].message
+    assert tree(remote) == tree(local)
+    # a second build on the cluster computes nothing: every page is unchanged
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
+        again = build([str(specs)], Options(remote, simulate=False), scheduler=cl.scheduler_address)
+    assert [o.skipped for o in again] == [True, True, False]
+    assert tree(remote) == tree(local)
+
+
+def test_workers_with_another_balpipe_are_refused(monkeypatch, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    import balpipe.build as build_mod
+
+    monkeypatch.setattr(build_mod, "code_hash", lambda: "not the workers' code")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
+        with pytest.raises(SchedulerError, match="run another balpipe"):
+            build([str(ROOT / "specs" / SPECS[0])], Options(tmp_path / "site", simulate=False),
+                  scheduler=cl.scheduler_address)
+    assert not (tmp_path / "site" / "scott_russell").exists()
+
+
+def balpipe(*args: str) -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "pipeline"))
+    return subprocess.run([sys.executable, "-m", "balpipe", *args], capture_output=True, text=True, env=env,
+                          timeout=120)
+
+
+def test_scheduler_usage_errors_exit_2_without_a_traceback(tmp_path):
+    pytest.importorskip("distributed")
+    spec = str(ROOT / "specs" / SPECS[0])
+    r = balpipe("build", spec, "-o", str(tmp_path / "a"), "--scheduler", "tcp://127.0.0.1:9", "-j", "2")
+    assert r.returncode == 2 and "exclude each other" in r.stderr and "Traceback" not in r.stderr
+    r = balpipe("build", spec, "-o", str(tmp_path / "b"), "--no-sim", "--scheduler", "tcp://127.0.0.1:9")
+    assert r.returncode == 2, r.stderr
+    assert "cannot reach the dask scheduler at tcp://127.0.0.1:9" in r.stderr and "Traceback" not in r.stderr
+    r = balpipe("build", "--help")
+    assert "--scheduler" in r.stdout
