@@ -6,7 +6,8 @@ import numpy as np
 
 from .. import realisable
 from ..study import Study, ratio_reference
-from . import figures, labels, present, toc
+from . import citations, figures, labels, present, toc
+from .design_card import design_card
 from .notation_table import notation_groups
 from .render import environment
 from .results import joint_load_table
@@ -163,4 +164,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         actuators=results.get("actuators") or [],
         nav=nav or {},
         inputs=notation_groups(spec),
+        verdict=results.get("verdict"),
+        card=design_card(study, results),
+        citation=citations.cite(spec.paper),
     ))
