@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from . import citations, site_filter, verdict
+from . import citations, site_earlier, site_filter, verdict
 from .costs import factor_text
 from .render import environment, num, printable, ratio
 from .render import tol as tol_fmt
@@ -158,11 +158,19 @@ def _costs(results: dict, first: dict, last: dict) -> dict:
 
 def write_site(out: Path, outcomes: list) -> None:
     entries = [_entry(out, o) for o in sorted(outcomes, key=lambda o: o.source)]
-    n_ok = sum(e["status"] == "ok" for e in entries)
-    n_flagged = sum(e["status"] == "ok" and bool(e["not_realisable"]) for e in entries)
-    n_invalid = sum(e["status"] == "invalid spec" for e in entries)  # the command line's counts
+    for old in site_earlier.earlier_pages(out, {o.slug for o in outcomes}):
+        e = _entry(out, old)
+        e["built"] = "in an earlier build"
+        if old.stale_reason:
+            e["stale"], e["stale_text"] = True, f"stale: {old.stale_reason}"
+        entries.append(e)
+    entries.sort(key=lambda e: e["source"])
+    now = [e for e in entries if not e["built"]]  # this build's specs: the command line's counts
+    n_ok = sum(e["status"] == "ok" for e in now)
+    n_flagged = sum(e["status"] == "ok" and bool(e["not_realisable"]) for e in now)
+    n_invalid = sum(e["status"] == "invalid spec" for e in now)
     html = environment().get_template("index.html").render(
-        entries=entries, n_ok=n_ok - n_flagged, n_failed=len(entries) - n_ok - n_invalid, n_flagged=n_flagged,
+        entries=entries, n_earlier=len(entries) - len(now), n_ok=n_ok - n_flagged, n_failed=len(now) - n_ok - n_invalid, n_flagged=n_flagged,
         n_invalid=n_invalid, n_ok_cli=n_ok,
         filters=site_filter.options(entries),
         papers=site_papers(entries),
