@@ -23,6 +23,7 @@
     tables.forEach(t => t.classList.remove("stack"));
     // outermost first: a stacked table gives its inner tables the room to fit
     tables.forEach(t => {
+      if (t.offsetParent === null) return;  // in a closed section: measured when it opens
       const room = t.parentElement.clientWidth;
       if (t.scrollWidth > room + 1 || t.getBoundingClientRect().right > document.documentElement.clientWidth + 1) t.classList.add("stack");
     });
@@ -31,6 +32,15 @@
   fit();
   let timer = 0;
   addEventListener("resize", () => { clearTimeout(timer); timer = setTimeout(fit, 100); });
-  addEventListener("beforeprint", () => document.querySelectorAll("main table.stack").forEach(t => t.classList.remove("stack")));
-  addEventListener("afterprint", fit);
+  // printing shows everything: the collapsed sections open, the tables as tables
+  addEventListener("beforeprint", () => {
+    document.querySelectorAll("details.section").forEach(d => { if (!d.open) { d.open = true; d.dataset.printed = "1"; } });
+    document.querySelectorAll("main table.stack").forEach(t => t.classList.remove("stack"));
+  });
+  addEventListener("afterprint", () => {
+    document.querySelectorAll("details.section[data-printed]").forEach(d => { d.open = false; delete d.dataset.printed; });
+    fit();
+  });
+  // a section opened later holds tables that could not be measured while closed
+  document.querySelectorAll("details").forEach(d => d.addEventListener("toggle", fit));
 })();

@@ -6,7 +6,7 @@ import numpy as np
 
 from .. import realisable
 from ..study import Study, ratio_reference
-from . import citations, figures, labels, present, toc
+from . import citations, figures, labels, present, sections, toc
 from .design_card import design_card
 from .notation_table import notation_groups
 from .render import environment
@@ -141,7 +141,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                 "per_driver": ", ".join(f"{k} {v:.2g}" for k, v in sorted(q.tracking_error.items())),
             })
     rl = study.reactionless
-    return toc.add_toc(environment().get_template("spec.html").render(
+    return toc.add_toc(sections.collapse(environment().get_template("spec.html").render(
         r=results,
         paper=spec.paper,
         description=spec.description,
@@ -167,4 +167,4 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         verdict=results.get("verdict"),
         card=design_card(study, results),
         citation=citations.cite(spec.paper),
-    ))
+    )))
