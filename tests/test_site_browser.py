@@ -98,13 +98,15 @@ def server(site):
 
 @pytest.fixture(scope="module")
 def browser():
+    # CI installs Chromium and sets BALPIPE_REQUIRE_BROWSER: there a missing browser fails
+    missing = pytest.fail if os.environ.get("BALPIPE_REQUIRE_BROWSER") else pytest.skip
     try:
         from playwright.sync_api import sync_playwright
     except ImportError:
-        pytest.skip("playwright for Python is not installed: pip install '.[test]'")
+        missing("playwright for Python is not installed: pip install '.[test]'")
     exe = chromium()
     if exe is None:
-        pytest.skip("no Chromium found (/usr/bin/chromium, chromium on PATH, or BALPIPE_CHROMIUM)")
+        missing("no Chromium found (/usr/bin/chromium, chromium on PATH, or BALPIPE_CHROMIUM)")
     with sync_playwright() as p:
         b = p.chromium.launch(executable_path=exe)
         try:

@@ -6,7 +6,7 @@ import numpy as np
 
 from .. import realisable
 from ..study import Study, ratio_reference
-from . import citations, figures, labels, present, sections, toc
+from . import citations, figures, labels, paper_figures, present, sections, toc
 from .design_card import design_card
 from .notation_table import notation_groups
 from .render import environment
@@ -47,6 +47,7 @@ def study_figures(study: Study) -> dict:
         for k, s in enumerate(shown_stages(study))
     ]
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
+    extra += paper_figures.own_figures(study)  # the paper's panels as it numbers them
     residuals, drift = [], []
     vals = [s for s in shown_stages(study) if s.validation is not None]
     if vals:
@@ -141,12 +142,14 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                 "per_driver": ", ".join(f"{k} {v:.2g}" for k, v in sorted(q.tracking_error.items())),
             })
     rl = study.reactionless
+    drawn = study_figures(study)
     return toc.add_toc(sections.collapse(environment().get_template("spec.html").render(
         r=results,
         paper=spec.paper,
         description=spec.description,
         law=spec.motion.law,
-        figures=study_figures(study),
+        figures=drawn,
+        paper_figs=paper_figures.listed([title for title, _, _ in drawn["extra"]]) if spec.paper else [],
         validation=validation_rows,
         torque=torque_rows,
         reactionless={"base_mass": rl.base_mass, "base_inertia": rl.base_inertia, "rows": rl.rows(),
