@@ -131,3 +131,23 @@ def test_index_agrees_with_results_json_and_leads_with_it(tmp_path):
     row = html[html.index('data-spec="custom_four_bar_balancing"'):]
     row = row[:row.index("</tbody>")]
     assert "26.67" not in row and "67.33 → 0 (&lt; 1e-9 of unbalanced)" in row
+
+
+def test_methods_on_one_mechanism_side_by_side():
+    from balpipe.report.site import comparisons
+
+    def entry(title, method, *st):
+        r = results(*st)
+        r.update({"mechanism": "rpr3", "method": method, "comparison": {"rows": [
+            {"stage": s["name"], "counter_rotations": 3} for s in r["stages"]]}})
+        return {"title": title, "link": f"{title}/index.html", "results": r, "verdict": V.verdict(r)}
+
+    a = entry("idler", "idler_loop", stage("cr", "force+moment", f=1e-13, m=1e-13))
+    b = entry("legs", "scott_russell", stage("cr", "force+moment", f=1e-13, m=6.7))
+    c = entry("other", "idler_loop", stage("cw", "force", f=1e-13, m=2.0))
+    c["results"]["mechanism"] = "four_bar"  # one method only on its mechanism: no comparison
+    got = comparisons([a, b, c])
+    assert [g["template"] for g in got] == ["rpr3"]
+    rows = {r["title"]: r for r in got[0]["rows"]}
+    assert rows["idler"]["moment"] == "cancelled" and rows["legs"]["level"] == "bad"
+    assert rows["legs"]["moment"].startswith("worse") and rows["idler"]["counter_rotations"] == 3

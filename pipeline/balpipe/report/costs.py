@@ -45,7 +45,7 @@ def cost_factors(results: dict, reference: str, final: str) -> dict:
         out[f"{name}_driver"] = best[1] if best else ""
     rows = {r["stage"]: r for r in (results.get("comparison") or {}).get("rows") or []}
     r0, r1 = rows.get(reference), rows.get(final)
-    out["joint_load"] = _factor(r1 and r1["max_joint_load"], r0 and r0["max_joint_load"])
+    out["joint_load"] = _factor((r1 or {}).get("max_joint_load"), (r0 or {}).get("max_joint_load"))
     out["joint"] = (r1 or {}).get("max_joint_load_joint", "")
     return out
 

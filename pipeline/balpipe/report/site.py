@@ -174,11 +174,43 @@ def write_site(out: Path, outcomes: list) -> None:
         n_invalid=n_invalid, n_ok_cli=n_ok,
         filters=site_filter.options(entries),
         papers=site_papers(entries),
+        comparisons=comparisons(entries),
     )
     from ..build import write_file_atomic  # replaced in one step, never through a planted symlink
 
     write_file_atomic(out / "index.html", html)
     write_file_atomic(out / "site_nav.js", site_nav_script(entries))
+
+
+def comparisons(entries: list[dict]) -> list[dict]:
+    """The methods applied to one mechanism side by side: per template with specs of two or more
+    methods, one row per spec (its main design's final stage): verdict, added mass and inertia,
+    counter-rotations, residual |F| and |M| as ratios, and the cost factors."""
+    by: dict[str, list[dict]] = {}
+    for e in entries:
+        r = e.get("results")
+        if r and e.get("verdict") and e["verdict"].get("motions"):
+            by.setdefault(r.get("mechanism") or "", []).append(e)
+    out = []
+    for template, group in sorted(by.items()):
+        if len({e["results"].get("method") for e in group}) < 2:
+            continue
+        rows = []
+        for e in group:
+            r, v = e["results"], e["verdict"]
+            g = v["motions"][0]
+            comp = next((c for c in (r.get("comparison") or {}).get("rows") or [] if c["stage"] == g["final"]), {})
+            c = g["costs"]
+            rows.append({
+                "title": e["title"], "link": e["link"], "method": r.get("method"), "level": v["level"],
+                "words": v["words"], "added_mass": num(c["added_mass"]),
+                "added_inertia": num(c["added_inertia"]) if c["added_inertia"] is not None else "cannot be built",
+                "counter_rotations": comp.get("counter_rotations", "—"),
+                "force": v["stages"][g["final"]]["force"]["text"], "moment": v["stages"][g["final"]]["moment"]["text"],
+                "effort": factor_text(c["effort"]), "joint_load": factor_text(c["joint_load"]),
+            })
+        out.append({"template": template, "rows": rows})
+    return out
 
 
 def site_papers(entries: list[dict]) -> list[dict]:
