@@ -19,7 +19,7 @@
     }
   }
   function fit() {
-    const tables = Array.from(document.querySelectorAll("main table"));
+    const tables = Array.from(document.querySelectorAll("main table:not(.u-legend)"));
     tables.forEach(t => t.classList.remove("stack"));
     // outermost first: a stacked table gives its inner tables the room to fit
     tables.forEach(t => {
@@ -28,7 +28,7 @@
       if (t.scrollWidth > room + 1 || t.getBoundingClientRect().right > document.documentElement.clientWidth + 1) t.classList.add("stack");
     });
   }
-  document.querySelectorAll("main table").forEach(label);
+  document.querySelectorAll("main table:not(.u-legend)").forEach(label);
   fit();
   let timer = 0;
   addEventListener("resize", () => { clearTimeout(timer); timer = setTimeout(fit, 100); });

@@ -169,6 +169,8 @@ def test_every_page_and_asset_loads_from_a_subfolder(site, server, browser):
 def check_figures_and_anchors(page, url: str) -> None:
     """Every figure is visible with a real size, and every in-page link (the table of contents)
     names an element of the page."""
+    page.evaluate("document.querySelectorAll('details').forEach(d => d.open = true)")  # collapsed sections
+    page.wait_for_timeout(50)
     figs = page.locator("figure")
     for k in range(figs.count()):
         f = figs.nth(k)
@@ -209,10 +211,17 @@ def test_study_pages_have_contents_and_links_between_studies(server, browser):
     assert not w.problems, "\n".join(w.problems)
 
 
+def open_sections(page) -> None:
+    """Open the page's collapsed sections, as a reader does to reach the player."""
+    page.evaluate("document.querySelectorAll('details').forEach(d => d.open = true)")
+    page.wait_for_timeout(50)
+
+
 def test_player_pauses_scrubs_and_answers_the_keyboard(server, browser):
     w = Watched(browser)
     p = w.page
     p.goto(server + "scott_russell/index.html", wait_until="load")
+    open_sections(p)
     p.locator("#player").scroll_into_view_if_needed()
     p.wait_for_timeout(300)
     assert p.get_attribute("#player", "data-playing") == "1"  # plays by default, in real time
@@ -254,6 +263,7 @@ def test_player_names_its_parts_and_shows_a_scale_bar_per_panel(server, browser)
     w = Watched(browser)
     p = w.page
     p.goto(server + "scott_russell/index.html", wait_until="load")
+    open_sections(p)
     p.click("#player-play")  # pause
     p.eval_on_selector("#player-time", "s => { s.value = '300'; s.dispatchEvent(new Event('input')); }")
     named = p.eval_on_selector("#player", "c => Object.keys(c.dataset).filter(k => k.startsWith('names')).map(k => +c.dataset[k])")
@@ -467,4 +477,29 @@ def test_index_verdicts_agree_with_results_json(paper_site, browser):
     for slug, level, words in shown:
         v = json.loads((paper_site / slug / "results.json").read_text(encoding="utf-8"))["verdict"]
         assert (level, words) == (v["level"], v["words"]), slug
+    assert not w.problems, "\n".join(w.problems)
+
+
+def test_hovering_a_plot_shows_its_values_and_a_click_hides_a_curve(paper_site, browser):
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto((paper_site / "paper002_decoupling" / "index.html").as_uri(), wait_until="load")
+    plot = p.locator("#live-loads .live-plot").first
+    plot.scroll_into_view_if_needed()
+    over = plot.locator(".u-over")
+    box = over.bounding_box()
+    assert box and box["width"] > 200, "no interactive plot drawn"
+    values = "el => [...el.querySelectorAll('.u-legend .u-series .u-value')].map(v => v.textContent)"
+    p.mouse.move(box["x"] + box["width"] * 0.4, box["y"] + box["height"] * 0.5)
+    shown = plot.evaluate(values)
+    assert shown and all(re.search(r"\d", v) for v in shown), shown  # time and every curve's value
+    # a click on a legend entry hides its curve
+    entry = plot.locator(".u-legend .u-series").nth(1)
+    entry.click()
+    assert "u-off" in (entry.get_attribute("class") or "")
+    # the static figure stays for printing; on screen the live plot replaces it
+    assert not p.is_visible("#live-loads + .static-plot svg")
+    p.emulate_media(media="print")
+    assert p.is_visible("#live-loads + .static-plot svg") and not p.is_visible("#live-loads")
     assert not w.problems, "\n".join(w.problems)

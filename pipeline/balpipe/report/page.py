@@ -6,7 +6,7 @@ import numpy as np
 
 from .. import realisable
 from ..study import Study, ratio_reference
-from . import citations, figures, labels, paper_figures, present, sections, toc
+from . import citations, figures, labels, live_plots, paper_figures, present, sections, toc
 from .design_card import design_card
 from .notation_table import notation_groups
 from .render import environment
@@ -68,7 +68,8 @@ def study_figures(study: Study) -> dict:
             + travel_text(runs[0]) + ".",
         ))
     key = "; ".join(f"{figures.style_text(k)}: {s.stage.label}" for k, s in enumerate(shown_stages(study)))
-    return {"loads": loads, "loads_key": key[:1].upper() + key[1:], "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
+    live = live_plots.as_script(live_plots.loads_data([(s.stage.label, s.analysis) for s in shown_stages(study)]))
+    return {"loads": loads, "live_loads": live, "loads_key": key[:1].upper() + key[1:], "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
