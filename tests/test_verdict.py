@@ -151,3 +151,12 @@ def test_methods_on_one_mechanism_side_by_side():
     rows = {r["title"]: r for r in got[0]["rows"]}
     assert rows["idler"]["moment"] == "cancelled" and rows["legs"]["level"] == "bad"
     assert rows["legs"]["moment"].startswith("worse") and rows["idler"]["counter_rotations"] == 3
+
+
+def test_a_spec_without_balancing_stages_has_a_neutral_verdict_and_an_index_row():
+    from balpipe.report.site import headline
+
+    v = V.verdict(results())
+    assert v["level"] == "neutral" and v["motions"] == []
+    h = headline(v, 1e-9)
+    assert h["force"] == "—" and h["costs"] == [] and h["realisable"]

@@ -78,7 +78,7 @@ def headline(v: dict, tol: float | None) -> dict:
     spec with several motions shows the range over them."""
     ms = v.get("motions") or []
     if not ms:
-        return {"force": "—", "moment": "—", "weight": "", "motions": 0, "rows": []}
+        return {"force": "—", "moment": "—", "weight": "", "motions": 0, "rows": [], "costs": [], "realisable": True}
 
     def after(g: dict, key: str) -> str:
         out = v["stages"][g["final"]][key]
