@@ -37,3 +37,23 @@ def test_each_papers_pages_reproduce_its_figures(paper):
         found |= set(PF.listed(titles))
     missing = [n for n in PF.FIGURES[paper] if not PF.covered(n, sorted(found))]
     assert not missing, f"paper {paper}: figures {missing} not on its pages (found {sorted(found)})"
+
+
+def test_the_papers_panels_keep_the_pages_stage_styles():
+    """Fig. 12 of paper 004 draws the force-balanced stage in that stage's style of the page (one
+    legend per page), not in the first style."""
+    from balpipe.report.page import render_page
+    from balpipe.report.results import results_dict
+
+    study = run(load(SPECS / "paper004_five_bar.yaml").spec)
+    force_only = next(s for s in study.stages if s.stage.balances == "force" and ":" not in s.stage.name)
+    k = PF._k(study, force_only)
+    assert k > 0 and study.stages[k] is force_only
+    title, svg, _ = next(f for f in PF.own_figures(study) if f[0].startswith("Fig. 12"))
+    a2 = force_only.analysis
+    mine = PF._series(a2.t, [(force_only.stage.label, a2.moment, k)], "M (N m)", "p004fig12")
+    first = PF._series(a2.t, [(force_only.stage.label, a2.moment, 0)], "M (N m)", "p004fig12")
+    assert svg == mine and svg != first
+    html = render_page(study, results_dict(study, "x", "h", False), "")
+    assert html.count('id="style-legend"') == 1
+    assert 'data-figures="' in html and "10a 10b 11 12" in html

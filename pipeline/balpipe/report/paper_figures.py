@@ -59,6 +59,25 @@ def listed(titles: list[str]) -> list[str]:
     return sorted(nums, key=lambda n: (int(re.match(r"\d+", n).group()), n))
 
 
+def _series(t, curves: list[tuple[str, np.ndarray, int]], ylabel: str, prefix: str) -> str:
+    """A time series in the page's stage styles: each curve (label, values, k) drawn in
+    ``figures.style(k)``, k the stage's place in the page's stage table, so that one line style
+    means one stage on the whole page."""
+    fig, ax = figures.plt.subplots(figsize=(6.0, 3.0))
+    for label, y, k in curves:
+        ax.plot(t, y, label=figures.literal(label), **figures.style(k))
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel(ylabel)
+    figures.legend_below(fig, ax, fontsize=8)
+    return figures.to_svg(fig, prefix)
+
+
+def _k(study, stage) -> int:
+    """The stage's style index: its place among the stages of its motion (the page's order)."""
+    group = [s for s in study.stages if s.stage.group == stage.stage.group]
+    return next(i for i, s in enumerate(group) if s is stage)
+
+
 def paper_id(study) -> str:
     return (study.spec.paper or "").split(":", 1)[0].strip()
 
@@ -76,12 +95,14 @@ def own_figures(study) -> list[tuple[str, str, str]]:
 
 
 def _paper002(study) -> list[tuple[str, str, str]]:
-    an = study.unbalanced.analysis
-    svg = figures.series_figure(an.t, [("shaking force |F| (N)", np.hypot(an.force[:, 0], an.force[:, 1])),
-                                       ("shaking moment M (N m)", an.moment)], "N, N m", prefix="p002fig2")
-    return [("Fig. 2 of paper 002: shaking force and moment of the unbalanced manipulator", svg,
-             "The unbalanced manipulator (stage '" + study.unbalanced.stage.label + "'): |F| including the links' "
-             "weight when gravity is on, M about the base joint, from the analysis of this spec.")]
+    un = study.unbalanced
+    an, k = un.analysis, _k(study, un)
+    f = _series(an.t, [(un.stage.label, np.hypot(an.force[:, 0], an.force[:, 1]), k)], "|F| (N)", "p002fig2f")
+    m = _series(an.t, [(un.stage.label, an.moment, k)], "M (N m)", "p002fig2m")
+    cap = ("The unbalanced manipulator (stage '" + un.stage.label + "', in its line style of this page): |F| including "
+           "the links' weight when gravity is on, M about the base joint, from the analysis of this spec.")
+    return [("Fig. 2 of paper 002: shaking force of the unbalanced manipulator", f, cap),
+            ("Fig. 2 of paper 002: shaking moment of the unbalanced manipulator", m, cap)]
 
 
 def _paper003(study) -> list[tuple[str, str, str]]:
@@ -91,10 +112,10 @@ def _paper003(study) -> list[tuple[str, str, str]]:
         return []
     t = stages[0].analysis.t
     label = [s.stage.label.split(" · ")[-1] for s in stages]
-    f = figures.series_figure(t, [(lab, np.hypot(s.analysis.force[:, 0], s.analysis.force[:, 1]))
-                                  for lab, s in zip(label, stages)], "|F| (N)", prefix="p003fig3")
-    m = figures.series_figure(t, [(lab, s.analysis.moment) for lab, s in zip(label, stages)], "M (N m)",
-                              prefix="p003fig4")
+    f = _series(t, [(lab, np.hypot(s.analysis.force[:, 0], s.analysis.force[:, 1]), k)
+                    for k, (lab, s) in enumerate(zip(label, stages))], "|F| (N)", "p003fig3")
+    m = _series(t, [(lab, s.analysis.moment, k) for k, (lab, s) in enumerate(zip(label, stages))], "M (N m)",
+                "p003fig4")
     cap = (f"Trajectory {PAPER_003_TRAJECTORY}, the one the paper's figures show; the four cases in the page's "
            "stage styles (the legend under the plot). Computed by the engine from this spec.")
     return [(f"Fig. 3 of paper 003: shaking force, trajectory {PAPER_003_TRAJECTORY}", f, cap),
@@ -105,22 +126,22 @@ def _paper004(study) -> list[tuple[str, str, str]]:
     un = study.unbalanced
     an = un.analysis
     force_only = next((s for s in study.stages if s.stage.balances == "force" and ":" not in s.stage.name), None)
+    k0 = _k(study, un)
     out = [
         ("Fig. 10a of paper 004: shaking force along x (N)",
-         figures.series_figure(an.t, [("F_x, " + un.stage.label, an.force[:, 0])], "F_x (N)", prefix="p004fig10a"),
+         _series(an.t, [(un.stage.label, an.force[:, 0], k0)], "F_x (N)", "p004fig10a"),
          "The unbalanced manipulator, from the analysis of this spec."),
         ("Fig. 10b of paper 004: shaking force along y (N)",
-         figures.series_figure(an.t, [("F_y, " + un.stage.label, an.force[:, 1])], "F_y (N)", prefix="p004fig10b"),
+         _series(an.t, [(un.stage.label, an.force[:, 1], k0)], "F_y (N)", "p004fig10b"),
          "The unbalanced manipulator, from the analysis of this spec."),
         ("Fig. 11 of paper 004: shaking moment (N m)",
-         figures.series_figure(an.t, [("M, " + un.stage.label, an.moment)], "M (N m)", prefix="p004fig11"),
+         _series(an.t, [(un.stage.label, an.moment, k0)], "M (N m)", "p004fig11"),
          "The unbalanced manipulator, about the moment point of the spec."),
     ]
     if force_only is not None:
         a2 = force_only.analysis
         out.append(("Fig. 12 of paper 004: shaking moment after shaking force balancing (N m)",
-                    figures.series_figure(a2.t, [("M, " + force_only.stage.label, a2.moment)], "M (N m)",
-                                          prefix="p004fig12"),
-                    f"Stage '{force_only.stage.label}' (force balanced by counterweights): the moment grows, "
-                    "as the paper says."))
+                    _series(a2.t, [(force_only.stage.label, a2.moment, _k(study, force_only))], "M (N m)", "p004fig12"),
+                    f"Stage '{force_only.stage.label}' (force balanced by counterweights), in its line style of this "
+                    "page: the moment grows, as the paper says."))
     return out
