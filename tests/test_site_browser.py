@@ -383,6 +383,12 @@ def paper_site(tmp_path_factory) -> Path:
     specs = Path(__file__).resolve().parents[1] / "specs"
     outcomes = build([str(specs / s) for s in PAPER_SPECS], Options(out=out, simulate=False))
     assert all(o.status == "ok" for o in outcomes), [o.message for o in outcomes]
+    # and a diff page beside them (balpipe diff -f html), a page of the site as well
+    new = out.parent / "heavier.yaml"
+    new.write_text((specs / "offset_slider_crank.yaml").read_text().replace("{mass: 600 g}", "{mass: 700 g}"))
+    r = subprocess.run([sys.executable, "-m", "balpipe", "diff", str(specs / "offset_slider_crank.yaml"), str(new),
+                        "--no-sim", "-f", "html", "-o", str(out / "diff.html")], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
     return out
 
 

@@ -132,7 +132,8 @@ def _costs(results: dict, first: dict, last: dict) -> dict:
             "moment": ratio(s.get("moment_ratio"), tol), "force": ratio(s.get("force_ratio"), tol),
         })
     mm = results.get("moving_mass") or 0.0
-    added = f"{num(last['added_mass'])} kg" + (f" ({ratio(last['added_mass'] / mm)} of {num(mm)} kg)" if mm else "")
+    # relative to the moving mass: the "moving mass ×" factor beside it (one format per column)
+    added = f"{num(last['added_mass'])} kg" + (f" on {num(mm)} kg" if mm else "")
     acts = results.get("actuators") or []
     efforts = []
     for a0 in [a for a in acts if a["stage"] == first["name"]]:
