@@ -99,3 +99,14 @@ def test_diff_leads_with_the_results(tmp_path):
     new.write_text(replaced(old.read_text(), "{mass: 600 g}", "{mass: 700 g}"))
     text = balpipe("diff", old, new, "--no-sim").stdout
     assert text.index("Stages:") < text.index("Computed parameters") < text.index("Inputs:")
+
+
+def test_diff_page_opens_with_the_headline_changes(tmp_path):
+    old = ROOT / "specs" / "offset_slider_crank.yaml"
+    new = tmp_path / "new.yaml"
+    new.write_text(replaced(old.read_text(), "{mass: 600 g}", "{mass: 700 g}"))
+    out = tmp_path / "d.html"
+    assert balpipe("diff", old, new, "--no-sim", "-f", "html", "-o", out).returncode == 0
+    html = out.read_text()
+    head = html[html.index('id="headline"'):html.index("<h2>")]
+    assert "What changed" in head and "counterweights: peak |M| (N m) 78.0642 &rarr; <strong>85.57</strong>" in head

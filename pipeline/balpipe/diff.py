@@ -247,6 +247,14 @@ def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
     return sections
 
 
+def headline(sections: list) -> list[list[str]]:
+    """The headline changes: the peak |F| and |M| rows of the stages, last stage first (the
+    balanced design's before the unbalanced one's)."""
+    rows = next((r for title, r, _ in sections if title == "Stages"), [])
+    keys = (STAGE_NAMES["max_shaking_force"], STAGE_NAMES["max_shaking_moment"])
+    return [r for r in reversed(rows) if r[1] in keys][:4]
+
+
 def to_text(data: dict) -> str:
     out = [f"balpipe diff: {data['old']} ({data['status']['old']}) -> {data['new']} ({data['status']['new']})"]
     for title, rows, header in _rows(data):
@@ -298,8 +306,9 @@ def to_html(data: dict, a: Side, b: Side, site: str = "") -> str:
             note = " and ".join(w for w, q in (("force", qf), ("moment", qm)) if q)
             figs.append((sa.stage.label, overlay_figure(sa.analysis, sb.analysis, prefix=f"diff{k}",
                                                         round_off=(qf, qm), scale=scale), note))
-    return environment().get_template("diff.html").render(d=data, sections=_rows(data), figures=figs, site=site,
-                                                          round_off=ROUND_OFF)
+    sections = _rows(data)
+    return environment().get_template("diff.html").render(d=data, sections=sections, figures=figs, site=site,
+                                                          round_off=ROUND_OFF, headline=headline(sections))
 
 
 RENDERERS = {"text": to_text, "markdown": to_markdown, "json": to_json}
