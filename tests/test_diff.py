@@ -80,3 +80,33 @@ def test_diff_with_simulation_reports_residual_changes(tmp_path):
     assert "pymunk validation passed" in stages and "residual" not in stages.split("Stages:")[1]
     assert "pymunk force residual" in sim
     assert d["status"] == {"old": "ok", "new": "failed"}
+
+
+def test_round_off_is_never_a_change():
+    from balpipe.diff import same
+
+    assert same(0.1, 0.1 + 1.39e-16) and same(0.0, 1.39e-16) and same(263.2, 263.2 * (1 + 1e-12))
+    assert not same(0.1, 0.12) and not same(0.0, 1e-6) and not same(None, 0.0) and not same(True, False)
+    assert not same(1e-3, 1e-3 + 1e-11)  # a real change of a small quantity is still a change
+
+
+def test_diff_leads_with_the_results(tmp_path):
+    old = ROOT / "specs" / "offset_slider_crank.yaml"
+    new = tmp_path / "new.yaml"
+    new.write_text(replaced(old.read_text(), "coupler_counterweight: -0.15 m", "coupler_counterweight: -0.15000000000000002 m"))
+    text = balpipe("diff", old, new, "--no-sim").stdout
+    assert "Inputs: no change" in text and "Stages: no change" in text  # round-off of an input: no change
+    new.write_text(replaced(old.read_text(), "{mass: 600 g}", "{mass: 700 g}"))
+    text = balpipe("diff", old, new, "--no-sim").stdout
+    assert text.index("Stages:") < text.index("Computed parameters") < text.index("Inputs:")
+
+
+def test_diff_page_opens_with_the_headline_changes(tmp_path):
+    old = ROOT / "specs" / "offset_slider_crank.yaml"
+    new = tmp_path / "new.yaml"
+    new.write_text(replaced(old.read_text(), "{mass: 600 g}", "{mass: 700 g}"))
+    out = tmp_path / "d.html"
+    assert balpipe("diff", old, new, "--no-sim", "-f", "html", "-o", out).returncode == 0
+    html = out.read_text()
+    head = html[html.index('id="headline"'):html.index("<h2>")]
+    assert "What changed" in head and "counterweights: peak |M| (N m) 78.0642 &rarr; <strong>85.57</strong>" in head

@@ -98,13 +98,15 @@ def server(site):
 
 @pytest.fixture(scope="module")
 def browser():
+    # CI installs Chromium and sets BALPIPE_REQUIRE_BROWSER: there a missing browser fails
+    missing = pytest.fail if os.environ.get("BALPIPE_REQUIRE_BROWSER") else pytest.skip
     try:
         from playwright.sync_api import sync_playwright
     except ImportError:
-        pytest.skip("playwright for Python is not installed: pip install '.[test]'")
+        missing("playwright for Python is not installed: pip install '.[test]'")
     exe = chromium()
     if exe is None:
-        pytest.skip("no Chromium found (/usr/bin/chromium, chromium on PATH, or BALPIPE_CHROMIUM)")
+        missing("no Chromium found (/usr/bin/chromium, chromium on PATH, or BALPIPE_CHROMIUM)")
     with sync_playwright() as p:
         b = p.chromium.launch(executable_path=exe)
         try:
@@ -167,6 +169,8 @@ def test_every_page_and_asset_loads_from_a_subfolder(site, server, browser):
 def check_figures_and_anchors(page, url: str) -> None:
     """Every figure is visible with a real size, and every in-page link (the table of contents)
     names an element of the page."""
+    page.evaluate("document.querySelectorAll('details').forEach(d => d.open = true)")  # collapsed sections
+    page.wait_for_timeout(50)
     figs = page.locator("figure")
     for k in range(figs.count()):
         f = figs.nth(k)
@@ -207,10 +211,17 @@ def test_study_pages_have_contents_and_links_between_studies(server, browser):
     assert not w.problems, "\n".join(w.problems)
 
 
+def open_sections(page) -> None:
+    """Open the page's collapsed sections, as a reader does to reach the player."""
+    page.evaluate("document.querySelectorAll('details').forEach(d => d.open = true)")
+    page.wait_for_timeout(50)
+
+
 def test_player_pauses_scrubs_and_answers_the_keyboard(server, browser):
     w = Watched(browser)
     p = w.page
     p.goto(server + "scott_russell/index.html", wait_until="load")
+    open_sections(p)
     p.locator("#player").scroll_into_view_if_needed()
     p.wait_for_timeout(300)
     assert p.get_attribute("#player", "data-playing") == "1"  # plays by default, in real time
@@ -252,6 +263,7 @@ def test_player_names_its_parts_and_shows_a_scale_bar_per_panel(server, browser)
     w = Watched(browser)
     p = w.page
     p.goto(server + "scott_russell/index.html", wait_until="load")
+    open_sections(p)
     p.click("#player-play")  # pause
     p.eval_on_selector("#player-time", "s => { s.value = '300'; s.dispatchEvent(new Event('input')); }")
     named = p.eval_on_selector("#player", "c => Object.keys(c.dataset).filter(k => k.startsWith('names')).map(k => +c.dataset[k])")
@@ -353,3 +365,147 @@ def test_the_watcher_sees_a_missing_asset_and_a_script_error(site, server, brows
     w.page.goto(server.replace(SUBFOLDER + "/", "probe/page.html"), wait_until="load")
     assert any(p.startswith("HTTP 404") and p.endswith("/probe/missing.js") for p in w.problems), w.problems
     assert any("undefinedFunction" in p for p in w.problems), w.problems
+
+
+# ------------------------------------------------------------------------------------------
+# Layout (issue 22): every built page at 400 px and 1400 px
+
+
+PAPER_SPECS = ("custom_four_bar_balancing.yaml", "paper000_rpr3_scott_russell.yaml", "paper002_decoupling.yaml")
+SCREENS = 12  # a page is at most this many screens long at 1400 px with its sections collapsed
+MAX_BYTES = 2_000_000  # and weighs less than this (the page with everything it loads)
+
+
+@pytest.fixture(scope="module")
+def paper_site(tmp_path_factory) -> Path:
+    """Three paper and custom specs built without simulation (their pages are the longest)."""
+    out = tmp_path_factory.mktemp("papers") / "site"
+    specs = Path(__file__).resolve().parents[1] / "specs"
+    outcomes = build([str(specs / s) for s in PAPER_SPECS], Options(out=out, simulate=False))
+    assert all(o.status == "ok" for o in outcomes), [o.message for o in outcomes]
+    # and a diff page beside them (balpipe diff -f html), a page of the site as well
+    new = out.parent / "heavier.yaml"
+    new.write_text((specs / "offset_slider_crank.yaml").read_text().replace("{mass: 600 g}", "{mass: 700 g}"))
+    r = subprocess.run([sys.executable, "-m", "balpipe", "diff", str(specs / "offset_slider_crank.yaml"), str(new),
+                        "--no-sim", "-f", "html", "-o", str(out / "diff.html")], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    return out
+
+
+# Elements whose content spills out of their box: clipped (overflow hidden/auto) or drawn over
+# their neighbours (overflow visible). Measured from the laid-out boxes.
+_SPILLS = """() => {
+  const out = [];
+  const vw = document.documentElement.clientWidth;
+  for (const el of document.querySelectorAll(
+      'main td, main th, main p, main li, main dd, main dt, main h1, main h2, main h3, main summary, main figcaption, header.top, main span.badge, main code, main pre')) {
+    const r = el.getBoundingClientRect();
+    if (!r.width || !r.height || el.offsetParent === null) continue;
+    const text = (el.textContent || '').trim().slice(0, 60);
+    if (r.right > vw + 1 || r.left < -1) out.push(`outside the window (${Math.round(r.left)}..${Math.round(r.right)} of ${vw} px): ${el.tagName} "${text}"`);
+    const cs = getComputedStyle(el);
+    if (cs.display === 'inline') continue;
+    if (el.scrollWidth > el.clientWidth + 1) out.push(`spills ${el.scrollWidth - el.clientWidth} px (overflow ${cs.overflowX}): ${el.tagName} "${text}"`);
+  }
+  // cells of one row never overlap
+  for (const tr of document.querySelectorAll('main tr')) {
+    const cells = [...tr.cells].map(c => c.getBoundingClientRect()).filter(r => r.width && r.height);
+    for (let i = 1; i < cells.length; i++) {
+      const a = cells[i - 1], b = cells[i];
+      const overlapX = Math.min(a.right, b.right) - Math.max(a.left, b.left);
+      const overlapY = Math.min(a.bottom, b.bottom) - Math.max(a.top, b.top);
+      if (overlapX > 1 && overlapY > 1) out.push(`cells overlap in a row: "${(tr.textContent || '').trim().slice(0, 60)}"`);
+    }
+  }
+  return out;
+}"""
+
+
+def _pages(root: Path) -> list[Path]:
+    return sorted(p for p in root.rglob("*.html") if "probe" not in p.parts)
+
+
+def _weight(page: Path) -> int:
+    """Bytes of a page and the local files it loads (scripts, styles, images)."""
+    parser = _Links()
+    parser.feed(page.read_text(encoding="utf-8"))
+    total = page.stat().st_size
+    for url in parser.urls:
+        if url.endswith((".js", ".css", ".png", ".svg")) and not url.startswith(("data:", "#")):
+            f = Path(urljoin(page.as_posix(), urlsplit(url).path))
+            total += f.stat().st_size if f.exists() else 0
+    return total
+
+
+@pytest.mark.parametrize("width", [400, 1400])
+def test_every_page_fits_the_window_with_nothing_clipped(site, paper_site, browser, width):
+    tops = [site / SUBFOLDER, paper_site]
+    problems = []
+    ctx = browser.new_context(viewport={"width": width, "height": 900})
+    try:
+        for top in tops:
+            for page_file in _pages(top):
+                w = Watched(ctx)
+                p = w.page
+                url = page_file.as_uri()  # from file://, as a reader opens a downloaded site
+                p.goto(url, wait_until="load")
+                p.wait_for_timeout(100)
+                if width == 1400 and page_file.name == "index.html" and page_file.parent != top:
+                    height = p.evaluate("document.documentElement.scrollHeight")
+                    if height > SCREENS * 900:
+                        problems.append(f"{url}: {height} px long with its sections collapsed (> {SCREENS} screens)")
+                p.evaluate("document.querySelectorAll('details').forEach(d => d.open = true)")
+                p.wait_for_timeout(150)
+                sw, cw = p.evaluate("[document.documentElement.scrollWidth, document.documentElement.clientWidth]")
+                if sw > cw + 1:
+                    problems.append(f"{url}: scrolls sideways ({sw} > {cw} px)")
+                problems += [f"{url}: {s}" for s in p.evaluate(_SPILLS)]
+                problems += w.problems
+                p.close()
+    finally:
+        ctx.close()
+    assert not problems, f"{len(problems)} problems at {width} px:\n" + "\n".join(problems[:40])
+
+
+def test_every_page_weighs_less_than_2_mb(site, paper_site):
+    heavy = [(p, _weight(p)) for top in (site / SUBFOLDER, paper_site) for p in _pages(top)]
+    assert heavy and all(n < MAX_BYTES for _, n in heavy), [(str(p), n) for p, n in heavy if n >= MAX_BYTES]
+
+
+def test_index_verdicts_agree_with_results_json(paper_site, browser):
+    import json
+
+    w = Watched(browser)
+    w.page.goto((paper_site / "index.html").as_uri(), wait_until="load")
+    shown = w.page.eval_on_selector_all(
+        "#studies tbody.entry", "els => els.map(e => [e.dataset.spec, e.dataset.verdict, e.querySelector('.verdict .badge').textContent])")
+    assert len(shown) == len(PAPER_SPECS)
+    for slug, level, words in shown:
+        v = json.loads((paper_site / slug / "results.json").read_text(encoding="utf-8"))["verdict"]
+        assert (level, words) == (v["level"], v["words"]), slug
+    assert not w.problems, "\n".join(w.problems)
+
+
+def test_hovering_a_plot_shows_its_values_and_a_click_hides_a_curve(paper_site, browser):
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto((paper_site / "paper002_decoupling" / "index.html").as_uri(), wait_until="load")
+    plot = p.locator("#live-loads .live-plot").first
+    plot.scroll_into_view_if_needed()
+    over = plot.locator(".u-over")
+    box = over.bounding_box()
+    assert box and box["width"] > 200, "no interactive plot drawn"
+    values = "el => [...el.querySelectorAll('.u-legend .u-series .u-value')].map(v => v.textContent)"
+    p.mouse.move(box["x"] + box["width"] * 0.4, box["y"] + box["height"] * 0.5)
+    shown = plot.evaluate(values)
+    assert shown and all(re.search(r"\d", v) for v in shown), shown  # time and every curve's value
+    # a click on a legend entry hides its curve
+    entry = plot.locator(".u-legend .u-series").nth(1)
+    entry.click()
+    assert "u-off" in (entry.get_attribute("class") or "")
+    # the static figure stays for printing; on screen the live plot replaces it
+    assert not p.is_visible("#live-loads + .static-plot svg")
+    p.emulate_media(media="print")
+    assert p.is_visible("#live-loads + .static-plot svg") and not p.is_visible("#live-loads")
+    assert not w.problems, "\n".join(w.problems)

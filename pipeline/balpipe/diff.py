@@ -80,6 +80,18 @@ def _flatten(obj: Any, prefix: str = "") -> dict[str, Any]:
     return out
 
 
+def same(old: Any, new: Any) -> bool:
+    """Equal, or two numbers that differ by round-off only (1e-9 relative, 1e-12 absolute in SI):
+    round-off never counts as a change."""
+    if old == new:
+        return True
+    if isinstance(old, bool) or isinstance(new, bool):
+        return False
+    if isinstance(old, (int, float)) and isinstance(new, (int, float)) and math.isfinite(old) and math.isfinite(new):
+        return abs(new - old) <= max(1e-12, ROUND_OFF * max(abs(old), abs(new)))
+    return False
+
+
 def _change(old: float | None, new: float | None) -> dict:
     d: dict[str, Any] = {"old": old, "new": new}
     if isinstance(old, (int, float)) and isinstance(new, (int, float)):
@@ -118,7 +130,7 @@ def compare(a: Side, b: Side) -> dict:
     units = _input_units(a) | _input_units(b)
     inputs = [
         {"field": k, "old": ia.get(k), "new": ib.get(k), "unit": units.get(k, "")}
-        for k in sorted(set(ia) | set(ib)) if ia.get(k) != ib.get(k)
+        for k in sorted(set(ia) | set(ib)) if not same(ia.get(k), ib.get(k))
     ]
     pa = {p.name: p for p in a.study.balance.parameters}
     pb = {p.name: p for p in b.study.balance.parameters}
@@ -152,14 +164,15 @@ def compare(a: Side, b: Side) -> dict:
          "old": ra.get(n, {}).get("computed"), "new": rb.get(n, {}).get("computed"),
          "old_status": ra.get(n, {}).get("status"), "new_status": rb.get(n, {}).get("status")}
         for n in list(ra) + [n for n in rb if n not in ra]
-        if ra.get(n, {}).get("computed") != rb.get(n, {}).get("computed") or ra.get(n, {}).get("status") != rb.get(n, {}).get("status")
+        if not same(ra.get(n, {}).get("computed"), rb.get(n, {}).get("computed"))
+        or ra.get(n, {}).get("status") != rb.get(n, {}).get("status")
     ]
     return _clean({
         "old": a.ref, "new": b.ref,
         "old_spec": a.loaded.spec.name, "new_spec": b.loaded.spec.name,
         "status": {"old": "ok" if a.study.ok else "failed", "new": "ok" if b.study.ok else "failed"},
         "inputs": inputs,
-        "parameters": [p for p in params if p["old"] != p["new"]],
+        "parameters": [p for p in params if not same(p["old"], p["new"])],
         "stages": stages,
         "references": refs,
     })
@@ -185,12 +198,9 @@ def _rel(d: dict) -> str:
 
 
 def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
-    """Sections as (title, rows, header) for the text and Markdown renderers."""
+    """Sections as (title, rows, header) for the text and Markdown renderers: the results (stages,
+    references, computed parameters) first, the inputs last."""
     sections = []
-    sections.append(("Inputs", [[d["field"], _fmt(d["old"]), _fmt(d["new"]), d.get("unit", "")] for d in data["inputs"]],
-                     ["field", "old", "new", "unit (SI)"]))
-    sections.append(("Computed parameters", [[p["name"], _fmt(p["old"]), _fmt(p["new"]), _rel(p), p["unit"]] for p in data["parameters"]],
-                     ["parameter", "old", "new", "change", "unit"]))
     rows: list[list[str]] = []
     sim: list[list[str]] = []
     for s in data["stages"]:
@@ -201,7 +211,7 @@ def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
         }
         for key in STAGE_KEYS:
             d = s[key]
-            if d["old"] == d["new"] or any(quiet[w] and w in key for w in quiet):
+            if same(d["old"], d["new"]) or any(quiet[w] and w in key for w in quiet):
                 continue
             rows.append([s["name"], STAGE_NAMES.get(key, key), _fmt(d["old"]), _fmt(d["new"]), _rel(d)])
         v = s.get("validation")
@@ -209,7 +219,7 @@ def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
             # the simulation's residuals are numerical noise, not a design change: their own section
             for key in ("force_residual", "moment_residual"):
                 d = v[key]
-                if d["old"] != d["new"]:
+                if not same(d["old"], d["new"]):
                     sim.append([s["name"], f"pymunk {key.replace('_', ' ')} (vs reference load)", _fmt(d["old"]),
                                 _fmt(d["new"]), _rel(d)])
             if v["passed"]["old"] != v["passed"]["new"]:
@@ -218,9 +228,22 @@ def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
     if sim:
         sections.append(("Simulation residuals (numerical, not a design change)", sim,
                          ["stage", "residual", "old", "new", "change"]))
-    sections.append(("References", [[r["name"], _fmt(r["published"]), _fmt(r["old"]), _fmt(r["new"]), f"{r['old_status']} -> {r['new_status']}"] for r in data["references"]],
+    sections.append(("References", [[r["name"], _fmt(r["published"]), _fmt(r["old"]), _fmt(r["new"]), f"{_fmt(r['old_status'])} -> {_fmt(r['new_status'])}"] for r in data["references"]],
                      ["reference", "published", "old", "new", "status"]))
+    # the results first (what changed), then what was changed to get there
+    sections.append(("Computed parameters", [[p["name"], _fmt(p["old"]), _fmt(p["new"]), _rel(p), p["unit"]] for p in data["parameters"]],
+                     ["parameter", "old", "new", "change", "unit"]))
+    sections.append(("Inputs", [[d["field"], _fmt(d["old"]), _fmt(d["new"]), d.get("unit", "")] for d in data["inputs"]],
+                     ["field", "old", "new", "unit (SI)"]))
     return sections
+
+
+def headline(sections: list) -> list[list[str]]:
+    """The headline changes: the peak |F| and |M| rows of the stages, last stage first (the
+    balanced design's before the unbalanced one's)."""
+    rows = next((r for title, r, _ in sections if title == "Stages"), [])
+    keys = (STAGE_NAMES["max_shaking_force"], STAGE_NAMES["max_shaking_moment"])
+    return [r for r in reversed(rows) if r[1] in keys][:4]
 
 
 def to_text(data: dict) -> str:
@@ -274,8 +297,9 @@ def to_html(data: dict, a: Side, b: Side, site: str = "") -> str:
             note = " and ".join(w for w, q in (("force", qf), ("moment", qm)) if q)
             figs.append((sa.stage.label, overlay_figure(sa.analysis, sb.analysis, prefix=f"diff{k}",
                                                         round_off=(qf, qm), scale=scale), note))
-    return environment().get_template("diff.html").render(d=data, sections=_rows(data), figures=figs, site=site,
-                                                          round_off=ROUND_OFF)
+    sections = _rows(data)
+    return environment().get_template("diff.html").render(d=data, sections=sections, figures=figs, site=site,
+                                                          round_off=ROUND_OFF, headline=headline(sections))
 
 
 RENDERERS = {"text": to_text, "markdown": to_markdown, "json": to_json}

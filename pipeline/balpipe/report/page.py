@@ -8,7 +8,8 @@ from .. import realisable
 from ..laws.drives import law_names
 from ..study import Study, ratio_reference
 from ..draw import figures, labels
-from . import partial_figures, present, toc
+from . import citations, live_plots, paper_figures, partial_figures, present, sections, toc
+from .design_card import design_card
 from .notation_table import notation_groups
 from .render import environment
 from .results import joint_load_table
@@ -50,6 +51,7 @@ def study_figures(study: Study) -> dict:
     ]
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
     extra += partial_figures.figures(study)  # the fronts of an optimal partial balancing, if any
+    extra += paper_figures.own_figures(study)  # the paper's panels as it numbers them
     residuals, drift = [], []
     vals = [s for s in shown_stages(study) if s.validation is not None]
     if vals:
@@ -70,7 +72,8 @@ def study_figures(study: Study) -> dict:
             + travel_text(runs[0]) + ".",
         ))
     key = "; ".join(f"{figures.style_text(k)}: {s.stage.label}" for k, s in enumerate(shown_stages(study)))
-    return {"loads": loads, "loads_key": key[:1].upper() + key[1:], "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
+    live = live_plots.as_script(live_plots.loads_data([(s.stage.label, s.analysis) for s in shown_stages(study)]))
+    return {"loads": loads, "live_loads": live, "loads_key": key[:1].upper() + key[1:], "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
@@ -144,12 +147,14 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                 "per_driver": ", ".join(f"{k} {v:.2g}" for k, v in sorted(q.tracking_error.items())),
             })
     rl = study.reactionless
-    return toc.add_toc(environment().get_template("spec.html").render(
+    drawn = study_figures(study)
+    return toc.add_toc(sections.collapse(environment().get_template("spec.html").render(
         r=results,
         paper=spec.paper,
         description=spec.description,
         law=law_names(spec.motion),  # the drives' own laws (balpipe.laws)
-        figures=study_figures(study),
+        figures=drawn,
+        paper_figs=paper_figures.listed([title for title, _, _ in drawn["extra"]]) if spec.paper else [],
         validation=validation_rows,
         torque=torque_rows,
         reactionless={"base_mass": rl.base_mass, "base_inertia": rl.base_inertia, "rows": rl.rows(),
@@ -167,4 +172,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         actuators=results.get("actuators") or [],
         nav=nav or {},
         inputs=notation_groups(spec),
-    ))
+        verdict=results.get("verdict"),
+        card=design_card(study, results),
+        citation=citations.cite(spec.paper),
+    )))

@@ -27,9 +27,9 @@ def num(x, digits: int = 4) -> str:
 
 
 def ratio(x, tol: float | None = None) -> str:
-    """A ratio to a reference, one format for a whole column: percent (4 significant digits,
-    scientific inside the percent when tiny), or "N.NN ×" from ten times on. With ``tol`` (the
-    stage's balance tolerance) a ratio at or below it is round-off and shows as "~0"."""
+    """A ratio to a reference, one format for every column: percent (4 significant digits,
+    scientific inside the percent when tiny), 674 % as well as 4743 %. With ``tol`` (the
+    stage's balance tolerance) a ratio at or below it is round-off and shows as "0 (< 1e-9)"."""
     if x is None:
         return "—"
     x = float(x)
@@ -38,9 +38,7 @@ def ratio(x, tol: float | None = None) -> str:
     if x == 0:
         return "0"
     if tol is not None and abs(x) <= tol:
-        return "~0"
-    if abs(x) >= 10:
-        return f"{x:.4g} ×"
+        return f"0 (< {_tol_text(tol)})"
     return f"{num(100 * x)} %"
 
 
@@ -50,6 +48,9 @@ def tol(x) -> str:
         return "—"
     m, _, e = f"{float(x):.3g}".partition("e")
     return f"{m}e{int(e)}" if e else m
+
+
+_tol_text = tol  # ratio() names its argument tol
 
 
 def load(x, ref, tolerance, unit_text: str = "", of: str = "reference") -> str:

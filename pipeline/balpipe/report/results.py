@@ -13,6 +13,7 @@ from .. import __version__
 from ..motion_outputs import motion_columns
 from ..study import Study, stage_metrics
 from . import present
+from .verdict import verdict
 
 SCHEMA_VERSION = 1
 
@@ -82,7 +83,16 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     if study.balance.details:
         out["balancing_details"] = study.balance.details
     out["paper"] = spec.paper  # the site index filters by it
+    out["verdict"] = verdict_of(study, out)
     return _clean(out)
+
+
+def verdict_of(study: Study, out: dict) -> dict:
+    """The ``verdict`` object (:mod:`balpipe.report.verdict`); with gravity on, each stage's
+    weight (total moving mass x g, N) is given apart from its inertial loads."""
+    g = math.hypot(*study.unbalanced.analysis.gravity)
+    weights = {s.stage.name: s.analysis.extra["total_mass"] * g for s in study.stages} if g else None
+    return verdict(out, weights)
 
 
 def comparison(study: Study, metrics: list[dict]) -> dict:

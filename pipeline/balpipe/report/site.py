@@ -6,8 +6,10 @@ import json
 from pathlib import Path
 
 from ..fsutil import write_file_atomic  # replaced in one step, never through a planted symlink
-from . import site_filter
-from .render import environment, load, num, printable, ratio
+from . import citations, site_earlier, site_filter, verdict
+from .costs import factor_text
+from .render import environment, num, printable, ratio
+from .render import tol as tol_fmt
 
 
 def _entry(out: Path, o) -> dict:
@@ -39,17 +41,22 @@ def _entry(out: Path, o) -> dict:
         "failed_link": f"{o.slug}/failed/index.html" if getattr(o, "kept_previous", False) else None,
         "error_rest": printable("\n".join(o.message.splitlines()[1:])) if o.status in ("error", "crash", "failed") else "",
         "not_realisable": [],
+        "slug": o.slug,
+        "verdict": None,
+        "citation": citations.cite((results or {}).get("paper")),
+        "built": "",
+        "stale_text": "page from an earlier build",
     }
     if e["results"]:
         st = results["stages"]
         first = st[0]
-        # the last stage compared with the first (a spec with several motions: of the first motion)
-        last = [s for s in st if s.get("reference", first["name"]) == first["name"]][-1]
+        v = results.get("verdict") or verdict.verdict(results)  # a results.json of an older build
+        e["verdict"] = v
         e["not_realisable"] = [f"{s['label']}: {s['not_realisable']}" for s in st if s.get("realisable") is False]
         tol = results.get("checks", {}).get("balance_tolerance")
-        ref = results.get("checks", {}).get("reference") or {}
-        e["peak_f"] = f"{num(first['max_shaking_force'])} → {load(last['max_shaking_force'], ref.get('force'), tol)}"
-        e["peak_m"] = f"{num(first['max_shaking_moment'])} → {load(last['max_shaking_moment'], ref.get('moment'), tol)}"
+        e["headline"] = headline(v, tol)
+        # the main design's last stage of its first motion (never a compared design's)
+        last = next((s for s in st if v["motions"] and s["name"] == v["motions"][0]["final"]), st[-1])
         e["added_mass"] = f"{num(last['added_mass'])} kg"
         e.update(_costs(results, first, last))
         refs = results.get("references") or []
@@ -64,6 +71,49 @@ def _entry(out: Path, o) -> dict:
             e["validation"] = '<span class="badge ok">pass</span>' if passed else '<span class="badge bad">fail</span>'
     e.update(site_filter.facets(e, results, out, o.slug))  # search, filter and history link
     return e
+
+
+def headline(v: dict, tol: float | None) -> dict:
+    """The index's headline numbers from the verdict's motions (the spec's main design only):
+    inertial |F| and |M| peaks, reference -> final stage, and with gravity the weight apart; a
+    spec with several motions shows the range over them."""
+    ms = v.get("motions") or []
+    if not ms:
+        return {"force": "—", "moment": "—", "weight": "", "motions": 0, "rows": [], "costs": [], "realisable": True}
+
+    def after(g: dict, key: str) -> str:
+        out = v["stages"][g["final"]][key]
+        return f"0 (< {tol_text(tol)})" if out["outcome"] == "cancelled" else num(g[key][1])
+
+    def span(values: list[str]) -> str:
+        return values[0] if len(set(values)) == 1 else f"{values[0]} … {values[-1]}"
+
+    rows = [{"label": g["reference_label"], "final": g["final_label"],
+             "force": f"{num(g['force'][0])} → {after(g, 'force')}",
+             "moment": f"{num(g['moment'][0])} → {after(g, 'moment')}",
+             "costs": g["costs"]} for g in ms]
+    if len(ms) == 1:
+        force, moment = rows[0]["force"], rows[0]["moment"]
+    else:
+        f0 = sorted(g["force"][0] for g in ms)
+        m0 = sorted(g["moment"][0] for g in ms)
+        f1 = sorted(g["force"][1] for g in ms)
+        m1 = sorted(g["moment"][1] for g in ms)
+        force = f"{span([num(f0[0]), num(f0[-1])])} → {span([num(f1[0]), num(f1[-1])])}"
+        moment = f"{span([num(m0[0]), num(m0[-1])])} → {span([num(m1[0]), num(m1[-1])])}"
+    w = ms[0].get("weight")
+    weight = f"{num(w[0])} → {num(w[1])}" if w and w[0] is not None else ""
+    c = ms[0]["costs"]
+    costs = [("moving mass", factor_text(c["moving_mass"])), ("peak effort", factor_text(c["effort"])),
+             ("RMS effort", factor_text(c["rms"])), ("peak power", factor_text(c["power"])),
+             ("largest joint load", factor_text(c["joint_load"]))]
+    return {"force": force, "moment": moment, "weight": weight, "motions": len(ms), "rows": rows,
+            "costs": costs, "realisable": c["realisable"]}
+
+
+def tol_text(tol: float | None) -> str:
+    """'< tolerance' text of a cancelled load: the balance tolerance of the reference."""
+    return f"{tol_fmt(tol)} of unbalanced" if tol is not None else "tolerance"
 
 
 def _costs(results: dict, first: dict, last: dict) -> dict:
@@ -83,7 +133,8 @@ def _costs(results: dict, first: dict, last: dict) -> dict:
             "moment": ratio(s.get("moment_ratio"), tol), "force": ratio(s.get("force_ratio"), tol),
         })
     mm = results.get("moving_mass") or 0.0
-    added = f"{num(last['added_mass'])} kg" + (f" ({ratio(last['added_mass'] / mm)} of {num(mm)} kg)" if mm else "")
+    # relative to the moving mass: the "moving mass ×" factor beside it (one format per column)
+    added = f"{num(last['added_mass'])} kg" + (f" on {num(mm)} kg" if mm else "")
     acts = results.get("actuators") or []
     efforts = []
     for a0 in [a for a in acts if a["stage"] == first["name"]]:
@@ -109,16 +160,68 @@ def _costs(results: dict, first: dict, last: dict) -> dict:
 
 def write_site(out: Path, outcomes: list) -> None:
     entries = [_entry(out, o) for o in sorted(outcomes, key=lambda o: o.source)]
-    n_ok = sum(e["status"] == "ok" for e in entries)
-    n_flagged = sum(e["status"] == "ok" and bool(e["not_realisable"]) for e in entries)
-    n_invalid = sum(e["status"] == "invalid spec" for e in entries)  # the command line's counts
+    for old in site_earlier.earlier_pages(out, {o.slug for o in outcomes}):
+        e = _entry(out, old)
+        e["built"] = "in an earlier build"
+        if old.stale_reason:
+            e["stale"], e["stale_text"] = True, f"stale: {old.stale_reason}"
+        entries.append(e)
+    entries.sort(key=lambda e: e["source"])
+    now = [e for e in entries if not e["built"]]  # this build's specs: the command line's counts
+    n_ok = sum(e["status"] == "ok" for e in now)
+    n_flagged = sum(e["status"] == "ok" and bool(e["not_realisable"]) for e in now)
+    n_invalid = sum(e["status"] == "invalid spec" for e in now)
     html = environment().get_template("index.html").render(
-        entries=entries, n_ok=n_ok - n_flagged, n_failed=len(entries) - n_ok - n_invalid, n_flagged=n_flagged,
+        entries=entries, n_earlier=len(entries) - len(now), n_ok=n_ok - n_flagged, n_failed=len(now) - n_ok - n_invalid, n_flagged=n_flagged,
         n_invalid=n_invalid, n_ok_cli=n_ok,
         filters=site_filter.options(entries),
+        papers=site_papers(entries),
+        comparisons=comparisons(entries),
     )
     write_file_atomic(out / "index.html", html)
     write_file_atomic(out / "site_nav.js", site_nav_script(entries))
+
+
+def comparisons(entries: list[dict]) -> list[dict]:
+    """The methods applied to one mechanism side by side: per template with specs of two or more
+    methods, one row per spec (its main design's final stage): verdict, added mass and inertia,
+    counter-rotations, residual |F| and |M| as ratios, and the cost factors."""
+    by: dict[str, list[dict]] = {}
+    for e in entries:
+        r = e.get("results")
+        if r and e.get("verdict") and e["verdict"].get("motions"):
+            by.setdefault(r.get("mechanism") or "", []).append(e)
+    out = []
+    for template, group in sorted(by.items()):
+        if len({e["results"].get("method") for e in group}) < 2:
+            continue
+        rows = []
+        for e in group:
+            r, v = e["results"], e["verdict"]
+            g = v["motions"][0]
+            comp = next((c for c in (r.get("comparison") or {}).get("rows") or [] if c["stage"] == g["final"]), {})
+            c = g["costs"]
+            rows.append({
+                "title": e["title"], "link": e["link"], "method": r.get("method"), "level": v["level"],
+                "words": v["words"], "added_mass": num(c["added_mass"]),
+                "added_inertia": num(c["added_inertia"]) if c["added_inertia"] is not None else "cannot be built",
+                "counter_rotations": comp.get("counter_rotations", "—"),
+                "force": v["stages"][g["final"]]["force"]["text"], "moment": v["stages"][g["final"]]["moment"]["text"],
+                "effort": factor_text(c["effort"]), "joint_load": factor_text(c["joint_load"]),
+            })
+        out.append({"template": template, "rows": rows})
+    return out
+
+
+def site_papers(entries: list[dict]) -> list[dict]:
+    """The papers the listed specs reproduce, each cited once, by id."""
+    seen: dict[str, str] = {}
+    for e in entries:
+        paper = (e.get("facets") or {}).get("paper") or ""
+        pid = citations.paper_id(paper)
+        if pid and paper != site_filter.NO_PAPER and pid not in seen:
+            seen[pid] = citations.cite(paper)
+    return [{"id": k, "text": seen[k]} for k in sorted(seen)]
 
 
 def site_nav_script(entries: list[dict]) -> str:

@@ -1,0 +1,72 @@
+"""The design summary card at the top of a study page: the parts the spec's main design adds to
+the unbalanced mechanism (name, mass, position, inertia) and what they cost, as factors
+(:mod:`balpipe.report.costs`). A part with a negative mass or centroidal inertia cannot be built
+(:mod:`balpipe.realisable`): it is flagged, and its inertia is never counted as a cost.
+"""
+
+from __future__ import annotations
+
+from ..model import Model
+from ..study import Study
+from .costs import factor_text
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.4g}"
+
+
+def added_parts(base: Model, final: Model) -> list[dict]:
+    """Counterweights and discs of ``final`` that ``base`` lacks, and links whose own mass or
+    inertia the method changed. Positions of attachments are in their link's frame (m)."""
+    rows = []
+    old = {b.name: b for b in base.bodies}
+    for b in final.bodies:
+        before = old.get(b.name)
+        if before is None:
+            rows.append({"name": b.name, "kind": "counter-rotation" if b.kind == "gear" else f"added {b.kind}",
+                         "mass": b.mass, "where": "a body of its own",
+                         "inertia": b.inertia, "buildable": b.mass >= 0 and b.inertia >= 0})
+            atts = b.attachments
+        else:
+            if abs(b.mass - before.mass) > 1e-12 or abs(b.inertia - before.inertia) > 1e-15:
+                rows.append({"name": b.name, "kind": "link changed",
+                             "mass": b.mass, "where": f"was {_fmt(before.mass)} kg, {_fmt(before.inertia)} kg m²",
+                             "inertia": b.inertia, "buildable": b.mass >= 0 and b.inertia >= 0})
+            had = {a.name for a in before.attachments}
+            atts = tuple(a for a in b.attachments if a.name not in had)
+        for a in atts:
+            rows.append({"name": a.name, "kind": a.kind, "mass": a.mass,
+                         "where": f"on {b.name} at ({_fmt(a.position[0])}, {_fmt(a.position[1])}) m",
+                         "inertia": a.inertia, "buildable": a.mass >= 0 and a.inertia >= 0})
+    return rows
+
+
+def design_card(study: Study, results: dict) -> dict | None:
+    """The card's content: the main design's final stage (first motion), its parts and cost
+    factors from ``results['verdict']``; None without a balancing stage."""
+    v = results.get("verdict") or {}
+    motions = v.get("motions") or []
+    if not motions:
+        return None
+    g = motions[0]
+    by = {s.stage.name: s for s in study.stages}
+    final, ref = by.get(g["final"]), by.get(g["reference"])
+    if final is None or ref is None:
+        return None
+    c = g["costs"]
+    factors = [
+        ("moving mass", factor_text(c["moving_mass"]), f"+{_fmt(c['added_mass'] or 0.0)} kg"),
+        ("peak actuator effort", factor_text(c["effort"]), c["effort_driver"]),
+        ("RMS actuator effort", factor_text(c["rms"]), c["rms_driver"]),
+        ("peak actuator power", factor_text(c["power"]), c["power_driver"]),
+        ("largest joint load", factor_text(c["joint_load"]), c["joint"]),
+    ]
+    parts = added_parts(ref.stage.model, final.stage.model)
+    kinds: dict[str, list[float]] = {}
+    for p in parts:
+        kinds.setdefault(p["kind"], []).append(p["mass"])
+    summary = "; ".join(f"{len(m)} {k}{'s' if len(m) != 1 and not k.endswith('changed') else ''} "
+                        f"({_fmt(sum(m))} kg)" for k, m in kinds.items())
+    return {"stage": final.stage.label, "reference": ref.stage.label, "parts": parts, "summary": summary,
+            "factors": factors, "unbuildable": [p for p in parts if not p["buildable"]],
+            "added_inertia": c["added_inertia"], "motions": len(motions)}

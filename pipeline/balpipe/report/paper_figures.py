@@ -1,0 +1,147 @@
+"""The papers' figures one for one (issue 22): which of a paper's figure numbers a page
+reproduces, read from its figure titles ("Fig. 8 of paper 000", "Figs. 2a, 4a, 6b", "Figs. 3-4"),
+and the panels that the generic pages did not draw as the paper numbers them:
+
+- paper 002, Fig. 2: shaking force and moment of the unbalanced manipulator;
+- paper 003, Figs. 3 and 4: |F| and M of the four cases on trajectory P15P7, the one the paper's
+  figures show (its Sec. 3);
+- paper 004, Figs. 10a, 10b, 11, 12: shaking force along x and along y, shaking moment (N m) of
+  the unbalanced manipulator, and the shaking moment after shaking force balancing.
+
+:data:`FIGURES` is the table of the papers' figures that the site reproduces; a test holds the
+pages to it.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from ..draw import figures
+
+#: per paper, the figure numbers its pages reproduce (a number covers its panels: "6" by "6a")
+FIGURES = {
+    "000": ("4", "8"),
+    "001": ("2", "3", "4", "6"),
+    "002": ("2",),
+    "003": ("2", "3", "4"),
+    "004": ("10a", "10b", "11", "12"),
+}
+#: paper 003's figures show this trajectory (Sec. 3: "Figs. 3-4 ... P15P7")
+PAPER_003_TRAJECTORY = "P15P7"
+
+_FIGS = re.compile(r"\bFigs?\.\s*((?:\d+[a-z]?(?:\s*[-–]\s*\d+[a-z]?)?)(?:\s*(?:,|and)\s*\d+[a-z]?(?:\s*[-–]\s*\d+[a-z]?)?)*)")
+_ONE = re.compile(r"(\d+)([a-z]?)(?:\s*[-–]\s*(\d+)([a-z]?))?")
+
+
+def numbers_in(title: str) -> list[str]:
+    """Figure numbers a title names: 'Figs. 2a, 4a, 6b' -> ['2a', '4a', '6b']; 'Figs. 3-4' ->
+    ['3', '4']; 'Fig. 8 of paper 000' -> ['8']."""
+    out: list[str] = []
+    for m in _FIGS.finditer(title):
+        for a, pa, b, pb in _ONE.findall(m.group(1)):
+            if b and not pa and not pb:
+                out += [str(k) for k in range(int(a), int(b) + 1)]
+            else:
+                out += [a + pa] + ([b + pb] if b else [])
+    return out
+
+
+def covered(wanted: str, found: list[str]) -> bool:
+    """A wanted figure number is covered by itself or, for a bare number, by one of its panels."""
+    return wanted in found or (wanted.isdigit() and any(re.fullmatch(wanted + "[a-z]", f) for f in found))
+
+
+def listed(titles: list[str]) -> list[str]:
+    """The distinct figure numbers of a page's titles, in numeric order."""
+    nums = {n for t in titles for n in numbers_in(t)}
+    return sorted(nums, key=lambda n: (int(re.match(r"\d+", n).group()), n))
+
+
+def _series(t, curves: list[tuple[str, np.ndarray, int]], ylabel: str, prefix: str) -> str:
+    """A time series in the page's stage styles: each curve (label, values, k) drawn in
+    ``figures.style(k)``, k the stage's place in the page's stage table, so that one line style
+    means one stage on the whole page."""
+    fig, ax = figures.plt.subplots(figsize=(6.0, 3.0))
+    for label, y, k in curves:
+        ax.plot(t, y, label=figures.literal(label), **figures.style(k))
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel(ylabel)
+    figures.legend_below(fig, ax, fontsize=8)
+    return figures.to_svg(fig, prefix)
+
+
+def _k(study, stage) -> int:
+    """The stage's style index: its place among the stages of its motion (the page's order)."""
+    group = [s for s in study.stages if s.stage.group == stage.stage.group]
+    return next(i for i, s in enumerate(group) if s is stage)
+
+
+def paper_id(study) -> str:
+    return (study.spec.paper or "").split(":", 1)[0].strip()
+
+
+def own_figures(study) -> list[tuple[str, str, str]]:
+    """The panels drawn here as the paper numbers them, (title, svg, caption)."""
+    pid = paper_id(study)
+    if pid == "002":
+        return _paper002(study)
+    if pid == "003":
+        return _paper003(study)
+    if pid == "004":
+        return _paper004(study)
+    return []
+
+
+def _paper002(study) -> list[tuple[str, str, str]]:
+    un = study.unbalanced
+    an, k = un.analysis, _k(study, un)
+    f = _series(an.t, [(un.stage.label, np.hypot(an.force[:, 0], an.force[:, 1]), k)], "|F| (N)", "p002fig2f")
+    m = _series(an.t, [(un.stage.label, an.moment, k)], "M (N m)", "p002fig2m")
+    cap = ("The unbalanced manipulator (stage '" + un.stage.label + "', in its line style of this page): |F| including "
+           "the links' weight when gravity is on, M about the base joint, from the analysis of this spec.")
+    return [("Fig. 2 of paper 002: shaking force of the unbalanced manipulator", f, cap),
+            ("Fig. 2 of paper 002: shaking moment of the unbalanced manipulator", m, cap)]
+
+
+def _paper003(study) -> list[tuple[str, str, str]]:
+    pre = PAPER_003_TRAJECTORY + "_"
+    stages = [s for s in study.stages if s.stage.name.startswith(pre)]
+    if not stages:
+        return []
+    t = stages[0].analysis.t
+    label = [s.stage.label.split(" · ")[-1] for s in stages]
+    f = _series(t, [(lab, np.hypot(s.analysis.force[:, 0], s.analysis.force[:, 1]), k)
+                    for k, (lab, s) in enumerate(zip(label, stages))], "|F| (N)", "p003fig3")
+    m = _series(t, [(lab, s.analysis.moment, k) for k, (lab, s) in enumerate(zip(label, stages))], "M (N m)",
+                "p003fig4")
+    cap = (f"Trajectory {PAPER_003_TRAJECTORY}, the one the paper's figures show; the four cases in the page's "
+           "stage styles (the legend under the plot). Computed by the engine from this spec.")
+    return [(f"Fig. 3 of paper 003: shaking force, trajectory {PAPER_003_TRAJECTORY}", f, cap),
+            (f"Fig. 4 of paper 003: shaking moment, trajectory {PAPER_003_TRAJECTORY}", m, cap)]
+
+
+def _paper004(study) -> list[tuple[str, str, str]]:
+    un = study.unbalanced
+    an = un.analysis
+    force_only = next((s for s in study.stages if s.stage.balances == "force" and ":" not in s.stage.name), None)
+    k0 = _k(study, un)
+    out = [
+        ("Fig. 10a of paper 004: shaking force along x (N)",
+         _series(an.t, [(un.stage.label, an.force[:, 0], k0)], "F_x (N)", "p004fig10a"),
+         "The unbalanced manipulator, from the analysis of this spec."),
+        ("Fig. 10b of paper 004: shaking force along y (N)",
+         _series(an.t, [(un.stage.label, an.force[:, 1], k0)], "F_y (N)", "p004fig10b"),
+         "The unbalanced manipulator, from the analysis of this spec."),
+        ("Fig. 11 of paper 004: shaking moment (N m)",
+         _series(an.t, [(un.stage.label, an.moment, k0)], "M (N m)", "p004fig11"),
+         "The unbalanced manipulator, about the moment point of the spec."),
+    ]
+    if force_only is not None:
+        a2 = force_only.analysis
+        out.append(("Fig. 12 of paper 004: shaking moment after shaking force balancing (N m)",
+                    _series(a2.t, [(force_only.stage.label, a2.moment, _k(study, force_only))], "M (N m)", "p004fig12"),
+                    f"Stage '{force_only.stage.label}' (force balanced by counterweights), in its line style of this "
+                    "page: the moment grows, as the paper says."))
+    return out

@@ -1,0 +1,65 @@
+"""Pages of earlier builds in the same output folder: building some specs into an existing site
+keeps the others listed on the index (issue 22).
+
+A folder of the site with an ``index.html`` and a ``results.json`` that this build did not
+touch is an earlier page. It stays on the index, marked as built earlier, and *stale* when its
+spec changed since (its input hash, recomputed from the spec file named in ``results.json``, no
+longer matches: the spec's text, the simulation option, balpipe's code or the spec's history
+changed) or when the spec file is gone.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..build import Options, input_hash
+from ..loader import SpecErrors, load
+from . import history_page
+
+
+@dataclass
+class Earlier:
+    """An earlier page, shaped as a build outcome for the index (:func:`balpipe.report.site._entry`)."""
+
+    source: str
+    slug: str
+    status: str
+    results: dict
+    message: str = ""
+    stale_reason: str = ""
+
+
+def spec_changed(folder: Path, results: dict) -> str:
+    """Why an earlier page no longer shows its spec ('' when it still does)."""
+    source = Path(results.get("source") or "")
+    if not source.is_file():
+        return f"spec {source} no longer found"
+    try:
+        loaded = load(source)
+    except (SpecErrors, OSError, ValueError):
+        return "its spec has changed and is now invalid"
+    simulated = results.get("validation") is not None
+    h = history_page.mix_hash(input_hash(loaded.text, Options(out=folder.parent, simulate=simulated)), folder)
+    return "" if h == results.get("input_hash") else "its spec or balpipe changed since this page was built"
+
+
+def earlier_pages(out: Path, built: set[str]) -> list[Earlier]:
+    """The site's study pages outside ``built`` (the slugs of this build), sorted by folder."""
+    found = []
+    for folder in sorted(p for p in out.iterdir() if p.is_dir() and not p.is_symlink()):
+        if folder.name in built or folder.name.startswith("."):
+            continue
+        page, data = folder / "index.html", folder / "results.json"
+        if not (page.is_file() and data.is_file()):
+            continue
+        try:
+            results = json.loads(data.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        if not isinstance(results, dict) or not results.get("stages"):
+            continue
+        found.append(Earlier(str(results.get("source") or folder.name), folder.name,
+                             results.get("status") or "ok", results, stale_reason=spec_changed(folder, results)))
+    return found

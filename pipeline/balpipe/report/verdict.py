@@ -1,0 +1,208 @@
+"""Did balancing work, and what did it cost? The ``verdict`` object of ``results.json``.
+
+"Built and cross-checked" (the build's status, the validation) says nothing about whether a
+stage balanced anything. This module reads a study's result rows (:func:`balpipe.study.stage_metrics`:
+peaks and ratios of the *inertial* loads to the stage's reference, the stage's claim) and says,
+per stage and per spec, for the force and for the moment each: *cancelled* (at most the balance
+tolerance of the reference), *reduced by x*, *unchanged* (within :data:`UNCHANGED`) or
+*worse* (x % of the reference: one format, percent, for every ratio), against what the stage claims; and how many of the paper's
+published numbers the build reproduces.
+
+Levels, worst first: ``bad`` (a claim fails, or the build failed), ``warn`` (a stage makes a
+load worse than its reference, a part cannot be built, or a published number does not
+reproduce), ``neutral`` (nothing changed), ``good``. A spec's level is the worst of its main
+design's final stages and of its references: a spec whose |M| gets worse after a stage that
+claims moment balance is never ``good``.
+
+The headline numbers come from the spec's main design (stages named without ``design:``), one
+row per motion (the stages sharing a reference stage); a compared design never stands in.
+With gravity on, the loads are the inertial part and the weight (total moving mass x g) is given
+apart. Pure functions of the result rows: the index reads a results.json written earlier with
+the same code.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .costs import cost_factors
+
+#: a ratio within this of 1 reads "unchanged"
+UNCHANGED = 0.01
+LEVELS = ("good", "neutral", "warn", "bad")  # from best to worst
+_ORDER = {"cancelled": 0, "reduced": 1, "unchanged": 2, "worse": 3}
+
+
+def worst(levels) -> str:
+    """The worst of ``levels`` ('good' for none)."""
+    return max(levels, key=LEVELS.index, default="good")
+
+
+def percent(x: float) -> str:
+    """0.6031 -> '60.3 %', 47.434 -> '4743 %' (three significant digits or whole percent, never
+    scientific)."""
+    v = 100 * x
+    if abs(v) >= 100:
+        return f"{v:.0f} %"  # 4743 %, never 4.74e+03
+    return f"{v:.3g} %" if abs(v) >= 1 else f"{v:.2g} %"
+
+
+def outcome(ratio: float | None, cancelled: bool, claimed: bool) -> dict:
+    """What a stage did to one load, its ratio to the reference's peak: cancelled / reduced /
+    unchanged / worse, with the words shown on the pages."""
+    if ratio is None:
+        return {"outcome": "unknown", "ratio": None, "claimed": claimed, "text": "—"}
+    r = float(ratio)
+    if cancelled:
+        kind, text = "cancelled", "cancelled"
+    elif abs(r - 1.0) <= UNCHANGED:
+        kind, text = "unchanged", "unchanged"
+    elif r < 1.0:
+        kind, text = "reduced", f"reduced by {percent(1.0 - r)}"
+    else:
+        kind, text = "worse", f"worse: {percent(r)} of the reference"
+    return {"outcome": kind, "ratio": r, "claimed": claimed, "text": text}
+
+
+def claims_of(stage: dict) -> list[str]:
+    """The loads a stage claims to balance, from its ``balances`` ('force', 'force+moment', '')."""
+    b = stage.get("balances") or ""
+    return [p for p in ("force", "moment") if p in b]
+
+
+def stage_verdict(stage: dict, weight: float | None = None) -> dict:
+    """The verdict of one stage against its own claim (see the module's docstring)."""
+    claims = claims_of(stage)
+    loads = {p: outcome(stage.get(f"{p}_ratio"), bool(stage.get(f"{p}_balanced")), p in claims)
+             for p in ("force", "moment")}
+    fails = [p for p in claims if loads[p]["outcome"] != "cancelled"]
+    worse = [p for p in ("force", "moment") if loads[p]["outcome"] == "worse"]
+    realisable = stage.get("realisable", True) is not False
+    if fails:
+        level = "bad"
+    elif worse or not realisable:
+        level = "warn"
+    elif all(loads[p]["outcome"] == "unchanged" for p in loads):
+        level = "neutral"
+    else:
+        level = "good"
+    words = f"force {loads['force']['text']}, moment {loads['moment']['text']}"
+    if claims:
+        words += f"; claims {' and '.join(claims)} balance: " + (
+            f"fails ({' and '.join(fails)} not cancelled)" if fails else "holds")
+    else:
+        words += "; no balance claimed"
+    if not realisable:
+        words += f"; {stage.get('not_realisable') or 'not realisable'} (balanced on paper only)"
+    return {
+        "level": level, "text": words, "claims": claims, "holds": (not fails) if claims else None,
+        "realisable": realisable, "force": loads["force"], "moment": loads["moment"],
+        "weight": weight,
+    }
+
+
+def is_main(stage: dict) -> bool:
+    """A stage of the spec's main design (those of ``compare`` are named 'design:stage')."""
+    return ":" not in stage["name"]
+
+
+def motions(stages: list[dict]) -> list[tuple[dict, list[dict]]]:
+    """The main design's stages per motion: (reference stage, the stages measured against it), in
+    the spec's order. One motion for most specs; one per trajectory for paper 003's."""
+    out: dict[str, tuple[dict, list[dict]]] = {}
+    by_name = {s["name"]: s for s in stages}
+    for s in stages:
+        ref = s.get("reference") or stages[0]["name"]
+        if ref == s["name"] or not is_main(s):
+            continue
+        out.setdefault(ref, (by_name.get(ref, stages[0]), []))[1].append(s)
+    return list(out.values())
+
+
+def references_verdict(refs: list[dict]) -> dict:
+    """Published numbers reproduced k of n; those the spec expects not to (a paper's typo,
+    documented in its note) counted apart."""
+    n = len(refs)
+    k = sum(r.get("status") == "agrees" for r in refs)
+    known = sum(r.get("status") != "agrees" and r.get("expected") == "differ" for r in refs)
+    unexpected = n - k - known
+    if not n:
+        return {"reproduced": 0, "total": 0, "known_not": 0, "unexpected": 0, "level": "neutral",
+                "text": "no published numbers"}
+    text = f"published numbers reproduced {k} of {n}"
+    if known:
+        text += f" ({known} known not to: the paper's own numbers do not reproduce)"
+    if unexpected:
+        text += f", {unexpected} unexpectedly not"
+    level = "bad" if unexpected else ("warn" if known else "good")
+    return {"reproduced": k, "total": n, "known_not": known, "unexpected": unexpected, "level": level,
+            "text": text}
+
+
+def _span(outs: list[dict]) -> dict:
+    """One load's outcome over several motions: the worst outcome, the range of the ratios."""
+    kind = max((o["outcome"] for o in outs), key=lambda k: _ORDER.get(k, 4))
+    ratios = [o["ratio"] for o in outs if o["ratio"] is not None]
+    if len(outs) == 1:
+        return dict(outs[0])
+    lo, hi = (min(ratios), max(ratios)) if ratios else (None, None)
+    kinds = {o["outcome"] for o in outs}
+    if kinds == {"reduced"}:
+        a, b = percent(1 - hi), percent(1 - lo)
+        text = f"reduced by {a} to {b}" if a != b else f"reduced by {a}"
+    elif kinds == {"cancelled"}:
+        text = "cancelled"
+    else:
+        text = ", ".join(f"{sum(o['outcome'] == k for o in outs)} {k}" for k in sorted(kinds, key=_ORDER.get))
+    return {"outcome": kind, "ratio": hi, "ratio_min": lo, "claimed": any(o["claimed"] for o in outs),
+            "text": f"{text} (over {len(outs)} motions)"}
+
+
+def verdict(results: dict, weights: dict[str, float] | None = None) -> dict[str, Any]:
+    """The ``verdict`` object of ``results.json`` from its other fields (``stages``,
+    ``references``, ``status``); ``weights``: per stage name, the moving links' weight (N), with
+    gravity on."""
+    weights = weights or {}
+    stages = results.get("stages") or []
+    per_stage = {}
+    for s in stages:
+        if s.get("reference", stages[0]["name"]) == s["name"]:
+            continue  # a reference: nothing to judge
+        per_stage[s["name"]] = stage_verdict(s, weights.get(s["name"]))
+    groups = []
+    for ref, members in motions(stages):
+        final = members[-1]
+        v = per_stage[final["name"]]
+        groups.append({
+            "reference": ref["name"], "reference_label": ref["label"], "final": final["name"],
+            "final_label": final["label"],
+            "force": [ref["max_inertial_force"], final["max_inertial_force"]],
+            "moment": [ref["max_inertial_moment"], final["max_inertial_moment"]],
+            "weight": [weights.get(ref["name"]), weights.get(final["name"])] if weights else None,
+            # an earlier stage may cost moment (counterweights before counter-rotations); one whose
+            # claim fails sinks the motion's verdict even when a later stage recovers
+            "level": "bad" if any(per_stage[m["name"]]["holds"] is False for m in members) else "good",
+            "final_level": v["level"],
+            "costs": cost_factors(results, ref["name"], final["name"]),
+        })
+    refs = references_verdict(results.get("references") or [])
+    if not groups:
+        force = moment = outcome(None, False, False)
+        balance_level = "neutral"
+    else:
+        force = _span([per_stage[g["final"]]["force"] for g in groups])
+        moment = _span([per_stage[g["final"]]["moment"] for g in groups])
+        balance_level = worst([g["level"] for g in groups] + [g["final_level"] for g in groups])
+    level = worst([balance_level, refs["level"] if refs["total"] else "good"])
+    if results.get("status") not in (None, "ok"):
+        level = "bad"
+    claimed = any(per_stage[g["final"]]["claims"] for g in groups)
+    good = "balanced as claimed" if claimed else "loads reduced"
+    words = {"good": good, "neutral": "no change", "warn": "mixed", "bad": "balancing fails"}[level]
+    if level == "warn" and balance_level in ("good", "neutral"):
+        words = f"{good if balance_level == 'good' else 'no change'}; published numbers not all reproduced"
+    text = f"{words}: force {force['text']}, moment {moment['text']}"
+    if refs["total"]:
+        text += f"; {refs['text']}"
+    return {"level": level, "words": words, "text": text, "force": force, "moment": moment,
+            "references": refs, "motions": groups, "stages": per_stage}

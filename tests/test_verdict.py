@@ -1,0 +1,162 @@
+"""Did balancing work? The verdict per stage and per spec (issue 22): separate from "built",
+against each stage's claim, from the main design only, and the same on the index as in
+results.json."""
+
+from __future__ import annotations
+
+import json
+import random
+import re
+from pathlib import Path
+
+import pytest
+
+from balpipe.build import Options, build
+from balpipe.loader import load as load_spec
+from balpipe.report import verdict as V
+from balpipe.report.results import results_dict
+from balpipe.study import run
+
+SPECS = Path(__file__).parent.parent / "specs"
+
+
+def stage(name, balances="", f=1.0, m=1.0, ref="unbalanced", tol=1e-9, realisable=True, **kw):
+    out = {"name": name, "label": name, "balances": balances, "force_ratio": f, "moment_ratio": m,
+           "force_balanced": f <= tol, "moment_balanced": m <= tol, "reference": ref,
+           "max_inertial_force": 10.0 * f, "max_inertial_moment": 2.0 * m, "added_mass": 1.0,
+           "added_inertia": 0.1, "realisable": realisable, "not_realisable": "" if realisable else "not realisable: negative inertia"}
+    out.update(kw)
+    return out
+
+
+def results(*stages, refs=()):
+    return {"status": "ok", "stages": [stage("unbalanced")] + list(stages), "references": list(refs),
+            "moving_mass": 2.0, "actuators": [], "comparison": {"rows": []}}
+
+
+def test_moment_worse_after_a_stage_claiming_moment_balance_is_never_positive():
+    rng = random.Random(22)
+    for _ in range(200):
+        worse = 1.0 + 10 ** rng.uniform(-1.5, 2)
+        later = rng.choice([1e-12, rng.uniform(0.0, 3.0)])  # a later stage may even cancel it
+        r = results(stage("cw", "force", f=1e-13, m=rng.uniform(0, 5)),
+                    stage("cr", "force+moment", f=1e-13, m=worse),
+                    stage("extra", rng.choice(["", "force+moment"]), f=1e-13, m=later))
+        v = V.verdict(r)
+        assert v["level"] == "bad" and v["stages"]["cr"]["level"] == "bad", v["text"]
+        assert v["stages"]["cr"]["holds"] is False
+        assert v["stages"]["cr"]["moment"]["outcome"] == "worse"
+        assert "fails" in v["stages"]["cr"]["text"]
+
+
+def test_outcomes_in_words():
+    assert V.outcome(1e-14, True, True)["text"] == "cancelled"
+    assert V.outcome(0.397, False, False)["text"] == "reduced by 60.3 %"
+    assert V.outcome(1.004, False, False)["outcome"] == "unchanged"
+    w = V.outcome(6.7404, False, False)
+    assert w["outcome"] == "worse" and w["text"] == "worse: 674 % of the reference"
+
+
+def test_unclaimed_worse_final_stage_is_a_warning_and_references_count():
+    r = results(stage("cw", "force", f=1e-13, m=6.74),
+                refs=[{"status": "agrees"}, {"status": "differs", "expected": "differ"}])
+    v = V.verdict(r)
+    assert v["level"] == "warn" and v["words"] == "mixed"
+    assert v["references"]["reproduced"] == 1 and v["references"]["total"] == 2
+    assert "moment worse" in v["text"]
+    r = results(stage("all", "force+moment", f=1e-13, m=1e-13))
+    assert V.verdict(r)["level"] == "good" and V.verdict(r)["words"] == "balanced as claimed"
+    r = results(stage("all", "force+moment", f=1e-13, m=1e-13), refs=[{"status": "differs", "expected": "agree"}])
+    assert V.verdict(r)["level"] == "bad"  # a published number that should reproduce and does not
+    r = results(stage("all", "force+moment", f=1e-13, m=1e-13, realisable=False))
+    assert V.verdict(r)["level"] == "warn"  # balanced on paper only
+
+
+def test_headline_from_the_main_design_never_a_compared_one():
+    r = results(stage("cw", "force", f=1e-13, m=2.0), stage("cr", "force+moment", f=1e-13, m=1e-13),
+                stage("other:cw", "force", f=0.4, m=1.1))
+    v = V.verdict(r)
+    assert [g["final"] for g in v["motions"]] == ["cr"]
+    assert v["force"]["outcome"] == "cancelled" and v["moment"]["outcome"] == "cancelled"
+    assert "other:cw" in v["stages"]  # judged, but not the spec's headline
+
+
+def test_several_motions_each_judged():
+    r = {"status": "ok", "references": [], "stages": [
+        stage("a_ref", ref="a_ref"), stage("a_plan", f=0.5, m=0.6, ref="a_ref"),
+        stage("b_ref", ref="b_ref"), stage("b_plan", f=0.4, m=0.3, ref="b_ref")]}
+    v = V.verdict(r)
+    assert [g["final"] for g in v["motions"]] == ["a_plan", "b_plan"]
+    assert v["force"]["text"] == "reduced by 50 % to 60 % (over 2 motions)"
+    assert v["level"] == "good" and v["words"] == "loads reduced"
+
+
+@pytest.fixture(scope="module")
+def four_bar():
+    spec = load_spec(SPECS / "custom_four_bar_balancing.yaml").spec
+    study = run(spec)
+    return study, results_dict(study, "custom_four_bar_balancing.yaml", "h", simulated=False)
+
+
+def test_results_json_carries_the_verdict_with_the_main_designs_costs(four_bar):
+    study, r = four_bar
+    v = r["verdict"]
+    assert set(v) >= {"level", "text", "force", "moment", "references", "motions", "stages"}
+    g = v["motions"][0]
+    assert g["final"] == "counter_rotations" and ":" not in g["final"]  # not crank_only:crank_cw
+    assert v["level"] == "good"
+    main = next(s for s in r["stages"] if s["name"] == g["final"])
+    assert g["force"][1] == main["max_inertial_force"] and g["moment"][1] == main["max_inertial_moment"]
+    c = g["costs"]
+    assert c["moving_mass"] == pytest.approx((r["moving_mass"] + main["added_mass"]) / r["moving_mass"])
+    json.dumps(r)  # plain JSON
+
+
+def test_index_agrees_with_results_json_and_leads_with_it(tmp_path):
+    out = tmp_path / "site"
+    build([str(SPECS / "custom_four_bar_balancing.yaml"), str(SPECS / "paper000_rpr3_scott_russell.yaml")],
+          Options(out=out, simulate=False))
+    html = (out / "index.html").read_text(encoding="utf-8")
+    head = html[html.index('<table id="studies"'):]
+    assert re.search(r"<th>Spec</th><th>Verdict</th>", head)
+    for slug in ("custom_four_bar_balancing", "paper000_rpr3_scott_russell"):
+        level = json.loads((out / slug / "results.json").read_text())["verdict"]["level"]
+        m = re.search(rf'data-spec="{slug}" data-verdict="(\w+)"', html)
+        assert m and m.group(1) == level
+        page = (out / slug / "index.html").read_text(encoding="utf-8")
+        assert f'data-verdict="{level}"' in page and 'id="design-summary"' in page
+    sr = json.loads((out / "paper000_rpr3_scott_russell" / "results.json").read_text())["verdict"]
+    assert sr["level"] != "good" and sr["moment"]["outcome"] == "worse"  # |M| 674 % after counter-rotations
+    # the index's headline |F| of the four-bar is its balanced design's (0), not the crank-only 26.67 N
+    row = html[html.index('data-spec="custom_four_bar_balancing"'):]
+    row = row[:row.index("</tbody>")]
+    assert "26.67" not in row and "67.33 → 0 (&lt; 1e-9 of unbalanced)" in row
+
+
+def test_methods_on_one_mechanism_side_by_side():
+    from balpipe.report.site import comparisons
+
+    def entry(title, method, *st):
+        r = results(*st)
+        r.update({"mechanism": "rpr3", "method": method, "comparison": {"rows": [
+            {"stage": s["name"], "counter_rotations": 3} for s in r["stages"]]}})
+        return {"title": title, "link": f"{title}/index.html", "results": r, "verdict": V.verdict(r)}
+
+    a = entry("idler", "idler_loop", stage("cr", "force+moment", f=1e-13, m=1e-13))
+    b = entry("legs", "scott_russell", stage("cr", "force+moment", f=1e-13, m=6.7))
+    c = entry("other", "idler_loop", stage("cw", "force", f=1e-13, m=2.0))
+    c["results"]["mechanism"] = "four_bar"  # one method only on its mechanism: no comparison
+    got = comparisons([a, b, c])
+    assert [g["template"] for g in got] == ["rpr3"]
+    rows = {r["title"]: r for r in got[0]["rows"]}
+    assert rows["idler"]["moment"] == "cancelled" and rows["legs"]["level"] == "bad"
+    assert rows["legs"]["moment"].startswith("worse") and rows["idler"]["counter_rotations"] == 3
+
+
+def test_a_spec_without_balancing_stages_has_a_neutral_verdict_and_an_index_row():
+    from balpipe.report.site import headline
+
+    v = V.verdict(results())
+    assert v["level"] == "neutral" and v["motions"] == []
+    h = headline(v, 1e-9)
+    assert h["force"] == "—" and h["costs"] == [] and h["realisable"]
