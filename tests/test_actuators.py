@@ -348,7 +348,7 @@ def _write(tmp_path, spec, name="bad.yaml") -> Path:
     (["A1", "A1", "A3"], "named twice"),
 ])
 def test_actuator_errors_are_located(tmp_path, acts, expect):
-    from balpipe.build import analyse as build_analyse
+    from balpipe.runner import analyse as build_analyse
 
     spec = rrr3_spec(actuators=acts)
     path = _write(tmp_path, spec)

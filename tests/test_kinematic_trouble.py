@@ -79,7 +79,7 @@ def test_loop_too_short_names_the_dyad_and_its_lengths():
 
 
 def test_loop_that_cannot_close_at_the_start_is_located(tmp_path):
-    from balpipe.build import analyse as build_analyse
+    from balpipe.runner import analyse as build_analyse
 
     p = _write(tmp_path, "x.yaml", _four_bar(coupler=0.5))  # |A O4| = 0.22 m at t = 0 is below 0.5 - 0.22
     with pytest.raises(SpecErrors) as err:

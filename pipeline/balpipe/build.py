@@ -33,8 +33,10 @@ from .loader import LoadedSpec, SpecErrors, load, load_text, schema
 from .report import history_page
 from .report.page import render_page
 from .report.results import dumps, results_dict, timeseries_csv
-from .spec_parts import SpecFieldError
 from .fsutil import remove_path, remove_temporaries, tmp_name, write_atomic_dir, write_file_atomic, write_new
+from .site_earlier import earlier_pages
+from .spec_files import MAX_SLUG, clash_notes, clashes, find_specs, slug_for  # noqa: F401  (build.find_specs, build.slug_for as before)
+from .spec_parts import SpecFieldError
 
 
 @dataclass
@@ -65,45 +67,6 @@ class SchedulerError(Exception):
 
 class OutputError(Exception):
     """The output folder cannot be used (a file, not writable): nothing was written."""
-
-
-def find_specs(paths: list[str], problems: list[str] | None = None) -> list[Path]:
-    """Spec files named on the command line or found (*.yaml, *.yml) in named folders, sorted.
-    Folders that cannot be read are appended to ``problems`` (not silently skipped)."""
-    found: list[Path] = []
-    for p in map(Path, paths):
-        if p.is_dir():
-            def unreadable(exc: OSError) -> None:
-                if problems is not None:
-                    problems.append(f"{exc.filename}: cannot read the folder: {exc.strerror or exc}")
-            files = []
-            for root, dirs, names in os.walk(p, onerror=unreadable):
-                dirs.sort()
-                files += [Path(root) / n for n in names if Path(n).suffix in (".yaml", ".yml")]
-            found += sorted(q for q in files if q.is_file())
-        else:
-            found.append(p)
-    seen, unique = set(), []
-    for f in found:
-        key = f.resolve()
-        if key not in seen:
-            seen.add(key)
-            unique.append(f)
-    return unique
-
-
-MAX_SLUG = 80  # characters of a page folder's name (file systems allow 255 bytes)
-
-
-def slug_for(path: Path) -> str:
-    """The page folder of a spec: its file name's stem with other characters than letters,
-    digits, '-' and '_' replaced by '-'; long names are cut and end in a hash of the stem."""
-    stem = path.stem
-    slug = "".join(c if (c.isalnum() and c.isascii()) or c in "-_" else "-" for c in stem)
-    if len(slug) > MAX_SLUG or not slug.strip("-_"):
-        digest = hashlib.sha256(stem.encode("utf-8", "surrogateescape")).hexdigest()[:10]
-        slug = slug[: MAX_SLUG - 11] + "-" + digest
-    return slug
 
 
 @lru_cache(maxsize=1)
@@ -174,6 +137,14 @@ class Computed:
     seconds: float = 0.0
 
 
+def page_hash(loaded: LoadedSpec, target: Path, simulate: bool) -> str:
+    """The input hash of a spec's page in ``target``: the spec's text and the CSV tables it reads,
+    the simulation option, balpipe's code, and the page's history (a new history.json re-renders
+    the page)."""
+    h = input_hash(loaded.text + table_texts(loaded.spec), Options(out=target.parent, simulate=simulate))
+    return history_page.mix_hash(h, target)
+
+
 def plan_one(path: Path, opts: Options) -> Job | Outcome:
     """Read one spec and decide: an :class:`Outcome` when there is nothing to compute (invalid,
     or unchanged since the last build), else the :class:`Job` that computes it."""
@@ -184,8 +155,7 @@ def plan_one(path: Path, opts: Options) -> Job | Outcome:
     except SpecErrors as exc:
         return Outcome(str(path), slug, "error", str(exc), spec_error=True, seconds=time.perf_counter() - start)
     target = opts.out / slug
-    h = input_hash(loaded.text + table_texts(loaded.spec), opts)  # the CSV tables it reads count too
-    h = history_page.mix_hash(h, target)  # a new history.json re-renders the page
+    h = page_hash(loaded, target, opts.simulate)
     if not opts.force:
         previous = _read_results(target)
         if previous is not None and previous.get("input_hash") == h:
@@ -337,37 +307,6 @@ def _worker_init() -> None:
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
-def _clash_groups(specs: list[Path]) -> list[list[Path]]:
-    """Specs whose page folders would be the same (x.yaml and x.yml, 'a b' and 'a-b', names that
-    differ only in case), each group in sorted order."""
-    groups: dict[str, list[Path]] = {}
-    for p in specs:
-        groups.setdefault(slug_for(p).lower(), []).append(p)
-    return [sorted(g, key=str) for g in groups.values() if len(g) > 1]
-
-
-def _clashes(specs: list[Path]) -> dict[Path, str]:
-    """The specs refused for a page-name clash: every one after the first of its group in sorted
-    order (the first is built), each with a message naming the others."""
-    out = {}
-    for first, *rest in _clash_groups(specs):
-        for p in rest:
-            others = ", ".join(str(q) for q in [first, *rest] if q is not p)
-            out[p] = (f"{p}: its page {slug_for(p)}/ would be the same as that of {others}; "
-                      f"{first} (the first in sorted order) is built, not this file; rename one of these files")
-    return out
-
-
-def _clash_notes(specs: list[Path]) -> dict[Path, str]:
-    """For the spec built from each clashing group: a note naming the files refused beside it."""
-    out = {}
-    for first, *rest in _clash_groups(specs):
-        others = ", ".join(map(str, rest))
-        out[first] = (f"{first}: its page {slug_for(first)}/ would be the same as that of {others}; "
-                      f"built from this file, the first in sorted order ({others} refused); rename one of these files")
-    return out
-
-
 def usable_cores() -> int:
     """The cores this process may run on: ``os.process_cpu_count()`` (Python 3.13), else the
     scheduler's affinity mask, else ``os.cpu_count()``; at least 1."""
@@ -402,7 +341,7 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
     problems: list[str] = []
     specs = find_specs(paths, problems)
     outcomes: list[Outcome] = [Outcome(msg.split(":", 1)[0], "", "error", msg, spec_error=True) for msg in problems]
-    clash = _clashes(specs)
+    clash = clashes(specs)
     todo: list[Path] = []
     for p in specs:
         if p in clash:
@@ -413,7 +352,7 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
     if progress:
         for o in outcomes:  # refused before any work: k = 0
             progress(0, len(todo), o)
-        for p, note in _clash_notes(specs).items():  # said before any work too; built as usual
+        for p, note in clash_notes(specs).items():  # said before any work too; built as usual
             progress(0, len(todo), Outcome(str(p), slug_for(p), "ok", note))
     if jobs is None:
         jobs = default_jobs(len(todo))
@@ -429,7 +368,8 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
             raise
         from .report.site import write_site
 
-        write_site(opts.out, [o for o in outcomes if o.slug])
+        built = [o for o in outcomes if o.slug]
+        write_site(opts.out, built, earlier_pages(opts.out, {o.slug for o in built}, page_hash))
         write_file_atomic(opts.out / "balpipe.schema.json", json.dumps(schema(), indent=2, sort_keys=True) + "\n")
     return outcomes
 

@@ -17,7 +17,7 @@ def run(args) -> int:
     """Everything ``build`` checks before simulating: schema, units, limits, geometry, the
     balancing, the analysis of every stage (singular motions), the references, and the paths and
     values of a ``sweep:`` block. Keeps going past a spec that fails."""
-    from ..build import _clashes, find_specs
+    from ..spec_files import clashes, find_specs
     from ..runner import analyse
     from ..loader import SpecErrors, load
     from ..sweep import SweepError, plan
@@ -29,7 +29,7 @@ def run(args) -> int:
     files = find_specs(args.paths, problems)
     for msg in problems:
         print(msg, file=sys.stderr)
-    clash = _clashes(files)
+    clash = clashes(files)
     bad = crashed = 0
     for f in files:
         try:

@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 
 from ..fsutil import write_file_atomic  # replaced in one step, never through a planted symlink
-from . import citations, site_earlier, site_filter, verdict
+from . import citations, site_filter, verdict
 from .costs import factor_text
 from .render import environment, num, printable, ratio
 from .render import tol as tol_fmt
@@ -158,9 +158,11 @@ def _costs(results: dict, first: dict, last: dict) -> dict:
     return {"claims": claims, "added_mass": added, "efforts": efforts, "joint_increase": joint}
 
 
-def write_site(out: Path, outcomes: list) -> None:
+def write_site(out: Path, outcomes: list, earlier: list = ()) -> None:
+    """The site's index (and its navigation script): this build's ``outcomes`` and the pages of
+    ``earlier`` builds still in ``out`` (:func:`balpipe.site_earlier.earlier_pages`)."""
     entries = [_entry(out, o) for o in sorted(outcomes, key=lambda o: o.source)]
-    for old in site_earlier.earlier_pages(out, {o.slug for o in outcomes}):
+    for old in earlier:
         e = _entry(out, old)
         e["built"] = "in an earlier build"
         if old.stale_reason:

@@ -24,11 +24,26 @@ Public API
     :func:`balpipe.validate.space.build_space` (the translation of a model into pymunk).
 """
 
-from .floating import FreeFloating, free_floating
-from .loads import StageValidation, validate
-from .run import SimulationRun, simulate
-from .settings import ValidationSettings, default_settings
-from .torque import TorqueDriven, torque_driven
+from importlib import import_module
+
+# the public names, loaded on first use: importing balpipe.validate.settings (the step size, for
+# the pre-run limits of ``balpipe check``) does not load pymunk
+_WHERE = {
+    "FreeFloating": ".floating", "free_floating": ".floating",
+    "StageValidation": ".loads", "validate": ".loads",
+    "SimulationRun": ".run", "simulate": ".run",
+    "ValidationSettings": ".settings", "default_settings": ".settings",
+    "TorqueDriven": ".torque", "torque_driven": ".torque",
+}
+
+
+def __getattr__(name: str):
+    if name not in _WHERE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(import_module(_WHERE[name], __name__), name)
+    globals()[name] = value
+    return value
+
 
 __all__ = [
     "ValidationSettings",

@@ -14,9 +14,11 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..build import Options, input_hash
-from ..loader import SpecErrors, load
-from . import history_page
+from typing import Callable
+
+from .loader import LoadedSpec, SpecErrors, load
+
+PageHash = Callable[[LoadedSpec, Path, bool], str]  # (spec, its page folder, simulated?) -> the build's input hash
 
 
 @dataclass
@@ -31,8 +33,9 @@ class Earlier:
     stale_reason: str = ""
 
 
-def spec_changed(folder: Path, results: dict) -> str:
-    """Why an earlier page no longer shows its spec ('' when it still does)."""
+def spec_changed(folder: Path, results: dict, page_hash: PageHash) -> str:
+    """Why an earlier page no longer shows its spec ('' when it still does): ``page_hash`` is the
+    hash a build would give the spec now (:func:`balpipe.build.page_hash`)."""
     source = Path(results.get("source") or "")
     if not source.is_file():
         return f"spec {source} no longer found"
@@ -41,11 +44,11 @@ def spec_changed(folder: Path, results: dict) -> str:
     except (SpecErrors, OSError, ValueError):
         return "its spec has changed and is now invalid"
     simulated = results.get("validation") is not None
-    h = history_page.mix_hash(input_hash(loaded.text, Options(out=folder.parent, simulate=simulated)), folder)
+    h = page_hash(loaded, folder, simulated)
     return "" if h == results.get("input_hash") else "its spec or balpipe changed since this page was built"
 
 
-def earlier_pages(out: Path, built: set[str]) -> list[Earlier]:
+def earlier_pages(out: Path, built: set[str], page_hash: PageHash) -> list[Earlier]:
     """The site's study pages outside ``built`` (the slugs of this build), sorted by folder."""
     found = []
     for folder in sorted(p for p in out.iterdir() if p.is_dir() and not p.is_symlink()):
@@ -61,5 +64,5 @@ def earlier_pages(out: Path, built: set[str]) -> list[Earlier]:
         if not isinstance(results, dict) or not results.get("stages"):
             continue
         found.append(Earlier(str(results.get("source") or folder.name), folder.name,
-                             results.get("status") or "ok", results, stale_reason=spec_changed(folder, results)))
+                             results.get("status") or "ok", results, stale_reason=spec_changed(folder, results, page_hash)))
     return found

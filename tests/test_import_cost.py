@@ -1,0 +1,37 @@
+"""``balpipe --help`` and ``balpipe check`` of a spec load only what they need (issue 23 item 4):
+no scipy, matplotlib, pymunk, jinja2, cvxpy or dask. Each runs in a fresh interpreter, so what
+another test imported cannot hide an import."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+HEAVY = ("scipy", "matplotlib", "pymunk", "jinja2", "cvxpy", "distributed", "dask")
+
+PROBE = """
+import json, sys
+from balpipe.cli import main
+try:
+    main(json.loads(sys.argv[1]))
+except SystemExit:
+    pass
+print(json.dumps(sorted(m for m in {heavy!r} if m in sys.modules)), file=sys.stderr)
+"""
+
+
+def loaded_by(args: list[str]) -> list[str]:
+    r = subprocess.run([sys.executable, "-c", PROBE.format(heavy=HEAVY), json.dumps(args)], cwd=ROOT,
+                       capture_output=True, text=True, timeout=120)
+    return json.loads(r.stderr.strip().splitlines()[-1])
+
+
+@pytest.mark.parametrize("args", [["--help"], ["build", "--help"], ["check", "specs/scott_russell.yaml"],
+                                  ["check", "specs/offset_slider_crank.yaml", "specs/paper002_decoupling.yaml"]])
+def test_a_command_loads_no_heavy_library_it_does_not_use(args):
+    assert loaded_by(args) == []
