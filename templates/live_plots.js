@@ -4,8 +4,6 @@
 (function () {
   "use strict";
   if (typeof uPlot === "undefined") return;
-  const COLORS = ["#000000", "#1f5fa8", "#c62828", "#1a7f37", "#9a6700", "#6f42c1", "#0b7285", "#d9480f"];
-  const DASH = [[], [6, 3], [2, 2], [8, 3, 2, 3], [1, 3]];
   function fmt(v) {
     if (v == null) return "—";
     const a = Math.abs(v);
@@ -22,9 +20,8 @@
       el.className = "live-plot";
       el.dataset.quantity = p.key;
       host.appendChild(el);
-      const series = [{ label: "t (s)", value: (u, v) => fmt(v) }].concat(d.series.map((s, k) => ({
-        label: s.label, stroke: COLORS[k % COLORS.length], dash: DASH[Math.floor(k / COLORS.length) % DASH.length],
-        width: 1.5, value: (u, v) => fmt(v),
+      const series = [{ label: "t (s)", value: (u, v) => fmt(v) }].concat(d.series.map(s => ({
+        label: s.label, stroke: s.stroke, dash: s.dash, width: s.width, value: (u, v) => fmt(v),
       })));
       const opts = {
         title: p.title + " (" + p.unit + ")", width: width(), height: 240,

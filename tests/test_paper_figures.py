@@ -57,3 +57,17 @@ def test_the_papers_panels_keep_the_pages_stage_styles():
     html = render_page(study, results_dict(study, "x", "h", False), "")
     assert html.count('id="style-legend"') == 1
     assert 'data-figures="' in html and "10a 10b 11 12" in html
+
+
+def test_live_plots_draw_each_stage_in_its_static_line_style():
+    """The interactive curves keep the page's one style legend: stage k has the colour, dashes and
+    width of the static figures' stage k (issue 22: one style per stage on a page)."""
+    from matplotlib.colors import to_hex
+
+    from balpipe.draw import figures
+    from balpipe.report.live_plots import DASHES, line_style
+
+    for k in range(8):
+        st = figures.style(k)
+        assert line_style(k) == {"stroke": to_hex(st["color"]), "dash": DASHES[st["linestyle"]], "width": st["linewidth"]}
+    assert line_style(1)["dash"] and not line_style(0)["dash"] and line_style(2)["stroke"] != line_style(0)["stroke"]

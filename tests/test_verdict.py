@@ -160,3 +160,13 @@ def test_a_spec_without_balancing_stages_has_a_neutral_verdict_and_an_index_row(
     assert v["level"] == "neutral" and v["motions"] == []
     h = headline(v, 1e-9)
     assert h["force"] == "—" and h["costs"] == [] and h["realisable"]
+
+
+def test_design_card_positions_show_round_off_as_zero():
+    """A counterweight computed on a link's axis has a lateral coordinate of round-off: the card
+    reads 0 there, and keeps a real offset."""
+    from balpipe.report.design_card import _position
+
+    assert _position((-0.2, 7.285e-17)) == "(-0.2, 0) m"
+    assert _position((-0.2, 3e-4)) == "(-0.2, 0.0003) m"
+    assert _position((0.0, 0.0)) == "(0, 0) m"

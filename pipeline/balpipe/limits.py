@@ -55,7 +55,7 @@ def check_simulation(study: Any) -> None:
     spec = study.spec
     if not spec.validation.enabled:
         return
-    from .validate.settings import default_settings  # not the simulation itself: no pymunk
+    from .validate import default_settings  # balpipe.validate loads only its settings for this: no pymunk
 
     T = spec.motion.duration
     for s in study.stages:

@@ -15,6 +15,14 @@ def _fmt(x: float) -> str:
     return f"{x:.4g}"
 
 
+def _position(p) -> str:
+    """A part's position on its link, (x, y) m; a coordinate below 1e-9 of the other is round-off
+    of the computation and reads 0."""
+    scale = max(abs(float(p[0])), abs(float(p[1])))
+    x, y = (0.0 if abs(float(c)) <= 1e-9 * scale else float(c) for c in p[:2])
+    return f"({_fmt(x)}, {_fmt(y)}) m"
+
+
 def added_parts(base: Model, final: Model) -> list[dict]:
     """Counterweights and discs of ``final`` that ``base`` lacks, and links whose own mass or
     inertia the method changed. Positions of attachments are in their link's frame (m)."""
@@ -36,7 +44,7 @@ def added_parts(base: Model, final: Model) -> list[dict]:
             atts = tuple(a for a in b.attachments if a.name not in had)
         for a in atts:
             rows.append({"name": a.name, "kind": a.kind, "mass": a.mass,
-                         "where": f"on {b.name} at ({_fmt(a.position[0])}, {_fmt(a.position[1])}) m",
+                         "where": f"on {b.name} at {_position(a.position)}",
                          "inertia": a.inertia, "buildable": a.mass >= 0 and a.inertia >= 0})
     return rows
 
