@@ -62,8 +62,17 @@ PHASES = ["import", "load", "balance", "analyse", "validate", "torque", "reactio
           "write", "other", "total"]
 
 DRIVER = r'''
-import importlib, json, sys, time
+import importlib, importlib.util, json, os, sys, time
 t_start = time.perf_counter()
+import balpipe
+# a source tree on PYTHONPATH: its templates/ folder (beside pipeline/, installed as
+# balpipe.templates) is found where no install of the same tree provides it
+_tpl = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(balpipe.__file__))), "templates")
+if importlib.util.find_spec("balpipe.templates") is None and os.path.isdir(_tpl):
+    _s = importlib.util.spec_from_file_location("balpipe.templates", os.path.join(_tpl, "__init__.py"),
+                                                submodule_search_locations=[_tpl])
+    balpipe.templates = sys.modules["balpipe.templates"] = importlib.util.module_from_spec(_s)
+    _s.loader.exec_module(balpipe.templates)
 import balpipe.cli as cli
 stack = []
 
