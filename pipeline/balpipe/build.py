@@ -21,7 +21,7 @@ import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from importlib import resources
 from importlib.util import find_spec
@@ -59,6 +59,7 @@ class Options:
     out: Path
     simulate: bool = True
     force: bool = False
+    sim_workers: int = 1  # processes for one spec's simulations (cores left over by fewer specs than cores)
 
 
 class SchedulerError(Exception):
@@ -123,6 +124,7 @@ class Job:
     simulate: bool
     history: dict | None
     history_files: dict[str, str]
+    sim_workers: int = 1  # the stages' simulations in that many processes (the same results)
 
 
 @dataclass
@@ -164,7 +166,8 @@ def plan_one(path: Path, opts: Options) -> Job | Outcome:
                 remove_path(stale_failed)
             return Outcome(str(path), slug, previous.get("status", "ok"), "unchanged", previous, skipped=True,
                            seconds=time.perf_counter() - start)
-    return Job(path, loaded.text, h, opts.simulate, history_page.section(target), history_page.build_files(target))
+    return Job(path, loaded.text, h, opts.simulate, history_page.section(target), history_page.build_files(target),
+               opts.sim_workers)
 
 
 def compute(job: Job) -> Computed:
@@ -177,7 +180,7 @@ def compute(job: Job) -> Computed:
         loaded = LoadedSpec(job.path, job.text, spec, node)
         st = runner.analyse(loaded, simulate=job.simulate)
         extra: dict[str, str] = {}
-        if job.simulate and runner.simulate(loaded, st):
+        if job.simulate and runner.simulate(loaded, st, workers=job.sim_workers):
             from .validation_stage import timing, timing_script
 
             times = timing(st)
@@ -354,8 +357,11 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
             progress(0, len(todo), o)
         for p, note in clash_notes(specs).items():  # said before any work too; built as usual
             progress(0, len(todo), Outcome(str(p), slug_for(p), "ok", note))
+    cores = jobs if jobs is not None else usable_cores()
     if jobs is None:
         jobs = default_jobs(len(todo))
+    if todo and not scheduler and cores > len(todo):  # fewer specs than cores: their stages share the rest
+        opts = replace(opts, sim_workers=cores // len(todo))
     with locked(opts.out):
         remove_temporaries(opts.out)
         try:

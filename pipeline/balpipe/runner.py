@@ -31,14 +31,15 @@ def analyse(loaded: LoadedSpec, simulate: bool = True):
                                     "check the magnitudes of masses, lengths and the duration")]) from None
 
 
-def simulate(loaded: LoadedSpec, st) -> bool:
-    """The pymunk validation of every stage of ``st`` when the spec enables it; True when it ran."""
+def simulate(loaded: LoadedSpec, st, workers: int = 1) -> bool:
+    """The pymunk validation of every stage of ``st`` when the spec enables it; True when it ran.
+    ``workers`` > 1: the stages' simulations in that many processes (the same results)."""
     if not loaded.spec.validation.enabled:
         return False
     from .validation_stage import simulate_study  # pymunk only when a simulation runs
 
     try:
-        simulate_study(st)
+        simulate_study(st, workers=workers)
     except SpecFieldError as exc:
         raise loaded.error(exc) from None
     return True

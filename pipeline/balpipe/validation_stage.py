@@ -132,12 +132,28 @@ def _parallel(study: Study, workers: int, fn, args: list[tuple]) -> list:
 
     global _FORKED
     _FORKED = study
+    pool = ProcessPoolExecutor(max_workers=min(workers, len(args)), mp_context=multiprocessing.get_context("fork"),
+                               initializer=_quiet_child)
     try:
-        ctx = multiprocessing.get_context("fork")
-        with ProcessPoolExecutor(max_workers=min(workers, len(args)), mp_context=ctx) as pool:
-            return list(pool.map(fn, *zip(*args)))
+        out = list(pool.map(fn, *zip(*args)))
+    except BaseException:  # Ctrl-C, SIGTERM, a failure: stop the other simulations now, not at their end
+        for proc in list(getattr(pool, "_processes", {}).values()):
+            proc.terminate()
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
     finally:
         _FORKED = None
+    pool.shutdown()
+    return out
+
+
+def _quiet_child() -> None:
+    """A forked simulation leaves Ctrl-C to its parent (no traceback of its own) and ends
+    silently on SIGTERM."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def simulate_study(study: Study, workers: int = 1) -> None:
