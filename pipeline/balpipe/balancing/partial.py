@@ -26,7 +26,7 @@ from . import partial_fronts as PF
 from .base import BalanceResult, Parameter, Stage
 from .force_balance import _point, counterweight_notation, regions_from_spec
 from .moment_balance import add_discs, counter_rotation_notation
-from .partial_maps import DiscVars, Maps, PartVars, build
+from .partial_maps import NO_PART, DiscVars, Maps, PartVars, build
 from .partial_program import Program, Term
 from .partial_spec import PartialBalance, PartialCounterweightSpec
 from .regressor import model_size
@@ -223,7 +223,7 @@ def design_table(maps: Maps, z: np.ndarray) -> list[dict]:
     big = max([abs(z[p.col]) for p in maps.parts] + [1e-300])
     for p in maps.parts:
         m, sx, sy, J = (float(v) for v in z[p.col : p.col + 4])
-        if m <= 1e-12 * big:  # no part (as Maps.design): its position is undefined, show the region's first point
+        if m <= NO_PART * big:  # no part (as Maps.design): its position is undefined, show the region's first point
             m, (sx, sy), J = 0.0, p.points[0], 0.0
             x, y = sx, sy
         else:

@@ -33,6 +33,11 @@ from .regressor import parameters
 
 JOINT_COMPONENTS = {"revolute": ("Fx", "Fy"), "prismatic": ("N",), "gear": ("T",)}
 
+#: a part lighter than this fraction of the heaviest is no part: the interior-point solver stops at
+#: its tolerance (1e-8 of the scaled problem), so a mass it leaves below that is its round-off
+#: (a counterweight of 2e-8 kg beside one of 0.6 kg), not a part to build
+NO_PART = 1e-7
+
 
 @dataclass(frozen=True)
 class PartVars:
@@ -114,10 +119,11 @@ class Maps:
     def added_mass(self, z: np.ndarray) -> float:
         return float(sum(z[p.col] for p in self.parts)) + self.fixed_mass
 
-    def realised(self, z: np.ndarray, tiny: float = 1e-12) -> np.ndarray:
+    def realised(self, z: np.ndarray, tiny: float | None = None) -> np.ndarray:
         """z as :meth:`design` builds it: no part below ``tiny`` x the largest mass, every
         J >= |s|^2 / m and every disc inertia >= 0 exactly (a solver meets them to its tolerance)."""
         z = np.asarray(z, dtype=float).copy()
+        tiny = NO_PART if tiny is None else tiny
         big = max([abs(z[p.col]) for p in self.parts] + [1e-300])
         for p in self.parts:
             m, sx, sy, J = z[p.col : p.col + 4]
@@ -129,11 +135,12 @@ class Maps:
             z[d.col] = max(0.0, z[d.col])
         return z
 
-    def design(self, z: np.ndarray, tiny: float = 1e-12) -> Model:
+    def design(self, z: np.ndarray, tiny: float | None = None) -> Model:
         """The model with the parts of design z: each counterweight of mass m at s / m with
         centroidal inertia J - |s|^2 / m (none below ``tiny`` x the largest mass), each disc's
         inertia."""
         z = np.asarray(z, dtype=float)
+        tiny = NO_PART if tiny is None else tiny
         out = self.model
         big = max([abs(z[p.col]) for p in self.parts] + [1e-300])
         for p in self.parts:
