@@ -32,6 +32,17 @@ MAX_TABLE_BYTES = 20_000_000
 JOIN_TOLERANCE = 1e-9
 
 
+def _tagger(laws: tuple[str, ...]):
+    """The discriminator of a union of laws: an entry's ``law`` when it is one of ``laws``, else
+    'profile' (a point-to-point law, whose ``law`` field may be absent)."""
+
+    def tag(v: Any) -> str:
+        law = v.get("law") if isinstance(v, dict) else getattr(v, "law", None)
+        return f"law[{law if law in laws else 'profile'}]"
+
+    return tag
+
+
 def _tag(kind: str) -> Tag:
     # 'law[...]' is not a key of the document: the loader drops it from error locations
     return Tag(f"law[{kind}]")
@@ -193,16 +204,11 @@ class ProfileTiming(Strict):
     accel_fraction: number(gt=0, le=0.5) = Field(1 / 3, description="trapezoidal law: fraction accelerating")
 
 
-def _timing_tag(v: Any) -> str:
-    law = v.get("law") if isinstance(v, dict) else getattr(v, "law", None)
-    return f"law[{law if law in ('constant_speed', 'cycle', 'cam', 'table', 'fourier') else 'profile'}]"
-
-
 Timing = Annotated[
     Union[Annotated[ProfileTiming, _tag("profile")], Annotated[ConstantSpeedDrive, _tag("constant_speed")],
           Annotated[CycleDrive, _tag("cycle")], Annotated[CamDrive, _tag("cam")],
           Annotated[TableDrive, _tag("table")], Annotated[FourierDrive, _tag("fourier")]],
-    Discriminator(_timing_tag),
+    Discriminator(_tagger(("constant_speed", "cycle", "cam", "table", "fourier"))),
 ]
 
 
@@ -243,18 +249,13 @@ class PathDrive(Strict):
 NEW_LAWS = ("constant_speed", "cam", "fourier", "table", "cycle", "path")
 
 
-def _drive_tag(v: Any) -> str:
-    law = v.get("law") if isinstance(v, dict) else getattr(v, "law", None)
-    return f"law[{law if law in NEW_LAWS else 'profile'}]"
-
-
 #: one ``motion.drive`` entry: point-to-point (DriveSpec) or one of the laws here
 Drive = Annotated[
     Union[Annotated[DriveSpec, _tag("profile")], Annotated[ConstantSpeedDrive, _tag("constant_speed")],
           Annotated[CamDrive, _tag("cam")], Annotated[FourierDrive, _tag("fourier")],
           Annotated[TableDrive, _tag("table")], Annotated[CycleDrive, _tag("cycle")],
           Annotated[PathDrive, _tag("path")]],
-    Discriminator(_drive_tag),
+    Discriminator(_tagger(NEW_LAWS)),
 ]
 
 
