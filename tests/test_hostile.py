@@ -459,7 +459,9 @@ def test_interrupt_is_clean_at_any_jobs(tmp_path, sig, code, jobs):
     d = tmp_path / "specs"
     d.mkdir()
     (d / "a_invalid.yaml").write_text("name: [\n")  # done at once: its worker waits idle for work
-    shutil.copy(SPECS / "paper004_five_bar.yaml", d / "paper004_five_bar.yaml")  # busy: simulated
+    # busy: simulated for about 20 s on an idle machine (the five-bar, 7 s since the validation got
+    # faster, could finish before the signal)
+    shutil.copy(SPECS / "paper000_rpr3_idler_loop.yaml", d / "paper000_rpr3_idler_loop.yaml")
     out = tmp_path / "out"
     old = _old_site(out)
     p = subprocess.Popen([sys.executable, "-m", "balpipe", "build", d, "-o", out, "-j", str(jobs)],
