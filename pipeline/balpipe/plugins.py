@@ -49,7 +49,10 @@ class Template:
 @dataclass(frozen=True)
 class Method:
     """A balancing method: ``spec`` is its pydantic section (a ``method`` literal names it),
-    ``balance(mechanism_spec, method_spec, model) -> BalanceResult`` for ``templates``."""
+    ``balance(mechanism_spec, method_spec, model) -> BalanceResult`` for ``templates``.
+    ``figures(study)`` optionally yields the method's report figures as (title, svg or html,
+    caption), drawn from the study's stages and ``study.balance.details``: the page composes the
+    template's figures and the method's, so no figure code branches on a method's name."""
 
     name: str
     spec: type[Strict]
@@ -59,6 +62,7 @@ class Method:
     uses_spec: bool = False  # balance(..., spec): the method also reads the motion and analysis settings
     generic: bool = False  # applies to every template; balance() also receives the time grid t
     notation: Any = None  # the papers' symbols of the inputs: a table or table(method_spec) (balpipe.notation)
+    figures: Callable[..., Any] | None = None
 
 
 @dataclass(frozen=True)

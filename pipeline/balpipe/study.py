@@ -61,9 +61,15 @@ class Study:
 
     def extra_figures(self) -> list[tuple[str, str, str]]:
         """Figures that only the mechanism's template or the method knows how to draw (title,
-        svg, caption)."""
-        hook = registry.TEMPLATES[self.spec.mechanism.template].figures
-        out = list(hook(self)) if hook is not None else []
+        svg, caption): the method's (:attr:`plugins.Method.figures`: the paper's figures of its
+        method), then the template's (:attr:`plugins.Template.figures`), then those of the
+        balancing result."""
+        out = []
+        method = registry.METHODS.get(self.spec.balancing.method)
+        for hook in (method.figures if method is not None else None,
+                     registry.TEMPLATES[self.spec.mechanism.template].figures):
+            if hook is not None:
+                out += list(hook(self))
         if self.balance.figures is not None:
             out += list(self.balance.figures(self))
         return out

@@ -14,9 +14,9 @@ FAMILY = Family(
     methods=(
         Method("rpr3_idler_loop", idler_loop.Rpr3IdlerLoop, idler_loop.balance, ("rpr3",),
                "idler loop E-F-P, counterweights (eqs. 5a-d), chained counter-rotations (eqs. 9a-d)",
-               notation=idler_loop.NOTATION),
+               notation=idler_loop.NOTATION, figures=figures.paper_figures("Fig. 4", "idler_loop", 17)),
         Method("rpr3_scott_russell", scott_russell.Rpr3ScottRussell, scott_russell.balance, ("rpr3",),
                "Scott-Russell legs, counterweights (eqs. 30a-d), eq. 30e, one counter-rotation per leg (eq. 30f)",
-               notation=scott_russell.NOTATION),
+               notation=scott_russell.NOTATION, figures=figures.paper_figures("Fig. 8", "scott_russell", 28)),
     ),
 )

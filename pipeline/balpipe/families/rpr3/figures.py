@@ -8,9 +8,6 @@ import numpy as np
 
 from .template import pose_of, prismatic_equivalent
 
-PAPER_FIGURES = {"rpr3_idler_loop": "Fig. 4", "rpr3_scott_russell": "Fig. 8"}
-ADDED_LINKAGE = {"rpr3_idler_loop": "idler_loop", "rpr3_scott_russell": "scott_russell"}
-
 
 def _own(study) -> list:
     """The main design's stages (those of ``compare`` designs are named design:stage and shown in
@@ -26,44 +23,55 @@ def _stage(study, name: str):
 
 
 def figures(study):
-    """The paper's shaking force x, y and moment figure with its line styles (Fig. 4 for the idler
-    loop, Fig. 8 for the Scott-Russell legs: unbalanced solid, counterweights dashed,
-    counter-rotations grey; the added-linkage stage, which the paper does not plot, dotted), and
-    a table of the peaks and of the factor by which the counterweights raise the peak moment."""
-    from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
-
-    method = study.spec.balancing.method
-    styles = {
-        "unbalanced": {"color": "black", "linestyle": "-", "linewidth": 1.3},
-        ADDED_LINKAGE.get(method, ""): {"color": "tab:blue", "linestyle": ":", "linewidth": 1.2},
-        "counterweights": {"color": "black", "linestyle": "--", "linewidth": 1.3},
-        "counter_rotations": {"color": "0.6", "linestyle": "-", "linewidth": 2.4},
-    }
-    fig, axes = plt.subplots(1, 3, figsize=(10.5, 3.2))
-    panels = (("(a) shaking force along x (N)", lambda a: a.force[:, 0]),
-              ("(b) shaking force along y (N)", lambda a: a.force[:, 1]),
-              ("(c) shaking moment about O (N m)", lambda a: a.moment))
-    for ax, (title, fn) in zip(axes, panels):
-        for s in _own(study):
-            st = styles.get(s.stage.name, {"color": "tab:red", "linestyle": "-.", "linewidth": 1.0})
-            ax.plot(s.analysis.t, fn(s.analysis), label=s.stage.label, **st)
-        ax.set_title(title, fontsize=9)
-        ax.set_xlabel("time (s)")
-    handles, labels = axes[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
-    fig.tight_layout(rect=(0, 0.08, 1, 1))
-    number = PAPER_FIGURES.get(method, "")
-    yield (
-        f"Shaking force and moment, every stage ({number} of paper 000)" if number else "Shaking force and moment",
-        to_svg(fig, "rpr3-loads"),
-        "The paper's line styles: before (solid) and after (dashed) the counterweights, after the "
-        "counter-rotations (grey); the stage with the added linkage but no counterweights, which the "
-        "paper does not plot, is dotted. Moments about O, the base's circumcentre; loads that the "
-        "moving links exert on the base.",
-    )
-    yield ("Peak loads and the moment factor", _factor_table(study, method), _factor_caption(study, method))
+    """The template's figure: the axial forces that prismatic actuators would need, when the
+    spec drives the revolutes."""
     if study.spec.mechanism.actuation == "revolute":
+        from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
+
         yield _prismatic_forces_figure(study, plt, to_svg)
+
+
+def paper_figures(number: str, linkage: str, published_factor: float):
+    """The figures of one of the paper's methods (its :attr:`plugins.Method.figures`): the
+    shaking force x, y and moment of every stage in the paper's line styles (``number``: Fig. 4
+    for the idler loop, Fig. 8 for the Scott-Russell legs: unbalanced solid, counterweights
+    dashed, counter-rotations grey; the added-linkage stage ``linkage``, which the paper does not
+    plot, dotted), and a table of the peaks and of the factor by which the counterweights raise
+    the peak moment (the paper reports ``published_factor``)."""
+
+    def figures(study):
+        from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
+
+        styles = {
+            "unbalanced": {"color": "black", "linestyle": "-", "linewidth": 1.3},
+            linkage: {"color": "tab:blue", "linestyle": ":", "linewidth": 1.2},
+            "counterweights": {"color": "black", "linestyle": "--", "linewidth": 1.3},
+            "counter_rotations": {"color": "0.6", "linestyle": "-", "linewidth": 2.4},
+        }
+        fig, axes = plt.subplots(1, 3, figsize=(10.5, 3.2))
+        panels = (("(a) shaking force along x (N)", lambda a: a.force[:, 0]),
+                  ("(b) shaking force along y (N)", lambda a: a.force[:, 1]),
+                  ("(c) shaking moment about O (N m)", lambda a: a.moment))
+        for ax, (title, fn) in zip(axes, panels):
+            for s in _own(study):
+                st = styles.get(s.stage.name, {"color": "tab:red", "linestyle": "-.", "linewidth": 1.0})
+                ax.plot(s.analysis.t, fn(s.analysis), label=s.stage.label, **st)
+            ax.set_title(title, fontsize=9)
+            ax.set_xlabel("time (s)")
+        handles, labels = axes[0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
+        fig.tight_layout(rect=(0, 0.08, 1, 1))
+        yield (
+            f"Shaking force and moment, every stage ({number} of paper 000)",
+            to_svg(fig, "rpr3-loads"),
+            "The paper's line styles: before (solid) and after (dashed) the counterweights, after the "
+            "counter-rotations (grey); the stage with the added linkage but no counterweights, which the "
+            "paper does not plot, is dotted. Moments about O, the base's circumcentre; loads that the "
+            "moving links exert on the base.",
+        )
+        yield ("Peak loads and the moment factor", _factor_table(study, linkage), _factor_caption(published_factor))
+
+    return figures
 
 
 def _prismatic_forces_figure(study, plt, to_svg):
@@ -90,7 +98,7 @@ def _prismatic_forces_figure(study, plt, to_svg):
     )
 
 
-def _factor_table(study, method: str) -> str:
+def _factor_table(study, linkage: str) -> str:
     rows = []
     for s in _own(study):
         an = s.analysis
@@ -106,7 +114,7 @@ def _factor_table(study, method: str) -> str:
             f"<th>peak actuator effort ({' or '.join(units)})</th><th>added mass (kg)</th><th>added inertia (kg m²)</th>"
             "</tr></thead><tbody>")
     out = head + "".join(rows) + "</tbody></table>"
-    cw, un, added = _stage(study, "counterweights"), study.unbalanced, _stage(study, ADDED_LINKAGE.get(method, ""))
+    cw, un, added = _stage(study, "counterweights"), study.unbalanced, _stage(study, linkage)
     if cw is not None:
         out += "<table><thead><tr><th>peak moment with counterweights relative to</th><th>factor</th></tr></thead><tbody>"
         for ref in (un, added):
@@ -117,10 +125,7 @@ def _factor_table(study, method: str) -> str:
     return out
 
 
-def _factor_caption(study, method: str) -> str:
-    paper = {"rpr3_idler_loop": 17, "rpr3_scott_russell": 28}.get(method)
-    text = ("Peaks over the motion of every stage. The factor is the counterweights stage's peak shaking "
-            "moment divided by the reference stage's")
-    if paper:
-        text += f"; the paper reports {paper} (the reference `counterweights.moment_ratio` compares it with the unbalanced 3-RPR)"
-    return text + "."
+def _factor_caption(published_factor: float) -> str:
+    return ("Peaks over the motion of every stage. The factor is the counterweights stage's peak shaking "
+            f"moment divided by the reference stage's; the paper reports {published_factor:g} (the reference "
+            "`counterweights.moment_ratio` compares it with the unbalanced 3-RPR).")
