@@ -160,13 +160,10 @@ def test_legends_never_cover_the_curves(monkeypatch):
 
 
 def test_rpr3_factor_table_gives_the_effort_unit_and_one_full_stop():
-    from balpipe.families.rpr3 import figures as rpr3
-
     st = study_mod.run(loader.load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
-    table = rpr3._factor_table(st, st.spec.balancing.method)
+    table, caption = {title: (body, cap) for title, body, cap in st.extra_figures()}["Peak loads and the moment factor"]
     assert "peak actuator effort (N m)</th>" in table  # revolute actuators A_i
-    caption = rpr3._factor_caption(st, st.spec.balancing.method)
-    assert caption.endswith("3-RPR).") and ".." not in caption
+    assert caption.endswith("3-RPR).") and ".." not in caption and "reports 17 " in caption
 
 
 def test_index_lead_agrees_in_number():

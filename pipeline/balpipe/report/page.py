@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import markupsafe
 import numpy as np
 
 from .. import realisable
@@ -167,7 +168,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         group=study.stages[0].stage.group if len(shown_stages(study)) < len(study.stages) else "",
         reference={"force": study.reference.describe("force"), "moment": study.reference.describe("moment"),
                    "floored": study.reference.floored},
-        spec_text=spec_text,
+        spec_text=markupsafe.escape(spec_text),  # verbatim: markup, so render.typeset leaves its units as written
         history=history,
         actuators=results.get("actuators") or [],
         nav=nav or {},

@@ -8,6 +8,7 @@ from functools import lru_cache
 from importlib import resources
 
 import jinja2
+import markupsafe
 
 from .. import __version__
 
@@ -78,6 +79,21 @@ def unit(u: str) -> str:
     return (u or "").replace("^2", "²").replace("^3", "³")
 
 
+_UNIT_POWERS = (("kg m^2", "kg m²"), ("/s^2", "/s²"), ("m^2", "m²"))
+
+
+def typeset(value):
+    """Every value a template writes, with the units of free text (notes, captions, messages,
+    which the balancing code writes in the specs' ASCII form 'kg m^2') in their display form,
+    so one page never shows 'kg m^2' beside 'kg m²' (issue 22, point 10). Only plain text:
+    markup (drawings, scripts, data) passes unchanged, as does every other value."""
+    if not isinstance(value, str) or isinstance(value, markupsafe.Markup) or "^2" not in value:
+        return value
+    for ascii_form, shown in _UNIT_POWERS:
+        value = value.replace(ascii_form, shown)
+    return value
+
+
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
     folder = resources.files("balpipe.templates")
@@ -86,6 +102,7 @@ def environment() -> jinja2.Environment:
         autoescape=jinja2.select_autoescape(["html"]),
         undefined=jinja2.StrictUndefined,
         keep_trailing_newline=True,
+        finalize=typeset,
     )
     env.filters["num"] = num
     env.filters["ratio"] = ratio
