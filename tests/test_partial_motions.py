@@ -143,6 +143,7 @@ def test_several_motions_are_reported_on_the_page_notes():
 @pytest.mark.parametrize("change, needle", [
     (lambda m: m["motion"]["drive"].update(wheel={"from": 0, "to": 1}), "balancing.motions[0].motion.drive.wheel: unknown drive 'wheel'"),
     (lambda m: m.update(name="motion"), "balancing.motions[0].name: the motion name 'motion' is taken"),
+    (lambda m: m["motion"].update(drive={}), "balancing.motions[0].motion.drive: the driver 'crank' has no law"),
     (lambda m: m["motion"].update(cycles=2), "balancing.motions[0].motion: "),
     (lambda m: m["motion"]["drive"].update(crank={"law": "table", "file": "missing.csv"}),
      "balancing.motions[0].motion.drive.crank.file: cannot read the table 'missing.csv'"),
@@ -161,3 +162,10 @@ def test_a_located_error_in_a_compared_design_s_motion(tmp_path, capsys):
     bal["motions"][0]["motion"]["drive"]["wheel"] = {"from": 0, "to": 1}
     d["compare"] = [{"name": "other", "balancing": bal}]
     _bad(tmp_path, capsys, d, "compare[0].balancing.motions[0].motion.drive.wheel: design 'other': unknown drive")
+
+
+def test_a_custom_driver_without_a_law_is_located(tmp_path, capsys):
+    """The spec's own motion too (it was a KeyError of the custom template)."""
+    d = two_motions(7)
+    d["motion"]["drive"] = {}
+    _bad(tmp_path, capsys, d, "motion.drive: the driver 'crank' has no law: give motion.drive.crank")
