@@ -100,7 +100,7 @@ class OtherMotion(Strict):
     """Another motion of the same mechanism that the design must also serve (the same machine at
     another speed, another trajectory), with the schema of the spec's ``motion`` section."""
 
-    name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_\-]+$", description="its name in the report (e.g. 600rpm)")
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_\-]+$", description="its name in the report (e.g. 600rpm; not 'motion', the spec's own)")
     motion: Motion = Field(description="the motion, as the spec's motion section")
     samples: count(ge=3, le=200_000) | None = Field(None, description="time samples over it (default: analysis.samples)")
 
