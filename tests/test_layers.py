@@ -21,10 +21,10 @@ LAYERS: tuple[tuple[str, ...], ...] = (
      "balpipe.motion_outputs", "balpipe.claim_precision"),
     # L1 computation (and the kinematic diagnosis on top of the engine: dyads, dead centres)
     ("balpipe.engine", "balpipe.validate", "balpipe.dyads", "balpipe.dead_centres"),
-    # L2 contracts and drawing (laws.drives: the motion's spec sections; actuators, loop closure and
+    # L2 contracts and drawing (laws.drives, laws.motion_spec: the motion's spec sections; actuators, loop closure and
     # the assembly branch: checks that locate their errors in the spec)
     ("balpipe.spec_parts", "balpipe.vary", "balpipe.balancing", "balpipe.draw", "balpipe.plugins", "balpipe.registry",
-     "balpipe.laws.drives", "balpipe.actuation", "balpipe.loop_closure", "balpipe.assembly"),
+     "balpipe.laws.drives", "balpipe.laws.motion_spec", "balpipe.actuation", "balpipe.loop_closure", "balpipe.assembly"),
     # L3 families (plugins)
     ("balpipe.families",),
     # L3' the schema

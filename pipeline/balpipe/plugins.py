@@ -61,6 +61,9 @@ class Method:
     label: str
     uses_spec: bool = False  # balance(..., spec): the method also reads the motion and analysis settings
     generic: bool = False  # applies to every template; balance() also receives the time grid t
+    # balance(..., models=f) also receives f(motion, samples, path) -> (unbalanced model, time grid)
+    # of the mechanism on another motion section (errors located at path); generic methods only
+    other_motions: bool = False
     notation: Any = None  # the papers' symbols of the inputs: a table or table(method_spec) (balpipe.notation)
     figures: Callable[..., Any] | None = None
 

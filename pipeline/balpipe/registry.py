@@ -3,8 +3,11 @@ unbalanced model and its balancing stages."""
 
 from __future__ import annotations
 
+import functools
 from dataclasses import replace
 from typing import Any
+
+import numpy as np
 
 from . import units
 from .balancing import force_balance as generic_force
@@ -22,7 +25,7 @@ from .spec_parts import DriveSpec, SpecFieldError
 
 __all__ = [
     "METHODS", "TEMPLATES", "Method", "Template", "balance", "balance_designs", "method_specs", "scalar_laws",
-    "template_specs", "time_grid", "unbalanced_model",
+    "template_specs", "time_grid", "unbalanced_model", "motion_model",
 ]
 
 # methods for every template (they read only the model); "none" is the spec's own default
@@ -36,7 +39,8 @@ GENERIC: tuple[Method, ...] = (
     Method("stages", generic_stages.Stages, generic_stages.balance, (), "stages written by hand, each adding parts",
            generic=True, notation=generic_stages.notation),
     Method("partial_balance", PartialBalance, generic_partial.balance, (),
-           "optimal partial balancing (cone programme)", uses_spec=True, generic=True, notation=generic_partial.notation),
+           "optimal partial balancing (cone programme)", uses_spec=True, generic=True, other_motions=True,
+           notation=generic_partial.notation),
 )
 
 
@@ -105,6 +109,20 @@ def unbalanced_model(spec: Any) -> Model:
     return template.build(mech, laws, time_grid(spec))
 
 
+def motion_model(spec: Any, motion: Any, samples: int | None, path: tuple) -> tuple[Model, np.ndarray]:
+    """The unbalanced model and time grid of ``spec``'s mechanism driven by another ``motion``
+    (a section of the spec's schema, at ``path``) on ``samples`` samples (default: the spec's);
+    its errors are located at ``path``."""
+    analysis = spec.analysis.model_copy(update={"samples": samples or spec.analysis.samples})
+    other = spec.model_copy(update={"motion": motion, "analysis": analysis})
+    try:
+        return unbalanced_model(other), time_grid(other)
+    except SpecFieldError as exc:
+        if exc.path[:1] != ("motion",):
+            raise
+        raise SpecFieldError(path + exc.path[1:], exc.message) from None
+
+
 def balance(spec: Any, balancing: Any = None) -> BalanceResult:
     """The unbalanced model and the method's stages, with every semantic check of the spec;
     ``balancing`` replaces ``spec.balancing`` (the designs of ``spec.compare``)."""
@@ -115,7 +133,10 @@ def balance(spec: Any, balancing: Any = None) -> BalanceResult:
         return BalanceResult([], [Stage("unbalanced", "unbalanced", model, "the mechanism as given")])
     method = METHODS[name]
     if method.generic:
-        return method.balance(spec.mechanism, balancing, model, t=time_grid(spec), **({"spec": spec} if method.uses_spec else {}))
+        extra = {"spec": spec} if method.uses_spec else {}
+        if method.other_motions:
+            extra["models"] = functools.partial(motion_model, spec)
+        return method.balance(spec.mechanism, balancing, model, t=time_grid(spec), **extra)
     if spec.mechanism.template not in method.templates:
         raise SpecFieldError(
             ("balancing", "method"),

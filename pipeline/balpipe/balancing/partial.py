@@ -3,9 +3,14 @@ of named links and counter-rotating discs chosen by a second-order cone programm
 (:mod:`.partial_program`) on the affine maps of the loads (:mod:`.partial_maps`), to global
 optimality at the analysed motion; Pareto fronts (:mod:`.partial_fronts`) for the page.
 
+Several motions at once (``motions``: the same machine at other speeds, other trajectories): each
+is analysed on its own time grid (the registry rebuilds the unbalanced model with its laws), its
+loads are affine maps of the same design variables, and a term over several motions is the
+largest of its per-motion measures (:mod:`.partial_motions`).
+
 Stages: ``unbalanced``, ``partial`` (the optimum's parts added). The details for results.json hold
 the objective achieved, each term, the active constraints, the budget's sensitivity (the dual
-value: d objective / d mass budget) and the fronts.
+value: d objective / d mass budget), the fronts and, per motion, the terms, caps and peaks.
 
 Requests that cannot be met are located errors before any stage is analysed: a region outside
 its link (farther than :data:`REACH` x the link's size from the link's frame origin), a non-convex
@@ -16,13 +21,16 @@ joint, and caps that no design within the budget meets (the error gives the leas
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
+from dataclasses import replace
 
 import numpy as np
 
 from ..model import Model
-from ..notation import ours, setting
+from ..notation import COMMON, ours, setting
 from ..spec_parts import SpecFieldError
 from . import partial_fronts as PF
+from . import partial_motions as PMo
 from .base import BalanceResult, Parameter, Stage
 from .force_balance import _point, counterweight_notation, regions_from_spec
 from .moment_balance import add_discs, counter_rotation_notation
@@ -74,7 +82,8 @@ def parts_from_spec(model: Model, method: PartialBalance) -> tuple[Model, list[P
     return with_discs, parts, discs
 
 
-def _check_names(maps: Maps, method: PartialBalance) -> None:
+def _check_names(motions: Sequence[Maps], method: PartialBalance) -> None:
+    maps = motions[0]
     joints = [j.name for j in maps.model.joints]
     for key, terms in (("objective", method.objective), ("caps", method.caps)):
         for k, t in enumerate(terms):
@@ -85,22 +94,30 @@ def _check_names(maps: Maps, method: PartialBalance) -> None:
             if t.load == "joint" and t.joint not in joints:
                 raise SpecFieldError(ROOT + (key, k, "joint"), f"no joint {t.joint!r} (joints: {', '.join(joints)})")
     for k, p in enumerate(maps.parts):
-        if not maps.moving[p.body]:
+        if not any(m.moving[p.body] for m in motions):
             raise SpecFieldError(ROOT + ("counterweights", k, "body"),
-                                 f"{p.body!r} neither accelerates nor turns during the motion: a part on it changes no load")
+                                 f"{p.body!r} neither accelerates nor turns during the motion{'s' if len(motions) > 1 else ''}: "
+                                 "a part on it changes no load")
 
 
-def term_of(maps: Maps, t, weight: float = 1.0) -> Term:
+def _motions(maps: Maps | Sequence[Maps]) -> list[Maps]:
+    return [maps] if isinstance(maps, Maps) else list(maps)
+
+
+def term_of(maps: Maps | Sequence[Maps], t, weight: float = 1.0) -> Term:
+    """The term ``t`` of the spec over one motion's maps or several (the largest of theirs)."""
     label = t.load + (f" {t.actuator}" if t.actuator else "") + (f" {t.joint}" if t.joint else "")
-    return Term(tuple(maps.load(t.load, t.actuator, t.joint)), t.measure, weight, f"{t.measure} {label}")
+    loads = tuple(L for m in _motions(maps) for L in m.load(t.load, t.actuator, t.joint))
+    return Term(loads, t.measure, weight, f"{t.measure} {label}")
 
 
-def standard_terms(maps: Maps) -> dict[str, Term]:
-    """The peaks the fronts and the tables report: force, moment, effort (all actuators)."""
-    out = {"shaking_force": Term((maps.loads["shaking_force"],), "peak", 1.0, "peak shaking_force"),
-           "shaking_moment": Term((maps.loads["shaking_moment"],), "peak", 1.0, "peak shaking_moment")}
-    if maps.drivers:
-        out["effort"] = Term(tuple(maps.load("effort")), "peak", 1.0, "peak effort")
+def standard_terms(maps: Maps | Sequence[Maps]) -> dict[str, Term]:
+    """The peaks the fronts and the tables report: force, moment, effort (all actuators), over
+    one motion or several."""
+    motions = _motions(maps)
+    out = {k: Term(tuple(m.loads[k] for m in motions), "peak", 1.0, f"peak {k}") for k in ("shaking_force", "shaking_moment")}
+    if motions[0].drivers:
+        out["effort"] = Term(tuple(L for m in motions for L in m.load("effort")), "peak", 1.0, "peak effort")
     return out
 
 
@@ -123,9 +140,10 @@ def _infeasible(program: Program, caps: list, method: PartialBalance) -> SpecFie
                           f"they need at least {program.maps.added_mass(out.z):.6g} kg")
 
 
-def solve(maps: Maps, method: PartialBalance):
-    """The optimum: (program, outcome, objective terms, caps as (term, bound))."""
-    program = Program(maps, method.budget.inertia)
+def solve(maps: Maps | Sequence[Maps], method: PartialBalance):
+    """The optimum over one motion's maps or several: (program, outcome, objective terms, caps as
+    (term, bound), the caps' constraints)."""
+    program = Program(_motions(maps)[0], method.budget.inertia)
     objective = [term_of(maps, t, t.weight) for t in method.objective]
     caps = []
     for c in method.caps:
@@ -166,15 +184,30 @@ def active_constraints(program: Program, z: np.ndarray, method: PartialBalance, 
     return out
 
 
-def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None) -> BalanceResult:
+def motion_maps(model: Model, t: np.ndarray, method: PartialBalance, spec=None, models: Callable | None = None) -> list[Maps]:
+    """The load maps of the spec's motion, then of each of ``method.motions`` (their models are
+    built, and their errors found, before any analysis), every region and name checked."""
     with_discs, parts, discs = parts_from_spec(model, method)
+    others = PMo.other_models(method, models, ROOT)
     gravity = (0.0, -spec.analysis.g) if spec is not None and spec.analysis.gravity else (0.0, 0.0)
     point = tuple(spec.analysis.moment_point) if spec is not None else (0.0, 0.0)
-    maps = build(with_discs, model, t, parts, discs, gravity, point)
-    _check_names(maps, method)
-    program, out, objective, caps, _ = solve(maps, method)
+    motions = [build(with_discs, model, t, parts, discs, gravity, point)]
+    for m, tm in others:
+        motions.append(build(add_discs(m, method.counter_rotations, ROOT + ("counter_rotations",)), m, tm, parts, discs,
+                             gravity, point))
+    _check_names(motions, method)
+    return motions
+
+
+def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None,
+            models: Callable | None = None) -> BalanceResult:
+    """The optimum's stage; ``models(motion, samples, path)`` gives the unbalanced model and time
+    grid of each of ``method.motions`` (:func:`balpipe.registry.motion_model`)."""
+    motions = motion_maps(model, t, method, spec, models)
+    maps = motions[0]
+    program, out, objective, caps, _ = solve(motions, method)
     z = out.z
-    std = standard_terms(maps)
+    std = standard_terms(motions)
     design = maps.design(z)
     active = active_constraints(program, z, method, caps)
     terms = [{"term": t.label, "weight": t.weight, "value": t.value(z), "unbalanced": t.scale,
@@ -192,6 +225,7 @@ def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None
         "status": out.status,
         "solver": "cvxpy + Clarabel",
         "design": design_table(maps, z),
+        "motions": PMo.per_motion(motions, PMo.names(method), objective, caps, std, z),
     }
     if method.fronts is not None:
         details["fronts"] = PF.compute(program, std, method.budget.mass, method.fronts.points, method.fronts.max_mass)
@@ -205,15 +239,20 @@ def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None
         Parameter("budget_sensitivity", out.budget_dual, "1/kg", "dual value of the mass budget",
                   "change of the objective per kg more budget"),
     ]
+    over = f"the {len(t)} time samples" if len(motions) == 1 else (
+        f"{len(motions)} motions ({', '.join(f'{n}: {len(m.t)} samples' for n, m in zip(PMo.names(method), motions))}; "
+        "a term is the largest of its values on each motion)")
     notes = [
-        "Optimal partial balancing by a second-order cone programme (cvxpy, Clarabel) over the "
-        f"{len(t)} time samples: objective {' + '.join(f'{x.weight:g} x {x.label}' for x in objective)} "
+        "Optimal partial balancing by a second-order cone programme (cvxpy, Clarabel) over "
+        f"{over}: objective {' + '.join(f'{x.weight:g} x {x.label}' for x in objective)} "
         f"(each divided by its unbalanced value) = {details['objective']:.6g} with {details['added_mass']:.6g} kg added; "
         f"active: {', '.join(active) or 'none'}; d objective / d budget = {out.budget_dual:.4g} per kg."
-    ]
+    ] + PMo.notes(details["motions"])
     label = method.label or "partial balance"
     stages = [Stage("unbalanced", "unbalanced", model, "the mechanism as given"),
-              Stage("partial", label, design, "parts chosen by the cone programme (global optimum at this motion)")]
+              Stage("partial", label, design, "parts chosen by the cone programme (global optimum at this motion)"
+                    if len(motions) == 1 else f"parts chosen by the cone programme (global optimum over {len(motions)} "
+                    "motions; analysed and validated on the spec's motion)")]
     return BalanceResult(params, stages, notes, details={"partial_balance": details})
 
 
@@ -264,6 +303,11 @@ def notation(method: PartialBalance) -> dict:
         table[f"balancing.counterweights[{k}].polygon"] = ours(f"`{n}`", f"`{n}` anywhere in a polygon on `{c.body}`")
     for k, d in enumerate(method.counter_rotations):
         table[f"balancing.counter_rotations[{k}].max_inertia"] = ours(f"I_{{{d.name},max}}", f"upper bound on the inertia of `{d.name}`")
+    for k, m in enumerate(method.motions):  # a further motion's inputs read as the spec's motion's, named
+        pre = f"balancing.motions[{k}]"
+        table[f"{pre}.samples"] = setting(f"N_{{{m.name}}}", f"time samples over the motion `{m.name}`")
+        table.update({f"{pre}.{key}": replace(sym, text=f"{sym.text} (motion `{m.name}`)")
+                      for key, sym in COMMON.items() if key.startswith("motion.")})
     table.update({
         "balancing.budget.mass": ours("M_{max}", "added mass at most (counterweights and discs)"),
         "balancing.budget.inertia": ours("I_{max}", "added inertia at most (discs, counterweights' second moments)"),

@@ -9,12 +9,14 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
+from ..laws.motion_spec import Motion
 from ..spec_parts import Strict
 from ..units import Inertia, Mass, count, number
 from .force_balance import CounterweightRegionSpec, Point
 from .moment_balance import CounterRotationSpec
 
 LOADS = ("shaking_force", "shaking_moment", "effort", "joint")
+MAIN_MOTION = "motion"  # the name of the spec's own motion in the report
 
 
 class PartialCounterweightSpec(CounterweightRegionSpec):
@@ -94,6 +96,15 @@ class FrontSettings(Strict):
     )
 
 
+class OtherMotion(Strict):
+    """Another motion of the same mechanism that the design must also serve (the same machine at
+    another speed, another trajectory), with the schema of the spec's ``motion`` section."""
+
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_\-]+$", description="its name in the report (e.g. 600rpm; not 'motion', the spec's own)")
+    motion: Motion = Field(description="the motion, as the spec's motion section")
+    samples: count(ge=3, le=200_000) | None = Field(None, description="time samples over it (default: analysis.samples)")
+
+
 class PartialBalance(Strict):
     """Optimal partial balancing: counterweights and counter-rotating discs chosen by a convex
     (second-order cone) programme that minimises peaks or RMS of the loads under a mass budget and
@@ -102,6 +113,10 @@ class PartialBalance(Strict):
     method: Literal["partial_balance"] = Field(description="balancing method")
     counterweights: list[PartialCounterweightSpec] = Field([], description="counterweights the optimiser may add")
     counter_rotations: list[PartialCounterRotationSpec] = Field([], description="counter-rotating discs the optimiser may add")
+    motions: list[OtherMotion] = Field(
+        [], description="further motions the design must serve with the spec's own: a peak is the largest over "
+        "every motion's samples, an RMS the largest of the motions' RMS, each term divided by its unbalanced value "
+        "so measured, and a cap holds on every motion; the pymunk validation runs the spec's motion")
     objective: list[WeightedTerm] = Field(min_length=1, description="terms minimised (their weighted sum)")
     budget: Budget
     caps: list[Cap] = Field([], description="caps on loads (e.g. peak effort at most 1.2 x the unbalanced)")

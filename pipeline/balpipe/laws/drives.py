@@ -476,26 +476,38 @@ def path_laws(name: str, drive: Any, motion: Any, n: int) -> tuple[Law, ...] | N
     return tuple(geometry.PathComponent(pm, k) for k in range(n))
 
 
+def motion_sections(spec: Any):
+    """(path, motion) of every motion section of ``spec``: its ``motion``, then the further
+    ``motions`` of its balancing methods (the main one's and each compared design's), if any."""
+    yield ("motion",), spec.motion
+    designs = [(("balancing",), spec.balancing)] + [(("compare", k, "balancing"), d.balancing)
+                                                   for k, d in enumerate(getattr(spec, "compare", None) or [])]
+    for root, balancing in designs:
+        for k, other in enumerate(getattr(balancing, "motions", None) or []):
+            yield root + ("motions", k, "motion"), other.motion
+
+
 def read_tables(spec: Any, folder: FilePath) -> None:
-    """Read the CSV file of every table drive of ``spec.motion`` (relative to ``folder``, the
+    """Read the CSV file of every table drive of ``spec``'s motions (relative to ``folder``, the
     spec's), keeping its text on the drive; a missing file is a located error."""
-    for name, drive in spec.motion.drive.items():
-        for sub, d in _tables(drive, ("motion", "drive", name)):
-            f = folder / d.file
-            try:
-                if f.stat().st_size > MAX_TABLE_BYTES:
-                    raise SpecFieldError(sub + ("file",), f"the table {d.file!r} is larger than {MAX_TABLE_BYTES // 10**6} MB")
-                d._text = f.read_text(encoding="utf-8")
-            except (OSError, UnicodeDecodeError) as exc:
-                reason = getattr(exc, "strerror", None) or str(exc)
-                raise SpecFieldError(sub + ("file",), f"cannot read the table {d.file!r}: {reason}") from None
+    for root, motion in motion_sections(spec):
+        for name, drive in motion.drive.items():
+            for sub, d in _tables(drive, root + ("drive", name)):
+                f = folder / d.file
+                try:
+                    if f.stat().st_size > MAX_TABLE_BYTES:
+                        raise SpecFieldError(sub + ("file",), f"the table {d.file!r} is larger than {MAX_TABLE_BYTES // 10**6} MB")
+                    d._text = f.read_text(encoding="utf-8")
+                except (OSError, UnicodeDecodeError) as exc:
+                    reason = getattr(exc, "strerror", None) or str(exc)
+                    raise SpecFieldError(sub + ("file",), f"cannot read the table {d.file!r}: {reason}") from None
 
 
 def table_texts(spec: Any) -> str:
     """The text of every table the spec reads, for the build's input hash ("" without tables, so
     the hash of a spec without tables is unchanged): a changed CSV rebuilds the page."""
-    return "".join(f"\0table {d.file}\0{d._text}" for name, drive in spec.motion.drive.items()
-                   for _, d in _tables(drive, ()))
+    return "".join(f"\0table {d.file}\0{d._text}" for _, motion in motion_sections(spec)
+                   for drive in motion.drive.values() for _, d in _tables(drive, ()))
 
 
 def _tables(drive: Any, path: tuple):

@@ -63,7 +63,8 @@ def headline(study, det: dict) -> str:
     """'removes 80 % of the peak force for 25 % of the complete balance's mass' for the chosen design."""
     c = det["fronts"].get("complete_force") if det.get("fronts") else None
     F, F0 = det["peaks"]["shaking_force"], det["unbalanced"]["shaking_force"]
-    text = f"The chosen design removes {100 * (1 - F / F0):.0f} % of the unbalanced peak shaking force"
+    over = "" if len(det.get("motions") or [None]) == 1 else " over every motion"
+    text = f"The chosen design removes {100 * (1 - F / F0):.0f} % of the unbalanced peak shaking force{over}"
     if c is not None and c["added_mass"] > 0:
         text += f" for {100 * det['added_mass'] / c['added_mass']:.0f} % of the mass of the complete force balance"
     return text + "."
@@ -75,13 +76,17 @@ def figures(study) -> list[tuple[str, str, str]]:
     if not det or not det.get("fronts"):
         return []
     out = []
+    n = len(det.get("motions") or [None])
+    where = "at the analysed motion" if n == 1 else (
+        f"over {n} motions at once (each peak the largest over every motion; the stages are analysed on the spec's motion)")
     for key, x, y, title, what in FRONTS:
         pts = det["fronts"].get(key) or []
         if len(pts) < 2:
             continue
         svg = _front_figure(pts, x, y, _marks(study, det, x, y), prefix=f"partial_{key}")
-        caption = (f"{len(pts)} points, each {what}, solved to global optimality at the analysed motion "
+        caption = (f"{len(pts)} points, each {what}, solved to global optimality {where} "
                    "(second-order cone programme, Clarabel). Markers: the least-mass complete balances in the same "
-                   "regions along this motion, where they exist, and every analysed stage. " + headline(study, det))
+                   f"regions along {'this motion' if n == 1 else 'these motions'}, where they exist, and every analysed "
+                   "stage. " + headline(study, det))
         out.append((title, svg, caption))
     return out

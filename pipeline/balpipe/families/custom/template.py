@@ -188,6 +188,9 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
             target = (d.coordinate, d.body) + ((d.point,) if d.point else ())
         else:
             raise SpecFieldError(dp, "a driver needs either joint, or body and coordinate")
+        if d.name not in laws:
+            raise SpecFieldError(("motion", "drive"), f"the driver {d.name!r} has no law: give motion.drive.{d.name} "
+                                 f"(drivers: {', '.join(x.name for x in mech.drivers)})")
         drivers.append(Driver(d.name, target, laws[d.name]))
     model_bodies = tuple(
         Body(b.name, b.mass, tuple(b.com), b.inertia, dict(b.points), outline=tuple(b.points), radius=b.radius,
