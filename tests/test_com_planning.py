@@ -354,3 +354,25 @@ def test_figs_3_and_4_draw_the_papers_cases_in_the_papers_line_styles_which_are_
     assert shown[:3] == ["case 1: end-effector quintic", "case 2: CoM bang-bang + φ optimised", "case 3: CoM trapezoidal"]
     for f in drawn.values():
         figures.plt.close(f)
+
+
+def test_the_index_names_the_main_motion_its_costs_come_from(tmp_path):
+    """A multi-trajectory spec built into a site: the index's cost cell names the main motion
+    (balancing.main_trajectory, here the second listed) and the page's design summary shows it."""
+    import os
+
+    from balpipe.build import Options, build
+
+    text = replaced(spec_text("[P1P13, P15P7]"), "orientation:", "main_trajectory: P15P7\n  orientation:")
+    text = replaced(text, "  samples: 501", "  samples: 101")
+    (tmp_path / "two.yaml").write_text(text, encoding="utf-8")
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        build(["two.yaml"], Options(out=tmp_path / "site", simulate=False))
+    finally:
+        os.chdir(cwd)
+    index = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
+    assert "P15P7 · case 3: CoM trapezoidal (main motion):" in index
+    page = (tmp_path / "site" / "two" / "index.html").read_text(encoding="utf-8")
+    assert "Design summary: P15P7 · case 3: CoM trapezoidal against P15P7 · case 1: end-effector quintic" in page
