@@ -107,3 +107,25 @@ def test_paper000_figures_draw_each_stage_in_its_style_of_the_page(spec, monkeyp
         assert (ln.get_linestyle() == "--") == (name == "counterweights")
     for f in drawn.values():
         figures.plt.close(f)
+
+
+def test_stage_styles_apply_only_to_a_complete_set_of_the_main_designs_stages():
+    """Stage.style orders the page's stages only when the main design's stages carry the styles
+    0..n-1 (compared designs follow in their order); a balancing that wraps a paper's method
+    (the partial balancing: its own unbalanced stage has no style) keeps its order."""
+    from types import SimpleNamespace as NS
+
+    from balpipe.balancing.base import in_style_order, style_index, styled
+
+    def r(name, style):
+        return NS(stage=NS(name=name, style=style, group=""))
+
+    main = [r("unbalanced", 0), r("linkage", 3), r("counterweights", 1), r("counter_rotations", 2)]
+    other = [r("b:unbalanced", 0), r("b:counterweights", 1)]
+    assert styled(main + other)
+    assert [x.stage.name for x in in_style_order(main + other)] == [
+        "unbalanced", "counterweights", "counter_rotations", "linkage", "b:unbalanced", "b:counterweights"]
+    assert style_index(main + other, main[1]) == 3 and style_index(main + other, other[0]) == 4
+    wrapped = [r("unbalanced", None), r("a:counterweights", 1), r("a:linkage", 3), r("partial", None)]
+    assert not styled(wrapped) and in_style_order(wrapped) == wrapped
+    assert not styled([r("x", 0), r("y", 0)]) and not styled([r("x", 1)])

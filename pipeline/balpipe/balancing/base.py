@@ -54,14 +54,24 @@ class BalanceResult:
     details: dict = field(default_factory=dict)  # method-specific blocks for results.json (e.g. force_balance)
 
 
+def styled(results: list) -> bool:
+    """Whether the method gave the main design's stages of ``results`` their line styles
+    (:attr:`Stage.style`): each has one, and they are 0 .. n-1 (a partial balancing that wraps a
+    paper's method, whose own stages have none, keeps the order of its stages)."""
+    styles = [r.stage.style for r in results if ":" not in r.stage.name]
+    return bool(styles) and None not in styles and sorted(styles) == list(range(len(styles)))
+
+
 def in_style_order(results: list) -> list:
     """Stage results (anything with a ``.stage``) in the order of their line styles on the page:
-    :attr:`Stage.style` where the method gives it, else their place in ``results`` (after the
-    styled ones). Item k of the list is drawn in ``draw.figures.style(k)`` in every figure of a
-    page, the generic ones and the paper's."""
-    n = len(results)
-    return [r for _, r in sorted(
-        enumerate(results), key=lambda kr: kr[1].stage.style if kr[1].stage.style is not None else n + kr[0])]
+    when :func:`styled`, the main design's stages by :attr:`Stage.style`, then those of the
+    compared designs (named design:stage) in their order; else in their order. Item k of the
+    list is drawn in ``draw.figures.style(k)`` in every figure of a page, the generic ones and
+    the paper's."""
+    if not styled(results):
+        return list(results)
+    main = sorted((r for r in results if ":" not in r.stage.name), key=lambda r: r.stage.style)
+    return main + [r for r in results if ":" in r.stage.name]
 
 
 def style_index(results: list, r) -> int:

@@ -6,7 +6,7 @@ import markupsafe
 import numpy as np
 
 from .. import realisable
-from ..balancing.base import in_style_order
+from ..balancing.base import in_style_order, styled
 from ..laws.drives import law_names
 from ..study import Study, ratio_reference
 from ..draw import figures, labels
@@ -78,7 +78,7 @@ def study_figures(study: Study) -> dict:
     key = "; ".join(f"{figures.style_text(k)}: {s.stage.label}" for k, s in enumerate(shown_stages(study)))
     live = live_plots.as_script(live_plots.loads_data([(s.stage.label, s.analysis) for s in shown_stages(study)]))
     # a method that gives its stages the paper's line styles (Stage.style): said in the legend
-    paper_styles = any(s.stage.style is not None for s in shown_stages(study))
+    paper_styles = styled(shown_stages(study))
     return {"loads": loads, "live_loads": live, "loads_key": key[:1].upper() + key[1:],
             "styles_note": "These are the paper's line styles for the stages it plots, so the figures titled with the "
                            "paper's numbers draw each stage as every other figure does" if paper_styles else "", "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
