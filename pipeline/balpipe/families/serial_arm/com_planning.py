@@ -549,11 +549,11 @@ def replan(spec, parameters: dict) -> tuple[Planner, list[Plan]]:
 def _description(key: str, plan: Plan, method: ComMotionPlanning) -> str:
     deg = method.phi.degree
     return {
-        "ee_quintic": "tip on the straight line and phi on the 3-4-5 law (case 1)",
-        "com_bang_bang": "centre of mass on the straight line, bang-bang; phi on the 3-4-5 law",
-        "com_bang_bang_phi_opt": f"centre of mass bang-bang; phi a degree-{deg} polynomial minimising the peak moment (case 2)",
+        "ee_quintic": "tip on the straight line and φ on the 3-4-5 law (case 1)",
+        "com_bang_bang": "centre of mass on the straight line, bang-bang; φ on the 3-4-5 law",
+        "com_bang_bang_phi_opt": f"centre of mass bang-bang; φ a degree-{deg} polynomial minimising the peak moment (case 2)",
         "com_trapezoidal": f"centre of mass on a trapezoidal acceleration, ramps {plan.ramp_fraction:.3g} T "
-                           f"(torque rate <= {method.torque_rate_limit:.3g} N m/s); phi as optimised (case 3)",
+                           f"(torque rate <= {method.torque_rate_limit:.3g} N m/s); φ as optimised (case 3)",
     }[key]
 
 
