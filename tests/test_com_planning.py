@@ -33,7 +33,9 @@ def paper():
 def test_eight_trajectories_with_their_reductions(paper):
     spec, st, p = paper
     names = ["P1P13", "P2P12", "P3P11", "P4P10", "P5P9", "P15P7", "P14P8", "P13P9"]
-    assert [s.stage.group for s in st.stages] == [n for n in names for _ in range(4)]
+    # the main trajectory (the one the paper's Figs. 3-4 show) first, then the others in the spec's order
+    shown = ["P15P7"] + [n for n in names if n != "P15P7"]
+    assert [s.stage.group for s in st.stages] == [n for n in shown for _ in range(4)]
     for n in names:
         for key in ("force_reduction", "moment_reduction", "force_reduction_case3", "moment_reduction_case3"):
             assert 0.2 < p[f"{key}_{n}"] < 0.8
@@ -110,7 +112,7 @@ def test_page_has_the_table_and_fig_2(paper):
     spec, st, p = paper
     figs = st.extra_figures()
     titles = [f[0] for f in figs]
-    assert "The test square and the trajectories (Fig. 2)" in titles
+    assert "Fig. 2 of paper 003: the tested trajectories" in titles
     table = figs[titles.index("Peak loads per trajectory (the paper's Sec. 3 results)")][1]
     assert table.count("end-effector quintic") == 8 and "published 48 % to 62.2 %" in table
 
@@ -173,7 +175,15 @@ def spec_text(trajectories: str, square: str = "{centre: [0 m, 0.487 m], side: 0
     text = replaced(text, "test_square: {centre: [0 m, 0.487 m], side: 0.3 m, divisions: 4, first_corner: bottom-left}",
                         f"test_square: {square}")
     text = replaced(text, "trajectories: [P1P13, P2P12, P3P11, P4P10, P5P9, P15P7, P14P8, P13P9]", f"trajectories: {trajectories}")
+    text = "\n".join(line for line in text.splitlines() if "main_trajectory:" not in line) + "\n"
     return replaced(text, "starts: 3", "starts: 1").split("references:")[0]
+
+
+def test_an_unknown_main_trajectory_is_a_located_error(tmp_path):
+    text = replaced(spec_text("[P1P13, P5P9]"), "orientation:", "main_trajectory: P15P7\n  orientation:")
+    out = check(tmp_path, text)
+    assert out.returncode == 2 and "Traceback" not in out.stderr, out.stderr
+    assert "balancing.main_trajectory: no trajectory 'P15P7' (the trajectories: P1P13, P5P9)" in out.stderr
 
 
 def check(tmp_path, text):
@@ -235,7 +245,7 @@ def test_single_trajectory_from_the_tip_drive():
 
     st = study.run(load_text(text, "one.yaml")[0])
     assert [s.stage.name for s in st.stages] == ["ee_quintic", "com_bang_bang", "com_bang_bang_phi_opt", "com_trapezoidal"]
-    assert [s.stage.label for s in st.stages][0] == "end-effector quintic"
+    assert [s.stage.label for s in st.stages][0] == "case 1: end-effector quintic"
     p = {x.name: x.value for x in st.balance.parameters}
     # the same trajectory as P15P7 of the paper's spec: the same 60.0 % force reduction
     assert p["force_reduction"] == pytest.approx(0.5996, abs=1e-3)
@@ -291,3 +301,78 @@ def test_each_trajectory_is_validated_against_its_own_unbalanced_reference(monke
     # the two trajectories' references differ: the test could tell them apart
     a, b = refs["P1P13"], refs["P5P9"]
     assert abs(a.force - b.force) > 0.05 * a.force or abs(a.moment - b.moment) > 0.05 * a.moment
+
+
+def test_the_headline_shows_the_trajectory_of_the_papers_figures(paper):
+    """Issue 22: the page's design summary, the index's headline costs and the stage figures show
+    P15P7, the trajectory of the paper's Figs. 3-4 (balancing.main_trajectory), not the first listed."""
+    from balpipe.report import site
+    from balpipe.report.design_card import design_card
+    from balpipe.report.page import shown_stages
+    from balpipe.report.results import results_dict
+
+    spec, st, p = paper
+    assert spec.balancing.main_trajectory == "P15P7" and spec.balancing.trajectories[0] == "P1P13"
+    res = results_dict(st, "x", "h", False)
+    v = res["verdict"]
+    assert v["motions"][0]["reference"] == "P15P7_ee_quintic"
+    assert v["motions"][0]["final"].startswith("P15P7_")
+    head = site.headline(v, res["checks"]["balance_tolerance"])
+    assert head["rows"][0]["label"].startswith("P15P7 ·") and head["motions"] == 8
+    f0 = next(s for s in res["stages"] if s["name"] == "P15P7_ee_quintic")["max_inertial_force"]
+    assert head["rows"][0]["force"].startswith(site.num(f0))
+    card = design_card(st, res)
+    assert card["stage"].startswith("P15P7 ·") and card["reference"] == "P15P7 · case 1: end-effector quintic"
+    assert {s.stage.group for s in shown_stages(st)} == {"P15P7"}
+
+
+def test_figs_3_and_4_draw_the_papers_cases_in_the_papers_line_styles_which_are_the_pages(paper, monkeypatch):
+    """Figs. 3-4: case 1 black full, case 2 black dashed, case 3 grey full (the paper's captions),
+    and each of these stages has that style in every figure of the page (the style legend)."""
+    from balpipe.draw import figures
+    from balpipe.report.page import shown_stages
+
+    spec, st, p = paper
+    drawn = {}
+    monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.setdefault(prefix, fig) and "<svg/>")
+    titles = [t for t, _, _ in st.extra_figures()]
+    assert "Fig. 3 of paper 003: variations of the shaking forces, trajectory P15P7" in titles
+    assert "Fig. 4 of paper 003: variations of the shaking moment, trajectory P15P7" in titles
+    assert not any("Figs. 3-4" in t for t in titles)  # the old grid of every trajectory is gone
+    paper_styles = {"case 1": ("black", "-"), "case 2": ("black", "--"), "case 3": ("0.6", "-")}
+    shown = [s.stage.label.split(" · ")[-1] for s in shown_stages(st)]
+    for prefix in ("p003fig3", "p003fig4"):
+        lines = drawn[prefix].axes[0].get_lines()
+        assert [ln.get_label()[:6] for ln in lines] == ["case 1", "case 2", "case 3"]
+        for ln in lines:
+            color, dash = paper_styles[ln.get_label()[:6]]
+            k = shown.index(ln.get_label())
+            assert figures.style(k)["color"] == color and figures.style(k)["linestyle"] == dash
+            assert ln.get_color() == color and ln.get_linestyle() == dash
+    # the stage figures' legend reads the same styles
+    assert [figures.style_text(k, markers=False) for k in range(3)] == ["solid black", "dashed black", "grey"]
+    assert shown[:3] == ["case 1: end-effector quintic", "case 2: CoM bang-bang + φ optimised", "case 3: CoM trapezoidal"]
+    for f in drawn.values():
+        figures.plt.close(f)
+
+
+def test_the_index_names_the_main_motion_its_costs_come_from(tmp_path):
+    """A multi-trajectory spec built into a site: the index's cost cell names the main motion
+    (balancing.main_trajectory, here the second listed) and the page's design summary shows it."""
+    import os
+
+    from balpipe.build import Options, build
+
+    text = replaced(spec_text("[P1P13, P15P7]"), "orientation:", "main_trajectory: P15P7\n  orientation:")
+    text = replaced(text, "  samples: 501", "  samples: 101")
+    (tmp_path / "two.yaml").write_text(text, encoding="utf-8")
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        build(["two.yaml"], Options(out=tmp_path / "site", simulate=False))
+    finally:
+        os.chdir(cwd)
+    index = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
+    assert "P15P7 · case 3: CoM trapezoidal (main motion):" in index
+    page = (tmp_path / "site" / "two" / "index.html").read_text(encoding="utf-8")
+    assert "Design summary: P15P7 · case 3: CoM trapezoidal against P15P7 · case 1: end-effector quintic" in page

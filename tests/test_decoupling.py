@@ -152,3 +152,30 @@ def test_balanced_stage_passes_the_pymunk_validation(paper):
     v = validate(full.stage.model, full.analysis, (F0, M0), None, ("force", "moment"))
     assert v.passed, v.reasons
     assert v.moment_peak < 1e-2 and v.force_peak < 1e-2
+
+
+def test_the_methods_figures_come_from_the_study_not_a_closure(paper):
+    """Issue 19: the figures are the method's hook (plugins.Method.figures), drawn from the
+    stages, parameters and spec; Fig. 2 of paper 002 gives F^sh with the weight said apart when
+    gravity is on; round-off of the decoupled mass matrix reads 0."""
+    from balpipe import registry
+
+    spec, st = paper[0], paper[1]
+    assert st.balance.figures is None
+    hook = registry.METHODS["gear_decoupling"].figures
+    figs = {title: (body, caption) for title, body, caption in hook(st)}
+    fig2 = figs["Fig. 2 of paper 002: shaking force and shaking moment of the unbalanced manipulator"]
+    an = st.unbalanced.analysis
+    if spec.analysis.gravity:
+        w = an.extra["total_mass"] * float(np.hypot(*an.gravity))
+        assert f"weight m g = {w:.4g} N" in fig2[1] and f"peaks at {an.max_inertial_force:.4g} N" in fig2[1]
+        assert an.max_force > an.max_inertial_force
+    else:
+        assert "Gravity is off" in fig2[1]
+    table = figs["Mass matrix before and after decoupling (eqs. 4-6, 17-18)"][0]
+    J = {p.name: p.value for p in st.balance.parameters}
+    rows = table.split("<tr>")
+    d12 = next(r for r in rows if r.startswith("<td>D₁₂"))
+    assert d12.endswith("<td><code>0</code></td></tr>")  # decoupled: D12 = 0 (round-off reads 0)
+    assert f"<code>{J['J1']:.6g}</code>" in table and f"<code>{J['J2']:.6g}</code>" in table
+    assert {"Mass matrix along the motion", "Torque against acceleration (eqs. 17-18)"} <= set(figs)

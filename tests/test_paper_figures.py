@@ -30,11 +30,24 @@ def test_the_table_names_the_issue_figures():
 
 @pytest.mark.parametrize("paper", sorted(PF.FIGURES))
 def test_each_papers_pages_reproduce_its_figures(paper):
+    """The acceptance of issue 22: each paper's pages list (data-figures, the line under the
+    title) the paper's figure numbers they reproduce, read from their figures' titles, and
+    together they cover the table."""
+    import re
+
+    from balpipe.report.page import render_page
+    from balpipe.report.results import results_dict
+
     found: set[str] = set()
     for path in sorted(SPECS.glob(f"paper{paper}_*.yaml")):
         study = run(load(path).spec)
         titles = [t for t, _, _ in study_figures(study)["extra"]]
-        found |= set(PF.listed(titles))
+        html = render_page(study, results_dict(study, "x", "h", False), "")
+        m = re.search(r'data-figures="([^"]*)"', html)
+        listed = m.group(1).split() if m else []
+        assert listed == PF.listed(titles), path.name
+        assert all(f"Fig. {n}" in html for n in listed)
+        found |= set(listed)
     missing = [n for n in PF.FIGURES[paper] if not PF.covered(n, sorted(found))]
     assert not missing, f"paper {paper}: figures {missing} not on its pages (found {sorted(found)})"
 
@@ -71,3 +84,48 @@ def test_live_plots_draw_each_stage_in_its_static_line_style():
         st = figures.style(k)
         assert line_style(k) == {"stroke": to_hex(st["color"]), "dash": DASHES[st["linestyle"]], "width": st["linewidth"]}
     assert line_style(1)["dash"] and not line_style(0)["dash"] and line_style(2)["stroke"] != line_style(0)["stroke"]
+
+
+@pytest.mark.parametrize("spec", ["paper000_rpr3_idler_loop", "paper000_rpr3_scott_russell"])
+def test_paper000_figures_draw_each_stage_in_its_style_of_the_page(spec, monkeypatch):
+    """Issue 22, point 4: on a paper-000 page dashed means the counterweights in every figure
+    (Fig. 4 / 8 and the stage figures), as the paper draws them; the added linkage, which the
+    paper does not plot, is never dashed."""
+    from balpipe.draw import figures
+    from balpipe.report.page import shown_stages
+
+    study = run(load(SPECS / f"{spec}.yaml").spec)
+    drawn = {}
+    monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.setdefault(prefix, fig) and "<svg/>")
+    list(study.extra_figures())
+    shown = [s.stage.name for s in shown_stages(study)]
+    assert shown[:3] == ["unbalanced", "counterweights", "counter_rotations"]
+    for ln in drawn["rpr3-loads"].axes[0].get_lines():
+        name = next(s.stage.name for s in study.stages if s.stage.label == ln.get_label())
+        st = figures.style(shown.index(name))
+        assert (ln.get_color(), ln.get_linestyle(), ln.get_linewidth()) == (st["color"], st["linestyle"], st["linewidth"])
+        assert (ln.get_linestyle() == "--") == (name == "counterweights")
+    for f in drawn.values():
+        figures.plt.close(f)
+
+
+def test_stage_styles_apply_only_to_a_complete_set_of_the_main_designs_stages():
+    """Stage.style orders the page's stages only when the main design's stages carry the styles
+    0..n-1 (compared designs follow in their order); a balancing that wraps a paper's method
+    (the partial balancing: its own unbalanced stage has no style) keeps its order."""
+    from types import SimpleNamespace as NS
+
+    from balpipe.balancing.base import in_style_order, style_index, styled
+
+    def r(name, style):
+        return NS(stage=NS(name=name, style=style, group=""))
+
+    main = [r("unbalanced", 0), r("linkage", 3), r("counterweights", 1), r("counter_rotations", 2)]
+    other = [r("b:unbalanced", 0), r("b:counterweights", 1)]
+    assert styled(main + other)
+    assert [x.stage.name for x in in_style_order(main + other)] == [
+        "unbalanced", "counterweights", "counter_rotations", "linkage", "b:unbalanced", "b:counterweights"]
+    assert style_index(main + other, main[1]) == 3 and style_index(main + other, other[0]) == 4
+    wrapped = [r("unbalanced", None), r("a:counterweights", 1), r("a:linkage", 3), r("partial", None)]
+    assert not styled(wrapped) and in_style_order(wrapped) == wrapped
+    assert not styled([r("x", 0), r("y", 0)]) and not styled([r("x", 1)])

@@ -36,6 +36,10 @@ class Stage:
     group: str = ""  # stages of one motion (a spec with several motions groups them, e.g. per trajectory)
     tolerance: float | None = None  # the claims' tolerance set by the spec (default: balpipe.claim_precision)
     rounding: tuple = ()  # balpipe.claim_precision.Rounding of the numbers entered by hand
+    # the stage's line style on the page, draw.figures.style(k) (default: its place in its group):
+    # a method whose paper states its figures' line styles gives them, so that one style means
+    # one stage on the whole page, the paper's figures included (issue 22)
+    style: int | None = None
 
 
 @dataclass(frozen=True)
@@ -48,3 +52,30 @@ class BalanceResult:
     figures: Callable[[Any], Any] | None = None
     derived: Callable[[Any], list[Parameter]] | None = None
     details: dict = field(default_factory=dict)  # method-specific blocks for results.json (e.g. force_balance)
+
+
+def styled(results: list) -> bool:
+    """Whether the method gave the main design's stages of ``results`` their line styles
+    (:attr:`Stage.style`): each has one, and they are 0 .. n-1 (a partial balancing that wraps a
+    paper's method, whose own stages have none, keeps the order of its stages)."""
+    styles = [r.stage.style for r in results if ":" not in r.stage.name]
+    return bool(styles) and None not in styles and sorted(styles) == list(range(len(styles)))
+
+
+def in_style_order(results: list) -> list:
+    """Stage results (anything with a ``.stage``) in the order of their line styles on the page:
+    when :func:`styled`, the main design's stages by :attr:`Stage.style`, then those of the
+    compared designs (named design:stage) in their order; else in their order. Item k of the
+    list is drawn in ``draw.figures.style(k)`` in every figure of a page, the generic ones and
+    the paper's."""
+    if not styled(results):
+        return list(results)
+    main = sorted((r for r in results if ":" not in r.stage.name), key=lambda r: r.stage.style)
+    return main + [r for r in results if ":" in r.stage.name]
+
+
+def style_index(results: list, r) -> int:
+    """The line style of stage result ``r`` on the page (``draw.figures.style(k)``): its place in
+    :func:`in_style_order` of the stages of its group (its motion)."""
+    group = [x for x in results if x.stage.group == r.stage.group]
+    return next(i for i, x in enumerate(in_style_order(group)) if x is r)

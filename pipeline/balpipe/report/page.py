@@ -6,6 +6,7 @@ import markupsafe
 import numpy as np
 
 from .. import realisable
+from ..balancing.base import in_style_order, styled
 from ..laws.drives import law_names
 from ..study import Study, ratio_reference
 from ..draw import figures, labels
@@ -20,8 +21,10 @@ INSTANTS = 5
 
 def shown_stages(study: Study) -> list:
     """The stages drawn in the generic figures: all, or those of the first group when the spec
-    runs several motions (the method's figures show the other groups)."""
-    return [s for s in study.stages if s.stage.group == study.stages[0].stage.group]
+    runs several motions (the method's figures show the other groups); in the order of their
+    line styles (:attr:`Stage.style` where a method gives it, else their place in the group), so
+    that stage k of this list is drawn in ``figures.style(k)`` in every figure of the page."""
+    return in_style_order([s for s in study.stages if s.stage.group == study.stages[0].stage.group])
 
 
 def drawn_times(study: Study) -> list[float]:
@@ -74,7 +77,11 @@ def study_figures(study: Study) -> dict:
         ))
     key = "; ".join(f"{figures.style_text(k)}: {s.stage.label}" for k, s in enumerate(shown_stages(study)))
     live = live_plots.as_script(live_plots.loads_data([(s.stage.label, s.analysis) for s in shown_stages(study)]))
-    return {"loads": loads, "live_loads": live, "loads_key": key[:1].upper() + key[1:], "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
+    # a method that gives its stages the paper's line styles (Stage.style): said in the legend
+    paper_styles = styled(shown_stages(study))
+    return {"loads": loads, "live_loads": live, "loads_key": key[:1].upper() + key[1:],
+            "styles_note": "These are the paper's line styles for the stages it plots, so the figures titled with the "
+                           "paper's numbers draw each stage as every other figure does" if paper_styles else "", "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 
 

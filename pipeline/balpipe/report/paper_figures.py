@@ -2,11 +2,11 @@
 reproduces, read from its figure titles ("Fig. 8 of paper 000", "Figs. 2a, 4a, 6b", "Figs. 3-4"),
 and the panels that the generic pages did not draw as the paper numbers them:
 
-- paper 002, Fig. 2: shaking force and moment of the unbalanced manipulator;
-- paper 003, Figs. 3 and 4: |F| and M of the four cases on trajectory P15P7, the one the paper's
-  figures show (its Sec. 3);
 - paper 004, Figs. 10a, 10b, 11, 12: shaking force along x and along y, shaking moment (N m) of
   the unbalanced manipulator, and the shaking moment after shaking force balancing.
+
+The other papers' figures are their methods' hooks (:attr:`plugins.Method.figures`: paper 000 in
+``families.rpr3.figures``, papers 002 and 003 in ``families.serial_arm.figures``).
 
 :data:`FIGURES` is the table of the papers' figures that the site reproduces; a test holds the
 pages to it.
@@ -18,6 +18,7 @@ import re
 
 import numpy as np
 
+from ..balancing.base import style_index
 from ..draw import figures
 
 #: per paper, the figure numbers its pages reproduce (a number covers its panels: "6" by "6a")
@@ -28,8 +29,6 @@ FIGURES = {
     "003": ("2", "3", "4"),
     "004": ("10a", "10b", "11", "12"),
 }
-#: paper 003's figures show this trajectory (Sec. 3: "Figs. 3-4 ... P15P7")
-PAPER_003_TRAJECTORY = "P15P7"
 
 _FIGS = re.compile(r"\bFigs?\.\s*((?:\d+[a-z]?(?:\s*[-–]\s*\d+[a-z]?)?)(?:\s*(?:,|and)\s*\d+[a-z]?(?:\s*[-–]\s*\d+[a-z]?)?)*)")
 _ONE = re.compile(r"(\d+)([a-z]?)(?:\s*[-–]\s*(\d+)([a-z]?))?")
@@ -73,9 +72,8 @@ def _series(t, curves: list[tuple[str, np.ndarray, int]], ylabel: str, prefix: s
 
 
 def _k(study, stage) -> int:
-    """The stage's style index: its place among the stages of its motion (the page's order)."""
-    group = [s for s in study.stages if s.stage.group == stage.stage.group]
-    return next(i for i, s in enumerate(group) if s is stage)
+    """The stage's style index on the page (:func:`balancing.base.style_index`)."""
+    return style_index(study.stages, stage)
 
 
 def paper_id(study) -> str:
@@ -84,42 +82,9 @@ def paper_id(study) -> str:
 
 def own_figures(study) -> list[tuple[str, str, str]]:
     """The panels drawn here as the paper numbers them, (title, svg, caption)."""
-    pid = paper_id(study)
-    if pid == "002":
-        return _paper002(study)
-    if pid == "003":
-        return _paper003(study)
-    if pid == "004":
+    if paper_id(study) == "004":
         return _paper004(study)
     return []
-
-
-def _paper002(study) -> list[tuple[str, str, str]]:
-    un = study.unbalanced
-    an, k = un.analysis, _k(study, un)
-    f = _series(an.t, [(un.stage.label, np.hypot(an.force[:, 0], an.force[:, 1]), k)], "|F| (N)", "p002fig2f")
-    m = _series(an.t, [(un.stage.label, an.moment, k)], "M (N m)", "p002fig2m")
-    cap = ("The unbalanced manipulator (stage '" + un.stage.label + "', in its line style of this page): |F| including "
-           "the links' weight when gravity is on, M about the base joint, from the analysis of this spec.")
-    return [("Fig. 2 of paper 002: shaking force of the unbalanced manipulator", f, cap),
-            ("Fig. 2 of paper 002: shaking moment of the unbalanced manipulator", m, cap)]
-
-
-def _paper003(study) -> list[tuple[str, str, str]]:
-    pre = PAPER_003_TRAJECTORY + "_"
-    stages = [s for s in study.stages if s.stage.name.startswith(pre)]
-    if not stages:
-        return []
-    t = stages[0].analysis.t
-    label = [s.stage.label.split(" · ")[-1] for s in stages]
-    f = _series(t, [(lab, np.hypot(s.analysis.force[:, 0], s.analysis.force[:, 1]), k)
-                    for k, (lab, s) in enumerate(zip(label, stages))], "|F| (N)", "p003fig3")
-    m = _series(t, [(lab, s.analysis.moment, k) for k, (lab, s) in enumerate(zip(label, stages))], "M (N m)",
-                "p003fig4")
-    cap = (f"Trajectory {PAPER_003_TRAJECTORY}, the one the paper's figures show; the four cases in the page's "
-           "stage styles (the legend under the plot). Computed by the engine from this spec.")
-    return [(f"Fig. 3 of paper 003: shaking force, trajectory {PAPER_003_TRAJECTORY}", f, cap),
-            (f"Fig. 4 of paper 003: shaking moment, trajectory {PAPER_003_TRAJECTORY}", m, cap)]
 
 
 def _paper004(study) -> list[tuple[str, str, str]]:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...balancing.base import in_style_order, style_index
 from .template import pose_of, prismatic_equivalent
 
 
@@ -33,41 +34,37 @@ def figures(study):
 
 def paper_figures(number: str, linkage: str, published_factor: float):
     """The figures of one of the paper's methods (its :attr:`plugins.Method.figures`): the
-    shaking force x, y and moment of every stage in the paper's line styles (``number``: Fig. 4
-    for the idler loop, Fig. 8 for the Scott-Russell legs: unbalanced solid, counterweights
-    dashed, counter-rotations grey; the added-linkage stage ``linkage``, which the paper does not
-    plot, dotted), and a table of the peaks and of the factor by which the counterweights raise
-    the peak moment (the paper reports ``published_factor``)."""
+    shaking force x, y and moment of every stage (``number``: Fig. 4 for the idler loop, Fig. 8
+    for the Scott-Russell legs), in the paper's line styles, which are the stages' styles on the
+    whole page (:data:`template.STYLES`: unbalanced solid, counterweights dashed, counter-rotations
+    grey; the added-linkage stage ``linkage``, which the paper does not plot, blue dash-dot), and a
+    table of the peaks and of the factor by which the counterweights raise the peak moment (the
+    paper reports ``published_factor``)."""
 
     def figures(study):
-        from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
+        from ...draw.figures import plt, style, to_svg  # matplotlib only when a report is drawn
 
-        styles = {
-            "unbalanced": {"color": "black", "linestyle": "-", "linewidth": 1.3},
-            linkage: {"color": "tab:blue", "linestyle": ":", "linewidth": 1.2},
-            "counterweights": {"color": "black", "linestyle": "--", "linewidth": 1.3},
-            "counter_rotations": {"color": "0.6", "linestyle": "-", "linewidth": 2.4},
-        }
         fig, axes = plt.subplots(1, 3, figsize=(10.5, 3.2))
         panels = (("(a) shaking force along x (N)", lambda a: a.force[:, 0]),
                   ("(b) shaking force along y (N)", lambda a: a.force[:, 1]),
                   ("(c) shaking moment about O (N m)", lambda a: a.moment))
+        own = in_style_order(_own(study))
         for ax, (title, fn) in zip(axes, panels):
-            for s in _own(study):
-                st = styles.get(s.stage.name, {"color": "tab:red", "linestyle": "-.", "linewidth": 1.0})
-                ax.plot(s.analysis.t, fn(s.analysis), label=s.stage.label, **st)
+            for s in own:
+                ax.plot(s.analysis.t, fn(s.analysis), label=s.stage.label, **style(style_index(study.stages, s)))
             ax.set_title(title, fontsize=9)
             ax.set_xlabel("time (s)")
         handles, labels = axes[0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
         fig.tight_layout(rect=(0, 0.08, 1, 1))
+        linkage_label = next((s.stage.label for s in own if s.stage.name == linkage), linkage)
         yield (
             f"Shaking force and moment, every stage ({number} of paper 000)",
             to_svg(fig, "rpr3-loads"),
-            "The paper's line styles: before (solid) and after (dashed) the counterweights, after the "
-            "counter-rotations (grey); the stage with the added linkage but no counterweights, which the "
-            "paper does not plot, is dotted. Moments about O, the base's circumcentre; loads that the "
-            "moving links exert on the base.",
+            "The paper's line styles, which every figure of this page gives these stages: before (solid) and after "
+            "(dashed) the counterweights, after the counter-rotations (grey); the stage with the "
+            f"{linkage_label} but no counterweights, which the paper does not plot, is blue dash-dot. Moments about "
+            "O, the base's circumcentre; loads that the moving links exert on the base.",
         )
         yield ("Peak loads and the moment factor", _factor_table(study, linkage), _factor_caption(published_factor))
 

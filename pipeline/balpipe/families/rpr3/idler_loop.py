@@ -223,14 +223,14 @@ def balance(mech: rpr3.Rpr3Mechanism, method: Rpr3IdlerLoop, model: Model, t: np
     at4 = E - s5 * np.array([math.cos(th5), math.sin(th5)])
     full = add_counter_rotation(full, "cr4", carrier=FRAME, at=(float(at4[0]), float(at4[1])), geared_to="link5",
                                 ratio=-1.0, inertia=I["Icr4"], radius=s5 / 2, radius_geared=s5 / 2)
-    stages = [
+    stages = [replace(st, style=rpr3.STYLES[st.name]) for st in (
         Stage("unbalanced", "unbalanced", model, "the plain 3-RPR (Fig. 2(a))"),
         Stage("idler_loop", "idler loop", idler, "the RRR chain E-F-P added between the base and the platform (Fig. 2(b))"),
         Stage("counterweights", "counterweights", cw, "eight counterweights of eqs. 5a-d (Fig. 3)", balances="force"),
         Stage("counter_rotations", "counter-rotations", full,
               "six chained counter-rotations of eqs. 9a-d: three on the base at A_i, one on link 6, one on "
               "link 5, one on the base at E", balances="force+moment"),
-    ]
+    )]  # the paper's line styles
     notes = [
         "Counter-rotations are massless discs; Icr2 and Icr3 turn on moving carriers (links 6 and 5) "
         "and mesh with the platform and link 6: the '2 Icr2' and '2 Icr3' terms of eqs. 9c-d are "

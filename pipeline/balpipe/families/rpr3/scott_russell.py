@@ -270,7 +270,7 @@ def balance(mech: rpr3.Rpr3Mechanism, method: Rpr3ScottRussell, model: Model) ->
         at = A[i] * (1 + s / mech.base_radius)
         full = add_counter_rotation(full, f"cr{i + 1}", carrier=FRAME, at=(float(at[0]), float(at[1])),
                                     geared_to=f"cyl{i + 1}", ratio=-1.0, inertia=Icr, radius=s / 2, radius_geared=s / 2)
-    stages = [
+    stages = [replace(st, style=rpr3.STYLES[st.name]) for st in (
         Stage("unbalanced", "unbalanced", model, "the plain 3-RPR (Fig. 2(a))"),
         Stage("scott_russell", "Scott-Russell legs", sr, "a crank and a coupler (L1 = L2) added to every leg (Fig. 6)"),
         Stage("counterweights", "counterweights", cw, "four counterweights per leg, eqs. 30a-d", balances="force"),
@@ -278,7 +278,7 @@ def balance(mech: rpr3.Rpr3Mechanism, method: Rpr3ScottRussell, model: Model) ->
               "one counter-rotation per leg on the base, geared to the cylinder (eq. 30f, Fig. 7)"
               + ("" if ok30e else "; eq. 30e does not hold, so the moment remains"),
               balances="force+moment" if ok30e else "force"),
-    ]
+    )]  # the paper's line styles
     return BalanceResult(params, stages, notes)
 
 

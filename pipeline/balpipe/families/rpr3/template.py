@@ -356,3 +356,10 @@ def _notation() -> dict:
 
 #: Paper 000's symbols (Sec. 2, Fig. 2; Sec. 2.1, eq. 10) for this template's inputs.
 NOTATION = _notation()
+
+
+#: the stages' line styles on a page (:attr:`balancing.base.Stage.style`, ``draw.figures.style``):
+#: Figs. 4 and 8 of paper 000 draw the plain 3-RPR solid (style 0), the counterweights dashed
+#: (style 1) and the counter-rotations grey (style 2); the added linkage, which the paper does not
+#: plot, takes the next style (blue dash-dot)
+STYLES = {"unbalanced": 0, "counterweights": 1, "counter_rotations": 2, "idler_loop": 3, "scott_russell": 3}

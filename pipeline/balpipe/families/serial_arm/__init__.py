@@ -2,7 +2,7 @@
 planning (paper 003)."""
 
 from ...plugins import Family, Method, Template
-from . import com_planning, decoupling, template
+from . import com_planning, decoupling, figures, template
 
 FAMILY = Family(
     name="serial_arm",
@@ -14,9 +14,9 @@ FAMILY = Family(
     methods=(
         Method("gear_decoupling", decoupling.GearDecoupling, decoupling.balance, ("serial_arm",),
                "decoupling by gears 1'-2' and mass redistribution, counter-rotating gear 3 (paper 002)",
-               notation=decoupling.NOTATION),
+               notation=decoupling.NOTATION, figures=figures.decoupling_figures),
         Method("com_motion_planning", com_planning.ComMotionPlanning, com_planning.balance, ("serial_arm",),
                "centre-of-mass motion planning, phi optimised (paper 003)", uses_spec=True,
-               notation=com_planning.NOTATION),
+               notation=com_planning.NOTATION, figures=figures.com_planning_figures),
     ),
 )

@@ -62,11 +62,15 @@ from ...sampling import gravity_vector, time_grid
 
 ROOT = ("balancing",)
 CASES = (
-    ("ee_quintic", "end-effector quintic"),
-    ("com_bang_bang", "CoM bang-bang"),
-    ("com_bang_bang_phi_opt", "CoM bang-bang + phi optimised"),
-    ("com_trapezoidal", "CoM trapezoidal"),
+    ("ee_quintic", "case 1: end-effector quintic"),
+    ("com_bang_bang", "CoM bang-bang, φ on the 3-4-5 law (not in the paper)"),
+    ("com_bang_bang_phi_opt", "case 2: CoM bang-bang + φ optimised"),
+    ("com_trapezoidal", "case 3: CoM trapezoidal"),
 )
+#: each case's line style on the page (:attr:`Stage.style`): Figs. 3-4 draw case 1 black full
+#: (style 0), case 2 black dashed (style 1), case 3 grey full (style 2); the stage the paper does
+#: not draw takes the next style (blue dash-dot)
+STYLES = {"ee_quintic": 0, "com_bang_bang_phi_opt": 1, "com_trapezoidal": 2, "com_bang_bang": 3}
 
 
 class TestSquare(Strict):
@@ -134,6 +138,9 @@ class ComMotionPlanning(Strict):
     )
     orientation: Orientation | None = Field(None, description="phi at both ends of every trajectory (with trajectories)")
     phi: PhiOptimisation = Field(PhiOptimisation(), description="the law of phi in case 2 and its optimisation")
+    main_trajectory: str | None = Field(
+        None, description="the trajectory shown first: the page's headline, design summary and stage figures, and "
+        "Figs. 3-4 (the paper's figures show P15P7); default the first")
     torque_rate_limit: number(gt=0) = Field(
         3e4, description="case 3: largest rate of change of any actuator torque, N m/s (the paper: 3.10^4)"
     )
@@ -466,7 +473,9 @@ def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, s
     params: list[Parameter] = []
     P = lambda *a: params.append(Parameter(*a))  # noqa: E731
     m_total = planner.arm.total_mass
-    for name, start, end, path in trajectories_of(method, model):
+    trajectories = trajectories_of(method, model)
+    main = main_trajectory(method, trajectories)
+    for name, start, end, path in trajectories:
         plan = planner.plan(name, start, end, path)
         # located errors on every path before optimising (case 1 and the bang-bang line)
         tip_laws = tuple(law_for(_Motion(law_name, T), a, b) for a, b in zip(plan.start, plan.end))
@@ -483,7 +492,7 @@ def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, s
                 label = f"end-effector {law_name}"
             stages.append(Stage(
                 prefix + key, f"{name} · {label}" if name else label, plan.models[key],
-                _description(key, plan, method), reference=prefix + "ee_quintic", group=name,
+                _description(key, plan, method), reference=prefix + "ee_quintic", group=name, style=STYLES[key],
             ))
         sfx = f"_{name}" if name else ""
         P(f"com_distance{sfx}", plan.com_distance, "m", "eq. 7", f"{name or 'the'} centre of mass displacement d (straight line)")
@@ -501,19 +510,50 @@ def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, s
         if not p.ramp_feasible:
             notes.append(f"Trajectory {p.name or ''}: even the longest ramps (f = 1/4) need a torque rate of "
                          f"{p.ramp_rate:.4g} N m/s, above the limit {method.torque_rate_limit:.4g} N m/s: case 3 uses f = 1/4.")
-    info = {"plans": plans, "planner": planner, "method": method, "law": law_name}
-    return BalanceResult(params, stages, notes, figures=lambda study: figures(study, info),
-                         derived=lambda results: derived(results, plans, T, m_total))
+    # the main trajectory's stages first: the page's headline, design card and stage figures show it
+    stages.sort(key=lambda s: s.group != main)
+    return BalanceResult(params, stages, notes, derived=lambda results: derived(results, plans, T, m_total))
+
+
+def main_trajectory(method: ComMotionPlanning, trajectories: list) -> str:
+    """The name of the trajectory shown first (``main_trajectory``, default the first)."""
+    names = [n for n, *_ in trajectories]
+    if method.main_trajectory is None:
+        return names[0]
+    if method.main_trajectory not in names:
+        raise SpecFieldError(ROOT + ("main_trajectory",), f"no trajectory {method.main_trajectory!r} "
+                             f"(the trajectories: {', '.join(names)})")
+    return method.main_trajectory
+
+
+def replan(spec, parameters: dict) -> tuple[Planner, list[Plan]]:
+    """The plans of a finished balancing, rebuilt from the spec and its computed parameters
+    (end configurations and centres of mass by the inverse kinematics, phi's coefficients and
+    the ramps as the balancing found them; nothing optimised again): what the figures draw."""
+    from ... import registry
+
+    method: ComMotionPlanning = spec.balancing
+    model = registry.unbalanced_model(spec)
+    planner = Planner(model, spec.mechanism, method, spec.motion.duration, time_grid(spec), gravity_vector(spec),
+                      spec.analysis.moment_point)
+    plans = []
+    for name, start, end, path in trajectories_of(method, model):
+        plan = planner.plan(name, start, end, path)
+        sfx = f"_{name}" if name else ""
+        plan.phi_coefficients = tuple(parameters[f"phi_c{k}{sfx}"] for k in range(method.phi.degree - 5))
+        plan.ramp_fraction, plan.ramp_rate = parameters[f"ramp_fraction{sfx}"], parameters[f"ramp_torque_rate{sfx}"]
+        plans.append(plan)
+    return planner, plans
 
 
 def _description(key: str, plan: Plan, method: ComMotionPlanning) -> str:
     deg = method.phi.degree
     return {
-        "ee_quintic": "tip on the straight line and phi on the 3-4-5 law (case 1)",
-        "com_bang_bang": "centre of mass on the straight line, bang-bang; phi on the 3-4-5 law",
-        "com_bang_bang_phi_opt": f"centre of mass bang-bang; phi a degree-{deg} polynomial minimising the peak moment (case 2)",
+        "ee_quintic": "tip on the straight line and φ on the 3-4-5 law (case 1)",
+        "com_bang_bang": "centre of mass on the straight line, bang-bang; φ on the 3-4-5 law",
+        "com_bang_bang_phi_opt": f"centre of mass bang-bang; φ a degree-{deg} polynomial minimising the peak moment (case 2)",
         "com_trapezoidal": f"centre of mass on a trapezoidal acceleration, ramps {plan.ramp_fraction:.3g} T "
-                           f"(torque rate <= {method.torque_rate_limit:.3g} N m/s); phi as optimised (case 3)",
+                           f"(torque rate <= {method.torque_rate_limit:.3g} N m/s); φ as optimised (case 3)",
     }[key]
 
 
@@ -563,149 +603,6 @@ def derived(results, plans: list[Plan], T: float, m_total: float) -> list[Parame
     return out
 
 
-# --------------------------------------------------------------------------------------------
-# Page
-
-
-def _pct(x: float) -> str:
-    return f"{100 * x:.1f} %"
-
-
-def figures(study, info: dict):
-    from ...draw.figures import legend_below, plt, style, to_svg
-
-    plans: list[Plan] = info["plans"]
-    method: ComMotionPlanning = info["method"]
-    by = {s.stage.name: s for s in study.stages}
-    params = {p.name: p.value for p in study.balance.parameters}
-    # the table per trajectory
-    rows = []
-    for p in plans:
-        pre = f"{p.name}_" if p.name else ""
-        a1 = by[pre + "ee_quintic"].analysis
-        rows.append(f'<tr><th colspan="7">{p.name or "trajectory"}: tip ({p.start[0]:.4g}, {p.start[1]:.4g}) → '
-                    f'({p.end[0]:.4g}, {p.end[1]:.4g}) m, centre of mass moves {1000 * p.com_distance:.4g} mm</th></tr>')
-        for key, label in CASES:
-            s = by[pre + key]
-            an = s.analysis
-            tau = max(float(np.max(np.abs(e))) for e in an.efforts.values())
-            fr = 1 - an.max_inertial_force / a1.max_inertial_force
-            mr = 1 - an.max_inertial_moment / a1.max_inertial_moment
-            rows.append(
-                f"<tr><td>{s.stage.label.split(' · ')[-1]}</td><td class=\"num\">{an.max_force:.4g}</td>"
-                f"<td class=\"num\">{'—' if key == 'ee_quintic' else _pct(fr)}</td>"
-                f"<td class=\"num\">{an.max_moment:.4g}</td><td class=\"num\">{'—' if key == 'ee_quintic' else _pct(mr)}</td>"
-                f"<td class=\"num\">{tau:.4g}</td><td class=\"num\">{_rate_cell(key, an, p, method)}</td></tr>"
-            )
-    fmin, fmax = params["force_reduction_min"], params["force_reduction_max"]
-    mmin, mmax = params["moment_reduction_min"], params["moment_reduction_max"]
-    head = ("<table><tr><th>Case</th><th>Peak |F| (N)</th><th>|F| reduction vs case 1</th><th>Peak |M| (N m)</th>"
-            "<th>|M| reduction vs case 1</th><th>Peak |τ| (N m)</th><th>Peak |dτ/dt| (N m/s)</th></tr>")
-    summary = (f'<tr><th colspan="7">All trajectories, case 2 (CoM bang-bang + phi optimised) vs case 1: force '
-               f'reduction {_pct(fmin)} to {_pct(fmax)} (published 48 % to 62.2 %); moment reduction {_pct(mmin)} to '
-               f'{_pct(mmax)} (published 37.2 % to 61 %)</th></tr>')
-    yield ("Peak loads per trajectory (the paper's Sec. 3 results)", head + "".join(rows) + summary + "</table>",
-           "Computed by the engine for every stage; reductions are 1 − peak / peak of the same trajectory's case 1 "
-           "(end-effector quintic). The paper gives only the ranges over its eight trajectories; the duration "
-           f"({study.spec.motion.duration:g} s here) does not change the ratios (all loads scale with 1/T²) but does "
-           "change case 3 (the torque-rate limit). In a horizontal plane the shaking moment about the base joint is "
-           "minus joint 1's torque (paper 002, eq. 16), hence equal peaks. Torque rates: case 1 by central "
-           f"differences on the analysis grid, case 3 on {method.rate_samples} samples and 64 in each ramp (the ramp search).")
-    yield from _square_figure(study, info, plt, to_svg)
-    # Figs. 3-4 for every trajectory: |F| and M, the four cases
-    n = len(plans)
-    fig, axes = plt.subplots(n, 2, figsize=(9.0, 2.1 * n + 0.4), squeeze=False)
-    for r, p in enumerate(plans):
-        pre = f"{p.name}_" if p.name else ""
-        for k, (key, label) in enumerate(CASES):
-            an = by[pre + key].analysis
-            axes[r, 0].plot(an.t, np.hypot(an.force[:, 0], an.force[:, 1]), label=label, **style(k))
-            axes[r, 1].plot(an.t, an.moment, label=label, **style(k))
-        axes[r, 0].set_title(f"{p.name}: shaking force |F| (N)", fontsize=8)
-        axes[r, 1].set_title(f"{p.name}: shaking moment M (N m)", fontsize=8)
-    for ax in axes[-1]:
-        ax.set_xlabel("time (s)")
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=7, frameon=False)
-    fig.tight_layout(rect=(0, 0.03 if n > 2 else 0.08, 1, 1))
-    yield ("Shaking force and moment per trajectory (Figs. 3-4)", to_svg(fig, "com-loads"),
-           "Solid black: case 1 (end-effector quintic); dashed: CoM bang-bang with phi on the 3-4-5 law; grey: "
-           "case 2 (CoM bang-bang, phi optimised); blue dash-dot: case 3 (CoM trapezoidal). The paper's Figs. 3-4 "
-           "show trajectory P15P7. Moment about the base joint, horizontal plane.")
-    fig, axes = plt.subplots(1, 1, figsize=(6.0, 3.0))
-    for k, p in enumerate(plans):
-        phi = PhiPolynomial(p.start[2], p.end[2], info["planner"].T, p.phi_coefficients)
-        tt = info["planner"].t
-        axes.plot(tt, np.degrees(phi(tt)[0]), label=p.name or "optimised", linewidth=1.0)
-    phi5 = PhiPolynomial(plans[0].start[2], plans[0].end[2], info["planner"].T)
-    axes.plot(info["planner"].t, np.degrees(phi5(info["planner"].t)[0]), color="black", linestyle="--", linewidth=1.4, label="3-4-5 law")
-    axes.set_xlabel("time (s)")
-    axes.set_ylabel("phi (deg)")
-    legend_below(fig, axes, fontsize=7)  # under the axes: never over a curve
-    yield ("Optimised end-effector orientation", to_svg(fig, "com-phi"),
-           f"phi(t) of case 2 per trajectory (degree {method.phi.degree}, ends fixed), and the 3-4-5 law it starts from.")
-
-
-def _rate_cell(key: str, an, plan: Plan, method: ComMotionPlanning) -> str:
-    """Peak actuator torque rate: unbounded where the bang-bang law makes the torques jump; case
-    3's as measured by the ramp search; case 1's by central differences on the analysis grid."""
-    if key.startswith("com_bang_bang"):
-        return "unbounded (torques jump)"
-    if key == "com_trapezoidal":
-        return f"{plan.ramp_rate:.4g} (limit {method.torque_rate_limit:.3g})"
-    return f"{max(float(np.max(np.abs(np.gradient(e, an.t)))) for e in an.efforts.values()):.4g}"
-
-
-def _square_figure(study, info, plt, to_svg):
-    """Fig. 2: the test square, its points and the trajectories of the tip and of the centre of mass."""
-    plans: list[Plan] = info["plans"]
-    method: ComMotionPlanning = info["method"]
-    planner: Planner = info["planner"]
-    fig, ax = plt.subplots(figsize=(6.0, 5.4))
-    names: list = []  # (text, point, kind): placed last, clear of the paths (report.figures.place_items)
-    segs: list = []
-    if method.test_square is not None:
-        sq = method.test_square
-        h = sq.side / 2
-        cx, cy = sq.centre
-        ax.fill([cx - h, cx + h, cx + h, cx - h], [cy - h, cy - h, cy + h, cy + h], color="0.88", zorder=0)
-        for name, (x, y) in sq.points().items():
-            ax.plot(x, y, "o", color="black", markersize=2.5)
-            names.append((name, (x, y), "joint"))
-        ax.plot([cx], [cy], "+", color="black")
-        names.append(("E", (cx, cy), "joint"))
-    for k, p in enumerate(plans):
-        c = f"C{k % 10}"
-        ax.annotate("", xy=p.end[:2], xytext=p.start[:2], arrowprops={"arrowstyle": "->", "color": c, "lw": 1.2})
-        ax.plot([p.com_start[0], p.com_end[0]], [p.com_start[1], p.com_end[1]], color=c, linestyle="--", linewidth=1.0,
-                label=f"{p.name}: tip → (solid), centre of mass (dashed)")
-        segs += [(tuple(p.start[:2]), tuple(p.end[:2])), (tuple(p.com_start[:2]), tuple(p.com_end[:2]))]
-    # the arm at the start of the first trajectory
-    p0 = plans[0]
-    th = np.cumsum(p0.q_start)
-    pts = [np.asarray(planner.arm.base)]
-    for L, a in zip(planner.arm.lengths, th):
-        pts.append(pts[-1] + L * np.array([math.cos(a), math.sin(a)]))
-    pts = np.array(pts)
-    ax.plot(pts[:, 0], pts[:, 1], "-o", color="0.3", linewidth=2.0, markersize=3, label=f"arm at the start of {p0.name}")
-    segs += [(tuple(a), tuple(b)) for a, b in zip(pts[:-1], pts[1:])]
-    ax.plot([planner.arm.base[0]], [planner.arm.base[1]], "^", color="black", markersize=8)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    from ...draw.figures import legend_below, place_items
-
-    legend_below(fig, ax, fontsize=7)  # under the drawing: never over the arm or the paths
-    place_items(fig, ax, names, segs, [(np.asarray(q, dtype=float), None) for _, q, _ in names]
-                + [(np.asarray(planner.arm.base, dtype=float), -1.0)])
-    yield ("The test square and the trajectories (Fig. 2)", to_svg(fig, "com-square"),
-           "Grey: the tested zone (side " + (f"{method.test_square.side:g} m, centre ({method.test_square.centre[0]:g}, "
-           f"{method.test_square.centre[1]:g}) m" if method.test_square else "—") + "), points P1.. numbered "
-           "counter-clockwise from P1 at the " + (method.test_square.first_corner if method.test_square else "—") +
-           " corner (our reading of the figure, which reproduces the paper's list of segments). Arrows: the tip's "
-           "straight paths of case 1; dashed: the centre of mass' straight paths of cases 2-3. Base joint: triangle.")
-
-
 def _notation() -> dict:
     from ...notation import Sym, ours, setting
 
@@ -718,6 +615,7 @@ def _notation() -> dict:
         "balancing.trajectories[<k>].name": ours("name", "label of a tip trajectory"),
         "balancing.trajectories[<k>].start": ours("x_0", "start point of a tip trajectory"),
         "balancing.trajectories[<k>].end": ours("x_f", "end point of a tip trajectory"),
+        "balancing.main_trajectory": ours("P_iP_j (shown)", "the trajectory shown first: headline, design summary, Figs. 3-4 (the paper: P15P7)"),
         "balancing.orientation.start": Sym("φ_0", "orientation φ of the last link at the start of every trajectory"),
         "balancing.orientation.end": Sym("φ_f", "orientation φ at the end"),
         "balancing.phi.degree": ours("deg φ", "degree of the polynomial law of φ (ends fixed to second order)"),

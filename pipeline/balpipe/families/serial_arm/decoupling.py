@@ -105,10 +105,13 @@ class MassMatrix2R:
         return np.stack([np.stack([ent[0], ent[1]], -1), np.stack([ent[1], ent[2]], -1)], -2)
 
     def text(self, entry: str) -> str:
+        """'0.132 + 0.054 cos θ₂'; a coefficient below 1e-12 of the matrix's largest is round-off
+        and reads 0."""
         k0, kc, ks = getattr(self, entry)
-        out = f"{k0:.6g}"
-        for v, f in ((kc, "cos q2"), (ks, "sin q2")):
-            if abs(v) > 1e-12 * max(1.0, abs(k0)):
+        scale = max(abs(v) for e in (self.M11, self.M12, self.M22) for v in e)
+        out = f"{k0:.6g}" if abs(k0) > 1e-12 * scale else "0"
+        for v, f in ((kc, "cos θ₂"), (ks, "sin θ₂")):
+            if abs(v) > 1e-12 * scale:
                 out += f" {'+' if v > 0 else '-'} {abs(v):.6g} {f}"
         return out
 
@@ -172,7 +175,6 @@ def balance(mech: SerialArmMechanism, method: GearDecoupling, model: Model) -> B
                                ratio=rho, inertia=Ig, mass=g1.mass, radius=r1p, radius_geared=r2p)
     ma, ca, Ia = _assembly(dec, "link1")
 
-    before = mass_matrix_2r(model, l1, None)
     after = mass_matrix_2r(dec, l1, (g1.mass, g1.position, Ig, rho))
     J1, J2 = after.M11[0], after.M22[0]
     cond1 = float(np.hypot(*cb))
@@ -228,65 +230,7 @@ def balance(mech: SerialArmMechanism, method: GearDecoupling, model: Model) -> B
         Stage("decoupled_counter_rotation", "decoupled + counter-rotation", full,
               "gear 1'' on link 1 at A meshing with gear 3 on the frame, I3 = J1", balances="force+moment"),
     ]
-    info = {"before": before, "after": after, "J": (J1, J2)}
-    return BalanceResult(params, stages, notes, figures=lambda study: figures(study, info))
-
-
-def figures(study, info: dict):
-    """Mass matrix before and after (symbolic and along the motion), torque against acceleration."""
-    from ...engine.joint_space import mass_matrix
-    from ...draw.figures import plt, style, to_svg
-
-    before, after = info["before"], info["after"]
-    J1, J2 = info["J"]
-    rows = "".join(
-        f"<tr><td>{e}</td><td><code>{before.text(e)}</code></td><td><code>{after.text(e)}</code></td></tr>"
-        for e in ("M11", "M12", "M22")
-    )
-    table = (
-        "<table><tr><th>Entry (kg m²)</th><th>unbalanced</th><th>decoupled</th></tr>" + rows + "</table>"
-    )
-    yield (
-        "Mass matrix before and after decoupling (eqs. 4-6)",
-        table,
-        "M11 = I_a + m_a|c_a|² + m1'|AC|² + I_S1' + I_b + m_b (l1² + |c_b|² + 2 l1 (c_bx cos q2 − c_by sin q2)); "
-        "M12 = ρ I_S1' + I_b + m_b (|c_b|² + l1 (c_bx cos q2 − c_by sin q2)); M22 = ρ² I_S1' + I_b + m_b |c_b|², "
-        "with link 1's assembly (m_a, c_a, I_a), gear 1' on C (m1', I_S1', ratio ρ) and link 2's assembly "
-        "(m_b, c_b from B, I_b); the numbers are computed from the stages' models.",
-    )
-    stages = [s for s in study.stages if s.stage.name in ("unbalanced", "decoupled")]
-    fig, axes = plt.subplots(1, 3, figsize=(9.6, 2.8))
-    for k, s in enumerate(stages):
-        an = s.analysis
-        _, M = mass_matrix(s.stage.model, an.t)
-        for ax, (i, j, name) in zip(axes, ((0, 0, "M11"), (0, 1, "M12"), (1, 1, "M22"))):
-            ax.plot(an.t, M[:, i, j], label=s.stage.label, **style(k))
-            ax.set_title(f"{name} (kg m²)", fontsize=9)
-            ax.set_xlabel("time (s)")
-    axes[0].legend(fontsize=7)
-    fig.tight_layout()
-    yield ("Mass matrix along the motion", to_svg(fig, "decoupling-mass"),
-           "Entries of the joint-space mass matrix computed by the engine from each stage's model "
-           "(M = Vᵀ diag(m, m, I) V, V the body velocities per unit joint rate): the decoupled arm's is "
-           "constant and diagonal.")
-    fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.2))
-    for k, s in enumerate(stages):
-        an = s.analysis
-        for j, ax in enumerate(axes):
-            qdd = an.a[:, an.names.index(f"link{j + 1}"), 2] - (an.a[:, an.names.index("link1"), 2] if j else 0.0)
-            ax.plot(qdd, an.efforts[f"q{j + 1}"], ".", markersize=2.5, color=style(k)["color"],
-                    alpha=0.7 if k else 0.5, label=s.stage.label)
-    for j, (ax, Jj) in enumerate(zip(axes, (J1, J2))):
-        lim = np.array(ax.get_xlim())
-        ax.plot(lim, Jj * lim, color="tab:red", linewidth=1.0, label=f"J{j + 1} q{j + 1}'' (J{j + 1} = {Jj:.4g} kg m²)")
-        ax.set_xlabel(f"q{j + 1}'' (rad/s²)")
-        ax.set_title(f"Joint {j + 1} torque (N m)", fontsize=9)
-        ax.legend(fontsize=7)
-    fig.tight_layout()
-    yield ("Torque against acceleration", to_svg(fig, "decoupling-torque"),
-           "Each joint's actuator torque against its own acceleration at every sample: coupled and "
-           "nonlinear before, on the line tau = J q'' after decoupling"
-           + (" (with gravity on, the decoupled arm's total centre of mass is on A: no gravity torque)." if study.spec.analysis.gravity else "."))
+    return BalanceResult(params, stages, notes)
 
 
 def _notation() -> dict:
