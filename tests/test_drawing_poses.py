@@ -177,3 +177,13 @@ def test_the_player_draws_the_same_connected_legs(studies):
     assert np.allclose(np.array(d["sleeves"][0]), np.array([[a, b] for a, b in first]), atol=1e-6)
     names = [b.name for b in s.stage.model.bodies]
     assert not any(sh["slider"] for n, sh in zip(names, d["shapes"]) if n.startswith("piston"))
+
+
+def test_the_player_names_the_platform_joints_first(studies):
+    """The player names coinciding points by the first in its list: the platform's C1-C3 (names
+    no other point has) come before the pistons' C."""
+    from balpipe.draw import player
+
+    s = studies("paper000_rpr3_idler_loop.yaml").stages[0]
+    joints = [j[3] for j in player._labels(s.stage.model, {})["joints"]]
+    assert joints.index("C1") < joints.index("C") and joints.index("C3") < joints.index("C")

@@ -149,6 +149,13 @@ def _labels(model: Model, numbers: dict[str, str]) -> dict:
             elif a.radius:
                 gears.append([j, round(a.position[0], 5), round(a.position[1], 5), round(a.radius, 5),
                               numbers.get(a.name, a.name)])
+    # the page names coinciding points once, first come first named: the name no other point has
+    # goes first (the platform's C1 before the pistons' C), as in the drawings
+    count: dict[str, int] = {}
+    for b in model.bodies:
+        for n in b.points:
+            count[n] = count.get(n, 0) + 1
+    joints.sort(key=lambda j: count[j[3]] > 1)
     return {"joints": joints, "links": links, "cws": cws, "gears": gears}
 
 
