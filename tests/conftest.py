@@ -52,3 +52,22 @@ def slider_crank_spec(rng: np.random.Generator | None = None, *, scott_russell: 
 @pytest.fixture
 def rng() -> np.random.Generator:
     return np.random.default_rng(20261122)
+
+
+@pytest.fixture(scope="module")
+def studies():
+    """``studies(name)``: the study of ``specs/<name>``, run once per test module."""
+    from pathlib import Path
+
+    from balpipe import loader
+    from balpipe import study as study_mod
+
+    specs = Path(__file__).resolve().parents[1] / "specs"
+    cache: dict = {}
+
+    def get(name: str):
+        if name not in cache:
+            cache[name] = study_mod.run(loader.load(specs / name).spec)
+        return cache[name]
+
+    return get

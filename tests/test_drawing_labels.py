@@ -10,8 +10,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balpipe import loader
-from balpipe import study as study_mod
 from balpipe.build import Options, build
 from balpipe.draw import figures, labels
 from balpipe.report import page
@@ -20,18 +18,6 @@ from balpipe.draw import player
 SPECS = Path(__file__).resolve().parents[1] / "specs"
 DRAWN = ["paper000_rpr3_idler_loop.yaml", "paper001_4rrr.yaml", "paper002_decoupling.yaml",
          "paper004_five_bar.yaml", "scott_russell.yaml", "custom_four_bar_balancing.yaml"]
-
-
-@pytest.fixture(scope="module")
-def studies() -> dict:
-    cache: dict = {}
-
-    def get(name: str):
-        if name not in cache:
-            cache[name] = study_mod.run(loader.load(SPECS / name).spec)
-        return cache[name]
-
-    return get
 
 
 # -- the placer itself -------------------------------------------------------------------------
@@ -83,6 +69,26 @@ def test_gear_numbers_from_names_else_in_model_order():
 
 # -- the papers' drawings ----------------------------------------------------------------------
 
+def _texts_and_links(fig):
+    """The drawn names' boxes (display pixels, the text alone, not its leader) and the solid
+    pose's links as segments (black lines; ghosts are grey)."""
+    from matplotlib.colors import to_rgba
+    from matplotlib.text import Text
+
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    ax = fig.axes[0]
+    texts = [(t.get_text(), Text.get_window_extent(t, renderer).extents) for t in ax.texts if t.get_text()]
+    to_px = ax.transData.transform
+    segs = []
+    for line in ax.lines:
+        if to_rgba(line.get_color()) == to_rgba("black") and line.get_linestyle() in ("-", "solid") \
+                and len(line.get_xydata()) >= 2:
+            xy = to_px(line.get_xydata())
+            segs += [(tuple(a), tuple(b)) for a, b in zip(xy[:-1], xy[1:])]
+    return texts, segs
+
+
 @pytest.mark.parametrize("name", DRAWN)
 def test_names_on_the_papers_drawings_never_overlap(studies, name):
     st = studies(name)
@@ -90,14 +96,22 @@ def test_names_on_the_papers_drawings_never_overlap(studies, name):
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown])
     numbers = labels.gear_numbers([s.stage.model for s in shown])
     for s in shown:
-        fig, placed = figures.mechanism_drawing(s.stage.model, s.analysis, page.INSTANTS, s.stage.label, limits,
+        fig, placed = figures.mechanism_drawing(s.stage.model, s.analysis, page.drawn_instants(st), s.stage.label, limits,
                                                 numbers)
         ax = fig.axes[0]
         x0, y0, x1, y1 = ax.bbox.extents
+        texts, segs = _texts_and_links(fig)
         figures.plt.close(fig)
         assert placed, s.stage.name
         for a, b in itertools.combinations(placed, 2):
             assert not labels.overlaps(a.box, b.box), f"{name} {s.stage.name}: {a.request.text!r} over {b.request.text!r}"
+        # as drawn: the names' text boxes, read back from the figure, overlap no other name nor a
+        # link of the solid pose
+        assert len(texts) == len(placed) and segs
+        for (ta, a), (tb, b) in itertools.combinations(texts, 2):
+            assert not labels.overlaps(a, b), f"{name} {s.stage.name}: {ta!r} over {tb!r} as drawn"
+        crossed = [t for t, box in texts if any(labels.segment_hits_box(sg, box) for sg in segs)]
+        assert not crossed, f"{name} {s.stage.name}: names over a link: {crossed}"
         for p in placed:
             assert x0 <= p.box[0] and p.box[2] <= x1 and y0 <= p.box[1] and p.box[3] <= y1, (name, p)
         texts = [p.request.text for p in placed]
@@ -116,8 +130,8 @@ def test_names_on_the_papers_drawings_never_overlap(studies, name):
 def test_the_drawing_is_the_same_bytes_twice(studies):
     st = studies("paper004_five_bar.yaml")
     s = st.stages[-1]
-    a = figures.mechanism_figure(s.stage.model, s.analysis, 5, prefix="m", title="x")
-    b = figures.mechanism_figure(s.stage.model, s.analysis, 5, prefix="m", title="x")
+    a = figures.mechanism_figure(s.stage.model, s.analysis, None, prefix="m", title="x")
+    b = figures.mechanism_figure(s.stage.model, s.analysis, None, prefix="m", title="x")
     assert a == b
 
 

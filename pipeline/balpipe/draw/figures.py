@@ -19,6 +19,8 @@ import numpy as np  # noqa: E402
 from matplotlib.patches import Circle, Polygon  # noqa: E402
 
 from ..model import Model  # noqa: E402
+from . import extremes  # noqa: E402
+from .sleeves import guided_sliders, sleeves  # noqa: E402
 
 plt.rcParams.update({
     "svg.hashsalt": "balpipe",
@@ -207,69 +209,103 @@ def _global_point(pose, p) -> np.ndarray:
     return np.array([x + c * p[0] - s * p[1], y + s * p[0] + c * p[1]])
 
 
-def mechanism_figure(model: Model, analysis, instants: int = 5, prefix: str = "mech",
+def mechanism_figure(model: Model, analysis, ghosts: list[int] | None = None, prefix: str = "mech",
                      title: str = "", limits: tuple[float, float, float, float] | None = None,
                      numbers: dict[str, str] | None = None) -> str:
-    """The mechanism drawn at several instants (light to dark), counterweights as discs whose
-    area grows with their mass, gears as circles, and the paths of the link points. The last
-    instant carries the spec's names (points, links, counterweights) and the gears' numbers
-    (``numbers``: part name -> number, :func:`labels.gear_numbers`), placed so that no two
-    overlap (:func:`labels.place`); ``limits`` (x0, y0, x1, y1) gives every panel of a figure
-    the same scale."""
-    fig, _ = mechanism_drawing(model, analysis, instants, title, limits, numbers)
+    """The mechanism drawn solid at its reference pose (t = 0, where the player starts) over its
+    extreme poses as light grey ghosts (:mod:`.extremes`: the instants where it is farthest from
+    the solid pose; ``ghosts``: their sample indices, computed from ``model`` when None), with
+    the thin paths of the link points. A prismatic pair between two links is one connected leg,
+    a rod in a sleeve (:mod:`.sleeves`); counterweights are discs whose area grows with their
+    mass, gears circles. The solid pose carries the spec's names (points, links,
+    counterweights) and the gears' numbers (``numbers``: part name -> number,
+    :func:`labels.gear_numbers`), placed so that no two overlap (:func:`labels.place`);
+    ``limits`` (x0, y0, x1, y1) gives every panel of a figure the same scale."""
+    fig, _ = mechanism_drawing(model, analysis, ghosts, title, limits, numbers)
     return to_svg(fig, prefix)
 
 
-def mechanism_drawing(model: Model, analysis, instants: int = 5, title: str = "",
+SOLID = {"link": "black", "width": 2.2, "marker": True, "fill": "0.85", "edge": "black", "alpha": 1.0, "z": 3}
+GHOST = {"link": "0.72", "width": 1.6, "marker": False, "fill": "0.94", "edge": "0.72", "alpha": 0.3, "z": 1}
+SLEEVE = 0.018  # half-width of a sleeve / span
+
+
+def _draw_pose(ax, model: Model, pose_row: np.ndarray, span: float, max_cw: float, guided: set[str],
+               look: dict) -> None:
+    """One pose of the mechanism in the style ``look`` (``SOLID`` or ``GHOST``): links, discs,
+    counterweights, slider blocks and the sleeves of prismatic pairs between links."""
+    a, z = look["alpha"], look["z"]
+    for i, b in enumerate(model.bodies):
+        pose = pose_row[i]
+        if b.radius:
+            centre, edge = _global_point(pose, (0, 0)), _global_point(pose, (b.radius, 0))
+            ax.add_patch(Circle(centre, b.radius, fill=False, color="tab:green", alpha=a, linewidth=1.2, zorder=z))
+            ax.plot([centre[0], edge[0]], [centre[1], edge[1]], color="tab:green", alpha=a, linewidth=0.8, zorder=z)
+        if b.kind == "slider" and b.name not in guided:
+            c = _global_point(pose, (0, 0))
+            w = 0.06 * span
+            ax.add_patch(Polygon([c + d for d in ((-w, -w / 2), (w, -w / 2), (w, w / 2), (-w, w / 2))], closed=True,
+                                 fill=True, facecolor=look["fill"], edgecolor=look["edge"], zorder=z))
+        for att in b.attachments:
+            if att.kind == "counterweight":
+                g = np.array([_global_point(pose, p) for p in
+                              (b.points[b.outline[0]] if b.outline else (0, 0), att.position)])
+                ax.plot(g[:, 0], g[:, 1], color="tab:red", alpha=a, linewidth=1.5, zorder=z)
+                r = 0.035 * span * math.sqrt(att.mass / max_cw)
+                ax.add_patch(Circle(_global_point(pose, att.position), r, color="tab:red", alpha=0.6 * a, zorder=z))
+            elif att.radius:
+                ax.add_patch(Circle(_global_point(pose, att.position), att.radius, fill=False, color="tab:green",
+                                    alpha=a, zorder=z))
+    # links (a guide's under its sleeve), the sleeves, the rods sliding in them (thinner), joints on top
+    outlines = [(b.name in guided, np.array([_global_point(pose_row[i], b.points[p]) for p in b.outline]))
+                for i, b in enumerate(model.bodies) if len(b.outline) >= 2]
+    for g in (g for rod, g in outlines if not rod):
+        ax.plot(g[:, 0], g[:, 1], color=look["link"], linewidth=look["width"], solid_capstyle="round", zorder=z)
+    for ends in sleeves(model, pose_row):
+        ax.add_patch(Polygon(_sleeve_outline(ends, span), closed=True, facecolor=look["fill"], edgecolor=look["edge"],
+                             linewidth=0.9, zorder=z))
+    for g in (g for rod, g in outlines if rod):
+        ax.plot(g[:, 0], g[:, 1], color=look["link"], linewidth=0.75 * look["width"], solid_capstyle="round", zorder=z)
+    if look["marker"]:
+        for _, g in outlines:
+            ax.plot(g[:, 0], g[:, 1], "o", color="white", markeredgecolor="black", markersize=4, zorder=z + 0.5)
+
+
+def _sleeve_outline(ends: tuple[np.ndarray, np.ndarray], span: float) -> list[np.ndarray]:
+    """The four corners of a sleeve (:func:`sleeves.sleeves`: its two ends, global)."""
+    p, q = ends
+    d = q - p
+    n = np.array([-d[1], d[0]]) / (float(np.hypot(*d)) or 1.0) * SLEEVE * span
+    return [p - n, q - n, q + n, p + n]
+
+
+def mechanism_drawing(model: Model, analysis, ghosts: list[int] | None = None, title: str = "",
                       limits: tuple[float, float, float, float] | None = None,
                       numbers: dict[str, str] | None = None) -> tuple:
     """The figure of :func:`mechanism_figure` and its placed labels (:class:`labels.Placed`,
     boxes in display pixels)."""
     fig, ax = plt.subplots(figsize=(6.0, 4.6))
-    N = len(analysis.t)
-    ks = np.unique(np.linspace(0, N - 1, instants).round().astype(int))
     poses = analysis.extra["frame_pose"]
+    ref = extremes.REFERENCE
+    if ghosts is None:
+        ghosts = extremes.extreme_instants(model, poses)
     max_cw = max([a.mass for b in model.bodies for a in b.attachments] + [1e-12])
     span = _span(model, poses)
-    # paths of every named point
+    guided = guided_sliders(model)
+    # paths of every named point, thin
     for i, b in enumerate(model.bodies):
         x, y, th = poses[:, i, 0], poses[:, i, 1], poses[:, i, 2]
         for p in b.points.values():
             px = x + np.cos(th) * p[0] - np.sin(th) * p[1]
             py = y + np.sin(th) * p[0] + np.cos(th) * p[1]
-            ax.plot(px, py, color="tab:blue", linewidth=0.5, alpha=0.5)
-    for n, k in enumerate(ks):
-        alpha = 0.25 + 0.75 * (n + 1) / len(ks)
-        for i, b in enumerate(model.bodies):
-            pose = poses[k, i]
-            if b.radius:
-                ax.add_patch(Circle(_global_point(pose, (0, 0)), b.radius, fill=False, color="tab:green", alpha=alpha, linewidth=1.2))
-                edge = _global_point(pose, (b.radius, 0))
-                centre = _global_point(pose, (0, 0))
-                ax.plot([centre[0], edge[0]], [centre[1], edge[1]], color="tab:green", alpha=alpha, linewidth=0.8)
-            if b.kind == "slider":
-                c = _global_point(pose, (0, 0))
-                w = 0.06 * span
-                ax.add_patch(Polygon([c + d for d in ((-w, -w / 2), (w, -w / 2), (w, w / 2), (-w, w / 2))],
-                                     closed=True, fill=True, facecolor="0.85", edgecolor="black", alpha=alpha))
-            pts = [b.points[p] for p in b.outline]
-            for a in b.attachments:
-                if a.kind == "counterweight":
-                    pts_cw = [b.points[b.outline[0]] if b.outline else (0, 0), a.position]
-                    g = np.array([_global_point(pose, p) for p in pts_cw])
-                    ax.plot(g[:, 0], g[:, 1], color="tab:red", alpha=alpha, linewidth=1.5)
-                    r = 0.035 * span * math.sqrt(a.mass / max_cw)
-                    ax.add_patch(Circle(_global_point(pose, a.position), r, color="tab:red", alpha=0.6 * alpha))
-                elif a.radius:
-                    ax.add_patch(Circle(_global_point(pose, a.position), a.radius, fill=False, color="tab:green", alpha=alpha))
-            if len(pts) >= 2:
-                g = np.array([_global_point(pose, p) for p in pts])
-                ax.plot(g[:, 0], g[:, 1], color="black", alpha=alpha, linewidth=2.2, solid_capstyle="round")
-                ax.plot(g[:, 0], g[:, 1], "o", color="white", markeredgecolor="black", markersize=4, alpha=alpha)
+            ax.plot(px, py, color="tab:blue", linewidth=0.5, alpha=0.5, zorder=0.5)
+    for k in ghosts:
+        _draw_pose(ax, model, poses[k], span, max_cw, guided, GHOST)
+    _draw_pose(ax, model, poses[ref], span, max_cw, guided, SOLID)
     for (a, b) in model.guides:
         ax.plot([a[0], b[0]], [a[1], b[1]], color="0.3", linewidth=1.0, linestyle="-")
     for name, p in model.frame_points.items():
-        ax.plot(p[0], p[1], marker="^", color="black", markersize=9)
+        ax.plot(p[0], p[1], marker="^", color="black", markersize=9, zorder=4)
     ax.set_aspect("equal")
     if limits is not None:
         x0, y0, x1, y1 = limits
@@ -280,7 +316,7 @@ def mechanism_drawing(model: Model, analysis, instants: int = 5, title: str = ""
     if title:
         ax.set_title(literal(title), fontsize=9)
     fig.tight_layout()
-    placed = place_names(fig, ax, model, poses[ks[-1]], span, max_cw, numbers)
+    placed = place_names(fig, ax, model, poses[ref], span, max_cw, numbers)
     return fig, placed
 
 
@@ -299,7 +335,9 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
     counterweights, links), in model coordinates: (text, anchor, kind) triples, the links'
     segments, and the joint markers, pivots, slider blocks and counterweight discs to keep clear,
     as (centre, radius), radius None for a joint's marker and -1 for a pivot's triangle.
-    ``disc``: a counterweight's disc radius / ``span`` for the heaviest (``max_cw``), as drawn."""
+    ``disc``: a counterweight's disc radius / ``span`` for the heaviest (``max_cw``), as drawn.
+    A slider in a moving guide is drawn as a rod in a sleeve (:mod:`.sleeves`), whose edges
+    and axis are kept clear, not as a block."""
     out: list[tuple[str, np.ndarray, str]] = []
     keep: list[tuple[np.ndarray, float | None]] = []
     segs: list[tuple[np.ndarray, np.ndarray]] = []
@@ -308,6 +346,13 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
         placed.add((round(p[0] / span, 2), round(p[1] / span, 2)))
         out.append((name, np.asarray(p, dtype=float), "pivot"))
         keep.append((np.asarray(p, dtype=float), -1.0))  # the pivot's triangle
+    # one name per place: of the points that coincide there, the first whose name no other body
+    # point of the model has (the platform's C1, not the piston's C of every leg)
+    count: dict[str, int] = {}
+    for b in model.bodies:
+        for name in b.points:
+            count[name] = count.get(name, 0) + 1
+    joints: dict[tuple[float, float], tuple[str, np.ndarray]] = {}
     for i, b in enumerate(model.bodies):
         if b.kind == "gear" and b.radius:
             continue  # a disc's axis: the disc carries its number
@@ -316,13 +361,16 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
             key = (round(g[0] / span, 2), round(g[1] / span, 2))
             if key in placed:
                 continue
-            placed.add(key)
-            out.append((name, g, "joint"))
-            keep.append((g, None))
+            if key not in joints or (count[joints[key][0]] > 1 and count[name] == 1):
+                joints[key] = (name, joints[key][1] if key in joints else g)
+    for name, g in joints.values():
+        out.append((name, g, "joint"))
+        keep.append((g, None))
     gears, cws, links = [], [], []
+    guided = guided_sliders(model)
     for i, b in enumerate(model.bodies):
         pose = pose_row[i]
-        if b.kind == "slider":
+        if b.kind == "slider" and b.name not in guided:
             keep.append((_global_point(pose, (0, 0)), 0.06 * span))  # the slider's block
         if b.radius:
             rim = _global_point(pose, (0, 0)) + b.radius * np.array([math.sqrt(0.5), math.sqrt(0.5)])
@@ -345,6 +393,9 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
             links.append((b.name, mid, "link"))
     for a, b in model.guides:
         segs.append((np.asarray(a, dtype=float), np.asarray(b, dtype=float)))
+    for ends in sleeves(model, pose_row):
+        c = _sleeve_outline(ends, span)
+        segs += [(c[0], c[1]), (c[2], c[3]), (0.5 * (c[0] + c[3]), 0.5 * (c[1] + c[2]))]
     return out + gears + cws + links, segs, keep
 
 

@@ -1,7 +1,8 @@
 """A small self-contained canvas player: the mechanism moving on its free-floating frame.
 
 The page embeds, per stage, the outline of every body (local points) and its pose at about 60
-frames, plus the frame's pose; a few lines of JavaScript draw them in a grid of panels. Each
+frames, plus the frame's pose and the sleeves of its prismatic pairs between links (one
+connected leg, :mod:`.sleeves`); a few lines of JavaScript draw them in a grid of panels. Each
 panel has its own view box, from that stage's swept extent (every instant, parts and frame
 included) with a small margin, and its own scale bar in m (the caption says when the panels'
 scales differ). The spec's names (pivots, joints, counterweights, links) and the gears' numbers
@@ -18,11 +19,13 @@ import math
 import numpy as np
 
 from ..model import Model
+from .sleeves import guided_sliders, sleeves
 
 FRAMES = 60
 
 
 def _outline(model: Model) -> list[dict]:
+    guided = guided_sliders(model)  # a rod in a sleeve (``sleeves`` of :func:`player_data`), no block
     shapes = []
     for b in model.bodies:
         pts = [b.points[p] for p in b.outline] if len(b.outline) >= 2 else []
@@ -33,7 +36,7 @@ def _outline(model: Model) -> list[dict]:
         shapes.append({
             "line": [[round(p[0], 5), round(p[1], 5)] for p in pts],
             "radius": round(b.radius, 5) if b.radius else 0,
-            "slider": b.kind == "slider",
+            "slider": b.kind == "slider" and b.name not in guided,
             "cw": cws,
             "gears": gears,
         })
@@ -146,6 +149,13 @@ def _labels(model: Model, numbers: dict[str, str]) -> dict:
             elif a.radius:
                 gears.append([j, round(a.position[0], 5), round(a.position[1], 5), round(a.radius, 5),
                               numbers.get(a.name, a.name)])
+    # the page names coinciding points once, first come first named: the name no other point has
+    # goes first (the platform's C1 before the pistons' C), as in the drawings
+    count: dict[str, int] = {}
+    for b in model.bodies:
+        for n in b.points:
+            count[n] = count.get(n, 0) + 1
+    joints.sort(key=lambda j: count[j[3]] > 1)
     return {"joints": joints, "links": links, "cws": cws, "gears": gears}
 
 
@@ -173,6 +183,8 @@ def player_data(stages: list[dict]) -> dict:
             "pivot_names": list(s["model"].frame_points),
             "names": _labels(s["model"], numbers),
             "guides": [[[round(a[0], 5), round(a[1], 5)], [round(b[0], 5), round(b[1], 5)]] for a, b in s["model"].guides],
+            "sleeves": [[[[round(float(v), 6) for v in end] for end in ends] for ends in sleeves(s["model"], frame)]
+                        for frame in poses],
         })
     views = panel_views(extents)
     for d, p in zip(data, views["panels"]):
@@ -290,6 +302,10 @@ function draw() {{
       g.strokeStyle = "#8aa4c0"; g.beginPath(); g.moveTo(...a); g.lineTo(...e); g.stroke(); segs.push([a, e]); }});
     st.pivots.forEach((p, j) => {{ const q = P(...T(base, p)); g.fillStyle = "#22303f"; g.fillRect(q[0] - 4, q[1] - 4, 8, 8);
       items.push({{text: st.pivot_names[j], at: q, clear: 4, mark: mark(q, 4), font: "11px sans-serif", color: "#111"}}); }});
+    st.sleeves[i].forEach(sl => {{ const a = P(...sl[0]), e = P(...sl[1]); g.lineCap = "butt";
+      g.strokeStyle = "#555"; g.lineWidth = 9; g.beginPath(); g.moveTo(...a); g.lineTo(...e); g.stroke();
+      g.strokeStyle = "#ddd"; g.lineWidth = 7; g.beginPath(); g.moveTo(...a); g.lineTo(...e); g.stroke();
+      g.lineWidth = 1; segs.push([a, e]); }});
     st.shapes.forEach((sh, j) => {{
       const pose = st.poses[i][j];
       if (sh.radius) {{ const c = P(...T(pose, [0, 0])); g.strokeStyle = "#2e8b57"; g.beginPath();

@@ -9,14 +9,12 @@ from .. import realisable
 from ..balancing.base import in_style_order, styled
 from ..laws.drives import law_names
 from ..study import Study, ratio_reference
-from ..draw import figures, labels
+from ..draw import extremes, figures, labels, sleeves
 from . import citations, live_plots, paper_figures, partial_figures, present, sections, toc
 from .design_card import design_card
 from .notation_table import notation_groups
 from .render import environment
 from .results import joint_load_table
-
-INSTANTS = 5
 
 
 def shown_stages(study: Study) -> list:
@@ -27,11 +25,28 @@ def shown_stages(study: Study) -> list:
     return in_style_order([s for s in study.stages if s.stage.group == study.stages[0].stage.group])
 
 
-def drawn_times(study: Study) -> list[float]:
-    """The instants (s) the mechanism drawings show, as :func:`figures.mechanism_figure` picks them."""
-    t = study.stages[0].analysis.t
-    ks = np.unique(np.linspace(0, len(t) - 1, INSTANTS).round().astype(int))
-    return [float(t[k]) for k in ks]
+def drawn_instants(study: Study) -> list[int]:
+    """The samples of the extreme poses that every mechanism drawing of the page shows as ghosts
+    (:func:`extremes.extreme_instants`), from the first stage drawn: one set of instants for
+    every panel, as the stages share their motion."""
+    s = shown_stages(study)[0]
+    return extremes.extreme_instants(s.stage.model, s.analysis.extra["frame_pose"])
+
+
+def drawn_times(study: Study) -> tuple[float, list[float]]:
+    """The time (s) of the solid pose (t = 0, where the player starts) and those of the ghosts."""
+    t = shown_stages(study)[0].analysis.t
+    return float(t[extremes.REFERENCE]), [float(t[k]) for k in drawn_instants(study)]
+
+
+def drawing_times(study: Study) -> dict:
+    """The caption's facts: ``solid`` (s, text), ``ghosts`` ('0.25 s', '0.1 s and 0.4 s'; empty when
+    the mechanism barely moves) and their ``count``, and ``sleeves``: whether a drawing has a
+    prismatic pair between two links (:mod:`balpipe.draw.sleeves`)."""
+    solid, ghosts = drawn_times(study)
+    texts = [f"{t:.4g} s" for t in ghosts]
+    sleeved = any(sleeves.guided_sliders(s.stage.model) for s in shown_stages(study))
+    return {"solid": f"{solid:.4g}", "ghosts": " and ".join(texts), "count": len(texts), "sleeves": sleeved}
 
 
 def study_figures(study: Study) -> dict:
@@ -48,8 +63,9 @@ def study_figures(study: Study) -> dict:
                                      marks=[(w["time"], w["kind"].replace("_", " ")) for w in study.warnings])
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
     numbers = labels.gear_numbers([s.stage.model for s in shown_stages(study)])
+    ghosts = drawn_instants(study)
     mech = [
-        (s.stage.label, figures.mechanism_figure(s.stage.model, s.analysis, INSTANTS, prefix=f"mech{k}",
+        (s.stage.label, figures.mechanism_figure(s.stage.model, s.analysis, ghosts, prefix=f"mech{k}",
                                                  title=s.stage.label, limits=limits, numbers=numbers))
         for k, s in enumerate(shown_stages(study))
     ]
@@ -168,8 +184,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         reactionless={"base_mass": rl.base_mass, "base_inertia": rl.base_inertia, "rows": rl.rows(),
                       "same_base": rl.same_base,
                       "player": rl.player(), "player_note": rl.player_note()} if rl is not None else None,
-        instants=INSTANTS,
-        instant_times=", ".join(f"{t:.4g}" for t in drawn_times(study)),
+        drawn=drawing_times(study),
         joint_loads=joint_load_table(study),
         stage_names=[(s.stage.name, s.stage.label) for s in shown_stages(study)],
         group=study.stages[0].stage.group if len(shown_stages(study)) < len(study.stages) else "",
