@@ -202,6 +202,12 @@ def fig4b_design(model: Model, g: cond.Geometry, proximal: float, distal: float)
                   "the sixteen first-moment changes (every link treated alike)")
 
 
+def designs(model: Model, g: cond.Geometry, proximal: float, distal: float) -> list[Design]:
+    """Every drawn design from eq. 17: Fig. 3's six (:func:`fig3_designs`), then Fig. 4b's
+    (:func:`fig4b_design`)."""
+    return fig3_designs(model, g, proximal, distal) + [fig4b_design(model, g, proximal, distal)]
+
+
 def arms_cross(model: Model) -> bool:
     """Whether any two links of different legs cross in the model's initial pose (its body
     frames' ``initial`` poses): Fig. 1's and Fig. 6a's layout; Fig. 6b's has none."""
