@@ -59,6 +59,15 @@ def modules(src: Path) -> dict[str, Path]:
     return out
 
 
+def source_of(node: ast.ImportFrom, pkg: str) -> str:
+    """The absolute name of the module a ``from ... import`` reads, in the package ``pkg``."""
+    if not node.level:
+        return node.module or ""
+    parts = pkg.split(".")
+    base = ".".join(parts[: len(parts) - (node.level - 1)])
+    return f"{base}.{node.module}" if node.module else base
+
+
 def imports(src: Path) -> dict[str, set[tuple[str, bool, int]]]:
     """module -> {(imported balpipe module, deferred?, line)}, every import statement of the file
     (inside functions too)."""
@@ -79,12 +88,7 @@ def imports(src: Path) -> dict[str, set[tuple[str, bool, int]]]:
                 if isinstance(ch, ast.Import):
                     found = [target(a.name) for a in ch.names]
                 elif isinstance(ch, ast.ImportFrom):
-                    if ch.level:
-                        parts = pkg.split(".")
-                        base = ".".join(parts[: len(parts) - (ch.level - 1)])
-                        mod = f"{base}.{ch.module}" if ch.module else base
-                    else:
-                        mod = ch.module or ""
+                    mod = source_of(ch, pkg)
                     found = [target(f"{mod}.{a.name}") for a in ch.names]
                 for t in found:
                     if t and t != m:
@@ -236,12 +240,7 @@ def private_names_across_packages(src: Path) -> list[str]:
 
         for n in ast.walk(tree):
             if isinstance(n, ast.ImportFrom):
-                if n.level:
-                    parts = pkg.split(".")
-                    base = ".".join(parts[: len(parts) - (n.level - 1)])
-                    mod = f"{base}.{n.module}" if n.module else base
-                else:
-                    mod = n.module or ""
+                mod = source_of(n, pkg)
                 if not mod.startswith("balpipe"):
                     continue
                 for a in n.names:
