@@ -164,31 +164,33 @@ def grid_columns(n: int) -> int:
     return 2 if n == 4 else min(3, n)
 
 
+def panels_svg(panels: list[tuple], prefix: str) -> str:
+    """One figure of ``panels`` (model, body poses, title), at most three a row (:func:`grid_columns`),
+    drawn by :func:`_draw` with one disc scale for the whole figure, then named by :func:`_name`."""
+    from ...draw.figures import plt, to_svg
+
+    cols = grid_columns(len(panels))
+    rows = (len(panels) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
+    max_cw = max([m for model, _, _ in panels for m in _counter_masses(model)] + [1e-12])
+    for ax in list(axes.flat)[len(panels):]:
+        ax.axis("off")
+    marks = [_draw(ax, model, poses, _span(model), max_cw, title) for ax, (model, poses, title) in zip(axes.flat, panels)]
+    fig.tight_layout()
+    for ax, (model, poses, _), mk in zip(axes.flat, panels, marks):
+        _name(fig, ax, model, poses, _span(model), max_cw, mk)
+    return to_svg(fig, prefix)
+
+
 def topology_figure(study):
     """The balanced stages at t = 0, one panel each: links, joints, pivots, each link's centre of
     mass (cross), counter-masses as red discs of area proportional to mass, and the fixed total
     centre of mass (star)."""
-    from ...draw.figures import plt, to_svg
-
     shown = [s for s in study.stages if s.stage.name in FIGURE_OF_STAGE]
     if not shown:
         return None
-    cols = grid_columns(len(shown))
-    rows = (len(shown) + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
-    max_cw = max([m for s in shown for m in _counter_masses(s.stage.model)] + [1e-12])
-    panels = []
-    for ax in list(axes.flat)[len(shown):]:
-        ax.axis("off")
-    for ax, s in zip(axes.flat, shown):
-        model = s.stage.model
-        poses = s.analysis.extra["frame_pose"][0]
-        marks = _draw(ax, model, poses, _span(model), max_cw, f"{s.stage.label}\nadded {s.added_mass:.3g} kg")
-        panels.append((ax, model, poses, marks))
-    fig.tight_layout()
-    for ax, model, poses, marks in panels:
-        _name(fig, ax, model, poses, _span(model), max_cw, marks)
-    return to_svg(fig, "rrr4-topology")
+    return panels_svg([(s.stage.model, s.analysis.extra["frame_pose"][0], f"{s.stage.label}\nadded {s.added_mass:.3g} kg")
+                       for s in shown], "rrr4-topology")
 
 
 def designs_drawn(study) -> list[tuple]:
@@ -218,29 +220,13 @@ def panel_title(figure: str, kept: str) -> str:
 def designs_figure(study, drawn: list[tuple], figures: tuple[str, ...]):
     """The designs of ``figures`` (e.g. Fig. 3a..f), one panel each, at the unbalanced stage's
     pose at t = 0 (the kinematics are the same), titled with the balancing's numbers."""
-    from ...draw.figures import plt, to_svg
-
     shown = [c for c in drawn if c[0].figure in figures]
     if not shown:
         return None
-    cols = grid_columns(len(shown))
-    rows = (len(shown) + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
     poses = study.stages[0].analysis.extra["frame_pose"][0]
-    max_cw = max([m for d, _ in shown for m in _counter_masses(d.model)] + [1e-12])
-    panels = []
-    for ax, (d, row) in zip(axes.flat, shown):
-        kept = ", ".join(row["kept"])
-        marks = _draw(ax, d.model, poses, _span(d.model), max_cw,
-                      f"{panel_title(d.figure, kept)}\nadded {row['added_mass']:.3g} kg, "
-                      f"peak |F| / reference {row['force_ratio']:.1e}")
-        panels.append((ax, d.model, marks))
-    for ax in list(axes.flat)[len(shown):]:
-        ax.axis("off")
-    fig.tight_layout()
-    for ax, model, marks in panels:
-        _name(fig, ax, model, poses, _span(model), max_cw, marks)
-    return to_svg(fig, "rrr4-" + figures[0].replace("Fig. ", "fig").lower())
+    return panels_svg([(d.model, poses, f"{panel_title(d.figure, ', '.join(row['kept']))}\nadded {row['added_mass']:.3g} kg, "
+                        f"peak |F| / reference {row['force_ratio']:.1e}") for d, row in shown],
+                      "rrr4-" + figures[0].replace("Fig. ", "fig").lower())
 
 
 def figures(study):
