@@ -159,7 +159,7 @@ def test_page_draws_fig3_and_fig4b_with_what_was_assumed():
     assert "not the paper's" in figs[t3][1] and "56" in figs[t3][1]
     assert "least Euclidean norm" in figs[t4][1] and "choice is ours" in figs[t4][1]
     for c in "abcdef":  # each panel is named ours, never as the paper's panel
-        assert f"ours ({c}), not the paper's Fig. 3{c}" in figs[t3][0]
+        assert f"our design {c}, not the paper's Fig. 3{c}" in figs[t3][0]
     assert "Fig. 4b as we read it" in figs[t4][0]
     for title, (body, _) in figs.items():  # every drawing's axes carry their unit
         if "<svg" in body[:500]:
@@ -200,7 +200,7 @@ def test_design_numbers_are_in_results_json_and_equal_an_engine_analysis_of_the_
         assert r["added_mass"] == pytest.approx(d.model.total_mass() - model.total_mass(), rel=1e-11)
         assert abs(r["peak_inertial_force"] - an.max_inertial_force) <= 1e-12 * ref, d.figure
         assert abs(r["force_ratio"] - an.max_inertial_force / ref) <= 1e-12, d.figure
-        assert params["peak_force_ratio_" + d.figure.replace("Fig. ", "fig").lower()] == r["force_ratio"]
+        assert params["peak_force_ratio_" + topo.tag(d.figure)] == r["force_ratio"]
     # the hook's ratio is the stages' force_ratio
     as_designs = [topo.Design(s.stage.name, (), s.stage.model, "") for s in st.stages]
     again = [{} for _ in as_designs]

@@ -295,15 +295,15 @@ def topology_designs(model: Model, g: cond.Geometry, spec: RRR4Balancing, found:
     free = topologies.freedoms(g)
     out = []
     for d in designs:
-        tag = d.figure.replace("Fig. ", "fig").lower()
+        tag, name = topologies.tag(d.figure), topologies.whose(d.figure)
         added = d.model.total_mass() - base_mass
         res17, resf = topologies.eq17_residual(d.model, g), found.design_residual(d.model)
-        params += [Parameter(f"added_mass_{tag}", added, "kg", "eq. 17", f"counter-masses of the {d.figure} design"),
-                   Parameter(f"eq17_residual_{tag}", res17, "", "eq. 17", f"largest relative residual of eq. 17, {d.figure}"),
+        params += [Parameter(f"added_mass_{tag}", added, "kg", "eq. 17", f"counter-masses of {name}"),
+                   Parameter(f"eq17_residual_{tag}", res17, "", "eq. 17", f"largest relative residual of eq. 17, {name}"),
                    Parameter(f"finder_residual_{tag}", resf, "", "momentum regressor rank",
-                             f"largest residual over the finder's conditions / (total mass x model size), {d.figure}")]
+                             f"largest residual over the finder's conditions / (total mass x model size), {name}")]
         if max(res17, resf) > 1e-9:
-            notes.append(f"{d.figure}: the counter-masses found do not meet the conditions (eq. 17 residual "
+            notes.append(f"{name[0].upper() + name[1:]}: the counter-masses found do not meet the conditions (eq. 17 residual "
                          f"{res17:.2g}, finder {resf:.2g}); the figure draws the design, which is not balanced.")
         out.append({"figure": d.figure, "kept": [f"l{b}" if b != "5" else "platform" for b in d.kept],
                     "assumed": d.assumed, "added_mass": added, "eq17_residual": res17, "finder_residual": resf,
@@ -339,9 +339,8 @@ def design_loads(designs: list[topologies.Design], rows: list[dict], stages: lis
         ratio = peak / ref if ref > 0 else 0.0
         row["peak_inertial_force"] = peak
         row["force_ratio"] = ratio
-        tag = d.figure.replace("Fig. ", "fig").lower()
-        out.append(Parameter(f"peak_force_ratio_{tag}", ratio, "", "engine",
-                             f"peak inertial shaking force of the {d.figure} design / the reference force"))
+        out.append(Parameter(f"peak_force_ratio_{topologies.tag(d.figure)}", ratio, "", "engine",
+                             f"peak inertial shaking force of {topologies.whose(d.figure)} / the reference force"))
     return out
 
 

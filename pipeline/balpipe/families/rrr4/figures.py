@@ -13,6 +13,7 @@ import numpy as np
 
 from . import counter_masses as recipe
 from . import conditions as cond
+from . import topologies as topo
 from .template import mass_parameters, resolve_legs
 
 FIGURE_OF_STAGE = {"leg_by_leg": "Fig. 2a", "least_mass": "least mass", "general": "Fig. 4a", "special": "Fig. 6"}
@@ -197,8 +198,6 @@ def designs_drawn(study) -> list[tuple]:
     """Figs. 3 and 4b's designs (:mod:`.topologies`) rebuilt from the spec for drawing, each with
     the numbers the balancing computed (``details["topologies"]["designs"]``: added mass, peak
     inertial shaking force / the reference force): (design, its row). Nothing is analysed here."""
-    from . import topologies as topo
-
     top = study.balance.details.get("topologies")
     if not top:
         return []
@@ -209,14 +208,6 @@ def designs_drawn(study) -> list[tuple]:
     return [(d, rows[d.figure]) for d in designs]
 
 
-def panel_title(figure: str, kept: str) -> str:
-    """A design panel's title, saying whose design it is: Fig. 3's panels are our selection (the
-    paper's six cannot be read from its text), Fig. 4b is our reading of the paper's words."""
-    if figure.startswith("Fig. 3"):
-        return f"ours ({figure[-1]}), not the paper's {figure}: {kept} as built"
-    return f"{figure} as we read it: {kept} as built"
-
-
 def designs_figure(study, drawn: list[tuple], figures: tuple[str, ...]):
     """The designs of ``figures`` (e.g. Fig. 3a..f), one panel each, at the unbalanced stage's
     pose at t = 0 (the kinematics are the same), titled with the balancing's numbers."""
@@ -224,9 +215,9 @@ def designs_figure(study, drawn: list[tuple], figures: tuple[str, ...]):
     if not shown:
         return None
     poses = study.stages[0].analysis.extra["frame_pose"][0]
-    return panels_svg([(d.model, poses, f"{panel_title(d.figure, ', '.join(row['kept']))}\nadded {row['added_mass']:.3g} kg, "
-                        f"peak |F| / reference {row['force_ratio']:.1e}") for d, row in shown],
-                      "rrr4-" + figures[0].replace("Fig. ", "fig").lower())
+    titles = [f"{topo.whose(d.figure)}: {', '.join(row['kept'])} as built\nadded {row['added_mass']:.3g} kg, "
+              f"peak |F| / reference {row['force_ratio']:.1e}" for d, row in shown]
+    return panels_svg([(d.model, poses, title) for (d, _), title in zip(shown, titles)], "rrr4-" + topo.tag(figures[0]))
 
 
 def figures(study):
