@@ -224,3 +224,22 @@ def test_design_numbers_are_in_results_json_and_equal_an_engine_analysis_of_the_
     body3 = next(b for t, b in figs.items() if "Fig. 3" in t)
     for r in rows[:-1]:
         assert f"added {r['added_mass']:.3g} kg, peak |F| / reference {r['force_ratio']:.1e}" in body3
+
+
+def test_topology_title_names_the_figures_of_the_stages_drawn():
+    """The stage panels' title lists the paper's figures that the stages reproduce, read from the
+    stages (Fig. 2b with one distal link kept, no Fig. 4a without topologies, "least mass" only
+    when that stage of ours is drawn)."""
+    from types import SimpleNamespace
+
+    from balpipe.families.rrr4 import figures as page
+
+    def title(spec, balancing=None):
+        res = registry.balance(spec, balancing)
+        return page.topology_title(SimpleNamespace(stages=[SimpleNamespace(stage=s) for s in res.stages]))
+
+    spec = load(PAPER, simulate=False)
+    assert title(spec) == "Balance topologies (paper 001, Figs. 2a, 4a; least mass)"
+    assert title(load(FIG6B, simulate=False)) == "Balance topologies (paper 001, Figs. 2a, 4a, 6b; least mass)"
+    kept = spec.balancing.model_copy(update={"independent": [12], "least_mass": False, "topologies": False})
+    assert title(spec, kept) == "Balance topologies (paper 001, Fig. 2b)"

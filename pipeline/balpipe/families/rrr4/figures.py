@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import html
 import math
+import re
 
 import numpy as np
 
@@ -183,6 +184,16 @@ def panels_svg(panels: list[tuple], prefix: str) -> str:
     return to_svg(fig, prefix)
 
 
+def topology_title(study) -> str:
+    """The stage panels' title: the paper's figure numbers that the stage labels name (Fig. 2a, or
+    2b-d with distal links kept as built; 4a; 6a, 6b or 6c), then "least mass" (ours) when drawn."""
+    shown = [s.stage for s in study.stages if s.stage.name in FIGURE_OF_STAGE]
+    figs = [m.group(1) for st in shown for m in [re.search(r"Fig\. (\d+[a-z])", st.label)] if m]
+    ours = ["least mass"] if any(st.name == "least_mass" for st in shown) else []
+    paper = [f"paper 001, Fig{'s' if len(figs) > 1 else ''}. {', '.join(figs)}"] if figs else []
+    return f"Balance topologies ({'; '.join(paper + ours)})"
+
+
 def topology_figure(study):
     """The balanced stages at t = 0, one panel each: links, joints, pivots, each link's centre of
     mass (cross), counter-masses as red discs of area proportional to mass, and the fixed total
@@ -257,11 +268,11 @@ def figures(study):
     svg = topology_figure(study)
     if svg is not None:
         yield (
-            "Balance topologies (paper 001, Figs. 2a, 4a" + "".join(
-                ", " + fig.replace("Fig. ", "") for fig in sorted({s.stage.label.split("(")[1].split(",")[0]
-                                                                 for s in study.stages if s.stage.name == "special"}))
-            + "; least mass)",
+            topology_title(study),
             svg,
+            "Whose designs: the figure numbers name the paper's topologies (which links carry counter-masses and the "
+            "equations that size them), here on this spec's geometry and masses, which the paper does not give; the "
+            "least-mass design is ours. "
             "Each force-balanced stage at t = 0: links (black; named l11 to l42 as in the paper, the spec's link11 to "
             "link42), joints (circles), base pivots (triangles, A1 to A4), each "
             "body's centre of mass (blue cross), counter-masses as red discs (area proportional to mass, the "
