@@ -194,6 +194,8 @@ def test_design_numbers_are_in_results_json_and_equal_an_engine_analysis_of_the_
     ref = load_reference(model, an0).force
     assert ref == an0.max_inertial_force > 0  # the reference is the unbalanced peak here
     assert [r["figure"] for r in rows] == [d.figure for d in designs]
+    assert [r["design"] for r in rows] == [f"our design {c}, not the paper's Fig. 3{c}" for c in "abcdef"] + [
+        "Fig. 4b as we read it"]
     for d, r in zip(designs, rows):
         an = analyse(d.model, an0.t, an0.gravity, an0.moment_point)
         # results.json keeps 12 significant digits (report.results)

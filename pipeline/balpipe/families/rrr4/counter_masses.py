@@ -305,7 +305,7 @@ def topology_designs(model: Model, g: cond.Geometry, spec: RRR4Balancing, found:
         if max(res17, resf) > 1e-9:
             notes.append(f"{name[0].upper() + name[1:]}: the counter-masses found do not meet the conditions (eq. 17 residual "
                          f"{res17:.2g}, finder {resf:.2g}); the figure draws the design, which is not balanced.")
-        out.append({"figure": d.figure, "kept": [f"l{b}" if b != "5" else "platform" for b in d.kept],
+        out.append({"figure": d.figure, "design": name, "kept": [f"l{b}" if b != "5" else "platform" for b in d.kept],
                     "assumed": d.assumed, "added_mass": added, "eq17_residual": res17, "finder_residual": resf,
                     "counter_masses": [{"body": b.name, "mass": a.mass, "position": list(a.position)}
                                        for b in d.model.bodies for a in b.attachments if a.kind == "counterweight"]})
