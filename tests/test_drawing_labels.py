@@ -257,7 +257,7 @@ def test_player_grid_and_names_in_the_html(studies):
 
 # -- paper 001's 4-RRR drawings (Figs. 2a, 3a-f, 4a, 4b, 6) -------------------------------------
 
-PAPER001 = ["paper001_4rrr.yaml", "paper001_4rrr_fig6a.yaml", "paper001_4rrr_fig6b.yaml"]
+PAPER001 = ["paper001_4rrr.yaml", "paper001_4rrr_fig6a.yaml", "paper001_4rrr_fig6b.yaml", "paper001_4rrr_fig6c.yaml"]
 
 
 def _drawn_geometry(ax, renderer):
@@ -307,7 +307,7 @@ def test_names_on_paper001_drawings_never_overlap(studies, name, monkeypatch):
     monkeypatch.setattr(figures, "to_svg", keep)
     st = studies(name)
     rrr4.topology_figure(st)
-    checked = rrr4.designs_checked(st)
+    checked = rrr4.designs_drawn(st)
     if checked:
         rrr4.designs_figure(st, checked, rrr4.FIG3)
         rrr4.designs_figure(st, checked, ("Fig. 4b",))

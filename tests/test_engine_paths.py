@@ -19,8 +19,8 @@ import pytest
 
 from balpipe import engine, registry
 from balpipe.engine import analyse, compiled, fastpath, jacobian
-from balpipe.engine.constraints import _extend
-from balpipe.engine.dynamics import _multipliers
+from balpipe.engine.constraints import with_frame
+from balpipe.engine.dynamics import solve_multipliers
 from balpipe.engine.kinematics import _vel_acc
 from balpipe.engine.structure import decompose
 from balpipe.engine import AnalysisError
@@ -113,7 +113,7 @@ def test_block_substitution_equals_dense_solves_at_the_same_positions(case):
         rhs = -Mdiag * a
         rhs[:, 0::3] += c.mass * g[0]
         rhs[:, 1::3] += c.mass * g[1]
-        lam = _multipliers(c, jacobian(c, _extend(q))[:, :, 3:], rhs)
+        lam = solve_multipliers(c, jacobian(c, with_frame(q))[:, :, 3:], rhs)
         mine = fastpath.multipliers(c.fast, kin, np.ascontiguousarray(rhs.T)).T
         assert np.abs(mine - lam).max() <= 1e-12 * np.abs(lam).max(), f"{case}/{stage.name}"
 

@@ -135,3 +135,47 @@ def test_an_out_of_tree_family_is_part_of_the_code_hash(tmp_path: Path):
     with_family = _run(["-c", code], tmp_path, **env).stdout
     assert plain.strip() and with_family.strip() and plain != with_family
     assert _run(["-c", code], tmp_path, **env).stdout == with_family
+
+
+def method_name_tests(source: str) -> list[int]:
+    """Lines of ``source`` that compare ``<...>.balancing.method`` (or a bare ``balancing.method``)
+    with a literal name or a literal collection of names (==, !=, in, not in, either side)."""
+    import ast
+
+    def names_method(node: ast.AST) -> bool:
+        return (isinstance(node, ast.Attribute) and node.attr == "method"
+                and ((isinstance(node.value, ast.Attribute) and node.value.attr == "balancing")
+                     or (isinstance(node.value, ast.Name) and node.value.id == "balancing")))
+
+    def literal(node: ast.AST) -> bool:
+        if isinstance(node, ast.Constant):
+            return isinstance(node.value, str)
+        return isinstance(node, (ast.Tuple, ast.List, ast.Set)) and all(literal(e) for e in node.elts)
+
+    out = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Compare):
+            sides = [node.left, *node.comparators]
+            if any(names_method(s) for s in sides) and any(literal(s) for s in sides):
+                out.append(node.lineno)
+    return out
+
+
+def test_no_family_module_branches_on_a_method_name():
+    """A family's figures are its method's or its template's (plugins.Method.figures,
+    Template.figures), composed by the page: no module under families/ asks which method ran by
+    comparing ``balancing.method`` with a name (issue 19)."""
+    found = [f"{p.relative_to(ROOT)}:{line}" for p in sorted((ROOT / "pipeline" / "balpipe" / "families").rglob("*.py"))
+             for line in method_name_tests(p.read_text(encoding="utf-8"))]
+    assert not found, f"compare balancing.method with a name: {found}"
+    # the check finds what it looks for
+    assert method_name_tests('if study.spec.balancing.method != "rrr4_counter_masses":\n    pass\n') == [1]
+    assert method_name_tests('x = "a" == spec.balancing.method\ny = balancing.method in ("a", "b")\n') == [1, 2]
+    assert method_name_tests('m = registry.METHODS[spec.balancing.method]\nok = spec.method == "x"\n') == []
+
+
+def test_rrr4_figures_are_its_methods():
+    """Paper 001's figures belong to its method rrr4_counter_masses (they draw that method's
+    stages and details); the template has none of its own."""
+    assert registry.TEMPLATES["rrr4"].figures is None
+    assert registry.METHODS["rrr4_counter_masses"].figures is not None

@@ -59,6 +59,15 @@ def modules(src: Path) -> dict[str, Path]:
     return out
 
 
+def source_of(node: ast.ImportFrom, pkg: str) -> str:
+    """The absolute name of the module a ``from ... import`` reads, in the package ``pkg``."""
+    if not node.level:
+        return node.module or ""
+    parts = pkg.split(".")
+    base = ".".join(parts[: len(parts) - (node.level - 1)])
+    return f"{base}.{node.module}" if node.module else base
+
+
 def imports(src: Path) -> dict[str, set[tuple[str, bool, int]]]:
     """module -> {(imported balpipe module, deferred?, line)}, every import statement of the file
     (inside functions too)."""
@@ -79,12 +88,7 @@ def imports(src: Path) -> dict[str, set[tuple[str, bool, int]]]:
                 if isinstance(ch, ast.Import):
                     found = [target(a.name) for a in ch.names]
                 elif isinstance(ch, ast.ImportFrom):
-                    if ch.level:
-                        parts = pkg.split(".")
-                        base = ".".join(parts[: len(parts) - (ch.level - 1)])
-                        mod = f"{base}.{ch.module}" if ch.module else base
-                    else:
-                        mod = ch.module or ""
+                    mod = source_of(ch, pkg)
                     found = [target(f"{mod}.{a.name}") for a in ch.names]
                 for t in found:
                     if t and t != m:
@@ -204,6 +208,72 @@ def test_a_planted_family_import_in_the_core_fails(tree_copy: Path):
     study = tree_copy / "balpipe" / "study.py"
     study.write_text(study.read_text(encoding="utf-8") + "\nfrom .families.rrr4 import template  # noqa\n")
     assert any(b.startswith("balpipe.study:") for b in family_imports_outside_families(tree_copy))
+
+
+def _unit(module: str, path: Path) -> str:
+    """What may share private names: a package's modules, among themselves (``balpipe.engine.*``);
+    a top-level module (``balpipe.history``) only with itself."""
+    pkg = module if path.name == "__init__.py" else module.rsplit(".", 1)[0]
+    return module if pkg == "balpipe" else pkg
+
+
+def private_names_across_packages(src: Path) -> list[str]:
+    """Every use of a private name (one leading underscore) of a module of another package or of
+    another top-level module: ``from balpipe.x import _y`` (deferred too) and ``x._y`` on a module
+    bound by an import. Such a name is the other package's API and must be public (no leading
+    underscore, a docstring)."""
+    mods = modules(src)
+    found = []
+    for m, p in mods.items():
+        pkg = m if p.name == "__init__.py" else m.rsplit(".", 1)[0]
+        mine = _unit(m, p)
+        tree = ast.parse(p.read_text(encoding="utf-8"))
+        bound: dict[str, str] = {}
+
+        def owner(name: str) -> str | None:
+            while name not in mods and "." in name:
+                name = name.rsplit(".", 1)[0]
+            return name if name in mods else None
+
+        def private(name: str) -> bool:
+            return name.startswith("_") and not name.startswith("__")
+
+        for n in ast.walk(tree):
+            if isinstance(n, ast.ImportFrom):
+                mod = source_of(n, pkg)
+                if not mod.startswith("balpipe"):
+                    continue
+                for a in n.names:
+                    if f"{mod}.{a.name}" in mods:  # a module: its private attributes are checked below
+                        bound[a.asname or a.name] = f"{mod}.{a.name}"
+                    elif private(a.name) and (o := owner(mod)) and _unit(o, mods[o]) != mine:
+                        found.append(f"{m}:{n.lineno} imports {o}.{a.name}")
+            elif isinstance(n, ast.Import):
+                for a in n.names:
+                    if a.asname and a.name in mods:
+                        bound[a.asname] = a.name
+        for n in ast.walk(tree):
+            if (isinstance(n, ast.Attribute) and isinstance(n.value, ast.Name) and n.value.id in bound
+                    and private(n.attr) and _unit(bound[n.value.id], mods[bound[n.value.id]]) != mine):
+                found.append(f"{m}:{n.lineno} uses {bound[n.value.id]}.{n.attr}")
+    return sorted(set(found))
+
+
+def test_no_private_name_crosses_a_package():
+    assert private_names_across_packages(SRC) == []
+
+
+def test_a_planted_private_import_fails(tree_copy: Path):
+    """A top-level module importing another package's private name fails, directly or deferred,
+    or through the module's attribute; a package's own modules may share theirs."""
+    history = tree_copy / "balpipe" / "history.py"
+    history.write_text(history.read_text(encoding="utf-8")
+                       + "\n\ndef _planted():\n    from .engine.compile import _perp\n    from . import units\n"
+                         "    return units._NUM\n")
+    found = private_names_across_packages(tree_copy)
+    assert any(b.startswith("balpipe.history:") and b.endswith("imports balpipe.engine.compile._perp") for b in found)
+    assert any(b.startswith("balpipe.history:") and b.endswith("uses balpipe.units._NUM") for b in found)
+    assert not any("balpipe.engine.constraints:" in b for b in found)  # engine.constraints imports compile._perp
 
 
 def _family_words() -> set[str]:

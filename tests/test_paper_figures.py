@@ -24,7 +24,7 @@ def test_figure_numbers_read_from_titles():
 
 
 def test_the_table_names_the_issue_figures():
-    assert PF.FIGURES == {"000": ("4", "8"), "001": ("2", "3", "4", "6"), "002": ("2",), "003": ("2", "3", "4"),
+    assert PF.FIGURES == {"000": ("4", "8"), "001": ("2", "3", "4", "6a", "6b", "6c"), "002": ("2",), "003": ("2", "3", "4"),
                           "004": ("10a", "10b", "11", "12")}
 
 

@@ -39,7 +39,7 @@ def designs_of(spec):
     model = registry.unbalanced_model(spec)
     g = recipe.geometry(spec.mechanism)
     cw = spec.balancing.counterweights
-    return model, g, topo.fig3_designs(model, g, cw.proximal, cw.distal) + [topo.fig4b_design(model, g, cw.proximal, cw.distal)]
+    return model, g, topo.designs(model, g, cw.proximal, cw.distal)
 
 
 @pytest.mark.parametrize("source", ["paper", 71, 72])
@@ -152,13 +152,15 @@ def test_page_draws_fig3_and_fig4b_with_what_was_assumed():
     figs = {title: (body, caption) for title, body, caption in page.figures(st)}
     t3 = next(k for k in figs if "Fig. 3" in k)
     t4 = next(k for k in figs if "Fig. 4b" in k)
-    assert "selection of ours" in t3 and "reconstructed" in t4
+    # the titles say what is the paper's and what is ours (issue 22 point 3)
+    assert "a selection of ours, not the paper's panels" in t3 and "reconstructed by us" in t4
     for k in (t3, t4):
         assert figs[k][0].lstrip().startswith("<svg") or "<svg" in figs[k][0][:500]
     assert "not the paper's" in figs[t3][1] and "56" in figs[t3][1]
     assert "least Euclidean norm" in figs[t4][1] and "choice is ours" in figs[t4][1]
-    for c in "abcdef":
-        assert f"Fig. 3{c}" in figs[t3][0]
+    for c in "abcdef":  # each panel is named ours, never as the paper's panel
+        assert f"our design {c}, not the paper's Fig. 3{c}" in figs[t3][0]
+    assert "Fig. 4b as we read it" in figs[t4][0]
     for title, (body, _) in figs.items():  # every drawing's axes carry their unit
         if "<svg" in body[:500]:
             assert "x (m)" in body and "y (m)" in body, title
@@ -168,3 +170,78 @@ def test_page_draws_fig3_and_fig4b_with_what_was_assumed():
     # deterministic
     again = {title: body for title, body, _ in page.figures(study.run(copy.deepcopy(spec)))}
     assert again[t3] == figs[t3][0]
+
+
+def test_design_numbers_are_in_results_json_and_equal_an_engine_analysis_of_the_rebuilt_designs(monkeypatch):
+    """Figs. 3 and 4b's added mass and peak shaking force are computed with the balancing (the
+    result's derived hook), so results.json carries them; each equals what the engine gives for
+    the design rebuilt from the spec, and the ratio is the stages' force_ratio (the hook applied
+    to the stage models gives the stages' own ratios, 1 for the unbalanced one). The page draws
+    those numbers and analyses nothing."""
+    import json
+
+    from balpipe.engine.load_reference import load_reference
+    from balpipe.families.rrr4 import figures as page
+    from balpipe.report.results import results_dict
+
+    spec = load(PAPER, samples=41, simulate=False)
+    st = study.run(spec)
+    res = json.loads(json.dumps(results_dict(st, "x", "h", False)))
+    rows = res["balancing_details"]["topologies"]["designs"]
+    params = {p["name"]: p["value"] for p in res["parameters"]}
+    model, g, designs = designs_of(spec)
+    an0 = st.stages[0].analysis
+    ref = load_reference(model, an0).force
+    assert ref == an0.max_inertial_force > 0  # the reference is the unbalanced peak here
+    assert [r["figure"] for r in rows] == [d.figure for d in designs]
+    assert [r["design"] for r in rows] == [f"our design {c}, not the paper's Fig. 3{c}" for c in "abcdef"] + [
+        "Fig. 4b as we read it"]
+    for d, r in zip(designs, rows):
+        an = analyse(d.model, an0.t, an0.gravity, an0.moment_point)
+        # results.json keeps 12 significant digits (report.results)
+        assert r["added_mass"] == pytest.approx(d.model.total_mass() - model.total_mass(), rel=1e-11)
+        assert abs(r["peak_inertial_force"] - an.max_inertial_force) <= 1e-12 * ref, d.figure
+        assert abs(r["force_ratio"] - an.max_inertial_force / ref) <= 1e-12, d.figure
+        assert params["peak_force_ratio_" + topo.tag(d.figure)] == r["force_ratio"]
+    # the hook's ratio is the stages' force_ratio
+    as_designs = [topo.Design(s.stage.name, (), s.stage.model, "") for s in st.stages]
+    again = [{} for _ in as_designs]
+    recipe.design_loads(as_designs, again, st.stages)
+    metrics = {m["name"]: m for m in res["stages"]}
+    assert again[0]["force_ratio"] == 1.0
+    for s, r in zip(st.stages, again):
+        assert r["force_ratio"] == pytest.approx(metrics[s.stage.name]["force_ratio"], rel=1e-11, abs=1e-18), s.stage.name
+
+    # the page draws from those numbers: no engine analysis while it renders
+    def refuse(*a, **k):
+        raise AssertionError("the page analysed a model")
+
+    import balpipe.engine
+    import balpipe.engine.analysis
+
+    monkeypatch.setattr(balpipe.engine, "analyse", refuse)
+    monkeypatch.setattr(balpipe.engine.analysis, "analyse", refuse)
+    monkeypatch.setattr(recipe, "analyse", refuse)
+    figs = {title: body for title, body, _ in page.figures(st)}
+    body3 = next(b for t, b in figs.items() if "Fig. 3" in t)
+    for r in rows[:-1]:
+        assert f"added {r['added_mass']:.3g} kg, peak |F| / reference {r['force_ratio']:.1e}" in body3
+
+
+def test_topology_title_names_the_figures_of_the_stages_drawn():
+    """The stage panels' title lists the paper's figures that the stages reproduce, read from the
+    stages (Fig. 2b with one distal link kept, no Fig. 4a without topologies, "least mass" only
+    when that stage of ours is drawn)."""
+    from types import SimpleNamespace
+
+    from balpipe.families.rrr4 import figures as page
+
+    def title(spec, balancing=None):
+        res = registry.balance(spec, balancing)
+        return page.topology_title(SimpleNamespace(stages=[SimpleNamespace(stage=s) for s in res.stages]))
+
+    spec = load(PAPER, simulate=False)
+    assert title(spec) == "Balance topologies (paper 001, Figs. 2a, 4a; least mass)"
+    assert title(load(FIG6B, simulate=False)) == "Balance topologies (paper 001, Figs. 2a, 4a, 6b; least mass)"
+    kept = spec.balancing.model_copy(update={"independent": [12], "least_mass": False, "topologies": False})
+    assert title(spec, kept) == "Balance topologies (paper 001, Fig. 2b)"

@@ -24,7 +24,7 @@ import numpy as np
 
 from . import loop_closure
 from .engine import AnalysisError, compile_model
-from .engine.positions import _newton
+from .engine.positions import newton_raphson
 from .model import Model
 from .spec_parts import SpecFieldError
 
@@ -43,7 +43,7 @@ def check(model: Model, t0: float) -> None:
     """Assemble ``model`` at ``t0`` from its initial poses; raise :class:`SpecFieldError` (at the
     loop that cannot close, or at the body whose pose is far from the assembly reached)."""
     c = compile_model(model)
-    q, ok, _ = _newton(c, c.q0[None, :], np.array([t0]), max_iter=50)
+    q, ok, _ = newton_raphson(c, c.q0[None, :], np.array([t0]), max_iter=50)
     if not ok[0]:
         exc = AnalysisError("cannot assemble the mechanism at t = 0", t0)
         exc.q = q[0]

@@ -19,7 +19,7 @@ from typing import Any
 
 from . import runner
 from .loader import LoadedSpec, SpecError, SpecErrors, load, load_text
-from .report.results import _clean
+from .report.results import json_safe
 from .study import Study, stage_metrics
 
 ROUND_OFF = 1e-9  # ratios to the unbalanced peak below this are cancelled loads
@@ -167,7 +167,7 @@ def compare(a: Side, b: Side) -> dict:
         if not same(ra.get(n, {}).get("computed"), rb.get(n, {}).get("computed"))
         or ra.get(n, {}).get("status") != rb.get(n, {}).get("status")
     ]
-    return _clean({
+    return json_safe({
         "old": a.ref, "new": b.ref,
         "old_spec": a.loaded.spec.name, "new_spec": b.loaded.spec.name,
         "status": {"old": "ok" if a.study.ok else "failed", "new": "ok" if b.study.ok else "failed"},

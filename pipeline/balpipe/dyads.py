@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .engine import Compiled, jacobian
-from .engine.constraints import _extend
+from .engine.constraints import with_frame
 from .engine.structure import maximum_matching, strong_components
 from .model import FRAME, Model, Revolute
 
@@ -72,7 +72,7 @@ def blocks(c: Compiled, q: np.ndarray) -> list[Block]:
     near positions ``q`` (3 nb,) (a fixed small perturbation keeps coincidental zeros out)."""
     rng = np.random.default_rng(0)
     qp = q + 1e-3 * rng.standard_normal(q.shape)
-    J = jacobian(c, _extend(qp[None, :]))[0, :, 3:]
+    J = jacobian(c, with_frame(qp[None, :]))[0, :, 3:]
     m, n = J.shape
     if m != n:
         return []

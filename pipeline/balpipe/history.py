@@ -325,9 +325,9 @@ def history_dict(w: _Work, known: dict[str, dict], failures: dict[str, str], sim
                    "parameters": [], "stages": [], "validation": "skipped", "references": []}
         commits.append({"hash": c.hash, "short": c.hash[:7], "date": c.date, "subject": c.subject,
                         "path": c.path, "input_hash": h, **fig})
-    from .report.results import _clean
+    from .report.results import json_safe
 
-    return _clean({
+    return json_safe({
         "schema_version": SCHEMA_VERSION,
         "source": w.path.as_posix(),
         "slug": w.slug,

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import dyads
 from .engine import AnalysisError, Compiled, compile_model, jacobian, residual
-from .engine.constraints import _extend
+from .engine.constraints import with_frame
 from .engine.positions import follow_motion
 from .model import Model
 from .spec_parts import SpecFieldError
@@ -95,12 +95,12 @@ def _close_block(c: Compiled, q: np.ndarray, t: float, b: dyads.Block, iteration
     rows, cols = list(b.rows), list(b.cols)
     tt = np.array([t])
     for _ in range(iterations):
-        phi = residual(c, _extend(q[None, :]), tt)[0, rows]
+        phi = residual(c, with_frame(q[None, :]), tt)[0, rows]
         if np.max(np.abs(phi)) <= 1e-13:
             break
-        J = jacobian(c, _extend(q[None, :]))[0][np.ix_(rows, [k + 3 for k in cols])]
+        J = jacobian(c, with_frame(q[None, :]))[0][np.ix_(rows, [k + 3 for k in cols])]
         q[cols] += np.linalg.lstsq(J, -phi, rcond=None)[0]
-    return float(np.max(np.abs(residual(c, _extend(q[None, :]), tt)[0, rows])))
+    return float(np.max(np.abs(residual(c, with_frame(q[None, :]), tt)[0, rows])))
 
 
 def explain(model: Model, c: Compiled, exc: AnalysisError) -> SpecFieldError:

@@ -104,13 +104,13 @@ def run_stage_analyses(spec: Spec, result: BalanceResult) -> list[StageResult]:
             StageResult(
                 stage, an,
                 added_mass=stage.model.total_mass() - base.total_mass(),
-                added_inertia=_total_inertia(stage.model) - _total_inertia(base),
+                added_inertia=total_inertia(stage.model) - total_inertia(base),
             )
         )
     return out
 
 
-def _total_inertia(model) -> float:
+def total_inertia(model) -> float:
     """Sum of the declared centroidal inertias of links, attachments and gears (no parallel-axis
     terms): what a balancing stage adds as rotating inertia (counter-rotations, inertia
     counterweights)."""

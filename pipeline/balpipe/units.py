@@ -50,10 +50,13 @@ MAX_ABS = {"length": 1e4, "angle": 1e5, "time": 1e5, "mass": 1e6, "inertia": 1e1
            "angular acceleration": 1e9, "dimensionless": 1e12}
 
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-_QTY = re.compile(rf"^\s*({_NUM})\s*(.*?)\s*$")
+#: a quantity as written, "<number> <unit>": group 1 the number, group 2 the unit (may be empty)
+QUANTITY = re.compile(rf"^\s*({_NUM})\s*(.*?)\s*$")
 
 
-def _normalise_unit(unit: str) -> str:
+def normalise_unit(unit: str) -> str:
+    """A unit written in one form: '·', '*' -> ' ', '²', '**2' -> '^2', spaces collapsed
+    ('kg · m²' -> 'kg m^2'), as the unit tables key them."""
     u = unit.replace("·", " ").replace("*", " ").replace("²", "^2").replace("**2", "^2")
     u = re.sub(r"\s+", " ", u).strip()
     return u.replace(" ^2", "^2")
@@ -62,7 +65,7 @@ def _normalise_unit(unit: str) -> str:
 def kinds_of(unit: str) -> dict[str, float]:
     """The dimensions whose unit tables hold ``unit`` (after normalising its spelling), in the
     order of :data:`UNITS`, each with the unit's factor to SI ({} for an unknown unit)."""
-    u = _normalise_unit(unit)
+    u = normalise_unit(unit)
     return {kind: table[u] for kind, table in UNITS.items() if u in table}
 
 
@@ -81,13 +84,13 @@ def parse(value: Any, dimension: str) -> float:
         except OverflowError:
             raise ValueError(f"{kind} too large (got an integer of {len(str(abs(value)))} digits)") from None
     elif isinstance(value, str):
-        m = _QTY.match(value)
+        m = QUANTITY.match(value)
         if not m:
             low = value.strip().lower().lstrip("+-.")
             if low in ("nan", "inf", "infinity"):
                 raise ValueError(f"{kind} must be a finite number, got {value!r}")
             raise ValueError(f"expected {a} {kind} like '{_example(dimension)}', got {value!r}")
-        unit = _normalise_unit(m.group(2))
+        unit = normalise_unit(m.group(2))
         table = UNITS[dimension]
         if unit == "" and dimension != "dimensionless":
             raise ValueError(
@@ -205,8 +208,8 @@ def _rate_parser(order: int):
         if isinstance(value, RateValue):
             return value
         if isinstance(value, str):
-            m = _QTY.match(value)
-            unit = _normalise_unit(m.group(2)) if m else ""
+            m = QUANTITY.match(value)
+            unit = normalise_unit(m.group(2)) if m else ""
             for dim in dims:
                 if unit and unit in UNITS[dim]:
                     return RateValue(parse(value, dim), dim)

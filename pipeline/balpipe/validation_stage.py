@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 from .study import Study, ratio_reference
 from .validate import FreeFloating, ValidationSettings, free_floating, validate
-from .validate.run import _model_scale
+from .validate.run import model_scale
 from .validate.torque import torque_driven
 
 #: mass of the free-floating frame (kg)
@@ -174,7 +174,7 @@ def simulate_study(study: Study, workers: int = 1) -> None:
 def reactionless_runs(study: Study, settings: ValidationSettings | None = None, workers: int = 1) -> Reactionless:
     """Every stage on the same free-floating frame: mass BASE_MASS, the inertia of a square
     plate reaching the farthest centre of mass of any stage."""
-    reach = max(_model_scale(s.analysis) for s in study.stages)
+    reach = max(model_scale(s.analysis) for s in study.stages)
     base_inertia = (2.0 / 3.0) * BASE_MASS * reach**2
     runs = _parallel(study, workers, _floating_run, [(k, base_inertia, settings) for k in range(len(study.stages))])
     return Reactionless(

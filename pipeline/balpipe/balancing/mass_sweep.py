@@ -10,7 +10,7 @@ frame origin; :func:`balpipe.balancing.regressor.parameters` with ``angular=True
   Phi_q^T lambda = -Y_D p in body-frame-origin coordinates (:func:`regressor.dynamics_regressor`),
   where Phi_q is the engine's Jacobian transformed from centre-of-mass to frame-origin
   coordinates (dr_c/dtheta = perp(A c)); the multipliers are unique and coordinate-free, and
-  with redundant actuation the engine's least-norm choice (:func:`engine._multipliers`) is
+  with redundant actuation the engine's least-norm choice (:func:`engine.solve_multipliers`) is
   linear too.
 
 So one engine analysis of a base design gives matrices from which every design's loads are a
@@ -27,9 +27,9 @@ import numpy as np
 
 from .regressor import dynamics_regressor, parameters, shaking_regressor, states_from_analysis
 from ..engine import analyse, compile_model, jacobian
-from ..engine.compile import _rotate
-from ..engine.constraints import _extend
-from ..engine.dynamics import _joint_reactions, _multipliers, _radial_tooth_loads, _tooth_rows
+from ..engine.compile import rotate
+from ..engine.constraints import with_frame
+from ..engine.dynamics import joint_reactions, solve_multipliers, radial_tooth_loads, tooth_rows
 from ..model import Model
 
 CHUNK = 512  # designs per block of the batched products (bounds the memory: CHUNK x N x rows)
@@ -93,16 +93,16 @@ class MassSweep:
         c = compile_model(model)
         c = c.dynamics or c  # with actuators: their rows, not the drivers' (engine.compile._actuated)
         N = len(t)
-        qx = _extend(an.q.reshape(N, -1))
+        qx = with_frame(an.q.reshape(N, -1))
         J = jacobian(c, qx)
-        geo = _tooth_rows(c, qx, J)
+        geo = tooth_rows(c, qx, J)
         for k, b in enumerate(model.bodies):  # centre-of-mass -> frame-origin coordinates
             _, com, _ = b.mass_properties()
-            s = _rotate(an.q[:, k, 2], np.asarray(com, dtype=float))
+            s = rotate(an.q[:, k, 2], np.asarray(com, dtype=float))
             col = 3 * (k + 1)
             J[:, :, col + 2] += -J[:, :, col] * s[:, 1, None] + J[:, :, col + 1] * s[:, 0, None]
         Jf = J[:, :, 3:]
-        Lam = _multipliers(c, Jf, -YD)  # every parameter's column at once
+        Lam = solve_multipliers(c, Jf, -YD)  # every parameter's column at once
         drivers = list(c.driver_rows)
         G = -Lam[:, [c.driver_rows[d] for d in drivers], :]
         key = geometry_key(model, t, gravity, moment_point)
@@ -128,12 +128,12 @@ class MassSweep:
         """All multipliers (N, m) of one design, radial tooth forces included."""
         lam = self.Lam @ p
         if self.compiled.meshes:
-            lam, _ = _radial_tooth_loads(self.compiled, self.mesh_geo, lam)
+            lam, _ = radial_tooth_loads(self.compiled, self.mesh_geo, lam)
         return lam
 
     def reactions(self, p: np.ndarray) -> dict[str, dict[str, np.ndarray]]:
         """Joint reactions of one design, as :attr:`balpipe.engine.Analysis.reactions`."""
-        return _joint_reactions(self.model, self.compiled, self.multipliers(p), self.mesh_geo)
+        return joint_reactions(self.model, self.compiled, self.multipliers(p), self.mesh_geo)
 
     def peaks(self, P: np.ndarray, chunk: int = CHUNK) -> dict[str, np.ndarray]:
         """Peak |F|, |M| and |effort| of every design (rows of P, (D, np)) by blocks of matrix

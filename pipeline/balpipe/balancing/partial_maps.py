@@ -13,7 +13,7 @@ vector z (per counterweight m, sx, sy, J; per disc I)
     p(z) = p0 + G z,    load_i(z) = Y_i p(z) = Y_i p0 + (Y_i G) z      (every time sample i)
 
 where p0 is the mechanism with the discs present at zero inertia. A joint's load is linear in the
-multipliers (:func:`balpipe.engine._joint_reactions`), so its map is that function applied to each
+multipliers (:func:`balpipe.engine.dynamics.joint_reactions`), so its map is that function applied to each
 column of the multipliers' map: one evaluation per basis direction. Radial tooth forces of meshes
 with pitch radii are not linear (|F_t| tan alpha) and are left out of the joint maps.
 """
@@ -25,7 +25,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..engine.dynamics import _joint_reactions
+from ..engine.dynamics import joint_reactions
 from .mass_sweep import MassSweep
 from ..model import Model, Prismatic, Revolute
 from .parts import add_counterweight
@@ -169,7 +169,7 @@ def _basis(model: Model, parts: list[PartVars], discs: list[DiscVars], nz: int) 
 def _joint_maps(sweep: MassSweep) -> dict[str, np.ndarray]:
     """Y (N, k, np) of each joint's load components, from the multipliers' map column by column."""
     model, c = sweep.model, sweep.compiled
-    cols = [_joint_reactions(model, c, sweep.Lam[:, :, j], sweep.mesh_geo) for j in range(sweep.Lam.shape[2])]
+    cols = [joint_reactions(model, c, sweep.Lam[:, :, j], sweep.mesh_geo) for j in range(sweep.Lam.shape[2])]
     out = {}
     for jt in model.joints:
         kind = "revolute" if isinstance(jt, Revolute) else "prismatic" if isinstance(jt, Prismatic) else "gear"

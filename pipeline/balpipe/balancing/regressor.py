@@ -30,8 +30,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..engine import Compiled, compile_model, jacobian, solve_positions
-from ..engine.constraints import _extend
-from ..engine.positions import _newton
+from ..engine.constraints import with_frame
+from ..engine.positions import newton_raphson
 from ..model import Law, Model
 
 MIN_CONDITION = 1e-7  # smallest / largest singular value of a kept configuration's Jacobian
@@ -113,7 +113,7 @@ def _square_subset(c: Compiled, q: np.ndarray) -> Compiled:
     chosen: list = []
     for p in driver_prims:
         trial = _restrict(c, joint_prims, chosen + [p])
-        J = jacobian(trial, _extend(q[None, :]))[0, :, 3:]
+        J = jacobian(trial, with_frame(q[None, :]))[0, :, 3:]
         if J.shape[0] <= n and np.linalg.matrix_rank(J) == J.shape[0]:
             chosen.append(p)
     return _restrict(c, joint_prims, chosen)
@@ -147,7 +147,7 @@ def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0) 
     target = samples or 2 * 4 * nb + 12
     t = np.asarray(t, dtype=float)
     tc = np.unique(t[np.linspace(0, len(t) - 1, min(len(t), 9)).round().astype(int)])
-    q_first, ok, _ = _newton(_square_subset(c, c.q0), c.q0[None, :], t[:1], max_iter=50)
+    q_first, ok, _ = newton_raphson(_square_subset(c, c.q0), c.q0[None, :], t[:1], max_iter=50)
     sq = _square_subset(c, q_first[0] if ok[0] else c.q0)
     base = solve_positions(sq, tc)
     joint_prims, driver_prims = _joint_and_driver_prims(sq)
@@ -169,8 +169,8 @@ def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0) 
         trial = replace(sq, prims=joint_prims + [
             replace(p, law=_Table(values[:, j])) for j, p in enumerate(driver_prims)
         ])
-        q, ok, _ = _newton(trial, base[k], np.arange(2 * need, dtype=float))
-        Jj = jacobian(joints_only, _extend(q))[:, :, 3:]
+        q, ok, _ = newton_raphson(trial, base[k], np.arange(2 * need, dtype=float))
+        Jj = jacobian(joints_only, with_frame(q))[:, :, 3:]
         u, s, vt = np.linalg.svd(Jj)
         rank = int(np.median(np.sum(s > 1e-9 * s[:, :1], axis=1)))
         dof = n - rank if dof is None else dof

@@ -70,7 +70,9 @@ def style(k: int) -> dict:
     return {**base, "color": MORE_COLORS[(k // n - 1 + k) % len(MORE_COLORS)]}
 
 
-def _marker(k: int) -> str:
+def marker(k: int) -> str:
+    """Stage ``k``'s marker symbol (matplotlib), the same order as :func:`marked` and
+    :func:`style_text` use."""
     return (MARKERS + MORE_MARKERS)[k % (len(MARKERS) + len(MORE_MARKERS))]
 
 
@@ -89,7 +91,7 @@ def marked(k: int, n: int) -> dict:
     """A stage's line style with its own marker, placed at staggered samples (offset per stage)
     so that curves that coincide stay distinguishable."""
     every = max(1, n // 12)
-    return {**style(k), "marker": _marker(k), "markersize": 4.5, "markerfacecolor": "none",
+    return {**style(k), "marker": marker(k), "markersize": 4.5, "markerfacecolor": "none",
             "markevery": (min(n - 1, (k * every) // max(1, len(MARKERS))), every)}
 
 
@@ -432,12 +434,12 @@ def place_items(fig, ax, items: list, segs: list, keep: list) -> list:
     to_px = ax.transData.transform
     renderer = fig.canvas.get_renderer()
     pad = 2.0 * fig.dpi / 72.0
-    marker = 3.0 * fig.dpi / 72.0
+    dot = 3.0 * fig.dpi / 72.0
     blocks = []
     for c, r in keep:
         x, y = to_px(c)
-        rr = marker if r is None else 5.0 * fig.dpi / 72.0 if r < 0 else \
-            max(marker, abs(float(to_px(c + np.array([r, 0.0]))[0]) - float(x)))
+        rr = dot if r is None else 5.0 * fig.dpi / 72.0 if r < 0 else \
+            max(dot, abs(float(to_px(c + np.array([r, 0.0]))[0]) - float(x)))
         blocks.append((float(x) - rr, float(y) - rr, float(x) + rr, float(y) + rr))
     requests = []
     for text, anchor, kind in items:

@@ -21,13 +21,13 @@ Inverse dynamics solves Phi_q^T lambda = Q - M q'' (M q'' + Phi_q^T lambda = Q).
 Redundant actuation (more drivers than degrees of freedom, e.g. a 4-RRR with four base motors):
 the consistent over-determined position, velocity and acceleration equations are solved in least
 squares (Gauss-Newton, least squares by QR, exact for consistent drivers), and the
-multipliers are those whose actuator efforts have the least norm (:func:`_multipliers`). The
+multipliers are those whose actuator efforts have the least norm (:func:`.dynamics.solve_multipliers`). The
 joints alone must not be over-constrained. The shaking
 loads are computed twice, independently:
 
 (a) reactions: F_sh, M_sh = -Phi_{q0}^T lambda (all frame joints, actuator reactions and gear
     mesh couples on the frame); a gear pair with pitch radii has its row rewritten as tooth
-    forces at the pitch point for the dynamics (:func:`_tooth_rows`, :mod:`balpipe.meshes`), so
+    forces at the pitch point for the dynamics (:func:`.dynamics.tooth_rows`, :mod:`balpipe.meshes`), so
     that its bearings carry the tooth force;
 (b) momentum: F_sh = sum m g - dP/dt, M_O = sum r x m g - dH_O/dt.
 

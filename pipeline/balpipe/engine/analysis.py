@@ -12,8 +12,8 @@ import numpy as np
 from ..model import Model
 from . import fastpath, structure
 from .compile import Compiled, compile_model
-from .constraints import _extend, jacobian
-from .dynamics import _joint_reactions, _multipliers, _radial_tooth_loads, _tooth_rows, actuation_condition
+from .constraints import with_frame, jacobian
+from .dynamics import joint_reactions, solve_multipliers, radial_tooth_loads, tooth_rows, actuation_condition
 from .kinematics import _vel_acc
 from .positions import condition_numbers, redundancy, solve_positions
 
@@ -27,7 +27,7 @@ class Analysis:
     (route a), about ``moment_point``; ``force_momentum``/``moment_momentum`` the same from the
     momentum derivative (route b). ``efforts``: actuator torque or force per driver, applied by
     the actuator to the driven body. ``reactions``: constraint loads per joint (the generalized
-    forces of the joint's multipliers, see :func:`_joint_reactions`), for revolutes the force
+    forces of the joint's multipliers, see :func:`joint_reactions`), for revolutes the force
     exerted on body b by body a.
     """
 
@@ -194,9 +194,9 @@ def analyse(
         mesh_geo: list = []
         gen0 = fastpath.frame_load(c.fast, kin.vals, lamT)
     else:
-        qx = _extend(q)
+        qx = with_frame(q)
         J = jacobian(cd, qx)
-        mesh_geo = _tooth_rows(cd, qx, J)  # gear meshes with pitch radii act by tooth forces
+        mesh_geo = tooth_rows(cd, qx, J)  # gear meshes with pitch radii act by tooth forces
         Jf, J0 = J[:, :, 3:], J[:, :, :3]
         Q = np.zeros_like(q)
         Q[:, 0::3] = c.mass * g[0]
@@ -205,8 +205,8 @@ def analyse(
         if c.dynamics is not None:
             actuation = actuation_condition(cd, Jf, t)
             rates = {name: np.einsum("nk,nk->n", Jf[:, row, :], v) for name, row in cd.driver_rows.items()}
-        lam = _multipliers(cd, Jf, rhs)
-        lam, radial_on_frame = _radial_tooth_loads(cd, mesh_geo, lam)
+        lam = solve_multipliers(cd, Jf, rhs)
+        lam, radial_on_frame = radial_tooth_loads(cd, mesh_geo, lam)
         gen0 = -np.einsum("nmk,nm->nk", J0, lam) + radial_on_frame  # load on the frame: Fx, Fy, M_O
     P = np.asarray(moment_point, dtype=float)
     force = gen0[:, :2]
@@ -231,7 +231,7 @@ def analyse(
         return M - (P[0] * F[:, 1] - P[1] * F[:, 0])
 
     efforts = {name: -lam[:, row] for name, row in cd.driver_rows.items()}
-    reactions = _joint_reactions(model, cd, lam, mesh_geo)
+    reactions = joint_reactions(model, cd, lam, mesh_geo)
     # frame poses for drawing: frame origin = com - A(theta) com_local
     frame_pose = fastpath._place(q, -c.com_local).reshape(qb.shape)
     return Analysis(

@@ -19,7 +19,7 @@ def _perp(v: np.ndarray) -> np.ndarray:
     return out
 
 
-def _rotate(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
+def rotate(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
     """A(theta) s for theta (N,), s (2,) -> (N, 2)."""
     c, si = np.cos(theta), np.sin(theta)
     out = np.empty(theta.shape + (2,))

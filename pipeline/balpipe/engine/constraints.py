@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .compile import Compiled, _Angle, _Coincident, _perp, _rotate
+from .compile import Compiled, _Angle, _Coincident, _perp, rotate
 
 
 def _split(q: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -27,7 +27,7 @@ def residual(c: Compiled, qx: np.ndarray, t: np.ndarray) -> np.ndarray:
         if isinstance(p, _Coincident):
             ri, thi = _split(qx, p.i)
             rj, thj = _split(qx, p.j)
-            out.append(ri + _rotate(thi, p.si) - rj - _rotate(thj, p.sj))
+            out.append(ri + rotate(thi, p.si) - rj - rotate(thj, p.sj))
         elif isinstance(p, _Angle):
             f = _law_values(p, t)[0]
             val = sum(v * qx[:, 3 * k + 2] for k, v in p.coeffs) - p.const - f
@@ -36,8 +36,8 @@ def residual(c: Compiled, qx: np.ndarray, t: np.ndarray) -> np.ndarray:
             f = _law_values(p, t)[0]
             ri, thi = _split(qx, p.i)
             rj, thj = _split(qx, p.j)
-            e = _rotate(thi, p.a)
-            d = rj + _rotate(thj, p.sj) - ri - _rotate(thi, p.si)
+            e = rotate(thi, p.a)
+            d = rj + rotate(thj, p.sj) - ri - rotate(thi, p.si)
             out.append((np.sum(e * d, axis=1) - p.const - f)[:, None])
     return np.concatenate(out, axis=1)
 
@@ -55,16 +55,16 @@ def jacobian(c: Compiled, qx: np.ndarray) -> np.ndarray:
             for a in range(2):
                 J[:, row + a, 3 * p.i + a] += 1.0
                 J[:, row + a, 3 * p.j + a] -= 1.0
-            J[:, row : row + 2, 3 * p.i + 2] += _perp(_rotate(thi, p.si))
-            J[:, row : row + 2, 3 * p.j + 2] -= _perp(_rotate(thj, p.sj))
+            J[:, row : row + 2, 3 * p.i + 2] += _perp(rotate(thi, p.si))
+            J[:, row : row + 2, 3 * p.j + 2] -= _perp(rotate(thj, p.sj))
         elif isinstance(p, _Angle):
             for k, v in p.coeffs:
                 J[:, row, 3 * k + 2] += v
         else:
             ri, thi = _split(qx, p.i)
             rj, thj = _split(qx, p.j)
-            e = _rotate(thi, p.a)
-            Asi, Asj = _rotate(thi, p.si), _rotate(thj, p.sj)
+            e = rotate(thi, p.a)
+            Asi, Asj = rotate(thi, p.si), rotate(thj, p.sj)
             d = rj + Asj - ri - Asi
             J[:, row, 3 * p.i : 3 * p.i + 2] -= e
             J[:, row, 3 * p.j : 3 * p.j + 2] += e
@@ -93,7 +93,7 @@ def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray)
             _, thi = _split(qx, p.i)
             _, thj = _split(qx, p.j)
             wi, wj = vx[:, 3 * p.i + 2], vx[:, 3 * p.j + 2]
-            out.append((wi**2)[:, None] * _rotate(thi, p.si) - (wj**2)[:, None] * _rotate(thj, p.sj))
+            out.append((wi**2)[:, None] * rotate(thi, p.si) - (wj**2)[:, None] * rotate(thj, p.sj))
         elif isinstance(p, _Angle):
             out.append(_law_values(p, t)[2][:, None])
         else:
@@ -101,8 +101,8 @@ def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray)
             rj, thj = _split(qx, p.j)
             vi, wi = _split(vx, p.i)
             vj, wj = _split(vx, p.j)
-            e = _rotate(thi, p.a)
-            Asi, Asj = _rotate(thi, p.si), _rotate(thj, p.sj)
+            e = rotate(thi, p.a)
+            Asi, Asj = rotate(thi, p.si), rotate(thj, p.sj)
             d = rj + Asj - ri - Asi
             dd = vj + wj[:, None] * _perp(Asj) - vi - wi[:, None] * _perp(Asi)
             quad = (
@@ -114,5 +114,7 @@ def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray)
     return np.concatenate(out, axis=1)
 
 
-def _extend(q: np.ndarray) -> np.ndarray:
+def with_frame(q: np.ndarray) -> np.ndarray:
+    """The moving bodies' coordinates ``q`` (N, 3n) with the frame's q_0 = 0 put first (N, 3 + 3n):
+    the coordinates that :func:`residual` and :func:`jacobian` take."""
     return np.concatenate([np.zeros((q.shape[0], 3)), q], axis=1)

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import Model, Prismatic, Revolute
-from .compile import Compiled, _perp, _rotate
+from .compile import Compiled, _perp, rotate
 from .constraints import _split
 from .errors import AnalysisError
 
 
-def _tooth_rows(c: Compiled, qx: np.ndarray, J: np.ndarray) -> list[dict[str, np.ndarray]]:
+def tooth_rows(c: Compiled, qx: np.ndarray, J: np.ndarray) -> list[dict[str, np.ndarray]]:
     """Write each mesh's generalized force as tooth forces at its pitch point (in place in J).
 
     The gear's angle row is replaced by the rolling condition t . (v_P(b) - v_P(a)) = 0 at the
@@ -26,8 +26,8 @@ def _tooth_rows(c: Compiled, qx: np.ndarray, J: np.ndarray) -> list[dict[str, np
     geo = []
     for m in c.meshes:
         rc, thc = _split(qx, m.ic)
-        Oa = rc + _rotate(thc, m.sca)
-        Ob = rc + _rotate(thc, m.scb)
+        Oa = rc + rotate(thc, m.sca)
+        Ob = rc + rotate(thc, m.scb)
         d = Ob - Oa
         u = d / np.linalg.norm(d, axis=1)[:, None]
         t = _perp(u)
@@ -42,7 +42,7 @@ def _tooth_rows(c: Compiled, qx: np.ndarray, J: np.ndarray) -> list[dict[str, np
     return geo
 
 
-def _radial_tooth_loads(
+def radial_tooth_loads(
     c: Compiled, geo: list[dict[str, np.ndarray]], lam: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """Add each mesh's radial tooth force, |F_t| tan(pressure angle), to its bearings.
@@ -69,7 +69,7 @@ def _radial_tooth_loads(
     return lam, on_frame
 
 
-def _joint_reactions(
+def joint_reactions(
     model: Model, c: Compiled, lam: np.ndarray, geo: list[dict[str, np.ndarray]] | None = None
 ) -> dict[str, dict[str, np.ndarray]]:
     """Loads that each joint transmits, from its multipliers (constraint force = -Phi_q^T lam).
@@ -136,7 +136,7 @@ def actuation_condition(c: Compiled, Jf: np.ndarray, t: np.ndarray) -> np.ndarra
     return cond
 
 
-def _multipliers(c: Compiled, Jf: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+def solve_multipliers(c: Compiled, Jf: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """Lagrange multipliers from Phi_q^T lambda = Q - M q'' (N samples): ``rhs`` (N, n) gives
     (N, m); (N, n, k), k right-hand sides at once (a regressor's columns), gives (N, m, k).
 

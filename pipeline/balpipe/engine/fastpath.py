@@ -38,13 +38,13 @@ from ..model import Model
 from . import warmstart
 from .compile import Compiled, compile_model
 from .positions import _COND_LIMIT, _TOL, _check_regular, _condition, follow_motion, redundancy
-from .constraints import _extend, jacobian
+from .constraints import with_frame, jacobian
 from .newton_blocks import polish
 from .structure import Decomposition, block_sigma_min, decompose, invert_blocks, solve
 from .vectorised import State, Vectorised, acceleration_rhs, jacobian_values, law_table, residual, velocity_rhs, vectorise
 
 _SCREEN = 1e-4  # exact condition numbers where the lower bound exceeds this fraction of the limit
-_RESIDUAL = 1e-9  # the general path's convergence test (:func:`.positions._newton`)
+_RESIDUAL = 1e-9  # the general path's convergence test (:func:`.positions.newton_raphson`)
 
 
 class Fallback(Exception):
@@ -217,7 +217,7 @@ def _screen(c: Compiled, p: Prepared, vals: np.ndarray, inverses: dict, X: np.nd
     close = ~(bound <= _COND_LIMIT * _SCREEN)
     if close.any():
         q = X[3:-1, close].T
-        if not np.all(_condition(jacobian(c, _extend(q))[:, :, 3:]) <= _COND_LIMIT):
+        if not np.all(_condition(jacobian(c, with_frame(q))[:, :, 3:]) <= _COND_LIMIT):
             _check_regular(c, X[3:-1].T, t)  # raises, naming the first singular sample
             raise Fallback  # pragma: no cover - the exact check disagreed with itself
 

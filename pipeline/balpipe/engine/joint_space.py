@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .compile import compile_model
-from .constraints import _extend, jacobian
+from .constraints import with_frame, jacobian
 from .positions import solve_positions
 from ..model import Model
 
@@ -22,7 +22,7 @@ def mass_matrix(model: Model, t: np.ndarray) -> tuple[list[str], np.ndarray]:
     c = compile_model(model)
     t = np.asarray(t, dtype=float)
     q = solve_positions(c, t)
-    J = jacobian(c, _extend(q))[:, :, 3:]
+    J = jacobian(c, with_frame(q))[:, :, 3:]
     names = list(c.driver_rows)
     E = np.zeros((len(t), J.shape[1], len(names)))
     for k, n in enumerate(names):

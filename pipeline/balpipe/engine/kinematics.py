@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .compile import Compiled
-from .constraints import _extend, acceleration_rhs, jacobian, velocity_rhs
+from .constraints import with_frame, acceleration_rhs, jacobian, velocity_rhs
 
 
 def _solve_rect(J: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -18,8 +18,8 @@ def _solve_rect(J: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _vel_acc(c: Compiled, q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    qx = _extend(q)
+    qx = with_frame(q)
     J = jacobian(c, qx)[:, :, 3:]
     v = _solve_rect(J, velocity_rhs(c, t))
-    a = _solve_rect(J, acceleration_rhs(c, qx, _extend(v), t))
+    a = _solve_rect(J, acceleration_rhs(c, qx, with_frame(v), t))
     return v, a

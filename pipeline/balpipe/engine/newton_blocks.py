@@ -1,7 +1,7 @@
 """Newton-Raphson and velocity/acceleration solves for the continuation of closed loops
 (:func:`.positions.follow_motion`) on the constraints evaluated by type (:mod:`.vectorised`).
 
-The same iteration as the general path (:func:`.positions._newton`, :func:`.kinematics._vel_acc`:
+The same iteration as the general path (:func:`.positions.newton_raphson`, :func:`.kinematics._vel_acc`:
 Haug, ch. 3 and 6): q <- q - Phi_q^-1 Phi until max |Phi| < 1e-12, then Phi_q q' = nu and
 Phi_q q'' = gamma. Only the evaluation differs: Phi and the Jacobian's non-zero entries come from
 :mod:`.vectorised` (a few numpy operations per primitive type instead of a Python loop over
@@ -23,13 +23,13 @@ from __future__ import annotations
 import numpy as np
 
 from .compile import Compiled
-from .constraints import _extend, jacobian
+from .constraints import with_frame, jacobian
 from .kinematics import _solve_rect, _vel_acc
 from .structure import Decomposition, invert_blocks, solve
 from .vectorised import State, Vectorised, acceleration_rhs, jacobian_values, law_table, residual, velocity_rhs
 
 _TOL = 1e-12  # as :data:`.positions._TOL`
-_CONVERGED = 1e-9  # as :func:`.positions._newton`'s convergence test
+_CONVERGED = 1e-9  # as :func:`.positions.newton_raphson`'s convergence test
 _DENSE_ENTRIES = 20_000  # samples x n^2 up to which the dense scattered Jacobian is used
 _POLISH = 1e-14  # closed loops: one more Newton step where the residual exceeds this (:func:`polish`)
 
@@ -75,7 +75,7 @@ class BlockOps:
 
     def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = 25):
         """Batched Newton-Raphson from q (N, n) at times t (N,). Returns (q, converged mask,
-        residual norms), as :func:`.positions._newton`."""
+        residual norms), as :func:`.positions.newton_raphson`."""
         vz = self.vz
         f = self._laws(t)[0]
         X = self._X(q)
@@ -111,7 +111,7 @@ class BlockOps:
 
     def _general(self, q: np.ndarray, phi: np.ndarray) -> np.ndarray:
         """The general path's step (least squares where the Jacobian is singular), (n, k)."""
-        J = jacobian(self.c, _extend(q.T))[:, :, 3:]
+        J = jacobian(self.c, with_frame(q.T))[:, :, 3:]
         try:
             dq = _solve_rect(J, -phi.T)
         except np.linalg.LinAlgError:

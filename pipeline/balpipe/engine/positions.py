@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from .compile import Compiled
-from .constraints import _extend, jacobian, residual
+from .constraints import with_frame, jacobian, residual
 from .errors import AnalysisError
 from .kinematics import _solve_rect, _vel_acc
 
@@ -43,7 +43,7 @@ def _check_redundancy(c: Compiled, q: np.ndarray, t: float) -> None:
     hence the reactions, are not determined by the minimum-norm efforts)."""
     if redundancy(c) == 0:
         return
-    J = jacobian(c, _extend(q[None, :]))[0, :, 3:]
+    J = jacobian(c, with_frame(q[None, :]))[0, :, 3:]
     drv = set(c.driver_rows.values())
     rows = [r for r in range(J.shape[0]) if r not in drv]
     s = np.linalg.svd(J[rows], compute_uv=False)
@@ -55,12 +55,12 @@ def _check_redundancy(c: Compiled, q: np.ndarray, t: float) -> None:
         )
 
 
-def _newton(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER):
+def newton_raphson(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER):
     """Batched Newton-Raphson. Returns (q, converged mask, residual norms)."""
     q = q.copy()
     norms = np.full(len(t), np.inf)
     for _ in range(max_iter):
-        qx = _extend(q)
+        qx = with_frame(q)
         phi = residual(c, qx, t)
         norms = np.abs(phi).max(axis=1)
         todo = ~(norms < _TOL)
@@ -72,7 +72,7 @@ def _newton(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER
         except np.linalg.LinAlgError:
             dq = np.stack([np.linalg.lstsq(Jk, -pk, rcond=None)[0] for Jk, pk in zip(J, phi[todo])])
         q[todo] += dq
-    qx = _extend(q)
+    qx = with_frame(q)
     norms = np.abs(residual(c, qx, t)).max(axis=1)
     return q, norms < 1e-9, norms
 
@@ -89,7 +89,7 @@ def _worst_rows(c: Compiled, values: np.ndarray) -> str:
 
 
 def _fail_position(c: Compiled, q: np.ndarray, t: float) -> AnalysisError:
-    qx = _extend(q[None, :])
+    qx = with_frame(q[None, :])
     phi = residual(c, qx, np.array([t]))[0]
     worst = int(np.argmax(np.abs(phi)))
     err = AnalysisError(
@@ -104,7 +104,7 @@ def _fail_position(c: Compiled, q: np.ndarray, t: float) -> AnalysisError:
 
 def condition_numbers(c: Compiled, q: np.ndarray) -> np.ndarray:
     """2-norm condition numbers of Phi_q (N,) at positions q (N, 3 nb)."""
-    return _condition(jacobian(c, _extend(q))[:, :, 3:])
+    return _condition(jacobian(c, with_frame(q))[:, :, 3:])
 
 
 def _condition(J: np.ndarray) -> np.ndarray:
@@ -114,7 +114,7 @@ def _condition(J: np.ndarray) -> np.ndarray:
 
 def _check_regular(c: Compiled, q: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Condition numbers of Phi_q along the motion; a singular configuration is an error."""
-    J = jacobian(c, _extend(q))[:, :, 3:]
+    J = jacobian(c, with_frame(q))[:, :, 3:]
     cond = _condition(J)
     bad = np.flatnonzero(cond > _COND_LIMIT)
     if bad.size:
@@ -132,14 +132,14 @@ def _check_regular(c: Compiled, q: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 
 class DenseOps:
-    """The general path's solves: :func:`_newton` and :func:`.kinematics._vel_acc` on every
+    """The general path's solves: :func:`newton_raphson` and :func:`.kinematics._vel_acc` on every
     sample's full Jacobian (:func:`.constraints.jacobian`)."""
 
     def __init__(self, c: Compiled):
         self.c = c
 
     def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER):
-        return _newton(self.c, q, t, max_iter)
+        return newton_raphson(self.c, q, t, max_iter)
 
     def vel_acc(self, q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return _vel_acc(self.c, q, t)

@@ -41,9 +41,9 @@ def _written_to_si(raw: Any, dimension: str | None) -> tuple[str, str] | None:
     if isinstance(raw, (int, float)):
         return num(raw), units.SI.get(dimension or "", "")
     if isinstance(raw, str):
-        m = units._QTY.match(raw)
+        m = units.QUANTITY.match(raw)
         if m:
-            kinds = units.kinds_of(m.group(2)) if units._normalise_unit(m.group(2)) else {}
+            kinds = units.kinds_of(m.group(2)) if units.normalise_unit(m.group(2)) else {}
             if kinds:
                 dim, factor = next(iter(kinds.items()))  # the first table holding the unit, as before
                 return num(float(m.group(1)) * factor), units.SI[dim]

@@ -24,7 +24,7 @@ from ..draw import figures
 #: per paper, the figure numbers its pages reproduce (a number covers its panels: "6" by "6a")
 FIGURES = {
     "000": ("4", "8"),
-    "001": ("2", "3", "4", "6"),
+    "001": ("2", "3", "4", "6a", "6b", "6c"),  # Fig. 6's three panels are three designs, one spec each
     "002": ("2",),
     "003": ("2", "3", "4"),
     "004": ("10a", "10b", "11", "12"),

@@ -9,7 +9,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from ..draw.figures import _marker, legend_below, style, to_svg  # noqa: E402
+from ..draw.figures import legend_below, marker, style, to_svg  # noqa: E402
 
 AXES = {
     "added_mass": "added mass (kg)",
@@ -36,7 +36,7 @@ def _front_figure(points: list[dict], x: str, y: str, marks: list[tuple[str, flo
     ax.plot([p[x] for p in points], [p[y] for p in points], "-o", ms=3, color="black", lw=1.2,
             label="optimal front (cone programme)")
     for k, (label, vx, vy) in enumerate(marks):
-        ax.plot([vx], [vy], linestyle="none", marker=_marker(k), color=style(k + 1)["color"], ms=8,
+        ax.plot([vx], [vy], linestyle="none", marker=marker(k), color=style(k + 1)["color"], ms=8,
                 markerfacecolor="none", mew=1.5, label=label)
     ax.set_xlabel(AXES[x])
     ax.set_ylabel(AXES[y])

@@ -18,12 +18,12 @@ from .verdict import verdict
 SCHEMA_VERSION = 1
 
 
-def _clean(x: Any) -> Any:
+def json_safe(x: Any) -> Any:
     """JSON-safe and deterministic: floats rounded to 12 significant digits, NaN -> None."""
     if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
+        return {str(k): json_safe(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
+        return [json_safe(v) for v in x]
     if isinstance(x, (bool, np.bool_)):
         return bool(x)
     if isinstance(x, (int, np.integer)):
@@ -84,7 +84,7 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
         out["balancing_details"] = study.balance.details
     out["paper"] = spec.paper  # the site index filters by it
     out["verdict"] = verdict_of(study, out)
-    return _clean(out)
+    return json_safe(out)
 
 
 def verdict_of(study: Study, out: dict) -> dict:
@@ -160,7 +160,7 @@ def joint_load_table(study: Study) -> list[dict]:
 
 def timeseries_csv(study: Study) -> str:
     """One row per sample: t, then per stage Fx, Fy, |F|, M (about the moment point), every
-    actuator effort, every joint reaction (see :func:`balpipe.engine._joint_reactions`), the
+    actuator effort, every joint reaction (see :func:`balpipe.engine.dynamics.joint_reactions`), the
     total centre of mass, every body's pose and every named point's path with their velocities
     (:func:`balpipe.motion_outputs.motion_columns`); SI units, 12 significant digits."""
     cols: list[tuple[str, np.ndarray]] = [("t_s", study.unbalanced.analysis.t)]

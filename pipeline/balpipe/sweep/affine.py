@@ -69,9 +69,9 @@ def _features(row: dict, extra: list[float]) -> np.ndarray | None:
 def _si_factor(vary, probes: list[tuple[float, float]]) -> float | None:
     """The factor from the vary's unit to SI, as :func:`balpipe.units.parse` applies it, checked
     on the probes' (number, validated SI value) pairs."""
-    from ..units import _normalise_unit, kinds_of
+    from ..units import normalise_unit, kinds_of
 
-    factors = {1.0} if not _normalise_unit(vary.unit) else set(kinds_of(vary.unit).values())
+    factors = {1.0} if not normalise_unit(vary.unit) else set(kinds_of(vary.unit).values())
     fits = [f for f in factors if all(x * f == si for x, si in probes)]
     return fits[0] if len(fits) == 1 else None
 

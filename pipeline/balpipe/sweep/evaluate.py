@@ -122,7 +122,7 @@ def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]
 
 def _evaluate(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]], stage: str | None,
               keys: tuple) -> list[dict]:
-    from ..study import _total_inertia
+    from ..study import total_inertia
 
     rows = []
     for index, values in chunk:
@@ -131,7 +131,7 @@ def _evaluate(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]], st
             spec, sr, base = build_design(data, paths, values, stage)
             row["si"] = [float(get_attr_path(spec, p)) for p in paths]
             row["added_mass"] = sr.model.total_mass() - base.model.total_mass()
-            row["added_inertia"] = _total_inertia(sr.model) - _total_inertia(base.model)
+            row["added_inertia"] = total_inertia(sr.model) - total_inertia(base.model)
             t, g, P = _settings(spec)
             row["route"] = _stage_loads(sr.model, keys[0], t, g, P, "", row)
             _stage_loads(base.model, keys[1], t, g, P, "unbalanced_", row)

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..engine import Analysis
 from ..model import Attachment, Model
-from .run import _cross, _model_scale, _rotate, _run_adaptive
+from .run import _cross, model_scale, _rotate, _run_adaptive
 from .settings import ValidationSettings, _step_grid, default_settings
 
 #: the small masses tried in turn, times ``small_mass``: the smallest that pymunk holds together
@@ -185,7 +185,7 @@ def free_floating(
     """
     settings = settings or ValidationSettings()
     wall0 = time.perf_counter()
-    reach = _model_scale(analysis)
+    reach = model_scale(analysis)
     bi = float(base_inertia) if base_inertia is not None else (2.0 / 3.0) * base_mass * reach**2
     centre = np.asarray(analysis.moment_point, dtype=float)
     names = [b.name for b in model.bodies]

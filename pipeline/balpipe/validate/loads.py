@@ -109,7 +109,7 @@ import pymunk
 from ..engine import Analysis
 from ..model import Model
 from .extend import continued, settling_steps
-from .run import SimulationRun, _model_scale, _relative_poses, _run_adaptive
+from .run import SimulationRun, model_scale, _relative_poses, _run_adaptive
 from .settings import MAX_ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings
 from .verdict import Verdict
 
@@ -294,7 +294,7 @@ def validate(
     dt_target = settings.dt or dt_default
     iterations = settings.iterations or it_default
     dt, nsteps, idx = _step_grid(np.asarray(analysis.t, dtype=float), dt_target)
-    scale = _model_scale(analysis)
+    scale = model_scale(analysis)
     F0, M0 = (float(x) for x in unbalanced_peaks)
     peaks = (F0, M0)
     basis = "force: unbalanced peak; moment: unbalanced peak"

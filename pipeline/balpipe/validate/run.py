@@ -366,7 +366,9 @@ def _run_adaptive(
     return run, notes, change
 
 
-def _model_scale(analysis: Analysis) -> float:
+def model_scale(analysis: Analysis) -> float:
+    """The model's size for relative position errors: the largest distance of a body's centre of
+    mass from the moment point over the analysis (at least 1 mm)."""
     r = np.linalg.norm(analysis.q[:, :, :2] - np.asarray(analysis.moment_point), axis=2)
     return max(float(r.max()) if r.size else 0.0, 1e-3)
 

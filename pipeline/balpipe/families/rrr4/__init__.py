@@ -9,12 +9,12 @@ FAMILY = Family(
     package=__name__,
     templates=(
         Template("rrr4", template.RRR4Mechanism, template.build,
-                 "planar n-RRR parallel manipulator (4-RRR of paper 001, legs removable)", figures.figures,
+                 "planar n-RRR parallel manipulator (4-RRR of paper 001, legs removable)",
                  notation=template.NOTATION),
     ),
     methods=(
         Method("rrr4_counter_masses", counter_masses.RRR4Balancing, counter_masses.balance, ("rrr4",),
                "counter-masses: leg by leg (eqs. 8-11), from eq. 17 (Fig. 4a) and eqs. 19/21 (Fig. 6)",
-               notation=counter_masses.NOTATION),
+               notation=counter_masses.NOTATION, figures=figures.figures),
     ),
 )

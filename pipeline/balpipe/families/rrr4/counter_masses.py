@@ -17,7 +17,9 @@ Stages:
   6c).
 
 With four legs and ``topologies``, the designs of Figs. 3 (a selection of ours) and 4b
-(:mod:`.rrr4_topologies`) go to ``details["topologies"]`` for the page to draw.
+(:mod:`.topologies`) go to ``details["topologies"]``: their added mass and conditions' residuals
+when balanced, their peak shaking force once the stages are analysed (:func:`design_loads`, the
+result's ``derived`` hook). The page draws them from those numbers.
 
 A target first moment is realised by one counter-mass at a given distance from the link's
 proximal joint (:func:`balpipe.balancing.parts.add_counterweight`), in the direction that the
@@ -27,6 +29,7 @@ missing first moment needs; its mass is |missing| / distance.
 from __future__ import annotations
 
 import math
+from functools import partial
 from typing import Literal
 
 import numpy as np
@@ -41,6 +44,8 @@ from . import finder as generic
 from . import topologies as topologies
 from .placement import realise
 from ...balancing.base import BalanceResult, Parameter, Stage
+from ...engine import analyse
+from ...engine.load_reference import load_reference
 
 
 class CounterMassDistances(Strict):
@@ -207,6 +212,7 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
                             "counter-masses of the leg-by-leg balancing"))
     notes = []
     details: dict = {}
+    derived = None
     if spec.least_mass or len(legs) == 4:
         found = finder_stage(mech, spec, model, lbl, stages, params, notes, details)
     if len(legs) == 4:
@@ -227,7 +233,8 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
                                 "from eq. 17's twelve conditions", "force"))
             params.append(Parameter("added_mass_general", gen.total_mass() - base_mass, "kg", "eq. 17",
                                     "counter-masses of the eq. 17 design (Fig. 4a)"))
-            topology_designs(model, g, spec, found, base_mass, params, notes, details)
+            designs = topology_designs(model, g, spec, found, base_mass, params, notes, details)
+            derived = partial(design_loads, designs, details["topologies"]["designs"])
             if mech.kinematics != "general":
                 fig = topologies.fig6_label(mech.kinematics, topologies.arms_cross(model))
                 eq = cond.SPECIAL_EQ[mech.kinematics]
@@ -275,31 +282,30 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
             f"A {len(legs)}-RRR: the leg-by-leg balancing (eqs. 8-11) applies; eq. 17 is written for four "
             "legs (paper 001 takes legs out by giving them zero mass, which keeps them in the kinematics)."
         )
-    return BalanceResult(params, stages, notes, details=details)
+    return BalanceResult(params, stages, notes, details=details, derived=derived)
 
 
 def topology_designs(model: Model, g: cond.Geometry, spec: RRR4Balancing, found: generic.FinderCheck,
-                     base_mass: float, params: list, notes: list, details: dict) -> None:
-    """Figs. 3 (our selection) and 4b from eq. 17 (:mod:`.rrr4_topologies`): each design's added
-    mass, eq. 17's largest residual and the finder's, in ``details["topologies"]`` for the page
-    (which draws them and analyses their shaking force)."""
+                     base_mass: float, params: list, notes: list, details: dict) -> list[topologies.Design]:
+    """Figs. 3 (our selection) and 4b from eq. 17 (:mod:`.topologies`): each design's added
+    mass, eq. 17's largest residual and the finder's, in ``details["topologies"]`` (the page
+    draws them from there); returns the designs for :func:`design_loads`."""
     cw = spec.counterweights
-    designs = topologies.fig3_designs(model, g, cw.proximal, cw.distal) + [
-        topologies.fig4b_design(model, g, cw.proximal, cw.distal)]
+    designs = topologies.designs(model, g, cw.proximal, cw.distal)
     free = topologies.freedoms(g)
     out = []
     for d in designs:
-        tag = d.figure.replace("Fig. ", "fig").lower()
+        tag, name = topologies.tag(d.figure), topologies.whose(d.figure)
         added = d.model.total_mass() - base_mass
         res17, resf = topologies.eq17_residual(d.model, g), found.design_residual(d.model)
-        params += [Parameter(f"added_mass_{tag}", added, "kg", "eq. 17", f"counter-masses of the {d.figure} design"),
-                   Parameter(f"eq17_residual_{tag}", res17, "", "eq. 17", f"largest relative residual of eq. 17, {d.figure}"),
+        params += [Parameter(f"added_mass_{tag}", added, "kg", "eq. 17", f"counter-masses of {name}"),
+                   Parameter(f"eq17_residual_{tag}", res17, "", "eq. 17", f"largest relative residual of eq. 17, {name}"),
                    Parameter(f"finder_residual_{tag}", resf, "", "momentum regressor rank",
-                             f"largest residual over the finder's conditions / (total mass x model size), {d.figure}")]
+                             f"largest residual over the finder's conditions / (total mass x model size), {name}")]
         if max(res17, resf) > 1e-9:
-            notes.append(f"{d.figure}: the counter-masses found do not meet the conditions (eq. 17 residual "
+            notes.append(f"{name[0].upper() + name[1:]}: the counter-masses found do not meet the conditions (eq. 17 residual "
                          f"{res17:.2g}, finder {resf:.2g}); the figure draws the design, which is not balanced.")
-        out.append({"figure": d.figure, "kept": [f"l{b}" if b != "5" else "platform" for b in d.kept],
+        out.append({"figure": d.figure, "design": name, "kept": [f"l{b}" if b != "5" else "platform" for b in d.kept],
                     "assumed": d.assumed, "added_mass": added, "eq17_residual": res17, "finder_residual": resf,
                     "counter_masses": [{"body": b.name, "mass": a.mass, "position": list(a.position)}
                                        for b in d.model.bodies for a in b.attachments if a.kind == "counterweight"]})
@@ -312,6 +318,30 @@ def topology_designs(model: Model, g: cond.Geometry, spec: RRR4Balancing, found:
         f"built fixes the rest for {details['topologies']['admissible_kept']} of the 84 triples (no two links of one "
         "leg). The drawn designs and what each assumes are in the figures below."
     )
+    return designs
+
+
+def design_loads(designs: list[topologies.Design], rows: list[dict], stages: list) -> list[Parameter]:
+    """The ``derived`` hook of the topology designs: each design analysed by the engine on the
+    stages' time grid, with their gravity and moment point; its peak inertial shaking force and
+    that peak over the reference force of the stage ratios (the unbalanced stage's inertial peak,
+    :func:`balpipe.engine.load_reference.load_reference`), the stages' ``force_ratio``. Written
+    into each design's row of ``details["topologies"]["designs"]`` (``rows``, in the order of
+    ``designs``) and returned as parameters ``peak_force_ratio_<fig>``. ``stages``: the analysed
+    stages (``StageResult``), the unbalanced one first."""
+    base = stages[0]
+    an0 = base.analysis
+    ref = load_reference(base.stage.model, an0).force
+    out = []
+    for d, row in zip(designs, rows, strict=True):
+        an = analyse(d.model, an0.t, an0.gravity, an0.moment_point)
+        peak = an.max_inertial_force
+        ratio = peak / ref if ref > 0 else 0.0
+        row["peak_inertial_force"] = peak
+        row["force_ratio"] = ratio
+        out.append(Parameter(f"peak_force_ratio_{topologies.tag(d.figure)}", ratio, "", "engine",
+                             f"peak inertial shaking force of {topologies.whose(d.figure)} / the reference force"))
+    return out
 
 
 def finder_grid(model: Model, samples: int = 9) -> np.ndarray:

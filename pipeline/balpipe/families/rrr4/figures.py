@@ -1,15 +1,20 @@
-"""Report figures of the n-RRR (paper 001): eq. 17's conditions with their residuals per stage,
-and the balance topologies (Figs. 2a, 3, 4a, 4b, 6) with their counter-masses drawn."""
+"""Report figures of the method ``rrr4_counter_masses`` (paper 001; :attr:`balpipe.plugins.Method.figures`):
+eq. 17's conditions with their residuals per stage, and the balance topologies (Figs. 2a, 3, 4a,
+4b, 6a-c) with their counter-masses drawn. Every number drawn comes from the study (its stages,
+parameters and ``balance.details``); a design is rebuilt from the spec only to be drawn, never
+analysed here."""
 
 from __future__ import annotations
 
 import html
 import math
+import re
 
 import numpy as np
 
 from . import counter_masses as recipe
 from . import conditions as cond
+from . import topologies as topo
 from .template import mass_parameters, resolve_legs
 
 FIGURE_OF_STAGE = {"leg_by_leg": "Fig. 2a", "least_mass": "least mass", "general": "Fig. 4a", "special": "Fig. 6"}
@@ -84,6 +89,9 @@ def finder_table(study) -> str | None:
     return out
 
 
+#: what a design panel's ratio is (computed with the balancing: counter_masses.design_loads)
+LOAD_TEXT = ("inertial shaking force over the spec's motion (engine, computed with the balancing, in results.json) "
+             "relative to the reference force of the stage ratios (the unbalanced stage's peak)")
 DISC = 0.05  # the heaviest counter-mass's disc radius / the span of the base pivots
 NAMED = ("pivot", "link")  # the names a panel carries: base pivots A1-A4 and links, as the paper: l11 for link11
 
@@ -158,85 +166,75 @@ def grid_columns(n: int) -> int:
     return 2 if n == 4 else min(3, n)
 
 
+def panels_svg(panels: list[tuple], prefix: str) -> str:
+    """One figure of ``panels`` (model, body poses, title), at most three a row (:func:`grid_columns`),
+    drawn by :func:`_draw` with one disc scale for the whole figure, then named by :func:`_name`."""
+    from ...draw.figures import plt, to_svg
+
+    cols = grid_columns(len(panels))
+    rows = (len(panels) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
+    max_cw = max([m for model, _, _ in panels for m in _counter_masses(model)] + [1e-12])
+    for ax in list(axes.flat)[len(panels):]:
+        ax.axis("off")
+    marks = [_draw(ax, model, poses, _span(model), max_cw, title) for ax, (model, poses, title) in zip(axes.flat, panels)]
+    fig.tight_layout()
+    for ax, (model, poses, _), mk in zip(axes.flat, panels, marks):
+        _name(fig, ax, model, poses, _span(model), max_cw, mk)
+    return to_svg(fig, prefix)
+
+
+def topology_title(study) -> str:
+    """The stage panels' title: the paper's figure numbers that the stage labels name (Fig. 2a, or
+    2b-d with distal links kept as built; 4a; 6a, 6b or 6c), then "least mass" (ours) when drawn."""
+    shown = [s.stage for s in study.stages if s.stage.name in FIGURE_OF_STAGE]
+    figs = [m.group(1) for st in shown for m in [re.search(r"Fig\. (\d+[a-z])", st.label)] if m]
+    ours = ["least mass"] if any(st.name == "least_mass" for st in shown) else []
+    paper = [f"paper 001, Fig{'s' if len(figs) > 1 else ''}. {', '.join(figs)}"] if figs else []
+    return f"Balance topologies ({'; '.join(paper + ours)})"
+
+
 def topology_figure(study):
     """The balanced stages at t = 0, one panel each: links, joints, pivots, each link's centre of
     mass (cross), counter-masses as red discs of area proportional to mass, and the fixed total
     centre of mass (star)."""
-    from ...draw.figures import plt, to_svg
-
     shown = [s for s in study.stages if s.stage.name in FIGURE_OF_STAGE]
     if not shown:
         return None
-    cols = grid_columns(len(shown))
-    rows = (len(shown) + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
-    max_cw = max([m for s in shown for m in _counter_masses(s.stage.model)] + [1e-12])
-    panels = []
-    for ax in list(axes.flat)[len(shown):]:
-        ax.axis("off")
-    for ax, s in zip(axes.flat, shown):
-        model = s.stage.model
-        poses = s.analysis.extra["frame_pose"][0]
-        marks = _draw(ax, model, poses, _span(model), max_cw, f"{s.stage.label}\nadded {s.added_mass:.3g} kg")
-        panels.append((ax, model, poses, marks))
-    fig.tight_layout()
-    for ax, model, poses, marks in panels:
-        _name(fig, ax, model, poses, _span(model), max_cw, marks)
-    return to_svg(fig, "rrr4-topology")
+    return panels_svg([(s.stage.model, s.analysis.extra["frame_pose"][0], f"{s.stage.label}\nadded {s.added_mass:.3g} kg")
+                       for s in shown], "rrr4-topology")
 
 
-def designs_checked(study):
-    """Figs. 3 and 4b's designs (:mod:`balpipe.balancing.rrr4_topologies`) rebuilt from the spec,
-    each with its shaking force analysed by the engine on the study's time grid: (design, added
-    mass, peak |F| / the unbalanced stage's peak)."""
-    from . import topologies as topo
-    from ...engine import analyse
-
-    if "topologies" not in study.balance.details:
+def designs_drawn(study) -> list[tuple]:
+    """Figs. 3 and 4b's designs (:mod:`.topologies`) rebuilt from the spec for drawing, each with
+    the numbers the balancing computed (``details["topologies"]["designs"]``: added mass, peak
+    inertial shaking force / the reference force): (design, its row). Nothing is analysed here."""
+    top = study.balance.details.get("topologies")
+    if not top:
         return []
-    base = study.stages[0]
-    model, an0 = base.stage.model, base.analysis
-    g = recipe.geometry(study.spec.mechanism)
+    model = study.stages[0].stage.model
     cw = study.spec.balancing.counterweights
-    designs = topo.fig3_designs(model, g, cw.proximal, cw.distal) + [topo.fig4b_design(model, g, cw.proximal, cw.distal)]
-    out = []
-    for d in designs:
-        an = analyse(d.model, an0.t)
-        out.append((d, d.model.total_mass() - model.total_mass(), an.max_force / max(an0.max_force, 1e-300)))
-    return out
+    designs = topo.designs(model, recipe.geometry(study.spec.mechanism), cw.proximal, cw.distal)
+    rows = {r["figure"]: r for r in top["designs"]}
+    return [(d, rows[d.figure]) for d in designs]
 
 
-def designs_figure(study, checked, figures: tuple[str, ...]):
+def designs_figure(study, drawn: list[tuple], figures: tuple[str, ...]):
     """The designs of ``figures`` (e.g. Fig. 3a..f), one panel each, at the unbalanced stage's
-    pose at t = 0 (the kinematics are the same)."""
-    from ...draw.figures import plt, to_svg
-
-    shown = [c for c in checked if c[0].figure in figures]
+    pose at t = 0 (the kinematics are the same), titled with the balancing's numbers."""
+    shown = [c for c in drawn if c[0].figure in figures]
     if not shown:
         return None
-    cols = grid_columns(len(shown))
-    rows = (len(shown) + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
     poses = study.stages[0].analysis.extra["frame_pose"][0]
-    max_cw = max([m for d, _, _ in shown for m in _counter_masses(d.model)] + [1e-12])
-    panels = []
-    for ax, (d, added, ratio) in zip(axes.flat, shown):
-        kept = ", ".join(f"l{b}" if b != "5" else "platform" for b in d.kept)
-        marks = _draw(ax, d.model, poses, _span(d.model), max_cw,
-                      f"{d.figure}: {kept} as built\nadded {added:.3g} kg, peak |F| / unbalanced {ratio:.1e}")
-        panels.append((ax, d.model, marks))
-    for ax in list(axes.flat)[len(shown):]:
-        ax.axis("off")
-    fig.tight_layout()
-    for ax, model, marks in panels:
-        _name(fig, ax, model, poses, _span(model), max_cw, marks)
-    return to_svg(fig, "rrr4-" + figures[0].replace("Fig. ", "fig").lower())
+    titles = [f"{topo.whose(d.figure)}: {', '.join(row['kept'])} as built\nadded {row['added_mass']:.3g} kg, "
+              f"peak |F| / reference {row['force_ratio']:.1e}" for d, row in shown]
+    return panels_svg([(d.model, poses, title) for (d, _), title in zip(shown, titles)], "rrr4-" + topo.tag(figures[0]))
 
 
 def figures(study):
-    """(title, html or svg, caption) for the page."""
-    if study.spec.balancing.method != "rrr4_counter_masses":
-        return
+    """(title, html or svg, caption) for the page: the figures of the method
+    ``rrr4_counter_masses`` (:attr:`balpipe.plugins.Method.figures`), drawn from its stages and
+    ``study.balance.details``."""
     table = conditions_table(study)
     if table is not None:
         mech = study.spec.mechanism
@@ -270,45 +268,46 @@ def figures(study):
     svg = topology_figure(study)
     if svg is not None:
         yield (
-            "Balance topologies (paper 001, Figs. 2a, 4a" + "".join(
-                ", " + fig.replace("Fig. ", "") for fig in sorted({s.stage.label.split("(")[1].split(",")[0]
-                                                                 for s in study.stages if s.stage.name == "special"}))
-            + "; least mass)",
+            topology_title(study),
             svg,
+            "Whose designs: the figure numbers name the paper's topologies (which links carry counter-masses and the "
+            "equations that size them), here on this spec's geometry and masses, which the paper does not give; the "
+            "least-mass design is ours. "
             "Each force-balanced stage at t = 0: links (black; named l11 to l42 as in the paper, the spec's link11 to "
             "link42), joints (circles), base pivots (triangles, A1 to A4), each "
             "body's centre of mass (blue cross), counter-masses as red discs (area proportional to mass, the "
             "largest over the panels has the largest disc) on a line from the link's proximal joint, and the "
             "total centre of mass (purple star), which stays fixed during the motion in every panel.",
         )
-    checked = designs_checked(study)
-    if checked:
+    drawn = designs_drawn(study)
+    if drawn:
         top = study.balance.details["topologies"]
         fr = top["freedoms"]
-        worst = max(r for _, _, r in checked)
-        svg = designs_figure(study, checked, FIG3)
+        worst = max(row["force_ratio"] for d, row in drawn if d.figure in FIG3)
+        svg = designs_figure(study, drawn, FIG3)
         if svg is not None:
             yield (
-                "Force balance topologies from the general conditions (paper 001, Fig. 3: a selection of ours)",
+                "Force balance topologies from the general conditions, of the kind of paper 001's Fig. 3 "
+                "(a selection of ours, not the paper's panels)",
                 svg,
                 "Designs from eq. 17 whose link centres of mass may leave the lines through the joints. What the "
                 f"paper's text fixes: with the masses given, eq. 17 leaves {fr['eq17']} mass-position parameters free "
                 f"(the paper's six, two per loop equation) where the leg-by-leg conditions of Fig. 2 leave {fr['leg_by_leg']}; "
                 f"keeping three bodies as built fixes the other twelve first moments for {top['admissible_kept']} of the "
                 "84 triples (computed: exactly those with no two links of one leg). The paper's six panels cannot be read "
-                "from its text, so the six drawn here are our selection, not the paper's: for each pair of legs (a, b) "
-                "the distal links l_a2, l_b2 and the platform as built, one counter-mass on each of the six other links "
-                "at the spec's distance from its proximal joint, in the direction eq. 17 needs (Fig. 3b is the design "
-                "of Fig. 4a). Each panel: added mass, and the peak shaking force over the spec's motion (engine) "
-                f"relative to the unbalanced stage's peak; largest over the panels {worst:.1e}. Drawn as the stage "
+                "from its text, so the six drawn here are our selection, not the paper's: for each pair of legs (i, j) "
+                "the distal links l_i2, l_j2 and the platform as built, one counter-mass on each of the six other links "
+                "at the spec's distance from its proximal joint, in the direction eq. 17 needs (our design b is the design "
+                "of Fig. 4a; its panel letters are ours, not the paper's). Each panel: added mass, and the peak "
+                f"{LOAD_TEXT}; largest over the panels {worst:.1e}. Drawn as the stage "
                 "panels above (red discs: counter-masses, area proportional to mass, the largest in this figure has "
                 "the largest disc; blue crosses: body centres of mass; purple star: total centre of mass).",
             )
-        svg = designs_figure(study, checked, ("Fig. 4b",))
+        svg = designs_figure(study, drawn, ("Fig. 4b",))
         if svg is not None:
             ranks = top["same_kind_per_leg_ranks"]
             yield (
-                "Symmetric balance topology (paper 001, Fig. 4b: reconstructed)",
+                "Symmetric balance topology (paper 001, Fig. 4b: reconstructed by us from its text)",
                 svg,
                 "The paper's text says Fig. 4b is fully symmetric and has more design freedom than Fig. 2a. Read here "
                 "as: a counter-mass on every link, as in Fig. 2a, but from eq. 17 instead of eqs. 8-11, the platform "
@@ -321,6 +320,5 @@ def figures(study):
                 "changes (every link treated alike; when that least-norm design is unique it has every symmetry of the "
                 "mechanism and its mass data). That "
                 "choice is ours: the paper's drawing is not in its text. Counter-masses at the spec's distances from "
-                "the proximal joints; the panel gives the added mass and the peak shaking force over the spec's motion "
-                "relative to the unbalanced stage's peak.",
+                f"the proximal joints; the panel gives the added mass and the peak {LOAD_TEXT}.",
             )

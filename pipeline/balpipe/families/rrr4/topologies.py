@@ -202,6 +202,26 @@ def fig4b_design(model: Model, g: cond.Geometry, proximal: float, distal: float)
                   "the sixteen first-moment changes (every link treated alike)")
 
 
+def designs(model: Model, g: cond.Geometry, proximal: float, distal: float) -> list[Design]:
+    """Every drawn design from eq. 17: Fig. 3's six (:func:`fig3_designs`), then Fig. 4b's
+    (:func:`fig4b_design`)."""
+    return fig3_designs(model, g, proximal, distal) + [fig4b_design(model, g, proximal, distal)]
+
+
+def whose(figure: str) -> str:
+    """A design's name that says whose it is: Fig. 3's six are our selection ("our design a, not
+    the paper's Fig. 3a": the paper's panels cannot be read from its text), Fig. 4b is our reading
+    of the paper's words ("Fig. 4b as we read it")."""
+    if figure.startswith("Fig. 3"):
+        return f"our design {figure[-1]}, not the paper's {figure}"
+    return f"{figure} as we read it"
+
+
+def tag(figure: str) -> str:
+    """A design's tag in parameter names: "Fig. 3a" -> "fig3a"."""
+    return figure.replace("Fig. ", "fig").lower()
+
+
 def arms_cross(model: Model) -> bool:
     """Whether any two links of different legs cross in the model's initial pose (its body
     frames' ``initial`` poses): Fig. 1's and Fig. 6a's layout; Fig. 6b's has none."""
