@@ -38,10 +38,13 @@ def study_figures(study: Study) -> dict:
     loads = figures.loads_figure(
         [(s.stage.label, s.analysis, sim) for s, sim in zip(shown_stages(study), sims)], prefix="loads"
     )
-    efforts = figures.efforts_figure([(s.stage.label, s.analysis) for s in shown_stages(study)], prefix="efforts",
-                                     units={d.name: present.driver_unit(s.stage.model, d.name)
-                                            for s in shown_stages(study) for d in (*s.stage.model.drivers, *s.stage.model.actuators)},
-                                     marks=[(w["time"], w["kind"].replace("_", " ")) for w in study.warnings])
+    shown = [(s.stage.label, s.analysis) for s in shown_stages(study)]
+    units = {d.name: present.driver_unit(s.stage.model, d.name)
+             for s in shown_stages(study) for d in (*s.stage.model.drivers, *s.stage.model.actuators)}
+    marks = [(w["time"], w["kind"].replace("_", " ")) for w in study.warnings]
+    efforts = figures.efforts_figure(shown, prefix="efforts", units=units, marks=marks)
+    joint_curves = live_plots.joints(shown)
+    joints = figures.panels_figure(live_plots.static_panels(joint_curves), "joints") if joint_curves.panels else ""
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
     numbers = labels.gear_numbers([s.stage.model for s in shown_stages(study)])
     mech = [
@@ -72,8 +75,9 @@ def study_figures(study: Study) -> dict:
             + travel_text(runs[0]) + ".",
         ))
     key = "; ".join(f"{figures.style_text(k)}: {s.stage.label}" for k, s in enumerate(shown_stages(study)))
-    live = live_plots.as_script(live_plots.loads_data([(s.stage.label, s.analysis) for s in shown_stages(study)]))
-    return {"loads": loads, "live_loads": live, "loads_key": key[:1].upper() + key[1:], "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
+    live = {"loads": live_plots.data(live_plots.loads(shown)), "efforts": live_plots.data(live_plots.efforts(shown, units, marks)),
+            "joints": live_plots.data(joint_curves)}
+    return {"loads": loads, "live": {k: live_plots.as_script(v) for k, v in live.items()}, "joints": joints, "loads_key": key[:1].upper() + key[1:], "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
