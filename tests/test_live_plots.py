@@ -102,9 +102,13 @@ def test_a_figure_of_many_curves_keeps_fewer_samples():
 
 def test_the_json_is_deterministic_and_safe_in_a_script(study):
     again = run(load(SPECS / "offset_slider_crank.yaml").spec)
-    one, two = study_figures(study)["live"], study_figures(again)["live"]
-    assert sorted(one) == ["efforts", "joints", "loads"] and one == two
-    assert all(json.loads(text)["series"] for text in one.values())
+    one, two = study_figures(study), study_figures(again)
+    for name in ("loads", "efforts", "joints"):
+        assert one[name] == two[name], name  # the same bytes from a second run of the spec
+        html = one[name]
+        assert html.startswith(f'<div class="live" id="live-{name}"></div><div class="static-plot"><svg')
+        script = html[html.index(f'data-live="live-{name}">') + len(f'data-live="live-{name}">'):html.rindex("</script>")]
+        assert json.loads(script)["series"]
     t = np.linspace(0.0, 1.0, 5)
     text = LP.as_script(LP.data(LP.Curves(t, [("</script><!--", {"F": t})], [{"key": "F", "title": "F", "axis": "F"}], [])))
     assert "</script" not in text and "<!--" not in text
@@ -119,5 +123,23 @@ def test_the_printed_joint_figure_has_a_panel_per_joint_load(study):
     for _, _, per_stage in panels:
         for (label, t, y), s in zip(per_stage, study.stages):
             assert label == s.stage.label and len(y) == len(t) == len(s.analysis.t)
-    svg = study_figures(study)["joints"]
-    assert svg.startswith("<svg") and all(r["joint"] in svg for r in joint_load_table(study))
+    html = study_figures(study)["joints"]
+    svg = html[html.index("<svg"):html.index("</svg>")]
+    assert svg.count('<g id="joints-axes_') == len(curves.panels)  # an axes per panel
+
+
+def test_the_papers_time_series_are_interactive_in_their_stage_styles():
+    """Paper 004's Fig. 12 draws the force-balanced stage: its live curve has that stage's line
+    style of the page (its place in the stage table), and the values of its analysis."""
+    from balpipe.report import paper_figures as PF
+
+    st = run(load(SPECS / "paper004_five_bar.yaml").spec)
+    force_only = next(s for s in st.stages if s.stage.balances == "force" and ":" not in s.stage.name)
+    _, html, _ = next(f for f in PF.own_figures(st) if f[0].startswith("Fig. 12"))
+    script = html[html.index('data-live="live-p004fig12">') + len('data-live="live-p004fig12">'):html.rindex("</script>")]
+    data = json.loads(script)
+    [series] = data["series"]
+    k = PF._k(st, force_only)
+    assert k > 0 and {key: series[key] for key in ("stroke", "dash", "width")} == LP.line_style(k)
+    assert data["panels"] == [{"key": "y", "title": "", "axis": "M (N m)"}]
+    _close(series["y"]["y"], force_only.analysis.moment[_kept(data, force_only.analysis.t)])

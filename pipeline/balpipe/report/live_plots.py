@@ -57,6 +57,7 @@ class Curves(NamedTuple):
     stages: list  # (label, key -> values over t); a stage without a panel's key has no curve there
     panels: list
     marks: list  # (time, label): kinematic warnings, dotted vertical lines
+    styles: list | None = None  # each stage's line style index (its place in the page's stage table); None: 0, 1, ...
 
 
 def data(c: Curves) -> dict:
@@ -68,6 +69,9 @@ def data(c: Curves) -> dict:
     series = [{"label": label, "y": {p["key"]: _round(np.asarray(curves[p["key"]], dtype=float)[k])
                                      for p in c.panels if p["key"] in curves}, **line_style(n)}
               for n, (label, curves) in enumerate(c.stages)]
+    if c.styles is not None:
+        for one, style in zip(series, c.styles):
+            one.update(line_style(style))
     return {"t": _round(t[k]), "series": series, "panels": c.panels,
             "marks": [[_round([tm])[0], text] for tm, text in sorted(set(c.marks))]}
 
@@ -111,6 +115,14 @@ def joints(stages: list) -> Curves:
                                     "axis": f"{comp if comp == 'Fr' else f'|{comp}|'} ({unit})"})
         curves.append((label, mine))
     return Curves(stages[0][1].t, curves, list(panels.values()), [])
+
+
+def html(name: str, svg: str, c: Curves) -> str:
+    """The page's markup of one figure: the element ``#live-<name>`` that ``live_plots.js`` fills,
+    the static ``svg`` after it (shown in print, and on screen until the script has drawn), and
+    the curves' JSON (:func:`data`)."""
+    return (f'<div class="live" id="live-{name}"></div><div class="static-plot">{svg}</div>\n'
+            f'<script type="application/json" data-live="live-{name}">{as_script(data(c))}</script>')
 
 
 def as_script(data: dict) -> str:

@@ -35,16 +35,20 @@ def study_figures(study: Study) -> dict:
     for s in shown_stages(study):
         v = s.validation
         sims.append((v.t, v.force, v.moment) if v is not None else None)
+    shown = [(s.stage.label, s.analysis) for s in shown_stages(study)]
     loads = figures.loads_figure(
         [(s.stage.label, s.analysis, sim) for s, sim in zip(shown_stages(study), sims)], prefix="loads"
     )
-    shown = [(s.stage.label, s.analysis) for s in shown_stages(study)]
     units = {d.name: present.driver_unit(s.stage.model, d.name)
              for s in shown_stages(study) for d in (*s.stage.model.drivers, *s.stage.model.actuators)}
     marks = [(w["time"], w["kind"].replace("_", " ")) for w in study.warnings]
-    efforts = figures.efforts_figure(shown, prefix="efforts", units=units, marks=marks)
+    # each time-series figure interactive above its static SVG (report/live_plots.py)
+    loads = live_plots.html("loads", loads, live_plots.loads(shown))
+    efforts = live_plots.html("efforts", figures.efforts_figure(shown, prefix="efforts", units=units, marks=marks),
+                              live_plots.efforts(shown, units, marks))
     joint_curves = live_plots.joints(shown)
-    joints = figures.panels_figure(live_plots.static_panels(joint_curves), "joints") if joint_curves.panels else ""
+    joints = (live_plots.html("joints", figures.panels_figure(live_plots.static_panels(joint_curves), "joints"),
+                              joint_curves) if joint_curves.panels else "")
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
     numbers = labels.gear_numbers([s.stage.model for s in shown_stages(study)])
     mech = [
@@ -75,9 +79,7 @@ def study_figures(study: Study) -> dict:
             + travel_text(runs[0]) + ".",
         ))
     key = "; ".join(f"{figures.style_text(k)}: {s.stage.label}" for k, s in enumerate(shown_stages(study)))
-    live = {"loads": live_plots.data(live_plots.loads(shown)), "efforts": live_plots.data(live_plots.efforts(shown, units, marks)),
-            "joints": live_plots.data(joint_curves)}
-    return {"loads": loads, "live": {k: live_plots.as_script(v) for k, v in live.items()}, "joints": joints, "loads_key": key[:1].upper() + key[1:], "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
+    return {"loads": loads, "joints": joints, "loads_key": key[:1].upper() + key[1:], "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
