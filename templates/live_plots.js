@@ -1,20 +1,48 @@
 // Interactive plots (report/live_plots.py): uPlot draws the curves of every
-// <script type="application/json" data-live="ID"> into the element #ID: hover for values, drag to
-// zoom (double-click resets), click a legend entry to hide a curve; the cursor follows the player.
+// <script type="application/json" data-live="ID"> into the element #ID, a plot per panel: hover for
+// values, drag to zoom (double-click resets), click a legend entry to hide a curve. Linked to the
+// player both ways: the player announces its time ("balpipe:time" on document) and every plot's
+// cursor follows it; a click (not a drag) in a plot asks the player to go to that time
+// ("balpipe:seek"). Pages without a player simply have no one announcing or listening.
 (function () {
   "use strict";
   if (typeof uPlot === "undefined") return;
+  const HEIGHT = 240;
   function fmt(v) {
     if (v == null) return "—";
     const a = Math.abs(v);
     return a !== 0 && (a < 1e-3 || a >= 1e6) ? v.toExponential(3) : (+v.toPrecision(4)).toString();
   }
+  // kinematic warnings (time, label): dotted vertical lines, as in the static figure
+  function marksPlugin(marks) {
+    return { hooks: { draw: u => {
+      const c = u.ctx, top = u.bbox.top, h = u.bbox.height, r = devicePixelRatio || 1;
+      c.save();
+      c.strokeStyle = "#666"; c.fillStyle = "#444"; c.lineWidth = r; c.setLineDash([2 * r, 2 * r]);
+      c.font = (10 * r) + "px sans-serif"; c.textAlign = "right";
+      for (const [t, text] of marks) {
+        const x = Math.round(u.valToPos(t, "x", true));
+        if (x < u.bbox.left || x > u.bbox.left + u.bbox.width) continue;
+        c.beginPath(); c.moveTo(x, top); c.lineTo(x, top + h); c.stroke();
+        c.save(); c.translate(x - 3 * r, top + 4 * r); c.rotate(-Math.PI / 2); c.fillText(text, 0, 0); c.restore();
+      }
+      c.restore();
+    } } };
+  }
+  const figures = [];  // {host, plots, hovering}
+  let playerTime = null;
+  function follow(f) {
+    if (playerTime == null || f.hovering || f.host.offsetParent === null) return;  // hidden: skip
+    f.plots.forEach(u => u.setCursor({ left: u.valToPos(playerTime, "x"), top: 20 }));
+  }
   document.querySelectorAll("script[type='application/json'][data-live]").forEach(src => {
     const host = document.getElementById(src.dataset.live);
     if (!host) return;
     const d = JSON.parse(src.textContent);
-    const plots = [];
-    const width = () => Math.max(240, host.clientWidth);
+    if (!d.panels.length) return;
+    const f = { host: host, plots: [], hovering: false };
+    if (d.panels.length > 2) host.classList.add("live-grid");  // small multiples: as many columns as fit
+    const width = el => Math.max(240, el.clientWidth);
     for (const p of d.panels) {
       const el = document.createElement("div");
       el.className = "live-plot";
@@ -24,28 +52,42 @@
         label: s.label, stroke: s.stroke, dash: s.dash, width: s.width, value: (u, v) => fmt(v),
       })));
       const opts = {
-        title: p.title + " (" + p.unit + ")", width: width(), height: 240,
+        title: p.title, width: width(el), height: HEIGHT,
         scales: { x: { time: false } },
-        axes: [{ label: "time (s)" }, { label: p.unit, size: 60 }],
+        axes: [{ label: "time (s)" }, { label: p.axis, size: 64 }],
         series: series,
         cursor: { sync: { key: src.dataset.live } },
+        plugins: d.marks.length ? [marksPlugin(d.marks)] : [],
       };
-      plots.push(new uPlot(opts, [d.t].concat(d.series.map(s => s[p.key])), el));
+      const u = new uPlot(opts, [d.t].concat(d.series.map(s => s.y[p.key] || d.t.map(() => null))), el);
+      f.plots.push(u);
+      u.over.addEventListener("mouseenter", () => { f.hovering = true; });
+      u.over.addEventListener("mouseleave", () => { f.hovering = false; follow(f); });
+      // a click, not a drag to zoom, sends the player to the time under the cursor
+      let down = null;
+      u.over.addEventListener("mousedown", e => { down = [e.clientX, e.clientY]; });
+      u.over.addEventListener("mouseup", e => {
+        const still = down && Math.abs(e.clientX - down[0]) < 4 && Math.abs(e.clientY - down[1]) < 4;
+        down = null;
+        if (!still) return;
+        const t = u.posToVal(e.clientX - u.over.getBoundingClientRect().left, "x");
+        if (isFinite(t)) document.dispatchEvent(new CustomEvent("balpipe:seek", { detail: { time: t } }));
+      });
     }
     host.classList.add("live-ready");
-    let timer = 0;
-    addEventListener("resize", () => {
-      clearTimeout(timer);
-      timer = setTimeout(() => plots.forEach(u => u.setSize({ width: width(), height: 240 })), 100);
-    });
-    // linked to the player: its time slider moves the plots' cursor
-    const slider = document.getElementById("player-time");
-    if (slider) {
-      const follow = () => {
-        const t = d.t[0] + (d.t[d.t.length - 1] - d.t[0]) * (+slider.value) / (+slider.max || 1000);
-        plots.forEach(u => u.setCursor({ left: u.valToPos(t, "x"), top: 20 }));
-      };
-      slider.addEventListener("input", follow);
-    }
+    figures.push(f);
+    // follow the host's width (the window, or a collapsed section opened): resize after the
+    // observer's callback, never inside it
+    let last = host.clientWidth, pending = 0;
+    new ResizeObserver(() => {
+      if (host.clientWidth === last || host.clientWidth === 0) return;
+      last = host.clientWidth;
+      cancelAnimationFrame(pending);
+      pending = requestAnimationFrame(() => { f.plots.forEach(u => u.setSize({ width: width(u.root.parentNode), height: HEIGHT })); follow(f); });
+    }).observe(host);
+  });
+  document.addEventListener("balpipe:time", e => {
+    playerTime = e.detail.time;
+    figures.forEach(follow);
   });
 })();

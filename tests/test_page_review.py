@@ -135,8 +135,9 @@ def _legends_clear_of_the_data(fig) -> list[str]:
 
 
 def test_legends_never_cover_the_curves(monkeypatch):
-    """The time plots with one curve per stage (efforts, residuals, tracking, drift) keep their
-    legend under the axes, in as many columns as fit, with long stage names (paper 001's)."""
+    """The time plots with one curve per stage (efforts, joint loads, residuals, tracking, drift)
+    keep their legend under the axes, in as many columns as fit, with long stage names (paper
+    001's); the joint loads' small multiples (rows of three panels) as well."""
     drawn = []
     monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.append((prefix, fig)) or "<svg/>")
     t = np.linspace(0.0, 0.5, 101)
@@ -144,11 +145,13 @@ def test_legends_never_cover_the_curves(monkeypatch):
              "force balance only: least-mass counterweights", "crank counterweight only: 1 kg at 80 mm behind O2"]
     an = [SimpleNamespace(t=t, efforts={"crank": (k + 1) * np.sin(9 * t)}) for k in range(len(names))]
     figures.efforts_figure(list(zip(names, an)), units={"crank": "N m"})
+    figures.panels_figure([(f"J{j}, revolute: |F| (N)", "|F| (N)", [(n, a.t, a.efforts["crank"] ** 2) for n, a in zip(names, an)])
+                           for j in range(7)], "joints")
     err = 1e-6 * (1 + np.abs(np.sin(20 * t)))
     figures.residual_figure([(n, t, err, err, 10.0, 2.0) for n in names])
     figures.series_figure(t, [(n + ": crank", err) for n in names], "|q_sim − q_plan| / travel", "torque")
     figures.drift_figure([(n, t, np.stack([err, err], 1), err) for n in names])
-    assert len(drawn) == 4
+    assert len(drawn) == 5
     for prefix, fig in drawn:
         assert _legends_clear_of_the_data(fig) == [], prefix
         assert _fits(fig) == [], prefix

@@ -509,3 +509,75 @@ def test_hovering_a_plot_shows_its_values_and_a_click_hides_a_curve(paper_site, 
     p.emulate_media(media="print")
     assert p.is_visible("#live-loads + .static-plot svg") and not p.is_visible("#live-loads")
     assert not w.problems, "\n".join(w.problems)
+
+
+_LEGEND_VALUES = "el => [...el.querySelectorAll('.u-legend .u-series .u-value')].map(v => v.textContent)"
+_CURSOR_TIME = "el => el.querySelector('.u-legend .u-series .u-value').textContent"
+
+
+@pytest.mark.parametrize("figure, unit", [("live-efforts", r"^(torque \(N m\)|force \(N\))$"),
+                                          ("live-joints", r"^\|?\w+\|? \((N|N m)\)$"),
+                                          ("live-p002fig2f", r"^\|F\| \(N\)$")])
+def test_the_efforts_joint_loads_and_paper_plots_are_interactive(paper_site, browser, figure, unit):
+    """As the shaking loads' plot: hover shows the time and every curve's value, the axis names
+    its unit, a click on a legend entry hides that curve, and printing shows the static figure;
+    for the actuator efforts, the joint loads and a paper's own time series (paper 002's Fig. 2)."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto((paper_site / "paper002_decoupling" / "index.html").as_uri(), wait_until="load")
+    open_sections(p)
+    plot = p.locator(f"#{figure} .live-plot").first
+    plot.scroll_into_view_if_needed()
+    p.wait_for_timeout(100)  # opened sections: the plots take their width
+    box = plot.locator(".u-over").bounding_box()
+    assert box and box["width"] > 200, "no interactive plot drawn"
+    axes = p.eval_on_selector(f"script[data-live='{figure}']", "s => JSON.parse(s.textContent).panels.map(q => q.axis)")
+    assert axes and all(re.match(unit, a) for a in axes), axes  # the value axis names its unit (drawn on the canvas)
+    p.mouse.move(box["x"] + box["width"] * 0.4, box["y"] + box["height"] * 0.5)
+    shown = plot.evaluate(_LEGEND_VALUES)
+    assert len(shown) >= 2 and all(re.search(r"\d", v) for v in shown), shown  # the time and every stage
+    pixels = plot.locator("canvas").evaluate("c => c.toDataURL()")
+    entry = plot.locator(".u-legend .u-series").nth(1)
+    entry.click()
+    assert "u-off" in (entry.get_attribute("class") or "")
+    assert plot.locator("canvas").evaluate("c => c.toDataURL()") != pixels  # the curve is gone
+    assert not p.is_visible(f"#{figure} + .static-plot svg")
+    p.emulate_media(media="print")
+    assert p.is_visible(f"#{figure} + .static-plot svg") and not p.is_visible(f"#{figure}")
+    assert not w.problems, "\n".join(w.problems)
+
+
+def test_the_player_and_the_plots_share_their_time(server, browser):
+    """Scrubbing the player moves every plot's cursor to its time; a click in a plot (not a drag,
+    which zooms) moves the paused player to the time clicked."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto(server + "scott_russell/index.html", wait_until="load")
+    open_sections(p)
+    p.click("#player-play")  # pause
+    p.eval_on_selector("#player-time", "s => { s.value = '500'; s.dispatchEvent(new Event('input')); }")
+    clock = re.match(r"t = (\d+\.\d+) s of (\d+\.\d+) s", p.text_content("#player-clock"))
+    t, end = float(clock.group(1)), float(clock.group(2))
+    step = end / 100  # the plots keep at least 100 samples: a cursor snaps to the nearest
+    plots = p.locator("#live-loads .live-plot, #live-efforts .live-plot, #live-joints .live-plot").all()
+    assert len(plots) >= 4
+    for plot in plots:
+        assert abs(float(plot.evaluate(_CURSOR_TIME)) - t) <= step, plot.get_attribute("data-quantity")
+    plot = p.locator("#live-efforts .live-plot").first
+    plot.scroll_into_view_if_needed()
+    box = plot.locator(".u-over").bounding_box()
+    p.mouse.click(box["x"] + box["width"] * 0.2, box["y"] + box["height"] * 0.5)
+    clicked = float(plot.evaluate(_CURSOR_TIME))
+    assert abs(clicked - 0.2 * end) <= 2 * step
+    shown = float(re.match(r"t = (\d+\.\d+)", p.text_content("#player-clock")).group(1))
+    assert abs(shown - clicked) <= step and p.get_attribute("#player", "data-playing") == "0"
+    assert abs(float(p.locator("#live-loads .live-plot").first.evaluate(_CURSOR_TIME)) - shown) <= step
+    # a drag zooms the plot and leaves the player where it is
+    p.mouse.move(box["x"] + box["width"] * 0.5, box["y"] + box["height"] * 0.5)
+    p.mouse.down()
+    p.mouse.move(box["x"] + box["width"] * 0.8, box["y"] + box["height"] * 0.5, steps=5)
+    p.mouse.up()
+    assert float(re.match(r"t = (\d+\.\d+)", p.text_content("#player-clock")).group(1)) == shown
+    assert not w.problems, "\n".join(w.problems)

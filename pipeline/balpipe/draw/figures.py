@@ -189,15 +189,41 @@ def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = N
     ``marks``: (time, label) of kinematic warnings (balpipe.dead_centres), drawn as dotted lines."""
     units = units or {}
     names = sorted({n for _, an in stages for n in an.efforts})
-    fig, axes = plt.subplots(1, max(1, len(names)), figsize=(4.6 * max(1, len(names)), 2.8), squeeze=False)
-    for ax, name in zip(axes[0], names):
-        for k, (label, an) in enumerate(stages):
-            if name in an.efforts:
-                ax.plot(an.t, an.efforts[name], label=literal(label), **style(k))
+    panels = []
+    for name in names:
         u = units.get(name, "")
-        ax.set_title(literal(f"Actuator effort: {name}" + (f" ({u})" if u else "")), fontsize=9)
-        ax.set_ylabel({"N m": "torque (N m)", "N": "force (N)"}.get(u, "effort"))
-        ax.set_xlabel("time (s)")
+        panels.append((f"Actuator effort: {name}" + (f" ({u})" if u else ""), effort_axis(u),
+                       [(label, an.t, an.efforts.get(name)) for label, an in stages]))
+    return panels_figure(panels, prefix, marks, columns=max(1, len(names)))
+
+
+def effort_axis(unit: str) -> str:
+    """An effort panel's axis label: 'torque (N m)', 'force (N)', or 'effort' without a unit."""
+    return {"N m": "torque (N m)", "N": "force (N)"}.get(unit, "effort")
+
+
+def panels_figure(panels: list, prefix: str, marks: list | None = None, columns: int = 3) -> str:
+    """Small multiples over time: ``panels`` (title, y label, curves), curves one per stage in stage
+    order as (label, t, values or None: the stage has no such curve), stage k in :func:`style` k;
+    ``columns`` panels a row, the legend of the first panel below; ``marks`` (time, label) drawn
+    as dotted vertical lines in every panel. The panels share the time axis, labelled under the
+    lowest panel of each column."""
+    cols = max(1, min(columns, len(panels)))
+    rows = max(1, math.ceil(len(panels) / cols))
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 2.8 * rows), squeeze=False, sharex=True)
+    for n, ax in enumerate(axes.flat):
+        if n >= len(panels):
+            ax.set_visible(n == 0)  # no panel at all: one empty axes, as before
+            continue
+        title, ylabel, curves = panels[n]
+        for k, (label, t, y) in enumerate(curves):
+            if y is not None:
+                ax.plot(t, y, label=literal(label), **style(k))
+        ax.set_title(literal(title), fontsize=9)
+        ax.set_ylabel(ylabel)
+        if n + cols >= len(panels):  # the lowest panel of its column
+            ax.set_xlabel("time (s)")
+            ax.tick_params(labelbottom=True)
         for tm, text in sorted(set(marks or [])):
             ax.axvline(tm, color="0.4", linestyle=":", linewidth=0.9)
             ax.annotate(literal(text), (tm, 1.0), xycoords=("data", "axes fraction"), fontsize=7, ha="right", va="top", rotation=90)

@@ -8,7 +8,10 @@ included) with a small margin, and its own scale bar in m (the caption says when
 scales differ). The spec's names (pivots, joints, counterweights, links) and the gears' numbers
 are placed so that they do not overlap, as in the drawings (:mod:`.labels`). Controls:
 play/pause, a time slider, the speed (real time by default, the time scale shown), names on or
-off; keyboard: Tab to the canvas, space to pause, arrows to step. No library, no external file.
+off; keyboard: Tab to the canvas, space to pause, arrows to step. Linked to the page's plots
+(``templates/live_plots.js``): each drawn frame announces its time (a ``balpipe:time`` event on
+the document) and a ``balpipe:seek`` event (a click in a plot) pauses it at the time it carries.
+No library, no external file.
 """
 
 from __future__ import annotations
@@ -351,6 +354,7 @@ function draw() {{
   }});
   slider.value = String(Math.round(1000 * (time - T0) / span));
   clock.textContent = `t = ${{time.toFixed(3)}} s of ${{T1.toFixed(3)}} s · ${{speedSel.value}}× real time`;
+  document.dispatchEvent(new CustomEvent("balpipe:time", {{detail: {{time: time}}}}));  // the plots' cursors follow
 }}
 function tick(now) {{
   if (!playing) {{ last = null; return; }}
@@ -363,6 +367,8 @@ function setPlaying(on) {{ playing = on; btn.textContent = on ? "Pause" : "Play"
 btn.addEventListener("click", () => setPlaying(!playing));
 slider.addEventListener("input", () => {{ setPlaying(false); time = T0 + span * parseInt(slider.value, 10) / 1000; draw(); }});
 speedSel.addEventListener("change", draw);
+// a click in a plot (live_plots.js) sends the player to that time, paused
+document.addEventListener("balpipe:seek", ev => {{ setPlaying(false); time = Math.min(T1, Math.max(T0, +ev.detail.time)); draw(); }});
 names.addEventListener("change", draw);
 cv.tabIndex = 0;
 cv.addEventListener("keydown", ev => {{

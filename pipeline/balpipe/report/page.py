@@ -54,13 +54,20 @@ def study_figures(study: Study) -> dict:
     for s in shown_stages(study):
         v = s.validation
         sims.append((v.t, v.force, v.moment) if v is not None else None)
+    shown = [(s.stage.label, s.analysis) for s in shown_stages(study)]
     loads = figures.loads_figure(
         [(s.stage.label, s.analysis, sim) for s, sim in zip(shown_stages(study), sims)], prefix="loads"
     )
-    efforts = figures.efforts_figure([(s.stage.label, s.analysis) for s in shown_stages(study)], prefix="efforts",
-                                     units={d.name: present.driver_unit(s.stage.model, d.name)
-                                            for s in shown_stages(study) for d in (*s.stage.model.drivers, *s.stage.model.actuators)},
-                                     marks=[(w["time"], w["kind"].replace("_", " ")) for w in study.warnings])
+    units = {d.name: present.driver_unit(s.stage.model, d.name)
+             for s in shown_stages(study) for d in (*s.stage.model.drivers, *s.stage.model.actuators)}
+    marks = [(w["time"], w["kind"].replace("_", " ")) for w in study.warnings]
+    # each time-series figure interactive above its static SVG (report/live_plots.py)
+    loads = live_plots.html("loads", loads, live_plots.loads(shown))
+    efforts = live_plots.html("efforts", figures.efforts_figure(shown, prefix="efforts", units=units, marks=marks),
+                              live_plots.efforts(shown, units, marks))
+    joint_curves = live_plots.joints(shown)
+    joints = (live_plots.html("joints", figures.panels_figure(live_plots.static_panels(joint_curves), "joints"),
+                              joint_curves) if joint_curves.panels else "")
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
     numbers = labels.gear_numbers([s.stage.model for s in shown_stages(study)])
     ghosts = drawn_instants(study)
@@ -92,12 +99,12 @@ def study_figures(study: Study) -> dict:
             + travel_text(runs[0]) + ".",
         ))
     key = "; ".join(f"{figures.style_text(k)}: {s.stage.label}" for k, s in enumerate(shown_stages(study)))
-    live = live_plots.as_script(live_plots.loads_data([(s.stage.label, s.analysis) for s in shown_stages(study)]))
     # a method that gives its stages the paper's line styles (Stage.style): said in the legend
     paper_styles = styled(shown_stages(study))
-    return {"loads": loads, "live_loads": live, "loads_key": key[:1].upper() + key[1:],
+    return {"loads": loads, "joints": joints, "loads_key": key[:1].upper() + key[1:],
             "styles_note": "These are the paper's line styles for the stages it plots, so the figures titled with the "
-                           "paper's numbers draw each stage as every other figure does" if paper_styles else "", "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
+                           "paper's numbers draw each stage as every other figure does" if paper_styles else "",
+            "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 
 

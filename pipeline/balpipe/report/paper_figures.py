@@ -20,6 +20,7 @@ import numpy as np
 
 from ..balancing.base import style_index
 from ..draw import figures
+from . import live_plots
 
 #: per paper, the figure numbers its pages reproduce (a number covers its panels: "6" by "6a")
 FIGURES = {
@@ -61,14 +62,17 @@ def listed(titles: list[str]) -> list[str]:
 def _series(t, curves: list[tuple[str, np.ndarray, int]], ylabel: str, prefix: str) -> str:
     """A time series in the page's stage styles: each curve (label, values, k) drawn in
     ``figures.style(k)``, k the stage's place in the page's stage table, so that one line style
-    means one stage on the whole page."""
+    means one stage on the whole page; interactive on screen, the static SVG in print
+    (:func:`live_plots.html`, element ``#live-<prefix>``)."""
     fig, ax = figures.plt.subplots(figsize=(6.0, 3.0))
     for label, y, k in curves:
         ax.plot(t, y, label=figures.literal(label), **figures.style(k))
     ax.set_xlabel("time (s)")
     ax.set_ylabel(ylabel)
     figures.legend_below(fig, ax, fontsize=8)
-    return figures.to_svg(fig, prefix)
+    live = live_plots.Curves(t, [(label, {"y": y}) for label, y, _ in curves],
+                             [{"key": "y", "title": "", "axis": ylabel}], [], styles=[k for _, _, k in curves])
+    return live_plots.html(prefix, figures.to_svg(fig, prefix), live)
 
 
 def _k(study, stage) -> int:

@@ -131,30 +131,35 @@ def dumps(results: dict) -> str:
     return json.dumps(results, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
 
 
+def joint_load_series(analysis) -> list[tuple[str, str, str, str, np.ndarray]]:
+    """Every joint's load over time, as (joint, component, kind, unit, values): |F| for a revolute
+    (bearing load, tooth forces included), |N| for a prismatic pair, |T| for a gear mesh and, for a
+    mesh with pitch radii, |Ft| (tangential) and Fr (radial, >= 0) tooth forces; from the
+    reactions of :func:`balpipe.engine._joint_reactions`."""
+    out = []
+    for j, comps in analysis.reactions.items():
+        if "Fx" in comps:
+            out.append((j, "F", "revolute: |F|", "N", np.hypot(comps["Fx"], comps["Fy"])))
+        elif "N" in comps:
+            out.append((j, "N", "prismatic: |N| (normal force)", "N", np.abs(comps["N"])))
+        elif "Ft" in comps:
+            out += [(j, "T", "gear mesh: |T| (torque on the driven gear)", "N m", np.abs(comps["T"])),
+                    (j, "Ft", "gear mesh: |Ft| (tangential tooth force)", "N", np.abs(comps["Ft"])),
+                    (j, "Fr", "gear mesh: Fr (radial tooth force)", "N", np.asarray(comps["Fr"], dtype=float))]
+        else:
+            out.append((j, "T", "gear pair without pitch radii, a couple only: |T| (torque on the driven gear)",
+                        "N m", np.abs(comps["T"])))
+    return out
+
+
 def joint_load_table(study: Study) -> list[dict]:
-    """Peak load of every joint in every stage: |F| for revolutes (bearing load, tooth forces
-    included), |N| and |M| for prismatic pairs, |T| for gear meshes and, for meshes with pitch
-    radii, the peak tangential |Ft| and radial Fr tooth forces (a row each)."""
+    """Peak load of every joint in every stage (:func:`joint_load_series`), a row per joint and
+    component."""
     rows: dict[tuple[str, str], dict] = {}
-
-    def put(joint: str, comp: str, kind: str, unit: str, stage: str, peak: float) -> None:
-        row = rows.setdefault((joint, comp), {"joint": joint, "kind": kind, "unit": unit, "peaks": {}})
-        row["peaks"][stage] = peak
-
     for s in study.stages:
-        n = s.stage.name
-        for j, comps in s.analysis.reactions.items():
-            if "Fx" in comps:
-                put(j, "F", "revolute: |F|", "N", n, float(np.max(np.hypot(comps["Fx"], comps["Fy"]))))
-            elif "N" in comps:
-                put(j, "N", "prismatic: |N| (normal force)", "N", n, float(np.max(np.abs(comps["N"]))))
-            elif "Ft" in comps:
-                put(j, "T", "gear mesh: |T| (torque on the driven gear)", "N m", n, float(np.max(np.abs(comps["T"]))))
-                put(j, "Ft", "gear mesh: |Ft| (tangential tooth force)", "N", n, float(np.max(np.abs(comps["Ft"]))))
-                put(j, "Fr", "gear mesh: Fr (radial tooth force)", "N", n, float(np.max(comps["Fr"])))
-            else:
-                put(j, "T", "gear pair without pitch radii, a couple only: |T| (torque on the driven gear)",
-                    "N m", n, float(np.max(np.abs(comps["T"]))))
+        for joint, comp, kind, unit, values in joint_load_series(s.analysis):
+            row = rows.setdefault((joint, comp), {"joint": joint, "kind": kind, "unit": unit, "peaks": {}})
+            row["peaks"][s.stage.name] = float(np.max(values))
     return list(rows.values())
 
 

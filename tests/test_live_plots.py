@@ -1,0 +1,145 @@
+"""The interactive plots' data (issue 22, report/live_plots.py): one builder per figure kind
+(shaking loads, actuator efforts, joint loads), each curve the analysis's own values at the kept
+samples, in its stage's line style, with its unit; thinned and rounded the same way every time."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balpipe.loader import load
+from balpipe.report import live_plots as LP
+from balpipe.report import present
+from balpipe.report.page import study_figures
+from balpipe.report.results import joint_load_series, joint_load_table
+from balpipe.study import run
+
+SPECS = Path(__file__).parent.parent / "specs"
+
+
+@pytest.fixture(scope="module")
+def study():
+    """The offset slider-crank: a crank torque, three revolutes and a prismatic guide, 501 samples."""
+    return run(load(SPECS / "offset_slider_crank.yaml").spec)
+
+
+def _stages(study) -> list:
+    return [(s.stage.label, s.analysis) for s in study.stages]
+
+
+def _kept(data: dict, t: np.ndarray) -> np.ndarray:
+    """Indices of the kept samples, found from their times."""
+    k = np.searchsorted(t, data["t"])
+    assert np.allclose(t[k], data["t"], rtol=1e-5, atol=0)
+    return k
+
+
+def _close(shown: list, exact: np.ndarray) -> None:
+    """Shown values are the exact ones to the 6 significant digits they keep."""
+    assert len(shown) == len(exact)
+    assert np.allclose(shown, exact, rtol=1e-5, atol=1e-12 * max(1.0, float(np.max(np.abs(exact)))))
+
+
+def test_efforts_are_the_analysis_efforts_at_the_kept_samples(study):
+    units = {d.name: present.driver_unit(s.stage.model, d.name) for s in study.stages for d in s.stage.model.drivers}
+    data = LP.data(LP.efforts(_stages(study), units))
+    t = study.stages[0].analysis.t
+    k = _kept(data, t)
+    assert k[0] == 0 and k[-1] == len(t) - 1 and len(k) == min(len(t), LP.POINTS)  # first and last kept
+    assert [p["key"] for p in data["panels"]] == ["crank"]
+    assert data["panels"][0]["axis"] == "torque (N m)" and "(N m)" in data["panels"][0]["title"]
+    for n, (s, series) in enumerate(zip(study.stages, data["series"])):
+        assert series["label"] == s.stage.label
+        assert {key: series[key] for key in ("stroke", "dash", "width")} == LP.line_style(n)  # the static style
+        _close(series["y"]["crank"], s.analysis.efforts["crank"][k])
+
+
+def test_joint_loads_are_the_table_s_joint_loads_at_the_kept_samples(study):
+    data = LP.data(LP.joints(_stages(study)))
+    t = study.stages[0].analysis.t
+    k = _kept(data, t)
+    table = joint_load_table(study)
+    # a panel per row of the joint-load table, in its order, with the row's unit
+    assert [p["key"] for p in data["panels"]] == ["A.F", "B.F", "C.F", "guide.N"]
+    assert [p["title"] for p in data["panels"]] == [f"{r['joint']}, {r['kind']} ({r['unit']})" for r in table]
+    assert [p["axis"] for p in data["panels"]] == ["|F| (N)", "|F| (N)", "|F| (N)", "|N| (N)"]
+    for s, series in zip(study.stages, data["series"]):
+        for joint, comp, _, _, values in joint_load_series(s.analysis):
+            _close(series["y"][f"{joint}.{comp}"], values[k])
+            row = next(r for r in table if r["joint"] == joint)
+            assert row["peaks"][s.stage.name] == float(np.max(values))  # one source for table and plot
+    # the revolute's load is the magnitude of its reaction components
+    comps = study.stages[0].analysis.reactions["A"]
+    _close(data["series"][0]["y"]["A.F"], np.hypot(comps["Fx"], comps["Fy"])[k])
+
+
+def test_loads_are_the_shaking_loads(study):
+    data = LP.data(LP.loads(_stages(study)))
+    k = _kept(data, study.stages[0].analysis.t)
+    for s, series in zip(study.stages, data["series"]):
+        F = s.analysis.force
+        _close(series["y"]["F"], np.hypot(F[:, 0], F[:, 1])[k])
+        _close(series["y"]["M"], s.analysis.moment[k])
+    assert [p["axis"] for p in data["panels"]] == ["|F| (N)", "M (N m)"]
+
+
+def test_a_figure_of_many_curves_keeps_fewer_samples():
+    t = np.linspace(0.0, 1.0, 1001)
+    panels = [{"key": f"p{i}", "title": f"p{i} (N)", "axis": "(N)"} for i in range(40)]
+    stages = [(f"s{j}", {p["key"]: np.sin(t * (j + 1)) for p in panels}) for j in range(3)]
+    data = LP.data(LP.Curves(t, stages, panels, []))
+    n = len(data["t"])
+    assert LP.MIN_POINTS <= n < LP.POINTS and n * 40 * 3 <= LP.VALUES
+    assert data["t"][0] == 0.0 and data["t"][-1] == 1.0
+    # a stage without a panel's curve has none there (the plot shows a gap, not zeros)
+    data = LP.data(LP.Curves(t, [("a", {"p0": t}), ("b", {})], panels[:1], [(0.5, "dead centre")]))
+    assert "p0" in data["series"][0]["y"] and data["series"][1]["y"] == {}
+    assert data["marks"] == [[0.5, "dead centre"]]
+
+
+def test_the_json_is_deterministic_and_safe_in_a_script(study):
+    again = run(load(SPECS / "offset_slider_crank.yaml").spec)
+    one, two = study_figures(study), study_figures(again)
+    for name in ("loads", "efforts", "joints"):
+        assert one[name] == two[name], name  # the same bytes from a second run of the spec
+        html = one[name]
+        assert html.startswith(f'<div class="live" id="live-{name}"></div><div class="static-plot"><svg')
+        script = html[html.index(f'data-live="live-{name}">') + len(f'data-live="live-{name}">'):html.rindex("</script>")]
+        assert json.loads(script)["series"]
+    t = np.linspace(0.0, 1.0, 5)
+    text = LP.as_script(LP.data(LP.Curves(t, [("</script><!--", {"F": t})], [{"key": "F", "title": "F", "axis": "F"}], [])))
+    assert "</script" not in text and "<!--" not in text
+    assert json.loads(text)["series"][0]["label"] == "</script><!--"
+
+
+def test_the_printed_joint_figure_has_a_panel_per_joint_load(study):
+    """The static SVG (what printing shows) is drawn from the same curves, unthinned."""
+    curves = LP.joints(_stages(study))
+    panels = LP.static_panels(curves)
+    assert [title for title, _, _ in panels] == [p["title"] for p in curves.panels]
+    for _, _, per_stage in panels:
+        for (label, t, y), s in zip(per_stage, study.stages):
+            assert label == s.stage.label and len(y) == len(t) == len(s.analysis.t)
+    html = study_figures(study)["joints"]
+    svg = html[html.index("<svg"):html.index("</svg>")]
+    assert svg.count('<g id="joints-axes_') == len(curves.panels)  # an axes per panel
+
+
+def test_the_papers_time_series_are_interactive_in_their_stage_styles():
+    """Paper 004's Fig. 12 draws the force-balanced stage: its live curve has that stage's line
+    style of the page (its place in the stage table), and the values of its analysis."""
+    from balpipe.report import paper_figures as PF
+
+    st = run(load(SPECS / "paper004_five_bar.yaml").spec)
+    force_only = next(s for s in st.stages if s.stage.balances == "force" and ":" not in s.stage.name)
+    _, html, _ = next(f for f in PF.own_figures(st) if f[0].startswith("Fig. 12"))
+    script = html[html.index('data-live="live-p004fig12">') + len('data-live="live-p004fig12">'):html.rindex("</script>")]
+    data = json.loads(script)
+    [series] = data["series"]
+    k = PF._k(st, force_only)
+    assert k > 0 and {key: series[key] for key in ("stroke", "dash", "width")} == LP.line_style(k)
+    assert data["panels"] == [{"key": "y", "title": "", "axis": "M (N m)"}]
+    _close(series["y"]["y"], force_only.analysis.moment[_kept(data, force_only.analysis.t)])
