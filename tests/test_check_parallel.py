@@ -68,3 +68,19 @@ def test_in_parallel_check_says_what_it_says_one_after_another(folder):
 def test_jobs_below_one_is_a_usage_error(folder):
     r = _check("-j", "0", "specs", cwd=folder)
     assert r.returncode == 2 and "--jobs must be at least 1" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_check_and_sweep_never_compute_the_fronts(tmp_path, monkeypatch, capsys):
+    from balpipe.balancing import partial_fronts
+    from balpipe.cli import main
+
+    def refuse(*a, **k):
+        raise AssertionError("the Pareto fronts were computed")
+
+    monkeypatch.setattr(partial_fronts, "compute", refuse)
+    spec = str(SPECS / "partial_offset_slider_crank.yaml")
+    assert main(["check", spec]) == 0
+    assert main(["sweep", spec, "--vary", "mechanism.crank.length=0.19 m:0.21 m:2", "-o", str(tmp_path / "s"),
+                 "-j", "1"]) == 0, capsys.readouterr().err
+    with pytest.raises(AssertionError, match="fronts were computed"):  # the page's balancing does need them
+        registry.balance(load(spec).spec)
