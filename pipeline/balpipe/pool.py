@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import os
 import signal
-from concurrent.futures import ProcessPoolExecutor
 from typing import Any, Callable, Iterable
 
 
@@ -45,6 +44,8 @@ def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any) -> Iter
         for item in items:
             yield fn(item, *args)
         return
+    from concurrent.futures import ProcessPoolExecutor  # multiprocessing: only when there is a pool
+
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # forked workers start ignoring it
     pool = ProcessPoolExecutor(max_workers=min(jobs, len(items)), initializer=worker_init)
     try:
