@@ -10,6 +10,7 @@ import pytest
 
 from _edits import replaced
 from balpipe import build as build_mod
+from balpipe import pool as pool_mod
 from balpipe.build import Options, build, default_jobs, usable_cores
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
@@ -56,7 +57,7 @@ def test_output_and_progress_do_not_depend_on_jobs(tmp_path):
 def test_default_is_one_process_per_usable_core_at_most_one_per_spec(tmp_path, monkeypatch):
     seen = []
     monkeypatch.setattr(build_mod, "_run", lambda todo, opts, jobs, progress, outcomes: seen.append((len(todo), jobs)))
-    monkeypatch.setattr(build_mod, "usable_cores", lambda: 3)
+    monkeypatch.setattr(pool_mod, "usable_cores", lambda: 3)
     d = tmp_path / "specs"
     d.mkdir()
     for k in range(5):

@@ -17,14 +17,33 @@ def balpipe(*args, cwd=None):
     return subprocess.run([sys.executable, "-m", "balpipe", *map(str, args)], capture_output=True, text=True, cwd=cwd)
 
 
-@pytest.fixture
-def work(tmp_path):
-    """A folder with the two slider-crank specs (fast to build)."""
-    d = tmp_path / "specs"
+def _two_specs(folder: Path) -> Path:
+    d = folder / "specs"
     d.mkdir()
     for name in ("scott_russell.yaml", "offset_slider_crank.yaml"):
         shutil.copy(SPECS / name, d / name)
-    return tmp_path
+    return folder
+
+
+@pytest.fixture
+def work(tmp_path):
+    """A folder with the two slider-crank specs (fast to build)."""
+    return _two_specs(tmp_path)
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    """The two specs built once for the tests that only read the site (-j 1, --no-sim, to
+    ``a``): (folder, the build's completed process)."""
+    work = _two_specs(tmp_path_factory.mktemp("built"))
+    return work, balpipe("build", "specs", "-o", "a", "--no-sim", "-j", "1", cwd=work)
+
+
+@pytest.fixture(scope="module")
+def simulated(tmp_path_factory):
+    """scott_russell.yaml built once with its simulations, to ``a``: (folder, completed process)."""
+    work = _two_specs(tmp_path_factory.mktemp("simulated"))
+    return work, balpipe("build", work / "specs" / "scott_russell.yaml", "-o", "a", cwd=work)
 
 
 def test_help_for_every_command():
@@ -66,13 +85,15 @@ def test_build_writes_the_site(work):
     assert again.returncode == 0 and again.stderr.count("unchanged") == 2
 
 
-def test_output_is_byte_identical(work):
-    assert balpipe("build", "specs", "-o", "a", "--no-sim", cwd=work).returncode == 0
-    assert balpipe("build", "specs", "-o", "b", "--no-sim", "--force", cwd=work).returncode == 0
+def test_output_is_byte_identical(built, tmp_path):
+    work, a = built
+    assert a.returncode == 0
+    b = tmp_path / "b"
+    assert balpipe("build", "specs", "-o", b, "--no-sim", "--force", "-j", "1", cwd=work).returncode == 0
     files = sorted(p.relative_to(work / "a") for p in (work / "a").rglob("*") if p.is_file())
     assert len(files) >= 8
     for f in files:
-        assert (work / "a" / f).read_bytes() == (work / "b" / f).read_bytes(), f
+        assert (work / "a" / f).read_bytes() == (b / f).read_bytes(), f
 
 
 def test_bad_spec_does_not_stop_the_others_nor_damage_its_old_page(work):
@@ -139,17 +160,17 @@ def test_a_counterweight_10_percent_off_fails_validation_visibly(work):
     assert '<span class="badge bad">fail</span>' in index and '<span class="badge bad">failed</span>' in index
 
 
-def test_simulated_build_passes_and_reports_validation(work):
-    r = balpipe("build", work / "specs" / "scott_russell.yaml", "-o", "out", cwd=work)
+def test_simulated_build_passes_and_reports_validation(simulated):
+    work, r = simulated
     assert r.returncode == 0, r.stderr
-    res = json.loads((work / "out" / "scott_russell" / "results.json").read_text())
+    res = json.loads((work / "a" / "scott_russell" / "results.json").read_text())
     for name, v in res["validation"].items():
         assert v["passed"], (name, v["reasons"])
         assert v["force_residual"] <= 0.01 and v["moment_residual"] <= 0.01
     rl = res["reactionless"]
     assert rl["unbalanced"]["max_drift"] > 1e3 * rl["full"]["max_drift"]
     assert rl["unbalanced"]["max_rotation"] > 1e3 * rl["full"]["max_rotation"]
-    out = work / "out" / "scott_russell"
+    out = work / "a" / "scott_russell"
     page = (out / "index.html").read_text()
     assert "timing.js" in page and (out / "timing.json").exists()
     assert "<canvas" in page and "Reactionless demonstration" in page and "Residuals of the simulation" in page
@@ -163,21 +184,22 @@ def test_simulated_build_passes_and_reports_validation(work):
     assert "simulation (pymunk)" in page and "conservation solution" in page
 
 
-def test_parallel_build_gives_the_same_site_and_quiet_hides_progress(work):
-    a = balpipe("build", "specs", "-o", "a", "--no-sim", cwd=work)
-    b = balpipe("build", "specs", "-o", "b", "--no-sim", "-j", "2", "-q", cwd=work)
+def test_parallel_build_gives_the_same_site_and_quiet_hides_progress(built, tmp_path):
+    work, a = built
+    b = balpipe("build", "specs", "-o", tmp_path / "b", "--no-sim", "-j", "2", "-q", cwd=work)
     assert a.returncode == b.returncode == 0
     assert "[1/2]" in a.stderr and "[1/2]" not in b.stderr and "2 ok" in b.stderr
     for f in sorted(p.relative_to(work / "a") for p in (work / "a").rglob("*") if p.is_file()):
-        assert (work / "a" / f).read_bytes() == (work / "b" / f).read_bytes(), f
+        assert (work / "a" / f).read_bytes() == (tmp_path / "b" / f).read_bytes(), f
 
 
-def test_simulated_output_is_byte_identical_but_for_the_timing_files(work):
+def test_simulated_output_is_byte_identical_but_for_the_timing_files(simulated, tmp_path):
+    work, a = simulated
     spec = work / "specs" / "scott_russell.yaml"
-    assert balpipe("build", spec, "-o", "a", cwd=work).returncode == 0
-    assert balpipe("build", spec, "-o", "b", "--force", cwd=work).returncode == 0
+    assert a.returncode == 0
+    assert balpipe("build", spec, "-o", tmp_path / "b", "--force", cwd=work).returncode == 0
     files = sorted(p.relative_to(work / "a") for p in (work / "a").rglob("*") if p.is_file())
     assert {f.name for f in files} >= {"index.html", "results.json", "timeseries.csv", "timing.json", "timing.js"}
     for f in files:
         if not f.name.startswith("timing."):
-            assert (work / "a" / f).read_bytes() == (work / "b" / f).read_bytes(), f
+            assert (work / "a" / f).read_bytes() == (tmp_path / "b" / f).read_bytes(), f

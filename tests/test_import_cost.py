@@ -35,3 +35,12 @@ def loaded_by(args: list[str]) -> list[str]:
                                   ["check", "specs/offset_slider_crank.yaml", "specs/paper002_decoupling.yaml"]])
 def test_a_command_loads_no_heavy_library_it_does_not_use(args):
     assert loaded_by(args) == []
+
+
+@pytest.mark.parametrize("args", [["--help"], ["check", "--help"], ["sweep", "--help"], ["--version"]])
+def test_help_loads_neither_numpy_nor_pydantic(args):
+    """The help states the sweep's limit (balpipe.sweep_limit) without the spec schema."""
+    probe = PROBE.format(heavy=HEAVY + ("numpy", "pydantic"))
+    r = subprocess.run([sys.executable, "-c", probe, json.dumps(args)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=120)
+    assert json.loads(r.stderr.strip().splitlines()[-1]) == []

@@ -18,7 +18,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     # L0 core data and maths
     ("balpipe", "balpipe.units", "balpipe.model", "balpipe.motion", "balpipe.meshes", "balpipe.joint_laws",
      "balpipe.realisable", "balpipe.notation", "balpipe.sampling", "balpipe.fsutil", "balpipe.drivers", "balpipe.laws",
-     "balpipe.motion_outputs", "balpipe.claim_precision"),
+     "balpipe.motion_outputs", "balpipe.claim_precision", "balpipe.sweep_limit", "balpipe.pool"),
     # L1 computation (and the kinematic diagnosis on top of the engine: dyads, dead centres)
     ("balpipe.engine", "balpipe.validate", "balpipe.dyads", "balpipe.dead_centres"),
     # L2 contracts and drawing (laws.drives, laws.motion_spec: the motion's spec sections; actuators, loop closure and

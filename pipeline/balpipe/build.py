@@ -15,11 +15,9 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import signal
 import sys
 import time
 import traceback
-from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from functools import lru_cache
@@ -33,6 +31,8 @@ from .loader import LoadedSpec, SpecErrors, load, load_text, schema
 from .report import history_page
 from .report.page import render_page
 from .report.results import dumps, results_dict, timeseries_csv
+from . import pool
+from .pool import default_jobs, usable_cores  # noqa: F401  (build.default_jobs as before)
 from .fsutil import remove_path, remove_temporaries, tmp_name, write_atomic_dir, write_file_atomic, write_new
 from .site_earlier import earlier_pages
 from .spec_files import MAX_SLUG, clash_notes, clashes, find_specs, slug_for  # noqa: F401  (build.find_specs, build.slug_for as before)
@@ -303,31 +303,6 @@ def locked(out: Path):
         os.close(fd)
 
 
-def _worker_init() -> None:
-    """Build workers leave Ctrl-C to the main process (no traceback from each worker); SIGTERM
-    ends them silently (its default action)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-
-
-def usable_cores() -> int:
-    """The cores this process may run on: ``os.process_cpu_count()`` (Python 3.13), else the
-    scheduler's affinity mask, else ``os.cpu_count()``; at least 1."""
-    count = getattr(os, "process_cpu_count", None)
-    if count is not None:
-        n = count()
-    elif hasattr(os, "sched_getaffinity"):
-        n = len(os.sched_getaffinity(0))
-    else:  # pragma: no cover - macOS, Windows before 3.13
-        n = os.cpu_count()
-    return max(1, n or 1)
-
-
-def default_jobs(specs: int) -> int:
-    """``build``'s default number of processes: one per usable core, at most one per spec."""
-    return max(1, min(usable_cores(), specs))
-
-
 def build(paths: list[str], opts: Options, jobs: int | None = None, progress=None,
           scheduler: str | None = None) -> list[Outcome]:
     """Build every spec (in parallel with ``jobs`` > 1; default, None: :func:`default_jobs`,
@@ -357,9 +332,9 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
             progress(0, len(todo), o)
         for p, note in clash_notes(specs).items():  # said before any work too; built as usual
             progress(0, len(todo), Outcome(str(p), slug_for(p), "ok", note))
-    cores = jobs if jobs is not None else usable_cores()
+    cores = jobs if jobs is not None else pool.usable_cores()
     if jobs is None:
-        jobs = default_jobs(len(todo))
+        jobs = pool.default_jobs(len(todo))
     if todo and not scheduler and cores > len(todo):  # fewer specs than cores: their stages share the rest
         opts = replace(opts, sim_workers=cores // len(todo))
     with locked(opts.out):
@@ -382,31 +357,10 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
 
 def _run(todo: list[Path], opts: Options, jobs: int, progress, outcomes: list[Outcome]) -> None:
     total = len(todo)
-    if jobs > 1 and total > 1:
-        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # forked workers start ignoring it
-        pool = ProcessPoolExecutor(max_workers=min(jobs, total), initializer=_worker_init)
-        try:
-            futures = [pool.submit(build_one, p, opts) for p in todo]
-        finally:
-            signal.signal(signal.SIGINT, previous)
-        try:
-            for k, f in enumerate(futures):
-                o = f.result()
-                outcomes.append(o)
-                if progress:
-                    progress(k + 1, total, o)
-        except BaseException:
-            for proc in list(getattr(pool, "_processes", {}).values()):
-                proc.terminate()
-            pool.shutdown(wait=True, cancel_futures=True)
-            raise
-        pool.shutdown()
-    else:
-        for k, p in enumerate(todo):
-            o = build_one(p, opts)
-            outcomes.append(o)
-            if progress:
-                progress(k + 1, total, o)
+    for k, o in enumerate(pool.in_order(build_one, todo, jobs, opts)):
+        outcomes.append(o)
+        if progress:
+            progress(k + 1, total, o)
 
 
 def _installed_code_hash() -> str:

@@ -52,7 +52,9 @@ class Method:
     ``balance(mechanism_spec, method_spec, model) -> BalanceResult`` for ``templates``.
     ``figures(study)`` optionally yields the method's report figures as (title, svg or html,
     caption), drawn from the study's stages and ``study.balance.details``: the page composes the
-    template's figures and the method's, so no figure code branches on a method's name."""
+    template's figures and the method's, so no figure code branches on a method's name.
+    ``page_only`` names fields of ``spec`` that only add to the page (no error depends on them):
+    ``balpipe check`` balances with them set to None."""
 
     name: str
     spec: type[Strict]
@@ -66,6 +68,7 @@ class Method:
     other_motions: bool = False
     notation: Any = None  # the papers' symbols of the inputs: a table or table(method_spec) (balpipe.notation)
     figures: Callable[..., Any] | None = None
+    page_only: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -40,7 +40,8 @@ GENERIC: tuple[Method, ...] = (
            generic=True, notation=generic_stages.notation),
     Method("partial_balance", PartialBalance, generic_partial.balance, (),
            "optimal partial balancing (cone programme)", uses_spec=True, generic=True, other_motions=True,
-           notation=generic_partial.notation),
+           notation=generic_partial.notation,
+           page_only=("fronts",)),  # the Pareto fronts: about 90 % of its time, drawn only on the page
 )
 
 
@@ -123,15 +124,18 @@ def motion_model(spec: Any, motion: Any, samples: int | None, path: tuple) -> tu
         raise SpecFieldError(path + exc.path[1:], exc.message) from None
 
 
-def balance(spec: Any, balancing: Any = None) -> BalanceResult:
+def balance(spec: Any, balancing: Any = None, page: bool = True) -> BalanceResult:
     """The unbalanced model and the method's stages, with every semantic check of the spec;
-    ``balancing`` replaces ``spec.balancing`` (the designs of ``spec.compare``)."""
+    ``balancing`` replaces ``spec.balancing`` (the designs of ``spec.compare``). Without
+    ``page``, the method's :attr:`Method.page_only` fields are left out (``balpipe check``)."""
     balancing = balancing if balancing is not None else spec.balancing
     name = balancing.method
     model = unbalanced_model(spec)
     if name == "none":
         return BalanceResult([], [Stage("unbalanced", "unbalanced", model, "the mechanism as given")])
     method = METHODS[name]
+    if not page and method.page_only:
+        balancing = balancing.model_copy(update=dict.fromkeys(method.page_only))
     if method.generic:
         extra = {"spec": spec} if method.uses_spec else {}
         if method.other_motions:
@@ -147,11 +151,12 @@ def balance(spec: Any, balancing: Any = None) -> BalanceResult:
     return method.balance(spec.mechanism, balancing, model)
 
 
-def balance_designs(spec: Any) -> BalanceResult:
+def balance_designs(spec: Any, page: bool = True) -> BalanceResult:
     """:func:`balance`, then the stages of every design in ``spec.compare`` after the main
     design's, named ``design:stage`` (their unbalanced stage, the same model, is dropped);
-    parameters are prefixed the same way and details go to ``details["compare"][design]``."""
-    main = balance(spec)
+    parameters are prefixed the same way and details go to ``details["compare"][design]``;
+    ``page`` as in :func:`balance`."""
+    main = balance(spec, page=page)
     designs = getattr(spec, "compare", None) or []
     if not designs:
         return main
@@ -160,7 +165,7 @@ def balance_designs(spec: Any) -> BalanceResult:
     details["compare"] = {}
     for k, d in enumerate(designs):
         try:
-            res = balance(spec, d.balancing)
+            res = balance(spec, d.balancing, page)
         except SpecFieldError as exc:
             path = exc.path
             if path[:1] == ("balancing",):

@@ -12,13 +12,14 @@ from .loader import LoadedSpec, SpecError, SpecErrors
 from .spec_parts import SpecFieldError
 
 
-def analyse(loaded: LoadedSpec, simulate: bool = True):
+def analyse(loaded: LoadedSpec, simulate: bool = True, page: bool = True):
     """Balance and analyse one loaded spec (no simulation, nothing written): the study, or
     :class:`SpecErrors` for every problem of the spec, located. The results must be finite and,
-    with ``simulate``, within the simulation's limits."""
+    with ``simulate``, within the simulation's limits. Without ``page`` (``balpipe check``), what
+    only the page shows is left out: the same errors, less work."""
     try:
         with _quiet_numpy():
-            st = study_mod.run(loaded.spec)
+            st = study_mod.run(loaded.spec, page)
             check_finite(st)
             if simulate:
                 check_simulation(st)

@@ -25,7 +25,7 @@ class SpecFieldError(ValueError):
 class Strict(BaseModel):
     """Base of every spec section: unknown keys are errors, values are immutable."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True, allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True, allow_inf_nan=False, defer_build=True)
 
 
 class LinkSpec(Strict):

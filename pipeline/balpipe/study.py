@@ -212,13 +212,14 @@ def _decimals(x: float) -> int:
     return 0 if frac == "0" else len(frac)
 
 
-def run(spec: Spec) -> Study:
-    """Balance and analyse every stage; collect checks and problems (no simulation)."""
+def run(spec: Spec, page: bool = True) -> Study:
+    """Balance and analyse every stage; collect checks and problems (no simulation). Without
+    ``page``, what only the page shows is not computed (:func:`.registry.balance`)."""
     model = registry.unbalanced_model(spec)
     if model.sources:  # a spec that gives its own poses (custom): the assembly must confirm them
         assembly.check(model, float(registry.time_grid(spec)[0]))
     try:
-        balance = registry.balance_designs(spec)
+        balance = registry.balance_designs(spec, page)
     except AnalysisError as exc:  # a balancing method analysed a motion that cannot be followed
         raise loop_closure.located(model, registry.time_grid(spec), exc) from None
     stages = run_stage_analyses(spec, balance)

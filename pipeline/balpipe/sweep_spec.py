@@ -27,10 +27,9 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, BeforeValidator, Field, WithJsonSchema, model_validator
 
 from .spec_parts import Strict
+from .sweep_limit import MAX_DESIGNS
 from .units import count
 from .vary import SweepError, parse_vary
-
-MAX_DESIGNS = 100_000
 
 
 def _range_text(value: Any) -> str:

@@ -9,6 +9,7 @@ give ``add_parser(sub)`` (the verb's options and help) and ``run(args) -> exit c
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib
 import os
 import sys
@@ -60,5 +61,17 @@ def main(argv: list[str] | None = None) -> int:
             signal.signal(signal.SIGTERM, previous)
 
 
+def entry() -> None:
+    """The ``balpipe`` console script and ``python -m balpipe``: :func:`main`, then exit with its
+    code. What is alive at the end is frozen first (:func:`gc.freeze`), so the interpreter's
+    shutdown does not walk every object of the loaded modules in a last collection: about 0.15 s
+    of a 0.6 s ``balpipe check`` of one spec. (Not in :func:`main`, which tests call in-process.)"""
+    try:
+        code = main()
+    finally:
+        gc.freeze()
+    sys.exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    entry()

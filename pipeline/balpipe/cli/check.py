@@ -4,51 +4,68 @@ from __future__ import annotations
 
 import sys
 
-from .common import EXIT_FAILED, EXIT_OK, EXIT_USAGE, missing, usage_error
+from .common import EXIT_FAILED, EXIT_OK, EXIT_USAGE, paths_jobs_problem, usage_error
 
 
 def add_parser(sub) -> None:
     c = sub.add_parser("check", help="validate specs without building",
                        description="Check specs: schema, units, geometry and balancing feasibility.")
     c.add_argument("paths", nargs="+", metavar="PATH", help="spec files or folders of specs")
+    c.add_argument("-j", "--jobs", type=int, default=None, metavar="N",
+                   help="check N specs in parallel (default: one per usable core, at most one per spec; "
+                   "1: one after another); the output is the same")
+
+
+def check_one(f, clash: str | None) -> tuple[str, str]:
+    """(verdict, message) of one spec file: ("ok", ...), ("invalid", the located errors) or
+    ("crashed", the internal error). ``clash``: the spec's page-name clash, if any."""
+    from ..loader import SpecErrors, load
+    from ..runner import analyse
+    from ..sweep import SweepError, plan
+
+    try:
+        if clash is not None:
+            return "invalid", clash
+        loaded = load(f)
+        analyse(loaded, page=False)  # what only the page shows cannot make a spec invalid
+        if loaded.spec.sweep is not None:  # its paths and values against the spec, as balpipe sweep does
+            try:
+                plan(str(f))
+            except SweepError as exc:
+                raise SpecErrors([]) from exc
+        return "ok", f"{f}: ok"
+    except SpecErrors as exc:
+        return "invalid", str(exc) or str(exc.__cause__ or "")
+    except Exception as exc:  # a bug in balpipe: report it, check the other specs
+        return "crashed", f"{f}: internal error: {type(exc).__name__}: {exc}"
 
 
 def run(args) -> int:
     """Everything ``build`` checks before simulating: schema, units, limits, geometry, the
     balancing, the analysis of every stage (singular motions), the references, and the paths and
-    values of a ``sweep:`` block. Keeps going past a spec that fails."""
+    values of a ``sweep:`` block. Keeps going past a spec that fails. With several specs, in
+    ``--jobs`` processes; the messages come in the specs' order whatever the number."""
+    from .. import loader, runner  # noqa: F401  (loaded once here, before the workers fork)
+    from ..pool import default_jobs, in_order
     from ..spec_files import clashes, find_specs
-    from ..runner import analyse
-    from ..loader import SpecErrors, load
-    from ..sweep import SweepError, plan
 
-    gone = missing(args.paths)
-    if gone:
-        return usage_error(f"no such file or folder: {', '.join(gone)}")
+    problem = paths_jobs_problem(args.paths, args.jobs)
+    if problem:
+        return usage_error(problem)
     problems: list[str] = []
     files = find_specs(args.paths, problems)
     for msg in problems:
         print(msg, file=sys.stderr)
     clash = clashes(files)
+    jobs = args.jobs if args.jobs is not None else default_jobs(len(files))
     bad = crashed = 0
-    for f in files:
-        try:
-            if f in clash:
-                raise SpecErrors([])
-            loaded = load(f)
-            analyse(loaded)
-            if loaded.spec.sweep is not None:  # its paths and values against the spec, as balpipe sweep does
-                try:
-                    plan(str(f))
-                except SweepError as exc:
-                    raise SpecErrors([]) from exc
-            print(f"{f}: ok")
-        except SpecErrors as exc:
-            bad += 1
-            print(str(exc) or str(exc.__cause__ or "") or clash[f], file=sys.stderr)
-        except Exception as exc:  # a bug in balpipe: report it, check the other specs
-            crashed += 1
-            print(f"{f}: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
+    for verdict, message in in_order(_check_item, [(f, clash.get(f)) for f in files], jobs):
+        if verdict == "ok":
+            print(message)
+            continue
+        bad += verdict == "invalid"
+        crashed += verdict == "crashed"
+        print(message, file=sys.stderr)
     bad += len(problems)
     print(f"balpipe: {len(files) - bad - crashed + len(problems)} valid, {bad} invalid"
           + (f", {crashed} internal errors" if crashed else ""), file=sys.stderr)
@@ -57,3 +74,7 @@ def run(args) -> int:
     if crashed:
         return EXIT_FAILED
     return EXIT_USAGE if bad else EXIT_OK
+
+
+def _check_item(item: tuple) -> tuple[str, str]:
+    return check_one(*item)

@@ -9,7 +9,7 @@ from .common import EXIT_FAILED, EXIT_OK, EXIT_USAGE
 
 
 def add_parser(sub) -> None:
-    from ..sweep_spec import MAX_DESIGNS  # the limit alone: no sweep machinery for --help
+    from ..sweep_limit import MAX_DESIGNS  # the limit alone: no pydantic, numpy or sweep machinery for --help
 
     s = sub.add_parser(
         "sweep", help="sweep numeric spec fields; table, Pareto fronts, design specs",

@@ -38,7 +38,7 @@ def build_design(data: dict, paths: list[tuple], values: tuple, stage: str | Non
     from .. import registry
 
     spec = _validate(with_values(data, paths, values))
-    result = registry.balance_designs(spec)
+    result = registry.balance_designs(spec, page=False)  # the sweep reads the stages only: no page-only work
     return spec, _pick_stage(result, stage), result.stages[0]
 
 

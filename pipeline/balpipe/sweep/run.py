@@ -44,7 +44,7 @@ def run(p: Plan, jobs: int = 0, scheduler: str | None = None,
     try:
         from .. import registry
 
-        result = registry.balance_designs(base_spec)
+        result = registry.balance_designs(base_spec, page=False)  # the sweep reads the stages only: no page-only work
         base = _pick_stage(result, p.stage)
         t, g, P = _settings(base_spec)
         with record_anchors() as anchors:  # the base's motions: where the other geometries start
