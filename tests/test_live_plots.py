@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from balpipe.loader import load
+from balpipe.draw import live as LV
 from balpipe.report import live_plots as LP
 from balpipe.report import present
 from balpipe.report.page import study_figures
@@ -45,20 +46,20 @@ def _close(shown: list, exact: np.ndarray) -> None:
 
 def test_efforts_are_the_analysis_efforts_at_the_kept_samples(study):
     units = {d.name: present.driver_unit(s.stage.model, d.name) for s in study.stages for d in s.stage.model.drivers}
-    data = LP.data(LP.efforts(_stages(study), units))
+    data = LV.data(LP.efforts(_stages(study), units))
     t = study.stages[0].analysis.t
     k = _kept(data, t)
-    assert k[0] == 0 and k[-1] == len(t) - 1 and len(k) == min(len(t), LP.POINTS)  # first and last kept
+    assert k[0] == 0 and k[-1] == len(t) - 1 and len(k) == min(len(t), LV.POINTS)  # first and last kept
     assert [p["key"] for p in data["panels"]] == ["crank"]
     assert data["panels"][0]["axis"] == "torque (N m)" and "(N m)" in data["panels"][0]["title"]
     for n, (s, series) in enumerate(zip(study.stages, data["series"])):
         assert series["label"] == s.stage.label
-        assert {key: series[key] for key in ("stroke", "dash", "width")} == LP.line_style(n)  # the static style
+        assert {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(n)  # the static style
         _close(series["y"]["crank"], s.analysis.efforts["crank"][k])
 
 
 def test_joint_loads_are_the_table_s_joint_loads_at_the_kept_samples(study):
-    data = LP.data(LP.joints(_stages(study)))
+    data = LV.data(LP.joints(_stages(study)))
     t = study.stages[0].analysis.t
     k = _kept(data, t)
     table = joint_load_table(study)
@@ -77,7 +78,7 @@ def test_joint_loads_are_the_table_s_joint_loads_at_the_kept_samples(study):
 
 
 def test_loads_are_the_shaking_loads(study):
-    data = LP.data(LP.loads(_stages(study)))
+    data = LV.data(LP.loads(_stages(study)))
     k = _kept(data, study.stages[0].analysis.t)
     for s, series in zip(study.stages, data["series"]):
         F = s.analysis.force
@@ -90,12 +91,12 @@ def test_a_figure_of_many_curves_keeps_fewer_samples():
     t = np.linspace(0.0, 1.0, 1001)
     panels = [{"key": f"p{i}", "title": f"p{i} (N)", "axis": "(N)"} for i in range(40)]
     stages = [(f"s{j}", {p["key"]: np.sin(t * (j + 1)) for p in panels}) for j in range(3)]
-    data = LP.data(LP.Curves(t, stages, panels, []))
+    data = LV.data(LV.Curves(t, stages, panels, []))
     n = len(data["t"])
-    assert LP.MIN_POINTS <= n < LP.POINTS and n * 40 * 3 <= LP.VALUES
+    assert LV.MIN_POINTS <= n < LV.POINTS and n * 40 * 3 <= LV.VALUES
     assert data["t"][0] == 0.0 and data["t"][-1] == 1.0
     # a stage without a panel's curve has none there (the plot shows a gap, not zeros)
-    data = LP.data(LP.Curves(t, [("a", {"p0": t}), ("b", {})], panels[:1], [(0.5, "dead centre")]))
+    data = LV.data(LV.Curves(t, [("a", {"p0": t}), ("b", {})], panels[:1], [(0.5, "dead centre")]))
     assert "p0" in data["series"][0]["y"] and data["series"][1]["y"] == {}
     assert data["marks"] == [[0.5, "dead centre"]]
 
@@ -110,7 +111,7 @@ def test_the_json_is_deterministic_and_safe_in_a_script(study):
         script = html[html.index(f'data-live="live-{name}">') + len(f'data-live="live-{name}">'):html.rindex("</script>")]
         assert json.loads(script)["series"]
     t = np.linspace(0.0, 1.0, 5)
-    text = LP.as_script(LP.data(LP.Curves(t, [("</script><!--", {"F": t})], [{"key": "F", "title": "F", "axis": "F"}], [])))
+    text = LV.as_script(LV.data(LV.Curves(t, [("</script><!--", {"F": t})], [{"key": "F", "title": "F", "axis": "F"}], [])))
     assert "</script" not in text and "<!--" not in text
     assert json.loads(text)["series"][0]["label"] == "</script><!--"
 
@@ -118,7 +119,7 @@ def test_the_json_is_deterministic_and_safe_in_a_script(study):
 def test_the_printed_joint_figure_has_a_panel_per_joint_load(study):
     """The static SVG (what printing shows) is drawn from the same curves, unthinned."""
     curves = LP.joints(_stages(study))
-    panels = LP.static_panels(curves)
+    panels = LV.static_panels(curves)
     assert [title for title, _, _ in panels] == [p["title"] for p in curves.panels]
     for _, _, per_stage in panels:
         for (label, t, y), s in zip(per_stage, study.stages):
@@ -140,6 +141,25 @@ def test_the_papers_time_series_are_interactive_in_their_stage_styles():
     data = json.loads(script)
     [series] = data["series"]
     k = PF._k(st, force_only)
-    assert k > 0 and {key: series[key] for key in ("stroke", "dash", "width")} == LP.line_style(k)
+    assert k > 0 and {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(k)
     assert data["panels"] == [{"key": "y", "title": "", "axis": "M (N m)"}]
     _close(series["y"]["y"], force_only.analysis.moment[_kept(data, force_only.analysis.t)])
+
+
+def test_a_familys_own_time_series_is_interactive_too():
+    """Paper 002's Fig. 2 is drawn by its family (families/serial_arm/figures.py), below the report
+    layer: it is live as well (draw/live.py), with the unbalanced stage's values of Fˢʰ = |F| and
+    Mˢʰ = M, in that stage's line style of the page."""
+    from balpipe.balancing.base import style_index
+
+    st = run(load(SPECS / "paper002_decoupling.yaml").spec)
+    _, html, _ = next(f for f in st.extra_figures() if f[0].startswith("Fig. 2 of paper 002"))
+    assert html.startswith('<div class="live" id="live-p002fig2"></div><div class="static-plot"><svg')
+    data = json.loads(html[html.index('data-live="live-p002fig2">') + len('data-live="live-p002fig2">'):html.rindex("</script>")])
+    [series] = data["series"]
+    an = st.unbalanced.analysis
+    k = _kept(data, an.t)
+    _close(series["y"]["F"], np.linalg.norm(an.force, axis=1)[k])
+    _close(series["y"]["M"], an.moment[k])
+    assert {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(style_index(st.stages, st.unbalanced))
+    assert [p["axis"] for p in data["panels"]] == ["Fˢʰ (N)", "Mˢʰ (N m)"]

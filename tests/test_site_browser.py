@@ -517,7 +517,7 @@ _CURSOR_TIME = "el => el.querySelector('.u-legend .u-series .u-value').textConte
 
 @pytest.mark.parametrize("figure, unit", [("live-efforts", r"^(torque \(N m\)|force \(N\))$"),
                                           ("live-joints", r"^\|?\w+\|? \((N|N m)\)$"),
-                                          ("live-p002fig2f", r"^\|F\| \(N\)$")])
+                                          ("live-p002fig2", r"^(Fˢʰ \(N\)|Mˢʰ \(N m\))$")])
 def test_the_efforts_joint_loads_and_paper_plots_are_interactive(paper_site, browser, figure, unit):
     """As the shaking loads' plot: hover shows the time and every curve's value, the axis names
     its unit, a click on a legend entry hides that curve, and printing shows the static figure;

@@ -9,7 +9,7 @@ from .. import realisable
 from ..balancing.base import in_style_order, styled
 from ..laws.drives import law_names
 from ..study import Study, ratio_reference
-from ..draw import extremes, figures, labels, sleeves
+from ..draw import extremes, figures, labels, live, sleeves
 from . import citations, live_plots, paper_figures, partial_figures, present, sections, toc
 from .design_card import design_card
 from .notation_table import notation_groups
@@ -61,13 +61,13 @@ def study_figures(study: Study) -> dict:
     units = {d.name: present.driver_unit(s.stage.model, d.name)
              for s in shown_stages(study) for d in (*s.stage.model.drivers, *s.stage.model.actuators)}
     marks = [(w["time"], w["kind"].replace("_", " ")) for w in study.warnings]
-    # each time-series figure interactive above its static SVG (report/live_plots.py)
-    loads = live_plots.html("loads", loads, live_plots.loads(shown))
-    efforts = live_plots.html("efforts", figures.efforts_figure(shown, prefix="efforts", units=units, marks=marks),
-                              live_plots.efforts(shown, units, marks))
+    # each time-series figure interactive above its static SVG (draw/live.py; curves: report/live_plots.py)
+    loads = live.html("loads", loads, live_plots.loads(shown))
+    efforts = live.html("efforts", figures.efforts_figure(shown, prefix="efforts", units=units, marks=marks),
+                        live_plots.efforts(shown, units, marks))
     joint_curves = live_plots.joints(shown)
-    joints = (live_plots.html("joints", figures.panels_figure(live_plots.static_panels(joint_curves), "joints"),
-                              joint_curves) if joint_curves.panels else "")
+    joints = (live.html("joints", figures.panels_figure(live.static_panels(joint_curves), "joints"),
+                        joint_curves) if joint_curves.panels else "")
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
     numbers = labels.gear_numbers([s.stage.model for s in shown_stages(study)])
     ghosts = drawn_instants(study)

@@ -107,6 +107,8 @@ def decoupling_figures(study):
 def _paper002_fig2(study, un, plt, style, to_svg):
     """Fig. 2 of paper 002: F^sh = |reaction force on the frame| (eq. 15) and M^sh = -tau1 (eq.
     16) of the unbalanced arm, in the stage's style; with gravity on, the weight is said apart."""
+    from ...draw import live  # matplotlib only when a report is drawn
+
     an, st = un.analysis, style(style_index(study.stages, un))
     fig, axes = plt.subplots(1, 2, figsize=(9.0, 2.9))
     axes[0].plot(an.t, np.linalg.norm(an.force, axis=1), label=un.stage.label, **st)
@@ -122,8 +124,12 @@ def _paper002_fig2(study, un, plt, style, to_svg):
                  f"alone peaks at {an.max_inertial_force:.4g} N, the whole at {an.max_force:.4g} N.")
     else:
         apart = " Gravity is off: Fˢʰ is the inertial force alone."
+    curves = live.Curves(an.t, [(un.stage.label, {"F": np.linalg.norm(an.force, axis=1), "M": an.moment})],
+                         [{"key": "F", "title": "(a) Fˢʰ (N), eq. 15", "axis": "Fˢʰ (N)"},
+                          {"key": "M", "title": "(b) Mˢʰ (N m), eq. 16", "axis": "Mˢʰ (N m)"}], [],
+                         styles=[style_index(study.stages, un)])
     return ("Fig. 2 of paper 002: shaking force and shaking moment of the unbalanced manipulator",
-            to_svg(fig, "p002fig2"),
+            live.html("p002fig2", to_svg(fig, "p002fig2"), curves),
             f"Stage '{un.stage.label}' in its line style of this page, from the analysis of this spec: Fˢʰ = "
             "√(F₁₀ₓ² + F₁₀ᵧ²), the reaction force on the frame, and Mˢʰ = −τ₁, about joint A." + apart)
 
@@ -232,6 +238,7 @@ def _figs_3_4(study, main: str, by: dict, plt, style, to_svg):
     """Figs. 3 and 4 of paper 003: |F| and M of cases 1, 2, 3 on the main trajectory, in the
     paper's line styles (case 1 black full, case 2 black dashed, case 3 grey full), which are these
     stages' styles on the whole page (:data:`com_planning.STYLES`)."""
+    from ...draw import live
     from ...draw.figures import legend_below
 
     pre = _prefix(main)
@@ -245,7 +252,11 @@ def _figs_3_4(study, main: str, by: dict, plt, style, to_svg):
         ax.set_xlabel("time (s)")
         ax.set_ylabel(ylabel)
         legend_below(fig, ax, fontsize=8)
-        yield (f"Fig. {number} of paper 003: variations of the {what}, trajectory {main}", to_svg(fig, prefix),
+        curves = live.Curves(stages[0].analysis.t, [(s.stage.label.split(" · ")[-1], {"y": fn(s.analysis)}) for s in stages],
+                             [{"key": "y", "title": "", "axis": ylabel}], [],
+                             styles=[style_index(study.stages, s) for s in stages])
+        yield (f"Fig. {number} of paper 003: variations of the {what}, trajectory {main}",
+               live.html(prefix, to_svg(fig, prefix), curves),
                f"Trajectory {main}, the one the paper's Figs. 3-4 show; case 1 (black full line), case 2 (black dashed "
                "line) and case 3 (grey full line), the paper's line styles and these stages' styles on the whole page. "
                + ("Moment about the base joint, horizontal plane. " if number == "4" else "")

@@ -1,0 +1,99 @@
+"""Interactive plots (issue 22): the curves of a time-series figure as JSON, drawn in the browser
+by uPlot (MIT, https://github.com/leeoniya/uPlot, shipped inside the page as
+``templates/uplot.iife.min.js``, about 50 KB: no network, works from ``file://``) with one
+script for every figure (``templates/live_plots.js``): hover shows the time and every curve's
+value, drag to zoom (double-click resets), a click on a legend entry hides its curve; where the
+page has a player, its time moves every plot's cursor and a click in a plot sets the player's
+time. The static SVG of the same curves stays in the page for printing and for readers without
+JavaScript.
+
+A figure's curves are a :class:`Curves`; :func:`data` thins them to at most :data:`POINTS`
+samples (evenly spaced, first and last kept; fewer for a figure of many curves, :data:`VALUES`)
+and rounds them to 6 significant digits: deterministic, and light (a page stays below 2 MB).
+:func:`html` writes the live element, the static SVG and the JSON together. Here, below the
+report, so that a family's own figures (a paper's time series) are interactive too; the page's
+generic figures build their curves in :mod:`balpipe.report.live_plots`.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import NamedTuple
+
+import numpy as np
+
+from . import figures
+
+POINTS = 400  # samples a curve keeps at most
+VALUES = 20_000  # values a figure keeps at most (curves x samples): fewer samples for a figure of many curves
+MIN_POINTS = 100
+DASHES = {"-": [], "--": [6, 3], "-.": [8, 3, 2, 3], ":": [2, 2]}  # matplotlib's line styles as canvas dashes
+
+
+def _thin(n: int, curves: int = 1) -> np.ndarray:
+    """The kept samples of ``n``, evenly spaced, first and last kept: :data:`POINTS` at most, fewer
+    (not below :data:`MIN_POINTS`) when a figure's ``curves`` would exceed :data:`VALUES`."""
+    keep = max(MIN_POINTS, min(POINTS, VALUES // max(1, curves)))
+    return np.unique(np.linspace(0, n - 1, min(n, keep)).round().astype(int))
+
+
+def _round(values) -> list[float]:
+    return [float(f"{v + 0.0:.6g}") for v in np.asarray(values, dtype=float)]
+
+
+def line_style(k: int) -> dict:
+    """Stage ``k``'s line as the static figures draw it (:func:`balpipe.draw.figures.style`): its
+    colour, dashes and width, so a style means the same stage in every figure of the page."""
+    from matplotlib.colors import to_hex
+
+    st = figures.style(k)
+    return {"stroke": to_hex(st["color"]), "dash": DASHES.get(st["linestyle"], []), "width": st["linewidth"]}
+
+
+class Curves(NamedTuple):
+    """The curves of one figure, before thinning: a panel per dict of ``panels`` (``key``,
+    ``title`` and ``axis`` label, each with its unit), a curve per stage and panel."""
+
+    t: np.ndarray  # the stages' common sample times (s)
+    stages: list  # (label, key -> values over t); a stage without a panel's key has no curve there
+    panels: list
+    marks: list  # (time, label): kinematic warnings, dotted vertical lines
+    styles: list | None = None  # each stage's line style index (its place in the page's stage table); None: 0, 1, ...
+
+
+def data(c: Curves) -> dict:
+    """The JSON of one interactive figure: a plot per panel, one series per stage in its stage's
+    line style (:func:`line_style`; null where the stage has no such curve); every curve thinned
+    to the same samples (:func:`_thin`) and rounded to 6 significant digits."""
+    t = np.asarray(c.t, dtype=float)
+    k = _thin(len(t), sum(p["key"] in curves for _, curves in c.stages for p in c.panels))
+    series = [{"label": label, "y": {p["key"]: _round(np.asarray(curves[p["key"]], dtype=float)[k])
+                                     for p in c.panels if p["key"] in curves}, **line_style(n)}
+              for n, (label, curves) in enumerate(c.stages)]
+    if c.styles is not None:
+        for one, style in zip(series, c.styles):
+            one.update(line_style(style))
+    return {"t": _round(t[k]), "series": series, "panels": c.panels,
+            "marks": [[_round([tm])[0], text] for tm, text in sorted(set(c.marks))]}
+
+
+def static_panels(c: Curves) -> list:
+    """The same curves, unthinned, as :func:`balpipe.draw.figures.panels_figure` draws them (the
+    printed figure)."""
+    return [(p["title"], p["axis"], [(label, c.t, curves.get(p["key"])) for label, curves in c.stages])
+            for p in c.panels]
+
+
+def html(name: str, svg: str, c: Curves) -> str:
+    """The page's markup of one figure: the element ``#live-<name>`` that ``live_plots.js`` fills,
+    the static ``svg`` after it (shown in print, and on screen until the script has drawn), and
+    the curves' JSON (:func:`data`)."""
+    return (f'<div class="live" id="live-{name}"></div><div class="static-plot">{svg}</div>\n'
+            f'<script type="application/json" data-live="live-{name}">{as_script(data(c))}</script>')
+
+
+def as_script(data: dict) -> str:
+    """JSON safe inside a ``<script type="application/json">`` element: every ``<`` (in a label;
+    nowhere else in JSON) written as its escape ``\\u003c``, which JSON.parse reads back."""
+    text = json.dumps(data, separators=(",", ":"), sort_keys=True, ensure_ascii=False)
+    return text.replace("<", "\\u003c")  # no '</script>' or '<!--' ends the element early; still valid JSON
