@@ -56,8 +56,14 @@ def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any) -> Iter
         for f in futures:
             yield f.result()
     except BaseException:
-        for proc in list(getattr(pool, "_processes", {}).values()):
-            proc.terminate()
-        pool.shutdown(wait=True, cancel_futures=True)
+        stop_now(pool)
         raise
     pool.shutdown()
+
+
+def stop_now(pool: Any) -> None:
+    """Stop a process pool's workers at once (Ctrl-C, SIGTERM, a failure elsewhere), not when
+    their work ends, and wait for them to be gone."""
+    for proc in list(getattr(pool, "_processes", {}).values()):
+        proc.terminate()
+    pool.shutdown(wait=True, cancel_futures=True)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from .pool import stop_now
 from .study import Study, ratio_reference
 from .validate import FreeFloating, ValidationSettings, free_floating, validate
 from .validate.run import model_scale
@@ -137,9 +138,7 @@ def _parallel(study: Study, workers: int, fn, args: list[tuple]) -> list:
     try:
         out = list(pool.map(fn, *zip(*args)))
     except BaseException:  # Ctrl-C, SIGTERM, a failure: stop the other simulations now, not at their end
-        for proc in list(getattr(pool, "_processes", {}).values()):
-            proc.terminate()
-        pool.shutdown(wait=True, cancel_futures=True)
+        stop_now(pool)
         raise
     finally:
         _FORKED = None
