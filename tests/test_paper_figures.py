@@ -78,7 +78,7 @@ def test_live_plots_draw_each_stage_in_its_static_line_style():
     from matplotlib.colors import to_hex
 
     from balpipe.draw import figures
-    from balpipe.report.live_plots import DASHES, line_style
+    from balpipe.draw.live import DASHES, line_style
 
     for k in range(8):
         st = figures.style(k)
