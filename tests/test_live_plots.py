@@ -163,3 +163,22 @@ def test_a_familys_own_time_series_is_interactive_too():
     _close(series["y"]["M"], an.moment[k])
     assert {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(style_index(st.stages, st.unbalanced))
     assert [p["axis"] for p in data["panels"]] == ["Fˢʰ (N)", "Mˢʰ (N m)"]
+
+
+def test_the_3rpr_paper_figure_is_interactive_with_every_stage_in_its_page_style():
+    """Paper 000's Fig. 4 (the idler-loop method's hook): three live panels, F_x, F_y and M, one
+    curve per stage of the main design in its line style of the page, with the analysis's values."""
+    from balpipe.balancing.base import style_index
+
+    st = run(load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
+    _, html, _ = next(f for f in st.extra_figures() if "(Fig. 4 of paper 000)" in f[0])
+    data = json.loads(html[html.index('data-live="live-rpr3-loads">') + len('data-live="live-rpr3-loads">'):html.rindex("</script>")])
+    assert [p["axis"] for p in data["panels"]] == ["F_x (N)", "F_y (N)", "M (N m)"]
+    own = {s.stage.label: s for s in st.stages if ":" not in s.stage.name}
+    assert sorted(x["label"] for x in data["series"]) == sorted(own)
+    for series in data["series"]:
+        s = own[series["label"]]
+        k = _kept(data, s.analysis.t)
+        _close(series["y"]["x"], s.analysis.force[k, 0])
+        _close(series["y"]["M"], s.analysis.moment[k])
+        assert {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(style_index(st.stages, s))

@@ -42,7 +42,8 @@ def paper_figures(number: str, linkage: str, published_factor: float):
     paper reports ``published_factor``)."""
 
     def figures(study):
-        from ...draw.figures import plt, style, to_svg  # matplotlib only when a report is drawn
+        from ...draw import live  # matplotlib only when a report is drawn
+        from ...draw.figures import plt, style, to_svg
 
         fig, axes = plt.subplots(1, 3, figsize=(10.5, 3.2))
         panels = (("(a) shaking force along x (N)", lambda a: a.force[:, 0]),
@@ -58,9 +59,14 @@ def paper_figures(number: str, linkage: str, published_factor: float):
         fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
         fig.tight_layout(rect=(0, 0.08, 1, 1))
         linkage_label = next((s.stage.label for s in own if s.stage.name == linkage), linkage)
+        curves = live.Curves(own[0].analysis.t,
+                             [(s.stage.label, {key: fn(s.analysis) for key, (_, fn) in zip("xyM", panels)}) for s in own],
+                             [{"key": key, "title": title, "axis": axis}
+                              for key, (title, _), axis in zip("xyM", panels, ("F_x (N)", "F_y (N)", "M (N m)"))], [],
+                             styles=[style_index(study.stages, s) for s in own])
         yield (
             f"Shaking force and moment, every stage ({number} of paper 000)",
-            to_svg(fig, "rpr3-loads"),
+            live.html("rpr3-loads", to_svg(fig, "rpr3-loads"), curves),
             "The paper's line styles, which every figure of this page gives these stages: before (solid) and after "
             "(dashed) the counterweights, after the counter-rotations (grey); the stage with the "
             f"{linkage_label} but no counterweights, which the paper does not plot, is blue dash-dot. Moments about "
