@@ -32,7 +32,6 @@ from .report import history_page
 from .report.page import render_page
 from .report.results import dumps, results_dict, timeseries_csv
 from . import pool
-from .pool import default_jobs, usable_cores  # noqa: F401  (build.default_jobs as before)
 from .fsutil import remove_path, remove_temporaries, tmp_name, write_atomic_dir, write_file_atomic, write_new
 from .site_earlier import earlier_pages
 from .spec_files import MAX_SLUG, clash_notes, clashes, find_specs, slug_for  # noqa: F401  (build.find_specs, build.slug_for as before)

@@ -20,6 +20,7 @@ from matplotlib.patches import Circle, Polygon  # noqa: E402
 
 from ..model import Model  # noqa: E402
 from . import extremes  # noqa: E402
+from .labels import point_name_counts  # noqa: E402
 from .sleeves import guided_sliders, sleeves  # noqa: E402
 
 plt.rcParams.update({
@@ -376,10 +377,7 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
         keep.append((np.asarray(p, dtype=float), -1.0))  # the pivot's triangle
     # one name per place: of the points that coincide there, the first whose name no other body
     # point of the model has (the platform's C1, not the piston's C of every leg)
-    count: dict[str, int] = {}
-    for b in model.bodies:
-        for name in b.points:
-            count[name] = count.get(name, 0) + 1
+    count = point_name_counts(model)
     joints: dict[tuple[float, float], tuple[str, np.ndarray]] = {}
     for i, b in enumerate(model.bodies):
         if b.kind == "gear" and b.radius:

@@ -203,3 +203,14 @@ def gear_key(numbers: dict[str, str]) -> str:
         return (int(re.match(r"\d+", num).group()), num)
 
     return "; ".join(f"{num} = {', '.join(by[num])}" for num in sorted(by, key=order))
+
+
+def point_name_counts(model: Model) -> dict[str, int]:
+    """How many bodies of ``model`` have a point of each name: where points coincide, the
+    drawings and the player name the place by a name only one body has (the 3-RPR platform's
+    C1, not the C of every leg's piston)."""
+    count: dict[str, int] = {}
+    for b in model.bodies:
+        for name in b.points:
+            count[name] = count.get(name, 0) + 1
+    return count

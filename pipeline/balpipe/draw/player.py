@@ -22,6 +22,7 @@ import math
 import numpy as np
 
 from ..model import Model
+from .labels import point_name_counts
 from .sleeves import guided_sliders, sleeves
 
 FRAMES = 60
@@ -154,10 +155,7 @@ def _labels(model: Model, numbers: dict[str, str]) -> dict:
                               numbers.get(a.name, a.name)])
     # the page names coinciding points once, first come first named: the name no other point has
     # goes first (the platform's C1 before the pistons' C), as in the drawings
-    count: dict[str, int] = {}
-    for b in model.bodies:
-        for n in b.points:
-            count[n] = count.get(n, 0) + 1
+    count = point_name_counts(model)
     joints.sort(key=lambda j: count[j[3]] > 1)
     return {"joints": joints, "links": links, "cws": cws, "gears": gears}
 
