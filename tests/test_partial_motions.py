@@ -169,3 +169,30 @@ def test_a_custom_driver_without_a_law_is_located(tmp_path, capsys):
     d = two_motions(7)
     d["motion"]["drive"] = {}
     _bad(tmp_path, capsys, d, "motion.drive: the driver 'crank' has no law: give motion.drive.crank")
+
+
+def test_the_fronts_over_several_motions_mark_only_designs_measured_the_same_way():
+    """The fronts' peaks are over every motion; a stage's analysis is over the spec's motion alone.
+    So a front of several motions marks the unbalanced mechanism and the chosen design at their
+    peaks over every motion (the method's own), and no design lies below the least-effort front:
+    the least effort is non-increasing in the force cap, so the chosen design's effort is at least
+    that of every front point at a larger peak force (the old markers, on the spec's motion alone,
+    fell below it)."""
+    from pathlib import Path
+
+    from balpipe.loader import load
+    from balpipe.report import partial_figures as PF
+    from balpipe.study import run
+
+    st = run(load(Path(__file__).parent.parent / "specs" / "custom_four_bar_partial_two_motions.yaml").spec)
+    det = st.balance.details["partial_balance"]
+    marks = {label: (vx, vy) for label, vx, vy in PF._marks(st, det, "shaking_force", "effort")}
+    chosen = marks["optimal for both motions (over every motion)"]
+    assert chosen == (det["peaks"]["shaking_force"], det["peaks"]["effort"])
+    assert marks["unbalanced (over every motion)"] == (det["unbalanced"]["shaking_force"], det["unbalanced"]["effort"])
+    assert not any(label.startswith("optimal for the steady state alone") for label in marks)
+    front = det["fronts"]["effort_vs_force"]
+    above = [p["effort"] for p in front if p["shaking_force"] >= chosen[0]]
+    assert above and chosen[1] >= max(above) * (1 - 1e-6)
+    _, _, caption = next(f for f in PF.figures(st) if f[0] == "Actuator effort against shaking force")
+    assert "their peaks over every motion as the front's" in caption

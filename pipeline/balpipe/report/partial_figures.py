@@ -54,6 +54,16 @@ def _marks(study, det: dict, x: str, y: str) -> list[tuple[str, float, float]]:
         c = fr.get(key)
         if c is not None and x in c and y in c:
             out.append((label, c[x], c[y]))
+    if len(det.get("motions") or [None]) > 1:
+        # the fronts' peaks are over every motion, the stages' analyses over the spec's motion
+        # alone: mark only what is measured as the fronts are, the unbalanced mechanism and the
+        # chosen design (the method's own peaks over every motion)
+        chosen = [s for s in study.stages if ":" not in s.stage.name][-1]
+        for label, peaks, mass in ((study.unbalanced.stage.label, det["unbalanced"], 0.0),
+                                   (chosen.stage.label, det["peaks"], det["added_mass"])):
+            values = {"added_mass": mass, **peaks}
+            out.append((f"{label} (over every motion)", values[x], values[y]))
+        return out
     for s in study.stages:
         out.append((s.stage.label, STAGE_KEYS[x](s), STAGE_KEYS[y](s)))
     return out
@@ -77,8 +87,10 @@ def figures(study) -> list[tuple[str, str, str]]:
         return []
     out = []
     n = len(det.get("motions") or [None])
-    where = "at the analysed motion" if n == 1 else (
-        f"over {n} motions at once (each peak the largest over every motion; the stages are analysed on the spec's motion)")
+    where = "at the analysed motion" if n == 1 else f"over {n} motions at once (each peak the largest over every motion)"
+    marked = ("every analysed stage" if n == 1 else
+              "the unbalanced mechanism and the chosen design, their peaks over every motion as the front's (the other "
+              "stages are analysed on the spec's motion alone: see the stage table)")
     for key, x, y, title, what in FRONTS:
         pts = det["fronts"].get(key) or []
         if len(pts) < 2:
@@ -86,7 +98,7 @@ def figures(study) -> list[tuple[str, str, str]]:
         svg = _front_figure(pts, x, y, _marks(study, det, x, y), prefix=f"partial_{key}")
         caption = (f"{len(pts)} points, each {what}, solved to global optimality {where} "
                    "(second-order cone programme, Clarabel). Markers: the least-mass complete balances in the same "
-                   f"regions along {'this motion' if n == 1 else 'these motions'}, where they exist, and every analysed "
-                   "stage. " + headline(study, det))
+                   f"regions along {'this motion' if n == 1 else 'these motions'}, where they exist, and {marked}. "
+                   + headline(study, det))
         out.append((title, svg, caption))
     return out
