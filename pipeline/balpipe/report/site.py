@@ -158,9 +158,11 @@ def _costs(results: dict, first: dict, last: dict) -> dict:
     return {"claims": claims, "added_mass": added, "efforts": efforts, "joint_increase": joint}
 
 
-def write_site(out: Path, outcomes: list, earlier: list = ()) -> None:
+def write_site(out: Path, outcomes: list, earlier: list = (), site_key: str = "") -> None:
     """The site's index (and its navigation script): this build's ``outcomes`` and the pages of
-    ``earlier`` builds still in ``out`` (:func:`balpipe.site_earlier.earlier_pages`)."""
+    ``earlier`` builds still in ``out`` (:func:`balpipe.site_earlier.earlier_pages`). ``site_key``
+    (:func:`balpipe.build.site_key`) is written into the index's head, so that a build with
+    nothing changed can leave the index as it is."""
     entries = [_entry(out, o) for o in sorted(outcomes, key=lambda o: o.source)]
     for old in earlier:
         e = _entry(out, old)
@@ -179,6 +181,7 @@ def write_site(out: Path, outcomes: list, earlier: list = ()) -> None:
         filters=site_filter.options(entries),
         papers=site_papers(entries),
         comparisons=comparisons(entries),
+        site_key=site_key,
     )
     write_file_atomic(out / "index.html", html)
     write_file_atomic(out / "site_nav.js", site_nav_script(entries))
