@@ -29,6 +29,14 @@
       c.restore();
     } } };
   }
+  // the legend's rows back in the stages' order (uPlot lists its series in drawing order);
+  // moving a row keeps its click handler and the cells that show the hovered values
+  function legendInStageOrder(u, order) {
+    const rows = u.root.querySelectorAll(".u-legend .u-series");  // rows[0]: the time
+    if (rows.length !== order.length + 1) return;
+    const parent = rows[0].parentNode;
+    for (let i = 0; i < order.length; i++) parent.appendChild(rows[1 + order.indexOf(i)]);
+  }
   const figures = [];  // {host, plots, hovering}
   let playerTime = null;
   function follow(f) {
@@ -43,12 +51,15 @@
     const f = { host: host, plots: [], hovering: false };
     if (d.panels.length > 2) host.classList.add("live-grid");  // small multiples: as many columns as fit
     const width = el => Math.max(240, el.clientWidth);
+    // drawn in d.draw's order (wide lines first, under the thin ones), listed in the stages' order
+    const order = d.draw || d.series.map((s, i) => i);
+    const drawn = order.map(i => d.series[i]);
     for (const p of d.panels) {
       const el = document.createElement("div");
       el.className = "live-plot";
       el.dataset.quantity = p.key;
       host.appendChild(el);
-      const series = [{ label: "t (s)", value: (u, v) => fmt(v) }].concat(d.series.map(s => ({
+      const series = [{ label: "t (s)", value: (u, v) => fmt(v) }].concat(drawn.map(s => ({
         label: s.label, stroke: s.stroke, dash: s.dash, width: s.width, value: (u, v) => fmt(v),
       })));
       const opts = {
@@ -59,7 +70,8 @@
         cursor: { sync: { key: src.dataset.live } },
         plugins: d.marks.length ? [marksPlugin(d.marks)] : [],
       };
-      const u = new uPlot(opts, [d.t].concat(d.series.map(s => s.y[p.key] || d.t.map(() => null))), el);
+      const u = new uPlot(opts, [d.t].concat(drawn.map(s => s.y[p.key] || d.t.map(() => null))), el);
+      legendInStageOrder(u, order);
       f.plots.push(u);
       u.over.addEventListener("mouseenter", () => { f.hovering = true; });
       u.over.addEventListener("mouseleave", () => { f.hovering = false; follow(f); });

@@ -63,12 +63,26 @@ MARKER_WORDS = ["circles", "squares", "triangles", "diamonds", "down-triangles",
                 "plus signs", "crosses", "hexagons", "left-triangles", "right-triangles"]
 
 
+#: a line wider than this (the grey of style 2) is drawn under the thin ones (:func:`wide`)
+WIDE = 2.0
+WIDE_ZORDER = 1.8  # below matplotlib's lines (2), above the grid (1.5)
+
+
+def wide(width: float) -> bool:
+    """Whether a line of ``width`` is drawn under the thin lines: so that a thin curve on the same
+    values stays visible over it (a balanced force of 0, dashed, over the grey stage that is 0
+    too: paper 000 Fig. 4; case 2's dashes over case 3 in paper 003's Figs. 3-4), in the static
+    figures (its zorder) and the interactive plots (:func:`balpipe.draw.live.data`'s ``draw``)."""
+    return width > WIDE
+
+
 def style(k: int) -> dict:
+    """Stage ``k``'s line: colour, line style, width, and a wide line's lower zorder (:func:`wide`)."""
     n = len(STAGE_STYLES)
     base = STAGE_STYLES[k % n]
-    if k < n:
-        return base
-    return {**base, "color": MORE_COLORS[(k // n - 1 + k) % len(MORE_COLORS)]}
+    if k >= n:
+        base = {**base, "color": MORE_COLORS[(k // n - 1 + k) % len(MORE_COLORS)]}
+    return {**base, "zorder": WIDE_ZORDER} if wide(base["linewidth"]) else base
 
 
 def marker(k: int) -> str:

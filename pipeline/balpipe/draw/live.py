@@ -73,8 +73,15 @@ def data(c: Curves) -> dict:
     if c.styles is not None:
         for one, style in zip(series, c.styles):
             one.update(line_style(style))
-    return {"t": _round(t[k]), "series": series, "panels": c.panels,
+    return {"t": _round(t[k]), "series": series, "panels": c.panels, "draw": draw_order(series),
             "marks": [[_round([tm])[0], text] for tm, text in sorted(set(c.marks))]}
+
+
+def draw_order(series: list[dict]) -> list[int]:
+    """The order in which the plot draws ``series`` (the legend keeps theirs): the wide lines
+    first, under the thin ones (:func:`balpipe.draw.figures.wide`, as the static figure's zorder),
+    each group in its own order."""
+    return sorted(range(len(series)), key=lambda i: not figures.wide(series[i]["width"]))
 
 
 def static_panels(c: Curves) -> list:

@@ -1,0 +1,58 @@
+"""The interactive figures in a real browser (issue 22), as tests/test_site_browser.py drives it
+(playwright and the system's Chromium; skipped with the reason when either is missing): the
+curves' drawing order against the legend's, the joint selector of a figure of many joints and the
+partial balancing's interactive fronts. Pages are opened from ``file://``: no server, no network."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from test_site_browser import Watched, browser, open_sections  # noqa: F401 (the browser fixture)
+
+from balpipe.build import Options, build
+
+SPECS = Path(__file__).resolve().parents[1] / "specs"
+LIVE_SPECS = ["paper000_rpr3_idler_loop.yaml"]
+
+
+@pytest.fixture(scope="module")
+def live_site(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("live") / "site"
+    outcomes = build([str(SPECS / s) for s in LIVE_SPECS], Options(out=out, simulate=False))
+    assert all(o.status == "ok" for o in outcomes), [o.message for o in outcomes]
+    return out
+
+
+def _json(page, figure: str) -> dict:
+    return page.eval_on_selector(f"script[data-live='{figure}']", "s => JSON.parse(s.textContent)")
+
+
+def test_wide_curves_are_drawn_first_and_the_legend_keeps_the_stages_order(live_site, browser):  # noqa: F811
+    """Paper 000 Fig. 4: the grey counter-rotations (0 force) are drawn first, under the dashed
+    counterweights (0 force too), while the legend lists the stages in their order; hovering still
+    shows each stage's own value beside its name."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto((live_site / "paper000_rpr3_idler_loop" / "index.html").as_uri(), wait_until="load")
+    open_sections(p)
+    d = _json(p, "live-rpr3-loads")
+    labels = [s["label"] for s in d["series"]]
+    plot = p.locator("#live-rpr3-loads .live-plot").first
+    plot.scroll_into_view_if_needed()
+    legend = plot.evaluate("el => [...el.querySelectorAll('.u-legend .u-series .u-label')].map(v => v.textContent)")
+    assert legend == ["t (s)"] + labels  # the stages' order, not the drawing order
+    assert d["draw"][0] == labels.index("counter-rotations") and d["draw"].index(labels.index("counterweights")) > 0
+    box = plot.locator(".u-over").bounding_box()
+    p.mouse.move(box["x"] + box["width"] * 0.2, box["y"] + box["height"] * 0.5)
+    shown = plot.evaluate("el => [...el.querySelectorAll('.u-legend .u-series .u-value')].map(v => v.textContent)")
+    t = float(shown[0])
+    k = min(range(len(d["t"])), key=lambda i: abs(d["t"][i] - t))
+    for label, value in zip(labels, shown[1:]):
+        exact = next(s for s in d["series"] if s["label"] == label)["y"]["x"][k]
+        assert abs(float(value) - exact) <= 1e-3 * max(1.0, abs(exact)), (label, value, exact)
+    assert not w.problems, "\n".join(w.problems)
