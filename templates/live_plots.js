@@ -37,6 +37,30 @@
     const parent = rows[0].parentNode;
     for (let i = 0; i < order.length; i++) parent.appendChild(rows[1 + order.indexOf(i)]);
   }
+  // a figure of many panels (a joint per panel): a selector above shows one panel at a time
+  // (first d.choose, the largest load) or every panel; a plot drawn hidden takes its width when shown
+  function chooser(host, d, f) {
+    const box = document.createElement("label");
+    box.className = "live-choose";
+    box.textContent = "Show ";
+    const sel = document.createElement("select");
+    d.panels.forEach((p, i) => sel.add(new Option(p.title + (i === d.choose ? " (largest load)" : ""), String(i))));
+    sel.add(new Option("every joint (" + d.panels.length + " panels)", "all"));
+    sel.value = String(d.choose);
+    box.appendChild(sel);
+    host.insertBefore(box, host.firstChild);
+    function show() {
+      f.plots.forEach((u, i) => {
+        const el = u.root.parentNode;
+        el.hidden = sel.value !== "all" && sel.value !== String(i);
+        if (!el.hidden) u.setSize({ width: Math.max(240, el.clientWidth), height: HEIGHT });
+      });
+      host.dataset.shown = sel.value;
+      follow(f);
+    }
+    sel.addEventListener("change", show);
+    show();
+  }
   const figures = [];  // {host, plots, hovering}
   let playerTime = null;
   function follow(f) {
@@ -86,6 +110,7 @@
         if (isFinite(t)) document.dispatchEvent(new CustomEvent("balpipe:seek", { detail: { time: t } }));
       });
     }
+    if (d.choose != null) chooser(host, d, f);
     host.classList.add("live-ready");
     figures.push(f);
     // follow the host's width (the window, or a collapsed section opened): resize after the

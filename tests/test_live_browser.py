@@ -16,7 +16,7 @@ from test_site_browser import Watched, browser, open_sections  # noqa: F401 (the
 from balpipe.build import Options, build
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
-LIVE_SPECS = ["paper000_rpr3_idler_loop.yaml"]
+LIVE_SPECS = ["paper000_rpr3_idler_loop.yaml", "paper000_rpr3_scott_russell.yaml"]
 
 
 @pytest.fixture(scope="module")
@@ -55,4 +55,44 @@ def test_wide_curves_are_drawn_first_and_the_legend_keeps_the_stages_order(live_
     for label, value in zip(labels, shown[1:]):
         exact = next(s for s in d["series"] if s["label"] == label)["y"]["x"][k]
         assert abs(float(value) - exact) <= 1e-3 * max(1.0, abs(exact)), (label, value, exact)
+    assert not w.problems, "\n".join(w.problems)
+
+
+def test_a_figure_of_many_joints_shows_one_joint_at_a_time(live_site, browser):  # noqa: F811
+    """The Scott-Russell legs' 30 joint loads: a selector above the plot shows one joint, first
+    the largest load; choosing another shows that one (hover still shows its values), 'every
+    joint' shows them all; printing shows the static figure of every panel."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto((live_site / "paper000_rpr3_scott_russell" / "index.html").as_uri(), wait_until="load")
+    open_sections(p)
+    d = _json(p, "live-joints")
+    n = len(d["panels"])
+    assert n >= 30 and d["choose"] is not None
+    visible = "h => [...h.querySelectorAll('.live-plot')].map(e => e.offsetParent !== null)"
+    sel = p.locator("#live-joints select")
+    assert sel.count() == 1 and sel.input_value() == str(d["choose"])
+    shown = p.eval_on_selector("#live-joints", visible)
+    assert len(shown) == n and shown.count(True) == 1 and shown[d["choose"]]
+    # the largest peak over every stage among the force panels
+    peak = [max(max(abs(v) for v in s["y"][q["key"]] if v is not None) for s in d["series"] if q["key"] in s["y"])
+            for q in d["panels"]]
+    forces = [i for i, q in enumerate(d["panels"]) if q["title"].endswith("(N)")]
+    assert peak[d["choose"]] == max(peak[i] for i in forces)
+    other = (d["choose"] + 1) % n
+    sel.select_option(str(other))
+    shown = p.eval_on_selector("#live-joints", visible)
+    assert shown.count(True) == 1 and shown[other]
+    plot = p.locator("#live-joints .live-plot").nth(other)
+    plot.scroll_into_view_if_needed()
+    box = plot.locator(".u-over").bounding_box()
+    assert box and box["width"] > 400  # drawn at its width once shown, not the hidden 240 px
+    p.mouse.move(box["x"] + box["width"] * 0.4, box["y"] + box["height"] * 0.5)
+    values = plot.evaluate("el => [...el.querySelectorAll('.u-legend .u-series .u-value')].map(v => v.textContent)")
+    assert re.search(r"\d", values[0]) and any(re.search(r"\d", v) for v in values[1:]), values
+    sel.select_option("all")
+    assert p.eval_on_selector("#live-joints", visible).count(True) == n
+    p.emulate_media(media="print")
+    assert p.is_visible("#live-joints + .static-plot svg") and not p.is_visible("#live-joints")
     assert not w.problems, "\n".join(w.problems)

@@ -182,3 +182,20 @@ def test_the_3rpr_paper_figure_is_interactive_with_every_stage_in_its_page_style
         _close(series["y"]["x"], s.analysis.force[k, 0])
         _close(series["y"]["M"], s.analysis.moment[k])
         assert {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(style_index(st.stages, s))
+
+
+def test_a_figure_of_many_joints_shows_the_largest_load_first(study, monkeypatch):
+    """Issue 22: past MANY_JOINTS panels the joint figure is shown a joint at a time (``choose``),
+    first the panel of the largest force over every stage (a larger torque, in N m, does not
+    count against forces); a figure of few joints shows every panel."""
+    assert "choose" not in LV.data(LP.joints(_stages(study)))  # the slider-crank's 4 joint loads
+    t = np.linspace(0.0, 1.0, 11)
+    n = LP.MANY_JOINTS + 2
+    # n revolutes with |F| peaks 1 .. n N, but J2's 50 N the largest; a gear mesh of 1000 N m
+    loads = [(f"J{i}", "F", "revolute", "N", (50.0 if i == 2 else i + 1) * np.sin(np.pi * t)) for i in range(n)]
+    loads.append(("mesh", "T", "gear mesh", "N m", 1e3 * np.sin(np.pi * t)))
+    monkeypatch.setattr(LP, "joint_load_series", lambda an: [(j, c, k, u, v * an.scale) for j, c, k, u, v in loads])
+    stage = lambda scale: type("Analysis", (), {"t": t, "scale": scale})()  # noqa: E731
+    data = LV.data(LP.joints([("one", stage(0.5)), ("two", stage(1.0))]))
+    assert len(data["panels"]) == n + 1 > LP.MANY_JOINTS
+    assert data["panels"][data["choose"]]["key"] == "J2.F"

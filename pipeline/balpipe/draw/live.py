@@ -59,6 +59,9 @@ class Curves(NamedTuple):
     panels: list
     marks: list  # (time, label): kinematic warnings, dotted vertical lines
     styles: list | None = None  # each stage's line style index (its place in the page's stage table); None: 0, 1, ...
+    # a figure of many panels (a joint per panel): shown one panel at a time, a selector above
+    # choosing which (or every one), this panel first; None: every panel shown
+    choose: int | None = None
 
 
 def data(c: Curves) -> dict:
@@ -73,8 +76,11 @@ def data(c: Curves) -> dict:
     if c.styles is not None:
         for one, style in zip(series, c.styles):
             one.update(line_style(style))
-    return {"t": _round(t[k]), "series": series, "panels": c.panels, "draw": draw_order(series),
-            "marks": [[_round([tm])[0], text] for tm, text in sorted(set(c.marks))]}
+    out = {"t": _round(t[k]), "series": series, "panels": c.panels, "draw": draw_order(series),
+           "marks": [[_round([tm])[0], text] for tm, text in sorted(set(c.marks))]}
+    if c.choose is not None:
+        out["choose"] = c.choose
+    return out
 
 
 def draw_order(series: list[dict]) -> list[int]:
