@@ -64,7 +64,7 @@
   const figures = [];  // {host, plots, hovering}
   let playerTime = null;
   function follow(f) {
-    if (playerTime == null || f.hovering || f.host.offsetParent === null) return;  // hidden: skip
+    if (playerTime == null || f.hovering || f.timeless || f.host.offsetParent === null) return;  // hidden: skip
     f.plots.forEach(u => u.setCursor({ left: u.valToPos(playerTime, "x"), top: 20 }));
   }
   document.querySelectorAll("script[type='application/json'][data-live]").forEach(src => {
@@ -72,7 +72,7 @@
     if (!host) return;
     const d = JSON.parse(src.textContent);
     if (!d.panels.length) return;
-    const f = { host: host, plots: [], hovering: false };
+    const f = { host: host, plots: [], hovering: false, timeless: !!d.x };
     if (d.panels.length > 2) host.classList.add("live-grid");  // small multiples: as many columns as fit
     const width = el => Math.max(240, el.clientWidth);
     // drawn in d.draw's order (wide lines first, under the thin ones), listed in the stages' order
@@ -83,13 +83,15 @@
       el.className = "live-plot";
       el.dataset.quantity = p.key;
       host.appendChild(el);
-      const series = [{ label: "t (s)", value: (u, v) => fmt(v) }].concat(drawn.map(s => ({
+      // over time, or (d.x) over another quantity: a front's budget, each value a design marked
+      const series = [{ label: d.x || "t (s)", value: (u, v) => fmt(v) }].concat(drawn.map(s => Object.assign({
         label: s.label, stroke: s.stroke, dash: s.dash, width: s.width, value: (u, v) => fmt(v),
-      })));
+      }, d.x ? { spanGaps: true, points: { show: true, size: s.points ? 10 : 5, width: 1.5, fill: "#fff" } } : {},
+         s.points ? { paths: () => null } : {})));
       const opts = {
         title: p.title, width: width(el), height: HEIGHT,
         scales: { x: { time: false } },
-        axes: [{ label: "time (s)" }, { label: p.axis, size: 64 }],
+        axes: [{ label: d.x || "time (s)" }, { label: p.axis, size: 64 }],
         series: series,
         cursor: { sync: { key: src.dataset.live } },
         plugins: d.marks.length ? [marksPlugin(d.marks)] : [],
@@ -97,6 +99,7 @@
       const u = new uPlot(opts, [d.t].concat(drawn.map(s => s.y[p.key] || d.t.map(() => null))), el);
       legendInStageOrder(u, order);
       f.plots.push(u);
+      if (d.x) continue;  // not over time: not linked to the player
       u.over.addEventListener("mouseenter", () => { f.hovering = true; });
       u.over.addEventListener("mouseleave", () => { f.hovering = false; follow(f); });
       // a click, not a drag to zoom, sends the player to the time under the cursor
@@ -112,7 +115,7 @@
     }
     if (d.choose != null) chooser(host, d, f);
     host.classList.add("live-ready");
-    figures.push(f);
+    if (!d.x) figures.push(f);
     // follow the host's width (the window, or a collapsed section opened): resize after the
     // observer's callback, never inside it
     let last = host.clientWidth, pending = 0;
