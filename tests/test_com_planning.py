@@ -406,6 +406,8 @@ def test_the_index_names_the_main_motion_its_costs_come_from(tmp_path):
     finally:
         os.chdir(cwd)
     index = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
-    assert "P15P7 · case 3: CoM trapezoidal (main motion):" in index
+    # the headline stage is case 2, whose reductions the paper publishes (Stage.headline)
+    assert "P15P7 · case 2: CoM bang-bang + φ optimised (main motion):" in index
     page = (tmp_path / "site" / "two" / "index.html").read_text(encoding="utf-8")
-    assert "Design summary: P15P7 · case 3: CoM trapezoidal against P15P7 · case 1: end-effector quintic" in page
+    assert ("Design summary: P15P7 · case 2: CoM bang-bang + φ optimised against P15P7 · case 1: end-effector quintic"
+            in page)
