@@ -20,7 +20,7 @@ from matplotlib.patches import Circle, Polygon  # noqa: E402
 
 from ..model import Model  # noqa: E402
 from . import extremes  # noqa: E402
-from .labels import point_name_counts  # noqa: E402
+from .labels import drawing_span, point_places, repeated_names  # noqa: E402
 from .sleeves import guided_sliders, sleeves  # noqa: E402
 
 plt.rcParams.update({
@@ -63,12 +63,26 @@ MARKER_WORDS = ["circles", "squares", "triangles", "diamonds", "down-triangles",
                 "plus signs", "crosses", "hexagons", "left-triangles", "right-triangles"]
 
 
+#: a line wider than this (the grey of style 2) is drawn under the thin ones (:func:`wide`)
+WIDE = 2.0
+WIDE_ZORDER = 1.8  # below matplotlib's lines (2), above the grid (1.5)
+
+
+def wide(width: float) -> bool:
+    """Whether a line of ``width`` is drawn under the thin lines: so that a thin curve on the same
+    values stays visible over it (a balanced force of 0, dashed, over the grey stage that is 0
+    too: paper 000 Fig. 4; case 2's dashes over case 3 in paper 003's Figs. 3-4), in the static
+    figures (its zorder) and the interactive plots (:func:`balpipe.draw.live.data`'s ``draw``)."""
+    return width > WIDE
+
+
 def style(k: int) -> dict:
+    """Stage ``k``'s line: colour, line style, width, and a wide line's lower zorder (:func:`wide`)."""
     n = len(STAGE_STYLES)
     base = STAGE_STYLES[k % n]
-    if k < n:
-        return base
-    return {**base, "color": MORE_COLORS[(k // n - 1 + k) % len(MORE_COLORS)]}
+    if k >= n:
+        base = {**base, "color": MORE_COLORS[(k // n - 1 + k) % len(MORE_COLORS)]}
+    return {**base, "zorder": WIDE_ZORDER} if wide(base["linewidth"]) else base
 
 
 def marker(k: int) -> str:
@@ -319,7 +333,7 @@ def mechanism_drawing(model: Model, analysis, ghosts: list[int] | None = None, t
     if ghosts is None:
         ghosts = extremes.extreme_instants(model, poses)
     max_cw = max([a.mass for b in model.bodies for a in b.attachments] + [1e-12])
-    span = _span(model, poses)
+    span = drawing_span(model, poses)
     guided = guided_sliders(model)
     # paths of every named point, thin
     for i, b in enumerate(model.bodies):
@@ -370,27 +384,16 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
     out: list[tuple[str, np.ndarray, str]] = []
     keep: list[tuple[np.ndarray, float | None]] = []
     segs: list[tuple[np.ndarray, np.ndarray]] = []
-    placed: set[tuple[float, float]] = set()
     for name, p in model.frame_points.items():
-        placed.add((round(p[0] / span, 2), round(p[1] / span, 2)))
         out.append((name, np.asarray(p, dtype=float), "pivot"))
         keep.append((np.asarray(p, dtype=float), -1.0))  # the pivot's triangle
-    # one name per place: of the points that coincide there, the first whose name no other body
-    # point of the model has (the platform's C1, not the piston's C of every leg)
-    count = point_name_counts(model)
-    joints: dict[tuple[float, float], tuple[str, np.ndarray]] = {}
-    for i, b in enumerate(model.bodies):
-        if b.kind == "gear" and b.radius:
-            continue  # a disc's axis: the disc carries its number
-        for name, p in b.points.items():
-            g = _global_point(pose_row[i], p)
-            key = (round(g[0] / span, 2), round(g[1] / span, 2))
-            if key in placed:
-                continue
-            if key not in joints or (count[joints[key][0]] > 1 and count[name] == 1):
-                joints[key] = (name, joints[key][1] if key in joints else g)
-    for name, g in joints.values():
-        out.append((name, g, "joint"))
+    # every named point once: one name per place, none for a name at several places (its marker
+    # is still kept clear)
+    places = point_places(model, pose_row, span)
+    unnamed = repeated_names(places)
+    for name, g in places:
+        if name not in unnamed:
+            out.append((name, g, "joint"))
         keep.append((g, None))
     gears, cws, links = [], [], []
     guided = guided_sliders(model)
@@ -498,13 +501,6 @@ def common_limits(items: list[tuple[Model, np.ndarray]], pad: float = 0.08) -> t
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     d = pad * float(max(hi - lo)) or 0.05
     return (float(lo[0] - d), float(lo[1] - d), float(hi[0] + d), float(hi[1] + d))
-
-
-def _span(model: Model, poses: np.ndarray) -> float:
-    xy = poses[:, :, :2].reshape(-1, 2)
-    fp = np.array(list(model.frame_points.values()) or [[0.0, 0.0]])
-    allp = np.vstack([xy, fp])
-    return float(max(np.ptp(allp[:, 0]), np.ptp(allp[:, 1]), 1e-3))
 
 
 def series_figure(t: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel: str, prefix: str,

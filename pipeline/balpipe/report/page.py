@@ -101,7 +101,7 @@ def study_figures(study: Study) -> dict:
     key = "; ".join(f"{figures.style_text(k)}: {s.stage.label}" for k, s in enumerate(shown_stages(study)))
     # a method that gives its stages the paper's line styles (Stage.style): said in the legend
     paper_styles = styled(shown_stages(study))
-    return {"loads": loads, "joints": joints, "loads_key": key[:1].upper() + key[1:],
+    return {"loads": loads, "joints": joints, "joints_chosen": joint_curves.choose is not None, "loads_key": key[:1].upper() + key[1:],
             "styles_note": "These are the paper's line styles for the stages it plots, so the figures titled with the "
                            "paper's numbers draw each stage as every other figure does" if paper_styles else "",
             "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,

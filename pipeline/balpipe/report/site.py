@@ -55,7 +55,7 @@ def _entry(out: Path, o) -> dict:
         e["not_realisable"] = [f"{s['label']}: {s['not_realisable']}" for s in st if s.get("realisable") is False]
         tol = results.get("checks", {}).get("balance_tolerance")
         e["headline"] = headline(v, tol)
-        # the main design's last stage of its first motion (never a compared design's)
+        # the main design's headline stage of its first motion (never a compared design's)
         last = next((s for s in st if v["motions"] and s["name"] == v["motions"][0]["final"]), st[-1])
         e["added_mass"] = f"{num(last['added_mass'])} kg"
         e.update(_costs(results, first, last))
