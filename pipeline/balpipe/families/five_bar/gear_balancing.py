@@ -373,9 +373,11 @@ def _full_stage(model: Model, links: dict[str, Body], I: dict[str, float], mech:
 
 
 def _notation() -> dict:
-    from ...notation import Sym, ours, setting
+    from ...notation import Sym, names_table, ours, setting
 
-    return {
+    names = names_table(parts={f"counterweight {j}": Sym(f"m_{{CW{j}}}", f"counterweight on link {j} (eqs. 9-12)")
+                               for j in range(1, 5)})
+    return names | {
         "balancing.counterweights.proximal": Sym(
             "−r_{CW1} = −r_{CW2}", "counterweights 1, 2 along A_jB_j from A_j (negative: beyond A_j, at r_{CW} from it)"),
         "balancing.counterweights.distal": Sym(

@@ -236,10 +236,20 @@ def balance(mech: SerialArmMechanism, method: GearDecoupling, model: Model) -> B
 def _notation() -> dict:
     """Paper 002's symbols (Figs. 1, 3-4, eqs. 3-16): joints A, B, centres of mass S_1, S_2,
     angles θ_1, θ_2; they replace the serial arm's generic ones for the 2R arm."""
-    from ...notation import Sym, drive_table, ours
+    from ...notation import Sym, drive_table, names_table, ours
 
-    table = drive_table({"q1": Sym("θ_1", "angle of link 1 relative to the base"),
-                         "q2": Sym("θ_2", "angle of link 2 relative to link 1")}, end_time="T")
+    drives = {"q1": Sym("θ_1", "angle of link 1 relative to the base"),
+              "q2": Sym("θ_2", "angle of link 2 relative to link 1")}
+    table = drive_table(drives, end_time="T")
+    # the model's names (Figs. 1, 3): drivers θ_1, θ_2, gears 1' (on link 1 at C) and 3 (on the
+    # frame), joints A (frame-link 1), B (link 1-link 2), C (gear 1' on link 1)
+    table.update(names_table(
+        drivers=drives,
+        parts={"gear1p": Sym("gear 1'", "gear 1', turning on link 1 at C, meshing with gear 2'"),
+               "gear3": Sym("gear 3", "gear 3 on the frame, meshing with gear 1'' (θ_3 = −θ_1)")},
+        joints={"J1": Sym("A", "joint A of link 1 on the frame"), "J2": Sym("B", "joint B between links 1 and 2"),
+                "link1-gear1p": Sym("C", "joint C of gear 1' on link 1")},
+    ))
     table.update({
         "mechanism.base": Sym("A", "joint A of link 1 on the frame"),
         "mechanism.links[0].length": Sym("l_1", "length AB of link 1"),
