@@ -254,7 +254,7 @@ def test_dimensionless_parameters_say_so_and_round_off_before_counter_rotations_
     html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
     params = html[html.index("Computed parameters</h2>"):]
     params = params[:params.index("</table>")]
-    row = next(r for r in params.split("<tr>") if "<td>rcp1</td>" in r)
+    row = next(r for r in params.split("<tr>") if ">rcp1</span></td>" in r)  # r_cp1, the model's rcp1 beside it
     assert '<td class="unit">1</td>' in row  # rcp1 = position / L1: a ratio, unit 1
     side = html[html.index("Designs side by side</h2>"):]
     side = side[:side.index("</table>")]

@@ -68,6 +68,17 @@ def test_parts_carry_the_papers_symbols(spec_file, part, symbol):
     assert _names(spec_file).sym("part", part).symbol == symbol
 
 
+@pytest.mark.parametrize("spec_file, param, shown", [
+    ("paper004_five_bar.yaml", "m1_star", "m₁*"),
+    ("paper004_five_bar.yaml", "U63", "U₆₃"),
+    ("paper000_rpr3_idler_loop.yaml", "Icr4", "I_cr4"),
+    ("paper000_rpr3_scott_russell.yaml", "mcp3", "m_cp3"),
+    ("paper002_decoupling.yaml", "J1", "J₁"),
+])
+def test_computed_parameters_carry_the_papers_symbols(spec_file, param, shown):
+    assert _names(spec_file).text("param", param) == shown
+
+
 def test_joints_carry_the_papers_points_and_gear_bearings_their_parts_names():
     n000, n002 = _names("paper000_rpr3_idler_loop.yaml"), _names("paper002_decoupling.yaml")
     assert n000.text("joint", "A1") == "A₁" and n000.text("joint", "B3") == "B₃"
@@ -143,6 +154,9 @@ def test_paper002_page_names_drivers_parts_and_joints_as_the_paper_does(page002)
     # the effort plots' panels, static and interactive
     assert "actuator effort: θ₂ [q2]" in page002.lower()
     assert "effort: q2" not in page002
+    # the computed parameters and the published numbers: J_1 (the model's J1 beside it)
+    params = _section(page002, "Computed parameters</h2>", "</table>")
+    assert "<td>J1</td>" not in params and re.search(r'<var>J</var><sub>1</sub></span> <span class="spec-name"', params)
 
 
 def test_a_custom_page_keeps_the_specs_names_and_keeps_the_numerics_collapsed():

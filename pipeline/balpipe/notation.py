@@ -272,24 +272,26 @@ def group_of(path: str, unit: str) -> str:
 #
 # Beside the inputs, a family's table may name the model's *drivers* (the ``motion.drive.<name>``
 # keys and the actuated joints whose efforts the pages tabulate), its *parts* (links,
-# counterweights, counter-rotations, added discs) and its *joints* in the paper's symbols: keys
-# ``driver:<name>``, ``part:<name>`` and ``joint:<name>`` (patterns as above, made by
-# :func:`names_table`), looked up in the same order as the inputs (method, template, common).
+# counterweights, counter-rotations, added discs), its *joints* and the method's computed
+# *parameters* (``results.json``'s ``parameters`` and ``references``) in the paper's symbols: keys
+# ``driver:<name>``, ``part:<name>``, ``joint:<name>`` and ``param:<name>`` (patterns as above,
+# made by :func:`names_table`), looked up in the same order as the inputs (method, template, common).
 # A name without a symbol stays the model's own; ``custom`` declares none, so its pages keep the
 # spec's names.
 
-KINDS = ("driver", "part", "joint")
+KINDS = ("driver", "part", "joint", "param")
 
 _SUBSCRIPT = dict(zip("0123456789+-=()aehijklmnoprstuvx", "₀₁₂₃₄₅₆₇₈₉₊₋₌₍₎ₐₑₕᵢⱼₖₗₘₙₒₚᵣₛₜᵤᵥₓ"))
 _SUPERSCRIPT = {"*": "*", "'": "'", "2": "²", "3": "³"}
 
 
 def names_table(drivers: Mapping[str, Sym] | None = None, parts: Mapping[str, Sym] | None = None,
-                joints: Mapping[str, Sym] | None = None) -> Table:
-    """Rows ``driver:<name>``, ``part:<name>``, ``joint:<name>`` for a family's notation table:
-    the paper's symbol of each model name (patterns such as ``theta<i>`` allowed)."""
+                joints: Mapping[str, Sym] | None = None, params: Mapping[str, Sym] | None = None) -> Table:
+    """Rows ``driver:<name>``, ``part:<name>``, ``joint:<name>``, ``param:<name>`` for a family's
+    notation table: the paper's symbol of each model or parameter name (patterns such as
+    ``theta<i>`` allowed)."""
     out: dict[str, Sym] = {}
-    for kind, rows in zip(KINDS, (drivers, parts, joints)):
+    for kind, rows in zip(KINDS, (drivers, parts, joints, params)):
         out.update({f"{kind}:{name}": s for name, s in (rows or {}).items()})
     return out
 

@@ -42,7 +42,7 @@ def names_for(spec: Any) -> "PageNames":
 
 class PageNames:
     """:class:`balpipe.notation.Names` for the templates: ``driver(name)``, ``part(name)``,
-    ``joint(name)`` give markup (the symbol, the model's name beside it); ``text(kind, name)``
+    ``joint(name)``, ``param(name)`` give markup (the symbol, the model's name beside it); ``text(kind, name)``
     plain text for plots (``θ₁ [theta1]``)."""
 
     def __init__(self, names: N.Names):
@@ -53,6 +53,9 @@ class PageNames:
 
     def part(self, name: str) -> Markup:
         return Markup(self.names.html("part", name)) if isinstance(name, str) else name
+
+    def param(self, name: str) -> Markup:
+        return Markup(self.names.html("param", name))
 
     def joint(self, name: str) -> Markup:
         return Markup(self.names.html("joint", name)) if name else Markup("")

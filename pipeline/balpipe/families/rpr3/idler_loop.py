@@ -254,6 +254,10 @@ def _notation() -> dict:
         "cr2": Sym("I_{cr2}", "counter-rotation carried by link 6, geared to the platform (eq. 9b)"),
         "cr3": Sym("I_{cr3}", "counter-rotation carried by link 5, geared to link 6 (eq. 9c)"),
         "cr4": Sym("I_{cr4}", "counter-rotation on the base at E (eq. 9d)"),
+    }, params={
+        **{f"mcp{j}": Sym(f"m_{{cp{j}}}", f"mass of counterweight {j} (eqs. 5a-d)") for j in (1, 2, 5, 6)},
+        **{f"rcp{j}": Sym(f"r_{{cp{j}}}", f"position coefficient of counterweight {j}") for j in (1, 2, 5, 6)},
+        **{f"Icr{k}": Sym(f"I_{{cr{k}}}", f"inertia of counter-rotation {k} (eqs. 9a-d)") for k in (1, 2, 3, 4)},
     })
     return names | {
         "balancing.E": Sym("E", "base pivot of the idler loop E-F-P (the paper: E = O)"),

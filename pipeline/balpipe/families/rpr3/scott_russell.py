@@ -293,6 +293,10 @@ def _notation() -> dict:
         **{f"mcp{j} (leg {i})": Sym(f"m_{{cp{j}}} (leg {i})", f"counterweight on link {j} of leg {i} (eqs. 30a-d)")
            for j in links.values() for i in legs},
         **{f"cr{i}": Sym(f"I_{{cr}} (leg {i})", f"counter-rotation of leg {i} on the base at A_{i} (eq. 30f)") for i in legs},
+    }, params={
+        **{f"mcp{j}": Sym(f"m_{{cp{j}}}", f"mass of counterweight {j} (eqs. 30a-d)") for j in links.values()},
+        **{f"rcp{j}": Sym(f"r_{{cp{j}}}", f"position coefficient of counterweight {j}") for j in links.values()},
+        "Icr": Sym("I_{cr}", "inertia of each leg's counter-rotation (eq. 30f)"),
     })
     return names | {
         # Sec. 3 renumbers the leg: the piston is link 3, the cylinder link 4 (Fig. 6)

@@ -367,7 +367,7 @@ def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Mo
     params += [
         Parameter("finder_conditions", gen.count, "", src, "independent force-balance conditions found by the generic "
                   "condition finder (every motion)"),
-        Parameter("finder_gap", gen.gap, "", src, "how clearly the conditions stand out from round-off (larger is clearer: the last kept over the first dropped singular value)"),
+        Parameter("finder_gap", gen.gap, "", src, "how clearly the conditions stand out from round-off (larger is clearer)"),
         Parameter("leg_by_leg_in_finder_space", found.design_residual(lbl), "", src,
                   "largest residual of the leg-by-leg design over the finder's conditions / (total mass x model size)"),
     ]

@@ -249,6 +249,14 @@ def _notation() -> dict:
                "gear3": Sym("gear 3", "gear 3 on the frame, meshing with gear 1'' (θ_3 = −θ_1)")},
         joints={"J1": Sym("A", "joint A of link 1 on the frame"), "J2": Sym("B", "joint B between links 1 and 2"),
                 "link1-gear1p": Sym("C", "joint C of gear 1' on link 1")},
+        params={"J1": Sym("J_1", "inertia that actuator 1 sees once decoupled (eq. 17)"),
+                "J2": Sym("J_2", "inertia that actuator 2 sees once decoupled (eq. 18)"),
+                "I3": Sym("I_3", "inertia of gear 3 (I_3 = J_1)"),
+                "m1": Sym("m_1", "mass of link 1 as redistributed"), "l_AS1": Sym("l_{AS1}", "A to S_1"),
+                "l_BS2": Sym("l_{BS2}", "B to S_2"), "I_S1": Sym("I_{S1}", "inertia of link 1 about S_1"),
+                "I_S1p": Sym("I_{S1'}", "inertia of gear 1'"),
+                "m2_plus_m2p": Sym("m_2 + m_{2'}", "link 2 with gear 2'"),
+                "I_S2_plus_I_S2p": Sym("I_{S2} + I_{S2'}", "link 2 with gear 2'")},
     ))
     table.update({
         "mechanism.base": Sym("A", "joint A of link 1 on the frame"),
