@@ -227,7 +227,7 @@ def test_tracking_error_caption_gives_each_travel():
         t = s.analysis.t
         s.torque = SimpleNamespace(t=t, travel={"crank": 2.5}, tracking={"crank": np.full(len(t), 1e-6)})
     [(title, svg, caption)] = page.study_figures(st)["torque"]
-    assert "relative to its travel" in caption and "crank 2.5 rad" in caption
+    assert "relative to its travel" in caption and "θ₁ [crank] 2.5 rad" in caption  # the paper's symbol, then the spec's name
     assert "|q_sim − q_plan| / travel" in svg and "time (s)" in svg
 
 
