@@ -199,15 +199,16 @@ def loads_figure(stages: list, prefix: str = "loads") -> str:
 
 
 def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = None,
-                   marks: list | None = None) -> str:
+                   marks: list | None = None, shown: dict | None = None) -> str:
     """Actuator torque (or force) of every driver, every stage; ``units``: driver -> 'N m' or 'N';
-    ``marks``: (time, label) of kinematic warnings (balpipe.dead_centres), drawn as dotted lines."""
+    ``marks``: (time, label) of kinematic warnings (balpipe.dead_centres), drawn as dotted lines;
+    ``shown``: driver -> the name its panel shows (the paper's symbol, balpipe.notation.Names)."""
     units = units or {}
     names = sorted({n for _, an in stages for n in an.efforts})
     panels = []
     for name in names:
         u = units.get(name, "")
-        panels.append((f"Actuator effort: {name}" + (f" ({u})" if u else ""), effort_axis(u),
+        panels.append((f"Actuator effort: {(shown or {}).get(name, name)}" + (f" ({u})" if u else ""), effort_axis(u),
                        [(label, an.t, an.efforts.get(name)) for label, an in stages]))
     return panels_figure(panels, prefix, marks, columns=max(1, len(names)))
 
@@ -254,7 +255,7 @@ def _global_point(pose, p) -> np.ndarray:
 
 def mechanism_figure(model: Model, analysis, ghosts: list[int] | None = None, prefix: str = "mech",
                      title: str = "", limits: tuple[float, float, float, float] | None = None,
-                     numbers: dict[str, str] | None = None) -> str:
+                     numbers: dict[str, str] | None = None, texts: dict[str, str] | None = None) -> str:
     """The mechanism drawn solid at its reference pose (t = 0, where the player starts) over its
     extreme poses as light grey ghosts (:mod:`.extremes`: the instants where it is farthest from
     the solid pose; ``ghosts``: their sample indices, computed from ``model`` when None), with
@@ -263,8 +264,9 @@ def mechanism_figure(model: Model, analysis, ghosts: list[int] | None = None, pr
     mass, gears circles. The solid pose carries the spec's names (points, links,
     counterweights) and the gears' numbers (``numbers``: part name -> number,
     :func:`labels.gear_numbers`), placed so that no two overlap (:func:`labels.place`);
-    ``limits`` (x0, y0, x1, y1) gives every panel of a figure the same scale."""
-    fig, _ = mechanism_drawing(model, analysis, ghosts, title, limits, numbers)
+    ``limits`` (x0, y0, x1, y1) gives every panel of a figure the same scale; ``texts``: name ->
+    the text drawn for it (the paper's symbol, :class:`balpipe.notation.Names`)."""
+    fig, _ = mechanism_drawing(model, analysis, ghosts, title, limits, numbers, texts)
     return to_svg(fig, prefix)
 
 
@@ -324,7 +326,7 @@ def _sleeve_outline(ends: tuple[np.ndarray, np.ndarray], span: float) -> list[np
 
 def mechanism_drawing(model: Model, analysis, ghosts: list[int] | None = None, title: str = "",
                       limits: tuple[float, float, float, float] | None = None,
-                      numbers: dict[str, str] | None = None) -> tuple:
+                      numbers: dict[str, str] | None = None, texts: dict[str, str] | None = None) -> tuple:
     """The figure of :func:`mechanism_figure` and its placed labels (:class:`labels.Placed`,
     boxes in display pixels)."""
     fig, ax = plt.subplots(figsize=(6.0, 4.6))
@@ -359,7 +361,7 @@ def mechanism_drawing(model: Model, analysis, ghosts: list[int] | None = None, t
     if title:
         ax.set_title(literal(title), fontsize=9)
     fig.tight_layout()
-    placed = place_names(fig, ax, model, poses[ref], span, max_cw, numbers)
+    placed = place_names(fig, ax, model, poses[ref], span, max_cw, numbers, texts=texts)
     return fig, placed
 
 

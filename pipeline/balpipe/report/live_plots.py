@@ -20,11 +20,12 @@ def loads(stages: list) -> Curves:
                    {"key": "M", "title": "shaking moment M (N m)", "axis": "M (N m)"}], [])
 
 
-def efforts(stages: list, units: dict, marks: list | None = None) -> Curves:
-    """``stages``: (label, analysis); ``units``: driver -> 'N m' or 'N'. A panel per driver: its
-    actuator's torque or force (as :func:`balpipe.draw.figures.efforts_figure`)."""
+def efforts(stages: list, units: dict, marks: list | None = None, shown: dict | None = None) -> Curves:
+    """``stages``: (label, analysis); ``units``: driver -> 'N m' or 'N'; ``shown``: driver -> the
+    name its panel shows (the paper's symbol). A panel per driver: its actuator's torque or force
+    (as :func:`balpipe.draw.figures.efforts_figure`)."""
     names = sorted({n for _, an in stages for n in an.efforts})
-    panels = [{"key": n, "title": f"actuator effort: {n}" + (f" ({units[n]})" if units.get(n) else ""),
+    panels = [{"key": n, "title": f"actuator effort: {(shown or {}).get(n, n)}" + (f" ({units[n]})" if units.get(n) else ""),
                "axis": figures.effort_axis(units.get(n, ""))} for n in names]
     return Curves(stages[0][1].t, [(label, an.efforts) for label, an in stages], panels, list(marks or []))
 

@@ -625,7 +625,7 @@ def _notation() -> dict:
         "balancing.orientation.end": Sym("φ_f", "orientation φ at the end"),
         "balancing.phi.degree": ours("deg φ", "degree of the polynomial law of φ (ends fixed to second order)"),
         "balancing.phi.starts": setting("starts", "multi-start: the 3-4-5 law plus random points"),
-        "balancing.phi.seed": setting("seed", "seed of the random starting points"),
+        "balancing.phi.seed": setting("seed", "picks the random starting points, the same ones at every build"),
         "balancing.phi.spread": setting("σ_c", "spread of the random starting coefficients"),
         "balancing.phi.max_evaluations": setting("evaluations", "objective evaluations per start (Nelder-Mead)"),
         "balancing.phi.tolerance": setting("tol", "Nelder-Mead tolerance"),
