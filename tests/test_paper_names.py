@@ -151,6 +151,8 @@ def test_paper002_page_names_drivers_parts_and_joints_as_the_paper_does(page002)
     assert "<td>q1</td>" not in acts and "<var>θ</var><sub>1</sub>" in acts
     joints = _section(page002, "<th>Joint</th>", "</table>")
     assert "<td>J1</td>" not in joints and re.search(r'<td><span class="sym"[^>]*><var>A</var></span>', joints)
+    # the joint-load plots' panels, static and interactive: the paper's A, the model's J1 beside it
+    assert "A [J1], revolute: |F| (N)" in page002 and "J1, revolute" not in page002
     # the effort plots' panels, static and interactive
     assert "actuator effort: θ₂ [q2]" in page002.lower()
     assert "effort: q2" not in page002

@@ -34,8 +34,9 @@ def efforts(stages: list, units: dict, marks: list | None = None, shown: dict | 
 MANY_JOINTS = 6
 
 
-def joints(stages: list) -> Curves:
-    """``stages``: (label, analysis). A panel per joint load, as the rows of the joint-load table
+def joints(stages: list, shown: dict | None = None) -> Curves:
+    """``stages``: (label, analysis); ``shown``: a joint's name in the panel titles (the paper's
+    symbol, :class:`balpipe.notation.Names`), else the model's. A panel per joint load, as the rows of the joint-load table
     (:func:`balpipe.report.results.joint_load_series`: |F| of a revolute, |N| of a prismatic
     pair, |T|, |Ft|, Fr of a gear mesh). With more than :data:`MANY_JOINTS` panels (the 30 of
     the Scott-Russell 3-RPR legs) the plot shows one at a time, first the largest load
@@ -49,7 +50,7 @@ def joints(stages: list) -> Curves:
             key = f"{joint}.{comp}"
             mine[key] = values
             units[key] = unit
-            panels.setdefault(key, {"key": key, "title": f"{joint}, {kind} ({unit})",
+            panels.setdefault(key, {"key": key, "title": f"{(shown or {}).get(joint, joint)}, {kind} ({unit})",
                                     "axis": f"{comp if comp == 'Fr' else f'|{comp}|'} ({unit})"})
         curves.append((label, mine))
     ordered = list(panels.values())

@@ -68,7 +68,8 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
     efforts = live.html("efforts", figures.efforts_figure(shown, prefix="efforts", units=units, marks=marks,
                                                           shown=shown_names),
                         live_plots.efforts(shown, units, marks, shown_names))
-    joint_curves = live_plots.joints(shown)
+    joint_names = {j: names.text("joint", j) for _, an in shown for j in an.reactions}  # the paper's symbols
+    joint_curves = live_plots.joints(shown, joint_names)
     joints = (live.html("joints", figures.panels_figure(live.static_panels(joint_curves), "joints"),
                         joint_curves) if joint_curves.panels else "")
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
