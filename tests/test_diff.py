@@ -110,3 +110,37 @@ def test_diff_page_opens_with_the_headline_changes(tmp_path):
     html = out.read_text()
     head = html[html.index('id="headline"'):html.index("<h2>")]
     assert "What changed" in head and "counterweights: peak |M| (N m) 78.0642 &rarr; <strong>85.57</strong>" in head
+
+
+def _stage(name: str, **values) -> dict:
+    from balpipe.diff import STAGE_KEYS, _change
+
+    row = {"name": name}
+    for key in STAGE_KEYS:
+        old, new = values.get(key, (1.0, 1.0))
+        row[key] = _change(old, new)
+    return row
+
+
+def test_a_load_cancelled_to_round_off_reads_zero_and_a_long_text_is_cut():
+    """The corrected Scott-Russell legs: |M| 11.5 N m -> 2.8e-13 N m is 'cancelled', shown as
+    0 (< tolerance), never as a number of round-off; a new stage's cancelled load too; a spec's
+    description of a thousand characters is shown by its start and its length."""
+    from balpipe.diff import ROUND_OFF_TEXT, _rows
+
+    data = {
+        "stages": [_stage("counter_rotations", max_shaking_moment=(11.51, 2.84e-13), moment_ratio=(6.74, 1.66e-13)),
+                   _stage("idler:counterweights", max_shaking_force=(None, 3.46e-13), force_ratio=(None, 1.0e-14)),
+                   _stage("worse", max_shaking_moment=(1e-13, 2.0), moment_ratio=(1e-14, 3.0))],
+        "references": [], "parameters": [],
+        "inputs": [{"field": "description", "old": "a" * 1097, "new": "short", "unit": ""}],
+    }
+    sections = dict((title, rows) for title, rows, _ in _rows(data))
+    rows = {(r[0], r[1]): r[2:] for r in sections["Stages"]}
+    assert rows["counter_rotations", "peak |M| (N m)"] == ["11.51", ROUND_OFF_TEXT, "cancelled"]
+    assert rows["counter_rotations", "|M| vs unbalanced"] == ["6.74", ROUND_OFF_TEXT, "cancelled"]
+    assert rows["idler:counterweights", "peak |F| (N)"] == ["—", ROUND_OFF_TEXT, ""]
+    assert rows["worse", "peak |M| (N m)"][:2] == [ROUND_OFF_TEXT, "2"]  # from round-off to a real load
+    assert not any("e-1" in c for r in sections["Stages"] for c in r)
+    (field, old, new, _), = sections["Inputs"]
+    assert old.startswith("a" * 20) and old.endswith("… (1097 characters)") and len(old) < 70 and new == "short"

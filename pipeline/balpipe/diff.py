@@ -188,6 +188,22 @@ def _fmt(x: Any) -> str:
     return str(x)
 
 
+ROUND_OFF_TEXT = "0 (< tolerance)"
+LONG_TEXT = 60  # an input longer than this (a description) is shown by its start and its length
+
+
+def _short(x: Any) -> str:
+    """An input's value for a row: a long text by its first words and its length."""
+    t = _fmt(x)
+    return t if len(t) <= LONG_TEXT else f"{t[:LONG_TEXT - 20].rstrip()}… ({len(t)} characters)"
+
+
+def _side_fmt(value: Any, cancelled: bool) -> str:
+    """A load of one side: round-off (its ratio to the unbalanced peak at most :data:`ROUND_OFF`)
+    reads ``0 (< tolerance)``, not as a number."""
+    return ROUND_OFF_TEXT if cancelled and isinstance(value, float) else _fmt(value)
+
+
 def _rel(d: dict) -> str:
     r = d.get("relative")
     if r is None:
@@ -209,11 +225,17 @@ def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
             "force": all(isinstance(x, float) and x <= ROUND_OFF for x in (s["force_ratio"]["old"], s["force_ratio"]["new"])),
             "moment": all(isinstance(x, float) and x <= ROUND_OFF for x in (s["moment_ratio"]["old"], s["moment_ratio"]["new"])),
         }
+        # per side: a load cancelled to round-off reads 0 (< tolerance)
+        cancelled = {(w, side): isinstance(s[f"{w}_ratio"][side], float) and s[f"{w}_ratio"][side] <= ROUND_OFF
+                     for w in quiet for side in ("old", "new")}
         for key in STAGE_KEYS:
             d = s[key]
             if same(d["old"], d["new"]) or any(quiet[w] and w in key for w in quiet):
                 continue
-            rows.append([s["name"], STAGE_NAMES.get(key, key), _fmt(d["old"]), _fmt(d["new"]), _rel(d)])
+            load = next((w for w in quiet if w in key), None)
+            old_text, new_text = (_side_fmt(d[side], load is not None and cancelled[load, side]) for side in ("old", "new"))
+            change = "cancelled" if new_text == ROUND_OFF_TEXT and old_text not in (ROUND_OFF_TEXT, "—") else _rel(d)
+            rows.append([s["name"], STAGE_NAMES.get(key, key), old_text, new_text, change])
         v = s.get("validation")
         if v:
             # the simulation's residuals are numerical noise, not a design change: their own section
@@ -233,7 +255,7 @@ def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
     # the results first (what changed), then what was changed to get there
     sections.append(("Computed parameters", [[p["name"], _fmt(p["old"]), _fmt(p["new"]), _rel(p), p["unit"]] for p in data["parameters"]],
                      ["parameter", "old", "new", "change", "unit"]))
-    sections.append(("Inputs", [[d["field"], _fmt(d["old"]), _fmt(d["new"]), d.get("unit", "")] for d in data["inputs"]],
+    sections.append(("Inputs", [[d["field"], _short(d["old"]), _short(d["new"]), d.get("unit", "")] for d in data["inputs"]],
                      ["field", "old", "new", "unit (SI)"]))
     return sections
 
