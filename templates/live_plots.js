@@ -8,9 +8,11 @@
   "use strict";
   if (typeof uPlot === "undefined") return;
   const HEIGHT = 240;
-  function fmt(v) {
+  // a value within the panel's round-off floor (draw/live.py) reads as the tables write it
+  function fmt(v, floor) {
     if (v == null) return "—";
     const a = Math.abs(v);
+    if (floor && a <= floor) return "0 (< tolerance)";
     return a !== 0 && (a < 1e-3 || a >= 1e6) ? v.toExponential(3) : (+v.toPrecision(4)).toString();
   }
   // kinematic warnings (time, label): dotted vertical lines, as in the static figure
@@ -85,7 +87,7 @@
       host.appendChild(el);
       // over time, or (d.x) over another quantity: a front's budget, each value a design marked
       const series = [{ label: d.x || "t (s)", value: (u, v) => fmt(v) }].concat(drawn.map(s => Object.assign({
-        label: s.label, stroke: s.stroke, dash: s.dash, width: s.width, value: (u, v) => fmt(v),
+        label: s.label, stroke: s.stroke, dash: s.dash, width: s.width, value: (u, v) => fmt(v, p.floor),
       }, d.x ? { spanGaps: true, points: { show: true, size: s.points ? 10 : 5, width: 1.5, fill: "#fff" } } : {},
          s.points ? { paths: () => null } : {})));
       const opts = {

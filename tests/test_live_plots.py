@@ -142,7 +142,8 @@ def test_the_papers_time_series_are_interactive_in_their_stage_styles():
     [series] = data["series"]
     k = PF._k(st, force_only)
     assert k > 0 and {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(k)
-    assert data["panels"] == [{"key": "y", "title": "", "axis": "M (N m)"}]
+    assert data["panels"] == [{"key": "y", "title": "", "axis": "M (N m)",
+                               "floor": pytest.approx(1e-9 * np.max(np.abs(force_only.analysis.moment)), rel=1e-2)}]
     _close(series["y"]["y"], force_only.analysis.moment[_kept(data, force_only.analysis.t)])
 
 
@@ -230,3 +231,23 @@ def test_a_partial_balancings_front_is_interactive_over_its_budget():
     many = [{"added_mass": m, "shaking_force": 100.0 - m} for m in np.linspace(0.0, 10.0, 1000)]
     data = LV.data(PFG.front_curves(many, "added_mass", "shaking_force", [("a design", 5.0, 50.0)]))
     assert len(data["t"]) == 1001
+
+
+def test_each_panel_carries_its_round_off_floor(study):
+    """A balanced stage's residual (1.9e-13 N m beside 11.5 N m) hovers as "0 (< tolerance)", as
+    the tables write it: each panel carries 1e-9 of its largest value over every stage, and the
+    script formats a value at or below it so."""
+    t = np.linspace(0.0, 1.0, 101)
+    panels = [{"key": "M", "title": "M (N m)", "axis": "M (N m)"}, {"key": "z", "title": "z", "axis": "z"}]
+    stages = [("unbalanced", {"M": 11.5 * np.sin(2 * np.pi * t), "z": 0 * t}),
+              ("balanced", {"M": 1.9e-13 * np.cos(2 * np.pi * t), "z": 0 * t})]
+    data = LV.data(LV.Curves(t, stages, panels, []))
+    assert [p["floor"] for p in data["panels"]] == [pytest.approx(1.15e-8, rel=1e-2), 0.0]
+    assert max(abs(v) for v in data["series"][1]["y"]["M"]) <= data["panels"][0]["floor"]
+    assert 11.5 * np.sin(2 * np.pi * 0.01) > data["panels"][0]["floor"]  # a real value stays a number
+    script = (Path(__file__).parent.parent / "templates" / "live_plots.js").read_text()
+    assert 'if (floor && a <= floor) return "0 (< tolerance)";' in script and "fmt(v, p.floor)" in script
+    # the real study's pages: the balanced stage's |F| is under its panel's floor
+    data = LV.data(LP.loads(_stages(study)))
+    force = data["panels"][0]
+    assert force["key"] == "F" and force["floor"] > 0

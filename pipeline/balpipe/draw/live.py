@@ -42,6 +42,18 @@ def _round(values) -> list[float | None]:
     return [float(f"{v + 0.0:.6g}") if np.isfinite(v) else None for v in np.asarray(values, dtype=float)]
 
 
+ROUND_OFF = 1e-9  # of a panel's largest value: what the hover shows as 0 (< tolerance), as the tables do
+
+
+def _floor(c: Curves, key: str) -> float:
+    """The panel's round-off floor: :data:`ROUND_OFF` of its largest |value| over every stage
+    (0 when it has none), below which the hover reads "0 (< tolerance)" instead of a number
+    such as 1.9e-13 N m (a balanced stage's residual)."""
+    peaks = [np.nanmax(np.abs(np.asarray(curves[key], dtype=float)), initial=0.0)
+             for _, curves in c.stages if key in curves]
+    return float(f"{ROUND_OFF * max(peaks, default=0.0):.3g}")
+
+
 def line_style(k: int) -> dict:
     """Stage ``k``'s line as the static figures draw it (:func:`balpipe.draw.figures.style`): its
     colour, dashes and width, so a style means the same stage in every figure of the page."""
@@ -84,7 +96,8 @@ def data(c: Curves) -> dict:
     if c.styles is not None:
         for one, style in zip(series, c.styles):
             one.update(line_style(style))
-    out = {"t": _round(t[k]), "series": series, "panels": c.panels, "draw": draw_order(series),
+    out = {"t": _round(t[k]), "series": series, "panels": [{**p, "floor": _floor(c, p["key"])} for p in c.panels],
+           "draw": draw_order(series),
            "marks": [[_round([tm])[0], text] for tm, text in sorted(set(c.marks))]}
     if c.choose is not None:
         out["choose"] = c.choose
