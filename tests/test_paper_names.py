@@ -185,3 +185,22 @@ def test_the_free_floating_run_says_what_the_small_masses_are_in_words():
     label = f.method_label
     assert label.startswith("simulation (pymunk)")
     assert "massless bodies" not in label and "100 % of the mechanism's mass" in label and "pymunk cannot" in label
+
+
+def test_the_index_names_each_driver_by_the_papers_symbol():
+    """results.json carries each driver's symbol, and the index's per-driver costs read
+    "θ₁ [q1]: peak …" (the paper's symbol, the spec's name beside it); a custom spec's driver
+    keeps its own name alone."""
+    from balpipe.report.site import _costs
+
+    loaded = load(SPECS / "paper002_decoupling.yaml")
+    st = study.run(loaded.spec)
+    res = results_dict(st, "paper002_decoupling.yaml", "h", simulated=False)
+    assert {a["driver"]: a["symbol"] for a in res["actuators"]} == {"q1": "θ₁", "q2": "θ₂"}
+    efforts = _costs(res, res["stages"][0], res["stages"][-1])["efforts"]
+    assert [e.split(":")[0] for e in efforts] == ["θ₁ [q1]", "θ₂ [q2]"]
+    custom = study.run(load(SPECS / "custom_four_bar_balancing.yaml").spec)
+    res = results_dict(custom, "custom_four_bar_balancing.yaml", "h", simulated=False)
+    assert res["actuators"] and all(a["symbol"] == a["driver"] for a in res["actuators"])
+    efforts = _costs(res, res["stages"][0], res["stages"][-1])["efforts"]
+    assert efforts and all("[" not in e.split(":")[0] for e in efforts)

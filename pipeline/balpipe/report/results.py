@@ -13,6 +13,7 @@ from .. import __version__
 from ..motion_outputs import motion_columns
 from ..study import Study, stage_metrics
 from . import present
+from .notation_table import names_for
 from .verdict import verdict
 
 SCHEMA_VERSION = 1
@@ -79,6 +80,9 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     # what balancing costs a motor: peak, RMS effort and peak power per stage and driver
     out["actuators"] = present.effort_rows(
         [(s.stage.name, s.stage.label, s.stage.model, s.analysis) for s in study.stages])
+    names = names_for(spec).names
+    for row in out["actuators"]:  # the paper's symbol of the driver, for the index (θ₁ for theta1)
+        row["symbol"] = names.text("driver", row["driver"])
     out["moving_mass"] = sum(b.mass_properties()[0] for b in study.unbalanced.stage.model.bodies)
     if study.balance.details:
         out["balancing_details"] = study.balance.details

@@ -142,7 +142,9 @@ def _costs(results: dict, first: dict, last: dict) -> dict:
         if a1 is None:
             continue
         u = a0["unit"]
-        efforts.append(f"{a0['driver']}: peak {num(a0['peak'])} → {num(a1['peak'])} {u}, RMS {num(a0['rms'])} → "
+        sym = a0.get("symbol") or a0["driver"]  # the paper's symbol, the spec's name beside it
+        who = sym if sym == a0["driver"] else f"{sym} [{a0['driver']}]"
+        efforts.append(f"{who}: peak {num(a0['peak'])} → {num(a1['peak'])} {u}, RMS {num(a0['rms'])} → "
                        f"{num(a1['rms'])} {u}, power {num(a0['power'])} → {num(a1['power'])} W")
     rows = (results.get("comparison") or {}).get("rows") or []
     base = next((r for r in rows if r["stage"] == first["name"]), None)
