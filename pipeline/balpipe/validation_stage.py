@@ -122,21 +122,24 @@ def _floating_run(k: int, base_inertia: float, settings: ValidationSettings | No
     return free_floating(s.stage.model, s.analysis, BASE_MASS, base_inertia, settings=settings)
 
 
-def _parallel(study: Study, workers: int, fn, args: list[tuple]) -> list:
-    """``fn(*a)`` for every ``a`` of ``args``, in that order; in ``workers`` forked processes
-    when more than one (each runs whole simulations, which are deterministic: the results do
-    not depend on ``workers``)."""
-    if workers <= 1 or len(args) <= 1:
-        return [fn(*a, study) for a in args]
+def _parallel(study: Study, workers: int, tasks: list[tuple]) -> list:
+    """``fn(*a)`` for every ``(fn, a)`` of ``tasks``, results in that order; in ``workers`` forked
+    processes when more than one, from one pool (a worker that finishes its task takes the next,
+    whatever its kind: no core waits for the slowest stage before the free-frame runs start).
+    Each task runs whole simulations, which are deterministic: the results do not depend on
+    ``workers``."""
+    if workers <= 1 or len(tasks) <= 1:
+        return [fn(*a, study) for fn, a in tasks]
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
     global _FORKED
     _FORKED = study
-    pool = ProcessPoolExecutor(max_workers=min(workers, len(args)), mp_context=multiprocessing.get_context("fork"),
+    pool = ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=multiprocessing.get_context("fork"),
                                initializer=_quiet_child)
     try:
-        out = list(pool.map(fn, *zip(*args)))
+        futures = [pool.submit(fn, *a) for fn, a in tasks]
+        out = [f.result() for f in futures]
     except BaseException:  # Ctrl-C, SIGTERM, a failure: stop the other simulations now, not at their end
         stop_now(pool)
         raise
@@ -157,29 +160,43 @@ def _quiet_child() -> None:
 
 def simulate_study(study: Study, workers: int = 1) -> None:
     """Validate every stage; failures become problems of the study (the build exits 1).
-    ``workers`` > 1: the stages' simulations run in that many forked processes (for a build that
-    leaves cores free); the results, and the order of the problems, are the same."""
-    runs = _parallel(study, workers, _stage_runs, [(k,) for k in range(len(study.stages))])
-    for s, (v, tq) in zip(study.stages, runs):
+    ``workers`` > 1: the stages' simulations, and the free-frame runs, run in that many forked
+    processes from one pool (for a build that leaves cores free); the results, and the order of
+    the problems, are the same."""
+    n = len(study.stages)
+    tasks: list[tuple] = [(_stage_runs, (k,)) for k in range(n)]
+    floating = reactionless_enabled(study)
+    if floating:
+        tasks += _floating_tasks(study, settings_for(study))
+    runs = _parallel(study, workers, tasks)
+    for s, (v, tq) in zip(study.stages, runs[:n]):
         s.validation, s.torque = v, tq
         if not v.passed:
             study.problems.append(f"pymunk validation of stage {s.stage.name!r} fails: {'; '.join(v.reasons)}")
         if not tq.passed:
             study.problems.append(f"torque-driven run of stage {s.stage.name!r} fails: {'; '.join(tq.reasons)}")
-    if reactionless_enabled(study):
-        study.reactionless = reactionless_runs(study, settings_for(study), workers=workers)
+    if floating:
+        study.reactionless = _reactionless(study, runs[n:])
 
 
-def reactionless_runs(study: Study, settings: ValidationSettings | None = None, workers: int = 1) -> Reactionless:
+def _floating_tasks(study: Study, settings: ValidationSettings | None) -> list[tuple]:
     """Every stage on the same free-floating frame: mass BASE_MASS, the inertia of a square
     plate reaching the farthest centre of mass of any stage."""
     reach = max(model_scale(s.analysis) for s in study.stages)
     base_inertia = (2.0 / 3.0) * BASE_MASS * reach**2
-    runs = _parallel(study, workers, _floating_run, [(k, base_inertia, settings) for k in range(len(study.stages))])
+    return [(_floating_run, (k, base_inertia, settings)) for k in range(len(study.stages))]
+
+
+def _reactionless(study: Study, runs: list[FreeFloating]) -> Reactionless:
     return Reactionless(
         [s.stage.label for s in study.stages], [s.stage.name for s in study.stages], runs,
         [s.stage.model for s in study.stages],
     )
+
+
+def reactionless_runs(study: Study, settings: ValidationSettings | None = None, workers: int = 1) -> Reactionless:
+    """The free-floating runs of every stage (:func:`_floating_tasks`)."""
+    return _reactionless(study, _parallel(study, workers, _floating_tasks(study, settings)))
 
 
 def timing(study: Study) -> dict:

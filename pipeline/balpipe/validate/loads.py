@@ -44,13 +44,27 @@ Defaults and why (measured with pymunk 7.3.1 on a 2-core machine)
       run with 5000 iterations (the solver's warm start is missing or wrong there; with only
       3 start-up steps at 500 the Scott-Russell "full" stage had a 2 % error at t0). Fixed
       counts do not fit all: the 2R arm diverges at 10 iterations with dead-beat joints, the
-      Scott-Russell "full" stage needs 3200 (its moment is 2 % off at 400), pymunk's C solver
-      is cheap next to the Python step loop (100 -> 800 iterations costs ~2x).
+      Scott-Russell "full" stage needs 3200 (its moment is 2 % off at 400). Cost of a step
+      (issue 23, pymunk 7.3.1, CPU time): 8 us at 100 iterations on paper 003's arm (a
+      torque-driven run of 5001 steps in 0.04 s, 0.11 s before the batched state read and the
+      drivers' targets and actuators' torques computed before the loop), 0.63 ms at 1600 on
+      the 3-RPR with counter-rotations, nearly all of it Chipmunk's solver. Where the solver converges slowly the iterations are what the stage
+      needs, not a retry: corrected Scott-Russell spec, dt 1.25e-4, one run per count
+      (``benchmarks/validation_settings.py --fixed``), moment residual of the idler loop's
+      counterweights stage 8.2e3 / 0.042 / 0.006 at 800 / 1600 / 3200 (apart below 800), of
+      its counter-rotations stage 0.010 / 0.0026 at 1600 / 3200 (apart below 1600); where it
+      converges, the residual is the step's from the first run that holds together (the
+      unbalanced stage: 1.4e-5 / 1.5e-5 at 800 to 3200, apart below 800).
     * mass floor 0.1: bodies lighter (of smaller moment) than 0.1 of the heaviest are simulated
       at that floor. A massless idler between two gears otherwise stalls the solver (floor 1e-6:
       comes apart at 3200 iterations; 1e-3: 800 iterations; 1e-2 and 0.1: 200, residuals
       4.7e-5 / 5.7e-5 in all converged cases). The motion is imposed by the drivers, so the
-      floors change internal forces only, not the measured loads.
+      floors change internal forces only, not the measured loads. Measured, not adopted: every
+      body simulated at the largest mass with its own radius of gyration converges with about
+      a quarter of the iterations on the idler loop's counterweights stages (paper000 idler loop:
+      moment residual 1.3e-3 at 800, 3.4e-4 at 1600, against 2.7e-2 at 1600 and 1.9e-3 at 3200
+      with the floor; corrected Scott-Russell spec: 2.2e-3 at 800, 3.8e-4 at 1600), but the
+      counter-rotations' meshes come apart with it at every count up to 1600.
     * tolerance 1 % of the unbalanced peaks (the reference loads, :mod:`balpipe.load_reference`, when
       given); balance_tolerance 1 % for the loads a stage claims
       to cancel (``expect``).

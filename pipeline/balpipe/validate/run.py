@@ -22,6 +22,10 @@ from .extend import start_state
 from .settings import HEALTH_LIMIT, MAX_ITERATIONS, _jumps
 from .space import SimModel, build_space
 
+#: checked samples compared with the analysis at a time (a run that comes apart ends at most
+#: this many checks, ten steps apart, after it strays)
+CHECK_BLOCK = 5
+
 @dataclass
 class SimulationRun:
     """Raw simulation output, one sample per step (``t``)."""
@@ -158,34 +162,56 @@ def simulate(
 
     nb = len(names)
     read = _BatchReader(space, everything)
-    # rows: the state before the first recorded step (k = -1), then after each recorded step
-    rec = np.empty((n + 2, len(everything), 6))
     check: dict[int, int] = {}
     if abort is not None:
         steps = np.rint((t - t0) / dt).astype(int)
         on = np.abs(t0 + steps * dt - t) <= 1e-9 * max(float(t[-1] - t0), 1e-12)
         check = {int(k): i for i, k in enumerate(steps) if on[i] and k % 10 == 0}
+    pending: list[int] = []  # checked steps whose states are not yet compared (a block at a time)
     if settle == 0:
-        read(rec, 0)
+        read()
     start = time.perf_counter()
-    iters = np.where(boost, startup_iterations, iterations)
-    drives = [(dr, targets[dr.driver.name]) for dr in sim.drives]
+    iters = np.where(boost, startup_iterations, iterations).tolist()
+    # per-step inputs as Python floats, computed before the loop with the same arithmetic
+    phases, grooves = [], []
+    for dr in sim.drives:
+        v = targets[dr.driver.name]
+        if dr.kind == "phase":  # the joint's phase, offset + scale * law (see _Drive.set)
+            phases.append((dr.constraint, (dr.offset + dr.scale * v).tolist()))
+        else:
+            grooves.append((dr, v))
+    set_phase = pymunk.GearJoint.phase.fset  # the property's setter, without pymunk's __setattr__ layer
     updates = sim.meshes + sim.carried
-    acts = [(act, np.asarray(efforts[act.name], dtype=float)) for act in sim.actuators] if efforts is not None else []
+    torques, acts = _actuator_inputs(sim.actuators, efforts, settle, n) if efforts is not None else ([], [])
+    set_torque = pymunk.Body.torque.fset
+    current = None
     for step in range(settle + n + 1):
-        space.iterations = int(iters[step])
-        for dr, v in drives:
+        if iters[step] != current:
+            current = space.iterations = iters[step]
+        for c, v in phases:
+            set_phase(c, v[step])
+        for dr, v in grooves:
             dr.set(v[step])
         for u in updates:
             u.update(dt)
         k = step - settle
+        for body, tq in torques:
+            set_torque(body, tq[step])
         for act, e in acts:
             act.apply(float(e[max(k, 0)]), dt)
         space.step(dt)
         if k >= -1:
-            read(rec, k + 1)
+            read()
         if k in check:
-            _check_apart(rec[k + 1], nb, len(bodies) if sim.floating else None, analysis.q[check[k]], abort, times[k])
+            pending.append(k)
+            if len(pending) == CHECK_BLOCK or k == n:
+                _check_apart(read.rows(pending), nb, len(bodies) if sim.floating else None,
+                             analysis.q[[check[j] for j in pending]], abort, times[pending])
+                pending.clear()
+    if pending:
+        _check_apart(read.rows(pending), nb, len(bodies) if sim.floating else None,
+                     analysis.q[[check[j] for j in pending]], abort, times[pending])
+    rec = read.rows()
     states = rec[1:]
     # momenta of the mechanism's bodies, measured with the model's masses and moments
     x, y, w = rec[:, : len(bodies), 0] - O[0], rec[:, : len(bodies), 1] - O[1], rec[:, : len(bodies), 5]
@@ -219,9 +245,11 @@ def simulate(
 
 
 class _BatchReader:
-    """Reads x, y, angle, vx, vy, w of ``bodies`` after a step with one call into Chipmunk
-    (``pymunk.batch``) instead of six attribute reads per body: ``read(rec, row)`` fills
-    ``rec[row]`` (len(bodies), 6) in the order of ``bodies``."""
+    """Records x, y, angle, vx, vy, w of ``bodies`` after each step with one call into Chipmunk
+    (``pymunk.batch``), appended to one buffer (no per-step conversion): ``read()`` records a row;
+    ``rows(ks)`` returns the rows of steps ``ks`` (row k + 1 holds the state after step k, row 0
+    the state before the first recorded step), every row by default, (len, len(bodies), 6) in the
+    order of ``bodies``."""
 
     FIELDS = (pymunk.batch.BodyFields.POSITION | pymunk.batch.BodyFields.ANGLE
               | pymunk.batch.BodyFields.VELOCITY | pymunk.batch.BodyFields.ANGULAR_VELOCITY)
@@ -231,28 +259,57 @@ class _BatchReader:
         self.buf = pymunk.batch.Buffer()
         pymunk.batch.get_space_bodies(space, pymunk.batch.BodyFields.BODY_ID, self.buf)
         ids = list(memoryview(self.buf.int_buf()).cast("P"))
+        self.buf.clear()
         self.count = len(ids)
         self.order = np.array([ids.index(b.id) for b in bodies], dtype=int)
+        self.recorded = 0
 
-    def __call__(self, rec: np.ndarray, row: int) -> None:
-        self.buf.clear()
+    def __call__(self) -> None:
         pymunk.batch.get_space_bodies(self.space, self.FIELDS, self.buf)
-        data = np.frombuffer(self.buf.float_buf(), dtype=float, count=6 * self.count).reshape(self.count, 6)
-        rec[row] = data[self.order]
+        self.recorded += 1
+
+    def rows(self, ks: list[int] | None = None) -> np.ndarray:
+        data = np.frombuffer(self.buf.float_buf(), dtype=float, count=6 * self.count * self.recorded)
+        data = data.reshape(self.recorded, self.count, 6)
+        if ks is not None:
+            data = data[np.asarray(ks, dtype=int) + 1]
+        return np.ascontiguousarray(data[:, self.order])  # C order: the sums below as before, bit for bit
 
 
-def _check_apart(state: np.ndarray, nb: int, base: int | None, q_ref: np.ndarray, abort: tuple[float, float],
-                 t: float) -> None:
-    """FloatingPointError when one of the first ``nb`` bodies of ``state`` (rows x, y, angle, ...),
-    in the frame's coordinates (the row ``base``, None: the fixed frame), is more than
-    ``abort[0]`` (rad, or times ``abort[1]`` m) from its analysed pose ``q_ref`` (nb, 3)."""
-    frame = state[base, :3] if base is not None else np.zeros(3)
-    q = state[:nb, :3]
-    rel = _rotate(np.full(nb, -frame[2]), q[:, :2] - frame[:2])
-    dev_p = float(np.max(np.abs(rel - q_ref[:, :2]))) / abort[1]
-    dev_a = float(np.max(np.abs(q[:, 2] - frame[2] - q_ref[:, 2])))
-    if not (dev_p <= abort[0] and dev_a <= abort[0]):
-        raise FloatingPointError(f"the simulation came apart at t = {t:.4g} s")
+def _actuator_inputs(actuators, efforts: dict[str, np.ndarray], settle: int, n: int):
+    """The actuators' inputs at every step (``settle`` steps before t0 at t0's effort):
+    ([(body, torque at each step)], []) when every actuator is a torque, each body's sum in the
+    actuators' order (what ``_Actuator.apply`` adds up, from the zero that pymunk resets the
+    torque to after a step, the same sums); otherwise ([], [(actuator, efforts)]), applied
+    step by step."""
+    acts = [(act, np.asarray(efforts[act.name], dtype=float)) for act in actuators]
+    if any(act.kind != "torque" for act in actuators):
+        return [], acts
+    at = np.maximum(np.arange(settle + n + 1) - settle, 0)
+    sums: dict[int, tuple[pymunk.Body, np.ndarray]] = {}
+    for act, e in acts:
+        for body, sign in ((act.body, 1.0), (act.other, -1.0)):
+            if body is None:
+                continue
+            b, total = sums.get(id(body), (body, np.zeros(len(at))))
+            sums[id(body)] = (b, total + e[at] if sign > 0 else total - e[at])
+    return [(b, total.tolist()) for b, total in sums.values()], []
+
+
+def _check_apart(states: np.ndarray, nb: int, base: int | None, q_ref: np.ndarray, abort: tuple[float, float],
+                 t: np.ndarray) -> None:
+    """FloatingPointError when one of the first ``nb`` bodies of ``states`` (m, bodies, rows x, y,
+    angle, ...), in the frame's coordinates (the row ``base``, None: the fixed frame), is more
+    than ``abort[0]`` (rad, or times ``abort[1]`` m) from its analysed pose ``q_ref`` (m, nb, 3)
+    at the times ``t`` (m,)."""
+    frame = states[:, base, :3] if base is not None else np.zeros((len(states), 3))
+    q = states[:, :nb, :3]
+    rel = _rotate(-frame[:, None, 2], q[:, :, :2] - frame[:, None, :2])
+    dev_p = np.max(np.abs(rel - q_ref[:, :, :2]), axis=(1, 2)) / abort[1]
+    dev_a = np.max(np.abs(q[:, :, 2] - frame[:, None, 2] - q_ref[:, :, 2]), axis=1)
+    bad = ~((dev_p <= abort[0]) & (dev_a <= abort[0]))
+    if bad.any():
+        raise FloatingPointError(f"the simulation came apart at t = {float(t[np.argmax(bad)]):.4g} s")
 
 
 def _relative_poses(run: SimulationRun, idx: np.ndarray | None, t: np.ndarray) -> np.ndarray:

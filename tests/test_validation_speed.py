@@ -1,0 +1,111 @@
+"""The simulation loop's shortcuts (issue 23, item 2) give the same runs, bit for bit, and the
+torque-driven run's cheaper tries keep its verdict.
+
+* Body states are appended to one pymunk.batch buffer per step and converted once at the end:
+  the recorded rows are the bodies' own states.
+* Revolute actuators' torques are summed per body before the loop (in the actuators' order, as
+  ``_Actuator.apply`` adds them up step by step): the run is the same to the last bit.
+* ``torque_driven(economic=True)`` doubles the solver iterations while a try comes apart and
+  keeps the first try that holds together only when it passes by ten times over.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from balpipe.engine import analyse
+from balpipe.validate import ValidationSettings, simulate
+from balpipe.validate import run as run_mod
+from balpipe.validate import torque as torque_mod
+from balpipe.validate.settings import ITERATIONS
+from balpipe.validate.torque import floored_model, torque_driven
+from test_validate import GRID, arm_2r, five_bar, reactionless_arm
+
+
+def _torque_run(model, **kw):
+    a = analyse(model, GRID)
+    sim_model, _ = floored_model(model, 0.1)
+    efforts = {k: np.asarray(v, dtype=float) for k, v in analyse(sim_model, GRID).efforts.items()}
+    return simulate(sim_model, a, float(GRID[1] - GRID[0]), 100, efforts=efforts, measure_with=model,
+                    mass_floor=0.1, **kw)
+
+
+def test_recorded_states_are_the_bodies_states():
+    model = five_bar()
+    a = analyse(model, GRID)
+    r = simulate(model, a, 1e-3, 100, mass_floor=0.1)
+    assert r.poses.shape == (len(r.t), len(model.bodies), 3)
+    last = np.array([(b.position.x, b.position.y, b.angle) for b in r.sim.bodies])
+    assert np.array_equal(r.poses[-1], last)
+    assert np.isfinite(r.force).all() and np.isfinite(r.moment).all()
+
+
+def test_summed_torques_give_the_step_by_step_run_bit_for_bit(monkeypatch):
+    for model in (arm_2r(), reactionless_arm()):
+        summed = _torque_run(model)
+        # the per-step path: every actuator applied in turn before each step
+        monkeypatch.setattr(run_mod, "_actuator_inputs",
+                            lambda acts, efforts, settle, n: ([], [(a, np.asarray(efforts[a.name], dtype=float))
+                                                                   for a in acts]))
+        stepwise = _torque_run(model)
+        monkeypatch.undo()
+        for name in ("force", "moment", "poses", "momentum"):
+            assert np.array_equal(getattr(summed, name), getattr(stepwise, name)), name
+        for k, v in summed.driver_error.items():
+            assert np.array_equal(v, stepwise.driver_error[k])
+
+
+def test_a_run_that_comes_apart_stops_early():
+    """The checks against the plan are compared a block at a time: the run still ends within
+    CHECK_BLOCK checks (ten steps apart) of the first one that strays."""
+    model = arm_2r()
+    a = analyse(model, GRID)
+    half = len(GRID) // 2
+    moved = a.q.copy()
+    moved[half:, :, 2] += 0.1  # the plan turns away half-way: the run strays from it there
+    with pytest.raises(FloatingPointError, match="came apart") as e:
+        simulate(model, dataclasses.replace(a, q=moved), 1e-3, 100, abort=(1e-2, 1.0))
+    t_stop = float(str(e.value).split("t = ")[1].split(" s")[0])
+    assert GRID[half] <= t_stop <= GRID[half] + 10 * 1e-3  # the first check that strays, named
+
+
+def _tries(monkeypatch, apart_below: int, pass_from: int):
+    """Record the solver iterations of each torque-driven try; tries below ``apart_below`` are made
+    to come apart and those from ``pass_from`` on pass by ten times over."""
+    real = torque_mod._torque_driven_once
+    seen = []
+
+    def fake(model, analysis, settings=None, **kw):
+        it = kw.get("iterations")
+        seen.append((it, kw.get("trial", False)))
+        r = real(model, analysis, settings, **kw)
+        if it < apart_below:
+            r.tracking_error_max, r.passed = math.inf, False
+        elif it < pass_from:
+            r.tracking_error_max = settings.tracking_tolerance / 2  # holds together, not ten times over
+        return r
+
+    monkeypatch.setattr(torque_mod, "_torque_driven_once", fake)
+    return seen
+
+
+def test_torque_tries_double_while_they_come_apart(monkeypatch):
+    model = reactionless_arm()
+    a = analyse(model, GRID)
+    seen = _tries(monkeypatch, apart_below=400, pass_from=400)
+    r = torque_driven(model, a, ValidationSettings(), economic=True, dt=1e-3, iterations=3200)
+    assert seen == [(ITERATIONS, True), (2 * ITERATIONS, True), (4 * ITERATIONS, True)]
+    assert r.passed and r.iterations == 4 * ITERATIONS
+
+
+def test_a_try_that_holds_together_without_ten_times_margin_goes_to_the_full_effort(monkeypatch):
+    model = reactionless_arm()
+    a = analyse(model, GRID)
+    seen = _tries(monkeypatch, apart_below=200, pass_from=10**9)
+    r = torque_driven(model, a, ValidationSettings(), economic=True, dt=1e-3, iterations=3200)
+    assert seen == [(ITERATIONS, True), (2 * ITERATIONS, True), (3200, False)]
+    assert r.iterations == 3200
