@@ -22,6 +22,7 @@ from ..model import Model  # noqa: E402
 from . import extremes  # noqa: E402
 from .labels import point_name_counts  # noqa: E402
 from .sleeves import guided_sliders, sleeves  # noqa: E402
+from .svgplot import panels_svg  # noqa: E402
 
 plt.rcParams.update({
     "svg.hashsalt": "balpipe",
@@ -209,27 +210,7 @@ def panels_figure(panels: list, prefix: str, marks: list | None = None, columns:
     ``columns`` panels a row, the legend of the first panel below; ``marks`` (time, label) drawn
     as dotted vertical lines in every panel. The panels share the time axis, labelled under the
     lowest panel of each column."""
-    cols = max(1, min(columns, len(panels)))
-    rows = max(1, math.ceil(len(panels) / cols))
-    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 2.8 * rows), squeeze=False, sharex=True)
-    for n, ax in enumerate(axes.flat):
-        if n >= len(panels):
-            ax.set_visible(n == 0)  # no panel at all: one empty axes, as before
-            continue
-        title, ylabel, curves = panels[n]
-        for k, (label, t, y) in enumerate(curves):
-            if y is not None:
-                ax.plot(t, y, label=literal(label), **style(k))
-        ax.set_title(literal(title), fontsize=9)
-        ax.set_ylabel(ylabel)
-        if n + cols >= len(panels):  # the lowest panel of its column
-            ax.set_xlabel("time (s)")
-            ax.tick_params(labelbottom=True)
-        for tm, text in sorted(set(marks or [])):
-            ax.axvline(tm, color="0.4", linestyle=":", linewidth=0.9)
-            ax.annotate(literal(text), (tm, 1.0), xycoords=("data", "axes fraction"), fontsize=7, ha="right", va="top", rotation=90)
-    legend_below(fig, axes[0][0])
-    return to_svg(fig, prefix)
+    return panels_svg(panels, prefix, style, marks, columns)  # written directly: no matplotlib figure
 
 
 def _global_point(pose, p) -> np.ndarray:
