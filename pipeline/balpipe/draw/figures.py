@@ -16,11 +16,13 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.layout_engine import PlaceHolderLayoutEngine  # noqa: E402
 from matplotlib.patches import Circle, Polygon  # noqa: E402
 
 from ..model import Model  # noqa: E402
 from . import extremes  # noqa: E402
 from .labels import point_name_counts  # noqa: E402
+from .layout import fixed_layout  # noqa: E402
 from .sleeves import guided_sliders, sleeves  # noqa: E402
 from .svgplot import panels_svg  # noqa: E402
 
@@ -117,6 +119,10 @@ def to_svg(fig, prefix: str) -> str:
     """Serialise a figure to SVG with no date, and every id prefixed so that several figures can
     be inlined in one page without clashing."""
     buf = io.StringIO()
+    if isinstance(fig.get_layout_engine(), PlaceHolderLayoutEngine):
+        # what fig.tight_layout() leaves behind: savefig would draw the whole figure once more
+        # (for a layout engine that does nothing); without it the SVG is byte for byte the same
+        fig.set_layout_engine(None)
     fig.savefig(buf, format="svg", metadata={"Date": None, "Creator": None})
     plt.close(fig)
     svg = buf.getvalue()
@@ -130,10 +136,10 @@ def to_svg(fig, prefix: str) -> str:
 def legend_below(fig, ax, fontsize: float = 8.5) -> None:
     """``ax``'s legend under the figure's axes, never over a curve: as many columns (at most 3) as
     the figure's width holds, the figure made taller by the legend's height, the layout above it.
-    Call it instead of ``fig.tight_layout()``."""
+    Call it instead of ``fig.tight_layout()`` (it lays the figure out with :func:`layout.fixed_layout`)."""
     handles, labels = ax.get_legend_handles_labels()
     if not labels:
-        fig.tight_layout()
+        fixed_layout(fig)
         return
     renderer = fig.canvas.get_renderer()
     W, H = fig.get_size_inches()
@@ -145,7 +151,7 @@ def legend_below(fig, ax, fontsize: float = 8.5) -> None:
         leg.remove()
     h = leg.get_window_extent(renderer).height / fig.dpi + 0.05
     fig.set_size_inches(W, H + h)
-    fig.tight_layout(rect=(0, h / (H + h), 1, 1))
+    fixed_layout(fig, rect=(0, h / (H + h), 1, 1))
 
 
 def loads_figure(stages: list, prefix: str = "loads") -> str:
@@ -181,7 +187,7 @@ def loads_figure(stages: list, prefix: str = "loads") -> str:
         lines = [f"Coincide in {', '.join(where)}: {groups}" for groups, where in notes.items()]
         fig.text(0.01, bottom, "\n".join(lines), fontsize=8, color="0.25", va="bottom", ha="left", wrap=True)
         bottom += 0.03 * len(lines) + 0.01
-    fig.tight_layout(rect=(0, bottom, 1, 1))
+    fixed_layout(fig, rect=(0, bottom, 1, 1))
     return to_svg(fig, prefix)
 
 
@@ -325,7 +331,7 @@ def mechanism_drawing(model: Model, analysis, ghosts: list[int] | None = None, t
     ax.set_ylabel("y (m)")
     if title:
         ax.set_title(literal(title), fontsize=9)
-    fig.tight_layout()
+    fixed_layout(fig)
     placed = place_names(fig, ax, model, poses[ref], span, max_cw, numbers)
     return fig, placed
 
@@ -571,5 +577,5 @@ def overlay_figure(old, new, prefix: str = "overlay", round_off: tuple[bool, boo
     for ax in axes[1]:
         ax.set_xlabel("time (s)")
     axes[0, 0].legend(fontsize=8)
-    fig.tight_layout()
+    fixed_layout(fig)
     return to_svg(fig, prefix)

@@ -45,12 +45,13 @@ def _renderer():
 
 
 @lru_cache(maxsize=4096)
-def text_size(text: str, size: float) -> tuple[float, float]:
-    """Width and height (pt) of ``text`` in DejaVu Sans at ``size`` pt, as matplotlib lays it out."""
+def text_size(text: str, size: float, math: bool = False) -> tuple[float, float]:
+    """Width and height (pt) of ``text`` in DejaVu Sans at ``size`` pt, as matplotlib lays it out
+    (``math``: as mathtext)."""
     from matplotlib.font_manager import FontProperties
 
     prop = FontProperties(family="DejaVu Sans", size=size)
-    w, h, _ = _renderer().get_text_width_height_descent(text, prop, ismath=False)
+    w, h, _ = _renderer().get_text_width_height_descent(text, prop, ismath=math)
     return float(w), float(h)
 
 
