@@ -150,8 +150,8 @@ def test_legends_never_cover_the_curves(monkeypatch):
              [(f"J{j}, revolute: |F| (N)", "|F| (N)", [(n, a.t, a.efforts["crank"] ** 2) for n, a in zip(names, an)])
               for j in range(7)]]
     for panels, columns in zip(small, (1, 3)):
-        lay = svgplot.layout(panels, columns)
-        assert lay.legend is not None and lay.entries == [(n, k) for k, n in enumerate(names)]
+        lay = svgplot.layout(panels, columns, styles=figures.style)
+        assert lay.legend is not None and lay.entries == [(n, figures.style(k)) for k, n in enumerate(names)]
         assert all(lay.legend.y0 >= box.y1 for box in lay.areas)  # under every plotting area
         assert lay.legend.x0 >= 0 and lay.legend.x1 <= lay.width and lay.legend.y1 <= lay.height
         n = lay.legend_cols  # as many columns (at most 3) as fit, not one long column

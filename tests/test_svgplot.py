@@ -65,3 +65,27 @@ def test_the_figure_has_every_panel_label_curve_and_legend_entry_and_is_determin
     w, h = map(float, re.search(r'viewBox="0 0 ([\d.]+) ([\d.]+)"', svg).groups())
     xs = [float(v) for v in re.findall(r'x="([-\d.]+)"', svg)]
     assert min(xs) >= 0 and max(xs) <= w
+
+
+def test_the_loads_figure_has_four_panels_markers_pymunk_curves_and_the_coincidence_note():
+    from types import SimpleNamespace
+
+    t = np.linspace(0.0, 0.5, 101)
+    F = np.stack([np.sin(9 * t), np.cos(9 * t)], axis=1)
+    stages = [("unbalanced", SimpleNamespace(t=t, force=F, moment=np.sin(5 * t)), (t, F * 1.001, np.sin(5 * t))),
+              ("counterweights", SimpleNamespace(t=t, force=0 * F, moment=2 * np.sin(5 * t)), None),
+              ("counter-rotations", SimpleNamespace(t=t, force=0 * F, moment=0 * t), None)]
+    svg = figures.loads_figure(stages)
+    assert svg == figures.loads_figure(stages)  # the same bytes again
+    assert svg.count('<g id="loads-axes_') == 4 and ">time (s)</text>" in svg
+    for title in ("Shaking force Fx (N)", "Shaking force Fy (N)", "Shaking force |F| (N)", "Shaking moment M (N m)"):
+        assert f">{title}</text>" in svg
+    assert ">unbalanced (pymunk)</text>" in svg  # in the legend
+    assert "Coincide in force Fx, force Fy, force |F|: counterweights = counter-rotations" in svg
+    # markers at matplotlib's markevery samples of each stage: 12 + 1 in the legend, per stage and panel
+    for k in range(3):
+        start, every = figures.marked(k, len(t))["markevery"]
+        n = len(t[start::every])
+        d = svgplot.marker_path(figures.marker(k), 4.5)
+        ident = re.search(rf'<path id="(loads-m[0-9a-f]+)" d="{re.escape(d)}"', svg).group(1)
+        assert svg.count(f'href="#{ident}"') == 2 * (4 * n + 1)  # xlink:href and href

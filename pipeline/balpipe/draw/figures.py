@@ -155,40 +155,33 @@ def legend_below(fig, ax, fontsize: float = 8.5) -> None:
 
 
 def loads_figure(stages: list, prefix: str = "loads") -> str:
-    """Fx, Fy, |F| and M over time, every stage on the same axes (paper 000 Fig. 4 style).
-    ``stages``: list of (label, Analysis, simulated or None) with simulated = (t, F, M)."""
-    fig, axes = plt.subplots(2, 2, figsize=(11.0, 6.4), sharex=True)
+    """Fx, Fy, |F| and M over time, every stage on the same axes (paper 000 Fig. 4 style), each
+    stage in its line style with its markers (:func:`marked`), its pymunk run dotted; a note says
+    which curves coincide. ``stages``: list of (label, Analysis, simulated or None) with
+    simulated = (t, F, M). Written by :func:`svgplot.panels_svg` (no matplotlib figure)."""
     panels = [
-        (axes[0, 0], "Shaking force Fx (N)", lambda F, M: F[:, 0]),
-        (axes[0, 1], "Shaking force Fy (N)", lambda F, M: F[:, 1]),
-        (axes[1, 0], "Shaking force |F| (N)", lambda F, M: np.hypot(F[:, 0], F[:, 1])),
-        (axes[1, 1], "Shaking moment M (N m)", lambda F, M: M),
+        ("Shaking force Fx (N)", lambda F, M: F[:, 0]),
+        ("Shaking force Fy (N)", lambda F, M: F[:, 1]),
+        ("Shaking force |F| (N)", lambda F, M: np.hypot(F[:, 0], F[:, 1])),
+        ("Shaking moment M (N m)", lambda F, M: M),
     ]
     notes: dict[str, list[str]] = {}  # coinciding groups -> the panels where they coincide
-    for ax, title, fn in panels:
+    for title, fn in panels:
         same = coinciding([(label, fn(an.force, an.moment)) for label, an, _ in stages])
         if same:
             notes.setdefault("; ".join(same), []).append(title.split(" (")[0].replace("Shaking ", ""))
-    for k, (label, an, sim) in enumerate(stages):
-        for ax, title, fn in panels:
-            ax.plot(an.t, fn(an.force, an.moment), label=literal(label), **marked(k, len(an.t)))
+    drawn = []
+    for title, fn in panels:
+        curves = []
+        for k, (label, an, sim) in enumerate(stages):
+            curves.append((label, an.t, fn(an.force, an.moment), marked(k, len(an.t))))
             if sim is not None:
                 ts, Fs, Ms = sim
-                ax.plot(ts, fn(Fs, Ms), color=SIM_COLORS[k % len(SIM_COLORS)], linestyle=":",
-                        linewidth=1.0, label=literal(f"{label} (pymunk)"))
-            ax.set_title(literal(title), fontsize=9)
-    for ax in axes[1]:
-        ax.set_xlabel("time (s)")
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    ncol = min(len(labels), 3)
-    fig.legend(handles, labels, loc="lower center", ncol=ncol, fontsize=9.5, frameon=False)
-    bottom = 0.04 + 0.035 * math.ceil(len(labels) / ncol)
-    if notes:
-        lines = [f"Coincide in {', '.join(where)}: {groups}" for groups, where in notes.items()]
-        fig.text(0.01, bottom, "\n".join(lines), fontsize=8, color="0.25", va="bottom", ha="left", wrap=True)
-        bottom += 0.03 * len(lines) + 0.01
-    fixed_layout(fig, rect=(0, bottom, 1, 1))
-    return to_svg(fig, prefix)
+                curves.append((f"{label} (pymunk)", ts, fn(Fs, Ms),
+                               {"color": SIM_COLORS[k % len(SIM_COLORS)], "linestyle": ":", "linewidth": 1.0}))
+        drawn.append((title, "", curves))
+    lines = [f"Coincide in {', '.join(where)}: {groups}" for groups, where in notes.items()]
+    return panels_svg(drawn, prefix, style, columns=2, cell=(5.5 * 72, 3.2 * 72), legend_font=9.5, notes=lines)
 
 
 def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = None,

@@ -20,6 +20,7 @@ matplotlib's SVG; numbers are rounded to 2 decimals, so the output is determinis
 from __future__ import annotations
 
 import math
+import zlib
 from functools import lru_cache
 from typing import NamedTuple
 from xml.sax.saxutils import escape
@@ -27,7 +28,7 @@ from xml.sax.saxutils import escape
 import numpy as np
 
 PANEL_W, PANEL_H = 4.6 * 72, 2.8 * 72  # a panel's cell (pt), as panels_figure's figsize per panel
-FONT, TITLE_FONT, LEGEND_FONT, MARK_FONT = 9.0, 9.0, 8.5, 7.0
+FONT, TITLE_FONT, LEGEND_FONT, MARK_FONT, NOTE_FONT = 9.0, 9.0, 8.5, 7.0, 8.0
 TICK, TICK_PAD, LABEL_PAD, TITLE_PAD, EDGE = 3.5, 3.5, 4.0, 6.0, 4.0  # matplotlib's rcParams (pt)
 LINE_W = 0.8  # spines, ticks and grid lines
 GRID = "#b0b0b0"
@@ -178,12 +179,14 @@ class Layout(NamedTuple):
     texts: list  # Box of every title, axis label and tick label (for the tests: all inside the figure)
     legend: Box | None
     legend_cols: int
-    entries: list  # (label, stage index) of the legend
+    entries: list  # (label, line style) of the legend
+    legend_font: float = LEGEND_FONT
+    notes: list = []  # (x, y, line) of the notes' lines, left aligned, between the panels and the legend
 
 
 def _limits(curves: list) -> tuple[float, float, float, float]:
-    xs = [np.asarray(t, dtype=float) for _, t, y in curves if y is not None]
-    ys = [np.asarray(y, dtype=float) for _, t, y in curves if y is not None]
+    xs = [np.asarray(c[1], dtype=float) for c in curves if c[2] is not None]
+    ys = [np.asarray(c[2], dtype=float) for c in curves if c[2] is not None]
     xs = [a[np.isfinite(a)] for a in xs]
     ys = [a[np.isfinite(a)] for a in ys]
     if not any(a.size for a in ys):
@@ -192,14 +195,22 @@ def _limits(curves: list) -> tuple[float, float, float, float]:
             min(float(a.min()) for a in ys if a.size), max(float(a.max()) for a in ys if a.size))
 
 
-def layout(panels: list, columns: int, marks: list | None = None) -> Layout:
-    """The fixed layout of :func:`panels_svg`: panels in rows of ``columns``, each cell as wide and
-    high as ``panels_figure``'s figure per panel; a cell's margins are the sizes of its title, y
-    label and tick labels (each column's left margin the widest of the column, each row's top
-    and bottom the same), the legend's rows below the last row."""
+def curve_style(curve: tuple, k: int, styles) -> dict:
+    """A curve's line style: its own (a fourth item) or stage ``k``'s, ``styles(k)``."""
+    return curve[3] if len(curve) > 3 else styles(k)
+
+
+def layout(panels: list, columns: int, marks: list | None = None, styles=None, cell: tuple | None = None,
+           legend_font: float = LEGEND_FONT, notes: list | tuple = ()) -> Layout:
+    """The fixed layout of :func:`panels_svg`: panels in rows of ``columns``, each ``cell`` (w, h)
+    pt (default: ``panels_figure``'s figure per panel); a cell's margins are the sizes of its
+    title, y label and tick labels (each column's left margin the widest of the column, each
+    row's top and bottom the same); below the last row the ``notes`` (lines wrapped to the
+    width) and the legend's rows."""
+    cw, ch = cell or (PANEL_W, PANEL_H)
     cols = max(1, min(columns, len(panels)))
     rows = max(1, math.ceil(len(panels) / cols))
-    W = PANEL_W * cols
+    W = cw * cols
     fh = text_size("0", FONT)[1]
     th = text_size("0", TITLE_FONT)[1]
     # the axes first (ticks depend on the lengths, the margins on the ticks: one refinement)
@@ -209,29 +220,48 @@ def layout(panels: list, columns: int, marks: list | None = None) -> Layout:
     bottom = [bottom_low if any(lows[n] for n in range(r * cols, min(len(panels), (r + 1) * cols))) else EDGE + 2 * fh
               for r in range(rows)]
     limits = [_limits(p[2]) for p in panels] or [(0.0, 1.0, 0.0, 1.0)]
-    height = [PANEL_H - top - bottom[r] for r in range(rows)]
+    height = [ch - top - bottom[r] for r in range(rows)]
     yaxes = [axis(lim[2], lim[3], height[n // cols], 2.0 * FONT) for n, lim in enumerate(limits)]
     left = []
     for c in range(cols):
         w = 0.0
         for n in range(c, len(limits), cols):
             w = max([w] + [text_size(s, FONT)[0] for s in yaxes[n].labels])
-        left.append(2 * EDGE + fh + LABEL_PAD + w + TICK_PAD + TICK)
+        labelled = any(panels[n][1] for n in range(c, len(panels), cols))
+        left.append(2 * EDGE + (fh + LABEL_PAD if labelled else 0.0) + w + TICK_PAD + TICK)
     areas, axes_, texts = [], [], []
     for n, lim in enumerate(limits):
         r, c = divmod(n, cols)
-        cx, cy = c * PANEL_W, r * PANEL_H
-        xa = axis(lim[0], lim[1], PANEL_W - left[c] - 12.0, 3.0 * FONT)
+        cx, cy = c * cw, r * ch
+        xa = axis(lim[0], lim[1], cw - left[c] - 12.0, 3.0 * FONT)
         last = text_size(xa.labels[-1], FONT)[0] / 2 if xa.labels else 0.0
         right = max(12.0, last + EDGE)
-        box = Box(cx + left[c], cy + top, cx + PANEL_W - right, cy + PANEL_H - bottom[r])
+        box = Box(cx + left[c], cy + top, cx + cw - right, cy + ch - bottom[r])
         areas.append(box)
         axes_.append((xa, yaxes[n]))
         if n < len(panels):
             texts += _text_boxes(panels[n], box, xa, yaxes[n], lows[n])
-    leg, ncol, entries = _legend(panels[0][2] if panels else [], W, rows * PANEL_H)
-    H = rows * PANEL_H + (leg.y1 - leg.y0 + EDGE if leg else 0.0)
-    return Layout(W, H, areas, axes_, texts, leg, ncol, entries)
+    top = rows * ch
+    lines = []
+    for note in notes:
+        for line in _wrap(note, NOTE_FONT, W - 4 * EDGE):
+            top += 1.25 * NOTE_FONT  # a line of the notes
+            lines.append((2 * EDGE, top, line))
+    styles = styles or (lambda k: {})
+    leg, ncol, entries = _legend(panels[0][2] if panels else [], W, top, styles, legend_font)
+    H = top + (leg.y1 - leg.y0 + EDGE if leg else EDGE if lines else 0.0)
+    return Layout(W, H, areas, axes_, texts, leg, ncol, entries, legend_font, lines)
+
+
+def _wrap(text: str, size: float, width: float) -> list[str]:
+    """``text`` in lines no wider than ``width`` pt (at word breaks; a longer word alone)."""
+    lines: list[str] = []
+    for word in text.split(" "):
+        if lines and text_size(lines[-1] + " " + word, size)[0] <= width:
+            lines[-1] += " " + word
+        else:
+            lines.append(word)
+    return lines
 
 
 def _text_boxes(panel, box: Box, xa: Axis, ya: Axis, low: bool) -> list:
@@ -257,33 +287,40 @@ def _text_boxes(panel, box: Box, xa: Axis, ya: Axis, low: bool) -> list:
     return out
 
 
-def _legend(curves: list, W: float, top: float) -> tuple[Box | None, int, list]:
+def _legend(curves: list, W: float, top: float, styles, fs: float = LEGEND_FONT) -> tuple[Box | None, int, list]:
     """The legend's box under the panels (``top``), centred, in as many columns (at most 3) as fit
     in 98 % of ``W``; the entries are the first panel's curves (one per stage that has one)."""
-    entries = [(label, k) for k, (label, _, y) in enumerate(curves) if y is not None]
+    entries = [(c[0], curve_style(c, k, styles)) for k, c in enumerate(curves) if c[2] is not None]
     if not entries:
         return None, 0, []
     for ncol in range(min(len(entries), 3), 0, -1):
-        w = _legend_width(entries, ncol)
+        w = _legend_width(entries, ncol, fs)
         if ncol == 1 or w <= 0.98 * W:
             break
     rows = math.ceil(len(entries) / ncol)
-    fh = text_size("0", LEGEND_FONT)[1]
-    h = rows * fh + (rows - 1) * 0.5 * LEGEND_FONT + 2 * 0.4 * LEGEND_FONT
+    fh = text_size("0", fs)[1]
+    h = rows * fh + (rows - 1) * 0.5 * fs + 2 * 0.4 * fs
     x0 = 0.5 * (W - w)
     return Box(x0, top + EDGE, x0 + w, top + EDGE + h), ncol, entries
 
 
 def _legend_columns(entries: list, ncol: int) -> list:
-    rows = math.ceil(len(entries) / ncol)
-    return [entries[c * rows:(c + 1) * rows] for c in range(ncol) if entries[c * rows:(c + 1) * rows]]
+    """The entries in ``ncol`` columns as matplotlib's legend fills them: in order, the first
+    ``len % ncol`` columns one entry longer."""
+    n, out, start = len(entries), [], 0
+    for c in range(ncol):
+        size = n // ncol + (1 if c < n % ncol else 0)
+        if size:
+            out.append(entries[start:start + size])
+        start += size
+    return out
 
 
-def _legend_width(entries: list, ncol: int) -> float:
-    handle = (2.0 + 0.8) * LEGEND_FONT
+def _legend_width(entries: list, ncol: int, fs: float = LEGEND_FONT) -> float:
+    handle = (2.0 + 0.8) * fs
     cols = _legend_columns(entries, ncol)
-    widths = [handle + max(text_size(label, LEGEND_FONT)[0] for label, _ in col) for col in cols]
-    return sum(widths) + 2.0 * LEGEND_FONT * (len(cols) - 1) + 2 * 0.4 * LEGEND_FONT
+    widths = [handle + max(text_size(label, fs)[0] for label, _ in col) for col in cols]
+    return sum(widths) + 2.0 * fs * (len(cols) - 1) + 2 * 0.4 * fs
 
 
 def _px(v: float, a: Axis, p0: float, p1: float) -> float:
@@ -320,13 +357,14 @@ def _polyline(x: np.ndarray, y: np.ndarray, attrs: str) -> str:
     return f'<path d="{" ".join(parts)}" {attrs}/>' if parts else ""
 
 
-def panels_svg(panels: list, prefix: str, styles, marks: list | None = None, columns: int = 3) -> str:
+def panels_svg(panels: list, prefix: str, styles, marks: list | None = None, columns: int = 3,
+               cell: tuple | None = None, legend_font: float = LEGEND_FONT, notes: list | tuple = ()) -> str:
     """The SVG of :func:`balpipe.draw.figures.panels_figure`: ``panels`` (title, y label, curves),
     curves (label, t, values or None) one per stage, stage k drawn in ``styles(k)`` (a
     matplotlib line style dict: color, linestyle, linewidth); every element's id prefixed with
     ``prefix`` (several figures in one page), each panel a group ``{prefix}-axes_{n}``."""
-    lay = layout(panels, columns, marks)
-    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{_fmt(lay.width)}pt" height="{_fmt(lay.height)}pt" '
+    lay = layout(panels, columns, marks, styles, cell, legend_font, notes)
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="{_fmt(lay.width)}pt" height="{_fmt(lay.height)}pt" '
            f'viewBox="0 0 {_fmt(lay.width)} {_fmt(lay.height)}" version="1.1">',
            f'<g id="{prefix}-figure_1">',
            f'<rect x="0" y="0" width="{_fmt(lay.width)}" height="{_fmt(lay.height)}" fill="#ffffff"/>']
@@ -337,8 +375,10 @@ def panels_svg(panels: list, prefix: str, styles, marks: list | None = None, col
         low = n + cols >= len(panels)
         out.append(_frame(Panel(*panel), lay.areas[n], *lay.axes[n], low, prefix, n + 1, styles,
                           sorted(set(marks or []))))
+    for x, y, line in lay.notes:
+        out.append(_text(x, y, line, NOTE_FONT, "start", ' fill="#404040"'))
     if lay.legend is not None:
-        out.append(_legend_svg(lay, prefix, styles))
+        out.append(_legend_svg(lay, prefix))
     out.append("</g>\n</svg>\n")
     return "\n".join(out)
 
@@ -356,11 +396,17 @@ def _frame(panel: Panel, box: Box, xa: Axis, ya: Axis, low: bool, prefix: str, n
         py = _fmt(_px(t, ya, box.y1, box.y0))
         g.append(f'<path d="M{_fmt(box.x0)} {py}H{_fmt(box.x1)}" {grid}/>')
     columns = int(COLUMNS_PER_PT * (box.x1 - box.x0))
-    for k, (label, t, y) in enumerate(panel.curves):
-        if y is None:
+    for k, curve in enumerate(panel.curves):
+        if curve[2] is None:
             continue
-        t, y = decimate(np.asarray(t, dtype=float), np.asarray(y, dtype=float), xa.lo, xa.hi, columns)
-        g.append(_polyline(_px(t, xa, box.x0, box.x1), _px(y, ya, box.y1, box.y0), _line_attrs(styles(k))))
+        st = curve_style(curve, k, styles)
+        t0, y0 = np.asarray(curve[1], dtype=float), np.asarray(curve[2], dtype=float)
+        t, y = decimate(t0, y0, xa.lo, xa.hi, columns)
+        g.append(_polyline(_px(t, xa, box.x0, box.x1), _px(y, ya, box.y1, box.y0), _line_attrs(st)))
+        if st.get("marker"):  # at matplotlib's markevery (start, every) of the samples
+            start, every = st.get("markevery", (0, 1))
+            g += _markers(_px(t0[start::every], xa, box.x0, box.x1), _px(y0[start::every], ya, box.y1, box.y0), st,
+                          prefix)
     for tm, text in marks:
         px = _px(tm, xa, box.x0, box.x1)
         g.append(f'<path d="M{_fmt(px)} {_fmt(box.y1)}V{_fmt(box.y0)}" stroke="#666666" stroke-width="0.9" '
@@ -397,20 +443,55 @@ def _frame(panel: Panel, box: Box, xa: Axis, ya: Axis, low: bool, prefix: str, n
     return "\n".join(x for x in g if x)
 
 
-def _legend_svg(lay: Layout, prefix: str, styles) -> str:
-    """The legend: a line sample in the stage's style and the label, column by column."""
+def _legend_svg(lay: Layout, prefix: str) -> str:
+    """The legend: a line sample in the curve's style (with one marker, if it has markers) and the
+    label, column by column."""
     box = lay.legend
-    fs = LEGEND_FONT
+    fs = lay.legend_font
     fh = text_size("0", fs)[1]
     g = [f'<g id="{prefix}-legend_1">']
     x = box.x0 + 0.4 * fs
     for col in _legend_columns(lay.entries, lay.legend_cols):
         y = box.y0 + 0.4 * fs
-        for label, k in col:
+        for label, st in col:
             mid = y + 0.5 * fh
-            g.append(f'<path d="M{_fmt(x)} {_fmt(mid)}H{_fmt(x + 2.0 * fs)}" {_line_attrs(styles(k))}/>')
+            g.append(f'<path d="M{_fmt(x)} {_fmt(mid)}H{_fmt(x + 2.0 * fs)}" {_line_attrs(st)}/>')
+            if st.get("marker"):
+                g += _markers(np.array([x + fs]), np.array([mid]), st, prefix)
             g.append(_text(x + 2.8 * fs, mid + 0.35 * fh, label, fs, "start"))
             y += fh + 0.5 * fs
         x += 2.8 * fs + max(text_size(label, fs)[0] for label, _ in col) + 2.0 * fs
     g.append("</g>")
     return "\n".join(g)
+
+
+@lru_cache(maxsize=64)
+def marker_path(marker: str, size: float) -> str:
+    """SVG path data of a matplotlib marker ``size`` pt wide, centred on (0, 0), y down: the
+    marker's own path (:class:`matplotlib.markers.MarkerStyle`), so every shape is matplotlib's."""
+    from matplotlib.markers import MarkerStyle
+    from matplotlib.path import Path
+    from matplotlib.transforms import Affine2D
+
+    ms = MarkerStyle(marker)
+    path = ms.get_path().transformed(ms.get_transform() + Affine2D().scale(size, -size))
+    out = []
+    for verts, code in path.iter_segments(simplify=False, curves=True):
+        pts = " ".join(f"{_fmt(v)}" for v in verts)
+        out.append({Path.MOVETO: "M", Path.LINETO: "L", Path.CURVE3: "Q", Path.CURVE4: "C"}.get(code, "Z")
+                   + ("" if code == Path.CLOSEPOLY else pts))
+    return "".join(out)
+
+
+def _markers(x: np.ndarray, y: np.ndarray, st: dict, prefix: str) -> list[str]:
+    """Markers of style ``st`` (marker, markersize, hollow: facecolor none) at (x, y), each a
+    ``<use>`` of one definition, as matplotlib writes them."""
+    d = marker_path(st["marker"], float(st.get("markersize", 6.0)))
+    colour = _colour(st["color"])
+    face = st.get("markerfacecolor", st["color"])
+    fill = "none" if face == "none" else _colour(face)
+    ident = f"{prefix}-m{zlib.crc32((d + colour + fill).encode()):08x}"
+    out = [f'<defs><path id="{ident}" d="{d}" fill="{fill}" stroke="{colour}" stroke-width="1"/></defs>']
+    out += [f'<use xlink:href="#{ident}" href="#{ident}" x="{_fmt(a)}" y="{_fmt(b)}"/>'
+            for a, b in zip(x.tolist(), y.tolist()) if math.isfinite(a) and math.isfinite(b)]
+    return out
