@@ -71,3 +71,10 @@ def studies():
         return cache[name]
 
     return get
+
+
+def pytest_addoption(parser):
+    parser.addoption(
+        "--built-site", metavar="DIR", default=None,
+        help="run the browser's page checks (tests/test_site_browser.py, the tests named built_site) "
+             "on every HTML page of a site already built into DIR (balpipe build specs/ -o DIR)")

@@ -326,6 +326,39 @@ def test_the_headline_shows_the_trajectory_of_the_papers_figures(paper):
     assert {s.stage.group for s in shown_stages(st)} == {"P15P7"}
 
 
+def test_the_verdict_judges_case_2_whose_reductions_the_paper_publishes(paper, tmp_path):
+    """Issue 22: the paper's published reductions are case 2 against case 1, so the headline
+    verdict (results.json and the index) is case 2's on every trajectory, not that of case 3 after
+    it; the index and the page say which case it is; every stage keeps its own verdict."""
+    from balpipe.build import Outcome
+    from balpipe.report import site
+    from balpipe.report.results import results_dict
+
+    spec, st, p = paper
+    res = results_dict(st, "paper003_com_planning.yaml", "h", False)
+    v = res["verdict"]
+    assert all(g["final"].endswith("_com_bang_bang_phi_opt") and g["declared"] for g in v["motions"])
+    assert len(v["motions"]) == len(spec.balancing.trajectories)
+    case2 = [s for s in res["stages"] if s["name"].endswith("_com_bang_bang_phi_opt")]
+    assert v["force"]["ratio"] == max(s["force_ratio"] for s in case2)
+    assert v["force"]["ratio_min"] == min(s["force_ratio"] for s in case2)
+    assert v["moment"]["ratio"] == max(s["moment_ratio"] for s in case2)
+    assert all(s["name"] in v["stages"] for s in res["stages"] if s["name"].endswith("_com_trapezoidal"))
+    out = tmp_path / "site"
+    (out / "paper003_com_planning").mkdir(parents=True)
+    (out / "paper003_com_planning" / "index.html").write_text("", encoding="utf-8")
+    site.write_site(out, [Outcome("paper003_com_planning.yaml", "paper003_com_planning", "ok", results=res)])
+    html = (out / "index.html").read_text(encoding="utf-8")
+    cell = html[html.index('data-spec="paper003_com_planning"'):]
+    assert "on P15P7 · case 2: CoM bang-bang + φ optimised, the stage the paper publishes" in cell
+    assert f"force {v['force']['text']}" in cell and "reduced by" in v["force"]["text"]
+    from balpipe.report.page import render_page
+    page = render_page(st, res, "text")
+    box = page[page.index('id="verdict"'):page.index("Per stage")]
+    assert "(P15P7 · case 2: CoM bang-bang + φ optimised against P15P7 · case 1" in box
+    assert "the stage whose numbers the paper publishes" in box
+
+
 def test_figs_3_and_4_draw_the_papers_cases_in_the_papers_line_styles_which_are_the_pages(paper, monkeypatch):
     """Figs. 3-4: case 1 black full, case 2 black dashed, case 3 grey full (the paper's captions),
     and each of these stages has that style in every figure of the page (the style legend)."""
@@ -373,6 +406,8 @@ def test_the_index_names_the_main_motion_its_costs_come_from(tmp_path):
     finally:
         os.chdir(cwd)
     index = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
-    assert "P15P7 · case 3: CoM trapezoidal (main motion):" in index
+    # the headline stage is case 2, whose reductions the paper publishes (Stage.headline)
+    assert "P15P7 · case 2: CoM bang-bang + φ optimised (main motion):" in index
     page = (tmp_path / "site" / "two" / "index.html").read_text(encoding="utf-8")
-    assert "Design summary: P15P7 · case 3: CoM trapezoidal against P15P7 · case 1: end-effector quintic" in page
+    assert ("Design summary: P15P7 · case 2: CoM bang-bang + φ optimised against P15P7 · case 1: end-effector quintic"
+            in page)

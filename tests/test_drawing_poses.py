@@ -187,3 +187,51 @@ def test_the_player_names_the_platform_joints_first(studies):
     s = studies("paper000_rpr3_idler_loop.yaml").stages[0]
     joints = [j[3] for j in player._labels(s.stage.model, {})["joints"]]
     assert joints.index("C1") < joints.index("C") and joints.index("C3") < joints.index("C")
+
+
+def test_every_named_point_is_named_once_and_repeated_names_are_left_off(studies):
+    """Issue 22: each 3-RPR leg's cylinder 'tip' and piston 'B' (the same name on every leg, three
+    places) are left unlabelled, in the drawing and the player; every other name appears once,
+    the pivots and the platform's joints included."""
+    from collections import Counter
+
+    from balpipe.draw import player
+
+    for spec in ("paper000_rpr3_idler_loop.yaml", "paper000_rpr3_scott_russell.yaml"):
+        s = studies(spec).stages[0]
+        fig, placed = figures.mechanism_drawing(s.stage.model, s.analysis, [])
+        figures.plt.close(fig)
+        texts = Counter(p.request.text for p in placed if p.request.kind in ("pivot", "joint"))
+        assert {"A1", "A2", "A3", "C1", "C2", "C3"} <= set(texts)
+        assert "tip" not in texts and "B" not in texts
+        assert all(n == 1 for n in texts.values()), texts
+        poses = np.asarray(s.analysis.extra["frame_pose"], dtype=float)
+        d = player.player_data([{"label": "x", "model": s.stage.model, "t": s.analysis.t,
+                                 "base": np.zeros((len(poses), 3)), "poses": poses}])["stages"][0]
+        names = {j[3] for j in d["names"]["joints"]}
+        assert "tip" not in names and "B" not in names and {"C1", "C2", "C3", "P"} <= names
+
+
+def test_a_name_two_bodies_share_at_one_place_is_named_once():
+    """A crank's B and the rod's B at the same pin: one place, one label 'B'; the rod's far end,
+    named by the rod alone, is labelled too."""
+    from balpipe.draw import labels
+
+    crank_ = Body("crank", 1.0, (0.05, 0.0), 0.001, {"O": (0.0, 0.0), "B": (0.1, 0.0)}, outline=("O", "B"))
+    rod = Body("rod", 1.0, (0.1, 0.0), 0.001, {"B": (0.0, 0.0), "D": (0.2, 0.0)}, outline=("B", "D"))
+    model = Model("two", (crank_, rod), (), (), {"crank": (0.0, 0.0, 0.0), "rod": (0.1, 0.0, 0.3)},
+                  frame_points={"O": (0.0, 0.0)})
+    row = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.3]])
+    places = labels.point_places(model, row, 0.3)
+    assert sorted(n for n, _ in places) == ["B", "D"] and labels.repeated_names(places) == set()
+    requests, _, keep = figures.name_requests(model, row, 0.3, 1.0, {})
+    assert [t for t, _, k in requests if k in ("pivot", "joint")] == ["O", "B", "D"]
+    # two rods, each with its own 'D' at different places: 'D' names no one point
+    rod2 = Body("rod2", 1.0, (0.1, 0.0), 0.001, {"B": (0.0, 0.0), "D": (0.2, 0.0)}, outline=("B", "D"))
+    model = Model("three", (crank_, rod, rod2), (), (),
+                  {"crank": (0.0, 0.0, 0.0), "rod": (0.1, 0.0, 0.3), "rod2": (0.1, 0.0, -0.3)},
+                  frame_points={"O": (0.0, 0.0)})
+    row = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.3], [0.1, 0.0, -0.3]])
+    requests, _, keep = figures.name_requests(model, row, 0.3, 1.0, {})
+    assert [t for t, _, k in requests if k in ("pivot", "joint")] == ["O", "B"]
+    assert len([c for c, r in keep if r is None]) == 3  # the unnamed ends' markers are still kept clear

@@ -182,3 +182,51 @@ def test_the_3rpr_paper_figure_is_interactive_with_every_stage_in_its_page_style
         _close(series["y"]["x"], s.analysis.force[k, 0])
         _close(series["y"]["M"], s.analysis.moment[k])
         assert {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(style_index(st.stages, s))
+
+
+def test_a_figure_of_many_joints_shows_the_largest_load_first(study, monkeypatch):
+    """Issue 22: past MANY_JOINTS panels the joint figure is shown a joint at a time (``choose``),
+    first the panel of the largest force over every stage (a larger torque, in N m, does not
+    count against forces); a figure of few joints shows every panel."""
+    assert "choose" not in LV.data(LP.joints(_stages(study)))  # the slider-crank's 4 joint loads
+    t = np.linspace(0.0, 1.0, 11)
+    n = LP.MANY_JOINTS + 2
+    # n revolutes with |F| peaks 1 .. n N, but J2's 50 N the largest; a gear mesh of 1000 N m
+    loads = [(f"J{i}", "F", "revolute", "N", (50.0 if i == 2 else i + 1) * np.sin(np.pi * t)) for i in range(n)]
+    loads.append(("mesh", "T", "gear mesh", "N m", 1e3 * np.sin(np.pi * t)))
+    monkeypatch.setattr(LP, "joint_load_series", lambda an: [(j, c, k, u, v * an.scale) for j, c, k, u, v in loads])
+    stage = lambda scale: type("Analysis", (), {"t": t, "scale": scale})()  # noqa: E731
+    data = LV.data(LP.joints([("one", stage(0.5)), ("two", stage(1.0))]))
+    assert len(data["panels"]) == n + 1 > LP.MANY_JOINTS
+    assert data["panels"][data["choose"]]["key"] == "J2.F"
+
+
+def test_a_partial_balancings_front_is_interactive_over_its_budget():
+    """Issue 22: each Pareto front of a partial balancing is a live plot over its budget (not
+    time): the front's designs at their budgets with their objective values, every marked design
+    a marker alone at its own values, every sample kept (a front of 1000 points too) and a
+    missing value null, never NaN (which JSON.parse refuses)."""
+    from balpipe.report import partial_figures as PFG
+
+    st = run(load(SPECS / "partial_offset_slider_crank.yaml").spec)
+    det = st.balance.details["partial_balance"]
+    figs = PFG.figures(st)
+    assert len(figs) == 4 and all('<div class="live" id="live-partial_' in html for _, html, _ in figs)
+    for key, x, y, _, _ in PFG.FRONTS:
+        pts = det["fronts"][key]
+        marks = PFG._marks(st, det, x, y)
+        data = LV.data(PFG.front_curves(pts, x, y, marks))
+        assert data["x"] == PFG.AXES[x] and data["panels"][0]["axis"] == PFG.AXES[y]
+        front, *marked = data["series"]
+        assert front["label"] == PFG.FRONT and "points" not in front and all(s["points"] for s in marked)
+        shown = sorted((xv, yv) for xv, yv in zip(data["t"], front["y"]["y"]) if yv is not None)
+        exact = sorted((float(f"{p[x]:.6g}"), float(f"{p[y]:.6g}")) for p in pts)
+        assert shown == exact  # every design of the front, none thinned away
+        for s, (label, vx, vy) in zip(marked, marks):
+            at = [(xv, yv) for xv, yv in zip(data["t"], s["y"]["y"]) if yv is not None]
+            assert s["label"] == label and at == [(float(f"{vx:.6g}"), float(f"{vy:.6g}"))]
+        assert data["t"] == sorted(data["t"])  # uPlot's x runs forward
+        json.loads(LV.as_script(data))  # valid JSON: null, not NaN
+    many = [{"added_mass": m, "shaking_force": 100.0 - m} for m in np.linspace(0.0, 10.0, 1000)]
+    data = LV.data(PFG.front_curves(many, "added_mass", "shaking_force", [("a design", 5.0, 50.0)]))
+    assert len(data["t"]) == 1001

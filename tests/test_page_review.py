@@ -239,7 +239,7 @@ def test_tracking_error_caption_gives_each_travel():
         t = s.analysis.t
         s.torque = SimpleNamespace(t=t, travel={"crank": 2.5}, tracking={"crank": np.full(len(t), 1e-6)})
     [(title, svg, caption)] = page.study_figures(st)["torque"]
-    assert "relative to its travel" in caption and "crank 2.5 rad" in caption
+    assert "relative to its travel" in caption and "θ₁ [crank] 2.5 rad" in caption  # the paper's symbol, then the spec's name
     assert "|q_sim − q_plan| / travel" in svg and "time (s)" in svg
 
 
@@ -266,7 +266,7 @@ def test_dimensionless_parameters_say_so_and_round_off_before_counter_rotations_
     html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
     params = html[html.index("Computed parameters</h2>"):]
     params = params[:params.index("</table>")]
-    row = next(r for r in params.split("<tr>") if "<td>rcp1</td>" in r)
+    row = next(r for r in params.split("<tr>") if ">rcp1</span></td>" in r)  # r_cp1, the model's rcp1 beside it
     assert '<td class="unit">1</td>' in row  # rcp1 = position / L1: a ratio, unit 1
     side = html[html.index("Designs side by side</h2>"):]
     side = side[:side.index("</table>")]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from balpipe.loader import load
@@ -126,6 +127,39 @@ def test_paper000_figures_draw_each_stage_in_its_style_of_the_page(spec, monkeyp
         st = figures.style(shown.index(name))
         assert (ln.get_color(), ln.get_linestyle(), ln.get_linewidth()) == (st["color"], st["linestyle"], st["linewidth"])
         assert (ln.get_linestyle() == "--") == (name == "counterweights")
+    for f in drawn.values():
+        figures.plt.close(f)
+
+
+def test_paper000_fig4_draws_the_dashed_zero_force_over_the_grey_line(monkeypatch):
+    """Issue 22: on Fig. 4 of paper 000 the counterweights' force (dashed) and the
+    counter-rotations' (grey, wide) are both 0; the dashed curve is drawn after the grey one, on
+    top, in the static figure (matplotlib draws by zorder, in order) and in the interactive plot
+    (its ``draw`` order), whose legend keeps the stages' order."""
+    import json
+
+    from balpipe.draw import figures
+
+    study = run(load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
+    drawn, html = {}, {}
+    monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.setdefault(prefix, fig) and "<svg/>")
+    html = next(h for title, h, _ in study.extra_figures() if "(Fig. 4 of paper 000)" in title)
+    by = {s.stage.label: s.stage.name for s in study.stages}
+    cw = next(s for s in study.stages if s.stage.name == "counterweights")
+    cr = next(s for s in study.stages if s.stage.name == "counter_rotations")
+    scale = study.unbalanced.analysis.max_force
+    assert np.max(np.abs(cw.analysis.force)) < 1e-9 * scale and np.max(np.abs(cr.analysis.force)) < 1e-9 * scale
+    for ax in drawn["rpr3-loads"].axes:
+        lines = sorted(ax.get_lines(), key=lambda ln: ln.get_zorder())  # matplotlib's drawing order (stable)
+        order = [by[ln.get_label()] for ln in lines]
+        assert order.index("counterweights") > order.index("counter_rotations")
+        assert order[0] == "counter_rotations"  # the wide grey line under every thin one
+    data = json.loads(html[html.index('data-live="live-rpr3-loads">') + len('data-live="live-rpr3-loads">'):html.rindex("</script>")])
+    labels = [x["label"] for x in data["series"]]
+    drawn_names = [by[labels[i]] for i in data["draw"]]
+    assert sorted(data["draw"]) == list(range(len(labels)))
+    assert drawn_names[0] == "counter_rotations" and drawn_names.index("counterweights") > 0
+    assert [by[x] for x in labels][:3] == ["unbalanced", "counterweights", "counter_rotations"]  # the legend's order
     for f in drawn.values():
         figures.plt.close(f)
 

@@ -10,6 +10,7 @@ of the links runs everywhere.
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import shutil
@@ -421,6 +422,28 @@ _SPILLS = """() => {
 }"""
 
 
+# Text of a drawing (SVG) shown smaller than MIN_TEXT_PX: a wide figure squeezed into a narrow
+# window. Size on screen = the text's font size times the scale of its transform to the screen.
+MIN_TEXT_PX = 6
+_SMALL_TEXT = """min => {
+  const out = [];
+  for (const svg of document.querySelectorAll('main svg')) {
+    if (!svg.getBoundingClientRect().width) continue;  // not shown (the print copy of a live plot)
+    let small = Infinity, text = '';
+    for (const t of svg.querySelectorAll('text')) {
+      const m = t.getScreenCTM();
+      const size = m ? parseFloat(getComputedStyle(t).fontSize) * Math.hypot(m.a, m.b) : Infinity;
+      if (size < small) { small = size; text = t.textContent; }
+    }
+    if (small < min) {
+      const cap = svg.closest('figure')?.querySelector('figcaption')?.textContent.trim().slice(0, 60) || '';
+      out.push(`drawing text ${small.toFixed(1)} px on screen (< ${min} px), "${text}" in the figure "${cap}"`);
+    }
+  }
+  return out;
+}"""
+
+
 def _pages(root: Path) -> list[Path]:
     return sorted(p for p in root.rglob("*.html") if "probe" not in p.parts)
 
@@ -437,31 +460,46 @@ def _weight(page: Path) -> int:
     return total
 
 
+def page_problems(ctx, page_file: Path, width: int) -> list[str]:
+    """What a reader meets on one built page opened from file:// (as a downloaded site) in a
+    window ``width`` px wide: a page longer than SCREENS windows at 1400 px as it opens (its long
+    sections collapsed), then, with every section open, a page that scrolls sideways, text clipped
+    or drawn over its neighbours (_SPILLS), drawings whose text is too small to read (_SMALL_TEXT),
+    and console errors, script errors or failed loads."""
+    w = Watched(ctx)
+    p = w.page
+    url = page_file.as_uri()
+    problems = []
+    try:
+        p.goto(url, wait_until="load")
+        p.wait_for_timeout(100)
+        if width == 1400:
+            height = p.evaluate("document.documentElement.scrollHeight")
+            if height > SCREENS * 900:
+                problems.append(f"{url}: {height} px long with its sections collapsed (> {SCREENS} screens)")
+        open_sections(p)
+        p.wait_for_timeout(100)  # the opened sections' tables and plots take their width
+        sw, cw = p.evaluate("[document.documentElement.scrollWidth, document.documentElement.clientWidth]")
+        if sw > cw + 1:
+            problems.append(f"{url}: scrolls sideways ({sw} > {cw} px)")
+        problems += [f"{url}: {s}" for s in p.evaluate(_SPILLS) + p.evaluate(_SMALL_TEXT, MIN_TEXT_PX)]
+        return problems + w.problems
+    finally:
+        p.close()
+
+
+def layout_context(browser, width: int):
+    return browser.new_context(viewport={"width": width, "height": 900})
+
+
 @pytest.mark.parametrize("width", [400, 1400])
 def test_every_page_fits_the_window_with_nothing_clipped(site, paper_site, browser, width):
-    tops = [site / SUBFOLDER, paper_site]
     problems = []
-    ctx = browser.new_context(viewport={"width": width, "height": 900})
+    ctx = layout_context(browser, width)
     try:
-        for top in tops:
+        for top in (site / SUBFOLDER, paper_site):
             for page_file in _pages(top):
-                w = Watched(ctx)
-                p = w.page
-                url = page_file.as_uri()  # from file://, as a reader opens a downloaded site
-                p.goto(url, wait_until="load")
-                p.wait_for_timeout(100)
-                if width == 1400 and page_file.name == "index.html" and page_file.parent != top:
-                    height = p.evaluate("document.documentElement.scrollHeight")
-                    if height > SCREENS * 900:
-                        problems.append(f"{url}: {height} px long with its sections collapsed (> {SCREENS} screens)")
-                p.evaluate("document.querySelectorAll('details').forEach(d => d.open = true)")
-                p.wait_for_timeout(150)
-                sw, cw = p.evaluate("[document.documentElement.scrollWidth, document.documentElement.clientWidth]")
-                if sw > cw + 1:
-                    problems.append(f"{url}: scrolls sideways ({sw} > {cw} px)")
-                problems += [f"{url}: {s}" for s in p.evaluate(_SPILLS)]
-                problems += w.problems
-                p.close()
+                problems += page_problems(ctx, page_file, width)
     finally:
         ctx.close()
     assert not problems, f"{len(problems)} problems at {width} px:\n" + "\n".join(problems[:40])
@@ -486,19 +524,28 @@ def test_index_verdicts_agree_with_results_json(paper_site, browser):
     assert not w.problems, "\n".join(w.problems)
 
 
+_LEGEND_VALUES = "el => [...el.querySelectorAll('.u-legend .u-series .u-value')].map(v => v.textContent)"
+_CURSOR_TIME = "el => el.querySelector('.u-legend .u-series .u-value').textContent"
+
+
+def hover(page, plot, min_width: int = 200) -> list[str]:
+    """Move the mouse over a live plot (a .live-plot), 40 % along its time axis, and read its
+    legend: the time and every curve's value there. The plot must be drawn, its plotting area
+    wider than ``min_width`` px."""
+    plot.scroll_into_view_if_needed()
+    box = plot.locator(".u-over").bounding_box()
+    assert box and box["width"] > min_width, f"no interactive plot drawn ({box})"
+    page.mouse.move(box["x"] + box["width"] * 0.4, box["y"] + box["height"] * 0.5)
+    return plot.evaluate(_LEGEND_VALUES)
+
+
 def test_hovering_a_plot_shows_its_values_and_a_click_hides_a_curve(paper_site, browser):
     w = Watched(browser)
     p = w.page
     p.set_viewport_size({"width": 1400, "height": 900})
     p.goto((paper_site / "paper002_decoupling" / "index.html").as_uri(), wait_until="load")
     plot = p.locator("#live-loads .live-plot").first
-    plot.scroll_into_view_if_needed()
-    over = plot.locator(".u-over")
-    box = over.bounding_box()
-    assert box and box["width"] > 200, "no interactive plot drawn"
-    values = "el => [...el.querySelectorAll('.u-legend .u-series .u-value')].map(v => v.textContent)"
-    p.mouse.move(box["x"] + box["width"] * 0.4, box["y"] + box["height"] * 0.5)
-    shown = plot.evaluate(values)
+    shown = hover(p, plot)
     assert shown and all(re.search(r"\d", v) for v in shown), shown  # time and every curve's value
     # a click on a legend entry hides its curve
     entry = plot.locator(".u-legend .u-series").nth(1)
@@ -511,8 +558,6 @@ def test_hovering_a_plot_shows_its_values_and_a_click_hides_a_curve(paper_site, 
     assert not w.problems, "\n".join(w.problems)
 
 
-_LEGEND_VALUES = "el => [...el.querySelectorAll('.u-legend .u-series .u-value')].map(v => v.textContent)"
-_CURSOR_TIME = "el => el.querySelector('.u-legend .u-series .u-value').textContent"
 
 
 @pytest.mark.parametrize("figure, unit", [("live-efforts", r"^(torque \(N m\)|force \(N\))$"),
@@ -527,18 +572,19 @@ def test_the_efforts_joint_loads_and_paper_plots_are_interactive(paper_site, bro
     p.set_viewport_size({"width": 1400, "height": 900})
     p.goto((paper_site / "paper002_decoupling" / "index.html").as_uri(), wait_until="load")
     open_sections(p)
-    plot = p.locator(f"#{figure} .live-plot").first
-    plot.scroll_into_view_if_needed()
+    plot = p.locator(f"#{figure} .live-plot:not([hidden])").first  # a figure of many joints shows one
     p.wait_for_timeout(100)  # opened sections: the plots take their width
-    box = plot.locator(".u-over").bounding_box()
-    assert box and box["width"] > 200, "no interactive plot drawn"
     axes = p.eval_on_selector(f"script[data-live='{figure}']", "s => JSON.parse(s.textContent).panels.map(q => q.axis)")
     assert axes and all(re.match(unit, a) for a in axes), axes  # the value axis names its unit (drawn on the canvas)
-    p.mouse.move(box["x"] + box["width"] * 0.4, box["y"] + box["height"] * 0.5)
-    shown = plot.evaluate(_LEGEND_VALUES)
-    assert len(shown) >= 2 and all(re.search(r"\d", v) for v in shown), shown  # the time and every stage
+    shown = hover(p, plot)
+    # the time and every stage with a curve in this panel (the joint first shown, the largest load,
+    # may be one that only a balanced stage has)
+    key = plot.get_attribute("data-quantity")
+    has = p.eval_on_selector(f"script[data-live='{figure}']", f"s => JSON.parse(s.textContent).series.map(q => {json.dumps(key)} in q.y)")
+    assert len(shown) == len(has) + 1 >= 2 and re.search(r"\d", shown[0]), shown
+    assert [bool(re.search(r"\d", v)) for v in shown[1:]] == has, (shown, has)
     pixels = plot.locator("canvas").evaluate("c => c.toDataURL()")
-    entry = plot.locator(".u-legend .u-series").nth(1)
+    entry = plot.locator(".u-legend .u-series").nth(1 + has.index(True))
     entry.click()
     assert "u-off" in (entry.get_attribute("class") or "")
     assert plot.locator("canvas").evaluate("c => c.toDataURL()") != pixels  # the curve is gone
@@ -580,4 +626,86 @@ def test_the_player_and_the_plots_share_their_time(server, browser):
     p.mouse.move(box["x"] + box["width"] * 0.8, box["y"] + box["height"] * 0.5, steps=5)
     p.mouse.up()
     assert float(re.match(r"t = (\d+\.\d+)", p.text_content("#player-clock")).group(1)) == shown
+    assert not w.problems, "\n".join(w.problems)
+
+
+# ------------------------------------------------------------------------------------------
+# The same checks on a site already built (the whole of specs/, say), page by page:
+#   balpipe build specs/ -o reports --no-sim
+#   python -m pytest tests/test_site_browser.py -k built_site --built-site reports
+
+
+NO_BUILT_SITE = ("no --built-site DIR given: to check every page of a built site, run "
+                 "python -m pytest tests/test_site_browser.py -k built_site --built-site DIR")
+
+
+def built_site_dir(config) -> Path | None:
+    given = config.getoption("--built-site")
+    if given is None:
+        return None
+    top = Path(given).resolve()
+    if not _pages(top):
+        raise pytest.UsageError(f"--built-site {given}: no HTML page under {top}")
+    return top
+
+
+def pytest_generate_tests(metafunc):
+    """``built_page``: every page of the --built-site; ``built_plot_page``: those with
+    interactive plots. Without the option, one skipped case that says how to run them."""
+    names = [n for n in ("built_page", "built_plot_page") if n in metafunc.fixturenames]
+    if not names:
+        return
+    top = built_site_dir(metafunc.config)
+    if top is None:
+        metafunc.parametrize(names[0], [pytest.param(None, marks=pytest.mark.skip(reason=NO_BUILT_SITE))])
+        return
+    pages = _pages(top)
+    if names[0] == "built_plot_page":
+        pages = [p for p in pages if "data-live=" in p.read_text(encoding="utf-8")]
+    metafunc.parametrize(names[0], pages, ids=[p.relative_to(top).as_posix() for p in pages])
+
+
+def test_built_site_page_weighs_less_than_2_mb(built_page):
+    assert _weight(built_page) < MAX_BYTES
+
+
+@pytest.mark.parametrize("width", [400, 1400])
+def test_built_site_page_fits_the_window_with_nothing_clipped(built_page, browser, width):
+    ctx = layout_context(browser, width)
+    try:
+        problems = page_problems(ctx, built_page, width)
+    finally:
+        ctx.close()
+    assert not problems, f"{len(problems)} problems at {width} px:\n" + "\n".join(problems[:40])
+
+
+# for a live plot: [has its quantity] per curve, from the data it was drawn from (a stage without
+# the joint of a joint-load panel has no curve there, its legend entry shows a dash)
+_CURVES_PRESENT = """el => {
+  const d = JSON.parse(document.querySelector(`script[data-live='${el.parentElement.id}']`).textContent);
+  return d.series.map(s => el.dataset.quantity in s.y);
+}"""
+
+
+@pytest.mark.parametrize("width", [400, 1400])
+def test_built_site_plots_show_values_on_hover(built_plot_page, browser, width):
+    """The first plot of every interactive figure of the page, its sections open, shows the time
+    and the value of every curve it draws under the mouse."""
+    ctx = layout_context(browser, width)
+    w = Watched(ctx)
+    p = w.page
+    try:
+        p.goto(built_plot_page.as_uri(), wait_until="load")
+        open_sections(p)
+        p.wait_for_timeout(100)
+        plots = [h.locator(".live-plot:not([hidden])").first for h in p.locator(".live.live-ready").all()]
+        assert plots, "no interactive plot drawn"
+        for plot in plots:
+            shown = hover(p, plot, min_width=width // 4)
+            present = plot.evaluate(_CURVES_PRESENT)
+            assert len(shown) == 1 + len(present) and any(present), plot.get_attribute("data-quantity")
+            valued = [bool(re.search(r"\d", v)) for v in shown]
+            assert valued == [True] + present, (plot.get_attribute("data-quantity"), shown)
+    finally:
+        ctx.close()
     assert not w.problems, "\n".join(w.problems)

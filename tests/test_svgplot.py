@@ -89,3 +89,14 @@ def test_the_loads_figure_has_four_panels_markers_pymunk_curves_and_the_coincide
         d = svgplot.marker_path(figures.marker(k), 4.5)
         ident = re.search(rf'<path id="(loads-m[0-9a-f]+)" d="{re.escape(d)}"', svg).group(1)
         assert svg.count(f'href="#{ident}"') == 2 * (4 * n + 1)  # xlink:href and href
+
+
+def test_a_wide_line_is_drawn_under_the_thin_ones():
+    """Paper 000 Fig. 4: the dashed stage's zero line stays visible over the grey stage's (style
+    2, wide), as matplotlib's zorder draws it."""
+    t = np.linspace(0.0, 1.0, 50)
+    panels = [("F (N)", "F (N)", [(n, t, 0 * t) for n in ("unbalanced", "counterweights", "counter-rotations")])]
+    svg = figures.panels_figure(panels, "z")
+    grey, dashed = svgplot._line_attrs(figures.style(2)), svgplot._line_attrs(figures.style(1))
+    axes = svg[svg.index('<g id="z-axes_1">'):svg.index('<g id="z-legend_1">')]
+    assert axes.index(grey) < axes.index(dashed)

@@ -91,6 +91,22 @@ def test_several_motions_each_judged():
     assert v["level"] == "good" and v["words"] == "loads reduced"
 
 
+def test_the_headline_judges_the_declared_stage_else_the_last():
+    """Issue 22: a method that declares the stage whose numbers the paper publishes (paper 003:
+    case 2, followed by a case 3) has its headline judged on that stage; every stage keeps its own
+    verdict; without the declaration the motion's last stage is judged."""
+    case2, case3 = stage("case2", f=0.5, m=0.6, headline=True), stage("case3", f=1.3, m=0.9)
+    v = V.verdict(results(case2, case3))
+    g = v["motions"][0]
+    assert g["final"] == "case2" and g["declared"] is True
+    assert v["force"]["outcome"] == "reduced" and v["force"]["ratio"] == 0.5  # not case 3's worse force
+    assert g["force"][1] == case2["max_inertial_force"] and v["level"] == "good"
+    assert v["stages"]["case3"]["force"]["outcome"] == "worse" and v["stages"]["case3"]["level"] == "warn"
+    plain = V.verdict(results(stage("case2", f=0.5, m=0.6), stage("case3", f=1.3, m=0.9)))
+    assert plain["motions"][0]["final"] == "case3" and plain["motions"][0]["declared"] is False
+    assert plain["force"]["outcome"] == "worse" and plain["level"] == "warn"
+
+
 @pytest.fixture(scope="module")
 def four_bar():
     spec = load_spec(SPECS / "custom_four_bar_balancing.yaml").spec

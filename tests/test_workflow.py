@@ -136,3 +136,35 @@ def test_pr_diff_reports_an_invalid_spec_without_failing(tmp_path):
     assert r.returncode == 0, r.stderr
     md = (repo.path / "diff.md").read_text()
     assert "## `specs/osc.yaml`: balpipe diff failed" in md and "mechanism.slider.mass: must be >= 0" in md
+
+
+SITE_TESTS = ROOT / ".github" / "workflows" / "tests.yml"
+
+
+def test_site_tests_workflow_passes_actionlint():
+    r = actionlint(str(SITE_TESTS.relative_to(ROOT)))
+    assert r.returncode == 0, r.stdout + r.stderr
+
+
+def test_site_tests_workflow_installs_chromium_and_requires_it():
+    """Every job that runs the browser tests installs Chromium first, points them at it and turns
+    a missing browser into a failure (elsewhere they are skipped); one job builds the whole of
+    specs/ and checks every page of it (--built-site)."""
+    w = yaml.safe_load(SITE_TESTS.read_text())
+    built = []
+    for name, job in w["jobs"].items():
+        steps = job["steps"]
+        uses = [s.get("uses", "").split("@")[0] for s in steps]
+        i_test = next(i for i, s in enumerate(steps) if "pytest" in s.get("run", ""))
+        assert "test_site_browser.py" in steps[i_test]["run"], name
+        i_chrome = uses.index("browser-actions/setup-chrome")
+        assert i_chrome < i_test, name
+        env = steps[i_test]["env"]
+        assert env["BALPIPE_REQUIRE_BROWSER"] and env["BALPIPE_CHROMIUM"] == f"${{{{ steps.{steps[i_chrome]['id']}.outputs.chrome-path }}}}"
+        assert "-rs" in steps[i_test]["run"].split(), name  # the summary names any skip and its reason
+        if "--built-site" in steps[i_test]["run"]:
+            site = steps[i_test]["run"].split("--built-site")[1].split()[0]
+            builds = " ".join(s.get("run", "") for s in steps[:i_test])
+            assert f"balpipe build specs -o {site}" in builds, name
+            built.append(name)
+    assert built, "no job checks the pages of the whole site"

@@ -10,3 +10,6 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     _os.environ.setdefault(_var, "1")
 
 __version__ = "0.1.0"
+
+#: the entry-point group of mechanism families (:mod:`balpipe.plugins`)
+FAMILY_GROUP = "balpipe.families"

@@ -15,6 +15,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import sys
 import time
 import traceback
@@ -25,17 +26,51 @@ from importlib import resources
 from importlib.util import find_spec
 from pathlib import Path
 
-from . import plugins, runner
-from .laws.drives import table_texts
-from .loader import LoadedSpec, SpecErrors, load, load_text, schema
-from .report import history_page
-from .report.page import render_page
-from .report.results import dumps, results_dict, timeseries_csv
-from . import pool
+from . import FAMILY_GROUP, pool
+from .report import history_file
 from .fsutil import remove_path, remove_temporaries, tmp_name, write_atomic_dir, write_file_atomic, write_new
 from .site_earlier import earlier_pages
 from .spec_files import MAX_SLUG, clash_notes, clashes, find_specs, slug_for  # noqa: F401  (build.find_specs, build.slug_for as before)
-from .spec_parts import SpecFieldError
+
+# The phases' modules (numpy, pydantic, matplotlib, jinja2) are imported when a spec is computed,
+# not when an unchanged site is checked (issue 23: a rebuild with nothing changed in 0.3 s). The
+# names below stay this module's, so that a caller (the build benchmark) can wrap them.
+
+
+def load(path):
+    """:func:`balpipe.loader.load`."""
+    from .loader import load as f
+    return f(path)
+
+
+def schema() -> dict:
+    """:func:`balpipe.loader.schema`."""
+    from .loader import schema as f
+    return f()
+
+
+def render_page(*args, **kwargs) -> str:
+    """:func:`balpipe.report.page.render_page`."""
+    from .report.page import render_page as f
+    return f(*args, **kwargs)
+
+
+def results_dict(*args, **kwargs) -> dict:
+    """:func:`balpipe.report.results.results_dict`."""
+    from .report.results import results_dict as f
+    return f(*args, **kwargs)
+
+
+def timeseries_csv(*args, **kwargs) -> str:
+    """:func:`balpipe.report.results.timeseries_csv`."""
+    from .report.results import timeseries_csv as f
+    return f(*args, **kwargs)
+
+
+def dumps(results: dict) -> str:
+    """:func:`balpipe.report.results.dumps`."""
+    from .report.results import dumps as f
+    return f(results)
 
 
 @dataclass
@@ -87,11 +122,16 @@ def code_hash() -> str:
 
 
 def _family_files() -> list[tuple[str, Path]]:
-    """(name, path) of the Python files of the discovered families that are not part of balpipe:
-    a package's files by their path in it, a single module by its file name."""
+    """(name, path) of the Python files of the families installed from packages other than
+    balpipe: the package that each ``balpipe.families`` entry point names, a package's files by
+    their path in it, a single module by its file name. Read from the entry points' metadata,
+    without importing a family (an unchanged site is checked without numpy or pydantic); the
+    families of the in-tree scan are balpipe's own files."""
+    from importlib.metadata import entry_points
+
     out = set()
-    for fam in plugins.discover():
-        top = (fam.package or "").split(".")[0]
+    for ep in entry_points(group=FAMILY_GROUP):
+        top = ep.module.split(".")[0]
         spec = find_spec(top) if top and top != "balpipe" else None
         if spec is None or not spec.origin:
             continue
@@ -138,17 +178,55 @@ class Computed:
     seconds: float = 0.0
 
 
-def page_hash(loaded: LoadedSpec, target: Path, simulate: bool) -> str:
-    """The input hash of a spec's page in ``target``: the spec's text and the CSV tables it reads,
-    the simulation option, balpipe's code, and the page's history (a new history.json re-renders
-    the page)."""
-    h = input_hash(loaded.text + table_texts(loaded.spec), Options(out=target.parent, simulate=simulate))
-    return history_page.mix_hash(h, target)
+def page_hash(loaded, target: Path, simulate: bool) -> str:
+    """The input hash of a spec's page in ``target`` (``loaded``: a :class:`balpipe.loader.LoadedSpec`):
+    the spec's text and the CSV tables it reads, the simulation option, balpipe's code, and the
+    page's history (a new history.json re-renders the page)."""
+    from .laws.drives import table_texts
+
+    return _mixed_hash(loaded.text + table_texts(loaded.spec), target, simulate)
+
+
+def _mixed_hash(inputs: str, target: Path, simulate: bool) -> str:
+    return history_file.mix_hash(input_hash(inputs, Options(out=target.parent, simulate=simulate)), target)
+
+
+def _unchanged(path: Path, slug: str, target: Path, previous: dict, seconds: float) -> Outcome:
+    stale_failed = target / "failed"
+    if stale_failed.exists() or stale_failed.is_symlink():  # the spec is back to its good page
+        remove_path(stale_failed)
+    return Outcome(str(path), slug, previous.get("status", "ok"), "unchanged", previous, skipped=True,
+                   seconds=seconds)
+
+
+def up_to_date(path: Path, opts: Options) -> dict | None:
+    """The results of the spec's page when the page is up to date, decided without reading the
+    spec's YAML (nothing is written). The page's ``results.json`` names the tables the spec read
+    (``input_tables``, as written in the spec, relative to its folder), so the input hash of
+    :func:`page_hash` is recomputed from the spec's text and those tables' texts: that list is the
+    one the same text gives, and the text is part of the hash, so a match is exact. Anything else
+    (no page, a changed spec or table, an unreadable file) gives None, and the spec is planned in
+    full (:func:`plan_one`)."""
+    if opts.force:
+        return None
+    target = opts.out / slug_for(path)
+    previous = _read_results(target)
+    if previous is None or not previous.get("input_hash"):
+        return None
+    try:
+        text = path.read_text(encoding="utf-8")
+        tables = "".join(f"\0table {f}\0" + (path.parent / f).read_text(encoding="utf-8")
+                         for f in previous.get("input_tables") or [])
+    except (OSError, UnicodeDecodeError, TypeError):
+        return None
+    return previous if _mixed_hash(text + tables, target, opts.simulate) == previous["input_hash"] else None
 
 
 def plan_one(path: Path, opts: Options) -> Job | Outcome:
     """Read one spec and decide: an :class:`Outcome` when there is nothing to compute (invalid,
     or unchanged since the last build), else the :class:`Job` that computes it."""
+    from .loader import SpecErrors
+
     start = time.perf_counter()
     slug = slug_for(path)
     try:
@@ -160,17 +238,20 @@ def plan_one(path: Path, opts: Options) -> Job | Outcome:
     if not opts.force:
         previous = _read_results(target)
         if previous is not None and previous.get("input_hash") == h:
-            stale_failed = target / "failed"
-            if stale_failed.exists() or stale_failed.is_symlink():  # the spec is back to its good page
-                remove_path(stale_failed)
-            return Outcome(str(path), slug, previous.get("status", "ok"), "unchanged", previous, skipped=True,
-                           seconds=time.perf_counter() - start)
+            return _unchanged(path, slug, target, previous, time.perf_counter() - start)
+    from .report import history_page
+
     return Job(path, loaded.text, h, opts.simulate, history_page.section(target), history_page.build_files(target),
                opts.sim_workers)
 
 
 def compute(job: Job) -> Computed:
     """Balance, analyse, validate and render one spec; never raises (errors become the result)."""
+    from . import runner
+    from .laws.drives import table_files
+    from .loader import LoadedSpec, SpecErrors, load_text
+    from .spec_parts import SpecFieldError
+
     start = time.perf_counter()
     source = str(job.path)
     loaded = None
@@ -186,6 +267,8 @@ def compute(job: Job) -> Computed:
             extra = {"timing.json": json.dumps(times, indent=2, sort_keys=True) + "\n",
                      "timing.js": timing_script(times)}
         results = results_dict(st, source, job.input_hash, simulated=st.stages[0].validation is not None)
+        if table_files(spec):  # what up_to_date reads to recompute the input hash
+            results["input_tables"] = table_files(spec)
         files = {
             "index.html": render_page(st, results, job.text, history=job.history),
             "results.json": dumps(results),
@@ -332,10 +415,11 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
         for p, note in clash_notes(specs).items():  # said before any work too; built as usual
             progress(0, len(todo), Outcome(str(p), slug_for(p), "ok", note))
     cores = jobs if jobs is not None else pool.usable_cores()
+    changed = len(todo) if scheduler else sum(up_to_date(p, opts) is None for p in todo)
     if jobs is None:
-        jobs = pool.default_jobs(len(todo))
-    if todo and not scheduler and cores > len(todo):  # fewer specs than cores: their stages share the rest
-        opts = replace(opts, sim_workers=cores // len(todo))
+        jobs = pool.default_jobs(changed)
+    if changed and not scheduler and cores > changed:  # fewer specs to compute than cores: their stages share the rest
+        opts = replace(opts, sim_workers=cores // changed)
     with locked(opts.out):
         remove_temporaries(opts.out)
         try:
@@ -346,17 +430,70 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
         except BaseException:
             remove_temporaries(opts.out)
             raise
-        from .report.site import write_site
-
         built = [o for o in outcomes if o.slug]
-        write_site(opts.out, built, earlier_pages(opts.out, {o.slug for o in built}, page_hash))
-        write_file_atomic(opts.out / "balpipe.schema.json", json.dumps(schema(), indent=2, sort_keys=True) + "\n")
+        earlier = earlier_pages(opts.out, {o.slug for o in built}, page_hash)
+        key = site_key(opts.out, built) if not earlier else ""
+        if not (key and _site_is_current(opts.out, key)):
+            from .report.site import write_site
+
+            write_site(opts.out, built, earlier, site_key=key)
+            write_file_atomic(opts.out / "balpipe.schema.json", json.dumps(schema(), indent=2, sort_keys=True) + "\n")
     return outcomes
 
 
+SITE_FILES = ("index.html", "site_nav.js", "balpipe.schema.json")
+_KEY_META = re.compile(r'<meta name="balpipe-site-key" content="([0-9a-f]{64})">')
+
+
+def site_key(out: Path, outcomes: list[Outcome]) -> str:
+    """A hash of everything the site index and the schema are made of when the index lists only
+    this build's ``outcomes``: balpipe's code, each outcome as the index reads it (its message
+    only where the index shows it: an invalid, crashed or failed spec), and the files of each page
+    folder that the index reads (``results.json``, the history) or links to (the page, the
+    history page, ``failed/``). A build whose key equals the one in the index's head leaves the
+    index, its script and the schema as they are (nothing they show changed)."""
+    h = hashlib.sha256(code_hash().encode())
+    for o in sorted(outcomes, key=lambda o: (o.source, o.slug)):
+        shown = o.message if o.status != "ok" else ""
+        h.update(json.dumps([o.source, o.slug, o.status, shown, o.spec_error, o.kept_previous]).encode())
+        folder = out / o.slug
+        for name in ("results.json", history_file.HISTORY_FILE):
+            try:
+                h.update(b"\0" + name.encode() + b"\0" + (folder / name).read_bytes())
+            except OSError:
+                h.update(b"\0" + name.encode() + b"\0-")
+        for name in ("index.html", history_file.HISTORY_PAGE, "failed"):
+            h.update(b"\1" if (folder / name).exists() else b"\2")
+    return h.hexdigest()
+
+
+def _site_is_current(out: Path, key: str) -> bool:
+    """Whether the site in ``out`` was written with ``key`` and has all its files."""
+    if not all((out / name).is_file() for name in SITE_FILES):
+        return False
+    try:
+        with open(out / "index.html", encoding="utf-8") as f:
+            head = f.read(4096)
+    except (OSError, UnicodeDecodeError):
+        return False
+    m = _KEY_META.search(head)
+    return m is not None and m.group(1) == key
+
+
 def _run(todo: list[Path], opts: Options, jobs: int, progress, outcomes: list[Outcome]) -> None:
+    """Build ``todo`` in its order: the specs whose pages are up to date are told here at once
+    (:func:`up_to_date`), the others go to the process pool, and the outcomes come back in
+    the specs' order whatever ``jobs``."""
     total = len(todo)
-    for k, o in enumerate(pool.in_order(build_one, todo, jobs, opts)):
+    known: dict[Path, tuple[dict | None, float]] = {}
+    for p in todo:
+        start = time.perf_counter()
+        known[p] = (up_to_date(p, opts), time.perf_counter() - start)
+    rest = [p for p in todo if known[p][0] is None]
+    built = pool.in_order(build_one, rest, jobs, opts)
+    for k, p in enumerate(todo):
+        previous, seconds = known[p]
+        o = next(built) if previous is None else _unchanged(p, slug_for(p), opts.out / slug_for(p), previous, seconds)
         outcomes.append(o)
         if progress:
             progress(k + 1, total, o)

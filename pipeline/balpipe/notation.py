@@ -240,9 +240,9 @@ COMMON: dict[str, Sym] = {
     "validation.tolerance": setting("ε_{sim}", "pymunk residuals pass below this fraction of the reference loads"),
     "validation.reactionless": setting("free frame", "free-floating frame demonstration"),
     # the generic finder's settings, shared by force_balance and moment_balance
-    "balancing.rank_tolerance": setting("ε_{rank}", "singular values below this fraction of the largest are dropped"),
-    "balancing.samples": setting("N_{states}", "sampled states of the momentum regressor (0: automatic)"),
-    "balancing.seed": setting("seed", "seed of the state sampler"),
+    "balancing.rank_tolerance": setting("ε_{rank}", "finding the conditions numerically: a direction smaller than this fraction of the largest counts as round-off"),
+    "balancing.samples": setting("N_{states}", "states the mechanism can reach at which its momentum is evaluated to find the conditions (0: automatic)"),
+    "balancing.seed": setting("seed", "picks those states at random, the same ones at every build"),
     "balancing.polygon_sides": setting("n_{sides}", "sides of the polygon inscribed in each disc region"),
 }
 
@@ -266,3 +266,103 @@ def group_of(path: str, unit: str) -> str:
     if unit in ("kg", "kg m^2") or leaves & _MASS_LEAVES:
         return "Mass parameters"
     return "Geometry"
+
+
+# --- the names a page shows: drivers, parts and joints -------------------------------------------
+#
+# Beside the inputs, a family's table may name the model's *drivers* (the ``motion.drive.<name>``
+# keys and the actuated joints whose efforts the pages tabulate), its *parts* (links,
+# counterweights, counter-rotations, added discs), its *joints* and the method's computed
+# *parameters* (``results.json``'s ``parameters`` and ``references``) in the paper's symbols: keys
+# ``driver:<name>``, ``part:<name>``, ``joint:<name>`` and ``param:<name>`` (patterns as above,
+# made by :func:`names_table`), looked up in the same order as the inputs (method, template, common).
+# A name without a symbol stays the model's own; ``custom`` declares none, so its pages keep the
+# spec's names.
+
+KINDS = ("driver", "part", "joint", "param")
+
+_SUBSCRIPT = dict(zip("0123456789+-=()aehijklmnoprstuvx", "₀₁₂₃₄₅₆₇₈₉₊₋₌₍₎ₐₑₕᵢⱼₖₗₘₙₒₚᵣₛₜᵤᵥₓ"))
+_SUPERSCRIPT = {"*": "*", "'": "'", "2": "²", "3": "³"}
+
+
+def names_table(drivers: Mapping[str, Sym] | None = None, parts: Mapping[str, Sym] | None = None,
+                joints: Mapping[str, Sym] | None = None, params: Mapping[str, Sym] | None = None) -> Table:
+    """Rows ``driver:<name>``, ``part:<name>``, ``joint:<name>``, ``param:<name>`` for a family's
+    notation table: the paper's symbol of each model or parameter name (patterns such as
+    ``theta<i>`` allowed)."""
+    out: dict[str, Sym] = {}
+    for kind, rows in zip(KINDS, (drivers, parts, joints, params)):
+        out.update({f"{kind}:{name}": s for name, s in (rows or {}).items()})
+    return out
+
+
+def symbol_text(markup: str) -> str:
+    """Plain text of a symbol, for plots and tooltips: ``θ_1`` -> ``θ₁``, ``θ_{11}`` -> ``θ₁₁``,
+    ``m_1^*`` -> ``m₁*``; a subscript with a character that has no subscript form keeps an
+    underscore (``m_{cp1}`` -> ``m_cp1``); backticks dropped."""
+    out: list[str] = []
+    pos = 0
+    while pos < len(markup):
+        c = markup[pos]
+        if c in "_^" and pos + 1 < len(markup):
+            if markup[pos + 1] == "{":
+                end = markup.find("}", pos + 2)
+                end = len(markup) if end < 0 else end
+                body, pos = markup[pos + 2:end], end + 1
+            else:
+                body, pos = markup[pos + 1], pos + 2
+            table = _SUBSCRIPT if c == "_" else _SUPERSCRIPT
+            out.append("".join(table[ch] for ch in body) if all(ch in table for ch in body) else c + body)
+        elif c == "`":
+            pos += 1
+        else:
+            out.append(c)
+            pos += 1
+    return "".join(out)
+
+
+@dataclass(frozen=True)
+class Names:
+    """The names a study's pages show for its drivers, parts and joints (``kind`` one of
+    :data:`KINDS`), from its notation tables (:func:`names_table`). A joint named
+    ``<body>-<body>`` without a row of its own (the bearing of a gear on its carrier, a mesh) is
+    named after its two bodies when both have a symbol or are the frame."""
+
+    tables: tuple[Table, ...] = ()
+
+    def sym(self, kind: str, name: str) -> Sym | None:
+        found = lookup(list(self.tables), f"{kind}:{name}")
+        if found is not None or kind != "joint" or "-" not in name:
+            return found
+        ends = name.split("-")
+        syms = [Sym("frame", "the frame") if e == "frame" else self.sym("part", e) for e in ends]
+        if len(ends) != 2 or any(s is None for s in syms) or all(s.symbol == "frame" for s in syms):
+            return None
+        return Sym(f"{syms[0].symbol} – {syms[1].symbol}",
+                   f"joint between {symbol_text(syms[0].symbol)} and {symbol_text(syms[1].symbol)}",
+                   paper=all(s.paper for s in syms))
+
+    def text(self, kind: str, name: str, spec_name: bool = False) -> str:
+        """Plain text of ``name``'s symbol (``θ₁``), or ``name`` itself; ``spec_name``: followed
+        by the model's name in brackets when they differ (``θ₁ [theta1]``), for plots."""
+        s = self.sym(kind, name)
+        if s is None:
+            return name
+        t = symbol_text(s.symbol)
+        return f"{t} [{name}]" if spec_name and t != name else t
+
+    def html(self, kind: str, name: str) -> str:
+        """HTML of ``name``: the symbol (:func:`symbol_html`) with its meaning as a tooltip and the
+        model's name after it, small and muted, so that it can be found in the spec, ``results.json``
+        and ``timeseries.csv``; a symbol not in the paper says so; ``name`` escaped without one."""
+        s = self.sym(kind, name)
+        if s is None:
+            return html.escape(name)
+        tip = _TEXT.sub(lambda m: m.group(1) if m.group(1) is not None else symbol_text(m.group(2) + "_" + m.group(3)),
+                        s.text) + ("" if s.paper else " (balpipe's name, not the paper's)")
+        out = f'<span class="sym" title="{html.escape(tip)}">{symbol_html(s.symbol)}</span>'
+        if not s.paper:
+            out += ' <span class="muted">(ours)</span>'
+        if symbol_text(s.symbol) == name:
+            return out
+        return out + f' <span class="spec-name" title="the name in the spec and the result files">{html.escape(name)}</span>'

@@ -24,11 +24,12 @@ from importlib import import_module
 from importlib.metadata import entry_points
 from typing import Any, Callable
 
+from . import FAMILY_GROUP
 from .balancing.base import BalanceResult
 from .model import Model
 from .spec_parts import Strict
 
-GROUP = "balpipe.families"
+GROUP = FAMILY_GROUP
 IN_TREE = "balpipe.families"
 
 

@@ -14,11 +14,9 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
-from typing import Callable
+from typing import Any, Callable
 
-from .loader import LoadedSpec, SpecErrors, load
-
-PageHash = Callable[[LoadedSpec, Path, bool], str]  # (spec, its page folder, simulated?) -> the build's input hash
+PageHash = Callable[[Any, Path, bool], str]  # (the spec, a balpipe.loader.LoadedSpec; its page folder; simulated?) -> the build's input hash
 
 
 @dataclass
@@ -36,6 +34,8 @@ class Earlier:
 def spec_changed(folder: Path, results: dict, page_hash: PageHash) -> str:
     """Why an earlier page no longer shows its spec ('' when it still does): ``page_hash`` is the
     hash a build would give the spec now (:func:`balpipe.build.page_hash`)."""
+    from .loader import SpecErrors, load
+
     source = Path(results.get("source") or "")
     if not source.is_file():
         return f"spec {source} no longer found"

@@ -141,6 +141,7 @@ def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float, override
         "label": sr.stage.label,
         "description": sr.stage.description,
         "balances": sr.stage.balances,
+        "headline": sr.stage.headline,
         "max_shaking_force": sr.analysis.max_force,
         "max_shaking_moment": sr.analysis.max_moment,
         "max_inertial_force": F,

@@ -40,6 +40,10 @@ class Stage:
     # a method whose paper states its figures' line styles gives them, so that one style means
     # one stage on the whole page, the paper's figures included (issue 22)
     style: int | None = None
+    # the stage whose numbers the paper publishes (paper 003: case 2 against case 1, while case 3
+    # follows it): the verdict's headline for its motion (default: the motion's last stage),
+    # balpipe.report.verdict.headline_stage
+    headline: bool = False
 
 
 @dataclass(frozen=True)

@@ -103,6 +103,15 @@ def _pivot_order(names: list[str]) -> list[int]:
     return first + [k for k, n in enumerate(names) if n.startswith("m[")]
 
 
+def clarity_text(gap: float) -> str:
+    """How clearly numerically found conditions stand out from round-off, in words: the
+    singular-value gap (last kept / first dropped) as 'clear of round-off by a factor 3e+14'
+    (larger is clearer), or 'no direction near round-off' when nothing was dropped."""
+    if not math.isfinite(gap):
+        return "no direction near round-off"
+    return f"clear of round-off by a factor {gap:.3g}"
+
+
 def pivot_tolerance(gap: float) -> float:
     """The smallest pivot (relative to the remaining rows' largest entry) that :func:`rref` may
     divide by for a row space whose singular-value gap is ``gap``: the basis from the sampled

@@ -114,7 +114,7 @@ def force_stage(model: Model, specs: list[CounterweightRegionSpec], settings: Fi
     except LM.Infeasible as exc:
         raise SpecFieldError(root, str(exc)) from None
     out = model
-    params = [Parameter(f"{prefix}force_conditions", cond.count, "", "momentum regressor rank",
+    params = [Parameter(f"{prefix}force_conditions", cond.count, "", "counted from the momentum at reachable states",
                         "independent force-balance conditions")]
     for cw in sol.counterweights:
         if cw.mass > 0:
@@ -138,11 +138,10 @@ def force_stage(model: Model, specs: list[CounterweightRegionSpec], settings: Fi
         "residual_after": sol.residual,
         "least_mass_unique": sol.unique,
     })
-    gap = "no singular value dropped" if not np.isfinite(cond.gap) else f"gap between the last kept and the first dropped singular value {cond.gap:.3g}"
     notes = [
-        f"{cond.count} independent force-balance conditions: rank of the linear-momentum regressor over "
-        f"{cond.samples} sampled states of mobility {cond.dof} (tolerance {cond.tolerance:g} of the largest "
-        f"singular value; {gap}). The counterweights of least added mass total {sol.total_mass:.6g} kg"
+        f"{cond.count} independent force-balance conditions, found numerically from {cond.samples} states the "
+        f"mechanism can reach ({cond.dof} degree{'s' if cond.dof != 1 else ''} of freedom; {C.clarity_text(cond.gap)}, "
+        f"larger is clearer). The counterweights of least added mass total {sol.total_mass:.6g} kg"
         + (f"; disc regions are replaced by inscribed {sol.polygon_sides}-gons (within "
            f"{sol.disc_accuracy:.1e} of their radius)" if any(r.kind == "disc" for r in regions) else "")
         + "."

@@ -176,8 +176,8 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
             at = _point(model, s.carrier, s.at, ())
             cw_model = add_counterweight(cw_model, s.carrier, f"{s.name} (mass)", s.mass, at)
     cancelled = residual <= MOMENT_TOLERANCE
-    params = [Parameter("force_conditions", cond.count, "", "momentum regressor rank", "independent force-balance conditions"),
-              Parameter("moment_conditions", len(mc.matrix), "", "angular-momentum regressor rank",
+    params = [Parameter("force_conditions", cond.count, "", "counted from the momentum at reachable states", "independent force-balance conditions"),
+              Parameter("moment_conditions", len(mc.matrix), "", "counted from the angular momentum at reachable states",
                         "independent conditions on the angular momentum (discs' inertias included)")]
     for cw in sol.counterweights:
         d = f"{cw.region.name} on {cw.region.body}, {cw.region.describe()}"
@@ -190,9 +190,9 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
         ]
     params.append(Parameter("counterweight_mass", sol.total_mass, "kg", "least added mass (linprog)", "total mass of the counterweights"))
     for name, J, s in zip(discs, inertias, method.counter_rotations):
-        params.append(Parameter(f"{name}.inertia", float(J), "kg m^2", "angular-momentum regressor (least squares)",
+        params.append(Parameter(f"{name}.inertia", float(J), "kg m^2", "least squares on the angular momentum",
                                 f"disc on {s.carrier}, geared to {s.geared_to} with ratio {s.ratio:g}"))
-    params.append(Parameter("moment_residual", residual, "", "angular-momentum regressor (least squares)",
+    params.append(Parameter("moment_residual", residual, "", "least squares on the angular momentum",
                             "|H| left by the discs / |H| of the counterweighted mechanism, over the samples"))
     if unmet:
         notes_unmet = [
@@ -206,11 +206,11 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
         notes_unmet = []
     notes = notes_unmet + [
         f"{cond.count} independent force-balance conditions and {len(mc.matrix)} on the angular momentum "
-        f"(ranks of the momentum regressors over {cond.samples} sampled states, tolerance {cond.tolerance:g}; the force count includes each disc's own: its centre of mass on its axis). "
+        f"(found numerically from {cond.samples} states the mechanism can reach; the force count includes each disc's own: its centre of mass on its axis). "
         + (f"Counterweights of least added mass ({sol.total_mass:.6g} kg) meeting both, with the discs' "
            "inertias, in one linear programme; a counterweight's inertia is that of its mass spread over its region."
            if not unmet else f"Counterweights of least added mass for the force: {sol.total_mass:.6g} kg."),
-        f"Counter-rotation inertias re-solved by least squares over {samples} sampled states: relative residual "
+        f"Counter-rotation inertias re-solved by least squares over {samples} states the mechanism can reach: relative residual "
         f"{residual:.2g}" + (" (the moment is cancelled for every motion)." if cancelled else
                              f", above {MOMENT_TOLERANCE:g}: the stage claims only the force."),
     ] + LM.tie_note(sol)

@@ -21,7 +21,7 @@ from matplotlib.patches import Circle, Polygon  # noqa: E402
 
 from ..model import Model  # noqa: E402
 from . import extremes  # noqa: E402
-from .labels import point_name_counts  # noqa: E402
+from .labels import drawing_span, point_places, repeated_names  # noqa: E402
 from .layout import fixed_layout  # noqa: E402
 from .sleeves import guided_sliders, sleeves  # noqa: E402
 from .svgplot import panels_svg  # noqa: E402
@@ -66,12 +66,26 @@ MARKER_WORDS = ["circles", "squares", "triangles", "diamonds", "down-triangles",
                 "plus signs", "crosses", "hexagons", "left-triangles", "right-triangles"]
 
 
+#: a line wider than this (the grey of style 2) is drawn under the thin ones (:func:`wide`)
+WIDE = 2.0
+WIDE_ZORDER = 1.8  # below matplotlib's lines (2), above the grid (1.5)
+
+
+def wide(width: float) -> bool:
+    """Whether a line of ``width`` is drawn under the thin lines: so that a thin curve on the same
+    values stays visible over it (a balanced force of 0, dashed, over the grey stage that is 0
+    too: paper 000 Fig. 4; case 2's dashes over case 3 in paper 003's Figs. 3-4), in the static
+    figures (its zorder) and the interactive plots (:func:`balpipe.draw.live.data`'s ``draw``)."""
+    return width > WIDE
+
+
 def style(k: int) -> dict:
+    """Stage ``k``'s line: colour, line style, width, and a wide line's lower zorder (:func:`wide`)."""
     n = len(STAGE_STYLES)
     base = STAGE_STYLES[k % n]
-    if k < n:
-        return base
-    return {**base, "color": MORE_COLORS[(k // n - 1 + k) % len(MORE_COLORS)]}
+    if k >= n:
+        base = {**base, "color": MORE_COLORS[(k // n - 1 + k) % len(MORE_COLORS)]}
+    return {**base, "zorder": WIDE_ZORDER} if wide(base["linewidth"]) else base
 
 
 def marker(k: int) -> str:
@@ -185,15 +199,16 @@ def loads_figure(stages: list, prefix: str = "loads") -> str:
 
 
 def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = None,
-                   marks: list | None = None) -> str:
+                   marks: list | None = None, shown: dict | None = None) -> str:
     """Actuator torque (or force) of every driver, every stage; ``units``: driver -> 'N m' or 'N';
-    ``marks``: (time, label) of kinematic warnings (balpipe.dead_centres), drawn as dotted lines."""
+    ``marks``: (time, label) of kinematic warnings (balpipe.dead_centres), drawn as dotted lines;
+    ``shown``: driver -> the name its panel shows (the paper's symbol, balpipe.notation.Names)."""
     units = units or {}
     names = sorted({n for _, an in stages for n in an.efforts})
     panels = []
     for name in names:
         u = units.get(name, "")
-        panels.append((f"Actuator effort: {name}" + (f" ({u})" if u else ""), effort_axis(u),
+        panels.append((f"Actuator effort: {(shown or {}).get(name, name)}" + (f" ({u})" if u else ""), effort_axis(u),
                        [(label, an.t, an.efforts.get(name)) for label, an in stages]))
     return panels_figure(panels, prefix, marks, columns=max(1, len(names)))
 
@@ -220,7 +235,7 @@ def _global_point(pose, p) -> np.ndarray:
 
 def mechanism_figure(model: Model, analysis, ghosts: list[int] | None = None, prefix: str = "mech",
                      title: str = "", limits: tuple[float, float, float, float] | None = None,
-                     numbers: dict[str, str] | None = None) -> str:
+                     numbers: dict[str, str] | None = None, texts: dict[str, str] | None = None) -> str:
     """The mechanism drawn solid at its reference pose (t = 0, where the player starts) over its
     extreme poses as light grey ghosts (:mod:`.extremes`: the instants where it is farthest from
     the solid pose; ``ghosts``: their sample indices, computed from ``model`` when None), with
@@ -229,8 +244,9 @@ def mechanism_figure(model: Model, analysis, ghosts: list[int] | None = None, pr
     mass, gears circles. The solid pose carries the spec's names (points, links,
     counterweights) and the gears' numbers (``numbers``: part name -> number,
     :func:`labels.gear_numbers`), placed so that no two overlap (:func:`labels.place`);
-    ``limits`` (x0, y0, x1, y1) gives every panel of a figure the same scale."""
-    fig, _ = mechanism_drawing(model, analysis, ghosts, title, limits, numbers)
+    ``limits`` (x0, y0, x1, y1) gives every panel of a figure the same scale; ``texts``: name ->
+    the text drawn for it (the paper's symbol, :class:`balpipe.notation.Names`)."""
+    fig, _ = mechanism_drawing(model, analysis, ghosts, title, limits, numbers, texts)
     return to_svg(fig, prefix)
 
 
@@ -290,7 +306,7 @@ def _sleeve_outline(ends: tuple[np.ndarray, np.ndarray], span: float) -> list[np
 
 def mechanism_drawing(model: Model, analysis, ghosts: list[int] | None = None, title: str = "",
                       limits: tuple[float, float, float, float] | None = None,
-                      numbers: dict[str, str] | None = None) -> tuple:
+                      numbers: dict[str, str] | None = None, texts: dict[str, str] | None = None) -> tuple:
     """The figure of :func:`mechanism_figure` and its placed labels (:class:`labels.Placed`,
     boxes in display pixels)."""
     fig, ax = plt.subplots(figsize=(6.0, 4.6))
@@ -299,7 +315,7 @@ def mechanism_drawing(model: Model, analysis, ghosts: list[int] | None = None, t
     if ghosts is None:
         ghosts = extremes.extreme_instants(model, poses)
     max_cw = max([a.mass for b in model.bodies for a in b.attachments] + [1e-12])
-    span = _span(model, poses)
+    span = drawing_span(model, poses)
     guided = guided_sliders(model)
     # paths of every named point, thin
     for i, b in enumerate(model.bodies):
@@ -325,7 +341,7 @@ def mechanism_drawing(model: Model, analysis, ghosts: list[int] | None = None, t
     if title:
         ax.set_title(literal(title), fontsize=9)
     fixed_layout(fig)
-    placed = place_names(fig, ax, model, poses[ref], span, max_cw, numbers)
+    placed = place_names(fig, ax, model, poses[ref], span, max_cw, numbers, texts=texts)
     return fig, placed
 
 
@@ -350,27 +366,16 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
     out: list[tuple[str, np.ndarray, str]] = []
     keep: list[tuple[np.ndarray, float | None]] = []
     segs: list[tuple[np.ndarray, np.ndarray]] = []
-    placed: set[tuple[float, float]] = set()
     for name, p in model.frame_points.items():
-        placed.add((round(p[0] / span, 2), round(p[1] / span, 2)))
         out.append((name, np.asarray(p, dtype=float), "pivot"))
         keep.append((np.asarray(p, dtype=float), -1.0))  # the pivot's triangle
-    # one name per place: of the points that coincide there, the first whose name no other body
-    # point of the model has (the platform's C1, not the piston's C of every leg)
-    count = point_name_counts(model)
-    joints: dict[tuple[float, float], tuple[str, np.ndarray]] = {}
-    for i, b in enumerate(model.bodies):
-        if b.kind == "gear" and b.radius:
-            continue  # a disc's axis: the disc carries its number
-        for name, p in b.points.items():
-            g = _global_point(pose_row[i], p)
-            key = (round(g[0] / span, 2), round(g[1] / span, 2))
-            if key in placed:
-                continue
-            if key not in joints or (count[joints[key][0]] > 1 and count[name] == 1):
-                joints[key] = (name, joints[key][1] if key in joints else g)
-    for name, g in joints.values():
-        out.append((name, g, "joint"))
+    # every named point once: one name per place, none for a name at several places (its marker
+    # is still kept clear)
+    places = point_places(model, pose_row, span)
+    unnamed = repeated_names(places)
+    for name, g in places:
+        if name not in unnamed:
+            out.append((name, g, "joint"))
         keep.append((g, None))
     gears, cws, links = [], [], []
     guided = guided_sliders(model)
@@ -478,13 +483,6 @@ def common_limits(items: list[tuple[Model, np.ndarray]], pad: float = 0.08) -> t
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     d = pad * float(max(hi - lo)) or 0.05
     return (float(lo[0] - d), float(lo[1] - d), float(hi[0] + d), float(hi[1] + d))
-
-
-def _span(model: Model, poses: np.ndarray) -> float:
-    xy = poses[:, :, :2].reshape(-1, 2)
-    fp = np.array(list(model.frame_points.values()) or [[0.0, 0.0]])
-    allp = np.vstack([xy, fp])
-    return float(max(np.ptp(allp[:, 0]), np.ptp(allp[:, 1]), 1e-3))
 
 
 def series_figure(t: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel: str, prefix: str,

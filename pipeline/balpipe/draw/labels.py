@@ -19,6 +19,8 @@ import math
 import re
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..model import Model
 
 Box = tuple[float, float, float, float]  # x0, y0, x1, y1 (y up)
@@ -203,6 +205,55 @@ def gear_key(numbers: dict[str, str]) -> str:
         return (int(re.match(r"\d+", num).group()), num)
 
     return "; ".join(f"{num} = {', '.join(by[num])}" for num in sorted(by, key=order))
+
+
+def place_key(p, span: float) -> tuple[float, float]:
+    """A place of a drawing (model coordinates rounded to 1 % of its ``span``): points at one
+    place are named once."""
+    return (round(float(p[0]) / span, 2), round(float(p[1]) / span, 2))
+
+
+def drawing_span(model: Model, poses) -> float:
+    """The size of a drawing of ``model`` over ``poses`` (instants x bodies x (x, y, angle)): the
+    larger extent of the bodies' origins and the frame pivots (m)."""
+    xy = np.asarray(poses, dtype=float)[:, :, :2].reshape(-1, 2)
+    fp = np.array(list(model.frame_points.values()) or [[0.0, 0.0]], dtype=float)
+    allp = np.vstack([xy, fp])
+    return float(max(np.ptp(allp[:, 0]), np.ptp(allp[:, 1]), 1e-3))
+
+
+def point_places(model: Model, pose_row, span: float) -> list[tuple[str, np.ndarray]]:
+    """The places of the body points at one instant (the frame pivots' places left to the
+    pivots; discs' axes to the discs' numbers), each with one name: of the points that coincide
+    there, the first whose name no other body point of the model has (the platform's C1, not the
+    piston's C of every leg)."""
+    pivots = {place_key(p, span) for p in model.frame_points.values()}
+    count = point_name_counts(model)
+    chosen: dict[tuple[float, float], tuple[str, np.ndarray]] = {}
+    for i, b in enumerate(model.bodies):
+        if b.kind == "gear" and b.radius:
+            continue
+        x, y, th = (float(v) for v in pose_row[i])
+        c, s = math.cos(th), math.sin(th)
+        for name, p in b.points.items():
+            g = np.array([x + c * p[0] - s * p[1], y + s * p[0] + c * p[1]])
+            key = place_key(g, span)
+            if key in pivots:
+                continue
+            if key not in chosen or (count[chosen[key][0]] > 1 and count[name] == 1):
+                chosen[key] = (name, chosen[key][1] if key in chosen else g)
+    return list(chosen.values())
+
+
+def repeated_names(places: list[tuple[str, np.ndarray]]) -> set[str]:
+    """The names of :func:`point_places` at more than one place (each 3-RPR leg's ``tip`` and
+    ``B``: a body's own name for its point, repeated on every leg). They name no one point, and
+    the drawings and the player leave them off (every named point is named once); the links'
+    names tell those bodies apart."""
+    seen: dict[str, int] = {}
+    for name, _ in places:
+        seen[name] = seen.get(name, 0) + 1
+    return {n for n, k in seen.items() if k > 1}
 
 
 def point_name_counts(model: Model) -> dict[str, int]:

@@ -37,8 +37,9 @@ def _thin(n: int, curves: int = 1) -> np.ndarray:
     return np.unique(np.linspace(0, n - 1, min(n, keep)).round().astype(int))
 
 
-def _round(values) -> list[float]:
-    return [float(f"{v + 0.0:.6g}") for v in np.asarray(values, dtype=float)]
+def _round(values) -> list[float | None]:
+    """6 significant digits; a missing value (NaN) as null, the one JSON has."""
+    return [float(f"{v + 0.0:.6g}") if np.isfinite(v) else None for v in np.asarray(values, dtype=float)]
 
 
 def line_style(k: int) -> dict:
@@ -59,6 +60,15 @@ class Curves(NamedTuple):
     panels: list
     marks: list  # (time, label): kinematic warnings, dotted vertical lines
     styles: list | None = None  # each stage's line style index (its place in the page's stage table); None: 0, 1, ...
+    # a figure of many panels (a joint per panel): shown one panel at a time, a selector above
+    # choosing which (or every one), this panel first; None: every panel shown
+    choose: int | None = None
+    # a figure over another quantity than time (a Pareto front over its budget): the x axis's
+    # label with its unit; such a figure is not linked to the player, keeps every sample, draws a
+    # marker at every value (a curve across the samples where it has none) and the stages of
+    # ``points`` (each a single design) as markers alone
+    x_axis: str = ""
+    points: tuple = ()
 
 
 def data(c: Curves) -> dict:
@@ -66,15 +76,30 @@ def data(c: Curves) -> dict:
     line style (:func:`line_style`; null where the stage has no such curve); every curve thinned
     to the same samples (:func:`_thin`) and rounded to 6 significant digits."""
     t = np.asarray(c.t, dtype=float)
-    k = _thin(len(t), sum(p["key"] in curves for _, curves in c.stages for p in c.panels))
+    k = (np.arange(len(t)) if c.x_axis else
+         _thin(len(t), sum(p["key"] in curves for _, curves in c.stages for p in c.panels)))
     series = [{"label": label, "y": {p["key"]: _round(np.asarray(curves[p["key"]], dtype=float)[k])
                                      for p in c.panels if p["key"] in curves}, **line_style(n)}
               for n, (label, curves) in enumerate(c.stages)]
     if c.styles is not None:
         for one, style in zip(series, c.styles):
             one.update(line_style(style))
-    return {"t": _round(t[k]), "series": series, "panels": c.panels,
-            "marks": [[_round([tm])[0], text] for tm, text in sorted(set(c.marks))]}
+    out = {"t": _round(t[k]), "series": series, "panels": c.panels, "draw": draw_order(series),
+           "marks": [[_round([tm])[0], text] for tm, text in sorted(set(c.marks))]}
+    if c.choose is not None:
+        out["choose"] = c.choose
+    if c.x_axis:
+        out["x"] = c.x_axis
+        for n in c.points:
+            series[n]["points"] = True
+    return out
+
+
+def draw_order(series: list[dict]) -> list[int]:
+    """The order in which the plot draws ``series`` (the legend keeps theirs): the wide lines
+    first, under the thin ones (:func:`balpipe.draw.figures.wide`, as the static figure's zorder),
+    each group in its own order."""
+    return sorted(range(len(series)), key=lambda i: not figures.wide(series[i]["width"]))
 
 
 def static_panels(c: Curves) -> list:

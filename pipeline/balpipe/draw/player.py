@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from ..model import Model
-from .labels import point_name_counts
+from .labels import drawing_span, point_name_counts, point_places, repeated_names
 from .sleeves import guided_sliders, sleeves
 
 FRAMES = 60
@@ -129,16 +129,17 @@ def same_scale(views: dict, rel: float = 0.02) -> bool:
     return max(s) <= (1 + rel) * min(s)
 
 
-def _labels(model: Model, numbers: dict[str, str]) -> dict:
-    """What the player names, in body frames: joints (body points, discs' axes left out),
-    links (middle of the first outline segment; a platform at its centroid), counterweights,
-    and every gear's number (:func:`labels.gear_numbers`)."""
+def _labels(model: Model, numbers: dict[str, str], unnamed: set[str] = frozenset()) -> dict:
+    """What the player names, in body frames: joints (body points, discs' axes left out, and
+    the names in ``unnamed``: :func:`labels.repeated_names`, as the drawings), links (middle of
+    the first outline segment; a platform at its centroid), counterweights, and every gear's
+    number (:func:`labels.gear_numbers`)."""
     joints, links, cws, gears = [], [], [], []
     for j, b in enumerate(model.bodies):
         if b.radius:
             gears.append([j, 0.0, 0.0, round(b.radius, 5), numbers.get(b.name, b.name)])
         else:
-            joints += [[j, round(p[0], 5), round(p[1], 5), n] for n, p in b.points.items()]
+            joints += [[j, round(p[0], 5), round(p[1], 5), n] for n, p in b.points.items() if n not in unnamed]
         pts = [b.points[p] for p in b.outline]
         if len(pts) >= 2:
             uniq = list(dict.fromkeys(tuple(p) for p in pts))
@@ -158,6 +159,11 @@ def _labels(model: Model, numbers: dict[str, str]) -> dict:
     count = point_name_counts(model)
     joints.sort(key=lambda j: count[j[3]] > 1)
     return {"joints": joints, "links": links, "cws": cws, "gears": gears}
+
+
+def unnamed(model: Model, poses: np.ndarray) -> set[str]:
+    """The point names the drawings leave off (:func:`labels.repeated_names`), at the first pose."""
+    return repeated_names(point_places(model, poses[0], drawing_span(model, poses)))
 
 
 def player_data(stages: list[dict]) -> dict:
@@ -182,7 +188,7 @@ def player_data(stages: list[dict]) -> dict:
             "shapes": _outline(s["model"]),
             "pivots": fp,
             "pivot_names": list(s["model"].frame_points),
-            "names": _labels(s["model"], numbers),
+            "names": _labels(s["model"], numbers, unnamed(s["model"], s["poses"])),
             "guides": [[[round(a[0], 5), round(a[1], 5)], [round(b[0], 5), round(b[1], 5)]] for a, b in s["model"].guides],
             "sleeves": [[[[round(float(v), 6) for v in end] for end in ends] for ends in sleeves(s["model"], frame)]
                         for frame in poses],

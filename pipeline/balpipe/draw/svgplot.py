@@ -396,10 +396,8 @@ def _frame(panel: Panel, box: Box, xa: Axis, ya: Axis, low: bool, prefix: str, n
         py = _fmt(_px(t, ya, box.y1, box.y0))
         g.append(f'<path d="M{_fmt(box.x0)} {py}H{_fmt(box.x1)}" {grid}/>')
     columns = int(COLUMNS_PER_PT * (box.x1 - box.x0))
-    for k, curve in enumerate(panel.curves):
-        if curve[2] is None:
-            continue
-        st = curve_style(curve, k, styles)
+    drawn = [(k, c, curve_style(c, k, styles)) for k, c in enumerate(panel.curves) if c[2] is not None]
+    for k, curve, st in sorted(drawn, key=lambda d: d[2].get("zorder", 2.0)):  # a wide line under the thin ones
         t0, y0 = np.asarray(curve[1], dtype=float), np.asarray(curve[2], dtype=float)
         t, y = decimate(t0, y0, xa.lo, xa.hi, columns)
         g.append(_polyline(_px(t, xa, box.x0, box.x1), _px(y, ya, box.y1, box.y0), _line_attrs(st)))

@@ -510,6 +510,12 @@ def table_texts(spec: Any) -> str:
                    for drive in motion.drive.values() for _, d in _tables(drive, ()))
 
 
+def table_files(spec: Any) -> list[str]:
+    """The files of the tables the spec reads, as written in it, in :func:`table_texts`'s order."""
+    return [d.file for _, motion in motion_sections(spec) for drive in motion.drive.values()
+            for _, d in _tables(drive, ())]
+
+
 def _tables(drive: Any, path: tuple):
     if isinstance(drive, TableDrive):
         yield path, drive

@@ -6,9 +6,12 @@ the unbalanced mechanism (name, mass, position, inertia) and what they cost, as 
 
 from __future__ import annotations
 
+from markupsafe import Markup
+
 from ..model import Model
 from ..study import Study
 from .costs import factor_text
+from .notation_table import PageNames, names_for
 
 
 def _fmt(x: float) -> str:
@@ -23,28 +26,33 @@ def _position(p) -> str:
     return f"({_fmt(x)}, {_fmt(y)}) m"
 
 
-def added_parts(base: Model, final: Model) -> list[dict]:
+def added_parts(base: Model, final: Model, names: PageNames | None = None) -> list[dict]:
     """Counterweights and discs of ``final`` that ``base`` lacks, and links whose own mass or
-    inertia the method changed. Positions of attachments are in their link's frame (m)."""
+    inertia the method changed. Positions of attachments are in their link's frame (m). With
+    ``names`` (:func:`names_for`), ``name`` and ``where`` are markup naming the parts in the
+    paper's symbols (the model's name beside each); ``part`` keeps the model's name."""
+    def nm(name: str) -> str:
+        return names.part(name) if names is not None else name
+
     rows = []
     old = {b.name: b for b in base.bodies}
     for b in final.bodies:
         before = old.get(b.name)
         if before is None:
-            rows.append({"name": b.name, "kind": "counter-rotation" if b.kind == "gear" else f"added {b.kind}",
+            rows.append({"part": b.name, "name": nm(b.name), "kind": "counter-rotation" if b.kind == "gear" else f"added {b.kind}",
                          "mass": b.mass, "where": "a body of its own",
                          "inertia": b.inertia, "buildable": b.mass >= 0 and b.inertia >= 0})
             atts = b.attachments
         else:
             if abs(b.mass - before.mass) > 1e-12 or abs(b.inertia - before.inertia) > 1e-15:
-                rows.append({"name": b.name, "kind": "link changed",
+                rows.append({"part": b.name, "name": nm(b.name), "kind": "link changed",
                              "mass": b.mass, "where": f"was {_fmt(before.mass)} kg, {_fmt(before.inertia)} kg m²",
                              "inertia": b.inertia, "buildable": b.mass >= 0 and b.inertia >= 0})
             had = {a.name for a in before.attachments}
             atts = tuple(a for a in b.attachments if a.name not in had)
         for a in atts:
-            rows.append({"name": a.name, "kind": a.kind, "mass": a.mass,
-                         "where": f"on {b.name} at {_position(a.position)}",
+            rows.append({"part": a.name, "name": nm(a.name), "kind": a.kind, "mass": a.mass,
+                         "where": Markup("on ") + nm(b.name) + f" at {_position(a.position)}",
                          "inertia": a.inertia, "buildable": a.mass >= 0 and a.inertia >= 0})
     return rows
 
@@ -62,14 +70,15 @@ def design_card(study: Study, results: dict) -> dict | None:
     if final is None or ref is None:
         return None
     c = g["costs"]
+    names = names_for(study.spec)
     factors = [
         ("moving mass", factor_text(c["moving_mass"]), f"+{_fmt(c['added_mass'] or 0.0)} kg"),
-        ("peak actuator effort", factor_text(c["effort"]), c["effort_driver"]),
-        ("RMS actuator effort", factor_text(c["rms"]), c["rms_driver"]),
-        ("peak actuator power", factor_text(c["power"]), c["power_driver"]),
-        ("largest joint load", factor_text(c["joint_load"]), c["joint"]),
+        ("peak actuator effort", factor_text(c["effort"]), names.driver(c["effort_driver"])),
+        ("RMS actuator effort", factor_text(c["rms"]), names.driver(c["rms_driver"])),
+        ("peak actuator power", factor_text(c["power"]), names.driver(c["power_driver"])),
+        ("largest joint load", factor_text(c["joint_load"]), names.joint(c["joint"])),
     ]
-    parts = added_parts(ref.stage.model, final.stage.model)
+    parts = added_parts(ref.stage.model, final.stage.model, names)
     kinds: dict[str, list[float]] = {}
     for p in parts:
         kinds.setdefault(p["kind"], []).append(p["mass"])

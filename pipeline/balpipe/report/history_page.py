@@ -4,33 +4,18 @@ takes them in.
 ``balpipe history`` writes ``<out>/<slug>/history.json``. When ``balpipe build`` rebuilds that
 spec's folder it keeps the file (:func:`build_files`), re-renders ``history.html`` and puts the
 same section into the study page (:func:`section`); the file's content is part of the build's
-input hash (:func:`mix_hash`), so a new history re-renders the page even if the spec did not
+input hash (:func:`balpipe.report.history_file.mix_hash`), so a new history re-renders the page even if the spec did not
 change. Both pages render the section from ``history.json`` alone: the same bytes whichever
 command ran last.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
 from pathlib import Path
 
-from .history_figures import (added_history_figure, changing_parameters, flagged, loads_history_figure,
-                              parameters_history_figure)
+from .history_file import HISTORY_FILE, HISTORY_PAGE, load
 from .render import environment, num
 from .render import load as peak_text
-
-HISTORY_FILE = "history.json"
-HISTORY_PAGE = "history.html"
-
-
-def load(folder: Path) -> tuple[str, dict] | None:
-    """The raw text and the data of ``folder/history.json``, or None."""
-    try:
-        text = (folder / HISTORY_FILE).read_text(encoding="utf-8")
-        return text, json.loads(text)
-    except (OSError, ValueError):
-        return None
 
 
 def _date(iso: str) -> str:
@@ -49,6 +34,9 @@ def _peaks(c: dict, key: str) -> str:
 
 def view(history: dict, prefix: str = "hist") -> dict:
     """What the templates need: figures (title, svg, caption) and one row per commit."""
+    from .history_figures import (added_history_figure, changing_parameters, flagged, loads_history_figure,
+                                  parameters_history_figure)  # matplotlib: only when there is a history
+
     commits = history.get("commits") or []
     changing, constant = changing_parameters(commits)
     shown = {name for name, _ in changing}
@@ -112,14 +100,6 @@ def section(folder: Path) -> dict | None:
     """The history section of the study page in ``folder``, if a history was recorded."""
     got = load(folder)
     return view(got[1], "hist") if got is not None else None
-
-
-def mix_hash(h: str, folder: Path) -> str:
-    """The build's input hash, extended by the content of ``history.json`` when there is one."""
-    got = load(folder)
-    if got is None:
-        return h
-    return hashlib.sha256((h + "\n" + got[0]).encode()).hexdigest()[:16]
 
 
 def build_files(folder: Path) -> dict[str, str]:

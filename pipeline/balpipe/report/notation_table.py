@@ -34,6 +34,48 @@ def tables_for(mechanism: Any, balancing: Any) -> list[N.Table]:
     return out
 
 
+def names_for(spec: Any) -> "PageNames":
+    """The names of a study's drivers, parts and joints on its pages, from its main design's
+    tables (:class:`balpipe.notation.Names`): the paper's symbols where its family declares them."""
+    return PageNames(N.Names(tuple(tables_for(spec.mechanism, spec.balancing))))
+
+
+class PageNames:
+    """:class:`balpipe.notation.Names` for the templates: ``driver(name)``, ``part(name)``,
+    ``joint(name)``, ``param(name)`` give markup (the symbol, the model's name beside it); ``text(kind, name)``
+    plain text for plots (``θ₁ [theta1]``)."""
+
+    def __init__(self, names: N.Names):
+        self.names = names
+
+    def driver(self, name: str) -> Markup:
+        return Markup(self.names.html("driver", name))
+
+    def part(self, name: str) -> Markup:
+        return Markup(self.names.html("part", name)) if isinstance(name, str) else name
+
+    def param(self, name: str) -> Markup:
+        return Markup(self.names.html("param", name))
+
+    def joint(self, name: str) -> Markup:
+        return Markup(self.names.html("joint", name)) if name else Markup("")
+
+    def text(self, kind: str, name: str) -> str:
+        return self.names.text(kind, name, spec_name=True)
+
+    def link_texts(self, models: list) -> dict[str, str]:
+        """Body name -> the text the mechanism drawings write for it: the paper's symbol of each
+        link and disc whose symbol reads as plain text (``l₄₁``, ``link 11``, ``gear 1'``), so
+        that a link has one name on the page (the card, the tables and every drawing)."""
+        out = {}
+        for model in models:
+            for b in model.bodies:
+                t = self.names.text("part", b.name)
+                if t != b.name and "_" not in t:
+                    out[b.name] = t
+        return out
+
+
 def _written_to_si(raw: Any, dimension: str | None) -> tuple[str, str] | None:
     """A drive's end value as written ("-80 deg", 0.2) converted to SI: (value, unit)."""
     if isinstance(raw, bool):

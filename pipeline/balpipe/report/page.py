@@ -12,7 +12,7 @@ from ..study import Study, ratio_reference
 from ..draw import extremes, figures, labels, live, sleeves
 from . import citations, live_plots, paper_figures, partial_figures, present, sections, toc
 from .design_card import design_card
-from .notation_table import notation_groups
+from .notation_table import PageNames, names_for, notation_groups
 from .render import environment
 from .results import joint_load_table
 
@@ -49,7 +49,8 @@ def drawing_times(study: Study) -> dict:
     return {"solid": f"{solid:.4g}", "ghosts": " and ".join(texts), "count": len(texts), "sleeves": sleeved}
 
 
-def study_figures(study: Study) -> dict:
+def study_figures(study: Study, names: PageNames | None = None) -> dict:
+    names = names if names is not None else names_for(study.spec)
     sims = []
     for s in shown_stages(study):
         v = s.validation
@@ -61,19 +62,23 @@ def study_figures(study: Study) -> dict:
     units = {d.name: present.driver_unit(s.stage.model, d.name)
              for s in shown_stages(study) for d in (*s.stage.model.drivers, *s.stage.model.actuators)}
     marks = [(w["time"], w["kind"].replace("_", " ")) for w in study.warnings]
+    shown_names = {d: names.text("driver", d) for d in units}  # the paper's symbols in the panels' titles
     # each time-series figure interactive above its static SVG (draw/live.py; curves: report/live_plots.py)
     loads = live.html("loads", loads, live_plots.loads(shown))
-    efforts = live.html("efforts", figures.efforts_figure(shown, prefix="efforts", units=units, marks=marks),
-                        live_plots.efforts(shown, units, marks))
-    joint_curves = live_plots.joints(shown)
+    efforts = live.html("efforts", figures.efforts_figure(shown, prefix="efforts", units=units, marks=marks,
+                                                          shown=shown_names),
+                        live_plots.efforts(shown, units, marks, shown_names))
+    joint_names = {j: names.text("joint", j) for _, an in shown for j in an.reactions}  # the paper's symbols
+    joint_curves = live_plots.joints(shown, joint_names)
     joints = (live.html("joints", figures.panels_figure(live.static_panels(joint_curves), "joints"),
                         joint_curves) if joint_curves.panels else "")
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
     numbers = labels.gear_numbers([s.stage.model for s in shown_stages(study)])
     ghosts = drawn_instants(study)
+    texts = names.link_texts([s.stage.model for s in shown_stages(study)])  # one name per link on the page
     mech = [
         (s.stage.label, figures.mechanism_figure(s.stage.model, s.analysis, ghosts, prefix=f"mech{k}",
-                                                 title=s.stage.label, limits=limits, numbers=numbers))
+                                                 title=s.stage.label, limits=limits, numbers=numbers, texts=texts))
         for k, s in enumerate(shown_stages(study))
     ]
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
@@ -89,29 +94,30 @@ def study_figures(study: Study) -> dict:
     torque = []
     runs = [s for s in study.stages if s.torque is not None]
     if runs:
-        curves = [(f"{s.stage.label}: {d}", np.abs(e) / (s.torque.travel[d] or 1.0))
+        curves = [(f"{s.stage.label}: {names.text('driver', d)}", np.abs(e) / (s.torque.travel[d] or 1.0))
                   for s in runs for d, e in sorted(s.torque.tracking.items())]
         torque.append((
             "Tracking error of the torque-driven run",
             figures.series_figure(runs[0].torque.t, curves, "|q_sim − q_plan| / travel", prefix="torque"),
             "Each driven coordinate of the simulation driven by the engine's efforts (no position drive), "
             "minus its planned motion, relative to its travel (largest excursion from its start): "
-            + travel_text(runs[0]) + ".",
+            + travel_text(runs[0], names) + ".",
         ))
     key = "; ".join(f"{figures.style_text(k)}: {s.stage.label}" for k, s in enumerate(shown_stages(study)))
     # a method that gives its stages the paper's line styles (Stage.style): said in the legend
     paper_styles = styled(shown_stages(study))
-    return {"loads": loads, "joints": joints, "loads_key": key[:1].upper() + key[1:],
+    return {"loads": loads, "joints": joints, "joints_chosen": joint_curves.choose is not None, "loads_key": key[:1].upper() + key[1:],
             "styles_note": "These are the paper's line styles for the stages it plots, so the figures titled with the "
                            "paper's numbers draw each stage as every other figure does" if paper_styles else "",
             "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
-def travel_text(s) -> str:
-    """'crank 2.793 rad' per driver of a stage's torque-driven run: the tracking error's reference."""
+def travel_text(s, names: PageNames | None = None) -> str:
+    """'crank 2.793 rad' per driver of a stage's torque-driven run: the tracking error's reference
+    (with ``names``, each driver in the paper's symbol: 'θ₁ [theta1] 0.61 rad')."""
     model = s.stage.model
-    return ", ".join(f"{d} {v:.4g} {'m' if present.driver_unit(model, d) == 'N' else 'rad'}"
+    return ", ".join(f"{names.text('driver', d) if names else d} {v:.4g} {'m' if present.driver_unit(model, d) == 'N' else 'rad'}"
                      for d, v in sorted(s.torque.travel.items()))
 
 
@@ -152,6 +158,7 @@ def _reference_phrase(ref, label: str, which: str) -> str:
 def render_page(study: Study, results: dict, spec_text: str, history: dict | None = None,
                 nav: dict | None = None) -> str:
     spec = study.spec
+    names = names_for(spec)
     validation_rows = []
     for s in study.stages:
         v = s.validation
@@ -175,10 +182,11 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                 "force_peak": q.force_peak, "moment_peak": q.moment_peak,
                 "dt": q.dt, "steps": q.steps, "iterations": q.iterations, "tolerance": q.tracking_tolerance,
                 "passed": q.passed, "reasons": "; ".join(q.reasons), "notes": "; ".join(q.notes),
-                "per_driver": ", ".join(f"{k} {v:.2g}" for k, v in sorted(q.tracking_error.items())),
+                "per_driver": markupsafe.Markup(", ").join(names.driver(k) + f" {v:.2g}"
+                                                           for k, v in sorted(q.tracking_error.items())),
             })
     rl = study.reactionless
-    drawn = study_figures(study)
+    drawn = study_figures(study, names)
     return toc.add_toc(sections.collapse(environment().get_template("spec.html").render(
         r=results,
         paper=spec.paper,
@@ -205,4 +213,5 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         verdict=results.get("verdict"),
         card=design_card(study, results),
         citation=citations.cite(spec.paper),
+        names=names,
     )))

@@ -9,6 +9,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+import numpy as np  # noqa: E402
+
+from ..draw import live  # noqa: E402
 from ..draw.figures import legend_below, marker, style, to_svg  # noqa: E402
 
 AXES = {
@@ -31,10 +34,12 @@ FRONTS = (
 )
 
 
+FRONT = "optimal front (cone programme)"
+
+
 def _front_figure(points: list[dict], x: str, y: str, marks: list[tuple[str, float, float]], prefix: str) -> str:
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    ax.plot([p[x] for p in points], [p[y] for p in points], "-o", ms=3, color="black", lw=1.2,
-            label="optimal front (cone programme)")
+    ax.plot([p[x] for p in points], [p[y] for p in points], "-o", ms=3, color="black", lw=1.2, label=FRONT)
     for k, (label, vx, vy) in enumerate(marks):
         ax.plot([vx], [vy], linestyle="none", marker=marker(k), color=style(k + 1)["color"], ms=8,
                 markerfacecolor="none", mew=1.5, label=label)
@@ -44,6 +49,21 @@ def _front_figure(points: list[dict], x: str, y: str, marks: list[tuple[str, flo
     ax.grid(alpha=0.3)
     legend_below(fig, ax)
     return to_svg(fig, prefix)
+
+
+def front_curves(points: list[dict], x: str, y: str, marks: list[tuple[str, float, float]]) -> live.Curves:
+    """The same front and marks for the interactive plot (:mod:`balpipe.draw.live`): over the
+    budget ``x``, a row per design in order of ``x`` (the front's designs, then each marked one),
+    the front's curve through its designs and each mark a marker alone; hovering a design shows
+    its budget and objective. Colours as :func:`_front_figure`'s (the marks in ``style(k + 1)``)."""
+    rows = sorted([(float(p[x]), 0, float(p[y])) for p in points] +
+                  [(float(vx), k + 1, float(vy)) for k, (_, vx, vy) in enumerate(marks)])
+    ys = np.full((len(marks) + 1, len(rows)), np.nan)
+    for i, (_, series, value) in enumerate(rows):
+        ys[series, i] = value
+    stages = [(FRONT, {"y": ys[0]})] + [(label, {"y": ys[k + 1]}) for k, (label, _, _) in enumerate(marks)]
+    return live.Curves(np.array([r[0] for r in rows]), stages, [{"key": "y", "title": "", "axis": AXES[y]}], [],
+                       styles=list(range(len(stages))), x_axis=AXES[x], points=tuple(range(1, len(stages))))
 
 
 def _marks(study, det: dict, x: str, y: str) -> list[tuple[str, float, float]]:
@@ -95,10 +115,14 @@ def figures(study) -> list[tuple[str, str, str]]:
         pts = det["fronts"].get(key) or []
         if len(pts) < 2:
             continue
-        svg = _front_figure(pts, x, y, _marks(study, det, x, y), prefix=f"partial_{key}")
+        marks = _marks(study, det, x, y)
+        svg = live.html(f"partial_{key}", _front_figure(pts, x, y, marks, prefix=f"partial_{key}"),
+                        front_curves(pts, x, y, marks))
         caption = (f"{len(pts)} points, each {what}, solved to global optimality {where} "
                    "(second-order cone programme, Clarabel). Markers: the least-mass complete balances in the same "
                    f"regions along {'this motion' if n == 1 else 'these motions'}, where they exist, and {marked}. "
-                   + headline(study, det))
+                   + headline(study, det) + " Interactive where JavaScript runs: hover a design for its "
+                   f"{AXES[x].split(' (')[0]} and {AXES[y].split(' (')[0]}, drag across to zoom (double-click "
+                   "resets), click a legend entry to hide it; printing shows the static figure.")
         out.append((title, svg, caption))
     return out

@@ -55,7 +55,7 @@ def _entry(out: Path, o) -> dict:
         e["not_realisable"] = [f"{s['label']}: {s['not_realisable']}" for s in st if s.get("realisable") is False]
         tol = results.get("checks", {}).get("balance_tolerance")
         e["headline"] = headline(v, tol)
-        # the main design's last stage of its first motion (never a compared design's)
+        # the main design's headline stage of its first motion (never a compared design's)
         last = next((s for s in st if v["motions"] and s["name"] == v["motions"][0]["final"]), st[-1])
         e["added_mass"] = f"{num(last['added_mass'])} kg"
         e.update(_costs(results, first, last))
@@ -158,9 +158,11 @@ def _costs(results: dict, first: dict, last: dict) -> dict:
     return {"claims": claims, "added_mass": added, "efforts": efforts, "joint_increase": joint}
 
 
-def write_site(out: Path, outcomes: list, earlier: list = ()) -> None:
+def write_site(out: Path, outcomes: list, earlier: list = (), site_key: str = "") -> None:
     """The site's index (and its navigation script): this build's ``outcomes`` and the pages of
-    ``earlier`` builds still in ``out`` (:func:`balpipe.site_earlier.earlier_pages`)."""
+    ``earlier`` builds still in ``out`` (:func:`balpipe.site_earlier.earlier_pages`). ``site_key``
+    (:func:`balpipe.build.site_key`) is written into the index's head, so that a build with
+    nothing changed can leave the index as it is."""
     entries = [_entry(out, o) for o in sorted(outcomes, key=lambda o: o.source)]
     for old in earlier:
         e = _entry(out, old)
@@ -179,6 +181,7 @@ def write_site(out: Path, outcomes: list, earlier: list = ()) -> None:
         filters=site_filter.options(entries),
         papers=site_papers(entries),
         comparisons=comparisons(entries),
+        site_key=site_key,
     )
     write_file_atomic(out / "index.html", html)
     write_file_atomic(out / "site_nav.js", site_nav_script(entries))

@@ -11,11 +11,14 @@ published numbers the build reproduces.
 Levels, worst first: ``bad`` (a claim fails, or the build failed), ``warn`` (a stage makes a
 load worse than its reference, a part cannot be built, or a published number does not
 reproduce), ``neutral`` (nothing changed), ``good``. A spec's level is the worst of its main
-design's final stages and of its references: a spec whose |M| gets worse after a stage that
-claims moment balance is never ``good``.
+design's headline stages (below), of its stages' claims and of its references: a spec whose |M|
+gets worse after a stage that claims moment balance is never ``good``.
 
 The headline numbers come from the spec's main design (stages named without ``design:``), one
-row per motion (the stages sharing a reference stage); a compared design never stands in.
+row per motion (the stages sharing a reference stage); a compared design never stands in. Per
+motion the headline is the stage whose numbers the paper publishes where the method declares one
+(:attr:`balpipe.balancing.base.Stage.headline`; paper 003: case 2, not the case 3 after it), else
+the motion's last stage: :func:`headline_stage`. Every stage keeps its own verdict.
 With gravity on, the loads are the inertial part and the weight (total moving mass x g) is given
 apart. Pure functions of the result rows: the index reads a results.json written earlier with
 the same code.
@@ -119,6 +122,13 @@ def motions(stages: list[dict]) -> list[tuple[dict, list[dict]]]:
     return list(out.values())
 
 
+def headline_stage(members: list[dict]) -> tuple[dict, bool]:
+    """The stage a motion's headline judges, and whether the method declared it: its last stage
+    marked ``headline`` (the stage whose numbers the paper publishes), else its last stage."""
+    declared = [m for m in members if m.get("headline")]
+    return (declared[-1], True) if declared else (members[-1], False)
+
+
 def references_verdict(refs: list[dict]) -> dict:
     """Published numbers reproduced k of n; those the spec expects not to (a paper's typo,
     documented in its note) counted apart."""
@@ -171,11 +181,11 @@ def verdict(results: dict, weights: dict[str, float] | None = None) -> dict[str,
         per_stage[s["name"]] = stage_verdict(s, weights.get(s["name"]))
     groups = []
     for ref, members in motions(stages):
-        final = members[-1]
+        final, declared = headline_stage(members)
         v = per_stage[final["name"]]
         groups.append({
             "reference": ref["name"], "reference_label": ref["label"], "final": final["name"],
-            "final_label": final["label"],
+            "final_label": final["label"], "declared": declared,
             "force": [ref["max_inertial_force"], final["max_inertial_force"]],
             "moment": [ref["max_inertial_moment"], final["max_inertial_moment"]],
             "weight": [weights.get(ref["name"]), weights.get(final["name"])] if weights else None,

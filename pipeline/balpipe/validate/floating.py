@@ -78,7 +78,8 @@ class FreeFloating:
         """What the page shows: a simulation or the conservation solution."""
         if self.method == "pymunk":
             return "simulation (pymunk)" + (
-                f", massless bodies given {100 * self.small_mass_fraction:g} % of the total mass" if self.small_masses else "")
+                f", each massless part given {100 * self.small_mass_fraction:g} % of the mechanism's mass "
+                "(pymunk cannot move a body without mass)" if self.small_masses else "")
         return "conservation solution (not simulated)"
 
     def to_json(self) -> dict:
@@ -238,11 +239,11 @@ def free_floating(
             if run is not None:
                 if fraction is not None:
                     notes.append(
-                        "massless bodies simulated with a small mass (" + ", ".join(
+                        "massless parts simulated with a mass of their own, as pymunk needs one (" + ", ".join(
                             f"{k} {1000 * m:.3g} g" + (f" and {i:.3g} kg m^2" if i > 0 else "")
                             for k, (m, i) in small.items()
-                        ) + f", {100 * fraction:g} % of the total mass)"
-                        + (f"; with {', '.join(failed)} of the total mass pymunk did not hold together" if failed else "")
+                        ) + f": each {100 * fraction:g} % of the mechanism's mass)"
+                        + (f"; with {', '.join(failed)} of the mechanism's mass pymunk did not hold together" if failed else "")
                     )
                     phi_ref, origin_ref = _conservation_solution(sim_model, analysis, float(base_mass), bi, centre)
                     drift_ref = origin_ref + _rotate(phi_ref, np.broadcast_to(centre, origin_ref.shape)) - centre
@@ -256,7 +257,7 @@ def free_floating(
         if run is None:
             sim_model, small, massless_ref = model, {}, None
             notes.append("pymunk did not hold the mechanism together" + (
-                f" (massless bodies given {', '.join(failed)} of the total mass)" if failed else "")
+                f" (with the massless parts given {', '.join(failed)} of the mechanism's mass each)" if failed else "")
                 + ": conservation solution used")
     if run is not None:
         if idx is None:

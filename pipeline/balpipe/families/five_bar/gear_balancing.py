@@ -373,9 +373,21 @@ def _full_stage(model: Model, links: dict[str, Body], I: dict[str, float], mech:
 
 
 def _notation() -> dict:
-    from ...notation import Sym, ours, setting
+    from ...notation import Sym, names_table, ours, setting
 
-    return {
+    links = range(1, 5)
+    names = names_table(
+        parts={f"counterweight {j}": Sym(f"m_{{CW{j}}}", f"counterweight on link {j} (eqs. 9-12)") for j in links},
+        params={**{f"theta{j}{e}": Sym(f"θ_{{{j}{e}}}", f"input angle of link {j} at the {w} position")
+                   for j in (1, 2) for e, w in (("i", "initial"), ("f", "final"))},
+                **{f"mCW{j}": Sym(f"m_{{CW{j}}}", f"mass of counterweight {j}") for j in links},
+                **{f"m{j}_star": Sym(f"m_{j}^*", f"mass of the balanced link {j} (eq. 14)") for j in links},
+                **{f"r{j}_star": Sym(f"r_{j}^*", f"centre of mass of the balanced link {j}") for j in links},
+                **{f"r{j}p": Sym(f"r_{{{j}'}}", f"pitch radius of gear {j}'") for j in links},
+                **{f"r{k}": Sym(f"r_{k}", f"pitch radius of gear {k}") for k in (5, 6, 7)},
+                **{f"I{k}": Sym(f"I_{k}", f"axial moment of inertia of gear {k} (eqs. 19-21)") for k in (5, 6, 7)},
+                **{f"U{ab}": Sym(f"U_{{{ab}}}", "transmission ratio") for ab in ("21", "51", "63", "74")}})
+    return names | {
         "balancing.counterweights.proximal": Sym(
             "−r_{CW1} = −r_{CW2}", "counterweights 1, 2 along A_jB_j from A_j (negative: beyond A_j, at r_{CW} from it)"),
         "balancing.counterweights.distal": Sym(

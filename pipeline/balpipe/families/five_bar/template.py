@@ -495,9 +495,19 @@ __all__ = [
 
 
 def _notation() -> dict:
-    from ...notation import Sym, drive_table, ours
+    from ...notation import Sym, drive_table, names_table, ours
 
     table = drive_table({"gripper": Sym("P", "gripper position (x, y)")}, end_time="T")
+    # the model's names (Sec. II, Fig. 3): input angles θ_1, θ_2 at A_1, A_2 (the gear-coupled
+    # five-bar drives θ_1 alone), links 1-4, gears 5-7, joints A_j, B_j
+    table.update(names_table(
+        drivers={"theta1": Sym("θ_1", "input angle of link 1 at A_1"),
+                 "A1": Sym("θ_1", "input angle of link 1, its motor at A_1"),
+                 "A2": Sym("θ_2", "input angle of link 2, its motor at A_2")},
+        parts={**{f"link{j}": Sym(f"link {j}", ("input" if j < 3 else "distal") + f" link {j}") for j in range(1, 5)},
+               **{f"gear{j}": Sym(f"gear {j}", f"gear {j}") for j in (5, 6, 7)}},
+        joints={f"{p}{j}": Sym(f"{p}_{j}", f"joint {p}_{j}") for p in "AB" for j in (1, 2)},
+    ))
     table.update({
         "mechanism.pivots.A1": Sym("A_1", "base pivot of input link 1, (−l_0, 0) in the paper"),
         "mechanism.pivots.A2": Sym("A_2", "base pivot of input link 2, (l_0, 0) in the paper"),

@@ -240,9 +240,26 @@ def balance(mech: rpr3.Rpr3Mechanism, method: Rpr3IdlerLoop, model: Model, t: np
 
 
 def _notation() -> dict:
-    from ...notation import Sym, ours
+    from ...notation import Sym, names_table, ours
 
-    return {
+    legs = range(1, 4)
+    names = names_table(parts={
+        "link5": Sym("link 5", "link 5 of the idler loop, EF"),
+        "link6": Sym("link 6", "link 6 of the idler loop, FP"),
+        **{f"mcp{j} (leg {i})": Sym(f"m_{{cp{j}}} (leg {i})", f"counterweight on link {i}{j} (eqs. 5a-b)")
+           for j in (1, 2) for i in legs},
+        "mcp5": Sym("m_{cp5}", "counterweight on link 5 (eq. 5d)"),
+        "mcp6": Sym("m_{cp6}", "counterweight on link 6 (eq. 5c)"),
+        **{f"cr1.{i}": Sym(f"I_{{cr1}} (leg {i})", f"counter-rotation on the base at A_{i} (eq. 9a)") for i in legs},
+        "cr2": Sym("I_{cr2}", "counter-rotation carried by link 6, geared to the platform (eq. 9b)"),
+        "cr3": Sym("I_{cr3}", "counter-rotation carried by link 5, geared to link 6 (eq. 9c)"),
+        "cr4": Sym("I_{cr4}", "counter-rotation on the base at E (eq. 9d)"),
+    }, params={
+        **{f"mcp{j}": Sym(f"m_{{cp{j}}}", f"mass of counterweight {j} (eqs. 5a-d)") for j in (1, 2, 5, 6)},
+        **{f"rcp{j}": Sym(f"r_{{cp{j}}}", f"position coefficient of counterweight {j}") for j in (1, 2, 5, 6)},
+        **{f"Icr{k}": Sym(f"I_{{cr{k}}}", f"inertia of counter-rotation {k} (eqs. 9a-d)") for k in (1, 2, 3, 4)},
+    })
+    return names | {
         "balancing.E": Sym("E", "base pivot of the idler loop E-F-P (the paper: E = O)"),
         "balancing.link5.length": Sym("L_5", "length EF of link 5"),
         "balancing.link5.mass": Sym("m_5", "mass of link 5"),

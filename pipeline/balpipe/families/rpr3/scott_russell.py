@@ -283,9 +283,22 @@ def balance(mech: rpr3.Rpr3Mechanism, method: Rpr3ScottRussell, model: Model) ->
 
 
 def _notation() -> dict:
-    from ...notation import Sym, ours, setting
+    from ...notation import Sym, names_table, ours, setting
 
-    return {
+    legs = range(1, 4)
+    links = {"crank": 1, "coupler": 2, "piston": 3, "cyl": 4}
+    names = names_table(parts={
+        **{f"{b}{i}": Sym(f"link {j} (leg {i})", f"link {j} of leg {i}'s Scott-Russell mechanism (Fig. 6)")
+           for b, j in links.items() for i in legs},
+        **{f"mcp{j} (leg {i})": Sym(f"m_{{cp{j}}} (leg {i})", f"counterweight on link {j} of leg {i} (eqs. 30a-d)")
+           for j in links.values() for i in legs},
+        **{f"cr{i}": Sym(f"I_{{cr}} (leg {i})", f"counter-rotation of leg {i} on the base at A_{i} (eq. 30f)") for i in legs},
+    }, params={
+        **{f"mcp{j}": Sym(f"m_{{cp{j}}}", f"mass of counterweight {j} (eqs. 30a-d)") for j in links.values()},
+        **{f"rcp{j}": Sym(f"r_{{cp{j}}}", f"position coefficient of counterweight {j}") for j in links.values()},
+        "Icr": Sym("I_{cr}", "inertia of each leg's counter-rotation (eq. 30f)"),
+    })
+    return names | {
         # Sec. 3 renumbers the leg: the piston is link 3, the cylinder link 4 (Fig. 6)
         "mechanism.cylinder.mass": Sym("m_4", "mass of each cylinder, link 4 of the leg (Sec. 3.2)"),
         "mechanism.cylinder.com": Sym("r_4 L_3", "centre of mass S_4 of the cylinder from A_i towards C_i"),

@@ -328,7 +328,7 @@ def prismatic_equivalent(mech: Rpr3Mechanism, pose: Pose, t: np.ndarray, torques
 
 
 def _notation() -> dict:
-    from ...notation import Sym, drive_table, ours, setting
+    from ...notation import Sym, drive_table, names_table, ours, setting
 
     table = drive_table({"x": Sym("x", "x of the platform's point P"), "y": Sym("y", "y of P"),
                          "phi": Sym("φ", "platform angle, C_1C_2 to A_1A_2")})
@@ -351,6 +351,17 @@ def _notation() -> dict:
         "mechanism.stroke": ours("|A_iC_i|_{min}, |A_iC_i|_{max}", "range of the leg length the prismatic pair allows"),
         "motion.duration": Sym("t_f", "duration of the motion (eq. 10)"),
     })
+    # the model's names (Sec. 2, Fig. 2): leg i's angle θ_i at A_i, its links i1 (cylinder) and
+    # i2 (piston), joints A_i, B_i, C_i; three legs, each named (a pattern would also take A1')
+    legs = range(1, 4)
+    table.update(names_table(
+        drivers={**{f"theta{i}": Sym(f"θ_{i}", f"angle of leg {i} at A_{i}, its actuated revolute joint") for i in legs},
+                 **{f"rho{i}": ours(f"ρ_{i}", f"length |A_{i}C_{i}| of leg {i}, set by its actuated prismatic pair B_{i}")
+                    for i in legs}},
+        parts={**{f"cyl{i}": Sym(f"link {i}1", f"cylinder of leg {i}, pivoted at A_{i}") for i in legs},
+               **{f"piston{i}": Sym(f"link {i}2", f"piston of leg {i}, pivoted on the platform at C_{i}") for i in legs}},
+        joints={f"{p}{i}": Sym(f"{p}_{i}", f"joint {p}_{i} of leg {i}") for p in "ABC" for i in legs},
+    ))
     return table
 
 

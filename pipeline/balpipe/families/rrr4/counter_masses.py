@@ -44,6 +44,7 @@ from . import finder as generic
 from . import topologies as topologies
 from .placement import realise
 from ...balancing.base import BalanceResult, Parameter, Stage
+from ...balancing.conditions import clarity_text
 from ...engine import analyse
 from ...engine.load_reference import load_reference
 
@@ -265,7 +266,7 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
                         "than eq. 17 needs, and the engine finds its shaking force cancelled although eq. 17 does "
                         "not hold. "
                         + ("They are not all necessary: " if found.translating.count < 8 else "")
-                        + "the generic finder's count for this motion class (the rank of its momentum regressor) "
+                        + "the generic finder's count for this motion class (found numerically from its momentum) "
                         "is in the note above."
                     )
         names = list(mass_parameters(model))
@@ -300,7 +301,7 @@ def topology_designs(model: Model, g: cond.Geometry, spec: RRR4Balancing, found:
         res17, resf = topologies.eq17_residual(d.model, g), found.design_residual(d.model)
         params += [Parameter(f"added_mass_{tag}", added, "kg", "eq. 17", f"counter-masses of {name}"),
                    Parameter(f"eq17_residual_{tag}", res17, "", "eq. 17", f"largest relative residual of eq. 17, {name}"),
-                   Parameter(f"finder_residual_{tag}", resf, "", "momentum regressor rank",
+                   Parameter(f"finder_residual_{tag}", resf, "", "counted from the momentum at reachable states",
                              f"largest residual over the finder's conditions / (total mass x model size), {name}")]
         if max(res17, resf) > 1e-9:
             notes.append(f"{name[0].upper() + name[1:]}: the counter-masses found do not meet the conditions (eq. 17 residual "
@@ -362,11 +363,11 @@ def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Mo
     found = generic.check(model, finder_grid(model), cond.eq17(g) if four else [],
                           cond.special(g, mech.kinematics) if special else None)
     gen = found.general
-    src = "momentum regressor rank"
+    src = "counted from the momentum at reachable states"
     params += [
         Parameter("finder_conditions", gen.count, "", src, "independent force-balance conditions found by the generic "
                   "condition finder (every motion)"),
-        Parameter("finder_gap", gen.gap, "", src, "last kept / first dropped singular value of the regressor"),
+        Parameter("finder_gap", gen.gap, "", src, "how clearly the conditions stand out from round-off (larger is clearer)"),
         Parameter("leg_by_leg_in_finder_space", found.design_residual(lbl), "", src,
                   "largest residual of the leg-by-leg design over the finder's conditions / (total mass x model size)"),
     ]
@@ -424,8 +425,7 @@ def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Mo
         saved = added_lbl - sol.total_mass
         same = abs(saved) <= 1e-9 * max(added_lbl, 1e-300)
         notes.append(
-            f"Generic condition finder: {gen.count} independent force-balance conditions (singular-value gap "
-            f"{gen.gap:.3g})" + (f"; each of eq. 17's twelve printed conditions lies in their space (largest "
+            f"Generic condition finder: {gen.count} independent force-balance conditions ({clarity_text(gen.gap)})" + (f"; each of eq. 17's twelve printed conditions lies in their space (largest "
                                  f"distance {found.eq17.max():.1e})" if four else "")
             + f"; the leg-by-leg design meets them (residual {found.design_residual(lbl):.1e}). The least-mass "
             f"counter-masses within the same distances of the proximal joints add {sol.total_mass:.6g} kg, the "

@@ -12,10 +12,12 @@ import re
 
 import numpy as np
 
+from ...balancing.conditions import clarity_text
+from ...notation import Names
 from . import counter_masses as recipe
 from . import conditions as cond
 from . import topologies as topo
-from .template import mass_parameters, resolve_legs
+from .template import NOTATION, mass_parameters, resolve_legs
 
 FIGURE_OF_STAGE = {"leg_by_leg": "Fig. 2a", "least_mass": "least mass", "general": "Fig. 4a", "special": "Fig. 6"}
 FIG3 = tuple(f"Fig. 3{c}" for c in "abcdef")
@@ -54,7 +56,7 @@ def finder_table(study) -> str | None:
     mech = study.spec.mechanism
     four = len(resolve_legs(mech)) == 4
     rows = [("force-balance conditions, every motion", f"{int(p['finder_conditions'])}",
-             "12 (eq. 17)" if four else "", f"singular-value gap {p['finder_gap']:.3g}")]
+             "12 (eq. 17)" if four else "", clarity_text(p['finder_gap']))]
     if four:
         rows.append(("eq. 17's printed rows: largest distance from the computed space", f"{p['eq17_in_finder_space']:.1e}",
                      "0", "relative, scaled columns; at most 1e-9: in the space"))
@@ -64,7 +66,7 @@ def finder_table(study) -> str | None:
         eq = cond.SPECIAL_EQ[mech.kinematics]
         rows += [
             ("conditions, translating platform (Fig. 5" + mech.kinematics[-1] + ")", f"{int(p['translating_conditions'])}",
-             f"8 ({eq})", f"singular-value gap {p['translating_gap']:.3g}"),
+             f"8 ({eq})", clarity_text(p['translating_gap'])),
             ("computed translating conditions: largest distance from the span of the printed eight",
              f"{p['translating_in_printed_span']:.1e}", "", "the printed eight are sufficient"),
             (f"{eq}'s rows with m5 p5, m5 q5 eliminated: independent combinations", f"{int(p['printed_reduced_conditions'])}",
@@ -146,7 +148,8 @@ def _name(fig, ax, model, poses, span: float, max_cw: float, marks: list) -> lis
     of mass ``marks`` where the panel leaves room. Call once the figure's layout is final."""
     from ...draw.figures import place_names
 
-    paper = {b.name: "l" + b.name[4:] for b in model.bodies if b.name.startswith("link")}
+    # the paper's l_ij, as the page's tables and drawings write it (balpipe.notation.Names)
+    paper = {b.name: Names((NOTATION,)).text("part", b.name) for b in model.bodies if b.name.startswith("link")}
     return place_names(fig, ax, model, np.asarray(poses, dtype=float), span, max_cw, {}, disc=DISC, kinds=NAMED,
                        marks=marks, texts=paper)
 
@@ -256,8 +259,8 @@ def figures(study):
         yield (
             "Generic condition finder against the printed conditions; least-mass counter-masses",
             finder,
-            "The force-balance conditions computed from the linear-momentum regressor of the model (any mechanism's "
-            "route, no loop algebra), counted by the rank of the regressor over sampled states, against the paper's "
+            "The force-balance conditions computed numerically from the model's linear momentum at states it can "
+            "reach (any mechanism's route, no loop algebra), against the paper's "
             "printed ones mapped onto the finder's parameters (m_ij p_ij = mx[link ij], m_ij q_ij = my[link ij], "
             "m5 p5 = mx[platform]: the body frames are the paper's). A printed row lies in the computed space when "
             "its distance from it (relative, in columns scaled to one unit) is at most 1e-9. With special kinematics "

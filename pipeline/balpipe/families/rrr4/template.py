@@ -400,7 +400,7 @@ __all__ = ["RRR4Mechanism", "LegSpec", "RRRLink", "PlatformSpec", "build", "reso
 
 
 def _notation() -> dict:
-    from ...notation import Sym, drive_table, ours, setting
+    from ...notation import Sym, drive_table, names_table, ours, setting
 
     table = drive_table({"platform": Sym("(x, y, θ_5)", "platform pose: position of its centre and orientation θ_5")}, end_time="T")
     table.update({
@@ -424,6 +424,17 @@ def _notation() -> dict:
             f"{p}.com_offset": Sym(f"q_{{<i>{j}}}", f"centre of mass of link <i>{j} normal to the link (left positive)"),
             f"{p}.inertia": ours(f"I_{{<i>{j}}}", f"centroidal moment of inertia of link <i>{j}"),
         })
+    # the model's names (Sec. II, Fig. 1): the paper calls link ij by its length l_ij ("links
+    # l_i2", "l_32"), its angles θ_i1, θ_i2; an actuator at A_i drives θ_i1, one at B_i the
+    # relative angle θ_i2 − θ_i1. Each leg named (patterns would also take "A1'").
+    legs = range(1, 5)
+    table.update(names_table(
+        drivers={**{f"A{i}": Sym(f"θ_{{{i}1}}", f"angle of link {i}1, actuated at A_{i}") for i in legs},
+                 **{f"B{i}": Sym(f"θ_{{{i}2}} − θ_{{{i}1}}", f"angle of link {i}2 relative to link {i}1, actuated at B_{i}")
+                    for i in legs}},
+        parts={f"link{i}{j}": Sym(f"l_{{{i}{j}}}", f"link {j} of leg {i}") for i in legs for j in (1, 2)},
+        joints={f"{p}{i}": Sym(f"{p}_{i}", f"joint {p}_{i} of leg {i}") for p in "ABC" for i in legs},
+    ))
     return table
 
 

@@ -236,10 +236,28 @@ def balance(mech: SerialArmMechanism, method: GearDecoupling, model: Model) -> B
 def _notation() -> dict:
     """Paper 002's symbols (Figs. 1, 3-4, eqs. 3-16): joints A, B, centres of mass S_1, S_2,
     angles θ_1, θ_2; they replace the serial arm's generic ones for the 2R arm."""
-    from ...notation import Sym, drive_table, ours
+    from ...notation import Sym, drive_table, names_table, ours
 
-    table = drive_table({"q1": Sym("θ_1", "angle of link 1 relative to the base"),
-                         "q2": Sym("θ_2", "angle of link 2 relative to link 1")}, end_time="T")
+    drives = {"q1": Sym("θ_1", "angle of link 1 relative to the base"),
+              "q2": Sym("θ_2", "angle of link 2 relative to link 1")}
+    table = drive_table(drives, end_time="T")
+    # the model's names (Figs. 1, 3): drivers θ_1, θ_2, gears 1' (on link 1 at C) and 3 (on the
+    # frame), joints A (frame-link 1), B (link 1-link 2), C (gear 1' on link 1)
+    table.update(names_table(
+        drivers=drives,
+        parts={"gear1p": Sym("gear 1'", "gear 1', turning on link 1 at C, meshing with gear 2'"),
+               "gear3": Sym("gear 3", "gear 3 on the frame, meshing with gear 1'' (θ_3 = −θ_1)")},
+        joints={"J1": Sym("A", "joint A of link 1 on the frame"), "J2": Sym("B", "joint B between links 1 and 2"),
+                "link1-gear1p": Sym("C", "joint C of gear 1' on link 1")},
+        params={"J1": Sym("J_1", "inertia that actuator 1 sees once decoupled (eq. 17)"),
+                "J2": Sym("J_2", "inertia that actuator 2 sees once decoupled (eq. 18)"),
+                "I3": Sym("I_3", "inertia of gear 3 (I_3 = J_1)"),
+                "m1": Sym("m_1", "mass of link 1 as redistributed"), "l_AS1": Sym("l_{AS1}", "A to S_1"),
+                "l_BS2": Sym("l_{BS2}", "B to S_2"), "I_S1": Sym("I_{S1}", "inertia of link 1 about S_1"),
+                "I_S1p": Sym("I_{S1'}", "inertia of gear 1'"),
+                "m2_plus_m2p": Sym("m_2 + m_{2'}", "link 2 with gear 2'"),
+                "I_S2_plus_I_S2p": Sym("I_{S2} + I_{S2'}", "link 2 with gear 2'")},
+    ))
     table.update({
         "mechanism.base": Sym("A", "joint A of link 1 on the frame"),
         "mechanism.links[0].length": Sym("l_1", "length AB of link 1"),

@@ -176,12 +176,6 @@ def com_planning_figures(study):
            "from, in the line style of the stage that uses it.")
 
 
-def _over(st: dict) -> dict:
-    """A style drawn under the thin lines when it is wide (the grey of case 3), so that a thin
-    curve on the same values stays visible (case 2's dashes over case 3 where they coincide)."""
-    return {**st, "zorder": 1.5 if st["linewidth"] > 2 else 2.5}
-
-
 def _prefix(name: str) -> str:
     return f"{name}_" if name else ""
 
@@ -250,7 +244,7 @@ def _figs_3_4(study, main: str, by: dict, plt, style, to_svg):
             ("4", "shaking moment", "M (N m)", lambda an: an.moment, "p003fig4")):
         fig, ax = plt.subplots(figsize=(6.0, 3.0))
         for s in stages:
-            ax.plot(s.analysis.t, fn(s.analysis), label=s.stage.label.split(" · ")[-1], **_over(style(style_index(study.stages, s))))
+            ax.plot(s.analysis.t, fn(s.analysis), label=s.stage.label.split(" · ")[-1], **style(style_index(study.stages, s)))
         ax.set_xlabel("time (s)")
         ax.set_ylabel(ylabel)
         legend_below(fig, ax, fontsize=8)
@@ -276,7 +270,7 @@ def _other_trajectories(study, plans, by: dict, plt, style, to_svg) -> tuple[str
         pre = _prefix(p.name)
         for key, _ in sorted(CASES, key=lambda kl: STYLES[kl[0]]):
             s = by[pre + key]
-            st, label = _over(style(style_index(study.stages, s))), s.stage.label.split(" · ")[-1]
+            st, label = style(style_index(study.stages, s)), s.stage.label.split(" · ")[-1]
             axes[r, 0].plot(s.analysis.t, np.linalg.norm(s.analysis.force, axis=1), label=label, **st)
             axes[r, 1].plot(s.analysis.t, s.analysis.moment, label=label, **st)
         axes[r, 0].set_title(f"{p.name}: shaking force |F| (N)", fontsize=8)

@@ -521,7 +521,7 @@ def notation(mech: SerialArmMechanism) -> dict:
     """Symbols of an n-link arm's inputs: paper 003's for the 3R arm (joints O, A, B, tip C:
     l_OA, l_AB, l_BC; r_i, m_i, I_i; q_i), the same pattern with l_i for other arms (paper 002's
     method renames them as that paper does)."""
-    from ...notation import Sym, drive_table, ours
+    from ...notation import Sym, drive_table, names_table, ours
 
     n = len(mech.links)
     joints = "OABC" if n == 3 else None
@@ -547,4 +547,11 @@ def notation(mech: SerialArmMechanism) -> dict:
         "mechanism.working_mode": Sym("±", "branch of the inverse kinematics (+1: the '+' root of paper 003's eq. 8)"),
         "motion.duration": Sym("t_f", "duration of the motion"),
     })
+    # the model's names: drivers q_k (joint k's angle), links k, and paper 003's joints O, A, B
+    table.update(names_table(
+        drivers={f"q{k}": Sym(f"q_{k}", f"angle of joint {k}") for k in range(1, n + 1)},
+        parts={f"link{k}": Sym(f"link {k}", f"link {k} of the arm") for k in range(1, n + 1)},
+        joints={f"J{k}": Sym(joints[k - 1], f"joint {joints[k - 1]}, joint {k} of the arm") for k in range(1, n + 1)}
+        if joints else {},
+    ))
     return table

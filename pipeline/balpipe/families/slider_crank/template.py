@@ -113,7 +113,7 @@ def build(mech: SliderCrankMechanism, laws: dict, t: np.ndarray) -> Model:
 
 
 def _notation() -> dict:
-    from ...notation import Sym, drive_table, ours
+    from ...notation import Sym, drive_table, names_table, ours
 
     table = {
         "mechanism.pivot": Sym("A", "the crank's pivot on the frame"),
@@ -134,7 +134,12 @@ def _notation() -> dict:
         "mechanism.branch": ours("σ", "assembly branch: +1 puts the slider on the +x side of B"),
         "motion.duration": Sym("t_f", "duration of the motion"),
     }
-    table.update(drive_table({"crank": Sym("θ_1", "crank angle"), "slider": ours("x_C", "slider position along the guide")}))
+    drives = {"crank": Sym("θ_1", "crank angle"), "slider": ours("x_C", "slider position along the guide")}
+    table.update(drive_table(drives))
+    # the model's names (Sec. 3.1, Fig. 5): links 1-3 (crank AB, coupler BC, slider), joints A, B, C
+    table.update(names_table(drivers=drives, parts={
+        "crank": Sym("link 1", "the crank AB"), "coupler": Sym("link 2", "the coupler BC"),
+        "slider": Sym("link 3", "the slider at C")}))
     return table
 
 

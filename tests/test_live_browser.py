@@ -1,0 +1,127 @@
+"""The interactive figures in a real browser (issue 22), as tests/test_site_browser.py drives it
+(playwright and the system's Chromium; skipped with the reason when either is missing): the
+curves' drawing order against the legend's, the joint selector of a figure of many joints and the
+partial balancing's interactive fronts. Pages are opened from ``file://``: no server, no network."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from test_site_browser import Watched, browser, open_sections  # noqa: F401 (the browser fixture)
+
+from balpipe.build import Options, build
+
+SPECS = Path(__file__).resolve().parents[1] / "specs"
+LIVE_SPECS = ["paper000_rpr3_idler_loop.yaml", "paper000_rpr3_scott_russell.yaml", "partial_offset_slider_crank.yaml"]
+
+
+@pytest.fixture(scope="module")
+def live_site(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("live") / "site"
+    outcomes = build([str(SPECS / s) for s in LIVE_SPECS], Options(out=out, simulate=False))
+    assert all(o.status == "ok" for o in outcomes), [o.message for o in outcomes]
+    return out
+
+
+def _json(page, figure: str) -> dict:
+    return page.eval_on_selector(f"script[data-live='{figure}']", "s => JSON.parse(s.textContent)")
+
+
+def _open(browser, site: Path, slug: str, figure: str) -> tuple:  # noqa: F811
+    """A watched page of ``slug`` at 1400 px, its sections open: (watcher, page, the figure's JSON)."""
+    w = Watched(browser)
+    w.page.set_viewport_size({"width": 1400, "height": 900})
+    w.page.goto((site / slug / "index.html").as_uri(), wait_until="load")
+    open_sections(w.page)
+    return w, w.page, _json(w.page, figure)
+
+
+_VALUES = "el => [...el.querySelectorAll('.u-legend .u-series .u-value')].map(v => v.textContent)"
+
+
+def test_wide_curves_are_drawn_first_and_the_legend_keeps_the_stages_order(live_site, browser):  # noqa: F811
+    """Paper 000 Fig. 4: the grey counter-rotations (0 force) are drawn first, under the dashed
+    counterweights (0 force too), while the legend lists the stages in their order; hovering still
+    shows each stage's own value beside its name."""
+    w, p, d = _open(browser, live_site, "paper000_rpr3_idler_loop", "live-rpr3-loads")
+    labels = [s["label"] for s in d["series"]]
+    plot = p.locator("#live-rpr3-loads .live-plot").first
+    plot.scroll_into_view_if_needed()
+    legend = plot.evaluate("el => [...el.querySelectorAll('.u-legend .u-series .u-label')].map(v => v.textContent)")
+    assert legend == ["t (s)"] + labels  # the stages' order, not the drawing order
+    assert d["draw"][0] == labels.index("counter-rotations") and d["draw"].index(labels.index("counterweights")) > 0
+    box = plot.locator(".u-over").bounding_box()
+    p.mouse.move(box["x"] + box["width"] * 0.2, box["y"] + box["height"] * 0.5)
+    shown = plot.evaluate(_VALUES)
+    t = float(shown[0])
+    k = min(range(len(d["t"])), key=lambda i: abs(d["t"][i] - t))
+    for label, value in zip(labels, shown[1:]):
+        exact = next(s for s in d["series"] if s["label"] == label)["y"]["x"][k]
+        assert abs(float(value) - exact) <= 1e-3 * max(1.0, abs(exact)), (label, value, exact)
+    assert not w.problems, "\n".join(w.problems)
+
+
+def test_a_figure_of_many_joints_shows_one_joint_at_a_time(live_site, browser):  # noqa: F811
+    """The Scott-Russell legs' 30 joint loads: a selector above the plot shows one joint, first
+    the largest load; choosing another shows that one (hover still shows its values), 'every
+    joint' shows them all; printing shows the static figure of every panel."""
+    w, p, d = _open(browser, live_site, "paper000_rpr3_scott_russell", "live-joints")
+    n = len(d["panels"])
+    assert n >= 30 and d["choose"] is not None
+    visible = "h => [...h.querySelectorAll('.live-plot')].map(e => e.offsetParent !== null)"
+    sel = p.locator("#live-joints select")
+    assert sel.count() == 1 and sel.input_value() == str(d["choose"])
+    shown = p.eval_on_selector("#live-joints", visible)
+    assert len(shown) == n and shown.count(True) == 1 and shown[d["choose"]]
+    # the largest peak over every stage among the force panels
+    peak = [max(max(abs(v) for v in s["y"][q["key"]] if v is not None) for s in d["series"] if q["key"] in s["y"])
+            for q in d["panels"]]
+    forces = [i for i, q in enumerate(d["panels"]) if q["title"].endswith("(N)")]
+    assert peak[d["choose"]] == max(peak[i] for i in forces)
+    other = (d["choose"] + 1) % n
+    sel.select_option(str(other))
+    shown = p.eval_on_selector("#live-joints", visible)
+    assert shown.count(True) == 1 and shown[other]
+    plot = p.locator("#live-joints .live-plot").nth(other)
+    plot.scroll_into_view_if_needed()
+    box = plot.locator(".u-over").bounding_box()
+    assert box and box["width"] > 400  # drawn at its width once shown, not the hidden 240 px
+    p.mouse.move(box["x"] + box["width"] * 0.4, box["y"] + box["height"] * 0.5)
+    values = plot.evaluate(_VALUES)
+    assert re.search(r"\d", values[0]) and any(re.search(r"\d", v) for v in values[1:]), values
+    sel.select_option("all")
+    assert p.eval_on_selector("#live-joints", visible).count(True) == n
+    p.emulate_media(media="print")
+    assert p.is_visible("#live-joints + .static-plot svg") and not p.is_visible("#live-joints")
+    assert not w.problems, "\n".join(w.problems)
+
+
+def test_the_partial_fronts_are_interactive_over_their_budget(live_site, browser):  # noqa: F811
+    """A partial balancing's force-against-mass front: hovering a design shows its added mass
+    and its peak force (those of a design of the front), a click on a legend entry hides a
+    curve, the plot is not linked to time, and printing shows the static figure."""
+    figure = "live-partial_force_vs_mass"
+    w, p, d = _open(browser, live_site, "partial_offset_slider_crank", figure)
+    assert d["x"] == "added mass (kg)"
+    plot = p.locator(f"#{figure} .live-plot").first
+    plot.scroll_into_view_if_needed()
+    labels = plot.evaluate("el => [...el.querySelectorAll('.u-legend .u-series .u-label')].map(v => v.textContent)")
+    assert labels[0] == "added mass (kg)" and labels[1] == "optimal front (cone programme)"
+    box = plot.locator(".u-over").bounding_box()
+    assert box and box["width"] > 400
+    front = [(x, y) for x, y in zip(d["t"], d["series"][0]["y"]["y"]) if y is not None]
+    lo, hi = min(d["t"]), max(d["t"])
+    x, y = front[len(front) // 3]
+    p.mouse.move(box["x"] + box["width"] * (x - lo) / (hi - lo), box["y"] + box["height"] * 0.5)
+    shown = plot.evaluate(_VALUES)
+    assert float(shown[0]) == pytest.approx(x, rel=1e-3) and float(shown[1]) == pytest.approx(y, rel=1e-3), shown
+    entry = plot.locator(".u-legend .u-series").nth(2)
+    entry.click()
+    assert "u-off" in (entry.get_attribute("class") or "")
+    p.emulate_media(media="print")
+    assert p.is_visible(f"#{figure} + .static-plot svg") and not p.is_visible(f"#{figure}")
+    assert not w.problems, "\n".join(w.problems)
