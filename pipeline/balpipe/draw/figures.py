@@ -16,12 +16,15 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.layout_engine import PlaceHolderLayoutEngine  # noqa: E402
 from matplotlib.patches import Circle, Polygon  # noqa: E402
 
 from ..model import Model  # noqa: E402
 from . import extremes  # noqa: E402
 from .labels import drawing_span, point_places, repeated_names  # noqa: E402
+from .layout import fixed_layout  # noqa: E402
 from .sleeves import guided_sliders, sleeves  # noqa: E402
+from .svgplot import panels_svg  # noqa: E402
 
 plt.rcParams.update({
     "svg.hashsalt": "balpipe",
@@ -130,6 +133,10 @@ def to_svg(fig, prefix: str) -> str:
     """Serialise a figure to SVG with no date, and every id prefixed so that several figures can
     be inlined in one page without clashing."""
     buf = io.StringIO()
+    if isinstance(fig.get_layout_engine(), PlaceHolderLayoutEngine):
+        # what fig.tight_layout() leaves behind: savefig would draw the whole figure once more
+        # (for a layout engine that does nothing); without it the SVG is byte for byte the same
+        fig.set_layout_engine(None)
     fig.savefig(buf, format="svg", metadata={"Date": None, "Creator": None})
     plt.close(fig)
     svg = buf.getvalue()
@@ -143,10 +150,10 @@ def to_svg(fig, prefix: str) -> str:
 def legend_below(fig, ax, fontsize: float = 8.5) -> None:
     """``ax``'s legend under the figure's axes, never over a curve: as many columns (at most 3) as
     the figure's width holds, the figure made taller by the legend's height, the layout above it.
-    Call it instead of ``fig.tight_layout()``."""
+    Call it instead of ``fig.tight_layout()`` (it lays the figure out with :func:`layout.fixed_layout`)."""
     handles, labels = ax.get_legend_handles_labels()
     if not labels:
-        fig.tight_layout()
+        fixed_layout(fig)
         return
     renderer = fig.canvas.get_renderer()
     W, H = fig.get_size_inches()
@@ -158,44 +165,37 @@ def legend_below(fig, ax, fontsize: float = 8.5) -> None:
         leg.remove()
     h = leg.get_window_extent(renderer).height / fig.dpi + 0.05
     fig.set_size_inches(W, H + h)
-    fig.tight_layout(rect=(0, h / (H + h), 1, 1))
+    fixed_layout(fig, rect=(0, h / (H + h), 1, 1))
 
 
 def loads_figure(stages: list, prefix: str = "loads") -> str:
-    """Fx, Fy, |F| and M over time, every stage on the same axes (paper 000 Fig. 4 style).
-    ``stages``: list of (label, Analysis, simulated or None) with simulated = (t, F, M)."""
-    fig, axes = plt.subplots(2, 2, figsize=(11.0, 6.4), sharex=True)
+    """Fx, Fy, |F| and M over time, every stage on the same axes (paper 000 Fig. 4 style), each
+    stage in its line style with its markers (:func:`marked`), its pymunk run dotted; a note says
+    which curves coincide. ``stages``: list of (label, Analysis, simulated or None) with
+    simulated = (t, F, M). Written by :func:`svgplot.panels_svg` (no matplotlib figure)."""
     panels = [
-        (axes[0, 0], "Shaking force Fx (N)", lambda F, M: F[:, 0]),
-        (axes[0, 1], "Shaking force Fy (N)", lambda F, M: F[:, 1]),
-        (axes[1, 0], "Shaking force |F| (N)", lambda F, M: np.hypot(F[:, 0], F[:, 1])),
-        (axes[1, 1], "Shaking moment M (N m)", lambda F, M: M),
+        ("Shaking force Fx (N)", lambda F, M: F[:, 0]),
+        ("Shaking force Fy (N)", lambda F, M: F[:, 1]),
+        ("Shaking force |F| (N)", lambda F, M: np.hypot(F[:, 0], F[:, 1])),
+        ("Shaking moment M (N m)", lambda F, M: M),
     ]
     notes: dict[str, list[str]] = {}  # coinciding groups -> the panels where they coincide
-    for ax, title, fn in panels:
+    for title, fn in panels:
         same = coinciding([(label, fn(an.force, an.moment)) for label, an, _ in stages])
         if same:
             notes.setdefault("; ".join(same), []).append(title.split(" (")[0].replace("Shaking ", ""))
-    for k, (label, an, sim) in enumerate(stages):
-        for ax, title, fn in panels:
-            ax.plot(an.t, fn(an.force, an.moment), label=literal(label), **marked(k, len(an.t)))
+    drawn = []
+    for title, fn in panels:
+        curves = []
+        for k, (label, an, sim) in enumerate(stages):
+            curves.append((label, an.t, fn(an.force, an.moment), marked(k, len(an.t))))
             if sim is not None:
                 ts, Fs, Ms = sim
-                ax.plot(ts, fn(Fs, Ms), color=SIM_COLORS[k % len(SIM_COLORS)], linestyle=":",
-                        linewidth=1.0, label=literal(f"{label} (pymunk)"))
-            ax.set_title(literal(title), fontsize=9)
-    for ax in axes[1]:
-        ax.set_xlabel("time (s)")
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    ncol = min(len(labels), 3)
-    fig.legend(handles, labels, loc="lower center", ncol=ncol, fontsize=9.5, frameon=False)
-    bottom = 0.04 + 0.035 * math.ceil(len(labels) / ncol)
-    if notes:
-        lines = [f"Coincide in {', '.join(where)}: {groups}" for groups, where in notes.items()]
-        fig.text(0.01, bottom, "\n".join(lines), fontsize=8, color="0.25", va="bottom", ha="left", wrap=True)
-        bottom += 0.03 * len(lines) + 0.01
-    fig.tight_layout(rect=(0, bottom, 1, 1))
-    return to_svg(fig, prefix)
+                curves.append((f"{label} (pymunk)", ts, fn(Fs, Ms),
+                               {"color": SIM_COLORS[k % len(SIM_COLORS)], "linestyle": ":", "linewidth": 1.0}))
+        drawn.append((title, "", curves))
+    lines = [f"Coincide in {', '.join(where)}: {groups}" for groups, where in notes.items()]
+    return panels_svg(drawn, prefix, style, columns=2, cell=(5.5 * 72, 3.2 * 72), legend_font=9.5, notes=lines)
 
 
 def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = None,
@@ -224,27 +224,7 @@ def panels_figure(panels: list, prefix: str, marks: list | None = None, columns:
     ``columns`` panels a row, the legend of the first panel below; ``marks`` (time, label) drawn
     as dotted vertical lines in every panel. The panels share the time axis, labelled under the
     lowest panel of each column."""
-    cols = max(1, min(columns, len(panels)))
-    rows = max(1, math.ceil(len(panels) / cols))
-    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 2.8 * rows), squeeze=False, sharex=True)
-    for n, ax in enumerate(axes.flat):
-        if n >= len(panels):
-            ax.set_visible(n == 0)  # no panel at all: one empty axes, as before
-            continue
-        title, ylabel, curves = panels[n]
-        for k, (label, t, y) in enumerate(curves):
-            if y is not None:
-                ax.plot(t, y, label=literal(label), **style(k))
-        ax.set_title(literal(title), fontsize=9)
-        ax.set_ylabel(ylabel)
-        if n + cols >= len(panels):  # the lowest panel of its column
-            ax.set_xlabel("time (s)")
-            ax.tick_params(labelbottom=True)
-        for tm, text in sorted(set(marks or [])):
-            ax.axvline(tm, color="0.4", linestyle=":", linewidth=0.9)
-            ax.annotate(literal(text), (tm, 1.0), xycoords=("data", "axes fraction"), fontsize=7, ha="right", va="top", rotation=90)
-    legend_below(fig, axes[0][0])
-    return to_svg(fig, prefix)
+    return panels_svg(panels, prefix, style, marks, columns)  # written directly: no matplotlib figure
 
 
 def _global_point(pose, p) -> np.ndarray:
@@ -360,7 +340,7 @@ def mechanism_drawing(model: Model, analysis, ghosts: list[int] | None = None, t
     ax.set_ylabel("y (m)")
     if title:
         ax.set_title(literal(title), fontsize=9)
-    fig.tight_layout()
+    fixed_layout(fig)
     placed = place_names(fig, ax, model, poses[ref], span, max_cw, numbers, texts=texts)
     return fig, placed
 
@@ -588,5 +568,5 @@ def overlay_figure(old, new, prefix: str = "overlay", round_off: tuple[bool, boo
     for ax in axes[1]:
         ax.set_xlabel("time (s)")
     axes[0, 0].legend(fontsize=8)
-    fig.tight_layout()
+    fixed_layout(fig)
     return to_svg(fig, prefix)

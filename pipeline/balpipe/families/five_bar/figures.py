@@ -11,6 +11,7 @@ from .template import gripper_path, input_angles, segment_distance
 def figures(study):
     """Report figures of the template: the gripper path (Fig. 7) and the input angles (Figs. 8-9)."""
     from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
+    from ...draw.layout import fixed_layout
 
     first = study.stages[0]
     an, model = first.analysis, first.stage.model
@@ -27,7 +28,7 @@ def figures(study):
     ax.set_ylabel("y (m)")
     ax.set_aspect("equal", adjustable="datalim")
     ax.legend(fontsize=7, loc="best")
-    fig.tight_layout()
+    fixed_layout(fig)
     dev = float(np.max(segment_distance(C, S, E)))
     coupled = model.name.startswith("fixed-sequence")
     yield (
@@ -43,7 +44,7 @@ def figures(study):
         ax.plot(an.t, th, color="black", linewidth=1.4)
         ax.set_title(f"{name} (rad)", fontsize=9)
         ax.set_xlabel("time (s)")
-    fig.tight_layout()
+    fixed_layout(fig)
     yield (
         "Input angles (Figs. 8-9)",
         to_svg(fig, "fivebar-angles"),

@@ -44,6 +44,7 @@ def paper_figures(number: str, linkage: str, published_factor: float):
     def figures(study):
         from ...draw import live  # matplotlib only when a report is drawn
         from ...draw.figures import plt, style, to_svg
+        from ...draw.layout import fixed_layout
 
         fig, axes = plt.subplots(1, 3, figsize=(10.5, 3.2))
         panels = (("(a) shaking force along x (N)", lambda a: a.force[:, 0]),
@@ -57,7 +58,7 @@ def paper_figures(number: str, linkage: str, published_factor: float):
             ax.set_xlabel("time (s)")
         handles, labels = axes[0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
-        fig.tight_layout(rect=(0, 0.08, 1, 1))
+        fixed_layout(fig, rect=(0, 0.08, 1, 1))
         linkage_label = next((s.stage.label for s in own if s.stage.name == linkage), linkage)
         curves = live.Curves(own[0].analysis.t,
                              [(s.stage.label, {key: fn(s.analysis) for key, (_, fn) in zip("xyM", panels)}) for s in own],
@@ -78,6 +79,8 @@ def paper_figures(number: str, linkage: str, published_factor: float):
 
 
 def _prismatic_forces_figure(study, plt, to_svg):
+    from ...draw.layout import fixed_layout
+
     mech = study.spec.mechanism
     pose = pose_of(study.unbalanced.stage.model)
     fig, axes = plt.subplots(1, 3, figsize=(10.5, 2.9), sharey=True)
@@ -90,7 +93,7 @@ def _prismatic_forces_figure(study, plt, to_svg):
             ax.set_title(f"|axial force| of leg {i + 1} (N)", fontsize=9)
             ax.set_xlabel("time (s)")
     axes[0].legend(fontsize=7)
-    fig.tight_layout()
+    fixed_layout(fig)
     return (
         "Axial forces that prismatic actuators would need",
         to_svg(fig, "rpr3-prismatic"),

@@ -173,6 +173,7 @@ def panels_svg(panels: list[tuple], prefix: str) -> str:
     """One figure of ``panels`` (model, body poses, title), at most three a row (:func:`grid_columns`),
     drawn by :func:`_draw` with one disc scale for the whole figure, then named by :func:`_name`."""
     from ...draw.figures import plt, to_svg
+    from ...draw.layout import fixed_layout
 
     cols = grid_columns(len(panels))
     rows = (len(panels) + cols - 1) // cols
@@ -181,7 +182,7 @@ def panels_svg(panels: list[tuple], prefix: str) -> str:
     for ax in list(axes.flat)[len(panels):]:
         ax.axis("off")
     marks = [_draw(ax, model, poses, _span(model), max_cw, title) for ax, (model, poses, title) in zip(axes.flat, panels)]
-    fig.tight_layout()
+    fixed_layout(fig)
     for ax, (model, poses, _), mk in zip(axes.flat, panels, marks):
         _name(fig, ax, model, poses, _span(model), max_cw, mk)
     return to_svg(fig, prefix)

@@ -46,6 +46,7 @@ def decoupling_figures(study):
     """Paper 002's figures: Fig. 2, the mass matrix before and after (its entries and along the
     motion), torque against acceleration."""
     from ...draw.figures import MARKERS, plt, style, to_svg  # matplotlib only when a report is drawn
+    from ...draw.layout import fixed_layout
     from ...engine.joint_space import mass_matrix
 
     by = _main(study)
@@ -77,7 +78,7 @@ def decoupling_figures(study):
             ax.set_title(f"{name} (kg m²)", fontsize=9)
             ax.set_xlabel("time (s)")
     axes[0].legend(fontsize=7)
-    fig.tight_layout()
+    fixed_layout(fig)
     yield ("Mass matrix along the motion", to_svg(fig, "decoupling-mass"),
            "Entries of the joint-space mass matrix computed by the engine from each stage's model "
            "(D = Vᵀ diag(m, m, I) V, V the body velocities per unit joint rate): the decoupled arm's is "
@@ -96,7 +97,7 @@ def decoupling_figures(study):
         ax.set_xlabel(f"θ̈{sub} (rad/s²)")
         ax.set_title(f"τ{sub} (N m)", fontsize=9)
         ax.legend(fontsize=7)
-    fig.tight_layout()
+    fixed_layout(fig)
     yield ("Torque against acceleration (eqs. 17-18)", to_svg(fig, "decoupling-torque"),
            "Each joint's actuator torque τᵢ against its own acceleration θ̈ᵢ at every sample: coupled and "
            "nonlinear before, on the line τᵢ = Jᵢ θ̈ᵢ after decoupling (red)"
@@ -108,6 +109,7 @@ def _paper002_fig2(study, un, plt, style, to_svg):
     """Fig. 2 of paper 002: F^sh = |reaction force on the frame| (eq. 15) and M^sh = -tau1 (eq.
     16) of the unbalanced arm, in the stage's style; with gravity on, the weight is said apart."""
     from ...draw import live  # matplotlib only when a report is drawn
+    from ...draw.layout import fixed_layout
 
     an, st = un.analysis, style(style_index(study.stages, un))
     fig, axes = plt.subplots(1, 2, figsize=(9.0, 2.9))
@@ -117,7 +119,7 @@ def _paper002_fig2(study, un, plt, style, to_svg):
     axes[1].set_title("(b) Mˢʰ (N m), eq. 16", fontsize=9)
     for ax in axes:
         ax.set_xlabel("time (s)")
-    fig.tight_layout()
+    fixed_layout(fig)
     weight = an.extra["total_mass"] * float(np.hypot(*an.gravity))
     if weight:
         apart = (f" With gravity on, Fˢʰ includes the links' constant weight m g = {weight:.4g} N: its inertial part "
@@ -260,6 +262,8 @@ def _figs_3_4(study, main: str, by: dict, plt, style, to_svg):
 
 def _other_trajectories(study, plans, by: dict, plt, style, to_svg) -> tuple[str, str, str]:
     """|F| and M of every stage on the trajectories that Figs. 3-4 do not show, one row each."""
+    from ...draw.layout import fixed_layout
+
     n = len(plans)
     fig, axes = plt.subplots(n, 2, figsize=(9.0, 2.1 * n + 0.4), squeeze=False)
     for r, p in enumerate(plans):
@@ -275,7 +279,7 @@ def _other_trajectories(study, plans, by: dict, plt, style, to_svg) -> tuple[str
         ax.set_xlabel("time (s)")
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=7, frameon=False)
-    fig.tight_layout(rect=(0, 0.05 if n > 2 else 0.12, 1, 1))
+    fixed_layout(fig, rect=(0, 0.05 if n > 2 else 0.12, 1, 1))
     return (f"Shaking force and moment on the other {n} trajectories", to_svg(fig, "com-loads"),
             "The same quantities as Figs. 3-4 on the trajectories the paper does not plot, every stage in its line "
             "style of this page (the legend under the plot). Moment about the base joint, horizontal plane.")
