@@ -22,7 +22,9 @@ def test_diff_of_two_spec_files_in_every_format(tmp_path):
     r = balpipe("diff", old, new, "--no-sim", "-f", "json")
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
-    assert d["inputs"] == [{"field": "balancing.crank_counterweight", "old": -0.1, "new": -0.12, "unit": "m"}]
+    # each input with the paper's symbol (the page's inputs table's): r_cp1 L_1 of eq. 15
+    assert d["inputs"] == [{"field": "balancing.crank_counterweight", "symbol": "r_cp1 L₁", "old": -0.1, "new": -0.12,
+                            "unit": "m"}]
     mcp1 = next(p for p in d["parameters"] if p["name"] == "mcp1")
     # eq. 15: mcp1 scales as 1 / rcp1
     assert abs(mcp1["new"] - mcp1["old"] * 0.1 / 0.12) < 1e-9
@@ -60,7 +62,10 @@ def test_diff_against_a_git_revision(tmp_path):
     r = balpipe("diff", "HEAD:specs/sc.yaml", "specs/sc.yaml", "--no-sim", "-f", "json", cwd=repo)
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
-    assert d["inputs"] == [{"field": "mechanism.slider.mass", "old": 0.6, "new": 0.7, "unit": "kg"}]
+    assert d["inputs"] == [{"field": "mechanism.slider.mass", "symbol": "m₃", "old": 0.6, "new": 0.7, "unit": "kg"}]
+    text = balpipe("diff", "HEAD:specs/sc.yaml", "specs/sc.yaml", "--no-sim", cwd=repo).stdout
+    inputs = text[text.index("Inputs:"):].splitlines()
+    assert inputs[1].split()[:3] == ["symbol", "(paper)", "field"] and inputs[2].split()[:2] == ["m₃", "mechanism.slider.mass"]
     bad = balpipe("diff", "NOPE:specs/sc.yaml", "specs/sc.yaml", cwd=repo)
     assert bad.returncode == 2 and "cannot read it from git" in bad.stderr and "Traceback" not in bad.stderr
 
@@ -142,5 +147,6 @@ def test_a_load_cancelled_to_round_off_reads_zero_and_a_long_text_is_cut():
     assert rows["idler:counterweights", "peak |F| (N)"] == ["—", ROUND_OFF_TEXT, ""]
     assert rows["worse", "peak |M| (N m)"][:2] == [ROUND_OFF_TEXT, "2"]  # from round-off to a real load
     assert not any("e-1" in c for r in sections["Stages"] for c in r)
-    (field, old, new, _), = sections["Inputs"]
+    (symbol, field, old, new, _), = sections["Inputs"]
+    assert symbol == "—" and field == "description"  # no symbol: a text of the spec's
     assert old.startswith("a" * 20) and old.endswith("… (1097 characters)") and len(old) < 70 and new == "short"

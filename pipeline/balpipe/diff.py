@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 from dataclasses import dataclass
 from pathlib import Path
@@ -123,13 +124,33 @@ def site_link(site: str, out: str | None) -> str:
     return ""
 
 
+def _input_symbol(side: Side, path: str) -> str:
+    """The paper's symbol of an input (plain text, as the page's inputs table has it:
+    :mod:`balpipe.notation`), '' for a setting of balpipe's or a field without one; a compared
+    design's field by that design's method's table."""
+    from . import notation as N
+    from .report.notation_table import tables_for
+
+    spec = side.loaded.spec
+    balancing = spec.balancing
+    m = re.fullmatch(r"compare\[(\d+)\]\.(.*)", path)
+    if m:
+        designs = getattr(spec, "compare", None) or []
+        if int(m.group(1)) >= len(designs):
+            return ""
+        balancing, path = designs[int(m.group(1))].balancing, m.group(2)
+    sym = N.lookup(tables_for(spec.mechanism, balancing), path)
+    return "" if sym is None or sym.setting else N.symbol_text(sym.symbol)
+
+
 def compare(a: Side, b: Side) -> dict:
     """The differences between two studies, as plain data (the JSON output)."""
     ia = _flatten(a.loaded.spec.model_dump(mode="json", by_alias=True))
     ib = _flatten(b.loaded.spec.model_dump(mode="json", by_alias=True))
     units = _input_units(a) | _input_units(b)
     inputs = [
-        {"field": k, "old": ia.get(k), "new": ib.get(k), "unit": units.get(k, "")}
+        {"field": k, "symbol": _input_symbol(b, k) or _input_symbol(a, k), "old": ia.get(k), "new": ib.get(k),
+         "unit": units.get(k, "")}
         for k in sorted(set(ia) | set(ib)) if not same(ia.get(k), ib.get(k))
     ]
     pa = {p.name: p for p in a.study.balance.parameters}
@@ -255,8 +276,9 @@ def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
     # the results first (what changed), then what was changed to get there
     sections.append(("Computed parameters", [[p["name"], _fmt(p["old"]), _fmt(p["new"]), _rel(p), p["unit"]] for p in data["parameters"]],
                      ["parameter", "old", "new", "change", "unit"]))
-    sections.append(("Inputs", [[d["field"], _short(d["old"]), _short(d["new"]), d.get("unit", "")] for d in data["inputs"]],
-                     ["field", "old", "new", "unit (SI)"]))
+    sections.append(("Inputs", [[d.get("symbol") or "—", d["field"], _short(d["old"]), _short(d["new"]), d.get("unit", "")]
+                                for d in data["inputs"]],
+                     ["symbol (paper)", "field", "old", "new", "unit (SI)"]))
     return sections
 
 
