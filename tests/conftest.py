@@ -93,6 +93,23 @@ def studies():
     return get
 
 
+@pytest.fixture(scope="session")
+def pages(studies):
+    """``pages(name)``: the page of ``studies(name)`` without the simulation (results of "x",
+    hash "h", no spec text), rendered once per session (per xdist worker)."""
+    from balpipe.report import page, results
+
+    cache: dict = {}
+
+    def get(name: str) -> str:
+        if name not in cache:
+            st = studies(name)
+            cache[name] = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+        return cache[name]
+
+    return get
+
+
 def _shared_root(tmp_path_factory) -> Path:
     """A folder that every xdist worker of this run sees (the parent of the workers' own)."""
     base = tmp_path_factory.getbasetemp()

@@ -213,9 +213,8 @@ def test_stage_table_names_each_ratios_reference_and_claims_only_what_is_claimed
     assert "for the stages of the first motion (" + st.stages[0].stage.label + ")" in html
 
 
-def test_single_motion_page_keeps_one_reference_sentence(studies):
-    st = studies("paper000_rpr3_idler_loop.yaml")
-    html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+def test_single_motion_page_keeps_one_reference_sentence(pages):
+    html = pages("paper000_rpr3_idler_loop.yaml")
     rows = _stage_rows(html)
     assert ">reference</span>" in rows["unbalanced"] and "— (no claim)" in rows["idler loop"]
     assert "first motion" not in html and "ratios vs" not in html
@@ -231,7 +230,7 @@ def test_tracking_error_caption_gives_each_travel():
     assert "|q_sim − q_plan| / travel" in svg and "time (s)" in svg
 
 
-def test_no_two_stages_look_alike_and_the_caption_names_each_style(monkeypatch, studies):
+def test_no_two_stages_look_alike_and_the_caption_names_each_style(monkeypatch, studies, pages):
     """A spec with compared designs has seven stages: the loads figure draws each in its own
     line, colour and marker, and its caption says which is which (it named only four)."""
     looks = [(str(figures.style(k)["color"]), figures.style(k)["linestyle"], figures.marked(k, 100)["marker"])
@@ -241,7 +240,7 @@ def test_no_two_stages_look_alike_and_the_caption_names_each_style(monkeypatch, 
     st = studies("paper000_rpr3_scott_russell_corrected.yaml")
     shown = page.shown_stages(st)
     assert len(shown) == 7
-    html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+    html = pages("paper000_rpr3_scott_russell_corrected.yaml")
     cap = html[html.index('<figure class="wide">'):]
     cap = cap[cap.index("<figcaption>"):cap.index("</figcaption>")]
     cap = html_mod.unescape(cap).lower()
@@ -329,9 +328,8 @@ def test_history_table_shows_round_off_as_zero():
     assert history_page._peaks(c, "max_shaking_moment") == "1.328 → 0.5"  # a real peak stays
 
 
-def test_unrealisable_parts_write_their_units_as_the_page_does():
-    st = study_mod.run(loader.load(SPECS / "paper004_five_bar.yaml").spec)
-    html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+def test_unrealisable_parts_write_their_units_as_the_page_does(pages):
+    html = pages("paper004_five_bar.yaml")
     table = html[html.index('<h2 id="balancing-stages"'):]
     table = table[:table.index("</table>")]
     assert "centroidal inertia" in table and "kg m²" in table and "kg m^2" not in table

@@ -395,11 +395,10 @@ def test_template_figures_reproduce_fig_4(idler):
     assert "17.07" in figs[1][1]  # the factor relative to the plain 3-RPR
 
 
-def test_methods_compared_on_the_same_3rpr(studies):
+def test_methods_compared_on_the_same_3rpr(studies, pages):
     """Issue 9, item 5, through the generic ``compare:`` block: both methods' stages on the same 3-RPR
     in the "Designs side by side" table with the counter-rotations needed and the peak moment
     before them; the paper's Fig. 8 keeps the main design's stages only."""
-    from balpipe.report.page import render_page
     from balpipe.report.results import results_dict
 
     s = studies("paper000_rpr3_scott_russell_corrected.yaml")
@@ -422,7 +421,7 @@ def test_methods_compared_on_the_same_3rpr(studies):
         assert r["max_joint_load"] > 0 and r["max_joint_load_joint"]
     by_name = {st.stage.name: st for st in s.stages}
     assert idl["added_mass"] == pytest.approx(by_name["idler:counter_rotations"].added_mass)
-    html = render_page(s, out, "text")
+    html = pages("paper000_rpr3_scott_russell_corrected.yaml")
     assert "Designs side by side" in html and "Peak |M| before counter-rotations (N m)" in html
     assert "idler loop (Sec. 2): counter-rotations" in html
     # Fig. 8 and the factor table: the Scott-Russell stages only
