@@ -1,14 +1,40 @@
-"""Shared helpers for the tests: slider-crank specs with random parameters."""
+"""Shared helpers for the tests: slider-crank specs with random parameters, the ``--long``
+option (see ``_long.py``), studies and builds computed once per session."""
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
 
 import balpipe  # noqa: F401  (first: it sets one BLAS thread before numpy loads)
 import numpy as np
 import pytest
 
 from balpipe.spec import Spec
+from _long import ENV as LONG_ENV
+
+SPECS = Path(__file__).resolve().parents[1] / "specs"
+
+
+def pytest_addoption(parser):
+    parser.addoption("--long", action="store_true", default=False,
+                     help=f"run the long random samples ({LONG_ENV}=1 does the same); "
+                          "by default a short seeded sample of them runs")
+    parser.addoption(
+        "--built-site", metavar="DIR", default=None,
+        help="run the browser's page checks (tests/test_site_browser.py, the tests named built_site) "
+             "on every HTML page of a site already built into DIR (balpipe build specs/ -o DIR)")
+
+
+def pytest_configure(config):
+    if config.getoption("long"):  # every xdist worker runs this too, before it imports the tests
+        os.environ[LONG_ENV] = "1"
 
 
 def slider_crank_spec(rng: np.random.Generator | None = None, *, scott_russell: bool = False,
@@ -54,27 +80,73 @@ def rng() -> np.random.Generator:
     return np.random.default_rng(20261122)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def studies():
-    """``studies(name)``: the study of ``specs/<name>``, run once per test module."""
-    from pathlib import Path
-
+    """``studies(name)``: the study of ``specs/<name>``, run once per session (per xdist worker);
+    the tests only read it."""
     from balpipe import loader
     from balpipe import study as study_mod
 
-    specs = Path(__file__).resolve().parents[1] / "specs"
     cache: dict = {}
 
     def get(name: str):
         if name not in cache:
-            cache[name] = study_mod.run(loader.load(specs / name).spec)
+            cache[name] = study_mod.run(loader.load(SPECS / name).spec)
         return cache[name]
 
     return get
 
 
-def pytest_addoption(parser):
-    parser.addoption(
-        "--built-site", metavar="DIR", default=None,
-        help="run the browser's page checks (tests/test_site_browser.py, the tests named built_site) "
-             "on every HTML page of a site already built into DIR (balpipe build specs/ -o DIR)")
+@pytest.fixture(scope="session")
+def pages(studies):
+    """``pages(name)``: the page of ``studies(name)`` without the simulation (results of "x",
+    hash "h", no spec text), rendered once per session (per xdist worker)."""
+    from balpipe.report import page, results
+
+    cache: dict = {}
+
+    def get(name: str) -> str:
+        if name not in cache:
+            st = studies(name)
+            cache[name] = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+        return cache[name]
+
+    return get
+
+
+def _shared_root(tmp_path_factory) -> Path:
+    """A folder that every xdist worker of this run sees (the parent of the workers' own)."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
+@pytest.fixture(scope="session")
+def shared_build(tmp_path_factory):
+    """``shared_build(names, *args)``: ``specs/<name>`` for each name copied to ``<folder>/specs``
+    and ``python -m balpipe build *args`` run in ``<folder>``, once per run whatever the number
+    of xdist workers (the first worker builds under a lock, keyed by the specs' text and the
+    arguments; the others read its result): (folder, the build's completed process). The
+    folder is shared: a test that changes it must work on a copy."""
+    import fcntl
+
+    root = _shared_root(tmp_path_factory) / "shared-builds"
+    root.mkdir(exist_ok=True)
+
+    def get(names: tuple[str, ...], *args: str) -> tuple[Path, subprocess.CompletedProcess]:
+        key = hashlib.sha256(json.dumps([[(n, (SPECS / n).read_text()) for n in names], list(args)]).encode())
+        folder = root / key.hexdigest()[:16]
+        with open(root / f"{folder.name}.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            done = folder / "completed.json"
+            if not done.exists():
+                shutil.rmtree(folder, ignore_errors=True)
+                (folder / "specs").mkdir(parents=True)
+                for n in names:
+                    shutil.copy(SPECS / n, folder / "specs" / n)
+                r = subprocess.run([sys.executable, "-m", "balpipe", "build", *args], capture_output=True,
+                                   text=True, cwd=folder)
+                done.write_text(json.dumps([r.args, r.returncode, r.stdout, r.stderr]))
+        a, rc, out, err = json.loads(done.read_text())
+        return folder, subprocess.CompletedProcess(a, rc, out, err)
+
+    return get

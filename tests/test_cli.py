@@ -17,10 +17,13 @@ def balpipe(*args, cwd=None):
     return subprocess.run([sys.executable, "-m", "balpipe", *map(str, args)], capture_output=True, text=True, cwd=cwd)
 
 
+TWO = ("scott_russell.yaml", "offset_slider_crank.yaml")
+
+
 def _two_specs(folder: Path) -> Path:
     d = folder / "specs"
     d.mkdir()
-    for name in ("scott_russell.yaml", "offset_slider_crank.yaml"):
+    for name in TWO:
         shutil.copy(SPECS / name, d / name)
     return folder
 
@@ -31,19 +34,18 @@ def work(tmp_path):
     return _two_specs(tmp_path)
 
 
-@pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    """The two specs built once for the tests that only read the site (-j 1, --no-sim, to
-    ``a``): (folder, the build's completed process)."""
-    work = _two_specs(tmp_path_factory.mktemp("built"))
-    return work, balpipe("build", "specs", "-o", "a", "--no-sim", "-j", "1", cwd=work)
+@pytest.fixture
+def built(shared_build):
+    """The two specs built once per run for the tests that only read the site (-j 1, --no-sim,
+    to ``a``): (folder, the build's completed process)."""
+    return shared_build(TWO, "specs", "-o", "a", "--no-sim", "-j", "1")
 
 
-@pytest.fixture(scope="module")
-def simulated(tmp_path_factory):
-    """scott_russell.yaml built once with its simulations, to ``a``: (folder, completed process)."""
-    work = _two_specs(tmp_path_factory.mktemp("simulated"))
-    return work, balpipe("build", work / "specs" / "scott_russell.yaml", "-o", "a", cwd=work)
+@pytest.fixture
+def simulated(shared_build):
+    """scott_russell.yaml built once per run with its simulations, to ``a``: (folder, completed
+    process)."""
+    return shared_build(TWO, "specs/scott_russell.yaml", "-o", "a")
 
 
 def test_help_for_every_command():
@@ -96,8 +98,10 @@ def test_output_is_byte_identical(built, tmp_path):
         assert (work / "a" / f).read_bytes() == (b / f).read_bytes(), f
 
 
-def test_bad_spec_does_not_stop_the_others_nor_damage_its_old_page(work):
-    assert balpipe("build", "specs", "-o", "out", "--no-sim", cwd=work).returncode == 0
+def test_bad_spec_does_not_stop_the_others_nor_damage_its_old_page(built, work):
+    shared, first = built  # the earlier build: a copy of the shared one
+    assert first.returncode == 0
+    shutil.copytree(shared / "a", work / "out")
     page = work / "out" / "offset_slider_crank" / "index.html"
     before = page.read_bytes()
     spec = work / "specs" / "offset_slider_crank.yaml"
@@ -195,9 +199,8 @@ def test_parallel_build_gives_the_same_site_and_quiet_hides_progress(built, tmp_
 
 def test_simulated_output_is_byte_identical_but_for_the_timing_files(simulated, tmp_path):
     work, a = simulated
-    spec = work / "specs" / "scott_russell.yaml"
     assert a.returncode == 0
-    assert balpipe("build", spec, "-o", tmp_path / "b", "--force", cwd=work).returncode == 0
+    assert balpipe("build", "specs/scott_russell.yaml", "-o", tmp_path / "b", "--force", cwd=work).returncode == 0
     files = sorted(p.relative_to(work / "a") for p in (work / "a").rglob("*") if p.is_file())
     assert {f.name for f in files} >= {"index.html", "results.json", "timeseries.csv", "timing.json", "timing.js"}
     for f in files:

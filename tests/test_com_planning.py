@@ -14,7 +14,6 @@ import pytest
 from balpipe import registry, study
 from balpipe.families.serial_arm import com_planning as cp
 from balpipe.engine import analyse
-from balpipe.loader import load
 from balpipe.families.serial_arm.template import ArmGeometry, TaskMotion, com_chain, joint_laws, with_joint_laws
 from balpipe.motion import PointToPoint, bang_bang, quintic
 from test_serial_arm import arm_spec
@@ -23,10 +22,10 @@ from _edits import replaced
 SPEC = Path(__file__).resolve().parents[1] / "specs" / "paper003_com_planning.yaml"
 
 
-@pytest.fixture(scope="module")
-def paper():
-    spec = load(SPEC).spec
-    st = study.run(spec)
+@pytest.fixture
+def paper(studies):
+    st = studies(SPEC.name)
+    spec = st.spec
     return spec, st, {p.name: p.value for p in st.balance.parameters}
 
 

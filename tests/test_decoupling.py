@@ -12,7 +12,6 @@ from balpipe import study
 from balpipe.families.serial_arm.decoupling import mass_matrix_2r
 from balpipe.engine import analyse
 from balpipe.engine.joint_space import mass_matrix
-from balpipe.loader import load
 from balpipe.families.serial_arm.template import with_joint_laws
 from balpipe.motion import Polynomial
 from balpipe.spec import Spec
@@ -33,10 +32,10 @@ def joint_accelerations(laws, t) -> np.ndarray:
     return np.stack([law(t)[2] for law in laws], axis=1)
 
 
-@pytest.fixture(scope="module", params=["paper002_decoupling.yaml", "paper002_decoupling_horizontal.yaml"])
-def paper(request):
-    spec = load(SPECS / request.param).spec
-    st = study.run(spec)
+@pytest.fixture(params=["paper002_decoupling.yaml", "paper002_decoupling_horizontal.yaml"])
+def paper(request, studies):
+    st = studies(request.param)
+    spec = st.spec
     return spec, st, {p.name: p.value for p in st.balance.parameters}
 
 

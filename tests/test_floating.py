@@ -11,7 +11,6 @@ from pathlib import Path
 
 import pytest
 
-from balpipe import loader, study
 from balpipe.engine import analyse
 from balpipe.validate import free_floating
 from balpipe.validation_stage import BASE_MASS, reactionless_runs
@@ -60,8 +59,8 @@ def test_models_without_massless_bodies_are_unchanged():
 
 
 @pytest.fixture(scope="module")
-def five_bar_runs():
-    st = study.run(loader.load(ROOT / "specs" / "paper004_five_bar.yaml").spec)
+def five_bar_runs(studies):
+    st = studies("paper004_five_bar.yaml")
     return st, reactionless_runs(st)
 
 

@@ -5,7 +5,8 @@ keys, swapped types, NaN, inf, 1e308, -0, negatives, zeros, empty and enormous l
 nesting, unicode and control characters, aliases). Every case must end with a located message
 (exit 2) or a valid result, never a traceback or a hang.
 
-CI runs a small fixed-seed sample (hypothesis ``derandomize``). A longer run by hand:
+The default run takes a small fixed-seed sample (hypothesis ``derandomize``); ``--long`` (or
+``BALPIPE_LONG_TESTS=1``) a larger one, still fixed. A long random run by hand:
 
     BALPIPE_FUZZ=long python -m pytest -q tests/test_fuzz.py -s
 
@@ -27,6 +28,7 @@ from hypothesis import strategies as st
 
 from balpipe.cli import main
 from balpipe.loader import SpecError, SpecErrors, load_text
+from _long import sample
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC_FILES = sorted((ROOT / "specs").glob("*.yaml"))
@@ -35,9 +37,11 @@ N = int(os.environ.get("BALPIPE_FUZZ_EXAMPLES", "0"))
 COUNT = {"loader": 0, "mutations": 0, "cli": 0}
 
 
-def fuzz_settings(ci: int, long: int):
+def fuzz_settings(ci: int, long: int, short: int | None = None):
+    """``short`` fixed-seed examples by default (``ci`` when not given), ``ci`` with ``--long``,
+    ``long`` random ones with BALPIPE_FUZZ=long."""
     return settings(
-        max_examples=N or (long if LONG else ci),
+        max_examples=N or (long if LONG else sample(ci if short is None else short, ci)),
         derandomize=not LONG,  # CI: fixed seed, the same cases every run
         deadline=None,
         database=None,
@@ -207,7 +211,7 @@ def test_mutated_specs_load_or_fail_located(text):
     _load_or_fail_located(text)
 
 
-@fuzz_settings(ci=10, long=1500)
+@fuzz_settings(ci=10, long=1500, short=3)  # each case a build: 3 by default
 @given(mutated_spec())
 def test_cli_check_and_build_on_mutated_specs(tmp_path_factory, text):
     """The whole pipeline on mutated specs: check, then build when check passes; exit 0, 1 or 2

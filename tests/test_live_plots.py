@@ -21,10 +21,10 @@ from balpipe.study import run
 SPECS = Path(__file__).parent.parent / "specs"
 
 
-@pytest.fixture(scope="module")
-def study():
+@pytest.fixture
+def study(studies):
     """The offset slider-crank: a crank torque, three revolutes and a prismatic guide, 501 samples."""
-    return run(load(SPECS / "offset_slider_crank.yaml").spec)
+    return studies("offset_slider_crank.yaml")
 
 
 def _stages(study) -> list:
@@ -166,12 +166,12 @@ def test_a_familys_own_time_series_is_interactive_too():
     assert [p["axis"] for p in data["panels"]] == ["Fˢʰ (N)", "Mˢʰ (N m)"]
 
 
-def test_the_3rpr_paper_figure_is_interactive_with_every_stage_in_its_page_style():
+def test_the_3rpr_paper_figure_is_interactive_with_every_stage_in_its_page_style(studies):
     """Paper 000's Fig. 4 (the idler-loop method's hook): three live panels, F_x, F_y and M, one
     curve per stage of the main design in its line style of the page, with the analysis's values."""
     from balpipe.balancing.base import style_index
 
-    st = run(load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
+    st = studies("paper000_rpr3_idler_loop.yaml")
     _, html, _ = next(f for f in st.extra_figures() if "(Fig. 4 of paper 000)" in f[0])
     data = json.loads(html[html.index('data-live="live-rpr3-loads">') + len('data-live="live-rpr3-loads">'):html.rindex("</script>")])
     assert [p["axis"] for p in data["panels"]] == ["F_x (N)", "F_y (N)", "M (N m)"]

@@ -20,10 +20,10 @@ from balpipe.study import ratio_reference
 SPECS = Path(__file__).resolve().parents[1] / "specs"
 
 
-@pytest.fixture(scope="module")
-def study003():
+@pytest.fixture
+def study003(studies):
     """Paper 003's eight trajectories in one spec (no simulation)."""
-    return study_mod.run(loader.load(SPECS / "paper003_com_planning.yaml").spec)
+    return studies("paper003_com_planning.yaml")
 
 
 @pytest.fixture
@@ -174,8 +174,8 @@ def test_legends_never_cover_the_curves(monkeypatch):
         figures.plt.close(fig)
 
 
-def test_rpr3_factor_table_gives_the_effort_unit_and_one_full_stop():
-    st = study_mod.run(loader.load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
+def test_rpr3_factor_table_gives_the_effort_unit_and_one_full_stop(studies):
+    st = studies("paper000_rpr3_idler_loop.yaml")
     table, caption = {title: (body, cap) for title, body, cap in st.extra_figures()}["Peak loads and the moment factor"]
     assert "peak actuator effort (N m)</th>" in table  # revolute actuators A_i
     assert caption.endswith("3-RPR).") and ".." not in caption and "reports 17 " in caption
@@ -225,9 +225,8 @@ def test_stage_table_names_each_ratios_reference_and_claims_only_what_is_claimed
     assert "for the stages of the first motion (" + st.stages[0].stage.label + ")" in html
 
 
-def test_single_motion_page_keeps_one_reference_sentence():
-    st = study_mod.run(loader.load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
-    html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+def test_single_motion_page_keeps_one_reference_sentence(pages):
+    html = pages("paper000_rpr3_idler_loop.yaml")
     rows = _stage_rows(html)
     assert ">reference</span>" in rows["unbalanced"] and "— (no claim)" in rows["idler loop"]
     assert "first motion" not in html and "ratios vs" not in html
@@ -243,17 +242,17 @@ def test_tracking_error_caption_gives_each_travel():
     assert "|q_sim − q_plan| / travel" in svg and "time (s)" in svg
 
 
-def test_no_two_stages_look_alike_and_the_caption_names_each_style(monkeypatch):
+def test_no_two_stages_look_alike_and_the_caption_names_each_style(monkeypatch, studies, pages):
     """A spec with compared designs has seven stages: the loads figure draws each in its own
     line, colour and marker, and its caption says which is which (it named only four)."""
     looks = [(str(figures.style(k)["color"]), figures.style(k)["linestyle"], figures.marked(k, 100)["marker"])
              for k in range(10)]
     assert len(set(looks)) == len(looks)
     assert len({figures.style_text(k) for k in range(10)}) == 10
-    st = study_mod.run(loader.load(SPECS / "paper000_rpr3_scott_russell_corrected.yaml").spec)
+    st = studies("paper000_rpr3_scott_russell_corrected.yaml")
     shown = page.shown_stages(st)
     assert len(shown) == 7
-    html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+    html = pages("paper000_rpr3_scott_russell_corrected.yaml")
     cap = html[html.index('<figure class="wide">'):]
     cap = cap[cap.index("<figcaption>"):cap.index("</figcaption>")]
     cap = html_mod.unescape(cap).lower()
@@ -341,9 +340,8 @@ def test_history_table_shows_round_off_as_zero():
     assert history_page._peaks(c, "max_shaking_moment") == "1.328 → 0.5"  # a real peak stays
 
 
-def test_unrealisable_parts_write_their_units_as_the_page_does():
-    st = study_mod.run(loader.load(SPECS / "paper004_five_bar.yaml").spec)
-    html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+def test_unrealisable_parts_write_their_units_as_the_page_does(pages):
+    html = pages("paper004_five_bar.yaml")
     table = html[html.index('<h2 id="balancing-stages"'):]
     table = table[:table.index("</table>")]
     assert "centroidal inertia" in table and "kg m²" in table and "kg m^2" not in table

@@ -15,12 +15,11 @@ import pytest
 
 from balpipe import realisable, registry
 from balpipe.engine import analyse
-from balpipe.loader import load, load_text
+from balpipe.loader import load_text
 from balpipe.model import FRAME, Attachment, Body, Driver, Model, Revolute
 from balpipe.motion import PROFILES, PointToPoint
 from balpipe.report.results import results_dict
 from balpipe.spec_parts import SpecFieldError
-from balpipe import study as study_mod
 from _edits import replaced
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -51,9 +50,9 @@ def test_negative_parts_are_found_even_when_the_body_total_is_positive():
 
 
 @pytest.fixture(scope="module")
-def paper():
-    spec = load(SPEC).spec
-    s = study_mod.run(spec)
+def paper(studies):
+    s = studies(SPEC.name)
+    spec = s.spec
     return spec, s, results_dict(s, "paper004_five_bar.yaml", "x", simulated=False)
 
 

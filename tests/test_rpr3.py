@@ -344,9 +344,9 @@ def test_scott_russell_out_of_reach_names_the_leg(tmp_path):
 # the paper's numerical applications
 
 
-@pytest.fixture(scope="module")
-def idler():
-    return study.run(load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
+@pytest.fixture
+def idler(studies):
+    return studies("paper000_rpr3_idler_loop.yaml")
 
 
 def test_idler_loop_reproduces_the_paper(idler):
@@ -364,9 +364,9 @@ def test_idler_loop_reproduces_the_paper(idler):
     assert idler.ok and all(r["status"] == "agrees" for r in idler.references)
 
 
-def test_scott_russell_as_printed_and_corrected():
-    printed = study.run(load(SPECS / "paper000_rpr3_scott_russell.yaml").spec)
-    corrected = study.run(load(SPECS / "paper000_rpr3_scott_russell_corrected.yaml").spec)
+def test_scott_russell_as_printed_and_corrected(studies):
+    printed = studies("paper000_rpr3_scott_russell.yaml")
+    corrected = studies("paper000_rpr3_scott_russell_corrected.yaml")
     for s in (printed, corrected):
         p = params(s.balance)
         for name, value in {"mcp1": 11.71, "mcp2": 3.17, "mcp3": 0.33, "mcp4": 0.75}.items():
@@ -395,14 +395,13 @@ def test_template_figures_reproduce_fig_4(idler):
     assert "17.07" in figs[1][1]  # the factor relative to the plain 3-RPR
 
 
-def test_methods_compared_on_the_same_3rpr():
+def test_methods_compared_on_the_same_3rpr(studies, pages):
     """Issue 9, item 5, through the generic ``compare:`` block: both methods' stages on the same 3-RPR
     in the "Designs side by side" table with the counter-rotations needed and the peak moment
     before them; the paper's Fig. 8 keeps the main design's stages only."""
-    from balpipe.report.page import render_page
     from balpipe.report.results import results_dict
 
-    s = study.run(load(SPECS / "paper000_rpr3_scott_russell_corrected.yaml").spec)
+    s = studies("paper000_rpr3_scott_russell_corrected.yaml")
     assert s.ok, s.problems
     out = results_dict(s, "x.yaml", "h", simulated=False)
     rows = {r["stage"]: r for r in out["comparison"]["rows"]}
@@ -422,7 +421,7 @@ def test_methods_compared_on_the_same_3rpr():
         assert r["max_joint_load"] > 0 and r["max_joint_load_joint"]
     by_name = {st.stage.name: st for st in s.stages}
     assert idl["added_mass"] == pytest.approx(by_name["idler:counter_rotations"].added_mass)
-    html = render_page(s, out, "text")
+    html = pages("paper000_rpr3_scott_russell_corrected.yaml")
     assert "Designs side by side" in html and "Peak |M| before counter-rotations (N m)" in html
     assert "idler loop (Sec. 2): counter-rotations" in html
     # Fig. 8 and the factor table: the Scott-Russell stages only

@@ -31,6 +31,10 @@ from _gitrepo import Repo, edit
 from balpipe import history
 from balpipe.build import Options, build
 
+# one xdist worker runs the whole module (addopts --dist loadgroup): its two sites and the browser
+# are made once per run, not once per worker
+pytestmark = pytest.mark.xdist_group("site_browser")
+
 SUBFOLDER = "team/balpipe"
 
 

@@ -12,10 +12,8 @@ from pathlib import Path
 import pytest
 
 from balpipe.build import Options, build
-from balpipe.loader import load as load_spec
 from balpipe.report import verdict as V
 from balpipe.report.results import results_dict
-from balpipe.study import run
 
 SPECS = Path(__file__).parent.parent / "specs"
 
@@ -108,9 +106,8 @@ def test_the_headline_judges_the_declared_stage_else_the_last():
 
 
 @pytest.fixture(scope="module")
-def four_bar():
-    spec = load_spec(SPECS / "custom_four_bar_balancing.yaml").spec
-    study = run(spec)
+def four_bar(studies):
+    study = studies("custom_four_bar_balancing.yaml")
     return study, results_dict(study, "custom_four_bar_balancing.yaml", "h", simulated=False)
 
 
