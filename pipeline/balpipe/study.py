@@ -231,7 +231,7 @@ def run(spec: Spec, page: bool = True) -> Study:
             raise SpecFieldError(("analysis", "claim_tolerance", name),
                                  f"no stage {name!r} (stages: {', '.join(s.stage.name for s in stages)})")
     metrics = [stage_metrics(s, reference_of(stages, s), tol, overrides) for s in stages]
-    if balance.derived is not None and page:  # results only (no error depends on them): not for check
+    if balance.derived is not None:
         balance.parameters.extend(balance.derived(stages))
     problems = []
     rvm = max(max(m["reactions_vs_momentum_force"], m["reactions_vs_momentum_moment"]) for m in metrics)

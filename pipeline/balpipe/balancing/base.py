@@ -52,8 +52,7 @@ class BalanceResult:
     stages: list[Stage]
     notes: list[str] = field(default_factory=list)
     # optional hooks: figures(study) -> [(title, svg or html, caption)] drawn on the page;
-    # derived(stage_results) -> [Parameter] computed from the analysed stages (before references);
-    # numbers for results.json and the page, never a check: ``balpipe check`` does not compute them
+    # derived(stage_results) -> [Parameter] computed from the analysed stages (before references)
     figures: Callable[[Any], Any] | None = None
     derived: Callable[[Any], list[Parameter]] | None = None
     details: dict = field(default_factory=dict)  # method-specific blocks for results.json (e.g. force_balance)
