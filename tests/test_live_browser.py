@@ -61,6 +61,9 @@ def test_wide_curves_are_drawn_first_and_the_legend_keeps_the_stages_order(live_
     k = min(range(len(d["t"])), key=lambda i: abs(d["t"][i] - t))
     for label, value in zip(labels, shown[1:]):
         exact = next(s for s in d["series"] if s["label"] == label)["y"]["x"][k]
+        if value == "0 (< tolerance)":  # round-off reads as the tables write it (its panel's floor)
+            assert abs(exact) <= d["panels"][0]["floor"], (label, value, exact)
+            continue
         assert abs(float(value) - exact) <= 1e-3 * max(1.0, abs(exact)), (label, value, exact)
     assert not w.problems, "\n".join(w.problems)
 

@@ -100,3 +100,27 @@ def test_a_wide_line_is_drawn_under_the_thin_ones():
     grey, dashed = svgplot._line_attrs(figures.style(2)), svgplot._line_attrs(figures.style(1))
     axes = svg[svg.index('<g id="z-axes_1">'):svg.index('<g id="z-legend_1">')]
     assert axes.index(grey) < axes.index(dashed)
+
+
+def test_a_curve_is_written_in_relative_steps_that_add_up_to_its_rounded_points():
+    """The path's relative steps (0.1 pt) sum to each point rounded to 0.1 pt, with no drift over
+    a long curve; a gap (NaN) starts a new absolute move."""
+    rng = np.random.default_rng(3)
+    x = np.cumsum(rng.uniform(0.05, 0.9, 2000))
+    y = 100 + np.cumsum(rng.normal(0, 3, 2000))
+    y[700] = np.nan
+    d = re.search(r'd="([^"]*)"', svgplot._polyline(x, y, "")).group(1)
+    runs = [r for r in re.split(r"(?=M)", d) if r]
+    assert len(runs) == 2
+    got = []
+    for r in runs:
+        head, _, rest = r[1:].partition("l")
+        px, py = map(float, head.split())
+        got.append((px, py))
+        nums = list(map(float, rest.split()))
+        for dx, dy in zip(nums[::2], nums[1::2]):
+            px, py = px + dx, py + dy
+            got.append((px, py))
+    ok = np.isfinite(y)
+    want = np.c_[np.round(x[ok] * 10) / 10, np.round(y[ok] * 10) / 10]
+    assert np.allclose(np.array(got), want, atol=1e-6)
