@@ -75,8 +75,8 @@ class Method:
 @dataclass(frozen=True)
 class Family:
     """One mechanism family: its templates and paper methods, in the order they appear in the
-    spec's unions. ``package`` is the family's import package (its code is part of the build's
-    code hash)."""
+    spec's unions. ``package`` is the family's import package (the build's code hash takes the
+    code of the package that the family's entry point names, read without importing it)."""
 
     name: str
     order: int
