@@ -219,6 +219,13 @@ def _short(x: Any) -> str:
     return t if len(t) <= LONG_TEXT else f"{t[:LONG_TEXT - 20].rstrip()}… ({len(t)} characters)"
 
 
+def _cancelled(stage: dict) -> dict[tuple[str, str], bool]:
+    """(load, side) -> whether a stage row's force or moment is round-off on that side: its
+    ratio to the unbalanced peak at most :data:`ROUND_OFF`."""
+    return {(w, side): isinstance(stage[f"{w}_ratio"][side], float) and stage[f"{w}_ratio"][side] <= ROUND_OFF
+            for w in ("force", "moment") for side in ("old", "new")}
+
+
 def _side_fmt(value: Any, cancelled: bool) -> str:
     """A load of one side: round-off (its ratio to the unbalanced peak at most :data:`ROUND_OFF`)
     reads ``0 (< tolerance)``, not as a number."""
@@ -241,14 +248,10 @@ def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
     rows: list[list[str]] = []
     sim: list[list[str]] = []
     for s in data["stages"]:
-        # a load cancelled to round-off in both designs is not a change worth a row
-        quiet = {
-            "force": all(isinstance(x, float) and x <= ROUND_OFF for x in (s["force_ratio"]["old"], s["force_ratio"]["new"])),
-            "moment": all(isinstance(x, float) and x <= ROUND_OFF for x in (s["moment_ratio"]["old"], s["moment_ratio"]["new"])),
-        }
-        # per side: a load cancelled to round-off reads 0 (< tolerance)
-        cancelled = {(w, side): isinstance(s[f"{w}_ratio"][side], float) and s[f"{w}_ratio"][side] <= ROUND_OFF
-                     for w in quiet for side in ("old", "new")}
+        # per side: a load cancelled to round-off reads 0 (< tolerance); cancelled in both designs,
+        # it is not a change worth a row
+        cancelled = _cancelled(s)
+        quiet = {w: cancelled[w, "old"] and cancelled[w, "new"] for w in ("force", "moment")}
         for key in STAGE_KEYS:
             d = s[key]
             if same(d["old"], d["new"]) or any(quiet[w] and w in key for w in quiet):
@@ -329,9 +332,8 @@ def to_html(data: dict, a: Side, b: Side, site: str = "") -> str:
 
     figs = []
     names_b = {s.stage.name: s for s in b.study.stages}
-    quiet = {s["name"]: (all(isinstance(x, float) and x <= ROUND_OFF for x in (s["force_ratio"]["old"], s["force_ratio"]["new"])),
-                         all(isinstance(x, float) and x <= ROUND_OFF for x in (s["moment_ratio"]["old"], s["moment_ratio"]["new"])))
-             for s in data["stages"]}
+    quiet = {s["name"]: tuple(c[w, "old"] and c[w, "new"] for w in ("force", "moment"))
+             for s in data["stages"] for c in [_cancelled(s)]}
     ua, ub = a.study.unbalanced.analysis, b.study.unbalanced.analysis
     scale = (max(ua.max_force, ub.max_force), max(ua.max_moment, ub.max_moment))
     for k, sa in enumerate(a.study.stages):
