@@ -19,7 +19,7 @@ S_M takes |r| |a|, not |r x a|: a machine whose masses all move along lines thro
 yoke on its axis) has no moment, and |r x a| = 0 would leave the moment figures no floor at all
 (round-off 5e-15 N m over 3.6e-15 N m read "150 %", and the reactions "disagree by 1.6").
 The reference is max(unbalanced inertial peak, FLOOR_FRACTION * S). On the specs and test
-models the unbalanced peaks are 0.09 to 1.0 of S, so the floor (1 %) never replaces them; on an
+models the unbalanced peaks are 0.08 to 1.0 of S, so the floor (1 %) never replaces them; on an
 already balanced arm it does, and the page says so.
 """
 
