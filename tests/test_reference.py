@@ -134,3 +134,33 @@ def test_a_machine_without_shaking_moment_still_has_a_moment_floor():
     assert ref.moment_basis != "unbalanced peak" and ref.moment == pytest.approx(FLOOR_FRACTION * sm) and sm > 1.0
     assert ref.force_basis == "unbalanced peak"
     assert st.problems == [] and st.checks["reactions_vs_momentum"] <= 1e-9
+
+
+def test_a_moment_already_zero_reads_zero_before_and_after_not_cancelled():
+    """The yoke's crank given a counterweight by optimal partial balancing: the shaking force is
+    reduced, and the shaking moment, round-off before (every mass on a line through O) and after
+    (the counterweight turns about O at constant speed), reads '0 before and after' on the
+    verdict and the index, never 'cancelled': the design cancelled nothing."""
+    from balpipe.loader import load_text
+    from balpipe.report.results import results_dict
+    from balpipe.report.site import headline
+
+    text = YOKE + """balancing:
+  method: partial_balance
+  counterweights:
+    - {body: crank, name: cw, segment: [[0, 0], [-0.05, 0]]}
+  objective:
+    - {load: shaking_force}
+  budget: {mass: 1 kg}
+"""
+    spec, _ = load_text(text, "yoke.yaml")
+    st = study.run(spec)
+    v = results_dict(st, "yoke.yaml", "h", False)["verdict"]
+    final = v["motions"][0]["final"]
+    assert v["stages"][final]["force"]["outcome"] == "reduced"
+    assert v["stages"][final]["moment"]["outcome"] == "zero"
+    assert "moment 0 before and after" in v["text"] and "cancelled" not in v["text"]
+    assert v["level"] == "good"
+    row = headline(v, 1e-9)
+    assert row["moment"].startswith("0 (<") and row["moment"].count("0 (<") == 2
+    assert not row["force"].startswith("0 (<")

@@ -81,16 +81,21 @@ def headline(v: dict, tol: float | None) -> dict:
     if not ms:
         return {"force": "—", "moment": "—", "weight": "", "motions": 0, "rows": [], "costs": [], "realisable": True}
 
+    zero = f"0 (< {tol_text(tol)})"
+
     def after(g: dict, key: str) -> str:
         out = v["stages"][g["final"]][key]
-        return f"0 (< {tol_text(tol)})" if out["outcome"] == "cancelled" else num(g[key][1])
+        return zero if out["outcome"] in ("cancelled", "zero") else num(g[key][1])
+
+    def before(g: dict, key: str) -> str:
+        return zero if v["stages"][g["final"]][key]["outcome"] == "zero" else num(g[key][0])
 
     def span(values: list[str]) -> str:
         return values[0] if len(set(values)) == 1 else f"{values[0]} … {values[-1]}"
 
     rows = [{"label": g["reference_label"], "final": g["final_label"],
-             "force": f"{num(g['force'][0])} → {after(g, 'force')}",
-             "moment": f"{num(g['moment'][0])} → {after(g, 'moment')}",
+             "force": f"{before(g, 'force')} → {after(g, 'force')}",
+             "moment": f"{before(g, 'moment')} → {after(g, 'moment')}",
              "costs": g["costs"]} for g in ms]
     if len(ms) == 1:
         force, moment = rows[0]["force"], rows[0]["moment"]

@@ -6,7 +6,9 @@ peaks and ratios of the *inertial* loads to the stage's reference, the stage's c
 per stage and per spec, for the force and for the moment each: *cancelled* (at most the balance
 tolerance of the reference), *reduced by x*, *unchanged* (within :data:`UNCHANGED`) or
 *worse* (x % of the reference: one format, percent, for every ratio), against what the stage claims; and how many of the paper's
-published numbers the build reproduces.
+published numbers the build reproduces. A load that was already at round-off in the reference
+(a Scotch yoke's shaking moment about its axis) and stays there reads *0 before and after*
+(outcome ``zero``): nothing was cancelled, and nothing is lost.
 
 Levels, worst first: ``bad`` (a claim fails, or the build failed), ``warn`` (a stage makes a
 load worse than its reference, a part cannot be built, or a published number does not
@@ -33,7 +35,8 @@ from .costs import cost_factors
 #: a ratio within this of 1 reads "unchanged"
 UNCHANGED = 0.01
 LEVELS = ("good", "neutral", "warn", "bad")  # from best to worst
-_ORDER = {"cancelled": 0, "reduced": 1, "unchanged": 2, "worse": 3}
+_ORDER = {"zero": 0, "cancelled": 0, "reduced": 1, "unchanged": 2, "worse": 3}
+ZERO_TEXT = "0 before and after"
 
 
 def worst(levels) -> str:
@@ -50,13 +53,16 @@ def percent(x: float) -> str:
     return f"{v:.3g} %" if abs(v) >= 1 else f"{v:.2g} %"
 
 
-def outcome(ratio: float | None, cancelled: bool, claimed: bool) -> dict:
+def outcome(ratio: float | None, cancelled: bool, claimed: bool, was_zero: bool = False) -> dict:
     """What a stage did to one load, its ratio to the reference's peak: cancelled / reduced /
-    unchanged / worse, with the words shown on the pages."""
+    unchanged / worse, with the words shown on the pages; ``was_zero``: the reference's own load
+    is at round-off, so a stage that keeps it there cancelled nothing (``zero``)."""
     if ratio is None:
         return {"outcome": "unknown", "ratio": None, "claimed": claimed, "text": "—"}
     r = float(ratio)
-    if cancelled:
+    if cancelled and was_zero:
+        kind, text = "zero", ZERO_TEXT
+    elif cancelled:
         kind, text = "cancelled", "cancelled"
     elif abs(r - 1.0) <= UNCHANGED:
         kind, text = "unchanged", "unchanged"
@@ -73,19 +79,21 @@ def claims_of(stage: dict) -> list[str]:
     return [p for p in ("force", "moment") if p in b]
 
 
-def stage_verdict(stage: dict, weight: float | None = None) -> dict:
-    """The verdict of one stage against its own claim (see the module's docstring)."""
+def stage_verdict(stage: dict, weight: float | None = None, reference: dict | None = None) -> dict:
+    """The verdict of one stage against its own claim (see the module's docstring); ``reference``:
+    the row of the stage it is measured against (a load at round-off there reads ``zero``)."""
     claims = claims_of(stage)
-    loads = {p: outcome(stage.get(f"{p}_ratio"), bool(stage.get(f"{p}_balanced")), p in claims)
+    loads = {p: outcome(stage.get(f"{p}_ratio"), bool(stage.get(f"{p}_balanced")), p in claims,
+                        bool(reference and reference.get(f"{p}_balanced")))
              for p in ("force", "moment")}
-    fails = [p for p in claims if loads[p]["outcome"] != "cancelled"]
+    fails = [p for p in claims if loads[p]["outcome"] not in ("cancelled", "zero")]
     worse = [p for p in ("force", "moment") if loads[p]["outcome"] == "worse"]
     realisable = stage.get("realisable", True) is not False
     if fails:
         level = "bad"
     elif worse or not realisable:
         level = "warn"
-    elif all(loads[p]["outcome"] == "unchanged" for p in loads):
+    elif all(loads[p]["outcome"] in ("unchanged", "zero") for p in loads):
         level = "neutral"
     else:
         level = "good"
@@ -162,6 +170,8 @@ def _span(outs: list[dict]) -> dict:
         text = f"reduced by {a} to {b}" if a != b else f"reduced by {a}"
     elif kinds == {"cancelled"}:
         text = "cancelled"
+    elif kinds == {"zero"}:
+        text = ZERO_TEXT
     else:
         text = ", ".join(f"{sum(o['outcome'] == k for o in outs)} {k}" for k in sorted(kinds, key=_ORDER.get))
     return {"outcome": kind, "ratio": hi, "ratio_min": lo, "claimed": any(o["claimed"] for o in outs),
@@ -175,10 +185,11 @@ def verdict(results: dict, weights: dict[str, float] | None = None) -> dict[str,
     weights = weights or {}
     stages = results.get("stages") or []
     per_stage = {}
+    by_name = {s["name"]: s for s in stages}
     for s in stages:
         if s.get("reference", stages[0]["name"]) == s["name"]:
             continue  # a reference: nothing to judge
-        per_stage[s["name"]] = stage_verdict(s, weights.get(s["name"]))
+        per_stage[s["name"]] = stage_verdict(s, weights.get(s["name"]), by_name.get(s.get("reference", stages[0]["name"])))
     groups = []
     for ref, members in motions(stages):
         final, declared = headline_stage(members)

@@ -49,6 +49,14 @@ from ...engine import analyse
 from ...engine.load_reference import load_reference
 
 
+def link_name(ij: str) -> str:
+    """Paper 001's name of link ij in plain text, its length l_ij (Sec. II): '41' -> 'l₄₁', as the
+    pages' tables write it (:func:`balpipe.notation.symbol_text`)."""
+    from ...notation import symbol_text
+
+    return symbol_text(f"l_{{{ij}}}")
+
+
 class CounterMassDistances(Strict):
     """Distance of each counter-mass from its link's proximal joint."""
 
@@ -161,9 +169,9 @@ def leg_by_leg(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> tuple[
                                 f"counter-mass {i}1")
         for ij, mass, pos, eq in ((f"{i}2", m2, pos2, "eqs. 9, 11"), (f"{i}1", m1, pos1, "eqs. 8, 10")):
             params += [
-                Parameter(f"m_cm{ij}", mass, "kg", eq, f"leg-by-leg counter-mass on link l{ij}"),
-                Parameter(f"x_cm{ij}", pos[0], "m", eq, f"its position along l{ij} from the proximal joint"),
-                Parameter(f"y_cm{ij}", pos[1], "m", eq, f"its position normal to l{ij} (left positive)"),
+                Parameter(f"m_cm{ij}", mass, "kg", eq, f"leg-by-leg counter-mass on link {link_name(ij)}"),
+                Parameter(f"x_cm{ij}", pos[0], "m", eq, f"its position along {link_name(ij)} from the proximal joint"),
+                Parameter(f"y_cm{ij}", pos[1], "m", eq, f"its position normal to {link_name(ij)} (left positive)"),
             ]
     return out, params
 
@@ -206,7 +214,7 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
     label = LEG_BY_LEG_LABEL
     if spec.independent:
         fig = "Fig. 2" + "abcd"[min(len(spec.independent), 3)]
-        label = f"leg-by-leg counter-masses ({fig}, eqs. 8-11; " + ", ".join(f"l{ij}" for ij in spec.independent) + " as built)"
+        label = f"leg-by-leg counter-masses ({fig}, eqs. 8-11; " + ", ".join(link_name(ij) for ij in spec.independent) + " as built)"
     stages.append(Stage("leg_by_leg", label, lbl,
                         "each leg's centre of mass on its base pivot, the platform lumped at the C_i (eqs. 2-11)", "force"))
     params.append(Parameter("added_mass_leg_by_leg", lbl.total_mass() - base_mass, "kg", "eqs. 8-11",
@@ -418,9 +426,9 @@ def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Mo
         for cw in sol.counterweights:
             ij = cw.region.body[4:]
             params += [
-                Parameter(f"m_lm{ij}", cw.mass, "kg", "least added mass (linprog)", f"least-mass counter-mass on l{ij}"),
-                Parameter(f"x_lm{ij}", cw.position[0], "m", "least added mass (linprog)", f"its position along l{ij}"),
-                Parameter(f"y_lm{ij}", cw.position[1], "m", "least added mass (linprog)", f"its position normal to l{ij}"),
+                Parameter(f"m_lm{ij}", cw.mass, "kg", "least added mass (linprog)", f"least-mass counter-mass on {link_name(ij)}"),
+                Parameter(f"x_lm{ij}", cw.position[0], "m", "least added mass (linprog)", f"its position along {link_name(ij)}"),
+                Parameter(f"y_lm{ij}", cw.position[1], "m", "least added mass (linprog)", f"its position normal to {link_name(ij)}"),
             ]
         saved = added_lbl - sol.total_mass
         same = abs(saved) <= 1e-9 * max(added_lbl, 1e-300)

@@ -418,11 +418,11 @@ def _notation() -> dict:
     for j, name, a, b in ((1, "proximal", "A", "B"), (2, "distal", "B", "C")):
         p = f"mechanism.legs.<i>.{name}"
         table.update({
-            f"{p}.length": Sym(f"l_{{<i>{j}}}", f"length {a}_<i>{b}_<i> of link <i>{j}"),
-            f"{p}.mass": Sym(f"m_{{<i>{j}}}", f"mass of the bare link <i>{j}"),
-            f"{p}.com": Sym(f"p_{{<i>{j}}}", f"centre of mass of link <i>{j} along the link from {a}_<i>"),
-            f"{p}.com_offset": Sym(f"q_{{<i>{j}}}", f"centre of mass of link <i>{j} normal to the link (left positive)"),
-            f"{p}.inertia": ours(f"I_{{<i>{j}}}", f"centroidal moment of inertia of link <i>{j}"),
+            f"{p}.length": Sym(f"l_{{<i>{j}}}", f"length {a}_<i>{b}_<i> of link l_{{<i>{j}}}"),
+            f"{p}.mass": Sym(f"m_{{<i>{j}}}", f"mass of the bare link l_{{<i>{j}}}"),
+            f"{p}.com": Sym(f"p_{{<i>{j}}}", f"centre of mass of link l_{{<i>{j}}} along the link from {a}_<i>"),
+            f"{p}.com_offset": Sym(f"q_{{<i>{j}}}", f"centre of mass of link l_{{<i>{j}}} normal to the link (left positive)"),
+            f"{p}.inertia": ours(f"I_{{<i>{j}}}", f"centroidal moment of inertia of link l_{{<i>{j}}}"),
         })
     # the model's names (Sec. II, Fig. 1): the paper calls link ij by its length l_ij ("links
     # l_i2", "l_32"), its angles θ_i1, θ_i2; an actuator at A_i drives θ_i1, one at B_i the
