@@ -595,8 +595,15 @@ def test_hovering_a_plot_shows_its_values_and_a_click_hides_a_curve(paper_site, 
     entry = plot.locator(".u-legend .u-series").nth(1)
     entry.click()
     assert "u-off" in (entry.get_attribute("class") or "")
-    # no static figure: printing prints the live plot, drawn again for print
+    # no static figure: printing prints the live plot, drawn again for print, the hidden curve hidden
     assert not p.locator(".static-plot").count() and not p.locator("#live-loads svg").count()
+    label = entry.locator(".u-label").text_content()
+    p.emulate_media(media="print")
+    p.wait_for_selector("#live-loads .live-print .u-legend", state="attached")
+    off = plot.evaluate("""(el, label) => [...el.querySelectorAll(".live-print .u-legend .u-series")]
+        .map(r => [r.querySelector(".u-label").textContent, r.classList.contains("u-off")])""", label)
+    assert [hidden for name, hidden in off if name == label] == [True] and [h for _, h in off].count(True) == 1, off
+    p.emulate_media(media="screen")
     assert_printed(p, "live-loads")
     assert not w.problems, "\n".join(w.problems)
 
