@@ -4,10 +4,16 @@
 // player both ways: the player announces its time ("balpipe:time" on document) and every plot's
 // cursor follows it; a click (not a drag) in a plot asks the player to go to that time
 // ("balpipe:seek"). Pages without a player simply have no one announcing or listening.
+// Printing prints these plots: on "beforeprint" (the print dialog, and Chromium's page.pdf) or when
+// the print media query starts to match (Chromium's emulated print media, the print layout), every
+// panel is drawn once more, for the paper: PRINT_WIDTH wide (half of it a panel in a figure of
+// small multiples, two a row), at PRINT_RATIO device pixels per CSS pixel, stretched to the
+// printed column by style.css; every panel of a joint selector; removed again after printing.
 (function () {
   "use strict";
   if (typeof uPlot === "undefined") return;
   const HEIGHT = 240;
+  const PRINT_WIDTH = 700, PRINT_GAP = 16, PRINT_RATIO = 3;  // CSS px: an A4 or Letter page's column
   // a value within the panel's round-off floor (draw/live.py) reads as the tables write it
   function fmt(v, floor) {
     if (v == null) return "—";
@@ -15,10 +21,12 @@
     if (floor && a <= floor) return "0 (< tolerance)";
     return a !== 0 && (a < 1e-3 || a >= 1e6) ? v.toExponential(3) : (+v.toPrecision(4)).toString();
   }
-  // kinematic warnings (time, label): dotted vertical lines, as in the static figure
+  // the canvas's device pixels per CSS pixel: the screen's, or PRINT_RATIO in a plot drawn for print
+  const ratio = u => u.ctx.canvas.width / u.width || 1;
+  // kinematic warnings (time, label): dotted vertical lines, labelled along them
   function marksPlugin(marks) {
     return { hooks: { draw: u => {
-      const c = u.ctx, top = u.bbox.top, h = u.bbox.height, r = devicePixelRatio || 1;
+      const c = u.ctx, top = u.bbox.top, h = u.bbox.height, r = ratio(u);
       c.save();
       c.strokeStyle = "#666"; c.fillStyle = "#444"; c.lineWidth = r; c.setLineDash([2 * r, 2 * r]);
       c.font = (10 * r) + "px sans-serif"; c.textAlign = "right";
@@ -31,13 +39,46 @@
       c.restore();
     } } };
   }
+  // a stage's markers (draw/live.py): matplotlib's symbol, unfilled, at every `every` sample from
+  // `start` (staggered per stage, so that coinciding curves stay apart), 4.5 pt as the paper figures
+  const SHAPES = {
+    o: [], s: [[-1, -1], [1, -1], [1, 1], [-1, 1]], D: [[0, -1.25], [1.25, 0], [0, 1.25], [-1.25, 0]],
+    "^": [[0, -1.2], [1.1, 0.8], [-1.1, 0.8]], v: [[0, 1.2], [1.1, -0.8], [-1.1, -0.8]],
+    "<": [[-1.2, 0], [0.8, -1.1], [0.8, 1.1]], ">": [[1.2, 0], [-0.8, -1.1], [-0.8, 1.1]],
+    h: [0, 1, 2, 3, 4, 5].map(i => [Math.sin(i * Math.PI / 3), -Math.cos(i * Math.PI / 3)]),
+    P: [[-0.4, -1], [0.4, -1], [0.4, -0.4], [1, -0.4], [1, 0.4], [0.4, 0.4], [0.4, 1], [-0.4, 1], [-0.4, 0.4], [-1, 0.4], [-1, -0.4], [-0.4, -0.4]],
+    X: [[-0.7, -1], [0, -0.3], [0.7, -1], [1, -0.7], [0.3, 0], [1, 0.7], [0.7, 1], [0, 0.3], [-0.7, 1], [-1, 0.7], [-0.3, 0], [-1, -0.7]],
+  };
+  function markersPlugin(drawn) {
+    return { hooks: { draw: u => {
+      const c = u.ctx, r = ratio(u), size = 3 * r;  // half of 4.5 pt, in device pixels
+      const b = u.bbox;
+      c.save();
+      c.beginPath(); c.rect(b.left, b.top, b.width, b.height); c.clip();
+      drawn.forEach((s, n) => {
+        if (!s.marker || !u.series[n + 1].show) return;
+        const [shape, start, every] = s.marker, ys = u.data[n + 1], pts = SHAPES[shape] || [];
+        c.strokeStyle = s.stroke; c.lineWidth = r; c.setLineDash([]);
+        for (let i = start; i < ys.length; i += every) {
+          if (ys[i] == null) continue;
+          const x = u.valToPos(u.data[0][i], "x", true), y = u.valToPos(ys[i], "y", true);
+          c.beginPath();
+          if (!pts.length) c.arc(x, y, size, 0, 2 * Math.PI);
+          else pts.forEach(([px, py], j) => (j ? c.lineTo : c.moveTo).call(c, x + px * size, y + py * size));
+          c.closePath(); c.stroke();
+        }
+      });
+      c.restore();
+    } } };
+  }
   // the legend's rows back in the stages' order (uPlot lists its series in drawing order);
   // moving a row keeps its click handler and the cells that show the hovered values
   function legendInStageOrder(u, order) {
-    const rows = u.root.querySelectorAll(".u-legend .u-series");  // rows[0]: the time
-    if (rows.length !== order.length + 1) return;
+    const rows = u.root.querySelectorAll(".u-legend .u-series");  // rows[0]: the time (none in print's legend)
+    const first = rows.length - order.length;
+    if (first !== 0 && first !== 1) return;
     const parent = rows[0].parentNode;
-    for (let i = 0; i < order.length; i++) parent.appendChild(rows[1 + order.indexOf(i)]);
+    for (let i = 0; i < order.length; i++) parent.appendChild(rows[first + order.indexOf(i)]);
   }
   // a figure of many panels (a joint per panel): a selector above shows one panel at a time
   // (first d.choose, the largest load) or every panel; a plot drawn hidden takes its width when shown
@@ -63,7 +104,7 @@
     sel.addEventListener("change", show);
     show();
   }
-  const figures = [];  // {host, plots, hovering}
+  const figures = [], all = [];  // {host, plots, hovering, ...}: the figures over time, every figure
   let playerTime = null;
   function follow(f) {
     if (playerTime == null || f.hovering || f.timeless || f.host.offsetParent === null) return;  // hidden: skip
@@ -80,25 +121,31 @@
     // drawn in d.draw's order (wide lines first, under the thin ones), listed in the stages' order
     const order = d.draw || d.series.map((s, i) => i);
     const drawn = order.map(i => d.series[i]);
-    for (const p of d.panels) {
-      const el = document.createElement("div");
-      el.className = "live-plot";
-      el.dataset.quantity = p.key;
-      host.appendChild(el);
+    f.build = (p, make, w, extra) => {  // panel p's plot by the uPlot `make`, w wide, in its element
       // over time, or (d.x) over another quantity: a front's budget, each value a design marked
       const series = [{ label: d.x || "t (s)", value: (u, v) => fmt(v) }].concat(drawn.map(s => Object.assign({
         label: s.label, stroke: s.stroke, dash: s.dash, width: s.width, value: (u, v) => fmt(v, p.floor),
       }, d.x ? { spanGaps: true, points: { show: true, size: s.points ? 10 : 5, width: 1.5, fill: "#fff" } } : {},
          s.points ? { paths: () => null } : {})));
-      const opts = {
-        title: p.title, width: width(el), height: HEIGHT,
+      const opts = Object.assign({
+        title: p.title, width: w, height: HEIGHT,
         scales: { x: { time: false } },
         axes: [{ label: d.x || "time (s)" }, { label: p.axis, size: 64 }],
         series: series,
         cursor: { sync: { key: src.dataset.live } },
-        plugins: d.marks.length ? [marksPlugin(d.marks)] : [],
-      };
-      const u = new uPlot(opts, [d.t].concat(drawn.map(s => s.y[p.key] || d.t.map(() => null))), el);
+        plugins: (d.marks.length ? [marksPlugin(d.marks)] : []).concat(drawn.some(s => s.marker) ? [markersPlugin(drawn)] : []),
+      }, extra || {});
+      return [opts, [d.t].concat(drawn.map(s => s.y[p.key] || d.t.map(() => null)))];
+    };
+    f.order = order;
+    f.panels = d.panels;
+    for (const p of d.panels) {
+      const el = document.createElement("div");
+      el.className = "live-plot";
+      el.dataset.quantity = p.key;
+      host.appendChild(el);
+      const [opts, data] = f.build(p, uPlot, width(el));
+      const u = new uPlot(opts, data, el);
       legendInStageOrder(u, order);
       f.plots.push(u);
       if (d.x) continue;  // not over time: not linked to the player
@@ -117,17 +164,69 @@
     }
     if (d.choose != null) chooser(host, d, f);
     host.classList.add("live-ready");
+    all.push(f);
     if (!d.x) figures.push(f);
     // follow the host's width (the window, or a collapsed section opened): resize after the
     // observer's callback, never inside it
     let last = host.clientWidth, pending = 0;
     new ResizeObserver(() => {
-      if (host.clientWidth === last || host.clientWidth === 0) return;
+      if (host.clientWidth === last || host.clientWidth === 0 || printing) return;
       last = host.clientWidth;
       cancelAnimationFrame(pending);
       pending = requestAnimationFrame(() => { f.plots.forEach(u => u.setSize({ width: width(u.root.parentNode), height: HEIGHT })); follow(f); });
     }).observe(host);
   });
+  // printing: every panel drawn again for the paper (see the top), with the screen plot's curves
+  // shown or hidden and its time range (a zoom), no cursor; a legend without values
+  let printing = false, PrintPlot = null;
+  function printUPlot() {  // uPlot drawing at PRINT_RATIO: its own copy, read while devicePixelRatio says so
+    if (PrintPlot) return PrintPlot;
+    const src = document.getElementById("uplot-js");
+    if (!src) return uPlot;
+    const own = Object.getOwnPropertyDescriptor(window, "devicePixelRatio");
+    try {
+      Object.defineProperty(window, "devicePixelRatio", { value: PRINT_RATIO, configurable: true, writable: true });
+      PrintPlot = new Function(src.textContent + "\nreturn uPlot;")();
+    } catch (e) {
+      PrintPlot = uPlot;  // the screen's ratio, stretched
+    }
+    if (own) Object.defineProperty(window, "devicePixelRatio", own); else delete window.devicePixelRatio;
+    return PrintPlot;
+  }
+  function toPrint() {
+    if (printing) return;
+    printing = true;
+    const Make = printUPlot();
+    all.forEach(f => {
+      const w = f.host.classList.contains("live-grid") ? (PRINT_WIDTH - PRINT_GAP) / 2 : PRINT_WIDTH;
+      f.plots.forEach((u, i) => {
+        const [opts, data] = f.build(f.panels[i], Make, w, { cursor: { show: false }, legend: { live: false } });
+        opts.series.forEach((s, n) => { s.show = u.series[n].show; });
+        const box = document.createElement("div");
+        box.className = "live-print";
+        u.root.parentNode.appendChild(box);
+        u.root.parentNode.classList.add("printed");
+        const p = new Make(opts, data, box);
+        legendInStageOrder(p, f.order);
+        const x = u.scales.x;
+        if (x.min != null && (x.min > data[0][0] || x.max < data[0][data[0].length - 1])) p.setScale("x", { min: x.min, max: x.max });
+        (f.printed = f.printed || []).push(p);
+      });
+    });
+  }
+  function fromPrint() {
+    if (!printing) return;
+    printing = false;
+    all.forEach(f => {
+      (f.printed || []).forEach(p => { const box = p.root.parentNode; p.destroy(); box.parentNode.classList.remove("printed"); box.remove(); });
+      f.printed = [];
+    });
+  }
+  addEventListener("beforeprint", toPrint);
+  addEventListener("afterprint", fromPrint);
+  const printMedia = matchMedia("print");
+  printMedia.addEventListener("change", e => (e.matches ? toPrint : fromPrint)());
+  if (printMedia.matches) toPrint();
   document.addEventListener("balpipe:time", e => {
     playerTime = e.detail.time;
     figures.forEach(follow);

@@ -358,34 +358,37 @@ def test_the_verdict_judges_case_2_whose_reductions_the_paper_publishes(paper, t
     assert "the stage whose numbers the paper publishes" in box
 
 
-def test_figs_3_and_4_draw_the_papers_cases_in_the_papers_line_styles_which_are_the_pages(paper, monkeypatch):
+def test_figs_3_and_4_draw_the_papers_cases_in_the_papers_line_styles_which_are_the_pages(paper):
     """Figs. 3-4: case 1 black full, case 2 black dashed, case 3 grey full (the paper's captions),
     and each of these stages has that style in every figure of the page (the style legend)."""
     from balpipe.draw import figures
     from balpipe.report.page import shown_stages
 
+    import json
+
+    from balpipe.draw.live import line_style
+
     spec, st, p = paper
-    drawn = {}
-    monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.setdefault(prefix, fig) and "<svg/>")
-    titles = [t for t, _, _ in st.extra_figures()]
+    figs = {t: h for t, h, _ in st.extra_figures()}
+    titles = list(figs)
     assert "Fig. 3 of paper 003: variations of the shaking forces, trajectory P15P7" in titles
     assert "Fig. 4 of paper 003: variations of the shaking moment, trajectory P15P7" in titles
     assert not any("Figs. 3-4" in t for t in titles)  # the old grid of every trajectory is gone
     paper_styles = {"case 1": ("black", "-"), "case 2": ("black", "--"), "case 3": ("0.6", "-")}
     shown = [s.stage.label.split(" · ")[-1] for s in shown_stages(st)]
-    for prefix in ("p003fig3", "p003fig4"):
-        lines = drawn[prefix].axes[0].get_lines()
-        assert [ln.get_label()[:6] for ln in lines] == ["case 1", "case 2", "case 3"]
-        for ln in lines:
-            color, dash = paper_styles[ln.get_label()[:6]]
-            k = shown.index(ln.get_label())
+    for number, prefix in (("3", "p003fig3"), ("4", "p003fig4")):
+        html = next(h for t, h in figs.items() if t.startswith(f"Fig. {number} of paper 003"))
+        start = html.index(f'data-live="live-{prefix}">') + len(f'data-live="live-{prefix}">')
+        series = json.loads(html[start:html.index("</script>", start)])["series"]
+        assert [x["label"][:6] for x in series] == ["case 1", "case 2", "case 3"]
+        for x in series:
+            color, dash = paper_styles[x["label"][:6]]
+            k = shown.index(x["label"])
             assert figures.style(k)["color"] == color and figures.style(k)["linestyle"] == dash
-            assert ln.get_color() == color and ln.get_linestyle() == dash
+            assert {key: x[key] for key in ("stroke", "dash", "width")} == line_style(k)
     # the stage figures' legend reads the same styles
     assert [figures.style_text(k, markers=False) for k in range(3)] == ["solid black", "dashed black", "grey"]
     assert shown[:3] == ["case 1: end-effector quintic", "case 2: CoM bang-bang + φ optimised", "case 3: CoM trapezoidal"]
-    for f in drawn.values():
-        figures.plt.close(f)
 
 
 def test_the_index_names_the_main_motion_its_costs_come_from(tmp_path):

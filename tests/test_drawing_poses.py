@@ -174,7 +174,10 @@ def test_the_player_draws_the_same_connected_legs(studies):
     assert len(d["sleeves"]) == len(d["poses"]) and all(len(f) == 3 for f in d["sleeves"])
     assert d["t"][0] == 0.0  # the player starts where the drawing's solid pose is
     first = sleeves.sleeves(s.stage.model, poses[0])
-    assert np.allclose(np.array(d["sleeves"][0]), np.array([[a, b] for a, b in first]), atol=1e-6)
+    # rounded to what the panel shows: no drawn point moves by more than player.PIXEL
+    scale = d["view"][2]
+    assert np.allclose(np.array(d["sleeves"][0]), np.array([[a, b] for a, b in first]), atol=player.PIXEL / scale)
+    assert np.allclose(np.array(d["poses"][0])[:, :2], poses[0][:, :2], atol=player.PIXEL / scale)
     names = [b.name for b in s.stage.model.bodies]
     assert not any(sh["slider"] for n, sh in zip(names, d["shapes"]) if n.startswith("piston"))
 
@@ -235,3 +238,18 @@ def test_a_name_two_bodies_share_at_one_place_is_named_once():
     requests, _, keep = figures.name_requests(model, row, 0.3, 1.0, {})
     assert [t for t, _, k in requests if k in ("pivot", "joint")] == ["O", "B"]
     assert len([c for c, r in keep if r is None]) == 3  # the unnamed ends' markers are still kept clear
+
+
+def test_the_players_rounding_moves_no_drawn_point_by_more_than_its_bound():
+    """The player's poses keep the decimals their panel shows (issue 22, a page's weight): half
+    the last kept digit, at the panel's scale (a position) or across the whole panel (an angle),
+    is at most player.PIXEL px; one decimal fewer would be more."""
+    from balpipe.draw import player
+
+    for scale in (0.3, 7.0, 500.0, 3000.0, 2.5e5):
+        for size in (120.0, 424.0, 900.0):
+            position, angle = player.digits(scale, size)
+            assert 0.5 * 10.0 ** -position * scale <= player.PIXEL
+            assert 0.5 * 10.0 ** -angle * size <= player.PIXEL
+            assert position == 0 or 0.5 * 10.0 ** (1 - position) * scale > player.PIXEL
+            assert 0.5 * 10.0 ** (1 - angle) * size > player.PIXEL

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from test_site_browser import Watched, browser, open_sections  # noqa: F401 (the browser fixture)
+from test_site_browser import Watched, assert_printed, browser, open_sections  # noqa: F401 (the browser fixture)
 
 from balpipe.build import Options, build
 
@@ -71,7 +71,7 @@ def test_wide_curves_are_drawn_first_and_the_legend_keeps_the_stages_order(live_
 def test_a_figure_of_many_joints_shows_one_joint_at_a_time(live_site, browser):  # noqa: F811
     """The Scott-Russell legs' 30 joint loads: a selector above the plot shows one joint, first
     the largest load; choosing another shows that one (hover still shows its values), 'every
-    joint' shows them all; printing shows the static figure of every panel."""
+    joint' shows them all; printing prints every panel, drawn for print."""
     w, p, d = _open(browser, live_site, "paper000_rpr3_scott_russell", "live-joints")
     n = len(d["panels"])
     assert n >= 30 and d["choose"] is not None
@@ -98,15 +98,17 @@ def test_a_figure_of_many_joints_shows_one_joint_at_a_time(live_site, browser): 
     assert re.search(r"\d", values[0]) and any(re.search(r"\d", v) for v in values[1:]), values
     sel.select_option("all")
     assert p.eval_on_selector("#live-joints", visible).count(True) == n
-    p.emulate_media(media="print")
-    assert p.is_visible("#live-joints + .static-plot svg") and not p.is_visible("#live-joints")
+    sel.select_option(str(d["choose"]))  # one joint on screen: printing shows every one
+    assert p.eval_on_selector("#live-joints", visible).count(True) == 1
+    assert_printed(p, "live-joints")
+    assert p.eval_on_selector("#live-joints", visible).count(True) == 1  # the screen's choice again
     assert not w.problems, "\n".join(w.problems)
 
 
 def test_the_partial_fronts_are_interactive_over_their_budget(live_site, browser):  # noqa: F811
     """A partial balancing's force-against-mass front: hovering a design shows its added mass
     and its peak force (those of a design of the front), a click on a legend entry hides a
-    curve, the plot is not linked to time, and printing shows the static figure."""
+    curve, the plot is not linked to time, and printing prints the plot drawn for print."""
     figure = "live-partial_force_vs_mass"
     w, p, d = _open(browser, live_site, "partial_offset_slider_crank", figure)
     assert d["x"] == "added mass (kg)"
@@ -125,6 +127,5 @@ def test_the_partial_fronts_are_interactive_over_their_budget(live_site, browser
     entry = plot.locator(".u-legend .u-series").nth(2)
     entry.click()
     assert "u-off" in (entry.get_attribute("class") or "")
-    p.emulate_media(media="print")
-    assert p.is_visible(f"#{figure} + .static-plot svg") and not p.is_visible(f"#{figure}")
+    assert_printed(p, figure)
     assert not w.problems, "\n".join(w.problems)

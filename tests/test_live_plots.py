@@ -38,8 +38,10 @@ def _kept(data: dict, t: np.ndarray) -> np.ndarray:
     return k
 
 
-def _close(shown: list, exact: np.ndarray) -> None:
-    """Shown values are the exact ones to the 6 significant digits they keep."""
+def _close(shown: list, exact: np.ndarray, floor: float = 0.0) -> None:
+    """Shown values are the exact ones to the 6 significant digits they keep; those within the
+    panel's round-off ``floor`` are written 0 (draw/live.py's _round)."""
+    exact = np.where(np.abs(exact) <= floor, 0.0, exact)
     assert len(shown) == len(exact)
     assert np.allclose(shown, exact, rtol=1e-5, atol=1e-12 * max(1.0, float(np.max(np.abs(exact)))))
 
@@ -82,9 +84,39 @@ def test_loads_are_the_shaking_loads(study):
     k = _kept(data, study.stages[0].analysis.t)
     for s, series in zip(study.stages, data["series"]):
         F = s.analysis.force
+        _close(series["y"]["Fx"], F[k, 0])
+        _close(series["y"]["Fy"], F[k, 1])
         _close(series["y"]["F"], np.hypot(F[:, 0], F[:, 1])[k])
         _close(series["y"]["M"], s.analysis.moment[k])
-    assert [p["axis"] for p in data["panels"]] == ["|F| (N)", "M (N m)"]
+    assert [p["axis"] for p in data["panels"]] == ["Fx (N)", "Fy (N)", "|F| (N)", "M (N m)"]
+
+
+def test_the_loads_have_markers_pymunk_curves_and_the_coincidence_note():
+    """What the printed loads figure drew, the live one draws (issue 22, its static SVG gone):
+    each stage's markers at its staggered samples (figures.marked over the kept samples), each
+    stage's pymunk run dotted in its simulation colour, and the note on coinciding curves."""
+    from types import SimpleNamespace
+
+    from balpipe.draw import figures
+
+    t = np.linspace(0.0, 0.5, 101)
+    F = np.stack([np.sin(9 * t), np.cos(9 * t)], axis=1)
+    stages = [("unbalanced", SimpleNamespace(t=t, force=F, moment=np.sin(5 * t))),
+              ("counterweights", SimpleNamespace(t=t, force=0 * F, moment=2 * np.sin(5 * t))),
+              ("counter-rotations", SimpleNamespace(t=t, force=0 * F, moment=0 * t))]
+    sims = [(t, F * 1.001, np.sin(5 * t)), None, None]
+    data = LV.data(LP.loads(stages, sims))
+    assert data == LV.data(LP.loads(stages, sims))
+    assert [s["label"] for s in data["series"]] == ["unbalanced", "counterweights", "counter-rotations",
+                                                     "unbalanced (pymunk)"]
+    for k in range(3):
+        start, every = figures.marked(k, len(t))["markevery"]
+        assert data["series"][k]["marker"] == [figures.marker(k), start, every]
+        assert {key: data["series"][k][key] for key in ("stroke", "dash", "width")} == LV.line_style(k)
+    sim = data["series"][3]
+    assert "marker" not in sim and sim["dash"] == LV.DASHES[":"] and sim["width"] == 1.0
+    _close(sim["y"]["Fx"], 1.001 * F[:, 0])
+    assert LP.coincide_notes(stages) == ["Coincide in force Fx, force Fy, force |F|: counterweights = counter-rotations"]
 
 
 def test_a_figure_of_many_curves_keeps_fewer_samples():
@@ -107,7 +139,8 @@ def test_the_json_is_deterministic_and_safe_in_a_script(study):
     for name in ("loads", "efforts", "joints"):
         assert one[name] == two[name], name  # the same bytes from a second run of the spec
         html = one[name]
-        assert html.startswith(f'<div class="live" id="live-{name}"></div><div class="static-plot"><svg')
+        assert html.startswith(f'<div class="live" id="live-{name}"><noscript>')
+        assert "<svg" not in html and "static-plot" not in html  # no static figure of the same curves
         script = html[html.index(f'data-live="live-{name}">') + len(f'data-live="live-{name}">'):html.rindex("</script>")]
         assert json.loads(script)["series"]
     t = np.linspace(0.0, 1.0, 5)
@@ -116,17 +149,13 @@ def test_the_json_is_deterministic_and_safe_in_a_script(study):
     assert json.loads(text)["series"][0]["label"] == "</script><!--"
 
 
-def test_the_printed_joint_figure_has_a_panel_per_joint_load(study):
-    """The static SVG (what printing shows) is drawn from the same curves, unthinned."""
-    curves = LP.joints(_stages(study))
-    panels = LV.static_panels(curves)
-    assert [title for title, _, _ in panels] == [p["title"] for p in curves.panels]
-    for _, _, per_stage in panels:
-        for (label, t, y), s in zip(per_stage, study.stages):
-            assert label == s.stage.label and len(y) == len(t) == len(s.analysis.t)
+def test_without_javascript_the_figure_says_where_its_numbers_are(study):
+    """No static figure: a reader without JavaScript reads, in the plot's place, that it needs
+    JavaScript and which files beside the page hold its numbers."""
     html = study_figures(study)["joints"]
-    svg = html[html.index("<svg"):html.index("</svg>")]
-    assert svg.count('<g id="joints-axes_') == len(curves.panels)  # an axes per panel
+    note = html[html.index("<noscript>"):html.index("</noscript>")]
+    assert "JavaScript" in note and 'href="timeseries.csv"' in note and 'href="results.json"' in note
+    assert html.index("</noscript>") < html.index("</div>")  # inside the live element
 
 
 def test_the_papers_time_series_are_interactive_in_their_stage_styles():
@@ -155,7 +184,7 @@ def test_a_familys_own_time_series_is_interactive_too():
 
     st = run(load(SPECS / "paper002_decoupling.yaml").spec)
     _, html, _ = next(f for f in st.extra_figures() if f[0].startswith("Fig. 2 of paper 002"))
-    assert html.startswith('<div class="live" id="live-p002fig2"></div><div class="static-plot"><svg')
+    assert html.startswith('<div class="live" id="live-p002fig2"><noscript>') and "<svg" not in html
     data = json.loads(html[html.index('data-live="live-p002fig2">') + len('data-live="live-p002fig2">'):html.rindex("</script>")])
     [series] = data["series"]
     an = st.unbalanced.analysis
@@ -180,8 +209,9 @@ def test_the_3rpr_paper_figure_is_interactive_with_every_stage_in_its_page_style
     for series in data["series"]:
         s = own[series["label"]]
         k = _kept(data, s.analysis.t)
-        _close(series["y"]["x"], s.analysis.force[k, 0])
-        _close(series["y"]["M"], s.analysis.moment[k])
+        floor = {p["key"]: p["floor"] for p in data["panels"]}
+        _close(series["y"]["x"], s.analysis.force[k, 0], floor["x"])
+        _close(series["y"]["M"], s.analysis.moment[k], floor["M"])
         assert {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(style_index(st.stages, s))
 
 
@@ -221,11 +251,12 @@ def test_a_partial_balancings_front_is_interactive_over_its_budget():
         front, *marked = data["series"]
         assert front["label"] == PFG.FRONT and "points" not in front and all(s["points"] for s in marked)
         shown = sorted((xv, yv) for xv, yv in zip(data["t"], front["y"]["y"]) if yv is not None)
-        exact = sorted((float(f"{p[x]:.6g}"), float(f"{p[y]:.6g}")) for p in pts)
+        floor = data["panels"][0]["floor"]  # a design's round-off, written 0
+        exact = sorted((float(f"{p[x]:.6g}"), float(f"{p[y]:.6g}") if abs(p[y]) > floor else 0.0) for p in pts)
         assert shown == exact  # every design of the front, none thinned away
         for s, (label, vx, vy) in zip(marked, marks):
             at = [(xv, yv) for xv, yv in zip(data["t"], s["y"]["y"]) if yv is not None]
-            assert s["label"] == label and at == [(float(f"{vx:.6g}"), float(f"{vy:.6g}"))]
+            assert s["label"] == label and at == [(float(f"{vx:.6g}"), float(f"{vy:.6g}") if abs(vy) > floor else 0.0)]
         assert data["t"] == sorted(data["t"])  # uPlot's x runs forward
         json.loads(LV.as_script(data))  # valid JSON: null, not NaN
     many = [{"added_mass": m, "shaking_force": 100.0 - m} for m in np.linspace(0.0, 10.0, 1000)]
@@ -236,7 +267,7 @@ def test_a_partial_balancings_front_is_interactive_over_its_budget():
 def test_each_panel_carries_its_round_off_floor(study):
     """A balanced stage's residual (1.9e-13 N m beside 11.5 N m) hovers as "0 (< tolerance)", as
     the tables write it: each panel carries 1e-9 of its largest value over every stage, and the
-    script formats a value at or below it so."""
+    script formats a value at or below it so; the JSON writes such a value as 0."""
     t = np.linspace(0.0, 1.0, 101)
     panels = [{"key": "M", "title": "M (N m)", "axis": "M (N m)"}, {"key": "z", "title": "z", "axis": "z"}]
     stages = [("unbalanced", {"M": 11.5 * np.sin(2 * np.pi * t), "z": 0 * t}),
@@ -244,10 +275,12 @@ def test_each_panel_carries_its_round_off_floor(study):
     data = LV.data(LV.Curves(t, stages, panels, []))
     assert [p["floor"] for p in data["panels"]] == [pytest.approx(1.15e-8, rel=1e-2), 0.0]
     assert max(abs(v) for v in data["series"][1]["y"]["M"]) <= data["panels"][0]["floor"]
+    assert set(data["series"][1]["y"]["M"]) == {0.0}  # written 0: 3 bytes a sample, not 12
     assert 11.5 * np.sin(2 * np.pi * 0.01) > data["panels"][0]["floor"]  # a real value stays a number
+    _close(data["series"][0]["y"]["M"], 11.5 * np.sin(2 * np.pi * t))
     script = (Path(__file__).parent.parent / "templates" / "live_plots.js").read_text()
     assert 'if (floor && a <= floor) return "0 (< tolerance)";' in script and "fmt(v, p.floor)" in script
     # the real study's pages: the balanced stage's |F| is under its panel's floor
     data = LV.data(LP.loads(_stages(study)))
-    force = data["panels"][0]
+    force = next(p for p in data["panels"] if p["key"] == "F")
     assert force["key"] == "F" and force["floor"] > 0

@@ -13,7 +13,7 @@ import pytest
 
 from balpipe import loader
 from balpipe import study as study_mod
-from balpipe.draw import figures, svgplot
+from balpipe.draw import figures
 from balpipe.report import page, results
 from balpipe.study import ratio_reference
 
@@ -135,30 +135,14 @@ def _legends_clear_of_the_data(fig) -> list[str]:
 
 
 def test_legends_never_cover_the_curves(monkeypatch):
-    """The time plots with one curve per stage (efforts, joint loads, residuals, tracking, drift)
-    keep their legend under the axes, in as many columns as fit, with long stage names (paper
-    001's); the joint loads' small multiples (rows of three panels) as well."""
+    """The matplotlib time plots with one curve per stage (residuals, tracking, drift) keep their
+    legend under the axes, in as many columns as fit, with long stage names (paper 001's); the
+    efforts and joint loads are live plots (uPlot's legend is under its plot)."""
     drawn = []
     monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.append((prefix, fig)) or "<svg/>")
     t = np.linspace(0.0, 0.5, 101)
     names = ["unbalanced", "counterweights", "counterweights + counter-rotations",
              "force balance only: least-mass counterweights", "crank counterweight only: 1 kg at 80 mm behind O2"]
-    an = [SimpleNamespace(t=t, efforts={"crank": (k + 1) * np.sin(9 * t)}) for k in range(len(names))]
-    # the efforts and the joint loads' small multiples are written without matplotlib (draw/svgplot.py):
-    # their computed layout must keep the legend below every panel and every text inside the figure
-    small = [[(f"Actuator effort: crank (N m)", "torque (N m)", [(n, a.t, a.efforts["crank"]) for n, a in zip(names, an)])],
-             [(f"J{j}, revolute: |F| (N)", "|F| (N)", [(n, a.t, a.efforts["crank"] ** 2) for n, a in zip(names, an)])
-              for j in range(7)]]
-    for panels, columns in zip(small, (1, 3)):
-        lay = svgplot.layout(panels, columns, styles=figures.style)
-        assert lay.legend is not None and lay.entries == [(n, figures.style(k)) for k, n in enumerate(names)]
-        assert all(lay.legend.y0 >= box.y1 for box in lay.areas)  # under every plotting area
-        assert lay.legend.x0 >= 0 and lay.legend.x1 <= lay.width and lay.legend.y1 <= lay.height
-        n = lay.legend_cols  # as many columns (at most 3) as fit, not one long column
-        assert n == 3 or svgplot._legend_width(lay.entries, n + 1) > 0.98 * lay.width
-        assert all(b.x0 >= 0 and b.y0 >= 0 and b.x1 <= lay.width and b.y1 <= lay.height for b in lay.texts)
-    figures.efforts_figure(list(zip(names, an)), units={"crank": "N m"})
-    figures.panels_figure(*small[1:], "joints")
     err = 1e-6 * (1 + np.abs(np.sin(20 * t)))
     figures.residual_figure([(n, t, err, err, 10.0, 2.0) for n in names])
     figures.series_figure(t, [(n + ": crank", err) for n in names], "|q_sim − q_plan| / travel", "torque")

@@ -94,9 +94,9 @@ def test_the_papers_panels_keep_the_pages_stage_styles():
     assert 'data-figures="' in html and "10a 10b 11 12" in html
 
 
-def test_live_plots_draw_each_stage_in_its_static_line_style():
+def test_live_plots_draw_each_stage_in_its_line_style_of_the_page():
     """The interactive curves keep the page's one style legend: stage k has the colour, dashes and
-    width of the static figures' stage k (issue 22: one style per stage on a page)."""
+    width of the matplotlib figures' stage k (issue 22: one style per stage on a page)."""
     from matplotlib.colors import to_hex
 
     from balpipe.draw import figures
@@ -108,60 +108,49 @@ def test_live_plots_draw_each_stage_in_its_static_line_style():
     assert line_style(1)["dash"] and not line_style(0)["dash"] and line_style(2)["stroke"] != line_style(0)["stroke"]
 
 
+def _live(html: str, name: str) -> dict:
+    import json
+
+    start = html.index(f'data-live="live-{name}">') + len(f'data-live="live-{name}">')
+    return json.loads(html[start:html.index("</script>", start)])
+
+
 @pytest.mark.parametrize("spec", ["paper000_rpr3_idler_loop", "paper000_rpr3_scott_russell"])
-def test_paper000_figures_draw_each_stage_in_its_style_of_the_page(spec, monkeypatch):
+def test_paper000_figures_draw_each_stage_in_its_style_of_the_page(spec):
     """Issue 22, point 4: on a paper-000 page dashed means the counterweights in every figure
     (Fig. 4 / 8 and the stage figures), as the paper draws them; the added linkage, which the
     paper does not plot, is never dashed."""
-    from balpipe.draw import figures
+    from balpipe.draw.live import line_style
     from balpipe.report.page import shown_stages
 
     study = run(load(SPECS / f"{spec}.yaml").spec)
-    drawn = {}
-    monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.setdefault(prefix, fig) and "<svg/>")
-    list(study.extra_figures())
+    html = next(h for title, h, _ in study.extra_figures() if "of paper 000)" in title)
     shown = [s.stage.name for s in shown_stages(study)]
     assert shown[:3] == ["unbalanced", "counterweights", "counter_rotations"]
-    for ln in drawn["rpr3-loads"].axes[0].get_lines():
-        name = next(s.stage.name for s in study.stages if s.stage.label == ln.get_label())
-        st = figures.style(shown.index(name))
-        assert (ln.get_color(), ln.get_linestyle(), ln.get_linewidth()) == (st["color"], st["linestyle"], st["linewidth"])
-        assert (ln.get_linestyle() == "--") == (name == "counterweights")
-    for f in drawn.values():
-        figures.plt.close(f)
+    for x in _live(html, "rpr3-loads")["series"]:
+        name = next(s.stage.name for s in study.stages if s.stage.label == x["label"])
+        assert {key: x[key] for key in ("stroke", "dash", "width")} == line_style(shown.index(name))
+        assert bool(x["dash"] == line_style(1)["dash"]) == (name == "counterweights")
 
 
-def test_paper000_fig4_draws_the_dashed_zero_force_over_the_grey_line(monkeypatch):
+def test_paper000_fig4_draws_the_dashed_zero_force_over_the_grey_line():
     """Issue 22: on Fig. 4 of paper 000 the counterweights' force (dashed) and the
-    counter-rotations' (grey, wide) are both 0; the dashed curve is drawn after the grey one, on
-    top, in the static figure (matplotlib draws by zorder, in order) and in the interactive plot
-    (its ``draw`` order), whose legend keeps the stages' order."""
-    import json
-
-    from balpipe.draw import figures
-
+    counter-rotations' (grey, wide) are both 0; the interactive plot draws the dashed curve
+    after the grey one, on top (its ``draw`` order, as matplotlib's zorder would), and its
+    legend keeps the stages' order."""
     study = run(load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
-    drawn, html = {}, {}
-    monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.setdefault(prefix, fig) and "<svg/>")
     html = next(h for title, h, _ in study.extra_figures() if "(Fig. 4 of paper 000)" in title)
     by = {s.stage.label: s.stage.name for s in study.stages}
     cw = next(s for s in study.stages if s.stage.name == "counterweights")
     cr = next(s for s in study.stages if s.stage.name == "counter_rotations")
     scale = study.unbalanced.analysis.max_force
     assert np.max(np.abs(cw.analysis.force)) < 1e-9 * scale and np.max(np.abs(cr.analysis.force)) < 1e-9 * scale
-    for ax in drawn["rpr3-loads"].axes:
-        lines = sorted(ax.get_lines(), key=lambda ln: ln.get_zorder())  # matplotlib's drawing order (stable)
-        order = [by[ln.get_label()] for ln in lines]
-        assert order.index("counterweights") > order.index("counter_rotations")
-        assert order[0] == "counter_rotations"  # the wide grey line under every thin one
-    data = json.loads(html[html.index('data-live="live-rpr3-loads">') + len('data-live="live-rpr3-loads">'):html.rindex("</script>")])
+    data = _live(html, "rpr3-loads")
     labels = [x["label"] for x in data["series"]]
     drawn_names = [by[labels[i]] for i in data["draw"]]
     assert sorted(data["draw"]) == list(range(len(labels)))
     assert drawn_names[0] == "counter_rotations" and drawn_names.index("counterweights") > 0
     assert [by[x] for x in labels][:3] == ["unbalanced", "counterweights", "counter_rotations"]  # the legend's order
-    for f in drawn.values():
-        figures.plt.close(f)
 
 
 def test_stage_styles_apply_only_to_a_complete_set_of_the_main_designs_stages():

@@ -222,6 +222,46 @@ def open_sections(page) -> None:
     page.wait_for_timeout(50)
 
 
+PRINT_RATIO = 3  # templates/live_plots.js: device pixels per CSS pixel of a plot drawn for print
+
+_PRINTED = """host => {
+  const style = getComputedStyle(host);
+  const columns = style.display === "grid" ? style.gridTemplateColumns.split(" ").length : 1;
+  return { width: host.clientWidth, columns: columns, plots: [...host.querySelectorAll(".live-plot")].map(el => {
+    const c = el.querySelector(".live-print canvas"), screen = el.querySelector(":scope > .uplot");
+    if (!c) return null;
+    const box = c.getBoundingClientRect(), wrap = c.parentNode;
+    return { width: box.width, height: box.height, pixels: c.width, drawn: parseFloat(wrap.style.width),
+             screen: screen.getBoundingClientRect().height };
+  }) };
+}"""
+
+
+def assert_printed(page, figure: str) -> None:
+    """In print media every panel of the live figure ``#figure`` is drawn for print: a canvas of
+    PRINT_RATIO device pixels per CSS pixel, stretched across its share of the printed width (a
+    figure of small multiples: two a row), the screen's plot hidden, and every panel shown (a
+    joint selector's too); back on screen the print copies are gone. The media query is what
+    Playwright's emulation and the print layout change (page.pdf and the print dialog also send
+    beforeprint: :func:`test_a_pdf_prints_every_panel_drawn_for_print`)."""
+    page.emulate_media(media="print")
+    try:
+        page.wait_for_function(f"document.querySelectorAll('#{figure} .live-print canvas').length === "
+                               f"document.querySelectorAll('#{figure} .live-plot').length", timeout=5000)
+        got = page.eval_on_selector(f"#{figure}", _PRINTED)
+        assert got["plots"] and all(got["plots"]), got
+        column = got["width"] / got["columns"]
+        for plot in got["plots"]:
+            assert plot["width"] >= 0.9 * column and plot["height"] > 0.2 * plot["width"], (figure, plot, column)
+            assert plot["pixels"] >= PRINT_RATIO * plot["drawn"] - 1, (figure, plot)  # sharp on paper
+            assert plot["screen"] == 0, (figure, plot)  # the screen's plot is not printed
+        assert not page.is_visible(f"#{figure} .live-choose")
+    finally:
+        page.emulate_media(media="screen")
+    page.wait_for_function(f"!document.querySelector('#{figure} .live-print')", timeout=5000)
+    assert page.is_visible(f"#{figure} .live-plot:not([hidden]) > .uplot canvas")
+
+
 def test_player_pauses_scrubs_and_answers_the_keyboard(server, browser):
     w = Watched(browser)
     p = w.page
@@ -555,10 +595,36 @@ def test_hovering_a_plot_shows_its_values_and_a_click_hides_a_curve(paper_site, 
     entry = plot.locator(".u-legend .u-series").nth(1)
     entry.click()
     assert "u-off" in (entry.get_attribute("class") or "")
-    # the static figure stays for printing; on screen the live plot replaces it
-    assert not p.is_visible("#live-loads + .static-plot svg")
+    # no static figure: printing prints the live plot, drawn again for print, the hidden curve hidden
+    assert not p.locator(".static-plot").count() and not p.locator("#live-loads svg").count()
+    label = entry.locator(".u-label").text_content()
     p.emulate_media(media="print")
-    assert p.is_visible("#live-loads + .static-plot svg") and not p.is_visible("#live-loads")
+    p.wait_for_selector("#live-loads .live-print .u-legend", state="attached")
+    off = plot.evaluate("""(el, label) => [...el.querySelectorAll(".live-print .u-legend .u-series")]
+        .map(r => [r.querySelector(".u-label").textContent, r.classList.contains("u-off")])""", label)
+    assert [hidden for name, hidden in off if name == label] == [True] and [h for _, h in off].count(True) == 1, off
+    p.emulate_media(media="screen")
+    assert_printed(p, "live-loads")
+    assert not w.problems, "\n".join(w.problems)
+
+
+def test_a_pdf_prints_every_panel_drawn_for_print(paper_site, browser):
+    """Playwright's page.pdf, as the print dialog, sends beforeprint with the screen's layout:
+    by then every panel of every live figure (the joints' hidden ones too, and those of the
+    collapsed sections, which printing opens: fit_tables.js) is drawn for print; after it the
+    print copies are gone and the screen's plots are drawn as before."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto((paper_site / "paper002_decoupling" / "index.html").as_uri(), wait_until="load")
+    p.evaluate("""addEventListener("beforeprint", () => { window.printedPanels = [...document.querySelectorAll(".live-plot")]
+        .map(el => { const c = el.querySelector(".live-print canvas"); return c ? c.width / parseFloat(c.parentNode.style.width) : 0; }); })""")
+    pdf = p.pdf()
+    assert pdf.startswith(b"%PDF") and len(pdf) > 10_000
+    ratios = p.evaluate("window.printedPanels")
+    assert ratios and len(ratios) == p.locator(".live-plot").count() and min(ratios) >= PRINT_RATIO - 0.01, ratios
+    assert not p.locator(".live-print").count()
+    assert p.is_visible("#live-loads .live-plot > .uplot canvas")
     assert not w.problems, "\n".join(w.problems)
 
 
@@ -569,7 +635,7 @@ def test_hovering_a_plot_shows_its_values_and_a_click_hides_a_curve(paper_site, 
                                           ("live-p002fig2", r"^(Fˢʰ \(N\)|Mˢʰ \(N m\))$")])
 def test_the_efforts_joint_loads_and_paper_plots_are_interactive(paper_site, browser, figure, unit):
     """As the shaking loads' plot: hover shows the time and every curve's value, the axis names
-    its unit, a click on a legend entry hides that curve, and printing shows the static figure;
+    its unit, a click on a legend entry hides that curve, and printing prints the plot drawn for print;
     for the actuator efforts, the joint loads and a paper's own time series (paper 002's Fig. 2)."""
     w = Watched(browser)
     p = w.page
@@ -592,9 +658,7 @@ def test_the_efforts_joint_loads_and_paper_plots_are_interactive(paper_site, bro
     entry.click()
     assert "u-off" in (entry.get_attribute("class") or "")
     assert plot.locator("canvas").evaluate("c => c.toDataURL()") != pixels  # the curve is gone
-    assert not p.is_visible(f"#{figure} + .static-plot svg")
-    p.emulate_media(media="print")
-    assert p.is_visible(f"#{figure} + .static-plot svg") and not p.is_visible(f"#{figure}")
+    assert_printed(p, figure)
     assert not w.problems, "\n".join(w.problems)
 
 
@@ -671,6 +735,15 @@ def pytest_generate_tests(metafunc):
 
 def test_built_site_page_weighs_less_than_2_mb(built_page):
     assert _weight(built_page) < MAX_BYTES
+
+
+def test_built_site_page_has_no_static_copy_of_a_live_figure(built_page):
+    """A live figure is its plot alone (issue 22): no static SVG of the same curves beside it
+    (printing prints the plot), a <noscript> line in its place for a reader without JavaScript."""
+    html = built_page.read_text(encoding="utf-8")
+    assert "static-plot" not in html
+    for m in re.finditer(r'<div class="live" id="(live-[^"]+)">(.*?)</div>', html, re.S):
+        assert m.group(2).startswith("<noscript>") and "<svg" not in m.group(2), m.group(1)
 
 
 @pytest.mark.parametrize("width", [400, 1400])

@@ -24,7 +24,6 @@ from . import extremes  # noqa: E402
 from .labels import drawing_span, point_places, repeated_names  # noqa: E402
 from .layout import fixed_layout  # noqa: E402
 from .sleeves import guided_sliders, sleeves  # noqa: E402
-from .svgplot import panels_svg  # noqa: E402
 
 plt.rcParams.update({
     "svg.hashsalt": "balpipe",
@@ -168,63 +167,9 @@ def legend_below(fig, ax, fontsize: float = 8.5) -> None:
     fixed_layout(fig, rect=(0, h / (H + h), 1, 1))
 
 
-def loads_figure(stages: list, prefix: str = "loads") -> str:
-    """Fx, Fy, |F| and M over time, every stage on the same axes (paper 000 Fig. 4 style), each
-    stage in its line style with its markers (:func:`marked`), its pymunk run dotted; a note says
-    which curves coincide. ``stages``: list of (label, Analysis, simulated or None) with
-    simulated = (t, F, M). Written by :func:`svgplot.panels_svg` (no matplotlib figure)."""
-    panels = [
-        ("Shaking force Fx (N)", lambda F, M: F[:, 0]),
-        ("Shaking force Fy (N)", lambda F, M: F[:, 1]),
-        ("Shaking force |F| (N)", lambda F, M: np.hypot(F[:, 0], F[:, 1])),
-        ("Shaking moment M (N m)", lambda F, M: M),
-    ]
-    notes: dict[str, list[str]] = {}  # coinciding groups -> the panels where they coincide
-    for title, fn in panels:
-        same = coinciding([(label, fn(an.force, an.moment)) for label, an, _ in stages])
-        if same:
-            notes.setdefault("; ".join(same), []).append(title.split(" (")[0].replace("Shaking ", ""))
-    drawn = []
-    for title, fn in panels:
-        curves = []
-        for k, (label, an, sim) in enumerate(stages):
-            curves.append((label, an.t, fn(an.force, an.moment), marked(k, len(an.t))))
-            if sim is not None:
-                ts, Fs, Ms = sim
-                curves.append((f"{label} (pymunk)", ts, fn(Fs, Ms),
-                               {"color": SIM_COLORS[k % len(SIM_COLORS)], "linestyle": ":", "linewidth": 1.0}))
-        drawn.append((title, "", curves))
-    lines = [f"Coincide in {', '.join(where)}: {groups}" for groups, where in notes.items()]
-    return panels_svg(drawn, prefix, style, columns=2, cell=(5.5 * 72, 3.2 * 72), legend_font=9.5, notes=lines)
-
-
-def efforts_figure(stages: list, prefix: str = "efforts", units: dict | None = None,
-                   marks: list | None = None, shown: dict | None = None) -> str:
-    """Actuator torque (or force) of every driver, every stage; ``units``: driver -> 'N m' or 'N';
-    ``marks``: (time, label) of kinematic warnings (balpipe.dead_centres), drawn as dotted lines;
-    ``shown``: driver -> the name its panel shows (the paper's symbol, balpipe.notation.Names)."""
-    units = units or {}
-    names = sorted({n for _, an in stages for n in an.efforts})
-    panels = []
-    for name in names:
-        u = units.get(name, "")
-        panels.append((f"Actuator effort: {(shown or {}).get(name, name)}" + (f" ({u})" if u else ""), effort_axis(u),
-                       [(label, an.t, an.efforts.get(name)) for label, an in stages]))
-    return panels_figure(panels, prefix, marks, columns=max(1, len(names)))
-
-
 def effort_axis(unit: str) -> str:
     """An effort panel's axis label: 'torque (N m)', 'force (N)', or 'effort' without a unit."""
     return {"N m": "torque (N m)", "N": "force (N)"}.get(unit, "effort")
-
-
-def panels_figure(panels: list, prefix: str, marks: list | None = None, columns: int = 3) -> str:
-    """Small multiples over time: ``panels`` (title, y label, curves), curves one per stage in stage
-    order as (label, t, values or None: the stage has no such curve), stage k in :func:`style` k;
-    ``columns`` panels a row, the legend of the first panel below; ``marks`` (time, label) drawn
-    as dotted vertical lines in every panel. The panels share the time axis, labelled under the
-    lowest panel of each column."""
-    return panels_svg(panels, prefix, style, marks, columns)  # written directly: no matplotlib figure
 
 
 def _global_point(pose, p) -> np.ndarray:

@@ -3,19 +3,18 @@
 ``fig.tight_layout()`` lays every tick label, axis label and title out and asks each for its
 drawn box (about a second a figure here, as long as drawing it). :func:`fixed_layout` gives the
 same margins from the texts themselves: the tick labels that the axis's locator and formatter
-will draw, its labels and title, each measured in its font (:func:`balpipe.draw.svgplot.text_size`,
+will draw, its labels and title, each measured in its font (:func:`text_size`,
 matplotlib's metrics, without laying a figure out), and sets them with ``subplots_adjust``, with
 tight_layout's padding (1.08 font sizes) around and between the panels of the grid.
 """
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import NamedTuple
 
 import matplotlib as mpl
 from matplotlib.font_manager import FontProperties
-
-from .svgplot import text_size
 
 PAD = 1.08  # tight_layout's default pad, in font sizes
 
@@ -27,6 +26,22 @@ class Decor(NamedTuple):
     right: float
     bottom: float
     top: float
+
+
+@lru_cache(maxsize=1)
+def _renderer():
+    from matplotlib.backends.backend_agg import RendererAgg
+
+    return RendererAgg(10, 10, 72)  # at 72 dpi a pixel is a point
+
+
+@lru_cache(maxsize=4096)
+def text_size(text: str, size: float, math: bool = False) -> tuple[float, float]:
+    """Width and height (pt) of ``text`` in DejaVu Sans at ``size`` pt, as matplotlib lays it out
+    (``math``: as mathtext)."""
+    prop = FontProperties(family="DejaVu Sans", size=size)
+    w, h, _ = _renderer().get_text_width_height_descent(text, prop, ismath=math)
+    return float(w), float(h)
 
 
 def _points(size) -> float:

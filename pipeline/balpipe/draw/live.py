@@ -4,13 +4,15 @@ by uPlot (MIT, https://github.com/leeoniya/uPlot, shipped inside the page as
 script for every figure (``templates/live_plots.js``): hover shows the time and every curve's
 value, drag to zoom (double-click resets), a click on a legend entry hides its curve; where the
 page has a player, its time moves every plot's cursor and a click in a plot sets the player's
-time. The static SVG of the same curves stays in the page for printing and for readers without
-JavaScript.
+time. Printing prints these plots themselves, redrawn at the printed width and a pixel ratio that
+prints sharply (``live_plots.js``); no static figure of the same curves is written (issue 22: it
+doubled a page's weight and its build time). Without JavaScript a line in the plot's place says
+where the numbers are (:data:`NUMBERS`).
 
 A figure's curves are a :class:`Curves`; :func:`data` thins them to at most :data:`POINTS`
 samples (evenly spaced, first and last kept; fewer for a figure of many curves, :data:`VALUES`)
-and rounds them to 6 significant digits: deterministic, and light (a page stays below 2 MB).
-:func:`html` writes the live element, the static SVG and the JSON together. Here, below the
+and rounds them to 6 significant digits (round-off, below 1e-9 of a panel's largest value, to 0): deterministic, and light (a page stays below 2 MB).
+:func:`html` writes the live element and the JSON together. Here, below the
 report, so that a family's own figures (a paper's time series) are interactive too; the page's
 generic figures build their curves in :mod:`balpipe.report.live_plots`.
 """
@@ -37,9 +39,13 @@ def _thin(n: int, curves: int = 1) -> np.ndarray:
     return np.unique(np.linspace(0, n - 1, min(n, keep)).round().astype(int))
 
 
-def _round(values) -> list[float | None]:
-    """6 significant digits; a missing value (NaN) as null, the one JSON has."""
-    return [float(f"{v + 0.0:.6g}") if np.isfinite(v) else None for v in np.asarray(values, dtype=float)]
+def _round(values, floor: float = 0.0) -> list[float | None]:
+    """6 significant digits; a missing value (NaN) as null, the one JSON has; a value within the
+    panel's round-off ``floor`` (:func:`_floor`) as 0: the plot cannot tell it from 0 and the
+    hover reads "0 (< tolerance)" either way, and a balanced stage's 1.23457e-13 costs 12 bytes
+    a sample."""
+    return [(0.0 if abs(v) <= floor else float(f"{v + 0.0:.6g}")) if np.isfinite(v) else None
+            for v in np.asarray(values, dtype=float)]
 
 
 ROUND_OFF = 1e-9  # of a panel's largest value: what the hover shows as 0 (< tolerance), as the tables do
@@ -54,13 +60,24 @@ def _floor(c: Curves, key: str) -> float:
     return float(f"{ROUND_OFF * max(peaks, default=0.0):.3g}")
 
 
-def line_style(k: int) -> dict:
-    """Stage ``k``'s line as the static figures draw it (:func:`balpipe.draw.figures.style`): its
-    colour, dashes and width, so a style means the same stage in every figure of the page."""
+def line_style(k: int | dict) -> dict:
+    """Stage ``k``'s line as the page's other figures draw it (:func:`balpipe.draw.figures.style`):
+    its colour, dashes and width, so a style means the same stage in every figure of the page; or
+    ``k`` a line style of its own (matplotlib's ``color``, ``linestyle``, ``linewidth``: a
+    stage's pymunk run)."""
     from matplotlib.colors import to_hex
 
-    st = figures.style(k)
+    st = k if isinstance(k, dict) else figures.style(k)
     return {"stroke": to_hex(st["color"]), "dash": DASHES.get(st["linestyle"], []), "width": st["linewidth"]}
+
+
+def markers(k: int, n: int) -> dict:
+    """Stage ``k``'s markers over ``n`` drawn samples (:func:`balpipe.draw.figures.marked`): its
+    symbol (matplotlib's letter, which ``live_plots.js`` draws) at every ``every`` sample from
+    ``start``, staggered per stage so that curves that coincide stay apart."""
+    st = figures.marked(k, n)
+    start, every = st["markevery"]
+    return {"marker": [st["marker"], int(start), int(every)]}
 
 
 class Curves(NamedTuple):
@@ -75,6 +92,8 @@ class Curves(NamedTuple):
     # a figure of many panels (a joint per panel): shown one panel at a time, a selector above
     # choosing which (or every one), this panel first; None: every panel shown
     choose: int | None = None
+    # each stage's markers (:func:`markers`) on its curve; a series of an explicit style (a dict) has none
+    markers: bool = False
     # a figure over another quantity than time (a Pareto front over its budget): the x axis's
     # label with its unit; such a figure is not linked to the player, keeps every sample, draws a
     # marker at every value (a curve across the samples where it has none) and the stages of
@@ -90,13 +109,19 @@ def data(c: Curves) -> dict:
     t = np.asarray(c.t, dtype=float)
     k = (np.arange(len(t)) if c.x_axis else
          _thin(len(t), sum(p["key"] in curves for _, curves in c.stages for p in c.panels)))
-    series = [{"label": label, "y": {p["key"]: _round(np.asarray(curves[p["key"]], dtype=float)[k])
+    floors = {p["key"]: _floor(c, p["key"]) for p in c.panels}
+    series = [{"label": label, "y": {p["key"]: _round(np.asarray(curves[p["key"]], dtype=float)[k], floors[p["key"]])
                                      for p in c.panels if p["key"] in curves}, **line_style(n)}
               for n, (label, curves) in enumerate(c.stages)]
     if c.styles is not None:
         for one, style in zip(series, c.styles):
             one.update(line_style(style))
-    out = {"t": _round(t[k]), "series": series, "panels": [{**p, "floor": _floor(c, p["key"])} for p in c.panels],
+    if c.markers:
+        for n, one in enumerate(series):
+            style = n if c.styles is None else c.styles[n]
+            if not isinstance(style, dict):
+                one.update(markers(style, len(k)))
+    out = {"t": _round(t[k]), "series": series, "panels": [{**p, "floor": floors[p["key"]]} for p in c.panels],
            "draw": draw_order(series),
            "marks": [[_round([tm])[0], text] for tm, text in sorted(set(c.marks))]}
     if c.choose is not None:
@@ -110,23 +135,22 @@ def data(c: Curves) -> dict:
 
 def draw_order(series: list[dict]) -> list[int]:
     """The order in which the plot draws ``series`` (the legend keeps theirs): the wide lines
-    first, under the thin ones (:func:`balpipe.draw.figures.wide`, as the static figure's zorder),
+    first, under the thin ones (:func:`balpipe.draw.figures.wide`, as the matplotlib figures' zorder),
     each group in its own order."""
     return sorted(range(len(series)), key=lambda i: not figures.wide(series[i]["width"]))
 
 
-def static_panels(c: Curves) -> list:
-    """The same curves, unthinned, as :func:`balpipe.draw.figures.panels_figure` draws them (the
-    printed figure)."""
-    return [(p["title"], p["axis"], [(label, c.t, curves.get(p["key"])) for label, curves in c.stages])
-            for p in c.panels]
+#: where a reader without JavaScript finds a time series' numbers (files beside the page)
+NUMBERS = ('its samples are in <a href="timeseries.csv">timeseries.csv</a>, its peaks in the tables '
+           'and in <a href="results.json">results.json</a>')
 
 
-def html(name: str, svg: str, c: Curves) -> str:
-    """The page's markup of one figure: the element ``#live-<name>`` that ``live_plots.js`` fills,
-    the static ``svg`` after it (shown in print, and on screen until the script has drawn), and
-    the curves' JSON (:func:`data`)."""
-    return (f'<div class="live" id="live-{name}"></div><div class="static-plot">{svg}</div>\n'
+def html(name: str, c: Curves, numbers: str = NUMBERS) -> str:
+    """The page's markup of one figure: the element ``#live-<name>`` that ``live_plots.js`` fills
+    (on screen and in print), holding a ``<noscript>`` line that says the plot needs JavaScript
+    and where its ``numbers`` are (HTML), and the curves' JSON (:func:`data`)."""
+    return (f'<div class="live" id="live-{name}"><noscript><p class="muted">This plot is drawn by JavaScript, '
+            f'which is off: {numbers}.</p></noscript></div>\n'
             f'<script type="application/json" data-live="live-{name}">{as_script(data(c))}</script>')
 
 

@@ -12,18 +12,44 @@ from ..draw.live import Curves
 from .results import joint_load_series
 
 
-def loads(stages: list) -> Curves:
-    """``stages``: (label, analysis). Panels |F| (N) and M (N m), from the analysis's shaking loads."""
-    return Curves(stages[0][1].t, [(label, {"F": np.hypot(an.force[:, 0], an.force[:, 1]), "M": an.moment})
-                                   for label, an in stages],
-                  [{"key": "F", "title": "shaking force |F| (N)", "axis": "|F| (N)"},
-                   {"key": "M", "title": "shaking moment M (N m)", "axis": "M (N m)"}], [])
+#: the shaking loads' panels: key, title, axis, the values of a force (N, 2) and moment (N,)
+LOADS = (("Fx", "shaking force Fx (N)", "Fx (N)", lambda F, M: F[:, 0]),
+         ("Fy", "shaking force Fy (N)", "Fy (N)", lambda F, M: F[:, 1]),
+         ("F", "shaking force |F| (N)", "|F| (N)", lambda F, M: np.hypot(F[:, 0], F[:, 1])),
+         ("M", "shaking moment M (N m)", "M (N m)", lambda F, M: M))
+
+
+def loads(stages: list, sims: list | None = None) -> Curves:
+    """``stages``: (label, analysis), stage k in line style k with its staggered markers
+    (paper 000 Fig. 4 style); ``sims``: each stage's pymunk run (t, F, M) on the analysis's
+    samples, or None: drawn dotted in :data:`balpipe.draw.figures.SIM_COLORS`. Panels Fx, Fy,
+    |F| (N) and M (N m) (:data:`LOADS`)."""
+    curves = [(label, {key: fn(an.force, an.moment) for key, _, _, fn in LOADS}) for label, an in stages]
+    styles: list = list(range(len(stages)))
+    for k, ((label, _), sim) in enumerate(zip(stages, sims or [])):
+        if sim is not None:
+            curves.append((f"{label} (pymunk)", {key: fn(sim[1], sim[2]) for key, _, _, fn in LOADS}))
+            styles.append({"color": figures.SIM_COLORS[k % len(figures.SIM_COLORS)], "linestyle": ":", "linewidth": 1.0})
+    return Curves(stages[0][1].t, curves, [{"key": key, "title": title, "axis": axis} for key, title, axis, _ in LOADS],
+                  [], styles=styles, markers=True)
+
+
+def coincide_notes(stages: list) -> list[str]:
+    """'Coincide in force Fx, force |F|: a = b' per group of stages whose loads agree within 1e-6 of a
+    panel's largest value (:func:`balpipe.draw.figures.coinciding`), with the panels where they
+    do; ``stages``: (label, analysis)."""
+    notes: dict[str, list[str]] = {}
+    for key, title, _, fn in LOADS:
+        same = figures.coinciding([(label, fn(an.force, an.moment)) for label, an in stages])
+        if same:
+            notes.setdefault("; ".join(same), []).append(title.split(" (")[0].replace("shaking ", ""))
+    return [f"Coincide in {', '.join(where)}: {groups}" for groups, where in notes.items()]
 
 
 def efforts(stages: list, units: dict, marks: list | None = None, shown: dict | None = None) -> Curves:
     """``stages``: (label, analysis); ``units``: driver -> 'N m' or 'N'; ``shown``: driver -> the
     name its panel shows (the paper's symbol). A panel per driver: its actuator's torque or force
-    (as :func:`balpipe.draw.figures.efforts_figure`)."""
+    (its axis label: :func:`balpipe.draw.figures.effort_axis`)."""
     names = sorted({n for _, an in stages for n in an.efforts})
     panels = [{"key": n, "title": f"actuator effort: {(shown or {}).get(n, n)}" + (f" ({units[n]})" if units.get(n) else ""),
                "axis": figures.effort_axis(units.get(n, ""))} for n in names]

@@ -56,22 +56,17 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
         v = s.validation
         sims.append((v.t, v.force, v.moment) if v is not None else None)
     shown = [(s.stage.label, s.analysis) for s in shown_stages(study)]
-    loads = figures.loads_figure(
-        [(s.stage.label, s.analysis, sim) for s, sim in zip(shown_stages(study), sims)], prefix="loads"
-    )
     units = {d.name: present.driver_unit(s.stage.model, d.name)
              for s in shown_stages(study) for d in (*s.stage.model.drivers, *s.stage.model.actuators)}
     marks = [(w["time"], w["kind"].replace("_", " ")) for w in study.warnings]
     shown_names = {d: names.text("driver", d) for d in units}  # the paper's symbols in the panels' titles
-    # each time-series figure interactive above its static SVG (draw/live.py; curves: report/live_plots.py)
-    loads = live.html("loads", loads, live_plots.loads(shown))
-    efforts = live.html("efforts", figures.efforts_figure(shown, prefix="efforts", units=units, marks=marks,
-                                                          shown=shown_names),
-                        live_plots.efforts(shown, units, marks, shown_names))
+    # each time-series figure interactive, on screen and in print (draw/live.py; curves: report/live_plots.py)
+    loads = live.html("loads", live_plots.loads(shown, sims)) + "".join(
+        f'<p class="muted coincide">{markupsafe.escape(note)}</p>' for note in live_plots.coincide_notes(shown))
+    efforts = live.html("efforts", live_plots.efforts(shown, units, marks, shown_names))
     joint_names = {j: names.text("joint", j) for _, an in shown for j in an.reactions}  # the paper's symbols
     joint_curves = live_plots.joints(shown, joint_names)
-    joints = (live.html("joints", figures.panels_figure(live.static_panels(joint_curves), "joints"),
-                        joint_curves) if joint_curves.panels else "")
+    joints = live.html("joints", joint_curves) if joint_curves.panels else ""
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
     numbers = labels.gear_numbers([s.stage.model for s in shown_stages(study)])
     ghosts = drawn_instants(study)

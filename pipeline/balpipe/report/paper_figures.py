@@ -19,7 +19,7 @@ import re
 import numpy as np
 
 from ..balancing.base import style_index
-from ..draw import figures, live
+from ..draw import live
 
 #: per paper, the figure numbers its pages reproduce (a number covers its panels: "6" by "6a")
 FIGURES = {
@@ -61,17 +61,11 @@ def listed(titles: list[str]) -> list[str]:
 def _series(t, curves: list[tuple[str, np.ndarray, int]], ylabel: str, prefix: str) -> str:
     """A time series in the page's stage styles: each curve (label, values, k) drawn in
     ``figures.style(k)``, k the stage's place in the page's stage table, so that one line style
-    means one stage on the whole page; interactive on screen, the static SVG in print
+    means one stage on the whole page; interactive, on screen and in print
     (:func:`balpipe.draw.live.html`, element ``#live-<prefix>``)."""
-    fig, ax = figures.plt.subplots(figsize=(6.0, 3.0))
-    for label, y, k in curves:
-        ax.plot(t, y, label=figures.literal(label), **figures.style(k))
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel(ylabel)
-    figures.legend_below(fig, ax, fontsize=8)
     curves_of = live.Curves(t, [(label, {"y": y}) for label, y, _ in curves],
                             [{"key": "y", "title": "", "axis": ylabel}], [], styles=[k for _, _, k in curves])
-    return live.html(prefix, figures.to_svg(fig, prefix), curves_of)
+    return live.html(prefix, curves_of)
 
 
 def _k(study, stage) -> int:

@@ -4,15 +4,9 @@ stage of the study (the compared designs, e.g. the paper's complete balancing) m
 
 from __future__ import annotations
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-import numpy as np  # noqa: E402
-
-from ..draw import live  # noqa: E402
-from ..draw.figures import legend_below, marker, style, to_svg  # noqa: E402
+from ..draw import live
 
 AXES = {
     "added_mass": "added mass (kg)",
@@ -37,25 +31,11 @@ FRONTS = (
 FRONT = "optimal front (cone programme)"
 
 
-def _front_figure(points: list[dict], x: str, y: str, marks: list[tuple[str, float, float]], prefix: str) -> str:
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    ax.plot([p[x] for p in points], [p[y] for p in points], "-o", ms=3, color="black", lw=1.2, label=FRONT)
-    for k, (label, vx, vy) in enumerate(marks):
-        ax.plot([vx], [vy], linestyle="none", marker=marker(k), color=style(k + 1)["color"], ms=8,
-                markerfacecolor="none", mew=1.5, label=label)
-    ax.set_xlabel(AXES[x])
-    ax.set_ylabel(AXES[y])
-    ax.set_ylim(bottom=0)
-    ax.grid(alpha=0.3)
-    legend_below(fig, ax)
-    return to_svg(fig, prefix)
-
-
 def front_curves(points: list[dict], x: str, y: str, marks: list[tuple[str, float, float]]) -> live.Curves:
-    """The same front and marks for the interactive plot (:mod:`balpipe.draw.live`): over the
+    """A front and its marks for the interactive plot (:mod:`balpipe.draw.live`): over the
     budget ``x``, a row per design in order of ``x`` (the front's designs, then each marked one),
     the front's curve through its designs and each mark a marker alone; hovering a design shows
-    its budget and objective. Colours as :func:`_front_figure`'s (the marks in ``style(k + 1)``)."""
+    its budget and objective. The front in stage style 0, each mark in ``style(k + 1)``."""
     rows = sorted([(float(p[x]), 0, float(p[y])) for p in points] +
                   [(float(vx), k + 1, float(vy)) for k, (_, vx, vy) in enumerate(marks)])
     ys = np.full((len(marks) + 1, len(rows)), np.nan)
@@ -116,13 +96,14 @@ def figures(study) -> list[tuple[str, str, str]]:
         if len(pts) < 2:
             continue
         marks = _marks(study, det, x, y)
-        svg = live.html(f"partial_{key}", _front_figure(pts, x, y, marks, prefix=f"partial_{key}"),
-                        front_curves(pts, x, y, marks))
+        svg = live.html(f"partial_{key}", front_curves(pts, x, y, marks),
+                        'its designs are in <a href="results.json">results.json</a> '
+                        '(<code>balancing_details.partial_balance.fronts</code>)')
         caption = (f"{len(pts)} points, each {what}, solved to global optimality {where} "
                    "(second-order cone programme, Clarabel). Markers: the least-mass complete balances in the same "
                    f"regions along {'this motion' if n == 1 else 'these motions'}, where they exist, and {marked}. "
                    + headline(study, det) + " Interactive where JavaScript runs: hover a design for its "
                    f"{AXES[x].split(' (')[0]} and {AXES[y].split(' (')[0]}, drag across to zoom (double-click "
-                   "resets), click a legend entry to hide it; printing shows the static figure.")
+                   "resets), click a legend entry to hide it.")
         out.append((title, svg, caption))
     return out

@@ -42,23 +42,12 @@ def paper_figures(number: str, linkage: str, published_factor: float):
     paper reports ``published_factor``)."""
 
     def figures(study):
-        from ...draw import live  # matplotlib only when a report is drawn
-        from ...draw.figures import plt, style, to_svg
-        from ...draw.layout import fixed_layout
+        from ...draw import live
 
-        fig, axes = plt.subplots(1, 3, figsize=(10.5, 3.2))
         panels = (("(a) shaking force along x (N)", lambda a: a.force[:, 0]),
                   ("(b) shaking force along y (N)", lambda a: a.force[:, 1]),
                   ("(c) shaking moment about O (N m)", lambda a: a.moment))
         own = in_style_order(_own(study))
-        for ax, (title, fn) in zip(axes, panels):
-            for s in own:
-                ax.plot(s.analysis.t, fn(s.analysis), label=s.stage.label, **style(style_index(study.stages, s)))
-            ax.set_title(title, fontsize=9)
-            ax.set_xlabel("time (s)")
-        handles, labels = axes[0].get_legend_handles_labels()
-        fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
-        fixed_layout(fig, rect=(0, 0.08, 1, 1))
         linkage_label = next((s.stage.label for s in own if s.stage.name == linkage), linkage)
         curves = live.Curves(own[0].analysis.t,
                              [(s.stage.label, {key: fn(s.analysis) for key, (_, fn) in zip("xyM", panels)}) for s in own],
@@ -67,7 +56,7 @@ def paper_figures(number: str, linkage: str, published_factor: float):
                              styles=[style_index(study.stages, s) for s in own])
         yield (
             f"Shaking force and moment, every stage ({number} of paper 000)",
-            live.html("rpr3-loads", to_svg(fig, "rpr3-loads"), curves),
+            live.html("rpr3-loads", curves),
             "The paper's line styles, which every figure of this page gives these stages: before (solid) and after "
             "(dashed) the counterweights, after the counter-rotations (grey); the stage with the "
             f"{linkage_label} but no counterweights, which the paper does not plot, is blue dash-dot. Moments about "

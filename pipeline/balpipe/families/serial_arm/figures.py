@@ -51,7 +51,7 @@ def decoupling_figures(study):
 
     by = _main(study)
     spec, method = study.spec, study.spec.balancing
-    yield _paper002_fig2(study, by["unbalanced"], plt, style, to_svg)
+    yield _paper002_fig2(study, by["unbalanced"])
     g1, l1 = method.gear_1p, spec.mechanism.links[0].length
     before = mass_matrix_2r(by["unbalanced"].stage.model, l1, None)
     after = mass_matrix_2r(by["decoupled"].stage.model, l1,
@@ -105,21 +105,12 @@ def decoupling_figures(study):
               if study.spec.analysis.gravity else "."))
 
 
-def _paper002_fig2(study, un, plt, style, to_svg):
+def _paper002_fig2(study, un):
     """Fig. 2 of paper 002: F^sh = |reaction force on the frame| (eq. 15) and M^sh = -tau1 (eq.
     16) of the unbalanced arm, in the stage's style; with gravity on, the weight is said apart."""
-    from ...draw import live  # matplotlib only when a report is drawn
-    from ...draw.layout import fixed_layout
+    from ...draw import live
 
-    an, st = un.analysis, style(style_index(study.stages, un))
-    fig, axes = plt.subplots(1, 2, figsize=(9.0, 2.9))
-    axes[0].plot(an.t, np.linalg.norm(an.force, axis=1), label=un.stage.label, **st)
-    axes[0].set_title("(a) Fˢʰ (N), eq. 15", fontsize=9)
-    axes[1].plot(an.t, an.moment, label=un.stage.label, **st)
-    axes[1].set_title("(b) Mˢʰ (N m), eq. 16", fontsize=9)
-    for ax in axes:
-        ax.set_xlabel("time (s)")
-    fixed_layout(fig)
+    an = un.analysis
     weight = an.extra["total_mass"] * float(np.hypot(*an.gravity))
     if weight:
         apart = (f" With gravity on, Fˢʰ includes the links' constant weight m g = {weight:.4g} N: its inertial part "
@@ -131,7 +122,7 @@ def _paper002_fig2(study, un, plt, style, to_svg):
                           {"key": "M", "title": "(b) Mˢʰ (N m), eq. 16", "axis": "Mˢʰ (N m)"}], [],
                          styles=[style_index(study.stages, un)])
     return ("Fig. 2 of paper 002: shaking force and shaking moment of the unbalanced manipulator",
-            live.html("p002fig2", to_svg(fig, "p002fig2"), curves),
+            live.html("p002fig2", curves),
             f"Stage '{un.stage.label}' in its line style of this page, from the analysis of this spec: Fˢʰ = "
             "√(F₁₀ₓ² + F₁₀ᵧ²), the reaction force on the frame, and Mˢʰ = −τ₁, about joint A." + apart)
 
@@ -154,7 +145,7 @@ def com_planning_figures(study):
     main = study.stages[0].stage.group  # the balancing lists the main trajectory first
     yield _peaks_table(study, plans, by, params)
     yield _square_figure(study, planner, plans, main, plt, to_svg)
-    yield from _figs_3_4(study, main, by, plt, style, to_svg)
+    yield from _figs_3_4(study, main, by)
     others = [p for p in plans if p.name != main]
     if others:
         yield _other_trajectories(study, others, by, plt, style, to_svg)
@@ -230,29 +221,22 @@ def _rate_cell(key: str, an, plan, method) -> str:
 PAPER_CASES = ("ee_quintic", "com_bang_bang_phi_opt", "com_trapezoidal")
 
 
-def _figs_3_4(study, main: str, by: dict, plt, style, to_svg):
+def _figs_3_4(study, main: str, by: dict):
     """Figs. 3 and 4 of paper 003: |F| and M of cases 1, 2, 3 on the main trajectory, in the
     paper's line styles (case 1 black full, case 2 black dashed, case 3 grey full), which are these
     stages' styles on the whole page (:data:`com_planning.STYLES`)."""
     from ...draw import live
-    from ...draw.figures import legend_below
 
     pre = _prefix(main)
     stages = [by[pre + key] for key in PAPER_CASES]
     for number, what, ylabel, fn, prefix in (
             ("3", "shaking forces", "|F| (N)", lambda an: np.linalg.norm(an.force, axis=1), "p003fig3"),
             ("4", "shaking moment", "M (N m)", lambda an: an.moment, "p003fig4")):
-        fig, ax = plt.subplots(figsize=(6.0, 3.0))
-        for s in stages:
-            ax.plot(s.analysis.t, fn(s.analysis), label=s.stage.label.split(" · ")[-1], **style(style_index(study.stages, s)))
-        ax.set_xlabel("time (s)")
-        ax.set_ylabel(ylabel)
-        legend_below(fig, ax, fontsize=8)
         curves = live.Curves(stages[0].analysis.t, [(s.stage.label.split(" · ")[-1], {"y": fn(s.analysis)}) for s in stages],
                              [{"key": "y", "title": "", "axis": ylabel}], [],
                              styles=[style_index(study.stages, s) for s in stages])
         yield (f"Fig. {number} of paper 003: variations of the {what}, trajectory {main}",
-               live.html(prefix, to_svg(fig, prefix), curves),
+               live.html(prefix, curves),
                f"Trajectory {main}, the one the paper's Figs. 3-4 show; case 1 (black full line), case 2 (black dashed "
                "line) and case 3 (grey full line), the paper's line styles and these stages' styles on the whole page. "
                + ("Moment about the base joint, horizontal plane. " if number == "4" else "")
