@@ -27,6 +27,7 @@ with this version, and prints the ratio this / REV of every phase. Run from the 
 
     python benchmarks/bench_build.py --specs scott_russell offset_slider_crank --against HEAD~3
     python benchmarks/bench_build.py --no-sim            # every spec of specs/, this version only
+    python benchmarks/bench_build.py --cpu --specs scott_russell --against main   # CPU seconds (a busy machine)
 """
 
 from __future__ import annotations
@@ -63,7 +64,8 @@ PHASES = ["import", "load", "balance", "analyse", "validate", "torque", "reactio
 
 DRIVER = r'''
 import importlib, importlib.util, json, os, sys, time
-t_start = time.perf_counter()
+clock = time.process_time if os.environ.get("BENCH_CLOCK") == "cpu" else time.perf_counter
+t_start = clock()
 import balpipe
 # a source tree on PYTHONPATH: its templates/ folder (beside pipeline/, installed as
 # balpipe.templates) is found where no install of the same tree provides it
@@ -83,13 +85,13 @@ def wrap(module, name, phase):
     except (ImportError, AttributeError):
         return
     def timed(*a, **k):
-        t0 = time.perf_counter()
+        t0 = clock()
         stack.append(0.0)
         try:
             return fn(*a, **k)
         finally:
             inner = stack.pop()
-            dt = time.perf_counter() - t0
+            dt = clock() - t0
             times[phase] = times.get(phase, 0.0) + dt - inner
             if stack:
                 stack[-1] += dt
@@ -97,21 +99,22 @@ def wrap(module, name, phase):
 
 for module, name, phase in json.loads(sys.argv[1]):
     wrap(module, name, phase)
-times = {"import": time.perf_counter() - t_start}
+times = {"import": clock() - t_start}
 args = ["build", sys.argv[2], "-o", sys.argv[3], "-j", "1"] + sys.argv[4:]
 try:
     rc = cli.main(args)
 except SystemExit as e:
     rc = e.code
-times["total"] = time.perf_counter() - t_start
+times["total"] = clock() - t_start
 times["other"] = times["total"] - sum(v for k, v in times.items() if k != "total")
 print("@@BENCH@@" + json.dumps({"rc": rc, "times": times}))
 '''
 
 
-def run_one(python: str, pipeline: Path, spec: Path, out: Path, extra: list[str]) -> dict:
-    """Build one spec in a new process with ``pipeline`` first on the path; its phase times."""
-    env = dict(os.environ, PYTHONPATH=str(pipeline), PYTHONHASHSEED="0")
+def run_one(python: str, pipeline: Path, spec: Path, out: Path, extra: list[str], cpu: bool = False) -> dict:
+    """Build one spec in a new process with ``pipeline`` first on the path; its phase times
+    (``cpu``: the process's CPU seconds, its total from balpipe's import on)."""
+    env = dict(os.environ, PYTHONPATH=str(pipeline), PYTHONHASHSEED="0", BENCH_CLOCK="cpu" if cpu else "wall")
     t0 = time.perf_counter()
     proc = subprocess.run([python, "-c", DRIVER, json.dumps(WRAPS), str(spec), str(out), *extra],
                           env=env, capture_output=True, text=True, cwd=str(pipeline.parent))
@@ -119,6 +122,8 @@ def run_one(python: str, pipeline: Path, spec: Path, out: Path, extra: list[str]
     for line in proc.stdout.splitlines():
         if line.startswith("@@BENCH@@"):
             res = json.loads(line[len("@@BENCH@@"):])
+            if cpu:
+                return res
             res["times"]["total"] = wall  # the process's wall time, interpreter start included
             res["times"]["other"] = wall - sum(res["times"].get(p, 0.0) for p in PHASES if p not in ("total", "other"))
             return res
@@ -171,6 +176,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-sim", action="store_true", help="build without the pymunk validation")
     ap.add_argument("--python", default=sys.executable, help="interpreter to build with (default: this one)")
     ap.add_argument("--json", metavar="FILE", help="also write the raw times to FILE")
+    ap.add_argument("--cpu", action="store_true",
+                    help="CPU seconds of the build's process instead of wall-clock seconds (a machine shared with "
+                         "other work; the build runs with -j 1, so its simulations run in that process)")
     args = ap.parse_args(argv)
     specs = resolve_specs(args.specs, ROOT)
     extra = ["--no-sim"] if args.no_sim else []
@@ -188,7 +196,7 @@ def main(argv: list[str] | None = None) -> int:
             results[spec.stem] = {}
             for v, pipeline in versions.items():  # alternate, so that the machine's load hits both alike
                 out = tmp / f"site-{len(results)}-{v.replace('/', '_')}"
-                results[spec.stem][v] = run_one(args.python, pipeline, spec, out, extra)
+                results[spec.stem][v] = run_one(args.python, pipeline, spec, out, extra, args.cpu)
                 print(f"  {spec.stem} [{v}] {results[spec.stem][v]['times']['total']:.2f} s", file=sys.stderr)
         print(table(results, list(versions)))
         if args.json:

@@ -49,3 +49,15 @@ def test_one_cold_build_is_timed_by_phase(tmp_path):
     assert "validate" not in t  # --no-sim
     parts = sum(v for k, v in t.items() if k != "total")
     assert abs(parts - t["total"]) < 1e-6 * t["total"]  # the phases and `other` make up the total
+
+
+def test_cpu_seconds_on_a_busy_machine(tmp_path):
+    """--cpu: the phases in CPU seconds of the build's process (-j 1: its simulations run there),
+    which other work on the machine does not inflate; they make up the total as the wall times do."""
+    b = _bench()
+    res = b.run_one(sys.executable, ROOT / "pipeline", ROOT / "specs" / "scott_russell.yaml", tmp_path / "site",
+                    ["--no-sim"], cpu=True)
+    t = res["times"]
+    assert res["rc"] == 0 and t["analyse"] > 0 and t["figures"] > 0
+    parts = sum(v for k, v in t.items() if k != "total")
+    assert abs(parts - t["total"]) < 1e-6 * t["total"]

@@ -38,7 +38,10 @@ Defaults and why (measured with pymunk 7.3.1 on a 2-core machine)
       balance claims hold is kept (``ValidationSettings.early_accept``: more iterations cannot
       change that verdict; a design with an error never passes early); otherwise doubled until
       the loads change by at most tolerance / 10 of the
-      unbalanced peaks between two doublings (so at least two runs), up to 3200; a run whose
+      unbalanced peaks between two doublings (so at least two runs), up to 3200; the change is
+      measured on the samples that enter the residuals (the step after the motion's end, where
+      the drive stops the mechanism within a step, kept the idler loop's stages doubling to 3200
+      for a change that no verdict reads); a run whose
       bodies stray more than 1e-3 (rad, or of the model's size) from the analysed motion is
       redone with more. The first 10 steps, and those after a jump of a law's acceleration,
       run with 5000 iterations (the solver's warm start is missing or wrong there; with only
@@ -55,6 +58,14 @@ Defaults and why (measured with pymunk 7.3.1 on a 2-core machine)
       its counter-rotations stage 0.010 / 0.0026 at 1600 / 3200 (apart below 1600); where it
       converges, the residual is the step's from the first run that holds together (the
       unbalanced stage: 1.4e-5 / 1.5e-5 at 800 to 3200, apart below 800).
+    * inertial forces (``ValidationSettings.feedforward``, :mod:`balpipe.validate.feedforward`):
+      each body gets the force and torque of its analysed acceleration before every step; the
+      drivers impose the motion either way and the solver only finds the remainder. Measured
+      (CPU, one core, validate only; ``benchmarks/validation_settings.py``): idler loop's
+      counterweights stage 800 + 1600 iterations, moment residual 0.0025 (was 800 + 1600 + 3200,
+      0.0019, not converged); paper 004's counterweights stage 100 iterations (was 400); loads
+      at 800 iterations the same with and without to 1e-4 of the unbalanced peaks
+      (tests/test_feedforward.py). The table below was measured without it.
     * mass floor 0.1: bodies lighter (of smaller moment) than 0.1 of the heaviest are simulated
       at that floor. A massless idler between two gears otherwise stalls the solver (floor 1e-6:
       comes apart at 3200 iterations; 1e-3: 800 iterations; 1e-2 and 0.1: 200, residuals
@@ -345,12 +356,18 @@ def validate(
         claims = all(pk <= settings.balance_tolerance for what, pk in (("force", fpk), ("moment", mpk)) if what in expect)
         return fres <= settings.tolerance / margin and mres <= settings.tolerance / margin and claims
 
+    def sampled(run: SimulationRun):
+        """The simulated loads that enter the residuals (the measured samples of the grid)."""
+        F, M, measured, *_ = measure(run)
+        return F[measured], M[measured]
+
     early = settings.early_accept
     run, notes, change = _run_adaptive(
         model, analysis, dt, iterations, settings, scale, idx, limit=limit, mass_floor=settings.mass_floor,
-        settle=settling_steps(model, analysis, nsteps),
+        settle=settling_steps(model, analysis, nsteps), feedforward=settings.feedforward,
         # the verdict cannot change with more solver iterations when a run passes by ten times over
         accept=(lambda r: passing(r, 10.0)) if early else None, passes=passing if early else None,
+        compare=sampled,
     )
     if F0 <= 0 or M0 <= 0:
         notes.append("an unbalanced peak is zero: that residual is absolute")

@@ -154,6 +154,22 @@ def _travel(model: Model, t: np.ndarray) -> dict[str, float]:
     return out
 
 
+def _floor_share(efforts: dict[str, np.ndarray], analysis: Analysis, analytic_model: Model, times: np.ndarray,
+                 idx: np.ndarray | None) -> float:
+    """Largest effort of the floor parts / the peak effort: ``efforts`` (with the floor parts, on
+    the step times ``times``) less the analytic model's own. On a uniform analysis grid (``idx``:
+    the step of each sample) those are ``analysis.efforts``, already computed, and the share is
+    taken at the samples; otherwise the analytic model is analysed on ``times``."""
+    if idx is not None:
+        bare = analysis.efforts
+        mine = {k: v[idx] for k, v in efforts.items()}
+    else:
+        bare = analyse(analytic_model, times, analysis.gravity, analysis.moment_point).efforts
+        mine = efforts
+    peak = max((float(np.max(np.abs(v))) for v in bare.values()), default=0.0) or 1.0
+    return max(float(np.max(np.abs(mine[k] - np.asarray(bare[k], dtype=float)))) for k in bare) / peak
+
+
 @dataclass
 class _Plan:
     """What every torque-driven run of a stage shares: the models (laws continued), the step grid
@@ -200,9 +216,7 @@ def _plan(model: Model, analysis: Analysis, settings: ValidationSettings, analyt
     notes: list[str] = []
     share = 0.0
     if floored:
-        bare = analyse(analytic_model, times, analysis.gravity, analysis.moment_point).efforts
-        peak = max((float(np.max(np.abs(v))) for v in bare.values()), default=0.0) or 1.0
-        share = max(float(np.max(np.abs(efforts[k] - bare[k]))) for k in bare) / peak
+        share = _floor_share(efforts, analysis, analytic_model, times, idx)
         notes.append(
             "simulated with floor parts (" + ", ".join(floored) + f": {100 * settings.mass_floor:g} % of the largest "
             f"mass and moment); the efforts include their inertial loads, {100 * share:.2g} % of the peak effort"
