@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import json
 import sys
 from pathlib import Path
 
@@ -61,3 +62,23 @@ def test_cpu_seconds_on_a_busy_machine(tmp_path):
     assert res["rc"] == 0 and t["analyse"] > 0 and t["figures"] > 0
     parts = sum(v for k, v in t.items() if k != "total")
     assert abs(parts - t["total"]) < 1e-6 * t["total"]
+
+
+def test_results_numbers_compares_every_number_to_a_relative_tolerance(tmp_path, capsys):
+    spec = importlib.util.spec_from_file_location("results_numbers", ROOT / "benchmarks" / "results_numbers.py")
+    r = importlib.util.module_from_spec(spec)
+    sys.modules["results_numbers"] = r  # its dataclass looks its module up
+    spec.loader.exec_module(r)
+    a = {"x": 1.0, "y": [2.0, {"z": 3}], "s": "ok", "code_hash": "abc"}
+    near = {"x": 1.0 + 1e-12, "y": [2.0, {"z": 3}], "s": "ok", "code_hash": "def"}
+    far = {"x": 1.0 + 1e-8, "y": [2.0, {"z": 3}], "s": "ok", "code_hash": "abc"}
+    c = r.compare(a, near, 1e-9)
+    assert (c.numbers, c.identical, c.problems) == (3, 2, ["/code_hash: 'abc' and 'def'"])
+    assert r.compare(a, far, 1e-9).problems[0].startswith("/x: 1.0 and 1.00000001")
+    assert r.compare(a, {**a, "y": [2.0]}, 1e-9).problems == ["/y: lengths 2 and 1"]
+    for d, v in (("A", a), ("B", near), ("C", far)):
+        (tmp_path / d / "spec").mkdir(parents=True)
+        (tmp_path / d / "spec" / "results.json").write_text(json.dumps(v))
+    assert r.main([str(tmp_path / "A"), str(tmp_path / "B")]) == 0  # code_hash is ignored in files
+    assert r.main([str(tmp_path / "A"), str(tmp_path / "C")]) == 1
+    assert "beyond 1e-09" in capsys.readouterr().out

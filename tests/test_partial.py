@@ -13,6 +13,7 @@ import pytest
 
 from balpipe import registry, study
 from balpipe.balancing import partial as P
+from balpipe.balancing import partial_fronts as PF
 from balpipe.balancing import partial_maps as PM
 from balpipe.engine import analyse
 from balpipe.spec import Spec
@@ -226,6 +227,30 @@ def test_budget_sensitivity_is_the_fronts_slope():
     up = program.solve(prob).objective
     assert out.budget_dual < 0
     assert out.budget_dual == pytest.approx((up - out.objective) / h, rel=1e-3)
+
+
+def test_fronts_reuse_one_compiled_problem_per_term_with_the_same_numbers():
+    """Program.least_at re-solves the one compiled problem of its term (after a front solved it at
+    other budgets) by a new solver: bit for bit the optimum of a problem compiled for it alone; a
+    second front asking for the same optimum gets it without solving again."""
+    rng = np.random.default_rng(5)
+    spec = Spec.model_validate(four_bar(rng, method(SEGMENTS + [POLYGON], budget=0.6)))
+    maps = setup(spec)
+    program = P.Program(maps)
+    terms = P.standard_terms(maps)
+    force, moment = terms["shaking_force"], terms["shaking_moment"]
+    front = PF.mass_front(program, force, np.linspace(0.0, 1.2, 4), terms)
+    assert len(front) == 4 and program.least(force) is program.least(force)
+    for term in (force, moment):
+        program.mass_budget.value = 0.6
+        ref = program.solve(program.problem([term])[0], polish=[term])
+        got = program.least_at(term, 0.6)
+        assert np.array_equal(got.z, ref.z) and (got.objective, got.budget_dual) == (ref.objective, ref.budget_dual)
+        assert program.least_at(term, 0.6) is got
+    # the trade-off front's ends are those optima
+    pts = PF.tradeoff_front(program, force, moment, 0.6, 3, terms)
+    assert pts[0]["cap"] == pytest.approx(moment.value(program.least_at(moment, 0.6).z), rel=1e-12)
+    assert pts[-1]["shaking_force"] == pytest.approx(force.value(program.least_at(force, 0.6).z), rel=1e-6)
 
 
 def test_scaling_masses_scales_the_optimal_loads():

@@ -53,12 +53,13 @@ def least_complete_mass(program: Program, terms: list[Term]) -> tuple[float, np.
 
 
 def mass_front(program: Program, term: Term, masses: np.ndarray, terms: dict[str, Term]) -> list[dict]:
-    """min ``term`` for each mass budget."""
-    prob, _, _ = program.problem([term])
+    """min ``term`` for each mass budget (:meth:`Program.least`'s problem: a new solver at the
+    first budget, its data updated at the others)."""
+    prob = program.least(term)
     pts = []
-    for M in masses:
+    for k, M in enumerate(masses):
         program.mass_budget.value = float(M)
-        out = program.solve(prob, polish=[term])
+        out = program.solve(prob, polish=[term], fresh=k == 0)
         if out.z is not None:
             pts.append({"budget": float(M), **point(program.maps, out.z, terms), "sensitivity": out.budget_dual * term.scale})
     return pts
@@ -67,10 +68,10 @@ def mass_front(program: Program, term: Term, masses: np.ndarray, terms: dict[str
 def tradeoff_front(program: Program, first: Term, second: Term, budget: float, n: int,
                    terms: dict[str, Term]) -> list[dict]:
     """min ``first`` s.t. ``second`` <= eps, eps from the least ``second`` to its value where
-    ``first`` is least, at the mass ``budget``."""
+    ``first`` is least, at the mass ``budget`` (those two optima by :meth:`Program.least_at`: the
+    mass fronts' compiled problems, each optimum solved once for both trade-off fronts)."""
+    lo, hi = program.least_at(second, budget), program.least_at(first, budget)
     program.mass_budget.value = float(budget)
-    lo = program.solve(program.problem([second])[0], polish=[second])
-    hi = program.solve(program.problem([first])[0], polish=[first])
     if lo.z is None or hi.z is None:
         return []
     a, b = second.value(lo.z) / second.scale, second.value(hi.z) / second.scale

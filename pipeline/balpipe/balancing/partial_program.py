@@ -126,6 +126,8 @@ class Program:
             self.inertia_budget = sum(second, start=0.0) / scale <= inertia_budget / scale
             cons.append(self.inertia_budget)
         self.base = cons
+        self._least: dict[int, tuple] = {}  # id(term) -> (term, compiled problem min term)
+        self._least_at: dict[tuple, Outcome] = {}  # (id(term), budget) -> its optimum
 
     def expression(self, term: Term) -> tuple:
         """The term's measure divided by its unbalanced value: (convex expression of z, the
@@ -168,11 +170,33 @@ class Program:
             cons += c + [e <= p]
         return cp.Problem(cp.Minimize(obj), cons + cap_cons), cap_cons, params
 
-    def solve(self, problem, polish: list[Term] = ()) -> Outcome:
+    def least(self, term: Term):
+        """The problem min ``term`` (the mass budget a parameter), built once per term: the
+        fronts solve it at several budgets (:mod:`.partial_fronts`) and cvxpy compiles it once."""
+        if id(term) not in self._least:
+            self._least[id(term)] = (term, self.problem([term])[0])  # the term kept: its id stays its own
+        return self._least[id(term)][1]
+
+    def least_at(self, term: Term, budget: float) -> Outcome:
+        """min ``term`` at the mass ``budget`` (polished as :meth:`solve`), by a new solver on
+        :meth:`least`'s problem: the same numbers as a problem compiled for it alone; solved once
+        per term and budget (two fronts may ask for the same)."""
+        key = (id(term), float(budget))
+        if key not in self._least_at:
+            problem = self.least(term)
+            self.mass_budget.value = float(budget)
+            self._least_at[key] = self.solve(problem, polish=[term], fresh=True)
+        return self._least_at[key]
+
+    def solve(self, problem, polish: list[Term] = (), fresh: bool = False) -> Outcome:
         """Solve; the terms of ``polish`` that come out below :data:`ZERO` of their unbalanced
         value are brought to round-off by a least-squares step on their equations (see
-        :func:`polish_zero`)."""
+        :func:`polish_zero`). A problem solved again reuses its Clarabel solver (cvxpy updates
+        its data; its equilibration is the first data's) unless ``fresh``: then a new solver
+        is set up on this data, as for a newly compiled problem."""
         cp = self.cp
+        if fresh:
+            problem._solver_cache = {}
         try:
             with warnings.catch_warnings():  # OPTIMAL_INACCURATE is reported in the status instead
                 warnings.simplefilter("ignore", UserWarning)

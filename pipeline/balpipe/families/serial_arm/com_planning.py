@@ -380,13 +380,14 @@ class Planner:
             return
         for _ in range(30):
             mid = 0.5 * (lo + hi)
-            if rate(mid) <= limit:
-                hi = mid
+            r_mid = rate(mid)
+            if r_mid <= limit:
+                hi, r_hi = mid, r_mid  # hi's rate kept: the result needs it, not computed again
             else:
                 lo = mid
             if hi - lo < 1e-5:
                 break
-        plan.ramp_fraction, plan.ramp_rate = hi, rate(hi)
+        plan.ramp_fraction, plan.ramp_rate = hi, r_hi
 
     def stages(self, plan: Plan, law_name: str, path: tuple) -> dict[str, Model]:
         """The four stage models of one trajectory (case 1 on the spec's law)."""
