@@ -1,6 +1,7 @@
 """The command line as a user meets it: exit codes, messages, the site, determinism."""
 
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -80,7 +81,12 @@ def test_build_writes_the_site(work):
     csv = (out / "scott_russell" / "timeseries.csv").read_text().splitlines()
     assert csv[0].startswith("t_s,unbalanced.Fx_N") and len(csv) == 1 + 501
     page = (out / "scott_russell" / "index.html").read_text()
-    assert page.count("<svg") >= 5 and "skipped" in page
+    # the drawings are inline SVG, the plots over time are drawn in the browser from their data
+    live = re.findall(r'<script type="application/json" data-live="([a-z-]+)">', page)
+    assert set(live) == {"live-loads", "live-efforts", "live-joints"}
+    assert all(f'<div class="live" id="{name}">' in page for name in live)
+    assert page.count("<figure>") + page.count('<figure class="wide">') >= 5
+    assert page.count("<svg") >= 3 and "skipped" in page
     assert (out / "balpipe.schema.json").exists()
     # unchanged specs are not rebuilt
     again = balpipe("build", "specs", "-o", "out", "--no-sim", cwd=work)
