@@ -223,6 +223,9 @@ def open_sections(page) -> None:
 
 
 PRINT_RATIO = 3  # templates/live_plots.js: device pixels per CSS pixel of a plot drawn for print
+# How long a print copy may take to appear or go: waiting returns as soon as it holds, the limit
+# only matters on a loaded machine (5 s failed once at a load average of 21 on 2 cores).
+PRINT_WAIT_MS = 30_000
 
 _PRINTED = """host => {
   const style = getComputedStyle(host);
@@ -247,7 +250,7 @@ def assert_printed(page, figure: str) -> None:
     page.emulate_media(media="print")
     try:
         page.wait_for_function(f"document.querySelectorAll('#{figure} .live-print canvas').length === "
-                               f"document.querySelectorAll('#{figure} .live-plot').length", timeout=5000)
+                               f"document.querySelectorAll('#{figure} .live-plot').length", timeout=PRINT_WAIT_MS)
         got = page.eval_on_selector(f"#{figure}", _PRINTED)
         assert got["plots"] and all(got["plots"]), got
         column = got["width"] / got["columns"]
@@ -258,7 +261,7 @@ def assert_printed(page, figure: str) -> None:
         assert not page.is_visible(f"#{figure} .live-choose")
     finally:
         page.emulate_media(media="screen")
-    page.wait_for_function(f"!document.querySelector('#{figure} .live-print')", timeout=5000)
+    page.wait_for_function(f"!document.querySelector('#{figure} .live-print')", timeout=PRINT_WAIT_MS)
     assert page.is_visible(f"#{figure} .live-plot:not([hidden]) > .uplot canvas")
 
 
