@@ -164,6 +164,10 @@ class Job:
     history: dict | None
     history_files: dict[str, str]
     sim_workers: int = 1  # the stages' simulations in that many processes (the same results)
+    #: the output folder whose figure cache (draw/cache.py: <out>/.cache/figures/<slug>/) the
+    #: figures are drawn through; None (a dask worker, which has no access to it): every figure drawn
+    figure_cache: Path | None = None
+    redraw: bool = False  # --force: every figure drawn, its cache entry rewritten
 
 
 @dataclass
@@ -242,11 +246,27 @@ def plan_one(path: Path, opts: Options) -> Job | Outcome:
     from .report import history_page
 
     return Job(path, loaded.text, h, opts.simulate, history_page.section(target), history_page.build_files(target),
-               opts.sim_workers)
+               opts.sim_workers, figure_cache=opts.out, redraw=opts.force)
 
 
 def compute(job: Job) -> Computed:
-    """Balance, analyse, validate and render one spec; never raises (errors become the result)."""
+    """Balance, analyse, validate and render one spec; never raises (errors become the result).
+    With ``job.figure_cache``, the figures come from that folder's figure cache where their
+    inputs are unchanged (:mod:`balpipe.draw.cache`), and the spec's entries this build did not
+    use are removed when its page is made."""
+    from .draw import cache
+
+    store = None if job.figure_cache is None else \
+        cache.Store(job.figure_cache, slug_for(job.path), code_hash(), reuse=not job.redraw)
+    with cache.using(store):
+        done = _compute(job)
+    if store is not None and done.status in ("ok", "failed"):
+        store.prune()
+    return done
+
+
+def _compute(job: Job) -> Computed:
+    """:func:`compute` without the figure cache's set-up."""
     from . import runner
     from .laws.drives import table_files
     from .loader import LoadedSpec, SpecErrors, load_text
@@ -431,6 +451,10 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
             remove_temporaries(opts.out)
             raise
         built = [o for o in outcomes if o.slug]
+        if any(not o.skipped for o in built):  # the figure caches of specs that have no page any more
+            from .draw.cache import prune_specs
+
+            prune_specs(opts.out, {o.slug for o in built})
         earlier = earlier_pages(opts.out, {o.slug for o in built}, page_hash)
         key = site_key(opts.out, built) if not earlier else ""
         if not (key and _site_is_current(opts.out, key)):
@@ -522,7 +546,8 @@ def _run_on_cluster(address: str, todo: list[Path], opts: Options, progress, out
         if other:
             raise SchedulerError(f"the workers {', '.join(other)} run another balpipe than this one (its code hash "
                                  f"differs): install the same version on every worker")
-        plans = [plan_one(p, opts) for p in todo]
+        # the workers cannot reach this machine's figure cache: they draw every figure
+        plans = [replace(job, figure_cache=None) if isinstance(job, Job) else job for job in (plan_one(p, opts) for p in todo)]
         futures = {k: client.submit(compute, job, pure=False) for k, job in enumerate(plans) if isinstance(job, Job)}
         total = len(todo)
         for k, job in enumerate(plans):
