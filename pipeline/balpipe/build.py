@@ -168,6 +168,7 @@ class Job:
     #: figures are drawn through; None (a dask worker, which has no access to it): every figure drawn
     figure_cache: Path | None = None
     redraw: bool = False  # --force: every figure drawn, its cache entry rewritten
+    figure_keys: frozenset[str] = frozenset()  # the cache entries the planning used (history figures): kept
 
 
 @dataclass
@@ -226,9 +227,11 @@ def up_to_date(path: Path, opts: Options) -> dict | None:
     return previous if _mixed_hash(text + tables, target, opts.simulate) == previous["input_hash"] else None
 
 
-def plan_one(path: Path, opts: Options) -> Job | Outcome:
+def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outcome:
     """Read one spec and decide: an :class:`Outcome` when there is nothing to compute (invalid,
-    or unchanged since the last build), else the :class:`Job` that computes it."""
+    or unchanged since the last build), else the :class:`Job` that computes it. The history
+    figures of the page (drawn here, where the page folder is read) and, with ``figure_cache``,
+    the job's figures go through the output folder's figure cache (:mod:`balpipe.draw.cache`)."""
     from .loader import SpecErrors
 
     start = time.perf_counter()
@@ -243,10 +246,15 @@ def plan_one(path: Path, opts: Options) -> Job | Outcome:
         previous = _read_results(target)
         if previous is not None and previous.get("input_hash") == h:
             return _unchanged(path, slug, target, previous, time.perf_counter() - start)
+    from .draw import cache
     from .report import history_page
 
-    return Job(path, loaded.text, h, opts.simulate, history_page.section(target), history_page.build_files(target),
-               opts.sim_workers, figure_cache=opts.out, redraw=opts.force)
+    store = cache.Store(opts.out, slug, code_hash(), reuse=not opts.force) if figure_cache else None
+    with cache.using(store):
+        history, files = history_page.section(target), history_page.build_files(target)
+    return Job(path, loaded.text, h, opts.simulate, history, files, opts.sim_workers,
+               figure_cache=opts.out if figure_cache else None, redraw=opts.force,
+               figure_keys=frozenset(store.used) if store is not None else frozenset())
 
 
 def compute(job: Job) -> Computed:
@@ -257,7 +265,7 @@ def compute(job: Job) -> Computed:
     from .draw import cache
 
     store = None if job.figure_cache is None else \
-        cache.Store(job.figure_cache, slug_for(job.path), code_hash(), reuse=not job.redraw)
+        cache.Store(job.figure_cache, slug_for(job.path), code_hash(), reuse=not job.redraw, used=set(job.figure_keys))
     with cache.using(store):
         done = _compute(job)
     if store is not None and done.status in ("ok", "failed"):
@@ -546,8 +554,7 @@ def _run_on_cluster(address: str, todo: list[Path], opts: Options, progress, out
         if other:
             raise SchedulerError(f"the workers {', '.join(other)} run another balpipe than this one (its code hash "
                                  f"differs): install the same version on every worker")
-        # the workers cannot reach this machine's figure cache: they draw every figure
-        plans = [replace(job, figure_cache=None) if isinstance(job, Job) else job for job in (plan_one(p, opts) for p in todo)]
+        plans = [plan_one(p, opts, figure_cache=False) for p in todo]  # the workers cannot reach the figure cache
         futures = {k: client.submit(compute, job, pure=False) for k, job in enumerate(plans) if isinstance(job, Job)}
         total = len(todo)
         for k, job in enumerate(plans):

@@ -105,17 +105,19 @@ def _digest_of(x: Any) -> bytes:
     return h.digest()
 
 
-@lru_cache(maxsize=1)
 def environment() -> str:
     """What the SVG depends on besides balpipe's code and the figure's inputs: matplotlib's
-    version and its settings (rcParams, after :mod:`balpipe.draw.figures` set its own; a
-    ``matplotlibrc`` of the user's changes them)."""
+    version and its settings (rcParams as they are now: a ``matplotlibrc`` of the user's changes
+    them; :mod:`balpipe.draw.figures` sets its own when imported, which its code hash covers)."""
     import matplotlib
 
-    from . import figures  # noqa: F401  (its rcParams)
+    rc = repr(sorted((k, repr(v)) for k, v in matplotlib.rcParams.items()))
+    return _digest(matplotlib.__version__, rc)
 
-    rc = sorted((k, repr(v)) for k, v in matplotlib.rcParams.items())
-    return hashlib.sha256(repr((matplotlib.__version__, rc)).encode()).hexdigest()
+
+@lru_cache(maxsize=8)
+def _digest(version: str, rc: str) -> str:
+    return hashlib.sha256(f"{version}\0{rc}".encode()).hexdigest()
 
 
 def key(fn: Callable[..., str], args: tuple, kwargs: dict, salt: str) -> str:
