@@ -253,8 +253,9 @@ def test_a_250_character_file_name_builds(tmp_path):
     r = balpipe("build", d, "-o", tmp_path / "out", "--no-sim")
     no_traceback(r)
     assert r.returncode == 0, r.stderr
-    folders = [p for p in (tmp_path / "out").iterdir() if p.is_dir()]
+    folders = [p for p in (tmp_path / "out").iterdir() if p.is_dir() and p.name != ".cache"]
     assert len(folders) == 1 and len(folders[0].name) <= build_mod.MAX_SLUG
+    assert any((tmp_path / "out" / ".cache" / "figures" / folders[0].name).iterdir())  # its figures cached
 
 
 @pytest.mark.parametrize("a,b", [("x.yaml", "x.yml"), ("a b.yaml", "a-b.yaml")])
