@@ -25,6 +25,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 IGNORED_KEYS = {"balpipe_version", "input_hash", "code_hash", "timing", "seconds", "elapsed"}
 IGNORED_FILES = {"timing.json", "timing.js", ".balpipe.lock"}
+IGNORED_DIRS = {".cache"}  # the build's figure cache (balpipe.draw.cache), not part of the site
 
 
 def export(rev: str, into: Path) -> Path:
@@ -64,9 +65,9 @@ def snapshot(out: Path) -> tuple[dict[str, object], set[str]]:
     files: dict[str, object] = {}
     values: set[str] = set()
     for p in sorted(out.rglob("*")):
-        if not p.is_file() or p.name in IGNORED_FILES:
-            continue
         rel = p.relative_to(out).as_posix()
+        if not p.is_file() or p.name in IGNORED_FILES or rel.split("/")[0] in IGNORED_DIRS:
+            continue
         if p.suffix == ".json":
             files[rel] = _scrub_json(json.loads(p.read_text(encoding="utf-8")), values)
         else:
@@ -110,7 +111,7 @@ def main(argv: list[str] | None = None) -> int:
         problems = compare(*sites)
         for p in problems:
             print(p)
-        n = sum(1 for p in sites[0].rglob("*") if p.is_file())
+        n = sum(1 for p in sites[0].rglob("*") if p.is_file() and p.relative_to(sites[0]).parts[0] not in IGNORED_DIRS)
         print(f"{'identical' if not problems else f'{len(problems)} differences'} ({n} files in A; ignored: "
               f"{', '.join(sorted(IGNORED_KEYS))}, {', '.join(sorted(IGNORED_FILES))})")
         return 1 if problems else 0

@@ -82,3 +82,13 @@ def test_results_numbers_compares_every_number_to_a_relative_tolerance(tmp_path,
     assert r.main([str(tmp_path / "A"), str(tmp_path / "B")]) == 0  # code_hash is ignored in files
     assert r.main([str(tmp_path / "A"), str(tmp_path / "C")]) == 1
     assert "beyond 1e-09" in capsys.readouterr().out
+
+
+def test_a_warm_build_rebuilds_the_changed_spec(tmp_path):
+    b = _bench()
+    out = tmp_path / "site"
+    res = b.warm_one(sys.executable, ROOT / "pipeline", ROOT / "specs" / "scott_russell.yaml", out, ["--no-sim"],
+                     tmp_path / "specs")
+    assert res["rc"] == 0 and res["times"]["analyse"] > 0  # computed again, not skipped as unchanged
+    assert (tmp_path / "specs" / "scott_russell.yaml").read_text().endswith(b.WARM_EDIT)
+    assert (out / ".cache" / "figures" / "scott_russell").is_dir()

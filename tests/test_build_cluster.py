@@ -18,7 +18,9 @@ SPECS = ["scott_russell.yaml", "offset_slider_crank.yaml"]
 
 
 def tree(folder: Path) -> dict[str, bytes]:
-    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+    """The site's files, the figure cache (``.cache/``, not part of the site) left out."""
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*"))
+            if p.is_file() and p.relative_to(folder).parts[0] != ".cache"}
 
 
 def specs_with_a_broken_one(tmp_path: Path) -> Path:
@@ -44,6 +46,8 @@ def test_a_two_worker_cluster_builds_the_same_site_as_one_process(tmp_path):
     assert [o.status for o in here] == ["ok", "ok", "error"]  # offset, scott_russell, short_coupler
     assert "short_coupler.yaml" in here[2].message and "coupler" in here[2].message
     assert tree(remote) == tree(local)
+    # the workers cannot reach this folder's figure cache: they draw every figure, none is cached
+    assert (local / ".cache" / "figures" / "scott_russell").is_dir() and not (remote / ".cache").exists()
     # a second build on the cluster computes nothing: every page is unchanged
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
         again = build([str(specs)], Options(remote, simulate=False), scheduler=cl.scheduler_address)

@@ -76,6 +76,13 @@ def test_workflow_structure():
     for s in steps:
         if s.get("uses", "").startswith("actions/upload-artifact"):
             assert s["if"] == "github.event_name == 'pull_request'"
+    # what is published (the Pages site, the pull request's artifact) is reports/ without the
+    # build's figure cache (balpipe.draw.cache), which actions/cache keeps in reports/.cache
+    i_site = next(i for i, r in enumerate(runs) if "--exclude=./.cache" in r)
+    assert i_build < i_site and "reports" in runs[i_site] and "_site" in runs[i_site]
+    uploads = [s for s in steps if s.get("uses", "").split("@")[0] in ("actions/upload-pages-artifact",
+                                                                       "actions/upload-artifact")]
+    assert sorted(s["with"]["path"] for s in uploads) == ["_site/", "_site/", "balpipe-diff.md"]
     diff_step = next(s for s in steps if "pr-diff.sh" in s.get("run", ""))
     assert diff_step["if"] == "github.event_name == 'pull_request'"
     deploy = w["jobs"]["deploy"]

@@ -164,6 +164,11 @@ class Job:
     history: dict | None
     history_files: dict[str, str]
     sim_workers: int = 1  # the stages' simulations in that many processes (the same results)
+    #: the output folder whose figure cache (draw/cache.py: <out>/.cache/figures/<slug>/) the
+    #: figures are drawn through; None (a dask worker, which has no access to it): every figure drawn
+    figure_cache: Path | None = None
+    redraw: bool = False  # --force: every figure drawn, its cache entry rewritten
+    figure_keys: frozenset[str] = frozenset()  # the cache entries the planning used (history figures): kept
 
 
 @dataclass
@@ -222,9 +227,11 @@ def up_to_date(path: Path, opts: Options) -> dict | None:
     return previous if _mixed_hash(text + tables, target, opts.simulate) == previous["input_hash"] else None
 
 
-def plan_one(path: Path, opts: Options) -> Job | Outcome:
+def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outcome:
     """Read one spec and decide: an :class:`Outcome` when there is nothing to compute (invalid,
-    or unchanged since the last build), else the :class:`Job` that computes it."""
+    or unchanged since the last build), else the :class:`Job` that computes it. The history
+    figures of the page (drawn here, where the page folder is read) and, with ``figure_cache``,
+    the job's figures go through the output folder's figure cache (:mod:`balpipe.draw.cache`)."""
     from .loader import SpecErrors
 
     start = time.perf_counter()
@@ -239,14 +246,35 @@ def plan_one(path: Path, opts: Options) -> Job | Outcome:
         previous = _read_results(target)
         if previous is not None and previous.get("input_hash") == h:
             return _unchanged(path, slug, target, previous, time.perf_counter() - start)
+    from .draw import cache
     from .report import history_page
 
-    return Job(path, loaded.text, h, opts.simulate, history_page.section(target), history_page.build_files(target),
-               opts.sim_workers)
+    store = cache.Store(opts.out, slug, code_hash(), reuse=not opts.force) if figure_cache else None
+    with cache.using(store):
+        history, files = history_page.section(target), history_page.build_files(target)
+    return Job(path, loaded.text, h, opts.simulate, history, files, opts.sim_workers,
+               figure_cache=opts.out if figure_cache else None, redraw=opts.force,
+               figure_keys=frozenset(store.used) if store is not None else frozenset())
 
 
 def compute(job: Job) -> Computed:
-    """Balance, analyse, validate and render one spec; never raises (errors become the result)."""
+    """Balance, analyse, validate and render one spec; never raises (errors become the result).
+    With ``job.figure_cache``, the figures come from that folder's figure cache where their
+    inputs are unchanged (:mod:`balpipe.draw.cache`), and the spec's entries this build did not
+    use are removed when its page is made."""
+    from .draw import cache
+
+    store = None if job.figure_cache is None else \
+        cache.Store(job.figure_cache, slug_for(job.path), code_hash(), reuse=not job.redraw, used=set(job.figure_keys))
+    with cache.using(store):
+        done = _compute(job)
+    if store is not None and done.status in ("ok", "failed"):
+        store.prune()
+    return done
+
+
+def _compute(job: Job) -> Computed:
+    """:func:`compute` without the figure cache's set-up."""
     from . import runner
     from .laws.drives import table_files
     from .loader import LoadedSpec, SpecErrors, load_text
@@ -431,6 +459,10 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
             remove_temporaries(opts.out)
             raise
         built = [o for o in outcomes if o.slug]
+        if any(not o.skipped for o in built):  # the figure caches of specs that have no page any more
+            from .draw.cache import prune_specs
+
+            prune_specs(opts.out, {o.slug for o in built})
         earlier = earlier_pages(opts.out, {o.slug for o in built}, page_hash)
         key = site_key(opts.out, built) if not earlier else ""
         if not (key and _site_is_current(opts.out, key)):
@@ -522,7 +554,7 @@ def _run_on_cluster(address: str, todo: list[Path], opts: Options, progress, out
         if other:
             raise SchedulerError(f"the workers {', '.join(other)} run another balpipe than this one (its code hash "
                                  f"differs): install the same version on every worker")
-        plans = [plan_one(p, opts) for p in todo]
+        plans = [plan_one(p, opts, figure_cache=False) for p in todo]  # the workers cannot reach the figure cache
         futures = {k: client.submit(compute, job, pure=False) for k, job in enumerate(plans) if isinstance(job, Job)}
         total = len(todo)
         for k, job in enumerate(plans):

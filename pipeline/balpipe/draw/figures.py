@@ -10,6 +10,7 @@ from __future__ import annotations
 import io
 import math
 import re
+from dataclasses import replace
 
 import matplotlib
 
@@ -20,7 +21,7 @@ from matplotlib.layout_engine import PlaceHolderLayoutEngine  # noqa: E402
 from matplotlib.patches import Circle, Polygon  # noqa: E402
 
 from ..model import Model  # noqa: E402
-from . import extremes  # noqa: E402
+from . import cache, extremes  # noqa: E402
 from .labels import drawing_span, point_places, repeated_names  # noqa: E402
 from .layout import fixed_layout  # noqa: E402
 from .sleeves import guided_sliders, sleeves  # noqa: E402
@@ -191,7 +192,22 @@ def mechanism_figure(model: Model, analysis, ghosts: list[int] | None = None, pr
     :func:`labels.gear_numbers`), placed so that no two overlap (:func:`labels.place`);
     ``limits`` (x0, y0, x1, y1) gives every panel of a figure the same scale; ``texts``: name ->
     the text drawn for it (the paper's symbol, :class:`balpipe.notation.Names`)."""
-    fig, _ = mechanism_drawing(model, analysis, ghosts, title, limits, numbers, texts)
+    return cache.svg(mechanism_svg, drawn_model(model), analysis.extra["frame_pose"], ghosts, prefix, title, limits,
+                     numbers, texts)
+
+
+def drawn_model(model: Model) -> Model:
+    """``model`` as the drawings read it: without its drivers and actuators (motion laws are
+    functions, which :mod:`.cache` cannot hash, and no drawing reads them), its initial
+    assembly pose and the spec locations of its parts."""
+    return replace(model, drivers=(), actuators=(), initial={}, sources={})
+
+
+def mechanism_svg(model: Model, poses: np.ndarray, ghosts: list[int] | None, prefix: str, title: str,
+                  limits: tuple[float, float, float, float] | None, numbers: dict[str, str] | None,
+                  texts: dict[str, str] | None) -> str:
+    """:func:`mechanism_figure` from the body poses (N, bodies, 3) alone: what :mod:`.cache` hashes."""
+    fig, _ = pose_drawing(model, poses, ghosts, title, limits, numbers, texts)
     return to_svg(fig, prefix)
 
 
@@ -254,8 +270,14 @@ def mechanism_drawing(model: Model, analysis, ghosts: list[int] | None = None, t
                       numbers: dict[str, str] | None = None, texts: dict[str, str] | None = None) -> tuple:
     """The figure of :func:`mechanism_figure` and its placed labels (:class:`labels.Placed`,
     boxes in display pixels)."""
+    return pose_drawing(model, analysis.extra["frame_pose"], ghosts, title, limits, numbers, texts)
+
+
+def pose_drawing(model: Model, poses: np.ndarray, ghosts: list[int] | None = None, title: str = "",
+                 limits: tuple[float, float, float, float] | None = None,
+                 numbers: dict[str, str] | None = None, texts: dict[str, str] | None = None) -> tuple:
+    """:func:`mechanism_drawing` from the body poses (N, bodies, 3) of the analysis."""
     fig, ax = plt.subplots(figsize=(6.0, 4.6))
-    poses = analysis.extra["frame_pose"]
     ref = extremes.REFERENCE
     if ghosts is None:
         ghosts = extremes.extreme_instants(model, poses)
@@ -432,7 +454,14 @@ def common_limits(items: list[tuple[Model, np.ndarray]], pad: float = 0.08) -> t
 
 def series_figure(t: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel: str, prefix: str,
                   title: str = "") -> str:
-    """A plain time-series plot: one line per (label, values), stage styles in order."""
+    """A plain time-series plot: one line per (label, values), stage styles in order (drawn by
+    :func:`series_svg`, through the figure cache)."""
+    return cache.svg(series_svg, t, curves, ylabel, prefix, title)
+
+
+def series_svg(t: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel: str, prefix: str,
+               title: str = "") -> str:
+    """:func:`series_figure`, drawn."""
     fig, ax = plt.subplots(figsize=(6.0, 3.0))
     for k, (label, y) in enumerate(curves):
         ax.plot(t, y, label=literal(label), **style(k))
@@ -444,12 +473,15 @@ def series_figure(t: np.ndarray, curves: list[tuple[str, np.ndarray]], ylabel: s
     return to_svg(fig, prefix)
 
 
-
-
-
 def drift_figure(runs: list, prefix: str = "drift") -> str:
     """Free-floating frame: drift of its centre of mass (mm) and rotation (deg) per stage.
-    ``runs``: (label, t, drift (N, 2) in m, rotation (N,) in rad)."""
+    ``runs``: (label, t, drift (N, 2) in m, rotation (N,) in rad). Drawn by :func:`drift_svg`,
+    through the figure cache."""
+    return cache.svg(drift_svg, runs, prefix)
+
+
+def drift_svg(runs: list, prefix: str = "drift") -> str:
+    """:func:`drift_figure`, drawn."""
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 2.8))
     for k, (label, t, drift, rot) in enumerate(runs):
         a1.plot(t, 1000 * np.hypot(drift[:, 0], drift[:, 1]), label=literal(label), **style(k))
@@ -463,6 +495,12 @@ def drift_figure(runs: list, prefix: str = "drift") -> str:
 
 
 def residual_figure(stages: list, prefix: str = "residuals") -> str:
+    """|F_sim - F_analytic| / F0 and |M_sim - M_analytic| / M0 over time, every stage (drawn by
+    :func:`residual_svg`, through the figure cache)."""
+    return cache.svg(residual_svg, stages, prefix)
+
+
+def residual_svg(stages: list, prefix: str = "residuals") -> str:
     """|F_sim - F_analytic| / F0 and |M_sim - M_analytic| / M0 over time, every stage.
     ``stages``: (label, t, force_error, moment_error, F0, M0), F0 and M0 the stage's own reference
     loads (N, N m); the titles give them when every stage has the same, else the legend does."""

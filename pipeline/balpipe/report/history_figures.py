@@ -3,7 +3,8 @@
 The x axis is the sequence of commits, oldest left, labelled with their short hashes; the
 history table of the page gives each commit's date and subject. A commit whose spec is invalid
 or crashed has no point (a gap), and its label is red, as is the label of a commit whose spec
-fails a check or the pymunk validation.
+fails a check or the pymunk validation. The figures are drawn through the figure cache
+(:mod:`balpipe.draw.cache`): a build re-renders a page's history section without redrawing them.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..draw import cache  # noqa: E402
 from ..draw.figures import style, to_svg  # noqa: E402
 
 MAX_LABELS = 16
@@ -89,16 +91,16 @@ def _panels_figure(commits: list[dict], stages: list[tuple[str, str]], panels: t
 
 def loads_history_figure(commits: list[dict], prefix: str = "hist-loads") -> str:
     """Peak shaking force |F| and moment |M| of every stage, per commit."""
-    return _panels_figure(commits, _stage_names(commits),
-                          (("max_shaking_force", "Peak shaking force |F| (N)"),
-                           ("max_shaking_moment", "Peak shaking moment |M| (N m)")), 3.4, 0, prefix)
+    return cache.svg(_panels_figure, commits, _stage_names(commits),
+                     (("max_shaking_force", "Peak shaking force |F| (N)"),
+                      ("max_shaking_moment", "Peak shaking moment |M| (N m)")), 3.4, 0, prefix)
 
 
 def added_history_figure(commits: list[dict], prefix: str = "hist-added") -> str:
     """Mass and rotating inertia that each balancing stage adds to the unbalanced mechanism."""
-    return _panels_figure(commits, _stage_names(commits)[1:] or _stage_names(commits),
-                          (("added_mass", "Added mass (kg)"), ("added_inertia", "Added inertia (kg m²)")),
-                          3.2, 1, prefix)
+    return cache.svg(_panels_figure, commits, _stage_names(commits)[1:] or _stage_names(commits),
+                     (("added_mass", "Added mass (kg)"), ("added_inertia", "Added inertia (kg m²)")),
+                     3.2, 1, prefix)
 
 
 def _parameters(commits: list[dict]) -> list[tuple[str, str]]:
@@ -129,6 +131,11 @@ def parameters_history_figure(commits: list[dict], prefix: str = "hist-params") 
     params = changing_parameters(commits)[0]
     if not params:
         return None
+    return cache.svg(_parameters_figure, commits, params, prefix)
+
+
+def _parameters_figure(commits: list[dict], params: list[tuple[str, str]], prefix: str) -> str:
+    """:func:`parameters_history_figure` of the changing ``params`` (name, unit), drawn."""
     ncol = min(3, len(params))
     nrow = math.ceil(len(params) / ncol)
     fig, axes = plt.subplots(nrow, ncol, figsize=(3.0 * ncol + 0.4, 2.5 * nrow), squeeze=False)

@@ -9,15 +9,41 @@ from .template import gripper_path, input_angles, segment_distance
 
 
 def figures(study):
-    """Report figures of the template: the gripper path (Fig. 7) and the input angles (Figs. 8-9)."""
-    from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
-    from ...draw.layout import fixed_layout
+    """Report figures of the template: the gripper path (Fig. 7) and the input angles (Figs. 8-9),
+    drawn through the figure cache (:mod:`balpipe.draw.cache`)."""
+    from ...draw import cache
 
     first = study.stages[0]
     an, model = first.analysis, first.stage.model
     C = gripper_path(an, model)
     S, E = C[0], C[-1]
     on_path = getattr(study.spec.motion.drive.get("gripper"), "law", None) == "path"  # balpipe.laws.paths
+    dev = float(np.max(segment_distance(C, S, E)))
+    coupled = model.name.startswith("fixed-sequence")
+    yield (
+        "Gripper path (Fig. 7)",
+        cache.svg(path_svg, C, on_path),
+        f"C(t) from the analysis, from ({S[0]:.4g}, {S[1]:.4g}) to ({E[0]:.4g}, {E[1]:.4g}) m; " + (
+            "the path of motion.drive.gripper." if on_path else f"largest distance from the straight segment {1000 * dev:.3g} mm"
+            + (" (the gear-coupled inputs do not keep the gripper on the segment)." if coupled else ".")),
+    )
+    th1, th2 = input_angles(an)
+    yield (
+        "Input angles (Figs. 8-9)",
+        cache.svg(angles_svg, an.t, th1, th2),
+        "theta1 follows the motion law; theta2 follows it through gears 1', 5, 2' (theta2 - theta2i = "
+        "U21 (theta1 - theta1i))." if coupled
+        else f"Both inputs follow the inverse kinematics of the {'given' if on_path else 'straight'} path.",
+    )
+
+
+def path_svg(C: np.ndarray, on_path: bool) -> str:
+    """The gripper path C (N, 2), its start (circle) and end (square), and the straight segment
+    between them unless the motion is a path of its own (``on_path``)."""
+    from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
+    from ...draw.layout import fixed_layout
+
+    S, E = C[0], C[-1]
     fig, ax = plt.subplots(figsize=(5.6, 3.6))
     ax.plot(C[:, 0], C[:, 1], color="black", linewidth=1.4, label="gripper path")
     if not on_path:
@@ -29,26 +55,18 @@ def figures(study):
     ax.set_aspect("equal", adjustable="datalim")
     ax.legend(fontsize=7, loc="best")
     fixed_layout(fig)
-    dev = float(np.max(segment_distance(C, S, E)))
-    coupled = model.name.startswith("fixed-sequence")
-    yield (
-        "Gripper path (Fig. 7)",
-        to_svg(fig, "fivebar-path"),
-        f"C(t) from the analysis, from ({S[0]:.4g}, {S[1]:.4g}) to ({E[0]:.4g}, {E[1]:.4g}) m; " + (
-            "the path of motion.drive.gripper." if on_path else f"largest distance from the straight segment {1000 * dev:.3g} mm"
-            + (" (the gear-coupled inputs do not keep the gripper on the segment)." if coupled else ".")),
-    )
-    th1, th2 = input_angles(an)
+    return to_svg(fig, "fivebar-path")
+
+
+def angles_svg(t: np.ndarray, th1: np.ndarray, th2: np.ndarray) -> str:
+    """The two input angles over time, one panel each."""
+    from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
+    from ...draw.layout import fixed_layout
+
     fig, axes = plt.subplots(1, 2, figsize=(8.4, 2.8))
     for ax, th, name in ((axes[0], th1, "theta1"), (axes[1], th2, "theta2")):
-        ax.plot(an.t, th, color="black", linewidth=1.4)
+        ax.plot(t, th, color="black", linewidth=1.4)
         ax.set_title(f"{name} (rad)", fontsize=9)
         ax.set_xlabel("time (s)")
     fixed_layout(fig)
-    yield (
-        "Input angles (Figs. 8-9)",
-        to_svg(fig, "fivebar-angles"),
-        "theta1 follows the motion law; theta2 follows it through gears 1', 5, 2' (theta2 - theta2i = "
-        "U21 (theta1 - theta1i))." if coupled
-        else f"Both inputs follow the inverse kinematics of the {'given' if on_path else 'straight'} path.",
-    )
+    return to_svg(fig, "fivebar-angles")

@@ -27,9 +27,7 @@ def figures(study):
     """The template's figure: the axial forces that prismatic actuators would need, when the
     spec drives the revolutes."""
     if study.spec.mechanism.actuation == "revolute":
-        from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
-
-        yield _prismatic_forces_figure(study, plt, to_svg)
+        yield _prismatic_forces_figure(study)
 
 
 def paper_figures(number: str, linkage: str, published_factor: float):
@@ -67,30 +65,41 @@ def paper_figures(number: str, linkage: str, published_factor: float):
     return figures
 
 
-def _prismatic_forces_figure(study, plt, to_svg):
-    from ...draw.layout import fixed_layout
+def _prismatic_forces_figure(study):
+    from ...draw import cache
 
     mech = study.spec.mechanism
     pose = pose_of(study.unbalanced.stage.model)
-    fig, axes = plt.subplots(1, 3, figsize=(10.5, 2.9), sharey=True)
-    for k, s in enumerate((study.stages[0], _own(study)[-1])):
+    runs = []
+    for s in (study.stages[0], _own(study)[-1]):
         an = s.analysis
         tau = np.stack([an.efforts[f"theta{i}"] for i in (1, 2, 3)], axis=1)
-        f = prismatic_equivalent(mech, pose, an.t, tau)
-        for i, ax in enumerate(axes):
-            ax.semilogy(an.t, np.abs(f[:, i]), color=("black", "0.6")[k], linewidth=(1.3, 2.2)[k], label=s.stage.label)
-            ax.set_title(f"|axial force| of leg {i + 1} (N)", fontsize=9)
-            ax.set_xlabel("time (s)")
-    axes[0].legend(fontsize=7)
-    fixed_layout(fig)
+        runs.append((s.stage.label, an.t, prismatic_equivalent(mech, pose, an.t, tau)))
     return (
         "Axial forces that prismatic actuators would need",
-        to_svg(fig, "rpr3-prismatic"),
+        cache.svg(prismatic_forces_svg, runs),
         "The same motion driven by actuators at the prismatic pairs B_i instead of the revolutes A_i: "
         "J_p^T f = J_r^T tau (the same generalised force on the platform). Where the three leg lines meet "
         "in one point (a parallel singularity of prismatic actuation, at phi = 0 for a platform homothetic "
         "to the base) the forces are unbounded; samples there are left out.",
     )
+
+
+def prismatic_forces_svg(runs: list[tuple[str, np.ndarray, np.ndarray]]) -> str:
+    """|axial force| of each leg over time, one line per (stage label, t, forces (N, 3)):
+    the first solid black, the second thick grey (drawn through :mod:`balpipe.draw.cache`)."""
+    from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
+    from ...draw.layout import fixed_layout
+
+    fig, axes = plt.subplots(1, 3, figsize=(10.5, 2.9), sharey=True)
+    for k, (label, t, f) in enumerate(runs):
+        for i, ax in enumerate(axes):
+            ax.semilogy(t, np.abs(f[:, i]), color=("black", "0.6")[k], linewidth=(1.3, 2.2)[k], label=label)
+            ax.set_title(f"|axial force| of leg {i + 1} (N)", fontsize=9)
+            ax.set_xlabel("time (s)")
+    axes[0].legend(fontsize=7)
+    fixed_layout(fig)
+    return to_svg(fig, "rpr3-prismatic")
 
 
 def _factor_table(study, linkage: str) -> str:

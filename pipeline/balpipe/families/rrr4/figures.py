@@ -171,7 +171,16 @@ def grid_columns(n: int) -> int:
 
 def panels_svg(panels: list[tuple], prefix: str) -> str:
     """One figure of ``panels`` (model, body poses, title), at most three a row (:func:`grid_columns`),
-    drawn by :func:`_draw` with one disc scale for the whole figure, then named by :func:`_name`."""
+    drawn by :func:`draw_panels` through the figure cache (:mod:`balpipe.draw.cache`)."""
+    from ...draw import cache
+    from ...draw.figures import drawn_model
+
+    return cache.svg(draw_panels, [(drawn_model(model), poses, title) for model, poses, title in panels], prefix)
+
+
+def draw_panels(panels: list[tuple], prefix: str) -> str:
+    """:func:`panels_svg`, drawn by :func:`_draw` with one disc scale for the whole figure, then
+    named by :func:`_name`."""
     from ...draw.figures import plt, to_svg
     from ...draw.layout import fixed_layout
 

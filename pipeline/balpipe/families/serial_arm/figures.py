@@ -45,8 +45,7 @@ def _params(study) -> dict:
 def decoupling_figures(study):
     """Paper 002's figures: Fig. 2, the mass matrix before and after (its entries and along the
     motion), torque against acceleration."""
-    from ...draw.figures import MARKERS, plt, style, to_svg  # matplotlib only when a report is drawn
-    from ...draw.layout import fixed_layout
+    from ...draw import cache
     from ...engine.joint_space import mass_matrix
 
     by = _main(study)
@@ -69,27 +68,52 @@ def decoupling_figures(study):
         "(m_b, c_b from B, I_b); the numbers are computed from the stages' models.",
     )
     stages = [by["unbalanced"], by["decoupled"]]
-    fig, axes = plt.subplots(1, 3, figsize=(9.6, 2.8))
+    rows = [(s.stage.label, style_index(study.stages, s), s.analysis.t, mass_matrix(s.stage.model, s.analysis.t)[1])
+            for s in stages]
+    yield ("Mass matrix along the motion", cache.svg(mass_matrix_svg, rows),
+           "Entries of the joint-space mass matrix computed by the engine from each stage's model "
+           "(D = Vᵀ diag(m, m, I) V, V the body velocities per unit joint rate): the decoupled arm's is "
+           "constant and diagonal.")
+    runs = []
     for s in stages:
-        an, st = s.analysis, style(style_index(study.stages, s))
-        _, M = mass_matrix(s.stage.model, an.t)
+        an = s.analysis
+        qdd = [an.a[:, an.names.index(f"link{j + 1}"), 2] - (an.a[:, an.names.index("link1"), 2] if j else 0.0)
+               for j in range(2)]
+        runs.append((s.stage.label, style_index(study.stages, s), qdd, [an.efforts[f"q{j + 1}"] for j in range(2)]))
+    yield ("Torque against acceleration (eqs. 17-18)", cache.svg(torque_acceleration_svg, runs, J),
+           "Each joint's actuator torque τᵢ against its own acceleration θ̈ᵢ at every sample: coupled and "
+           "nonlinear before, on the line τᵢ = Jᵢ θ̈ᵢ after decoupling (red)"
+           + (" (with gravity on, the decoupled arm's total centre of mass is on A: no gravity torque)."
+              if study.spec.analysis.gravity else "."))
+
+
+def mass_matrix_svg(rows: list[tuple]) -> str:
+    """D11, D12, D22 over time, one line per (stage label, style index, t, D (N, 2, 2))."""
+    from ...draw.figures import plt, style, to_svg  # matplotlib only when a report is drawn
+    from ...draw.layout import fixed_layout
+
+    fig, axes = plt.subplots(1, 3, figsize=(9.6, 2.8))
+    for label, k, t, M in rows:
         for ax, (i, j, name) in zip(axes, ((0, 0, "D₁₁"), (0, 1, "D₁₂"), (1, 1, "D₂₂"))):
-            ax.plot(an.t, M[:, i, j], label=s.stage.label, **st)
+            ax.plot(t, M[:, i, j], label=label, **style(k))
             ax.set_title(f"{name} (kg m²)", fontsize=9)
             ax.set_xlabel("time (s)")
     axes[0].legend(fontsize=7)
     fixed_layout(fig)
-    yield ("Mass matrix along the motion", to_svg(fig, "decoupling-mass"),
-           "Entries of the joint-space mass matrix computed by the engine from each stage's model "
-           "(D = Vᵀ diag(m, m, I) V, V the body velocities per unit joint rate): the decoupled arm's is "
-           "constant and diagonal.")
+    return to_svg(fig, "decoupling-mass")
+
+
+def torque_acceleration_svg(runs: list[tuple], J: tuple[float, float]) -> str:
+    """Each joint's torque against its acceleration, one marker style per (stage label, style
+    index, [q1'', q2''], [tau1, tau2]), and the lines tau_i = J_i q_i''."""
+    from ...draw.figures import MARKERS, plt, style, to_svg  # matplotlib only when a report is drawn
+    from ...draw.layout import fixed_layout
+
     fig, axes = plt.subplots(1, 2, figsize=(9.0, 3.2))
-    for s in stages:
-        an, k = s.analysis, style_index(study.stages, s)
+    for label, k, qdd, tau in runs:
         for j, ax in enumerate(axes):
-            qdd = an.a[:, an.names.index(f"link{j + 1}"), 2] - (an.a[:, an.names.index("link1"), 2] if j else 0.0)
-            ax.plot(qdd, an.efforts[f"q{j + 1}"], MARKERS[k % len(MARKERS)], markersize=2.5, color=style(k)["color"],
-                    markerfacecolor="none", alpha=0.7, label=s.stage.label)
+            ax.plot(qdd[j], tau[j], MARKERS[k % len(MARKERS)], markersize=2.5, color=style(k)["color"],
+                    markerfacecolor="none", alpha=0.7, label=label)
     for j, (ax, Jj) in enumerate(zip(axes, J)):
         sub = "₁₂"[j]
         lim = np.array(ax.get_xlim())
@@ -98,11 +122,7 @@ def decoupling_figures(study):
         ax.set_title(f"τ{sub} (N m)", fontsize=9)
         ax.legend(fontsize=7)
     fixed_layout(fig)
-    yield ("Torque against acceleration (eqs. 17-18)", to_svg(fig, "decoupling-torque"),
-           "Each joint's actuator torque τᵢ against its own acceleration θ̈ᵢ at every sample: coupled and "
-           "nonlinear before, on the line τᵢ = Jᵢ θ̈ᵢ after decoupling (red)"
-           + (" (with gravity on, the decoupled arm's total centre of mass is on A: no gravity torque)."
-              if study.spec.analysis.gravity else "."))
+    return to_svg(fig, "decoupling-torque")
 
 
 def _paper002_fig2(study, un):
@@ -137,34 +157,43 @@ def _pct(x: float) -> str:
 
 def com_planning_figures(study):
     """Paper 003's figures: the peaks per trajectory, Figs. 2-4, the other trajectories, phi."""
-    from ...draw.figures import legend_below, plt, style, to_svg  # matplotlib only when a report is drawn
+    from ...draw import cache
 
     params = _params(study)
     planner, plans = replan(study.spec, params)
     by = _main(study)
     main = study.stages[0].stage.group  # the balancing lists the main trajectory first
     yield _peaks_table(study, plans, by, params)
-    yield _square_figure(study, planner, plans, main, plt, to_svg)
+    yield _square_figure(study, planner, plans, main)
     yield from _figs_3_4(study, main, by)
     others = [p for p in plans if p.name != main]
     if others:
-        yield _other_trajectories(study, others, by, plt, style, to_svg)
-    fig, ax = plt.subplots(figsize=(6.0, 3.0))
+        yield _other_trajectories(study, others, by)
     t = planner.t
-    for k, p in enumerate(plans):
-        phi = PhiPolynomial(p.start[2], p.end[2], planner.T, p.phi_coefficients)
-        ax.plot(t, np.degrees(phi(t)[0]), label=p.name or "optimised", linewidth=1.0,
-                color=TRAJECTORY_COLOURS[k % len(TRAJECTORY_COLOURS)])
+    phis = [(p.name or "optimised", np.degrees(PhiPolynomial(p.start[2], p.end[2], planner.T, p.phi_coefficients)(t)[0]))
+            for p in plans]
     phi5 = PhiPolynomial(plans[0].start[2], plans[0].end[2], planner.T)
     k345 = style_index(study.stages, by[_prefix(main) + "com_bang_bang"])
-    ax.plot(t, np.degrees(phi5(t)[0]), label="3-4-5 law", **style(k345))
+    svg = cache.svg(phi_svg, t, phis, np.degrees(phi5(t)[0]), k345)
+    method = study.spec.balancing
+    yield ("Optimised end-effector orientation φ", svg,
+           f"φ(t) of case 2 per trajectory (degree {method.phi.degree}, ends fixed), and the 3-4-5 law it starts "
+           "from, in the line style of the stage that uses it.")
+
+
+def phi_svg(t: np.ndarray, phis: list[tuple[str, np.ndarray]], phi345: np.ndarray, k345: int) -> str:
+    """φ (deg) over time per (trajectory, values), each in its colour, and the 3-4-5 law in the
+    line style ``k345`` of the stage that uses it."""
+    from ...draw.figures import legend_below, plt, style, to_svg  # matplotlib only when a report is drawn
+
+    fig, ax = plt.subplots(figsize=(6.0, 3.0))
+    for k, (name, phi) in enumerate(phis):
+        ax.plot(t, phi, label=name, linewidth=1.0, color=TRAJECTORY_COLOURS[k % len(TRAJECTORY_COLOURS)])
+    ax.plot(t, phi345, label="3-4-5 law", **style(k345))
     ax.set_xlabel("time (s)")
     ax.set_ylabel("φ (deg)")
     legend_below(fig, ax, fontsize=7)  # under the axes: never over a curve
-    method = study.spec.balancing
-    yield ("Optimised end-effector orientation φ", to_svg(fig, "com-phi"),
-           f"φ(t) of case 2 per trajectory (degree {method.phi.degree}, ends fixed), and the 3-4-5 law it starts "
-           "from, in the line style of the stage that uses it.")
+    return to_svg(fig, "com-phi")
 
 
 def _prefix(name: str) -> str:
@@ -244,73 +273,101 @@ def _figs_3_4(study, main: str, by: dict):
                "in the page's stage figures. Computed by the engine from this spec.")
 
 
-def _other_trajectories(study, plans, by: dict, plt, style, to_svg) -> tuple[str, str, str]:
+def _other_trajectories(study, plans, by: dict) -> tuple[str, str, str]:
     """|F| and M of every stage on the trajectories that Figs. 3-4 do not show, one row each."""
-    from ...draw.layout import fixed_layout
+    from ...draw import cache
 
     n = len(plans)
-    fig, axes = plt.subplots(n, 2, figsize=(9.0, 2.1 * n + 0.4), squeeze=False)
-    for r, p in enumerate(plans):
+    rows = []
+    for p in plans:
         pre = _prefix(p.name)
+        curves = []
         for key, _ in sorted(CASES, key=lambda kl: STYLES[kl[0]]):
             s = by[pre + key]
-            st, label = style(style_index(study.stages, s)), s.stage.label.split(" · ")[-1]
-            axes[r, 0].plot(s.analysis.t, np.linalg.norm(s.analysis.force, axis=1), label=label, **st)
-            axes[r, 1].plot(s.analysis.t, s.analysis.moment, label=label, **st)
-        axes[r, 0].set_title(f"{p.name}: shaking force |F| (N)", fontsize=8)
-        axes[r, 1].set_title(f"{p.name}: shaking moment M (N m)", fontsize=8)
+            curves.append((s.stage.label.split(" · ")[-1], style_index(study.stages, s), s.analysis.t,
+                           np.linalg.norm(s.analysis.force, axis=1), s.analysis.moment))
+        rows.append((p.name, curves))
+    return (f"Shaking force and moment on the other {n} trajectories", cache.svg(other_trajectories_svg, rows),
+            "The same quantities as Figs. 3-4 on the trajectories the paper does not plot, every stage in its line "
+            "style of this page (the legend under the plot). Moment about the base joint, horizontal plane.")
+
+
+def other_trajectories_svg(rows: list[tuple[str, list[tuple]]]) -> str:
+    """One row of panels (|F|, M) per (trajectory, curves), each curve (label, style index, t,
+    |F|, M); the legend under the plot."""
+    from ...draw.figures import plt, style, to_svg  # matplotlib only when a report is drawn
+    from ...draw.layout import fixed_layout
+
+    n = len(rows)
+    fig, axes = plt.subplots(n, 2, figsize=(9.0, 2.1 * n + 0.4), squeeze=False)
+    for r, (name, curves) in enumerate(rows):
+        for label, k, t, F, M in curves:
+            st = style(k)
+            axes[r, 0].plot(t, F, label=label, **st)
+            axes[r, 1].plot(t, M, label=label, **st)
+        axes[r, 0].set_title(f"{name}: shaking force |F| (N)", fontsize=8)
+        axes[r, 1].set_title(f"{name}: shaking moment M (N m)", fontsize=8)
     for ax in axes[-1]:
         ax.set_xlabel("time (s)")
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=7, frameon=False)
     fixed_layout(fig, rect=(0, 0.05 if n > 2 else 0.12, 1, 1))
-    return (f"Shaking force and moment on the other {n} trajectories", to_svg(fig, "com-loads"),
-            "The same quantities as Figs. 3-4 on the trajectories the paper does not plot, every stage in its line "
-            "style of this page (the legend under the plot). Moment about the base joint, horizontal plane.")
+    return to_svg(fig, "com-loads")
 
 
-def _square_figure(study, planner, plans, main: str, plt, to_svg) -> tuple[str, str, str]:
+def _square_figure(study, planner, plans, main: str) -> tuple[str, str, str]:
     """Fig. 2 of paper 003: the tested square, its points P_i, the tip's and the centre of mass'
     straight paths of every trajectory, and the arm at the start of the main trajectory."""
-    from ...draw.figures import legend_below, place_items
+    from ...draw import cache
 
     method = study.spec.balancing
-    fig, ax = plt.subplots(figsize=(6.0, 5.4))
-    names: list = []  # (text, point, kind): placed last, clear of the paths (draw.figures.place_items)
-    segs: list = []
     sq = method.test_square
-    if sq is not None:
-        h = sq.side / 2
-        cx, cy = sq.centre
-        ax.fill([cx - h, cx + h, cx + h, cx - h], [cy - h, cy - h, cy + h, cy + h], color="0.88", zorder=0)
-        for name, (x, y) in sq.points().items():
-            ax.plot(x, y, "o", color="black", markersize=2.5)
-            names.append((name, (x, y), "joint"))
-        ax.plot([cx], [cy], "+", color="black")
-        names.append(("E", (cx, cy), "joint"))
-    for k, p in enumerate(plans):
-        c = TRAJECTORY_COLOURS[k % len(TRAJECTORY_COLOURS)]
-        ax.annotate("", xy=p.end[:2], xytext=p.start[:2], arrowprops={"arrowstyle": "->", "color": c, "lw": 1.2})
-        ax.plot([p.com_start[0], p.com_end[0]], [p.com_start[1], p.com_end[1]], color=c, linestyle="--", linewidth=1.0,
-                label=f"{p.name}: tip → (solid), centre of mass (dashed)")
-        segs += [(tuple(p.start[:2]), tuple(p.end[:2])), (tuple(p.com_start[:2]), tuple(p.com_end[:2]))]
+    square = (sq.side, tuple(sq.centre), sq.points()) if sq is not None else None
+    paths = [(p.name, p.start[:2], p.end[:2], p.com_start[:2], p.com_end[:2]) for p in plans]
     p0 = next(p for p in plans if p.name == main)
     pts = [np.asarray(planner.arm.base, dtype=float)]
     for L, a in zip(planner.arm.lengths, np.cumsum(p0.q_start)):
         pts.append(pts[-1] + L * np.array([math.cos(a), math.sin(a)]))
-    pts = np.array(pts)
-    ax.plot(pts[:, 0], pts[:, 1], "-o", color="0.3", linewidth=2.0, markersize=3, label=f"arm at the start of {p0.name}")
+    svg = cache.svg(square_svg, square, paths, np.array(pts), tuple(planner.arm.base), p0.name)
+    zone = (f"side {sq.side:g} m, centre E = ({sq.centre[0]:g}, {sq.centre[1]:g}) m; points P1.. numbered "
+            f"counter-clockwise from P1 at the {sq.first_corner} corner (our reading of the figure, which reproduces "
+            "the paper's list of segments)") if sq is not None else "no test square in the spec"
+    return ("Fig. 2 of paper 003: the tested trajectories", svg,
+            f"Grey: the tested zone ({zone}). Arrows: the tip's straight paths of case 1; dashed: the centre of mass' "
+            "straight paths of cases 2-3, each trajectory in a colour of its own. Base joint: triangle.")
+
+
+def square_svg(square: tuple | None, paths: list[tuple], pts: np.ndarray, base: tuple, main: str) -> str:
+    """:func:`_square_figure`'s drawing: ``square`` (side, centre, named points) or None, the
+    ``paths`` (name, tip start, tip end, centre of mass start, end) of every trajectory, the arm's
+    joints ``pts`` at the start of trajectory ``main``, its ``base``."""
+    from ...draw.figures import legend_below, place_items, plt, to_svg  # matplotlib only when a report is drawn
+
+    fig, ax = plt.subplots(figsize=(6.0, 5.4))
+    names: list = []  # (text, point, kind): placed last, clear of the paths (draw.figures.place_items)
+    segs: list = []
+    if square is not None:
+        side, (cx, cy), points = square
+        h = side / 2
+        ax.fill([cx - h, cx + h, cx + h, cx - h], [cy - h, cy - h, cy + h, cy + h], color="0.88", zorder=0)
+        for name, (x, y) in points.items():
+            ax.plot(x, y, "o", color="black", markersize=2.5)
+            names.append((name, (x, y), "joint"))
+        ax.plot([cx], [cy], "+", color="black")
+        names.append(("E", (cx, cy), "joint"))
+    for k, (name, start, end, com_start, com_end) in enumerate(paths):
+        c = TRAJECTORY_COLOURS[k % len(TRAJECTORY_COLOURS)]
+        ax.annotate("", xy=end, xytext=start, arrowprops={"arrowstyle": "->", "color": c, "lw": 1.2})
+        ax.plot([com_start[0], com_end[0]], [com_start[1], com_end[1]], color=c, linestyle="--", linewidth=1.0,
+                label=f"{name}: tip → (solid), centre of mass (dashed)")
+        segs += [(tuple(start), tuple(end)), (tuple(com_start), tuple(com_end))]
+    ax.plot(pts[:, 0], pts[:, 1], "-o", color="0.3", linewidth=2.0, markersize=3, label=f"arm at the start of {main}")
     segs += [(tuple(a), tuple(b)) for a, b in zip(pts[:-1], pts[1:])]
-    ax.plot([planner.arm.base[0]], [planner.arm.base[1]], "^", color="black", markersize=8)
+    ax.plot([base[0]], [base[1]], "^", color="black", markersize=8)
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     legend_below(fig, ax, fontsize=7)  # under the drawing: never over the arm or the paths
     place_items(fig, ax, names, segs, [(np.asarray(q, dtype=float), None) for _, q, _ in names]
-                + [(np.asarray(planner.arm.base, dtype=float), -1.0)])
-    zone = (f"side {sq.side:g} m, centre E = ({sq.centre[0]:g}, {sq.centre[1]:g}) m; points P1.. numbered "
-            f"counter-clockwise from P1 at the {sq.first_corner} corner (our reading of the figure, which reproduces "
-            "the paper's list of segments)") if sq is not None else "no test square in the spec"
-    return ("Fig. 2 of paper 003: the tested trajectories", to_svg(fig, "com-square"),
-            f"Grey: the tested zone ({zone}). Arrows: the tip's straight paths of case 1; dashed: the centre of mass' "
-            "straight paths of cases 2-3, each trajectory in a colour of its own. Base joint: triangle.")
+                + [(np.asarray(base, dtype=float), -1.0)])
+    return to_svg(fig, "com-square")
