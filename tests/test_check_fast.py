@@ -76,9 +76,22 @@ def test_check_path_skips_the_page_diagnostics_but_not_the_stages():
     assert quick.checks["max_condition_number"] is None and quick.warnings == []
     assert full.checks["max_condition_number"] > 1.0
     assert [s.stage.name for s in quick.stages] == [s.stage.name for s in full.stages]
-    assert [p.name for p in quick.balance.parameters] == [p.name for p in full.balance.parameters]
-    for a, b in zip(quick.balance.parameters, full.balance.parameters):
-        assert a.value == pytest.approx(b.value, rel=1e-6, abs=1e-9), a.name
+    derived = [p.name for p in full.balance.parameters if p.name.startswith("peak_force_ratio_")]
+    assert derived and not loaded.spec.references  # the method's derived hook: skipped without references
+    assert [p.name for p in quick.balance.parameters] == [p.name for p in full.balance.parameters
+                                                          if p.name not in derived]
+    values = {p.name: p.value for p in full.balance.parameters}
+    for p in quick.balance.parameters:
+        assert p.value == pytest.approx(values[p.name], rel=1e-6, abs=1e-9), p.name
+
+
+def test_check_path_keeps_derived_parameters_that_references_may_name():
+    loaded = load("specs/paper003_com_planning.yaml")
+    assert loaded.spec.references and any(r.name.startswith(("force_reduction", "moment_reduction"))
+                                          for r in loaded.spec.references)
+    quick = run_analyse(loaded, page=False)
+    assert any(p.name == "force_reduction_min" for p in quick.balance.parameters)
+    assert [r["name"] for r in quick.references] == [r.name for r in loaded.spec.references]
 
 
 @pytest.mark.parametrize("path", [RRR4, "specs/paper000_rpr3_idler_loop.yaml", "specs/paper004_five_bar.yaml",
@@ -91,11 +104,16 @@ def test_revolute_rows_at_once_equal_the_joints_one_at_a_time_to_the_bit(path, m
         c = compiled(s.model)
         assert constraints.revolute_rows(c) is not None
         q = c.q0[None, :] + rng.normal(scale=0.3, size=(len(t), len(c.q0)))
-        qx = with_frame(q)
-        fast = constraints.residual(c, qx, t), constraints.jacobian(c, qx)
+        qx, vx = with_frame(q), with_frame(rng.normal(size=q.shape))
+
+        def rows():
+            return (constraints.residual(c, qx, t), constraints.jacobian(c, qx),
+                    constraints.acceleration_rhs(c, qx, vx, t))
+
+        fast = rows()
         with monkeypatch.context() as m:
             m.setattr(constraints, "revolute_rows", lambda c: None)
-            slow = constraints.residual(c, qx, t), constraints.jacobian(c, qx)
+            slow = rows()
         for a, b in zip(fast, slow):
             assert a.tobytes() == b.tobytes(), s.name  # signed zeros included
 

@@ -235,7 +235,8 @@ def run(spec: Spec, page: bool = True) -> Study:
     """Balance and analyse every stage; collect checks and problems (no simulation). Without
     ``page``, what only the page shows is not computed (:func:`.registry.balance`), nor the
     condition numbers, near-singular notes and dead-centre warnings (``checks`` then has
-    ``max_condition_number`` None): none of them makes a spec invalid; and the stages and designs
+    ``max_condition_number`` None), nor the parameters of the method's ``derived`` hook unless
+    the spec has references (which may name them): none of them makes a spec invalid; and the stages and designs
     of one geometry share its motion on the engine's general path
     (:func:`.engine.shared_motions`: the same errors, numbers equal to the Newton tolerance only,
     which ``balpipe check`` does not write)."""
@@ -259,7 +260,7 @@ def _run(spec: Spec, page: bool) -> Study:
             raise SpecFieldError(("analysis", "claim_tolerance", name),
                                  f"no stage {name!r} (stages: {', '.join(s.stage.name for s in stages)})")
     metrics = [stage_metrics(s, reference_of(stages, s), tol, overrides) for s in stages]
-    if balance.derived is not None:
+    if balance.derived is not None and (page or spec.references):  # the page's, and what a reference may name
         balance.parameters.extend(balance.derived(stages))
     problems = []
     rvm = max(max(m["reactions_vs_momentum_force"], m["reactions_vs_momentum_moment"]) for m in metrics)

@@ -21,7 +21,6 @@ def check_one(f, clash: str | None) -> tuple[str, str]:
     ("crashed", the internal error). ``clash``: the spec's page-name clash, if any."""
     from ..loader import SpecErrors, load
     from ..runner import analyse
-    from ..sweep import SweepError, plan
 
     try:
         if clash is not None:
@@ -29,6 +28,8 @@ def check_one(f, clash: str | None) -> tuple[str, str]:
         loaded = load(f)
         analyse(loaded, page=False)  # what only the page shows cannot make a spec invalid
         if loaded.spec.sweep is not None:  # its paths and values against the spec, as balpipe sweep does
+            from ..sweep import SweepError, plan  # only for a spec with a sweep block
+
             try:
                 plan(str(f))
             except SweepError as exc:

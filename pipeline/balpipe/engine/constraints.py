@@ -167,16 +167,24 @@ def velocity_rhs(c: Compiled, t: np.ndarray) -> np.ndarray:
 
 
 def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """gamma = Phi_q q'' (everything in Phi'' but the q'' terms, moved to the right), (N, m)."""
-    out = []
+    """gamma = Phi_q q'' (everything in Phi'' but the q'' terms, moved to the right), (N, m);
+    the revolute rows for every joint at once, as in :func:`residual`."""
+    rev = revolute_rows(c)
+    out = np.empty((qx.shape[0], len(c.row_owner)))
+    if rev is not None:
+        wi, wj = vx[:, rev.ti], vx[:, rev.tj]
+        Ai, Aj = _rotate_all(qx[:, rev.ti], rev.si), _rotate_all(qx[:, rev.tj], rev.sj)
+        out[:, rev.rows] = (wi**2)[..., None] * Ai - (wj**2)[..., None] * Aj
+    row = 0
     for p in c.prims:
         if isinstance(p, _Coincident):
-            _, thi = _split(qx, p.i)
-            _, thj = _split(qx, p.j)
-            wi, wj = vx[:, 3 * p.i + 2], vx[:, 3 * p.j + 2]
-            out.append((wi**2)[:, None] * rotate(thi, p.si) - (wj**2)[:, None] * rotate(thj, p.sj))
+            if rev is None:
+                _, thi = _split(qx, p.i)
+                _, thj = _split(qx, p.j)
+                wi, wj = vx[:, 3 * p.i + 2], vx[:, 3 * p.j + 2]
+                out[:, row : row + 2] = (wi**2)[:, None] * rotate(thi, p.si) - (wj**2)[:, None] * rotate(thj, p.sj)
         elif isinstance(p, _Angle):
-            out.append(_law_values(p, t)[2][:, None])
+            out[:, row] = _law_values(p, t)[2]
         else:
             ri, thi = _split(qx, p.i)
             rj, thj = _split(qx, p.j)
@@ -191,8 +199,9 @@ def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray)
                 + 2 * wi * np.sum(_perp(e) * dd, axis=1)
                 + np.sum(e * (-(wj**2)[:, None] * Asj + (wi**2)[:, None] * Asi), axis=1)
             )
-            out.append((_law_values(p, t)[2] - quad)[:, None])
-    return np.concatenate(out, axis=1)
+            out[:, row] = _law_values(p, t)[2] - quad
+        row += p.rows
+    return out
 
 
 def with_frame(q: np.ndarray) -> np.ndarray:
