@@ -69,6 +69,11 @@ def test_a_shared_motion_that_does_not_solve_the_model_is_rejected(monkeypatch):
     assert np.abs(q - ref).max() <= 1e-9 * np.abs(ref).max()
 
 
+def _drawn_design(name: str) -> bool:
+    """Paper 001's drawn designs (Figs. 3, 4b): their parameters, and their derived peak forces."""
+    return name.startswith(("peak_force_ratio_", "added_mass_fig", "eq17_residual_fig", "finder_residual_fig"))
+
+
 def test_check_path_skips_the_page_diagnostics_but_not_the_stages():
     loaded = load("specs/paper001_4rrr_fig6a.yaml")
     quick = run_analyse(loaded, page=False)
@@ -76,13 +81,27 @@ def test_check_path_skips_the_page_diagnostics_but_not_the_stages():
     assert quick.checks["max_condition_number"] is None and quick.warnings == []
     assert full.checks["max_condition_number"] > 1.0
     assert [s.stage.name for s in quick.stages] == [s.stage.name for s in full.stages]
-    derived = [p.name for p in full.balance.parameters if p.name.startswith("peak_force_ratio_")]
-    assert derived and not loaded.spec.references  # the method's derived hook: skipped without references
+    for a, b in zip(quick.stages, full.stages):
+        assert a.max_effort == pytest.approx(b.max_effort, rel=1e-9)
+    drawn = [p.name for p in full.balance.parameters if _drawn_design(p.name)]
+    assert drawn and not loaded.spec.references  # page only: left out without references
+    assert "topologies" in full.balance.details and "topologies" not in quick.balance.details
     assert [p.name for p in quick.balance.parameters] == [p.name for p in full.balance.parameters
-                                                          if p.name not in derived]
+                                                          if p.name not in drawn]
     values = {p.name: p.value for p in full.balance.parameters}
     for p in quick.balance.parameters:
         assert p.value == pytest.approx(values[p.name], rel=1e-6, abs=1e-9), p.name
+
+
+def test_check_path_computes_what_a_reference_may_name(tmp_path):
+    """A reference may name a drawn design's parameter: with references the check computes them."""
+    src = open("specs/paper001_4rrr_fig6a.yaml", encoding="utf-8").read()
+    path = tmp_path / "fig6a_ref.yaml"
+    path.write_text(src + "references:\n  - {name: peak_force_ratio_fig4b, published: 1.0, expect: differ}\n"
+                    "  - {name: added_mass_fig3a, published: 1.0, expect: differ}\n", encoding="utf-8")
+    quick = run_analyse(load(path), page=False)
+    assert [r["name"] for r in quick.references] == ["peak_force_ratio_fig4b", "added_mass_fig3a"]
+    assert any(_drawn_design(p.name) for p in quick.balance.parameters)
 
 
 def test_check_path_keeps_derived_parameters_that_references_may_name():
