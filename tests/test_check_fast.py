@@ -143,3 +143,15 @@ def test_spread_indices_are_np_unique_of_the_rounded_linspace(n, keep):
     expected = np.unique(np.linspace(0, n - 1, min(n, keep)).round().astype(int))
     got = spread_indices(n, keep)
     assert got.dtype == expected.dtype and np.array_equal(got, expected)
+
+
+def test_prepare_builds_the_spec_validator_before_a_pool_forks():
+    """``balpipe check`` with a pool builds the spec's validator (deferred by pydantic to the first
+    spec validated) once in the parent: the workers inherit it."""
+    import subprocess
+    import sys
+
+    probe = ("from balpipe.spec import Spec\nfrom balpipe import loader\nbefore = Spec.__pydantic_complete__\n"
+             "loader.prepare()\nprint(before, Spec.__pydantic_complete__)")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120).stdout.split()
+    assert out == ["False", "True"]

@@ -59,6 +59,8 @@ def run(args) -> int:
         print(msg, file=sys.stderr)
     clash = clashes(files)
     jobs = args.jobs if args.jobs is not None else default_jobs(len(files))
+    if jobs > 1 and len(files) > 1:
+        loader.prepare()  # once here, not in every worker
     bad = crashed = 0
     for verdict, message in in_order(_check_item, [(f, clash.get(f)) for f in files], jobs):
         if verdict == "ok":
