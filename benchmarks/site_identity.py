@@ -5,8 +5,9 @@
 Each revision is exported with ``git archive`` (its templates/ copied into the package, as an
 install does) and built with this Python, ``PYTHONPATH`` pointing at the export; the working tree
 and other checkouts are not touched. Fields that name the version or hash the code
-(``balpipe_version``, ``input_hash``, ``code_hash``) and the timing files and fields are
-ignored, in JSON by key and in other text files by value. Prints every other difference and exits
+(``balpipe_version``, ``input_hash``, ``code_hash``, and the index's site key, which hashes
+the code) and the timing files and fields are ignored, in JSON by key and in other text files by
+value. Prints every other difference and exits
 1 when there is one, 0 when the sites are the same.
 """
 
@@ -26,6 +27,8 @@ ROOT = Path(__file__).resolve().parents[1]
 IGNORED_KEYS = {"balpipe_version", "input_hash", "code_hash", "timing", "seconds", "elapsed"}
 IGNORED_FILES = {"timing.json", "timing.js", ".balpipe.lock"}
 IGNORED_DIRS = {".cache"}  # the build's figure cache (balpipe.draw.cache), not part of the site
+# the index's site key hashes the code (balpipe.build.site_key starts from code_hash)
+SITE_KEY = re.compile(rb'(<meta name="balpipe-site-key" content=")[0-9a-f]*(")')
 
 
 def export(rev: str, into: Path) -> Path:
@@ -84,8 +87,10 @@ def compare(a: Path, b: Path) -> list[str]:
     problems += [f"only in B: {n}" for n in sorted(set(fb) - set(fa))]
     for name in sorted(set(fa) & set(fb)):
         x, y = fa[name], fb[name]
-        if isinstance(x, bytes) and isinstance(y, bytes) and pattern is not None:
-            x, y = pattern.sub(b"<ignored>", x), pattern.sub(b"<ignored>", y)
+        if isinstance(x, bytes) and isinstance(y, bytes):
+            x, y = SITE_KEY.sub(rb"\1<ignored>\2", x), SITE_KEY.sub(rb"\1<ignored>\2", y)
+            if pattern is not None:
+                x, y = pattern.sub(b"<ignored>", x), pattern.sub(b"<ignored>", y)
         if x != y:
             problems.append(f"differs: {name}")
     return problems

@@ -44,3 +44,16 @@ def test_help_loads_neither_numpy_nor_pydantic(args):
     r = subprocess.run([sys.executable, "-c", probe, json.dumps(args)], cwd=ROOT, capture_output=True, text=True,
                        timeout=120)
     assert json.loads(r.stderr.strip().splitlines()[-1]) == []
+
+
+@pytest.mark.parametrize("args", [["check", "specs/scott_russell.yaml"],
+                                  ["check", "specs/offset_slider_crank.yaml", "specs/paper002_decoupling.yaml"]])
+def test_check_loads_neither_numpy_ma_nor_numpy_random(args):
+    """``np.unique`` imports numpy.ma (~90 ms) and the dead-centre search numpy.random: the
+    engine spreads its continuation's samples without it (:func:`balpipe.sampling.spread_indices`)
+    and check leaves the page's diagnostics out. The sweep's planner only for a spec with a
+    ``sweep:`` block."""
+    probe = PROBE.format(heavy=HEAVY + ("numpy.ma", "numpy.random", "balpipe.sweep"))
+    r = subprocess.run([sys.executable, "-c", probe, json.dumps(args)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=120)
+    assert json.loads(r.stderr.strip().splitlines()[-1]) == []

@@ -431,6 +431,12 @@ def load(path: str | Path) -> LoadedSpec:
     return LoadedSpec(p, text, spec, node)
 
 
+def prepare() -> None:
+    """Build the spec's validator now (pydantic defers it to the first spec validated, ~50 ms):
+    before a process pool forks, so that its workers inherit it instead of each building it."""
+    Spec.model_rebuild()
+
+
 def schema() -> dict[str, Any]:
     """The JSON Schema of a spec (``balpipe schema``)."""
     s = _stable_def_names(Spec.model_json_schema(by_alias=True))

@@ -55,7 +55,9 @@ class Method:
     caption), drawn from the study's stages and ``study.balance.details``: the page composes the
     template's figures and the method's, so no figure code branches on a method's name.
     ``page_only`` names fields of ``spec`` that only add to the page (no error depends on them):
-    ``balpipe check`` balances with them set to None."""
+    ``balpipe check`` balances with them set to None. With ``page_aware``, ``balance`` also
+    receives ``page=``: False in ``balpipe check`` of a spec without references, where it may
+    leave out parameters, notes and details that no error depends on (designs only drawn)."""
 
     name: str
     spec: type[Strict]
@@ -70,6 +72,7 @@ class Method:
     notation: Any = None  # the papers' symbols of the inputs: a table or table(method_spec) (balpipe.notation)
     figures: Callable[..., Any] | None = None
     page_only: tuple[str, ...] = ()
+    page_aware: bool = False  # balance(..., page=bool): whether the page's outputs are wanted
 
 
 @dataclass(frozen=True)

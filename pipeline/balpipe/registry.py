@@ -127,7 +127,8 @@ def motion_model(spec: Any, motion: Any, samples: int | None, path: tuple) -> tu
 def balance(spec: Any, balancing: Any = None, page: bool = True) -> BalanceResult:
     """The unbalanced model and the method's stages, with every semantic check of the spec;
     ``balancing`` replaces ``spec.balancing`` (the designs of ``spec.compare``). Without
-    ``page``, the method's :attr:`Method.page_only` fields are left out (``balpipe check``)."""
+    ``page``, the method's :attr:`Method.page_only` fields are left out (``balpipe check``), and a
+    :attr:`Method.page_aware` method is told so unless the spec has references."""
     balancing = balancing if balancing is not None else spec.balancing
     name = balancing.method
     model = unbalanced_model(spec)
@@ -136,8 +137,9 @@ def balance(spec: Any, balancing: Any = None, page: bool = True) -> BalanceResul
     method = METHODS[name]
     if not page and method.page_only:
         balancing = balancing.model_copy(update=dict.fromkeys(method.page_only))
+    aware = {"page": bool(page or spec.references)} if method.page_aware else {}  # references may name anything
     if method.generic:
-        extra = {"spec": spec} if method.uses_spec else {}
+        extra = {"spec": spec, **aware} if method.uses_spec else dict(aware)
         if method.other_motions:
             extra["models"] = functools.partial(motion_model, spec)
         return method.balance(spec.mechanism, balancing, model, t=time_grid(spec), **extra)
@@ -147,8 +149,8 @@ def balance(spec: Any, balancing: Any = None, page: bool = True) -> BalanceResul
             f"method {name!r} applies to {', '.join(method.templates)}, not to {spec.mechanism.template!r}",
         )
     if method.uses_spec:
-        return method.balance(spec.mechanism, balancing, model, spec)
-    return method.balance(spec.mechanism, balancing, model)
+        return method.balance(spec.mechanism, balancing, model, spec, **aware)
+    return method.balance(spec.mechanism, balancing, model, **aware)
 
 
 def balance_designs(spec: Any, page: bool = True) -> BalanceResult:

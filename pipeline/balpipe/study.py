@@ -3,6 +3,7 @@ checks and references. No files are written here (see :mod:`balpipe.build`)."""
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -12,7 +13,7 @@ import numpy as np
 from . import actuation, assembly, dead_centres, loop_closure, realisable, registry
 from .balancing.base import BalanceResult, Stage
 from .claim_precision import claim_tolerances
-from .engine import Analysis, AnalysisError, analyse
+from .engine import Analysis, AnalysisError, analyse, shared_motions
 from .engine.load_reference import LoadReference, load_reference
 from .sampling import gravity_vector  # noqa: F401  (balpipe.study.gravity_vector, as before)
 from .spec import Spec
@@ -213,9 +214,37 @@ def _decimals(x: float) -> int:
     return 0 if frac == "0" else len(frac)
 
 
+def near_singular_note(stages: list[StageResult], balance: BalanceResult, problems: list[str]) -> float:
+    """The largest condition number of the constraint Jacobian over the stages' motions (an SVD
+    per sample, computed here when the engine's block path has not); above
+    :data:`NEAR_SINGULAR`, a note of the accuracy lost there, also appended to the balance
+    ``problems`` (in place). Only the page shows them: ``balpipe check`` skips this."""
+    worst = max(stages, key=lambda s: float(np.max(s.analysis.extra["condition"])))
+    cond = worst.analysis.extra["condition"]
+    k = int(np.argmax(cond))
+    if float(cond[k]) > NEAR_SINGULAR:
+        where = (f"the motion passes near a singular configuration (condition number of the constraint "
+                 f"Jacobian {cond[k]:.3g} at t = {worst.analysis.t[k]:.4g} s): accelerations there lose about "
+                 f"{min(1.0, cond[k] ** 2 * 1e-16):.1g} of their relative accuracy")
+        balance.notes.append(where[0].upper() + where[1:] + ".")
+        problems[:] = [p + f"; {where}" if "should cancel" in p else p for p in problems]
+    return float(cond[k])
+
+
 def run(spec: Spec, page: bool = True) -> Study:
     """Balance and analyse every stage; collect checks and problems (no simulation). Without
-    ``page``, what only the page shows is not computed (:func:`.registry.balance`)."""
+    ``page``, what only the page shows is not computed (:func:`.registry.balance`), nor the
+    condition numbers, near-singular notes and dead-centre warnings (``checks`` then has
+    ``max_condition_number`` None), nor the parameters of the method's ``derived`` hook unless
+    the spec has references (which may name them): none of them makes a spec invalid; and the stages and designs
+    of one geometry share its motion on the engine's general path
+    (:func:`.engine.shared_motions`: the same errors, numbers equal to the Newton tolerance only,
+    which ``balpipe check`` does not write)."""
+    with (contextlib.nullcontext() if page else shared_motions()):
+        return _run(spec, page)
+
+
+def _run(spec: Spec, page: bool) -> Study:
     model = registry.unbalanced_model(spec)
     if model.sources:  # a spec that gives its own poses (custom): the assembly must confirm them
         assembly.check(model, float(registry.time_grid(spec)[0]))
@@ -231,7 +260,7 @@ def run(spec: Spec, page: bool = True) -> Study:
             raise SpecFieldError(("analysis", "claim_tolerance", name),
                                  f"no stage {name!r} (stages: {', '.join(s.stage.name for s in stages)})")
     metrics = [stage_metrics(s, reference_of(stages, s), tol, overrides) for s in stages]
-    if balance.derived is not None:
+    if balance.derived is not None and (page or spec.references):  # the page's, and what a reference may name
         balance.parameters.extend(balance.derived(stages))
     problems = []
     rvm = max(max(m["reactions_vs_momentum_force"], m["reactions_vs_momentum_moment"]) for m in metrics)
@@ -248,16 +277,7 @@ def run(spec: Spec, page: bool = True) -> Study:
                 f"{m[f'{w}_tolerance']:.3g} of the reference {w} (achieved {m[f'{w}_ratio']:.3g})" for w in claimed)
                 + f", set by the {m['tolerance_source']}" + ("" if m["tolerance_source"] == "spec" else
                 " (each rounded at its last digit, the worst case carried through the loads)") + ".")
-    worst = max(stages, key=lambda s: float(np.max(s.analysis.extra["condition"])))
-    cond = worst.analysis.extra["condition"]
-    k = int(np.argmax(cond))
-    near_singular = float(cond[k]) > NEAR_SINGULAR
-    if near_singular:
-        where = (f"the motion passes near a singular configuration (condition number of the constraint "
-                 f"Jacobian {cond[k]:.3g} at t = {worst.analysis.t[k]:.4g} s): accelerations there lose about "
-                 f"{min(1.0, cond[k] ** 2 * 1e-16):.1g} of their relative accuracy")
-        balance.notes.append(where[0].upper() + where[1:] + ".")
-        problems = [p + f"; {where}" if "should cancel" in p else p for p in problems]
+    max_condition = near_singular_note(stages, balance, problems) if page else None
     redundant = max(int(s.analysis.extra.get("redundant_actuators", 0)) for s in stages)
     if redundant:
         n = len(stages[0].stage.model.drivers)
@@ -267,11 +287,12 @@ def run(spec: Spec, page: bool = True) -> Study:
             "the least sum of squares, no internal preload), and the joint reactions follow from the same "
             "multipliers. The shaking force and moment do not depend on how the actuators share the load."
         )
-    warnings = dead_centres.unique([w for s in stages for w in dead_centres.find(s.stage.model, s.analysis, s.stage.name)])
+    warnings = (dead_centres.unique([w for s in stages for w in dead_centres.find(s.stage.model, s.analysis, s.stage.name)])
+                if page else [])
     virtual = actuation.virtual_note(stages[0].stage.model)
     if virtual:
         balance.notes.append(virtual)
     refs = compare_references(spec, balance, metrics)
-    checks = {"reactions_vs_momentum": rvm, "balance_tolerance": tol, "max_condition_number": float(cond[k]),
+    checks = {"reactions_vs_momentum": rvm, "balance_tolerance": tol, "max_condition_number": max_condition,
               "reference": ratio_reference(stages[0]).to_json()}
     return Study(spec, balance, stages, refs, checks, problems, warnings=warnings)

@@ -21,7 +21,6 @@ def check_one(f, clash: str | None) -> tuple[str, str]:
     ("crashed", the internal error). ``clash``: the spec's page-name clash, if any."""
     from ..loader import SpecErrors, load
     from ..runner import analyse
-    from ..sweep import SweepError, plan
 
     try:
         if clash is not None:
@@ -29,6 +28,8 @@ def check_one(f, clash: str | None) -> tuple[str, str]:
         loaded = load(f)
         analyse(loaded, page=False)  # what only the page shows cannot make a spec invalid
         if loaded.spec.sweep is not None:  # its paths and values against the spec, as balpipe sweep does
+            from ..sweep import SweepError, plan  # only for a spec with a sweep block
+
             try:
                 plan(str(f))
             except SweepError as exc:
@@ -58,6 +59,8 @@ def run(args) -> int:
         print(msg, file=sys.stderr)
     clash = clashes(files)
     jobs = args.jobs if args.jobs is not None else default_jobs(len(files))
+    if jobs > 1 and len(files) > 1:
+        loader.prepare()  # once here, not in every worker
     bad = crashed = 0
     for verdict, message in in_order(_check_item, [(f, clash.get(f)) for f in files], jobs):
         if verdict == "ok":

@@ -10,12 +10,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model import Model
-from . import fastpath, structure
+from . import fastpath, shared, structure
 from .compile import Compiled, compile_model
 from .constraints import with_frame, jacobian
 from .dynamics import joint_reactions, solve_multipliers, radial_tooth_loads, tooth_rows, actuation_condition
 from .kinematics import _vel_acc
-from .positions import condition_numbers, redundancy, solve_positions
+from .positions import condition_numbers, redundancy
 
 
 @dataclass
@@ -176,7 +176,7 @@ def analyse(
         except fastpath.Fallback:
             kin = None
     if kin is None:
-        q = solve_positions(c, t)
+        q = shared.positions(c, t)  # solve_positions, or a shared motion (balpipe check only)
         v, a = _vel_acc(c, q, t)
         cond = c.condition
         condition = None

@@ -3,6 +3,8 @@ velocity (nu) and acceleration (gamma) equations, vectorised over samples (Haug,
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .compile import Compiled, _Angle, _Coincident, _perp, rotate
@@ -21,42 +23,66 @@ def _law_values(prim, t: np.ndarray):
 
 
 def residual(c: Compiled, qx: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Phi(q, t), shape (N, m)."""
-    out = []
+    """Phi(q, t), shape (N, m). The revolute rows of every joint at once (:func:`revolute_rows`),
+    the same arithmetic as one joint at a time, so the same bits."""
+    rev = revolute_rows(c)
+    out = np.empty((qx.shape[0], len(c.row_owner)))
+    if rev is not None:
+        ri, rj = qx[:, rev.xi], qx[:, rev.xj]
+        Ai, Aj = _rotate_all(qx[:, rev.ti], rev.si), _rotate_all(qx[:, rev.tj], rev.sj)
+        out[:, rev.rows] = ri + Ai - rj - Aj
+    row = 0
     for p in c.prims:
         if isinstance(p, _Coincident):
-            ri, thi = _split(qx, p.i)
-            rj, thj = _split(qx, p.j)
-            out.append(ri + rotate(thi, p.si) - rj - rotate(thj, p.sj))
+            if rev is None:
+                ri, thi = _split(qx, p.i)
+                rj, thj = _split(qx, p.j)
+                out[:, row : row + 2] = ri + rotate(thi, p.si) - rj - rotate(thj, p.sj)
         elif isinstance(p, _Angle):
             f = _law_values(p, t)[0]
             val = sum(v * qx[:, 3 * k + 2] for k, v in p.coeffs) - p.const - f
-            out.append(val[:, None])
+            out[:, row] = val
         else:
             f = _law_values(p, t)[0]
             ri, thi = _split(qx, p.i)
             rj, thj = _split(qx, p.j)
             e = rotate(thi, p.a)
             d = rj + rotate(thj, p.sj) - ri - rotate(thi, p.si)
-            out.append((np.sum(e * d, axis=1) - p.const - f)[:, None])
-    return np.concatenate(out, axis=1)
+            out[:, row] = np.sum(e * d, axis=1) - p.const - f
+        row += p.rows
+    return out
 
 
 def jacobian(c: Compiled, qx: np.ndarray) -> np.ndarray:
-    """Phi_q over the extended coordinates (frame included), shape (N, m, 3 nb + 3)."""
+    """Phi_q over the extended coordinates (frame included), shape (N, m, 3 nb + 3). Every entry
+    of a revolute joint's rows has that joint alone as its source: they are written for every
+    joint at once (``0.0 + x``, ``0.0 - x``: the signed zeros of the accumulation)."""
     N = qx.shape[0]
     m = len(c.row_owner)
     J = np.zeros((N, m, qx.shape[1]))
+    rev = revolute_rows(c)
+    if rev is not None:
+        r0, r1 = rev.rows[:, 0], rev.rows[:, 1]
+        for a, r in ((0, r0), (1, r1)):
+            J[:, r, rev.xi[:, a]] = 0.0 + 1.0
+            J[:, r, rev.xj[:, a]] = 0.0 - 1.0
+        Pi = _perp(_rotate_all(qx[:, rev.ti], rev.si))
+        Pj = _perp(_rotate_all(qx[:, rev.tj], rev.sj))
+        J[:, r0, rev.ti] = 0.0 + Pi[..., 0]
+        J[:, r1, rev.ti] = 0.0 + Pi[..., 1]
+        J[:, r0, rev.tj] = 0.0 - Pj[..., 0]
+        J[:, r1, rev.tj] = 0.0 - Pj[..., 1]
     row = 0
     for p in c.prims:
         if isinstance(p, _Coincident):
-            _, thi = _split(qx, p.i)
-            _, thj = _split(qx, p.j)
-            for a in range(2):
-                J[:, row + a, 3 * p.i + a] += 1.0
-                J[:, row + a, 3 * p.j + a] -= 1.0
-            J[:, row : row + 2, 3 * p.i + 2] += _perp(rotate(thi, p.si))
-            J[:, row : row + 2, 3 * p.j + 2] -= _perp(rotate(thj, p.sj))
+            if rev is None:
+                _, thi = _split(qx, p.i)
+                _, thj = _split(qx, p.j)
+                for a in range(2):
+                    J[:, row + a, 3 * p.i + a] += 1.0
+                    J[:, row + a, 3 * p.j + a] -= 1.0
+                J[:, row : row + 2, 3 * p.i + 2] += _perp(rotate(thi, p.si))
+                J[:, row : row + 2, 3 * p.j + 2] -= _perp(rotate(thj, p.sj))
         elif isinstance(p, _Angle):
             for k, v in p.coeffs:
                 J[:, row, 3 * k + 2] += v
@@ -74,6 +100,61 @@ def jacobian(c: Compiled, qx: np.ndarray) -> np.ndarray:
     return J
 
 
+@dataclass(frozen=True)
+class RevoluteRows:
+    """Indices of every revolute joint (``_Coincident``) of a compiled model, in prim order:
+    ``rows`` (K, 2) its two constraint rows, ``xi``/``xj`` (K, 2) the position columns of bodies
+    i and j in the extended coordinates, ``ti``/``tj`` (K,) their angle columns, ``si``/``sj``
+    (K, 2) the joint point relative to each centre of mass."""
+
+    rows: np.ndarray
+    xi: np.ndarray
+    xj: np.ndarray
+    ti: np.ndarray
+    tj: np.ndarray
+    si: np.ndarray
+    sj: np.ndarray
+
+
+_REVOLUTE: dict[int, tuple[list, RevoluteRows | None]] = {}
+
+
+def revolute_rows(c: Compiled) -> RevoluteRows | None:
+    """The :class:`RevoluteRows` of ``c``, made once per list of prims; None when ``c`` has none
+    or a joint joins a body to itself (then the joints are evaluated one at a time)."""
+    hit = _REVOLUTE.get(id(c.prims))
+    if hit is not None and hit[0] is c.prims:
+        return hit[1]
+    rows, idx = [], []
+    row = 0
+    for p in c.prims:
+        if isinstance(p, _Coincident):
+            rows.append((row, row + 1))
+            idx.append(p)
+        row += p.rows
+    out = None
+    if idx and all(p.i != p.j for p in idx):
+        i = np.array([p.i for p in idx])
+        j = np.array([p.j for p in idx])
+        out = RevoluteRows(np.array(rows), np.stack([3 * i, 3 * i + 1], axis=1),
+                           np.stack([3 * j, 3 * j + 1], axis=1), 3 * i + 2, 3 * j + 2,
+                           np.array([p.si for p in idx], dtype=float), np.array([p.sj for p in idx], dtype=float))
+    if len(_REVOLUTE) >= 256:
+        _REVOLUTE.clear()
+    _REVOLUTE[id(c.prims)] = (c.prims, out)  # the list kept alive: its id stays its own
+    return out
+
+
+def _rotate_all(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """A(theta_k) s_k for theta (N, K), s (K, 2) -> (N, K, 2): :func:`.compile.rotate` of every
+    joint at once (the same operations)."""
+    c, si = np.cos(theta), np.sin(theta)
+    out = np.empty(theta.shape + (2,))
+    out[..., 0] = c * s[:, 0] - si * s[:, 1]
+    out[..., 1] = si * s[:, 0] + c * s[:, 1]
+    return out
+
+
 def velocity_rhs(c: Compiled, t: np.ndarray) -> np.ndarray:
     """nu = -Phi_t, shape (N, m)."""
     out = []
@@ -86,16 +167,24 @@ def velocity_rhs(c: Compiled, t: np.ndarray) -> np.ndarray:
 
 
 def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """gamma = Phi_q q'' (everything in Phi'' but the q'' terms, moved to the right), (N, m)."""
-    out = []
+    """gamma = Phi_q q'' (everything in Phi'' but the q'' terms, moved to the right), (N, m);
+    the revolute rows for every joint at once, as in :func:`residual`."""
+    rev = revolute_rows(c)
+    out = np.empty((qx.shape[0], len(c.row_owner)))
+    if rev is not None:
+        wi, wj = vx[:, rev.ti], vx[:, rev.tj]
+        Ai, Aj = _rotate_all(qx[:, rev.ti], rev.si), _rotate_all(qx[:, rev.tj], rev.sj)
+        out[:, rev.rows] = (wi**2)[..., None] * Ai - (wj**2)[..., None] * Aj
+    row = 0
     for p in c.prims:
         if isinstance(p, _Coincident):
-            _, thi = _split(qx, p.i)
-            _, thj = _split(qx, p.j)
-            wi, wj = vx[:, 3 * p.i + 2], vx[:, 3 * p.j + 2]
-            out.append((wi**2)[:, None] * rotate(thi, p.si) - (wj**2)[:, None] * rotate(thj, p.sj))
+            if rev is None:
+                _, thi = _split(qx, p.i)
+                _, thj = _split(qx, p.j)
+                wi, wj = vx[:, 3 * p.i + 2], vx[:, 3 * p.j + 2]
+                out[:, row : row + 2] = (wi**2)[:, None] * rotate(thi, p.si) - (wj**2)[:, None] * rotate(thj, p.sj)
         elif isinstance(p, _Angle):
-            out.append(_law_values(p, t)[2][:, None])
+            out[:, row] = _law_values(p, t)[2]
         else:
             ri, thi = _split(qx, p.i)
             rj, thj = _split(qx, p.j)
@@ -110,8 +199,9 @@ def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray)
                 + 2 * wi * np.sum(_perp(e) * dd, axis=1)
                 + np.sum(e * (-(wj**2)[:, None] * Asj + (wi**2)[:, None] * Asi), axis=1)
             )
-            out.append((_law_values(p, t)[2] - quad)[:, None])
-    return np.concatenate(out, axis=1)
+            out[:, row] = _law_values(p, t)[2] - quad
+        row += p.rows
+    return out
 
 
 def with_frame(q: np.ndarray) -> np.ndarray:

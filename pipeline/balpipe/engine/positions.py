@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..sampling import spread_indices
 from .compile import Compiled
 from .constraints import with_frame, jacobian, residual
 from .errors import AnalysisError
@@ -189,7 +190,7 @@ def follow_motion(c: Compiled, t: np.ndarray, ops=None) -> np.ndarray:
         err.q = q[0]
         raise err
     _check_redundancy(c, q[0], float(t[0]))
-    coarse_idx = np.unique(np.linspace(0, N - 1, min(N, _COARSE)).round().astype(int))
+    coarse_idx = spread_indices(N, _COARSE)
     tc = t[coarse_idx]
     qc = np.zeros((len(tc), q.shape[1]))
     vc = np.zeros_like(qc)

@@ -15,6 +15,6 @@ FAMILY = Family(
     methods=(
         Method("rrr4_counter_masses", counter_masses.RRR4Balancing, counter_masses.balance, ("rrr4",),
                "counter-masses: leg by leg (eqs. 8-11), from eq. 17 (Fig. 4a) and eqs. 19/21 (Fig. 6)",
-               notation=counter_masses.NOTATION, figures=figures.figures),
+               notation=counter_masses.NOTATION, figures=figures.figures, page_aware=True),
     ),
 )

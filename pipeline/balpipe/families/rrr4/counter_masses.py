@@ -206,7 +206,12 @@ def platform_rotates(model: Model, samples: int = 201) -> bool:
     return bool(np.ptp(th) > 1e-12)
 
 
-def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceResult:
+def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, page: bool = True) -> BalanceResult:
+    """The stages (unbalanced, leg by leg, least mass, eq. 17's general design, the special
+    kinematics' design), their parameters and notes. Without ``page`` (``balpipe check`` of a
+    spec without references) the drawn designs of Figs. 3 and 4b (:func:`topology_designs`:
+    parameters, a note, details and their derived peak forces) are left out: no stage and no
+    error depends on them."""
     legs = resolve_legs(mech)
     stages = [Stage("unbalanced", "unbalanced", model, f"the {model.name} as given")]
     lbl, params = leg_by_leg(mech, spec, model)
@@ -242,8 +247,9 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model) -> BalanceRe
                                 "from eq. 17's twelve conditions", "force"))
             params.append(Parameter("added_mass_general", gen.total_mass() - base_mass, "kg", "eq. 17",
                                     "counter-masses of the eq. 17 design (Fig. 4a)"))
-            designs = topology_designs(model, g, spec, found, base_mass, params, notes, details)
-            derived = partial(design_loads, designs, details["topologies"]["designs"])
+            if page:
+                designs = topology_designs(model, g, spec, found, base_mass, params, notes, details)
+                derived = partial(design_loads, designs, details["topologies"]["designs"])
             if mech.kinematics != "general":
                 fig = topologies.fig6_label(mech.kinematics, topologies.arms_cross(model))
                 eq = cond.SPECIAL_EQ[mech.kinematics]

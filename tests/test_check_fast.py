@@ -1,0 +1,157 @@
+"""``balpipe check`` does less than ``build`` for the same verdicts (issue 23, "check in a
+blink"): the stages of one geometry share its motion on the engine's general path
+(:func:`balpipe.engine.shared_motions`, check only), the page-only diagnostics (condition
+numbers, dead centres) are skipped, and the engine's revolute rows, evaluated for every joint at
+once, are the per-joint arithmetic to the last bit (``build``'s output is unchanged)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from balpipe import engine, registry
+from balpipe.engine import analyse, compiled, constraints, shared
+from balpipe.engine.constraints import with_frame
+from balpipe.loader import load
+from balpipe.runner import analyse as run_analyse
+from balpipe.sampling import spread_indices, time_grid
+from balpipe.study import gravity_vector
+
+RRR4 = "specs/paper001_4rrr.yaml"  # redundant actuation: the general (dense) path
+
+
+def _stages(path: str):
+    spec = load(path).spec
+    return spec, registry.balance(spec).stages
+
+
+def test_stages_share_the_motion_of_their_geometry_within_the_block():
+    spec, stages = _stages(RRR4)
+    t = time_grid(spec)
+    g, mp = gravity_vector(spec), tuple(spec.analysis.moment_point)
+    engine.clear_cache()
+    fresh = [analyse(s.model, t, g, mp) for s in stages]
+    before = dict(shared.STATS)
+    with engine.shared_motions():
+        mine = [analyse(s.model, t, g, mp) for s in stages]
+    assert shared.STATS["solved"] - before["solved"] == 1  # one continuation, every other stage shared
+    assert shared.STATS["shared"] - before["shared"] == len(stages) - 1
+    assert shared.STATS["rejected"] == before["rejected"]
+    for s, a, b in zip(stages, mine, fresh):
+        qa, qb = a.q, b.q
+        assert np.abs(qa - qb).max() <= 1e-9 * np.abs(qb).max(), s.name
+        assert np.abs(a.force - b.force).max() <= 1e-9 * max(np.abs(b.force).max(), 1.0), s.name
+        assert a.extra["condition"] == pytest.approx(b.extra["condition"], rel=1e-6)
+    analyse(stages[1].model, t, g, mp)  # outside the block: nothing shared any more
+    assert shared.STATS["shared"] - before["shared"] == len(stages) - 1
+
+
+def test_a_shared_motion_that_does_not_solve_the_model_is_rejected(monkeypatch):
+    """A motion that is not the model's (here: shifted by 0.5 rad) fails the branch guard; the
+    continuation runs and gives the model's own motion."""
+    spec, stages = _stages(RRR4)
+    t = time_grid(spec)
+    engine.clear_cache()
+    ref = analyse(stages[1].model, t).q
+    real = shared._from_shared
+
+    def shifted(c, t, frame):
+        bad = frame.copy()
+        bad[:, 2::3] += 0.5
+        return real(c, t, bad)
+
+    monkeypatch.setattr(shared, "_from_shared", shifted)
+    before = dict(shared.STATS)
+    with engine.shared_motions():
+        analyse(stages[0].model, t)
+        q = analyse(stages[1].model, t).q
+    assert shared.STATS["rejected"] - before["rejected"] == 1
+    assert np.abs(q - ref).max() <= 1e-9 * np.abs(ref).max()
+
+
+def _drawn_design(name: str) -> bool:
+    """Paper 001's drawn designs (Figs. 3, 4b): their parameters, and their derived peak forces."""
+    return name.startswith(("peak_force_ratio_", "added_mass_fig", "eq17_residual_fig", "finder_residual_fig"))
+
+
+def test_check_path_skips_the_page_diagnostics_but_not_the_stages():
+    loaded = load("specs/paper001_4rrr_fig6a.yaml")
+    quick = run_analyse(loaded, page=False)
+    full = run_analyse(loaded)
+    assert quick.checks["max_condition_number"] is None and quick.warnings == []
+    assert full.checks["max_condition_number"] > 1.0
+    assert [s.stage.name for s in quick.stages] == [s.stage.name for s in full.stages]
+    for a, b in zip(quick.stages, full.stages):
+        assert a.max_effort == pytest.approx(b.max_effort, rel=1e-9)
+    drawn = [p.name for p in full.balance.parameters if _drawn_design(p.name)]
+    assert drawn and not loaded.spec.references  # page only: left out without references
+    assert "topologies" in full.balance.details and "topologies" not in quick.balance.details
+    assert [p.name for p in quick.balance.parameters] == [p.name for p in full.balance.parameters
+                                                          if p.name not in drawn]
+    values = {p.name: p.value for p in full.balance.parameters}
+    for p in quick.balance.parameters:
+        assert p.value == pytest.approx(values[p.name], rel=1e-6, abs=1e-9), p.name
+
+
+def test_check_path_computes_what_a_reference_may_name(tmp_path):
+    """A reference may name a drawn design's parameter: with references the check computes them."""
+    src = open("specs/paper001_4rrr_fig6a.yaml", encoding="utf-8").read()
+    path = tmp_path / "fig6a_ref.yaml"
+    path.write_text(src + "references:\n  - {name: peak_force_ratio_fig4b, published: 1.0, expect: differ}\n"
+                    "  - {name: added_mass_fig3a, published: 1.0, expect: differ}\n", encoding="utf-8")
+    quick = run_analyse(load(path), page=False)
+    assert [r["name"] for r in quick.references] == ["peak_force_ratio_fig4b", "added_mass_fig3a"]
+    assert any(_drawn_design(p.name) for p in quick.balance.parameters)
+
+
+def test_check_path_keeps_derived_parameters_that_references_may_name():
+    loaded = load("specs/paper003_com_planning.yaml")
+    assert loaded.spec.references and any(r.name.startswith(("force_reduction", "moment_reduction"))
+                                          for r in loaded.spec.references)
+    quick = run_analyse(loaded, page=False)
+    assert any(p.name == "force_reduction_min" for p in quick.balance.parameters)
+    assert [r["name"] for r in quick.references] == [r.name for r in loaded.spec.references]
+
+
+@pytest.mark.parametrize("path", [RRR4, "specs/paper000_rpr3_idler_loop.yaml", "specs/paper004_five_bar.yaml",
+                                  "specs/custom_stephenson_six_bar_120rpm.yaml"])
+def test_revolute_rows_at_once_equal_the_joints_one_at_a_time_to_the_bit(path, monkeypatch):
+    spec, stages = _stages(path)
+    t = time_grid(spec)
+    rng = np.random.default_rng(7)
+    for s in stages:
+        c = compiled(s.model)
+        assert constraints.revolute_rows(c) is not None
+        q = c.q0[None, :] + rng.normal(scale=0.3, size=(len(t), len(c.q0)))
+        qx, vx = with_frame(q), with_frame(rng.normal(size=q.shape))
+
+        def rows():
+            return (constraints.residual(c, qx, t), constraints.jacobian(c, qx),
+                    constraints.acceleration_rhs(c, qx, vx, t))
+
+        fast = rows()
+        with monkeypatch.context() as m:
+            m.setattr(constraints, "revolute_rows", lambda c: None)
+            slow = rows()
+        for a, b in zip(fast, slow):
+            assert a.tobytes() == b.tobytes(), s.name  # signed zeros included
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 5, 16, 17, 18, 33, 501, 1000])
+@pytest.mark.parametrize("keep", [1, 2, 9, 17])
+def test_spread_indices_are_np_unique_of_the_rounded_linspace(n, keep):
+    expected = np.unique(np.linspace(0, n - 1, min(n, keep)).round().astype(int))
+    got = spread_indices(n, keep)
+    assert got.dtype == expected.dtype and np.array_equal(got, expected)
+
+
+def test_prepare_builds_the_spec_validator_before_a_pool_forks():
+    """``balpipe check`` with a pool builds the spec's validator (deferred by pydantic to the first
+    spec validated) once in the parent: the workers inherit it."""
+    import subprocess
+    import sys
+
+    probe = ("from balpipe.spec import Spec\nfrom balpipe import loader\nbefore = Spec.__pydantic_complete__\n"
+             "loader.prepare()\nprint(before, Spec.__pydantic_complete__)")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120).stdout.split()
+    assert out == ["False", "True"]
