@@ -80,10 +80,56 @@ def rng() -> np.random.Generator:
     return np.random.default_rng(20261122)
 
 
+def _shared_root(tmp_path_factory) -> Path:
+    """A folder that every xdist worker of this run sees (the parent of the workers' own)."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
+class Shared:
+    """Values computed once per run whatever the number of xdist workers: ``get(key, compute)``
+    runs ``compute()`` in the first worker that asks, under a lock, and keeps its pickle in the
+    run's shared folder; the other workers load it. A value that cannot be pickled (paper 003's
+    study holds local functions) is computed by each worker that asks."""
+
+    def __init__(self, root: Path):
+        self.root = root
+        root.mkdir(exist_ok=True)
+
+    def get(self, key: str, compute):
+        import fcntl
+        import pickle
+
+        name = hashlib.sha256(key.encode()).hexdigest()[:16]
+        path, refused = self.root / f"{name}.pickle", self.root / f"{name}.unpicklable"
+        with open(self.root / f"{name}.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            if path.exists():
+                return pickle.loads(path.read_bytes())
+            if not refused.exists():
+                value = compute()
+                try:
+                    data = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+                except (pickle.PicklingError, AttributeError, TypeError):
+                    refused.touch()
+                    return value
+                tmp = path.with_suffix(".part")
+                tmp.write_bytes(data)
+                tmp.replace(path)
+                return value
+        return compute()
+
+
 @pytest.fixture(scope="session")
-def studies():
-    """``studies(name)``: the study of ``specs/<name>``, run once per session (per xdist worker);
-    the tests only read it."""
+def shared(tmp_path_factory) -> Shared:
+    """:class:`Shared` in this run's folder shared by the xdist workers."""
+    return Shared(_shared_root(tmp_path_factory) / "shared-objects")
+
+
+@pytest.fixture(scope="session")
+def studies(shared):
+    """``studies(name)``: the study of ``specs/<name>``, run once per run (the first xdist worker
+    that needs it runs it, the others load it: :class:`Shared`); the tests only read it."""
     from balpipe import loader
     from balpipe import study as study_mod
 
@@ -91,7 +137,9 @@ def studies():
 
     def get(name: str):
         if name not in cache:
-            cache[name] = study_mod.run(loader.load(SPECS / name).spec)
+            text = (SPECS / name).read_text(encoding="utf-8")
+            cache[name] = shared.get(f"study\n{name}\n{text}",
+                                     lambda: study_mod.run(loader.load(SPECS / name).spec))
         return cache[name]
 
     return get
@@ -101,14 +149,19 @@ class Pages:
     """``pages(name)``: the page of ``studies(name)`` without the simulation (results of "x",
     hash "h", no spec text); ``pages.figures(name)``: the figures that page drew
     (:func:`balpipe.report.page.study_figures`'s dict, the very one the page was rendered
-    from). Each rendered once per session (per xdist worker)."""
+    from). Each rendered once per run (:class:`Shared`)."""
 
-    def __init__(self, studies):
+    def __init__(self, studies, shared: Shared):
         self._studies = studies
+        self._shared = shared
         self._html: dict[str, str] = {}
         self._figures: dict[str, dict] = {}
 
     def _render(self, name: str) -> None:
+        text = (SPECS / name).read_text(encoding="utf-8")
+        self._html[name], self._figures[name] = self._shared.get(f"page\n{name}\n{text}", lambda: self._draw(name))
+
+    def _draw(self, name: str) -> tuple[str, dict]:
         from balpipe.report import page, results
 
         st = self._studies(name)
@@ -125,7 +178,7 @@ class Pages:
         finally:
             page.study_figures = real
         assert len(drawn) == 1
-        self._html[name], self._figures[name] = html, drawn[0]
+        return html, drawn[0]
 
     def __call__(self, name: str) -> str:
         if name not in self._html:
@@ -139,16 +192,10 @@ class Pages:
 
 
 @pytest.fixture(scope="session")
-def pages(studies) -> Pages:
+def pages(studies, shared) -> Pages:
     """:class:`Pages` of the specs' studies (``pages(name)``, ``pages.figures(name)``); the tests
     only read them."""
-    return Pages(studies)
-
-
-def _shared_root(tmp_path_factory) -> Path:
-    """A folder that every xdist worker of this run sees (the parent of the workers' own)."""
-    base = tmp_path_factory.getbasetemp()
-    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+    return Pages(studies, shared)
 
 
 @pytest.fixture(scope="session")
