@@ -13,7 +13,6 @@ from __future__ import annotations
 import json
 import os
 import re
-import shutil
 import socket
 import subprocess
 import sys
@@ -27,7 +26,6 @@ from urllib.parse import urljoin, urlsplit
 import pytest
 
 from _gitrepo import Repo, edit
-from conftest import chromium  # noqa: F401 (where the browser is found)
 
 from balpipe import history
 from balpipe.build import Options, build
