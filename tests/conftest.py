@@ -80,10 +80,56 @@ def rng() -> np.random.Generator:
     return np.random.default_rng(20261122)
 
 
+def _shared_root(tmp_path_factory) -> Path:
+    """A folder that every xdist worker of this run sees (the parent of the workers' own)."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
+class Shared:
+    """Values computed once per run whatever the number of xdist workers: ``get(key, compute)``
+    runs ``compute()`` in the first worker that asks, under a lock, and keeps its pickle in the
+    run's shared folder; the other workers load it. A value that cannot be pickled (paper 003's
+    study holds local functions) is computed by each worker that asks."""
+
+    def __init__(self, root: Path):
+        self.root = root
+        root.mkdir(exist_ok=True)
+
+    def get(self, key: str, compute):
+        import fcntl
+        import pickle
+
+        name = hashlib.sha256(key.encode()).hexdigest()[:16]
+        path, refused = self.root / f"{name}.pickle", self.root / f"{name}.unpicklable"
+        with open(self.root / f"{name}.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            if path.exists():
+                return pickle.loads(path.read_bytes())
+            if not refused.exists():
+                value = compute()
+                try:
+                    data = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+                except (pickle.PicklingError, AttributeError, TypeError):
+                    refused.touch()
+                    return value
+                tmp = path.with_suffix(".part")
+                tmp.write_bytes(data)
+                tmp.replace(path)
+                return value
+        return compute()
+
+
 @pytest.fixture(scope="session")
-def studies():
-    """``studies(name)``: the study of ``specs/<name>``, run once per session (per xdist worker);
-    the tests only read it."""
+def shared(tmp_path_factory) -> Shared:
+    """:class:`Shared` in this run's folder shared by the xdist workers."""
+    return Shared(_shared_root(tmp_path_factory) / "shared-objects")
+
+
+@pytest.fixture(scope="session")
+def studies(shared):
+    """``studies(name)``: the study of ``specs/<name>``, run once per run (the first xdist worker
+    that needs it runs it, the others load it: :class:`Shared`); the tests only read it."""
     from balpipe import loader
     from balpipe import study as study_mod
 
@@ -91,33 +137,65 @@ def studies():
 
     def get(name: str):
         if name not in cache:
-            cache[name] = study_mod.run(loader.load(SPECS / name).spec)
+            text = (SPECS / name).read_text(encoding="utf-8")
+            cache[name] = shared.get(f"study\n{name}\n{text}",
+                                     lambda: study_mod.run(loader.load(SPECS / name).spec))
         return cache[name]
 
     return get
+
+
+class Pages:
+    """``pages(name)``: the page of ``studies(name)`` without the simulation (results of "x",
+    hash "h", no spec text); ``pages.figures(name)``: the figures that page drew
+    (:func:`balpipe.report.page.study_figures`'s dict, the very one the page was rendered
+    from). Each rendered once per run (:class:`Shared`)."""
+
+    def __init__(self, studies, shared: Shared):
+        self._studies = studies
+        self._shared = shared
+        self._html: dict[str, str] = {}
+        self._figures: dict[str, dict] = {}
+
+    def _render(self, name: str) -> None:
+        text = (SPECS / name).read_text(encoding="utf-8")
+        self._html[name], self._figures[name] = self._shared.get(f"page\n{name}\n{text}", lambda: self._draw(name))
+
+    def _draw(self, name: str) -> tuple[str, dict]:
+        from balpipe.report import page, results
+
+        st = self._studies(name)
+        real = page.study_figures
+        drawn: list[dict] = []
+
+        def keep(*args, **kwargs):  # the page's own call, its result kept
+            drawn.append(real(*args, **kwargs))
+            return drawn[-1]
+
+        page.study_figures = keep
+        try:
+            html = page.render_page(st, results.results_dict(st, "x", "h", False), "")
+        finally:
+            page.study_figures = real
+        assert len(drawn) == 1
+        return html, drawn[0]
+
+    def __call__(self, name: str) -> str:
+        if name not in self._html:
+            self._render(name)
+        return self._html[name]
+
+    def figures(self, name: str) -> dict:
+        if name not in self._figures:
+            self._render(name)
+        return self._figures[name]
 
 
 @pytest.fixture(scope="session")
-def pages(studies):
-    """``pages(name)``: the page of ``studies(name)`` without the simulation (results of "x",
-    hash "h", no spec text), rendered once per session (per xdist worker)."""
-    from balpipe.report import page, results
-
-    cache: dict = {}
-
-    def get(name: str) -> str:
-        if name not in cache:
-            st = studies(name)
-            cache[name] = page.render_page(st, results.results_dict(st, "x", "h", False), "")
-        return cache[name]
-
-    return get
-
-
-def _shared_root(tmp_path_factory) -> Path:
-    """A folder that every xdist worker of this run sees (the parent of the workers' own)."""
-    base = tmp_path_factory.getbasetemp()
-    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+def pages(studies, shared) -> Pages:
+    """:class:`Pages` of the specs' studies (``pages(name)``, ``pages.figures(name)``); the tests
+    only read them."""
+    return Pages(studies, shared)
 
 
 @pytest.fixture(scope="session")
@@ -150,3 +228,85 @@ def shared_build(tmp_path_factory):
         return folder, subprocess.CompletedProcess(a, rc, out, err)
 
     return get
+
+
+def chromium() -> str | None:
+    """The system's Chromium: ``BALPIPE_CHROMIUM``, /usr/bin/chromium or one on ``PATH``."""
+    for cand in (os.environ.get("BALPIPE_CHROMIUM"), "/usr/bin/chromium", shutil.which("chromium"),
+                 shutil.which("chromium-browser"), shutil.which("google-chrome")):
+        if cand and Path(cand).exists():
+            return cand
+    return None
+
+
+@pytest.fixture(scope="session")
+def browser():
+    """Headless Chromium through playwright, launched once per xdist worker: the browser tests
+    (tests/test_site_browser.py, tests/test_live_browser.py) share one xdist_group, so one worker
+    launches it. Skipped with the reason when playwright or Chromium is missing."""
+    # CI installs Chromium and sets BALPIPE_REQUIRE_BROWSER: there a missing browser fails
+    missing = pytest.fail if os.environ.get("BALPIPE_REQUIRE_BROWSER") else pytest.skip
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        missing("playwright for Python is not installed: pip install '.[test]'")
+    exe = chromium()
+    if exe is None:
+        missing("no Chromium found (/usr/bin/chromium, chromium on PATH, or BALPIPE_CHROMIUM)")
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=exe)
+        try:
+            yield b
+        finally:
+            b.close()
+
+
+#: Test modules whose tests take longest, slowest first (wall time of a full run, 2 cores). They
+#: are collected first, so xdist hands them out first and the short tests fill the workers'
+#: last minutes; the xdist groups (the browser tests) go first anyway (xdist orders the work
+#: units by their number of tests). A deterministic order: every worker collects the same.
+SLOW_FIRST = (
+    "test_rrr4_topologies.py", "test_check_parallel.py", "test_partial.py", "test_rrr4_finder.py",
+    "test_sweep.py", "test_history.py", "test_paper_figures.py", "test_realisable.py", "test_sweep_block.py",
+    "test_drawing_labels.py", "test_rrr4.py", "test_partial_motions.py", "test_build_cluster.py",
+    "test_validation_power.py", "test_hostile.py", "test_diff.py", "test_rpr3_pymunk.py", "test_rpr3_generic.py",
+    "test_engine_paths.py", "test_cli.py", "test_own_machine_examples.py", "test_verdict.py", "test_families.py",
+)
+
+
+#: The xdist groups (``--dist loadgroup``, the default of pyproject's addopts): the modules whose
+#: tests run on one worker, as their ``xdist_group`` mark says. The scheduler below reads this
+#: table, not the marks: pytest-xdist 3.8 sends a mark's group to the controller in the test's
+#: node id, which pytest 9.2 no longer lets it change (pytest-xdist issue 1386), and the groups
+#: were silently spread over the workers (each built the browser tests' sites and a browser).
+GROUPS = {"test_site_browser.py": "site_browser", "test_live_browser.py": "site_browser"}
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """The modules of :data:`SLOW_FIRST` first, in that order; the others after them, each
+    module's tests in their own order. A module's ``xdist_group`` mark must be its entry in
+    :data:`GROUPS`."""
+    for item in items:
+        for mark in item.iter_markers("xdist_group"):
+            name = mark.args[0] if mark.args else mark.kwargs.get("name", "default")
+            if GROUPS.get(item.path.name) != name:
+                raise pytest.UsageError(f"{item.path.name}: xdist_group {name!r} is not its entry in "
+                                        f"tests/conftest.py GROUPS ({GROUPS.get(item.path.name)!r})")
+    rank = {name: k for k, name in enumerate(SLOW_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))  # stable: the modules stay whole
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadgroup`` with the groups of :data:`GROUPS`, found from the node ids' module
+    (the mark's ``@group`` suffix, where xdist can still add it, names the same group)."""
+    if config.getvalue("dist") != "loadgroup":
+        return None
+    from xdist.scheduler import LoadGroupScheduling
+
+    class ModuleGroups(LoadGroupScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            group = GROUPS.get(nodeid.split("::", 1)[0].rsplit("/", 1)[-1])
+            return group if group is not None else super()._split_scope(nodeid)
+
+    return ModuleGroups(config, log)

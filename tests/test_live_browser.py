@@ -11,11 +11,14 @@ from pathlib import Path
 
 import pytest
 
-from test_site_browser import Watched, assert_printed, browser, open_sections  # noqa: F401 (the browser fixture)
+from test_site_browser import Watched, assert_printed, open_sections
 
 from balpipe.build import Options, build
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
+
+# on the worker of tests/test_site_browser.py, with its browser (one Chromium per run)
+pytestmark = pytest.mark.xdist_group("site_browser")
 LIVE_SPECS = ["paper000_rpr3_idler_loop.yaml", "paper000_rpr3_scott_russell.yaml", "partial_offset_slider_crank.yaml"]
 
 
@@ -31,7 +34,7 @@ def _json(page, figure: str) -> dict:
     return page.eval_on_selector(f"script[data-live='{figure}']", "s => JSON.parse(s.textContent)")
 
 
-def _open(browser, site: Path, slug: str, figure: str) -> tuple:  # noqa: F811
+def _open(browser, site: Path, slug: str, figure: str) -> tuple:
     """A watched page of ``slug`` at 1400 px, its sections open: (watcher, page, the figure's JSON)."""
     w = Watched(browser)
     w.page.set_viewport_size({"width": 1400, "height": 900})
@@ -43,7 +46,7 @@ def _open(browser, site: Path, slug: str, figure: str) -> tuple:  # noqa: F811
 _VALUES = "el => [...el.querySelectorAll('.u-legend .u-series .u-value')].map(v => v.textContent)"
 
 
-def test_wide_curves_are_drawn_first_and_the_legend_keeps_the_stages_order(live_site, browser):  # noqa: F811
+def test_wide_curves_are_drawn_first_and_the_legend_keeps_the_stages_order(live_site, browser):
     """Paper 000 Fig. 4: the grey counter-rotations (0 force) are drawn first, under the dashed
     counterweights (0 force too), while the legend lists the stages in their order; hovering still
     shows each stage's own value beside its name."""
@@ -68,7 +71,7 @@ def test_wide_curves_are_drawn_first_and_the_legend_keeps_the_stages_order(live_
     assert not w.problems, "\n".join(w.problems)
 
 
-def test_a_figure_of_many_joints_shows_one_joint_at_a_time(live_site, browser):  # noqa: F811
+def test_a_figure_of_many_joints_shows_one_joint_at_a_time(live_site, browser):
     """The Scott-Russell legs' 30 joint loads: a selector above the plot shows one joint, first
     the largest load; choosing another shows that one (hover still shows its values), 'every
     joint' shows them all; printing prints every panel, drawn for print."""
@@ -105,7 +108,7 @@ def test_a_figure_of_many_joints_shows_one_joint_at_a_time(live_site, browser): 
     assert not w.problems, "\n".join(w.problems)
 
 
-def test_the_partial_fronts_are_interactive_over_their_budget(live_site, browser):  # noqa: F811
+def test_the_partial_fronts_are_interactive_over_their_budget(live_site, browser):
     """A partial balancing's force-against-mass front: hovering a design shows its added mass
     and its peak force (those of a design of the front), a click on a legend entry hides a
     curve, the plot is not linked to time, and printing prints the plot drawn for print."""

@@ -8,10 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balpipe.loader import load
 from balpipe.report import paper_figures as PF
-from balpipe.report.page import study_figures
-from balpipe.study import run
 
 SPECS = Path(__file__).parent.parent / "specs"
 
@@ -57,30 +54,24 @@ def test_every_paper_spec_is_in_the_table_and_the_pages_cover_each_papers_figure
 
 
 @pytest.mark.parametrize("spec", sorted(REPRODUCES))
-def test_each_paper_page_lists_the_figures_it_draws(spec):
+def test_each_paper_page_lists_the_figures_it_draws(spec, pages):
     """A paper spec's page lists (data-figures) the paper's figure numbers read from its figures'
-    titles, each shown on the page as "Fig. n", and they are the table's."""
+    titles, each shown on the page as "Fig. n", and they are the table's (the titles of the
+    figures the page was rendered from: ``pages.figures``, study_figures' own result)."""
     import re
 
-    from balpipe.report.page import render_page
-    from balpipe.report.results import results_dict
-
-    study = run(load(SPECS / spec).spec)
-    titles = [t for t, _, _ in study_figures(study)["extra"]]
-    html = render_page(study, results_dict(study, "x", "h", False), "")
+    titles = [t for t, _, _ in pages.figures(spec)["extra"]]
+    html = pages(spec)
     m = re.search(r'data-figures="([^"]*)"', html)
     listed = m.group(1).split() if m else []
     assert listed == PF.listed(titles) == REPRODUCES[spec]
     assert all(f"Fig. {n}" in html for n in listed)
 
 
-def test_the_papers_panels_keep_the_pages_stage_styles():
+def test_the_papers_panels_keep_the_pages_stage_styles(studies, pages):
     """Fig. 12 of paper 004 draws the force-balanced stage in that stage's style of the page (one
     legend per page), not in the first style."""
-    from balpipe.report.page import render_page
-    from balpipe.report.results import results_dict
-
-    study = run(load(SPECS / "paper004_five_bar.yaml").spec)
+    study = studies("paper004_five_bar.yaml")
     force_only = next(s for s in study.stages if s.stage.balances == "force" and ":" not in s.stage.name)
     k = PF._k(study, force_only)
     assert k > 0 and study.stages[k] is force_only
@@ -89,7 +80,7 @@ def test_the_papers_panels_keep_the_pages_stage_styles():
     mine = PF._series(a2.t, [(force_only.stage.label, a2.moment, k)], "M (N m)", "p004fig12")
     first = PF._series(a2.t, [(force_only.stage.label, a2.moment, 0)], "M (N m)", "p004fig12")
     assert svg == mine and svg != first
-    html = render_page(study, results_dict(study, "x", "h", False), "")
+    html = pages("paper004_five_bar.yaml")
     assert html.count('id="style-legend"') == 1
     assert 'data-figures="' in html and "10a 10b 11 12" in html
 
@@ -116,14 +107,14 @@ def _live(html: str, name: str) -> dict:
 
 
 @pytest.mark.parametrize("spec", ["paper000_rpr3_idler_loop", "paper000_rpr3_scott_russell"])
-def test_paper000_figures_draw_each_stage_in_its_style_of_the_page(spec):
+def test_paper000_figures_draw_each_stage_in_its_style_of_the_page(spec, studies):
     """Issue 22, point 4: on a paper-000 page dashed means the counterweights in every figure
     (Fig. 4 / 8 and the stage figures), as the paper draws them; the added linkage, which the
     paper does not plot, is never dashed."""
     from balpipe.draw.live import line_style
     from balpipe.report.page import shown_stages
 
-    study = run(load(SPECS / f"{spec}.yaml").spec)
+    study = studies(f"{spec}.yaml")
     html = next(h for title, h, _ in study.extra_figures() if "of paper 000)" in title)
     shown = [s.stage.name for s in shown_stages(study)]
     assert shown[:3] == ["unbalanced", "counterweights", "counter_rotations"]
@@ -133,12 +124,12 @@ def test_paper000_figures_draw_each_stage_in_its_style_of_the_page(spec):
         assert bool(x["dash"] == line_style(1)["dash"]) == (name == "counterweights")
 
 
-def test_paper000_fig4_draws_the_dashed_zero_force_over_the_grey_line():
+def test_paper000_fig4_draws_the_dashed_zero_force_over_the_grey_line(studies):
     """Issue 22: on Fig. 4 of paper 000 the counterweights' force (dashed) and the
     counter-rotations' (grey, wide) are both 0; the interactive plot draws the dashed curve
     after the grey one, on top (its ``draw`` order, as matplotlib's zorder would), and its
     legend keeps the stages' order."""
-    study = run(load(SPECS / "paper000_rpr3_idler_loop.yaml").spec)
+    study = studies("paper000_rpr3_idler_loop.yaml")
     html = next(h for title, h, _ in study.extra_figures() if "(Fig. 4 of paper 000)" in title)
     by = {s.stage.label: s.stage.name for s in study.stages}
     cw = next(s for s in study.stages if s.stage.name == "counterweights")

@@ -13,7 +13,6 @@ from __future__ import annotations
 import json
 import os
 import re
-import shutil
 import socket
 import subprocess
 import sys
@@ -31,19 +30,12 @@ from _gitrepo import Repo, edit
 from balpipe import history
 from balpipe.build import Options, build
 
-# one xdist worker runs the whole module (addopts --dist loadgroup): its two sites and the browser
-# are made once per run, not once per worker
+# one xdist worker runs the whole module and tests/test_live_browser.py (addopts --dist loadgroup):
+# their sites and the browser (the session's ``browser`` fixture, tests/conftest.py) are made once
+# per run, not once per worker
 pytestmark = pytest.mark.xdist_group("site_browser")
 
 SUBFOLDER = "team/balpipe"
-
-
-def chromium() -> str | None:
-    for cand in (os.environ.get("BALPIPE_CHROMIUM"), "/usr/bin/chromium", shutil.which("chromium"),
-                 shutil.which("chromium-browser"), shutil.which("google-chrome")):
-        if cand and Path(cand).exists():
-            return cand
-    return None
 
 
 @pytest.fixture(scope="module")
@@ -99,25 +91,6 @@ def server(site):
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.wait()
-
-
-@pytest.fixture(scope="module")
-def browser():
-    # CI installs Chromium and sets BALPIPE_REQUIRE_BROWSER: there a missing browser fails
-    missing = pytest.fail if os.environ.get("BALPIPE_REQUIRE_BROWSER") else pytest.skip
-    try:
-        from playwright.sync_api import sync_playwright
-    except ImportError:
-        missing("playwright for Python is not installed: pip install '.[test]'")
-    exe = chromium()
-    if exe is None:
-        missing("no Chromium found (/usr/bin/chromium, chromium on PATH, or BALPIPE_CHROMIUM)")
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=exe)
-        try:
-            yield b
-        finally:
-            b.close()
 
 
 class Watched:

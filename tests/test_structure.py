@@ -137,9 +137,12 @@ def test_edge_cases():
 
 
 def _models():
+    """Every stage model of every spec. Built at collection, in every xdist worker: without the
+    page-only work (``page=False``, as ``balpipe check``: the partial balancing's Pareto fronts,
+    27 s of the 33 s), which changes no stage's model."""
     for path in sorted(glob.glob("specs/*.yaml")):
         spec = load(path).spec
-        for stage in registry.balance(spec).stages:
+        for stage in registry.balance(spec, page=False).stages:
             yield f"{path}:{stage.name}", stage.model
 
 
