@@ -6,6 +6,7 @@ cache is never followed; the cache is invisible in the site."""
 from __future__ import annotations
 
 import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -35,7 +36,10 @@ def entries(out: Path, slug: str = "scott_russell") -> dict[str, bytes]:
 
 @pytest.fixture
 def drawn(monkeypatch):
-    """Counts the figures that are drawn (``to_svg`` calls) in this process."""
+    """Counts the figures that are drawn (``to_svg`` calls) in this process: in ``draw.figures``
+    and in every balpipe module already imported that bound ``to_svg`` to its own name (e.g.
+    ``report.history_figures``: imported by an earlier test of the same worker, it would
+    otherwise keep calling the uncounted function)."""
     calls = []
     real = figures.to_svg
 
@@ -43,7 +47,9 @@ def drawn(monkeypatch):
         calls.append(prefix)
         return real(fig, prefix)
 
-    monkeypatch.setattr(figures, "to_svg", counted)
+    for name, module in list(sys.modules.items()):
+        if (name == "balpipe" or name.startswith("balpipe.")) and getattr(module, "to_svg", None) is real:
+            monkeypatch.setattr(module, "to_svg", counted)
     return calls
 
 
