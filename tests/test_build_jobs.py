@@ -126,7 +126,9 @@ def test_ctrl_c_during_a_parallel_simulation_is_clean(tmp_path):
     import time
 
     spec = Path(__file__).resolve().parents[1] / "specs" / "paper000_rpr3_idler_loop.yaml"
-    p = subprocess.Popen([sys.executable, "-m", "balpipe", "build", str(spec), "-o", str(tmp_path / "out"), "-j", "2"],
+    from _terminal import balpipe_command
+
+    p = subprocess.Popen(balpipe_command("build", spec, "-o", tmp_path / "out", "-j", 2),
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
     time.sleep(5.0)  # inside the simulations (about 3 s of analysis, then 10-20 s of simulations)
     assert p.poll() is None

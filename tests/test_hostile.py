@@ -21,6 +21,7 @@ from balpipe import build as build_mod
 from balpipe.cli import main
 from balpipe.loader import SpecErrors, load, load_text
 from _edits import replaced
+from _terminal import balpipe_command
 
 ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"
@@ -466,7 +467,7 @@ def test_interrupt_is_clean_at_any_jobs(tmp_path, sig, code, jobs):
     shutil.copy(SPECS / "paper000_rpr3_idler_loop.yaml", d / "paper000_rpr3_idler_loop.yaml")
     out = tmp_path / "out"
     old = _old_site(out)
-    p = subprocess.Popen([sys.executable, "-m", "balpipe", "build", d, "-o", out, "-j", str(jobs)],
+    p = subprocess.Popen(balpipe_command("build", d, "-o", out, "-j", jobs),
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
     time.sleep(8.0)  # inside the work: the specs are being analysed (the build takes longer)
     assert p.poll() is None
