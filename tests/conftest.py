@@ -261,6 +261,17 @@ def browser():
             b.close()
 
 
+@pytest.fixture(autouse=True)
+def _close_browser_pages(request):
+    """After each test that uses the session's Chromium, close the pages it opened (every browser
+    context): a study page left open keeps its player animating, and in a browser shared by the
+    whole run two such pages kept two renderer processes at half a core each until the end."""
+    yield
+    if "browser" in request.fixturenames:
+        for context in list(request.getfixturevalue("browser").contexts):
+            context.close()
+
+
 #: Test modules whose tests take longest, slowest first (wall time of a full run, 2 cores). They
 #: are collected first, so xdist hands them out first and the short tests fill the workers'
 #: last minutes; the xdist groups (the browser tests) go first anyway (xdist orders the work
