@@ -80,6 +80,7 @@ class Compiled:
     frame: "Compiled | None" = None  # the frame model's (:func:`.fastpath.frame_motion`), made once
     keys: tuple | None = None  # (shape, numbers, law ids) of the model (:func:`.warmstart.model_keys`), made once
     dynamics: "Compiled | None" = None  # with actuators: the joints' rows and the actuators' (:func:`_actuated`)
+    revolutes: object = None  # the revolute joints' rows at once (:func:`.constraints.revolute_rows`), made once
 
     @property
     def nb(self) -> int:
@@ -203,7 +204,7 @@ def _actuated(c: Compiled, joints: dict, idx, local) -> Compiled | None:
     owner = c.row_owner[:rows] + list(actuator_rows)
     joint_rows = {n: [r for r in rs if r < rows] for n, rs in c.joint_rows.items() if n in joints}
     return replace(c, prims=prims, row_owner=owner, driver_rows=actuator_rows, joint_rows=joint_rows,
-                   fast=None, frame=None, keys=None, condition=None)
+                   fast=None, frame=None, keys=None, condition=None, revolutes=None)
 
 
 @dataclass

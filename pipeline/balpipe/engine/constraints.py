@@ -116,33 +116,29 @@ class RevoluteRows:
     sj: np.ndarray
 
 
-_REVOLUTE: dict[int, tuple[list, RevoluteRows | None]] = {}
-
-
 def revolute_rows(c: Compiled) -> RevoluteRows | None:
-    """The :class:`RevoluteRows` of ``c``, made once per list of prims; None when ``c`` has none
-    or a joint joins a body to itself (then the joints are evaluated one at a time)."""
-    hit = _REVOLUTE.get(id(c.prims))
-    if hit is not None and hit[0] is c.prims:
-        return hit[1]
+    """The :class:`RevoluteRows` of ``c``, made once (kept in ``c.revolutes``); None when ``c``
+    has none or a joint joins a body to itself (then the joints are evaluated one at a time)."""
+    if c.revolutes is None:
+        c.revolutes = _revolute_rows(c.prims) or False
+    return c.revolutes or None
+
+
+def _revolute_rows(prims: list) -> RevoluteRows | None:
     rows, idx = [], []
     row = 0
-    for p in c.prims:
+    for p in prims:
         if isinstance(p, _Coincident):
             rows.append((row, row + 1))
             idx.append(p)
         row += p.rows
-    out = None
-    if idx and all(p.i != p.j for p in idx):
-        i = np.array([p.i for p in idx])
-        j = np.array([p.j for p in idx])
-        out = RevoluteRows(np.array(rows), np.stack([3 * i, 3 * i + 1], axis=1),
-                           np.stack([3 * j, 3 * j + 1], axis=1), 3 * i + 2, 3 * j + 2,
-                           np.array([p.si for p in idx], dtype=float), np.array([p.sj for p in idx], dtype=float))
-    if len(_REVOLUTE) >= 256:
-        _REVOLUTE.clear()
-    _REVOLUTE[id(c.prims)] = (c.prims, out)  # the list kept alive: its id stays its own
-    return out
+    if not idx or any(p.i == p.j for p in idx):
+        return None
+    i = np.array([p.i for p in idx])
+    j = np.array([p.j for p in idx])
+    return RevoluteRows(np.array(rows), np.stack([3 * i, 3 * i + 1], axis=1), np.stack([3 * j, 3 * j + 1], axis=1),
+                        3 * i + 2, 3 * j + 2, np.array([p.si for p in idx], dtype=float),
+                        np.array([p.sj for p in idx], dtype=float))
 
 
 def _rotate_all(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
