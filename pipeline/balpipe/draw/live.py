@@ -24,6 +24,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..sampling import spread_indices
 from . import figures
 
 POINTS = 400  # samples a curve keeps at most
@@ -36,7 +37,7 @@ def _thin(n: int, curves: int = 1) -> np.ndarray:
     """The kept samples of ``n``, evenly spaced, first and last kept: :data:`POINTS` at most, fewer
     (not below :data:`MIN_POINTS`) when a figure's ``curves`` would exceed :data:`VALUES`."""
     keep = max(MIN_POINTS, min(POINTS, VALUES // max(1, curves)))
-    return np.unique(np.linspace(0, n - 1, min(n, keep)).round().astype(int))
+    return spread_indices(n, keep)
 
 
 def _round(values, floor: float = 0.0) -> list[float | None]:

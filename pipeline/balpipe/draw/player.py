@@ -22,6 +22,7 @@ import math
 import numpy as np
 
 from ..model import Model
+from ..sampling import spread_indices
 from .labels import drawing_span, point_name_counts, point_places, repeated_names
 from .sleeves import guided_sliders, sleeves
 
@@ -200,7 +201,7 @@ def player_data(stages: list[dict]) -> dict:
     data = []
     for s, view in zip(stages, views["panels"]):
         n = len(s["t"])
-        ks = np.unique(np.linspace(0, n - 1, min(n, FRAMES)).round().astype(int))
+        ks = spread_indices(n, FRAMES)
         poses = s["poses"][ks]
         base = s["base"][ks]
         position, angle = digits(view["view"][2], size)

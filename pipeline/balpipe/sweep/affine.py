@@ -32,6 +32,8 @@ from typing import Any
 
 import numpy as np
 
+from ..sampling import spread_indices
+
 TOL = 1e-11  # relative: the prediction at the check designs must agree with the full build
 CHECKS = 3   # designs of the sweep itself built in full as checks (besides the upper corner)
 STEPS = (1.0, 0.5, 0.25)  # probe steps along a field, as fractions of its span
@@ -183,7 +185,7 @@ def build_route(p, keys: tuple, names: tuple[list[str], list[str]], anchors=None
     if any(f is None for f in factors):
         return None
     route = AffineRoute(lo, span, f0, D, factors, len(row0["p"]), len(row0["unbalanced_p"]), names)
-    picks = np.unique(np.linspace(0, len(p.designs) - 1, CHECKS).round().astype(int))
+    picks = spread_indices(len(p.designs), CHECKS)
     checks = [hi] + [np.array([numeric(v) for v in p.designs[i]], dtype=float) for i in picks]
     route.probes = 1 + int(np.count_nonzero(hi > lo)) + len(checks)
     scale = np.abs(f0) + np.abs(D).sum(axis=0)
