@@ -21,6 +21,22 @@
     if (floor && a <= floor) return "0 (< tolerance)";
     return a !== 0 && (a < 1e-3 || a >= 1e6) ? v.toExponential(3) : (+v.toPrecision(4)).toString();
   }
+  // an axis's tick labels: uPlot's own (at most 3 decimals: a residual of 1e-5 read "0"), in
+  // exponent form when the ticks are all below 1e-3 or from 1e6; on a log axis (p.log) the powers
+  // of ten only
+  const num = uPlot.fmtNum || (v => String(v));
+  function ticks(log) {
+    return (u, vals) => {
+      const big = Math.max(0, ...vals.map(v => Math.abs(v || 0)));
+      const exp = big !== 0 && (big < 1e-3 || big >= 1e6);
+      return vals.map(v => {
+        if (v == null) return "";
+        if (!log) return exp && v !== 0 ? v.toExponential(1) : num(v);
+        const e = Math.round(Math.log10(v));
+        return Math.abs(Math.log10(v) - e) > 1e-6 ? "" : Math.abs(e) >= 3 ? "1e" + e : num(v);
+      });
+    };
+  }
   // the canvas's device pixels per CSS pixel: the screen's, or PRINT_RATIO in a plot drawn for print
   const ratio = u => u.ctx.canvas.width / u.width || 1;
   // kinematic warnings (time, label): dotted vertical lines, labelled along them
@@ -116,7 +132,7 @@
     const d = JSON.parse(src.textContent);
     if (!d.panels.length) return;
     const f = { host: host, plots: [], hovering: false, timeless: !!d.x };
-    if (d.panels.length > 2) host.classList.add("live-grid");  // small multiples: as many columns as fit
+    if (d.panels.length > 2 || d.grid) host.classList.add("live-grid");  // small multiples: as many columns as fit
     const width = el => Math.max(240, el.clientWidth);
     // drawn in d.draw's order (wide lines first, under the thin ones), listed in the stages' order
     const order = d.draw || d.series.map((s, i) => i);
@@ -129,8 +145,8 @@
          s.points ? { paths: () => null } : {})));
       const opts = Object.assign({
         title: p.title, width: w, height: HEIGHT,
-        scales: { x: { time: false } },
-        axes: [{ label: d.x || "time (s)" }, { label: p.axis, size: 64 }],
+        scales: p.log ? { x: { time: false }, y: { distr: 3 } } : { x: { time: false } },  // p.log: a log10 axis
+        axes: [{ label: d.x || "time (s)" }, { label: p.axis, size: 64, values: ticks(!!p.log) }],
         series: series,
         cursor: { sync: { key: src.dataset.live } },
         plugins: (d.marks.length ? [marksPlugin(d.marks)] : []).concat(drawn.some(s => s.marker) ? [markersPlugin(drawn)] : []),
@@ -164,6 +180,7 @@
     }
     if (d.choose != null) chooser(host, d, f);
     host.classList.add("live-ready");
+    host.uplots = f.plots;  // the drawn plots, for the console and the browser tests
     all.push(f);
     if (!d.x) figures.push(f);
     // follow the host's width (the window, or a collapsed section opened): resize after the

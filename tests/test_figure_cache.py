@@ -92,7 +92,7 @@ def test_the_key_is_deterministic_and_sees_every_input():
     assert base not in keys and len(keys) == len(changed)
     # dicts in their order: the order a figure draws (and places labels) in
     assert cache.key(_plot, ({"a": 1, "b": 2},), {}, "") != cache.key(_plot, ({"b": 2, "a": 1},), {}, "")
-    assert cache.key(figures.series_svg, (), {}, "") != cache.key(figures.drift_svg, (), {}, "")
+    assert cache.key(series_svg, (), {}, "") != cache.key(figures.mechanism_svg, (), {}, "")
 
 
 def test_what_cannot_be_hashed_is_refused():
@@ -107,52 +107,67 @@ def test_what_cannot_be_hashed_is_refused():
 # --- the store --------------------------------------------------------------------------------
 
 
+def series_svg(t: np.ndarray, curves: list, ylabel: str, prefix: str, title: str = "") -> str:
+    """A plain time-series figure, drawn by matplotlib (through ``figures.to_svg``, which
+    ``drawn`` counts): a stand-in for any figure a build caches."""
+    fig, ax = figures.plt.subplots(figsize=(6.0, 3.0))
+    for k, (label, y) in enumerate(curves):
+        ax.plot(t, y, label=label, **figures.style(k))
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    return figures.to_svg(fig, prefix)
+
+
+def series_figure(t: np.ndarray, curves: list, ylabel: str, prefix: str, title: str = "") -> str:
+    return cache.svg(series_svg, t, curves, ylabel, prefix, title)
+
+
 def _series() -> tuple:
     t = np.linspace(0.0, 1.0, 50)
     return t, [("unbalanced", np.sin(6 * t)), ("balanced", 0.1 * np.cos(6 * t))], "force (N)", "s"
 
 
 def test_a_hit_is_the_fresh_drawing_byte_for_byte(tmp_path, drawn):
-    fresh = figures.series_figure(*_series())  # no store: drawn
+    fresh = series_figure(*_series())  # no store: drawn
     store = cache.Store(tmp_path, "spec", "salt")
     with cache.using(store):
-        first = figures.series_figure(*_series())
-        again = figures.series_figure(*_series())
+        first = series_figure(*_series())
+        again = series_figure(*_series())
     assert first == fresh and again == fresh
     assert (store.drawn, store.hits) == (1, 1) and len(drawn) == 2
     t, curves, ylabel, prefix = _series()
     with cache.using(cache.Store(tmp_path, "spec", "salt")) as other:
-        figures.series_figure(t, curves[:1], ylabel, prefix)  # another input: a miss
+        series_figure(t, curves[:1], ylabel, prefix)  # another input: a miss
     assert (other.drawn, other.hits) == (1, 0)
 
 
 @pytest.mark.parametrize("damage", ["truncated", "flipped", "empty", "no header"])
 def test_a_damaged_entry_is_redrawn_and_rewritten(tmp_path, damage):
-    fresh = figures.series_figure(*_series())
+    fresh = series_figure(*_series())
     with cache.using(cache.Store(tmp_path, "spec", "salt")):
-        figures.series_figure(*_series())
+        series_figure(*_series())
     (entry,) = (tmp_path / ".cache" / "figures" / "spec").iterdir()
     good = entry.read_bytes()
     bad = {"truncated": good[: len(good) // 2], "flipped": good.replace(b"<path", b"<pbth", 1), "empty": b"",
            "no header": good.split(b"\n", 1)[1]}[damage]
     entry.write_bytes(bad)
     with cache.using(cache.Store(tmp_path, "spec", "salt")) as store:
-        assert figures.series_figure(*_series()) == fresh
+        assert series_figure(*_series()) == fresh
     assert (store.drawn, store.hits) == (1, 0)
     assert entry.read_bytes() == good
 
 
 def test_a_symlinked_entry_or_folder_is_never_followed(tmp_path):
-    fresh = figures.series_figure(*_series())
+    fresh = series_figure(*_series())
     forged = tmp_path / "forged.svg"
     forged.write_text(cache._pack("<svg>forged</svg>"))  # a valid entry, planted outside the cache
     out = tmp_path / "out"
     store = cache.Store(out, "spec", "salt")
-    k = cache.key(figures.series_svg, _series() + ("",), {}, "salt")  # series_figure's call, title ""
+    k = cache.key(series_svg, _series() + ("",), {}, "salt")  # series_figure's call, title ""
     store.folder.mkdir(parents=True)
     (store.folder / f"{k}.svg").symlink_to(forged)
     with cache.using(store):
-        assert figures.series_figure(*_series()) == fresh
+        assert series_figure(*_series()) == fresh
     assert store.hits == 0 and forged.read_text() == cache._pack("<svg>forged</svg>")  # the target untouched
     assert not (store.folder / f"{k}.svg").is_symlink()  # the link was replaced by the entry
     # a cache folder that is a link: neither read nor written
@@ -163,7 +178,7 @@ def test_a_symlinked_entry_or_folder_is_never_followed(tmp_path):
     out2.mkdir()
     (out2 / ".cache").symlink_to(elsewhere, target_is_directory=True)
     with cache.using(cache.Store(out2, "spec", "salt")) as s2:
-        assert figures.series_figure(*_series()) == fresh
+        assert series_figure(*_series()) == fresh
         s2.prune()
     assert s2.hits == 0 and s2.drawn == 1
     assert [p.name for p in (elsewhere / "figures" / "spec").iterdir()] == [f"{k}.svg"]

@@ -132,3 +132,44 @@ def test_the_partial_fronts_are_interactive_over_their_budget(live_site, browser
     assert "u-off" in (entry.get_attribute("class") or "")
     assert_printed(p, figure)
     assert not w.problems, "\n".join(w.problems)
+
+
+@pytest.fixture(scope="module")
+def simulated_site(tmp_path_factory) -> Path:
+    """The Scott-Russell slider-crank with its pymunk runs (41 samples: a few seconds)."""
+    folder = tmp_path_factory.mktemp("simulated")
+    spec = folder / "scott_russell.yaml"
+    spec.write_text((SPECS / "scott_russell.yaml").read_text().replace("  samples: 501", "  samples: 41"))
+    out = folder / "site"
+    outcomes = build([str(spec)], Options(out=out, simulate=True))
+    assert all(o.status == "ok" for o in outcomes), [o.message for o in outcomes]
+    return out
+
+
+_TICKS = "el => el.uplots.map(u => u.axes[1]._values.filter(v => v !== ''))"
+
+
+def test_the_simulations_figures_are_interactive_with_readable_axes(simulated_site, browser):
+    """Residuals, tracking errors and the free frame's drift are live plots (issue 23: no
+    matplotlib): the residuals on log axes labelled in powers of ten, the two panels side by side
+    at 1400 px; the tracking error's ticks of 1e-5 written as such (not rounded to "0"); each
+    prints itself."""
+    w, p, d = _open(browser, simulated_site, "scott_russell", "live-residuals")
+    assert [x["log"] for x in d["panels"]] == [True, True]
+    host = p.locator("#live-residuals")
+    host.scroll_into_view_if_needed()
+    assert "live-grid" in (host.get_attribute("class") or "")
+    boxes = [b.bounding_box() for b in host.locator(".live-plot").all()]
+    assert len(boxes) == 2 and boxes[0]["y"] == boxes[1]["y"] and boxes[0]["x"] < boxes[1]["x"]
+    for ticks in host.evaluate(_TICKS):
+        assert len(ticks) >= 2 and all(re.fullmatch(r"1e-\d+|0\.0*1|1", t) for t in ticks), ticks
+    tracking = _json(p, "live-tracking")
+    peak = max(abs(v) for s in tracking["series"] for v in s["y"]["q"] if v is not None)
+    assert peak < 1e-3  # a tracking error of a few 1e-5 of the travel
+    (ticks,) = p.locator("#live-tracking").evaluate(_TICKS)
+    assert len(set(ticks)) == len(ticks) >= 3 and "0" in ticks and any("e-" in t for t in ticks), ticks
+    drift = _json(p, "live-drift")
+    assert [x["key"] for x in drift["panels"]] == ["drift", "rotation"]
+    for figure in ("live-residuals", "live-tracking", "live-drift"):
+        assert_printed(p, figure)
+    assert not w.problems, "\n".join(w.problems)

@@ -13,8 +13,8 @@ import pytest
 
 from balpipe import loader
 from balpipe import study as study_mod
-from balpipe.draw import figures
-from balpipe.report import page, results
+from balpipe.draw import figures, live
+from balpipe.report import live_plots, page, results
 from balpipe.study import ratio_reference
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
@@ -62,21 +62,27 @@ def test_residuals_are_relative_to_each_stages_own_reference(paper003):
     groups = list(firsts)
     first = [r for r, s in zip(rows, st.stages) if s.stage.group == groups[0]]
     two = first + [r for r, s in zip(rows, st.stages) if s.stage.group == groups[1]]
-    svg = figures.residual_figure(two)
-    assert "F_ref per stage" in svg and "M_ref per stage" in svg
-    for r in two:
-        assert f"F_ref {r[4]:.4g} N, M_ref {r[5]:.4g} N m" in svg
-    svg1 = figures.residual_figure(first)
+    data = live.data(live_plots.residuals(two))
+    titles = [p["title"] for p in data["panels"]]
+    assert "F_ref per stage" in titles[0] and "M_ref per stage" in titles[1]
+    for r, series in zip(two, data["series"]):
+        assert series["label"].endswith(f"(F_ref {r[4]:.4g} N, M_ref {r[5]:.4g} N m)")
+    one = live.data(live_plots.residuals(first))
     F0, M0 = first[0][4], first[0][5]
-    assert f"F_ref = {F0:.4g} N" in svg1 and f"M_ref = {M0:.4g} N m" in svg1
-    assert "|F_sim − F_analytic| / F_ref" in svg1 and "time (s)" in svg1
+    assert f"F_ref = {F0:.4g} N" in one["panels"][0]["title"] and f"M_ref = {M0:.4g} N m" in one["panels"][1]["title"]
+    assert "|F_sim − F_analytic| / F_ref" in one["panels"][0]["title"] and [p["axis"] for p in one["panels"]] == [
+        "|ΔF| / F_ref", "|ΔM| / M_ref"]
+    assert all(p["log"] for p in one["panels"])  # residuals span decades: a log axis
+    # each curve is the stage's error over its own reference (1e-3 N / F_ref), to 6 digits
+    assert one["series"][0]["y"]["force"][5] == pytest.approx(1e-3 / F0, rel=1e-5)
 
 
 def test_the_pages_residual_figure_says_what_it_divides_by(paper003):
     figs = page.study_figures(paper003)
-    [(title, svg, caption)] = figs["residuals"]
+    [(title, html, caption)] = figs["residuals"]
     ref = paper003.reference
-    assert f"F_ref = {ref.force:.4g} N" in svg and f"F_ref = {ref.force:.4g} N" in caption
+    assert 'id="live-residuals"' in html and "<svg" not in html  # drawn by the browser, no matplotlib
+    assert f"F_ref = {ref.force:.4g} N" in html and f"F_ref = {ref.force:.4g} N" in caption
     assert f"M_ref = {ref.moment:.4g} N m" in caption and "'" + paper003.stages[0].stage.label + "'" in caption
 
 
@@ -134,28 +140,25 @@ def _legends_clear_of_the_data(fig) -> list[str]:
     return out
 
 
-def test_legends_never_cover_the_curves(monkeypatch):
-    """The matplotlib time plots with one curve per stage (residuals, tracking, drift) keep their
-    legend under the axes, in as many columns as fit, with long stage names (paper 001's); the
-    efforts and joint loads are live plots (uPlot's legend is under its plot)."""
+def test_simulation_figures_are_live_plots_with_every_stage(monkeypatch):
+    """The time plots with one curve per stage of the simulation (residuals, tracking, drift) are
+    drawn by the browser (uPlot's legend is under its plot, never over a curve): no matplotlib
+    figure is drawn for them, and every stage, long names included, has its curve and legend entry."""
     drawn = []
-    monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.append((prefix, fig)) or "<svg/>")
+    monkeypatch.setattr(figures, "to_svg", lambda fig, prefix: drawn.append(prefix) or "<svg/>")
     t = np.linspace(0.0, 0.5, 101)
     names = ["unbalanced", "counterweights", "counterweights + counter-rotations",
              "force balance only: least-mass counterweights", "crank counterweight only: 1 kg at 80 mm behind O2"]
     err = 1e-6 * (1 + np.abs(np.sin(20 * t)))
-    figures.residual_figure([(n, t, err, err, 10.0, 2.0) for n in names])
-    figures.series_figure(t, [(n + ": crank", err) for n in names], "|q_sim − q_plan| / travel", "torque")
-    figures.drift_figure([(n, t, np.stack([err, err], 1), err) for n in names])
-    assert len(drawn) == 3  # the matplotlib ones
-    for prefix, fig in drawn:
-        assert _legends_clear_of_the_data(fig) == [], prefix
-        assert _fits(fig) == [], prefix
-        W = fig.bbox.width
-        for leg in fig.legends:
-            box = leg.get_window_extent(fig.canvas.get_renderer())
-            assert box.x0 >= 0 and box.x1 <= W and box.y0 >= 0, prefix
-        figures.plt.close(fig)
+    figs = [live_plots.residuals([(n, t, err, err, 10.0, 2.0) for n in names]),
+            live_plots.tracking(t, [(n + ": crank", err) for n in names]),
+            live_plots.drift([(n, t, np.stack([err, err], 1), err) for n in names])]
+    assert drawn == []
+    for c in figs:
+        data = live.data(c)
+        assert [s["label"] for s in data["series"]][:len(names)] in (names, [n + ": crank" for n in names])
+        assert all(len(s["y"]) == len(data["panels"]) for s in data["series"])
+    assert live.data(figs[2])["series"][0]["y"]["drift"][-1] == pytest.approx(1000 * np.hypot(err[-1], err[-1]), rel=1e-5)
 
 
 def test_rpr3_factor_table_gives_the_effort_unit_and_one_full_stop(studies):
@@ -223,7 +226,7 @@ def test_tracking_error_caption_gives_each_travel():
         s.torque = SimpleNamespace(t=t, travel={"crank": 2.5}, tracking={"crank": np.full(len(t), 1e-6)})
     [(title, svg, caption)] = page.study_figures(st)["torque"]
     assert "relative to its travel" in caption and "θ₁ [crank] 2.5 rad" in caption  # the paper's symbol, then the spec's name
-    assert "|q_sim − q_plan| / travel" in svg and "time (s)" in svg
+    assert "|q_sim − q_plan| / travel" in svg and 'id="live-tracking"' in svg  # over time, drawn by the browser
 
 
 def test_no_two_stages_look_alike_and_the_caption_names_each_style(monkeypatch, studies, pages):

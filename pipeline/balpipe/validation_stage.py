@@ -64,15 +64,6 @@ class Reactionless:
         """Every stage ran on the same frame (mass and inertia)."""
         return len({(r.base_mass, r.base_inertia) for r in self.runs}) == 1
 
-    def figures(self):
-        from .draw.figures import drift_figure
-
-        yield (
-            "Frame drift and rotation",
-            drift_figure([(lab, r.t, r.drift, r.rotation) for lab, r in zip(self.labels, self.runs)]),
-            "Displacement of the free frame's centre of mass and its rotation during the motion.",
-        )
-
     def player(self) -> str:
         from .draw.player import player_html
 

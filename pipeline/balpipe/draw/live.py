@@ -101,6 +101,8 @@ class Curves(NamedTuple):
     # ``points`` (each a single design) as markers alone
     x_axis: str = ""
     points: tuple = ()
+    # the panels side by side where the page is wide enough (as a figure of more than two panels)
+    grid: bool = False
 
 
 def data(c: Curves) -> dict:
@@ -110,9 +112,16 @@ def data(c: Curves) -> dict:
     t = np.asarray(c.t, dtype=float)
     k = (np.arange(len(t)) if c.x_axis else
          _thin(len(t), sum(p["key"] in curves for _, curves in c.stages for p in c.panels)))
-    floors = {p["key"]: _floor(c, p["key"]) for p in c.panels}
-    series = [{"label": label, "y": {p["key"]: _round(np.asarray(curves[p["key"]], dtype=float)[k], floors[p["key"]])
-                                     for p in c.panels if p["key"] in curves}, **line_style(n)}
+    # a panel on a log axis (``"log": True``: residuals) keeps its small values, which are what it
+    # shows, and has no value at or below 0 (null: a gap)
+    floors = {p["key"]: 0.0 if p.get("log") else _floor(c, p["key"]) for p in c.panels}
+
+    def values(p: dict, y) -> list:
+        out = _round(np.asarray(y, dtype=float)[k], floors[p["key"]])
+        return [v if v is None or v > 0 else None for v in out] if p.get("log") else out
+
+    series = [{"label": label, "y": {p["key"]: values(p, curves[p["key"]]) for p in c.panels if p["key"] in curves},
+               **line_style(n)}
               for n, (label, curves) in enumerate(c.stages)]
     if c.styles is not None:
         for one, style in zip(series, c.styles):
@@ -127,6 +136,8 @@ def data(c: Curves) -> dict:
            "marks": [[_round([tm])[0], text] for tm, text in sorted(set(c.marks))]}
     if c.choose is not None:
         out["choose"] = c.choose
+    if c.grid:
+        out["grid"] = True
     if c.x_axis:
         out["x"] = c.x_axis
         for n in c.points:

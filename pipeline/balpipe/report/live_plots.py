@@ -1,6 +1,9 @@
 """The curves of a page's generic time-series figures (shaking loads, actuator efforts, joint
-loads) for the interactive plots of :mod:`balpipe.draw.live`: a builder per figure kind
-(:func:`loads`, :func:`efforts`, :func:`joints`), each giving its :class:`~balpipe.draw.live.Curves`.
+loads, and the simulation's residuals, tracking errors and free-frame drift) for the interactive
+plots of :mod:`balpipe.draw.live`: a builder per figure kind (:func:`loads`, :func:`efforts`,
+:func:`joints`, :func:`residuals`, :func:`tracking`, :func:`drift`), each giving its
+:class:`~balpipe.draw.live.Curves`. The browser draws them: no matplotlib (issue 23: the three
+simulation figures were 13.5 s of matplotlib in a build of specs/).
 """
 
 from __future__ import annotations
@@ -93,3 +96,60 @@ def largest_load(panels: list[dict], curves: list, units: dict[str, str]) -> int
 
     forces = [i for i, p in enumerate(panels) if units[p["key"]] == "N"] or list(range(len(panels)))
     return max(forces, key=lambda i: (peak(panels[i]["key"]), -i))
+
+
+#: where a reader without JavaScript finds the simulation figures' numbers
+SIMULATED = 'its largest values are in the table above and in <a href="results.json">results.json</a>'
+
+
+def residuals(rows: list) -> Curves:
+    """|F_sim − F_analytic| / F_ref and |M_sim − M_analytic| / M_ref over time, a curve per
+    simulated stage on a log axis; ``rows``: (label, t, force error (N,), moment error (N,),
+    F_ref, M_ref) of :func:`balpipe.report.page.residual_rows`, each stage divided by its own
+    reference. One reference for every stage: the titles give it; several: each stage's legend
+    entry does. A reference of 0 leaves the errors in N and N m. Drawn in the simulation's
+    colours (:data:`balpipe.draw.figures.SIM_COLORS`), solid."""
+    one = len({(F0, M0) for *_, F0, M0 in rows}) == 1  # one reference for every stage: in the titles
+    curves, styles = [], []
+    for k, (label, t, fe, me, F0, M0) in enumerate(rows):
+        name = label if one else f"{label} (F_ref {F0:.4g} N, M_ref {M0:.4g} N m)"
+        curves.append((name, {"force": fe / F0 if F0 > 0 else fe, "moment": me / M0 if M0 > 0 else me}))
+        styles.append({"color": figures.SIM_COLORS[k % len(figures.SIM_COLORS)], "linestyle": "-", "linewidth": 1.0})
+    F0, M0 = rows[0][4], rows[0][5]
+    panels = [
+        {"key": "force", "log": True,
+         "title": "Force residual |F_sim − F_analytic|" + (f" / F_ref, F_ref = {F0:.4g} N" if F0 > 0 and one else
+                                                            " / F_ref, F_ref per stage (legend)" if not one else " (N)"),
+         "axis": "|ΔF| / F_ref" if F0 > 0 or not one else "|ΔF| (N)"},
+        {"key": "moment", "log": True,
+         "title": "Moment residual |M_sim − M_analytic|" + (f" / M_ref, M_ref = {M0:.4g} N m" if M0 > 0 and one else
+                                                              " / M_ref, M_ref per stage (legend)" if not one else " (N m)"),
+         "axis": "|ΔM| / M_ref" if M0 > 0 or not one else "|ΔM| (N m)"},
+    ]
+    return Curves(_common_t(r[1] for r in rows), curves, panels, [], styles=styles, grid=True)
+
+
+def tracking(t, curves: list[tuple[str, np.ndarray]]) -> Curves:
+    """The torque-driven runs' tracking errors: one curve per (stage: driver) of ``curves``
+    (|q_sim − q_plan| / travel over ``t``), in the stage styles in order."""
+    return Curves(np.asarray(t, dtype=float), [(label, {"q": y}) for label, y in curves],
+                  [{"key": "q", "title": "Tracking error of the torque-driven run", "axis": "|q_sim − q_plan| / travel"}], [])
+
+
+def drift(runs: list) -> Curves:
+    """The free-floating frame: drift of its centre of mass (mm) and its rotation (deg) per
+    stage; ``runs``: (label, t, drift (N, 2) in m, rotation (N,) in rad)."""
+    curves = [(label, {"drift": 1000.0 * np.hypot(d[:, 0], d[:, 1]), "rotation": np.degrees(rot)})
+              for label, _, d, rot in runs]
+    panels = [{"key": "drift", "title": "Drift of the free frame (mm)", "axis": "drift (mm)"},
+              {"key": "rotation", "title": "Rotation of the free frame (deg)", "axis": "rotation (deg)"}]
+    return Curves(_common_t(r[1] for r in runs), curves, panels, [], grid=True)
+
+
+def _common_t(ts) -> np.ndarray:
+    """The stages' common sample times: every simulation samples its stage's analysis grid, and
+    a study's stages share one grid (the time column of timeseries.csv)."""
+    ts = [np.asarray(t, dtype=float) for t in ts]
+    if any(not np.array_equal(t, ts[0]) for t in ts[1:]):
+        raise ValueError("the simulated stages do not share their sample times")
+    return ts[0]

@@ -83,9 +83,14 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
     vals = [s for s in shown_stages(study) if s.validation is not None]
     if vals:
         rows, caption = residual_rows(study, vals)
-        residuals.append(("Residuals of the simulation", figures.residual_figure(rows), caption))
+        residuals.append(("Residuals of the simulation",
+                          live.html("residuals", live_plots.residuals(rows), live_plots.SIMULATED), caption))
     if study.reactionless is not None:
-        drift = list(study.reactionless.figures())
+        r = study.reactionless
+        drift.append(("Frame drift and rotation",
+                      live.html("drift", live_plots.drift([(lab, x.t, x.drift, x.rotation) for lab, x in zip(r.labels, r.runs)]),
+                                live_plots.SIMULATED),
+                      "Displacement of the free frame's centre of mass and its rotation during the motion."))
     torque = []
     runs = [s for s in study.stages if s.torque is not None]
     if runs:
@@ -93,7 +98,7 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
                   for s in runs for d, e in sorted(s.torque.tracking.items())]
         torque.append((
             "Tracking error of the torque-driven run",
-            figures.series_figure(runs[0].torque.t, curves, "|q_sim − q_plan| / travel", prefix="torque"),
+            live.html("tracking", live_plots.tracking(runs[0].torque.t, curves), live_plots.SIMULATED),
             "Each driven coordinate of the simulation driven by the engine's efforts (no position drive), "
             "minus its planned motion, relative to its travel (largest excursion from its start): "
             + travel_text(runs[0], names) + ".",
