@@ -164,10 +164,11 @@ class Job:
     history: dict | None
     history_files: dict[str, str]
     sim_workers: int = 1  # the stages' simulations in that many processes (the same results)
-    #: the output folder whose figure cache (draw/cache.py: <out>/.cache/figures/<slug>/) the
-    #: figures are drawn through; None (a dask worker, which has no access to it): every figure drawn
+    #: the output folder whose caches the figures are drawn through (draw/cache.py:
+    #: <out>/.cache/figures/<slug>/) and the simulations run through (sim_cache.py:
+    #: <out>/.cache/sims/<slug>/); None (a dask worker, which has no access to it): all computed
     figure_cache: Path | None = None
-    redraw: bool = False  # --force: every figure drawn, its cache entry rewritten
+    redraw: bool = False  # --force: every figure drawn and simulation run, its cache entry rewritten
     figure_keys: frozenset[str] = frozenset()  # the cache entries the planning used (history figures): kept
 
 
@@ -259,17 +260,23 @@ def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outc
 
 def compute(job: Job) -> Computed:
     """Balance, analyse, validate and render one spec; never raises (errors become the result).
-    With ``job.figure_cache``, the figures come from that folder's figure cache where their
-    inputs are unchanged (:mod:`balpipe.draw.cache`), and the spec's entries this build did not
-    use are removed when its page is made."""
+    With ``job.figure_cache``, the figures and the simulations come from that folder's caches
+    where their inputs are unchanged (:mod:`balpipe.draw.cache`, :mod:`balpipe.sim_cache`), and
+    the spec's entries this build did not use are removed when its page is made."""
+    from . import sim_cache
     from .draw import cache
 
+    slug = slug_for(job.path)
     store = None if job.figure_cache is None else \
-        cache.Store(job.figure_cache, slug_for(job.path), code_hash(), reuse=not job.redraw, used=set(job.figure_keys))
-    with cache.using(store):
+        cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw, used=set(job.figure_keys))
+    sims = None if job.figure_cache is None or not job.simulate else \
+        sim_cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw)
+    with cache.using(store), sim_cache.using(sims):
         done = _compute(job)
-    if store is not None and done.status in ("ok", "failed"):
-        store.prune()
+    if done.status in ("ok", "failed"):
+        for used in (store, sims):
+            if used is not None:
+                used.prune()
     return done
 
 

@@ -16,10 +16,14 @@ def tmp_name(name: str) -> str:
     return f".{name[:100]}{TMP_MARK}{os.getpid()}-{secrets.token_hex(4)}"
 
 
-def write_new(path: Path, content: str) -> None:
-    """Create ``path`` (it must not exist: never writes through a planted symlink); mode from
-    the umask."""
+def write_new(path: Path, content: str | bytes) -> None:
+    """Create ``path`` (it must not exist: never writes through a planted symlink) with
+    ``content`` (text as UTF-8, or bytes); mode from the umask."""
     fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o666)
+    if isinstance(content, bytes):
+        with os.fdopen(fd, "wb") as fb:
+            fb.write(content)
+        return
     with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
         f.write(content)
 
@@ -32,7 +36,7 @@ def remove_path(path: Path) -> None:
         shutil.rmtree(path, ignore_errors=True)
 
 
-def write_file_atomic(path: Path, content: str) -> None:
+def write_file_atomic(path: Path, content: str | bytes) -> None:
     """Replace ``path`` in one step: a reader sees the old or the new file, never a part; a
     symlink at ``path`` is replaced by the file, its target is left alone."""
     tmp = path.with_name(tmp_name(path.name))

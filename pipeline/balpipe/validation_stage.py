@@ -4,8 +4,9 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
+from . import sim_cache
 from .pool import stop_now
 from .study import Study, ratio_reference
 from .validate import FreeFloating, ValidationSettings, free_floating, validate
@@ -98,19 +99,27 @@ def _stage_runs(k: int, study: Study | None = None):
     ref = ratio_reference(study.reference_stage(s))
     F0, M0 = ref.force_peak, ref.moment_peak
     expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
-    v = validate(s.stage.model, s.analysis, (F0, M0), settings, expect, reference=ref)
+    model = simulated_model(s.stage.model)
+    v = sim_cache.run(validate, model, s.analysis, (F0, M0), settings, expect, reference=ref)
     # the inverse dynamics: the engine's efforts drive the mechanism (same step and solver effort)
-    tq = torque_driven(
-        s.stage.model, s.analysis, settings, economic=True, reference=(ref.force, ref.moment),
+    tq = sim_cache.run(
+        torque_driven, model, s.analysis, settings, economic=True, reference=(ref.force, ref.moment),
         dt=v.dt, iterations=v.iterations,
     )
     return v, tq
 
 
+def simulated_model(model):
+    """``model`` as the simulations read it: without the spec locations of its parts (for error
+    messages only), so that the same stage in two specs is one simulation (:mod:`.sim_cache`)."""
+    return replace(model, sources={})
+
+
 def _floating_run(k: int, base_inertia: float, settings: ValidationSettings | None,
                   study: Study | None = None) -> FreeFloating:
     s = (study or _FORKED).stages[k]
-    return free_floating(s.stage.model, s.analysis, BASE_MASS, base_inertia, settings=settings)
+    return sim_cache.run(free_floating, simulated_model(s.stage.model), s.analysis, BASE_MASS, base_inertia,
+                         settings=settings)
 
 
 def _parallel(study: Study, workers: int, tasks: list[tuple]) -> list:
@@ -129,8 +138,12 @@ def _parallel(study: Study, workers: int, tasks: list[tuple]) -> list:
     pool = ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=multiprocessing.get_context("fork"),
                                initializer=_quiet_child)
     try:
-        futures = [pool.submit(fn, *a) for fn, a in tasks]
-        out = [f.result() for f in futures]
+        futures = [pool.submit(_keyed, fn, a) for fn, a in tasks]
+        out = []
+        for f in futures:
+            result, keys = f.result()
+            sim_cache.mark_used(keys)  # the worker's cache keys: the parent's store prunes the rest
+            out.append(result)
     except BaseException:  # Ctrl-C, SIGTERM, a failure: stop the other simulations now, not at their end
         stop_now(pool)
         raise
@@ -138,6 +151,13 @@ def _parallel(study: Study, workers: int, tasks: list[tuple]) -> list:
         _FORKED = None
     pool.shutdown()
     return out
+
+
+def _keyed(fn, a: tuple) -> tuple:
+    """``fn(*a)`` in a forked worker, with the simulation cache keys it used (:mod:`.sim_cache`)."""
+    before = sim_cache.used()
+    result = fn(*a)
+    return result, sim_cache.used() - before
 
 
 def _quiet_child() -> None:

@@ -1,0 +1,291 @@
+"""Results cached by content in the output folder (issue 23, "Fast"): what a build computed from
+some inputs is kept under the SHA-256 of those inputs, so that a build whose inputs did not change
+reads it instead of computing it again. Two caches use it: the figures (:mod:`balpipe.draw.cache`,
+``<out>/.cache/figures/``) and the pymunk simulations (:mod:`balpipe.sim_cache`,
+``<out>/.cache/sims/``).
+
+Keys
+    :func:`key` hashes a function's module and name, its arguments and a salt (balpipe's code
+    hash, and what else the result depends on). Arguments are fed by :func:`feed`: numbers,
+    strings, bytes, numpy arrays, lists, tuples, dicts (in their order), sets, enums, dataclasses,
+    pydantic models (their JSON), and functions: a named function by its module and name (its
+    code is balpipe's, which the salt covers), its defaults and the values its closure captured.
+    Anything else (a lambda, an arbitrary object) is :class:`Unhashable`: such a result is
+    computed, never cached.
+
+Entries
+    ``<out>/.cache/<kind>/<slug>/<sha256><suffix>``: a header line with the SHA-256 of the
+    payload that follows (a truncated or damaged entry is computed again, never served),
+    written atomically (:func:`balpipe.fsutil.write_file_atomic`); a symlink anywhere on the way
+    is never followed. :meth:`Store.prune` removes the spec's entries that its build did not use;
+    :func:`prune_specs` the folders of specs that have no page any more.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import hashlib
+import os
+import re
+import struct
+import types
+from pathlib import Path
+from typing import Any, Callable, ClassVar
+
+import numpy as np
+
+from .fsutil import TMP_MARK, remove_path, write_file_atomic
+
+#: the caches' folder in the output folder; never part of the published site
+CACHE_DIR = ".cache"
+
+
+class Unhashable(TypeError):
+    """An input that :func:`key` cannot serialise deterministically (a lambda, an arbitrary
+    object): pass the plain data the result is computed from instead."""
+
+
+def callable_name(fn: Any, closures: bool = False) -> str:
+    """``module:qualname`` of a named function; a lambda (no unique name), or a function defined
+    inside another when not ``closures``, is :class:`Unhashable`."""
+    name = getattr(fn, "__qualname__", "") or ""
+    module = getattr(fn, "__module__", "") or ""
+    anonymous = "<" in name.replace("<locals>", "")  # <lambda>, <listcomp>, ...
+    if not name or not module or anonymous or ("<locals>" in name and not closures):
+        raise Unhashable(f"{fn!r}: only a named function can be part of a key")
+    return f"{module}:{name}"
+
+
+def feed(h, x: Any) -> None:
+    """Feed ``x`` into the hash ``h``, every value tagged with its type so that no two different
+    inputs give the same bytes (1 and 1.0 and '1' and [1] differ; dicts in their order)."""
+    if x is None:
+        h.update(b"N")
+    elif x is True or x is False:
+        h.update(b"T" if x else b"F")
+    elif isinstance(x, np.ndarray) or isinstance(x, np.generic):
+        a = np.asarray(x)
+        if a.dtype.hasobject:
+            raise Unhashable(f"a numpy array of objects ({a.dtype}) cannot be hashed")
+        data = np.ascontiguousarray(a).tobytes()
+        h.update(b"A" + a.dtype.str.encode() + repr(a.shape).encode() + struct.pack("<Q", len(data)))
+        h.update(data)
+    elif isinstance(x, enum.Enum):
+        h.update(b"E" + type(x).__qualname__.encode() + b"." + x.name.encode() + b"\0")
+    elif isinstance(x, int):
+        h.update(b"I" + str(int(x)).encode() + b"\0")
+    elif isinstance(x, float):
+        h.update(b"R" + float(x).hex().encode() + b"\0")
+    elif isinstance(x, str):
+        b = x.encode("utf-8", "surrogatepass")
+        h.update(b"S" + struct.pack("<Q", len(b)) + b)
+    elif isinstance(x, bytes):
+        h.update(b"B" + struct.pack("<Q", len(x)) + x)
+    elif isinstance(x, (list, tuple)):
+        h.update((b"L" if isinstance(x, list) else b"U") + struct.pack("<Q", len(x)))
+        for v in x:
+            feed(h, v)
+    elif isinstance(x, dict):
+        h.update(b"M" + struct.pack("<Q", len(x)))
+        for k, v in x.items():
+            feed(h, k)
+            feed(h, v)
+    elif isinstance(x, (set, frozenset)):
+        parts = sorted(hashlib.sha256(digest_of(v)).digest() for v in x)
+        h.update(b"Z" + struct.pack("<Q", len(parts)) + b"".join(parts))
+    elif dataclasses.is_dataclass(x) and not isinstance(x, type):
+        cls = type(x)
+        h.update(b"C" + f"{cls.__module__}.{cls.__qualname__}".encode() + b"\0")
+        fields = dataclasses.fields(x)
+        h.update(struct.pack("<Q", len(fields)))
+        for f in fields:
+            h.update(f.name.encode() + b"=")
+            feed(h, getattr(x, f.name))
+    elif isinstance(x, types.FunctionType):
+        # a motion law's profile (motion.quintic) or a closure of one (its captured values)
+        h.update(b"f" + callable_name(x, closures=True).encode() + b"\0")
+        feed(h, x.__defaults__)
+        feed(h, x.__kwdefaults__)
+        feed(h, tuple(c.cell_contents for c in (x.__closure__ or ())))
+    elif hasattr(type(x), "model_fields") and hasattr(x, "model_dump_json"):  # a pydantic model of a spec
+        cls = type(x)
+        h.update(b"P" + f"{cls.__module__}.{cls.__qualname__}".encode() + b"\0")
+        feed(h, x.model_dump_json())
+    else:
+        raise Unhashable(f"an input of type {type(x).__qualname__} cannot be hashed; pass plain data")
+
+
+def digest_of(x: Any) -> bytes:
+    h = hashlib.sha256()
+    feed(h, x)
+    return h.digest()
+
+
+def key(fn: Callable[..., Any], args: tuple, kwargs: dict, salt: str) -> str:
+    """The SHA-256 (hex) of ``fn(*args, **kwargs)``: ``fn``'s module and name (a module-level
+    function: :class:`Unhashable` otherwise), ``args`` and ``kwargs`` (:func:`feed`) and
+    ``salt``."""
+    h = hashlib.sha256()
+    h.update(f"{callable_name(fn)}\0{salt}\0".encode())
+    feed(h, tuple(args))
+    feed(h, dict(sorted(kwargs.items())))
+    return h.hexdigest()
+
+
+def pack(header: bytes, payload: bytes) -> bytes:
+    """An entry: ``header``, the payload's SHA-256, a newline, the payload."""
+    return header + hashlib.sha256(payload).hexdigest().encode() + b"\n" + payload
+
+
+def unpack(header: bytes, data: bytes) -> bytes | None:
+    """The payload of an entry whose header and checksum hold, else None."""
+    head, sep, body = data.partition(b"\n")
+    if not sep or not head.startswith(header):
+        return None
+    if hashlib.sha256(body).hexdigest().encode() != head[len(header):]:
+        return None
+    return body
+
+
+def safe_folder(out: Path, parts: tuple[str, ...], create: bool) -> Path | None:
+    """``out / parts...``, created when ``create``; None when it is missing or when anything on
+    the way from ``out`` is a symlink or not a folder (refused, never followed)."""
+    p = out
+    for part in parts:
+        p = p / part
+        if p.is_symlink():
+            return None
+        if not p.exists():
+            if not create:
+                return None
+            try:
+                os.mkdir(p, 0o777)
+            except FileExistsError:
+                pass
+            except OSError:
+                return None
+            if p.is_symlink():
+                return None
+        if not p.is_dir():
+            return None
+    return p
+
+
+def read_entry(path: Path) -> bytes | None:
+    """The bytes of the file ``path``, never through a symlink; None when it cannot be read."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+    except OSError:
+        return None
+    try:
+        with os.fdopen(fd, "rb") as f:
+            return f.read()
+    except OSError:
+        return None
+
+
+@dataclasses.dataclass
+class Store:
+    """The cache of one kind (:attr:`KIND`, a folder of ``<out>/.cache``) for one spec: ``out`` the
+    output folder, ``slug`` the spec's page name, ``salt`` balpipe's code hash; ``reuse`` False
+    (``--force``): everything is computed and its entry rewritten. ``used``: the keys this build
+    asked for (:meth:`prune` keeps those); ``hits``: entries served; ``computed``: results
+    computed (and stored). A subclass gives :meth:`get` and :meth:`put` (its values as bytes)."""
+
+    KIND: ClassVar[str] = ""
+    SUFFIX: ClassVar[str] = ""
+    HEADER: ClassVar[bytes] = b""
+
+    out: Path
+    slug: str
+    salt: str
+    reuse: bool = True
+    used: set[str] = dataclasses.field(default_factory=set)
+    hits: int = 0
+    computed: int = 0
+
+    @property
+    def folder(self) -> Path:
+        return self.out / CACHE_DIR / self.KIND / self.slug
+
+    def _folder(self, create: bool) -> Path | None:
+        return safe_folder(self.out, (CACHE_DIR, self.KIND, self.slug), create)
+
+    def get(self, k: str) -> Any | None:
+        raise NotImplementedError
+
+    def put(self, k: str, value: Any) -> None:
+        raise NotImplementedError
+
+    def serve(self, k: str, compute: Callable[[], Any]) -> Any:
+        """The value of key ``k``: the stored one when there is one (and ``reuse``), else
+        ``compute()``, stored. ``k`` is kept by :meth:`prune` either way."""
+        self.used.add(k)
+        if self.reuse:
+            hit = self.get(k)
+            if hit is not None:
+                self.hits += 1
+                return hit
+        out = compute()
+        self.computed += 1
+        self.put(k, out)
+        return out
+
+    def get_bytes(self, k: str) -> bytes | None:
+        """The payload of key ``k`` in this spec's folder, or None (missing, damaged, or behind
+        a symlink)."""
+        folder = self._folder(create=False)
+        data = read_entry(folder / f"{k}{self.SUFFIX}") if folder is not None else None
+        return unpack(self.HEADER, data) if data is not None else None
+
+    def put_bytes(self, k: str, payload: bytes) -> None:
+        """Store ``payload`` under ``k`` (atomically; a symlink at the entry is replaced, not
+        followed). A cache that cannot be written is left alone: the page does not need it."""
+        folder = self._folder(create=True)
+        if folder is None:
+            return
+        try:
+            write_file_atomic(folder / f"{k}{self.SUFFIX}", pack(self.HEADER, payload))
+        except OSError:
+            pass
+
+    def prune(self) -> None:
+        """Remove this spec's entries that this build did not use (and temporaries that an
+        interrupted write left)."""
+        folder = self._folder(create=False)
+        if folder is None:
+            return
+        keep = {f"{k}{self.SUFFIX}" for k in self.used}
+        entry = re.compile(r"[0-9a-f]{64}" + re.escape(self.SUFFIX))
+        try:
+            entries = list(folder.iterdir())
+        except OSError:
+            return
+        for e in entries:
+            if e.name not in keep and (entry.fullmatch(e.name) or TMP_MARK in e.name):
+                try:
+                    remove_path(e)
+                except OSError:
+                    pass
+
+
+def prune_specs(out: Path, pages: set[str], kind: str) -> None:
+    """Remove the ``kind`` cache folders of specs that have no page folder in ``out`` any more
+    (a spec deleted or renamed), keeping those of ``pages`` (this build's specs)."""
+    root = out / CACHE_DIR / kind
+    if any(p.is_symlink() for p in (out / CACHE_DIR, root)) or not root.is_dir():
+        return
+    try:
+        entries = list(root.iterdir())
+    except OSError:
+        return
+    for e in entries:
+        page = out / e.name
+        if e.name.startswith("."):
+            continue  # the cache's own files (the simulations' locks)
+        if e.name not in pages and not (page.is_dir() and not page.is_symlink()):
+            try:
+                remove_path(e)
+            except OSError:
+                pass

@@ -1,0 +1,216 @@
+"""Issue 23: the pymunk simulations cached by content (``balpipe.sim_cache``). A rebuild whose
+stages did not change runs no simulation and writes the same results and page, byte for byte; a
+changed stage is simulated again, the unchanged ones are not; another spec with the same stage
+reuses its simulation; a damaged entry is simulated again; ``--force`` simulates everything;
+the keys of forked workers are kept; two processes needing one simulation run it once."""
+
+from __future__ import annotations
+
+import multiprocessing
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balpipe import content_cache, sim_cache
+from balpipe.build import Options, build
+from balpipe.loader import load
+from balpipe.study import run as run_study
+from balpipe.validation_stage import simulated_model
+from _edits import replaced
+
+ROOT = Path(__file__).resolve().parents[1]
+QUICK = replaced((ROOT / "specs" / "scott_russell.yaml").read_text(), "  samples: 501", "  samples: 41")
+DESCRIPTION = "The slider-crank of Fig. 5 with the Scott-Russell geometry"
+
+
+@pytest.fixture
+def simulated(monkeypatch):
+    """The simulations that ran (not served from the cache) in this process: their keys."""
+    ran: list[str] = []
+    real = sim_cache.Store.put
+
+    def put(self, k, value):
+        ran.append(k)
+        return real(self, k, value)
+
+    monkeypatch.setattr(sim_cache.Store, "put", put)
+    return ran
+
+
+def write_spec(folder: Path, text: str = QUICK, name: str = "scott_russell") -> Path:
+    folder.mkdir(exist_ok=True)
+    (folder / f"{name}.yaml").write_text(text)
+    return folder
+
+
+def run(specs: Path, out: Path, **kw) -> list:
+    outcomes = build([str(specs)], Options(out, simulate=True, **kw), jobs=1)
+    assert all(o.status == "ok" for o in outcomes), [o.message for o in outcomes]
+    return outcomes
+
+
+def sims(out: Path, slug: str = "scott_russell") -> dict[str, bytes]:
+    folder = out / ".cache" / "sims" / slug
+    return {p.name: p.read_bytes() for p in sorted(folder.iterdir())} if folder.is_dir() else {}
+
+
+def page(out: Path, slug: str = "scott_russell") -> tuple[bytes, bytes]:
+    """What a simulation feeds (timing.js, the run times, excepted): the page and results.json."""
+    return (out / slug / "index.html").read_bytes(), (out / slug / "results.json").read_bytes()
+
+
+def test_a_rebuild_of_unchanged_stages_runs_no_simulation(tmp_path, simulated):
+    specs = write_spec(tmp_path / "specs")
+    out = tmp_path / "out"
+    run(specs, out)
+    n = len(simulated)
+    assert n >= 9 and set(sims(out)) == {f"{k}.pickle" for k in simulated}  # 3 stages x 3 kinds of run
+    kept = sims(out)
+    simulated.clear()
+    write_spec(specs, replaced(QUICK, DESCRIPTION, "A slider-crank with the Scott-Russell geometry"))
+    (o,) = run(specs, out)
+    assert not o.skipped and simulated == [] and sims(out) == kept
+    # the same results and page as a build that simulated everything (another output folder)
+    fresh = tmp_path / "fresh"
+    run(specs, fresh)
+    assert len(simulated) == n
+    assert page(out) == page(fresh)
+
+
+def test_a_changed_stage_is_simulated_again_and_the_others_are_not(tmp_path, simulated):
+    specs = write_spec(tmp_path / "specs")
+    out = tmp_path / "out"
+    run(specs, out)
+    n, old = len(simulated), set(sims(out))
+    simulated.clear()
+    # the coupler's counterweight moves: its stages change, the unbalanced stage does not
+    write_spec(specs, replaced(QUICK, "coupler_counterweight: -0.1 m", "coupler_counterweight: -0.09 m"))
+    run(specs, out)
+    new = set(sims(out))
+    assert 0 < len(simulated) < n
+    assert new - old == {f"{k}.pickle" for k in simulated}  # exactly what ran is new
+    assert len(new & old) >= 2  # the unbalanced stage's runs (prescribed motion, torque-driven) kept
+    assert len(new) == len(old)  # the changed stages' old entries pruned
+
+
+def test_another_spec_with_the_same_stages_reuses_their_simulations(tmp_path, simulated):
+    specs = write_spec(tmp_path / "specs")
+    out = tmp_path / "out"
+    run(specs, out)
+    first = sims(out)
+    simulated.clear()
+    write_spec(specs, replaced(QUICK, DESCRIPTION, "A copy of it"), name="copy")
+    run(specs, out)
+    assert simulated == []  # scott_russell unchanged (skipped), copy: every run from scott_russell's entries
+    assert sims(out, "copy") == first  # copied into its own folder: scott_russell's changes cannot take them away
+
+
+def entry_damaged(good: bytes, damage: str) -> bytes:
+    head, body = good.split(b"\n", 1)
+    return {"truncated": good[: len(good) // 2], "flipped": head + b"\n" + body[:-1] + bytes([body[-1] ^ 1]),
+            "no header": body}[damage]
+
+
+@pytest.mark.parametrize("damage", ["truncated", "flipped", "no header"])
+def test_a_damaged_entry_is_simulated_again(tmp_path, simulated, damage):
+    specs = write_spec(tmp_path / "specs")
+    out = tmp_path / "out"
+    run(specs, out)
+    name = sorted(sims(out))[0]
+    entry = out / ".cache" / "sims" / "scott_russell" / name
+    good = entry.read_bytes()
+    entry.write_bytes(entry_damaged(good, damage))
+    simulated.clear()
+    write_spec(specs, replaced(QUICK, DESCRIPTION, "Changed text"))
+    run(specs, out)
+    assert simulated == [name.removesuffix(".pickle")] and entry.read_bytes() != entry_damaged(good, damage)
+    fresh = tmp_path / "fresh"
+    run(specs, fresh)
+    assert page(out) == page(fresh)  # the run again gives what a build without the cache gives
+
+
+def test_force_simulates_everything_and_no_sim_keeps_the_cache(tmp_path, simulated):
+    specs = write_spec(tmp_path / "specs")
+    out = tmp_path / "out"
+    run(specs, out)
+    n, kept = len(simulated), sims(out)
+    simulated.clear()
+    before = page(out)
+    run(specs, out, force=True)
+    assert len(simulated) == n and set(sims(out)) == set(kept)  # the same keys, every entry written again
+    assert page(out) == before  # deterministic: the same results
+    outcomes = build([str(specs)], Options(out, simulate=False, force=True), jobs=1)
+    assert [o.status for o in outcomes] == ["ok"] and set(sims(out)) == set(kept)  # --no-sim: uses none, prunes none
+
+
+def test_the_keys_of_forked_simulation_workers_are_kept(tmp_path, simulated):
+    specs = write_spec(tmp_path / "specs")
+    out = tmp_path / "out"
+    run(specs, out, sim_workers=2)  # the runs in two forked workers: their puts happen there
+    kept = sims(out)
+    assert len(kept) >= 9
+    write_spec(specs, replaced(QUICK, DESCRIPTION, "Changed text"))
+    simulated.clear()
+    run(specs, out, sim_workers=2)
+    assert sims(out) == kept  # none pruned as unused, none run again
+    assert simulated == []
+
+
+def test_keys_see_the_model_and_not_its_spec_locations():
+    st = run_study(load(ROOT / "specs" / "offset_slider_crank.yaml").spec)
+    s = st.stages[0]
+    model = simulated_model(s.stage.model)
+    assert model.sources == {}  # the spec locations of the parts are for messages only
+
+    def k(m, an=s.analysis):
+        return content_cache.key(sim_cache.run, (m, an), {}, "salt")
+
+    assert k(model) == k(simulated_model(s.stage.model))
+    from dataclasses import replace
+
+    heavier = replace(model, bodies=(replace(model.bodies[0], mass=model.bodies[0].mass * (1 + 1e-12)),) + model.bodies[1:])
+    assert k(heavier) != k(model)
+    shifted = replace(s.analysis, q=s.analysis.q + np.where(np.arange(s.analysis.q.size) == 7, 1e-15, 0.0).reshape(s.analysis.q.shape))
+    assert k(model, shifted) != k(model)
+    assert k(st.stages[1].stage.model) != k(s.stage.model)
+
+
+def _slow_square(x: float, log: str) -> float:
+    with open(log, "a") as f:
+        f.write("ran\n")
+    time.sleep(1.0)
+    return x * x
+
+
+def _in_child(out: str, log: str, q) -> None:
+    store = sim_cache.Store(Path(out), "spec", "salt")
+    with sim_cache.using(store):
+        q.put(sim_cache.run(_slow_square, 3.0, log))
+
+
+def test_two_processes_needing_one_simulation_run_it_once(tmp_path):
+    (tmp_path / "out").mkdir()  # the output folder, as a build has it
+    log = tmp_path / "log"
+    ctx = multiprocessing.get_context("fork")
+    q = ctx.Queue()
+    procs = [ctx.Process(target=_in_child, args=(str(tmp_path / "out"), str(log), q)) for _ in range(2)]
+    for p in procs:
+        p.start()
+    for p in procs:
+        p.join(30)
+    assert [q.get(timeout=5), q.get(timeout=5)] == [9.0, 9.0]
+    assert log.read_text() == "ran\n"  # the second waited for the first's entry
+
+
+def test_what_cannot_be_keyed_is_run_not_cached(tmp_path):
+    store = sim_cache.Store(tmp_path, "spec", "salt")
+    with sim_cache.using(store):
+        def local(x):
+            return x + 2
+
+        assert sim_cache.run(lambda x: x + 1, 1) == 2  # no name to key by
+        assert sim_cache.run(local, 1) == 3  # a function inside another: not a module's name
+        assert sim_cache.run(len, [object()]) == 1  # an argument that is not plain data
+    assert store.used == set() and not (tmp_path / ".cache" / "sims" / "spec").exists()
