@@ -319,3 +319,15 @@ def test_the_history_figures_are_cached_too(tmp_path, monkeypatch, drawn):
     shutil.copytree("out", fresh, ignore=shutil.ignore_patterns(".cache"))
     run(Path("specs"), fresh, force=True)
     assert site(Path("out")) == site(fresh)
+
+
+def test_another_spec_drawing_the_same_figures_draws_none(tmp_path, drawn):
+    specs = one_spec(tmp_path)
+    out = tmp_path / "out"
+    run(specs, out)
+    first = entries(out)
+    drawn.clear()
+    (specs / "the_copy.yaml").write_text(replaced(QUICK, DESCRIPTION, "A copy of it"))
+    run(specs, out)
+    assert drawn == [] and entries(out, "the_copy") == first  # read from scott_russell's, copied
+    assert (out / "the_copy" / "index.html").read_text().count("<svg") == (out / "scott_russell" / "index.html").read_text().count("<svg")

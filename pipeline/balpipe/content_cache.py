@@ -233,11 +233,35 @@ class Store:
         return out
 
     def get_bytes(self, k: str) -> bytes | None:
-        """The payload of key ``k`` in this spec's folder, or None (missing, damaged, or behind
-        a symlink)."""
-        folder = self._folder(create=False)
+        """The payload of key ``k``: from this spec's folder, else from another spec's of the
+        same output folder (then copied into this one, so that the other spec's changes never
+        take it away: the same stage or figure in two specs is computed once); None when no
+        entry holds (missing, damaged, or behind a symlink)."""
+        data = self._read(self.slug, k)
+        if data is None:
+            data = self._elsewhere(k)
+            if data is not None:
+                self.put_bytes(k, data)
+        return data
+
+    def _read(self, slug: str, k: str) -> bytes | None:
+        folder = safe_folder(self.out, (CACHE_DIR, self.KIND, slug), create=False)
         data = read_entry(folder / f"{k}{self.SUFFIX}") if folder is not None else None
         return unpack(self.HEADER, data) if data is not None else None
+
+    def _elsewhere(self, k: str) -> bytes | None:
+        root = safe_folder(self.out, (CACHE_DIR, self.KIND), create=False)
+        if root is None:
+            return None
+        try:
+            slugs = sorted(p.name for p in root.iterdir() if p.name != self.slug and not p.name.startswith("."))
+        except OSError:
+            return None
+        for slug in slugs:
+            data = self._read(slug, k)
+            if data is not None:
+                return data
+        return None
 
     def put_bytes(self, k: str, payload: bytes) -> None:
         """Store ``payload`` under ``k`` (atomically; a symlink at the entry is replaced, not

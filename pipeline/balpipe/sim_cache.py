@@ -7,7 +7,7 @@ analysis it is measured against, the settings, the reference loads), balpipe's c
 version (and numpy's): :func:`run` keys it by all of them (:func:`balpipe.content_cache.key`) and keeps its
 result (the run's dataclass, pickled) in ``<out>/.cache/sims/<slug>/<sha256>.pickle``. A key is
 looked up in the spec's own folder, then in the other specs' folders (copied into its own when
-found there, so that another spec's changes never take it away). While one process computes a
+found there: :class:`balpipe.content_cache.Store`). While one process computes a
 key, another that needs the same key waits for it (a lock file per key prefix, ``.locks/``),
 so that a cold build of several specs runs a shared simulation once. What :func:`run` cannot
 key (a lambda in a model) is simulated, never cached.
@@ -43,35 +43,15 @@ class Store(content_cache.Store):
     HEADER: ClassVar[bytes] = b"balpipe-sim-1 "
 
     def get(self, k: str) -> Any | None:
-        """The result of key ``k``: from this spec's folder, else from another spec's (then
-        copied into this one); None when no entry holds."""
+        """The result of key ``k`` (:meth:`balpipe.content_cache.Store.get_bytes`: this spec's
+        entry or another spec's), or None."""
         data = self.get_bytes(k)
-        if data is None:
-            data = self._elsewhere(k)
-            if data is not None:
-                self.put_bytes(k, data)
         if data is None:
             return None
         try:
             return pickle.loads(data)
         except Exception:  # an entry of an older layout: computed again
             return None
-
-    def _elsewhere(self, k: str) -> bytes | None:
-        root = content_cache.safe_folder(self.out, (CACHE_DIR, SIMS), create=False)
-        if root is None:
-            return None
-        try:
-            slugs = sorted(p.name for p in root.iterdir() if p.name != self.slug and not p.name.startswith("."))
-        except OSError:
-            return None
-        for slug in slugs:
-            folder = content_cache.safe_folder(self.out, (CACHE_DIR, SIMS, slug), create=False)
-            data = content_cache.read_entry(folder / f"{k}{self.SUFFIX}") if folder is not None else None
-            payload = content_cache.unpack(self.HEADER, data) if data is not None else None
-            if payload is not None:
-                return payload
-        return None
 
     def put(self, k: str, value: Any) -> None:
         try:

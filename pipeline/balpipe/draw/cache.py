@@ -13,7 +13,9 @@ Entries live in ``<out>/.cache/figures/<slug>/<sha256>.svg``, each a header line
 SHA-256 of the SVG that follows (a truncated or damaged entry is redrawn, never served),
 written atomically (:func:`balpipe.fsutil.write_file_atomic`); a symlink anywhere on the way
 (the cache folders or the entry) is never followed: the figure is drawn and nothing is read or
-written there. After a spec's page is built, :meth:`Store.prune` removes the entries of that
+written there. A key missing from the spec's folder is looked up in the other specs' folders
+(two specs drawing the same figure draw it once; :class:`balpipe.content_cache.Store`).
+After a spec's page is built, :meth:`Store.prune` removes the entries of that
 spec that its build did not use. Without an active store (``--scheduler``, ``balpipe diff``, a
 test) :func:`svg` just draws.
 """
