@@ -35,11 +35,14 @@ def default_jobs(items: int) -> int:
     return max(1, min(usable_cores(), items))
 
 
-def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any) -> Iterable[Any]:
+def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any,
+             cost: Callable[[Any], float] | None = None) -> Iterable[Any]:
     """``fn(item, *args)`` for each item, yielded in the items' order: in ``jobs`` processes
     when ``jobs`` > 1 and there is more than one item (``fn`` and its arguments must pickle),
-    else here, one after another. On any exception (KeyboardInterrupt included) while the
-    results are read, the workers are stopped before it propagates."""
+    else here, one after another. ``cost``: an estimate of each item's work; the pool starts the
+    costliest first (longest processing time first: no core left with the one long item at the
+    end), the results still come in the items' order. On any exception (KeyboardInterrupt
+    included) while the results are read, the workers are stopped before it propagates."""
     if jobs <= 1 or len(items) <= 1:
         for item in items:
             yield fn(item, *args)
@@ -48,8 +51,10 @@ def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any) -> Iter
 
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # forked workers start ignoring it
     pool = ProcessPoolExecutor(max_workers=min(jobs, len(items)), initializer=worker_init)
+    start = sorted(range(len(items)), key=lambda i: -cost(items[i])) if cost is not None else range(len(items))
     try:
-        futures = [pool.submit(fn, item, *args) for item in items]
+        submitted = {i: pool.submit(fn, items[i], *args) for i in start}
+        futures = [submitted[i] for i in range(len(items))]
     finally:
         signal.signal(signal.SIGINT, previous)
     try:

@@ -1,0 +1,38 @@
+"""The build's process pool starts the costliest specs first (longest processing time first, issue
+23: the slowest spec no longer starts last) and still hands the results back in the specs' order."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from balpipe import pool
+from balpipe.build import spec_cost
+
+
+def _logged(item: tuple[str, str]) -> str:
+    name, log = item
+    with open(log, "a") as f:
+        f.write(name + "\n")
+    time.sleep(0.3)
+    return name.upper()
+
+
+def test_the_costliest_items_start_first_and_results_keep_the_items_order(tmp_path):
+    log = str(tmp_path / "log")
+    items = [("a", log), ("bbbbb", log), ("cc", log), ("dddd", log)]
+    out = list(pool.in_order(_logged, items, 2, cost=lambda item: len(item[0])))
+    assert out == ["A", "BBBBB", "CC", "DDDD"]
+    started = Path(log).read_text().split()
+    assert set(started[:2]) == {"bbbbb", "dddd"} and started[-1] == "a"
+    # one process: in the items' order, the cost unused
+    Path(log).unlink()
+    assert list(pool.in_order(_logged, items, 1, cost=lambda item: len(item[0]))) == out
+    assert Path(log).read_text().split() == ["a", "bbbbb", "cc", "dddd"]
+
+
+def test_a_spec_costs_its_text_length(tmp_path):
+    short, long = tmp_path / "short.yaml", tmp_path / "long.yaml"
+    short.write_text("name: x\n")
+    long.write_text("name: x\n" + "# more\n" * 50)
+    assert spec_cost(long) > spec_cost(short) > 0 and spec_cost(tmp_path / "gone.yaml") == 0.0
