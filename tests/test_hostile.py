@@ -328,7 +328,8 @@ def _unchanged(out: Path, old: dict[str, str]) -> None:
     for k, v in old.items():
         assert (out / k).read_text() == v
     # no temporaries left behind (the figure cache's folder is no temporary; one in it would be)
-    left = [p for p in out.rglob(".*") if p.name != ".balpipe.lock" and p != out / ".cache"]
+    left = [p for p in out.rglob(".*") if p.name != ".balpipe.lock" and p != out / ".cache"
+            and p != out / ".cache" / "sims" / ".locks"]  # the simulation cache's lock files (sim_cache.py)
     assert not left, left
 
 
