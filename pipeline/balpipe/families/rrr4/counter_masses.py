@@ -172,8 +172,9 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, page: bool =
     """The stages (unbalanced, leg by leg, least mass, eq. 17's general design, the special
     kinematics' design), their parameters and notes. Without ``page`` (``balpipe check`` of a
     spec without references) the drawn designs of Figs. 3 and 4b (:func:`topology_designs`:
-    parameters, a note, details and their derived peak forces) are left out: no stage and no
-    error depends on them."""
+    parameters, a note, details and their derived peak forces) and the finder's count for
+    translating-platform motions (:func:`finder_stage`) are left out: no stage and no error
+    depends on them."""
     legs = resolve_legs(mech)
     stages = [Stage("unbalanced", "unbalanced", model, f"the {model.name} as given")]
     lbl, params = leg_by_leg(mech, spec, model)
@@ -190,7 +191,7 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, page: bool =
     details: dict = {}
     derived = None
     if spec.least_mass or len(legs) == 4:
-        found = finder_stage(mech, spec, model, lbl, stages, params, notes, details)
+        found = finder_stage(mech, spec, model, lbl, stages, params, notes, details, page)
     if len(legs) == 4:
         g = geometry(mech)
         rows = cond.eq17(g)
@@ -241,7 +242,7 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, page: bool =
                         "sufficient for balance: the special stage meets them with counter-masses on fewer links "
                         "than eq. 17 needs, and the engine finds its shaking force cancelled although eq. 17 does "
                         "not hold. "
-                        + ("They are not all necessary: " if found.translating.count < 8 else "")
+                        + ("They are not all necessary: " if page and found.translating.count < 8 else "")
                         + "the generic finder's count for this motion class (found numerically from its momentum) "
                         "is in the note above."
                     )
@@ -328,14 +329,15 @@ def finder_grid(model: Model, samples: int = 9) -> np.ndarray:
 
 
 def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Model, stages: list,
-                 params: list, notes: list, details: dict) -> generic.FinderCheck:
+                 params: list, notes: list, details: dict, page: bool = True) -> generic.FinderCheck:
     """The generic condition finder on the model (issue 8): its count, eq. 17's rows and the
     leg-by-leg design checked against its space, the translating-platform count of the special
-    kinematics, and (``spec.least_mass``) the least-mass stage after the leg-by-leg one."""
+    kinematics (with ``page`` only: its parameters, note and details are shown, no stage uses
+    it), and (``spec.least_mass``) the least-mass stage after the leg-by-leg one."""
     legs = resolve_legs(mech)
     four = len(legs) == 4
     g = geometry(mech) if four else None
-    special = four and mech.kinematics != "general" and not platform_rotates(model)
+    special = page and four and mech.kinematics != "general" and not platform_rotates(model)
     found = generic.check(model, finder_grid(model), cond.eq17(g) if four else [],
                           cond.special(g, mech.kinematics) if special else None)
     gen = found.general
