@@ -74,6 +74,11 @@ def _drawn_design(name: str) -> bool:
     return name.startswith(("peak_force_ratio_", "added_mass_fig", "eq17_residual_fig", "finder_residual_fig"))
 
 
+#: the finder's count for translating-platform motions (special kinematics): shown, used by no stage
+TRANSLATING = ("translating_conditions", "translating_gap", "translating_in_printed_span",
+               "printed_reduced_conditions", "printed_reduced_in_translating")
+
+
 def test_check_path_skips_the_page_diagnostics_but_not_the_stages():
     loaded = load("specs/paper001_4rrr_fig6a.yaml")
     quick = run_analyse(loaded, page=False)
@@ -86,8 +91,10 @@ def test_check_path_skips_the_page_diagnostics_but_not_the_stages():
     drawn = [p.name for p in full.balance.parameters if _drawn_design(p.name)]
     assert drawn and not loaded.spec.references  # page only: left out without references
     assert "topologies" in full.balance.details and "topologies" not in quick.balance.details
+    assert "finder_translating" in full.balance.details and "finder_translating" not in quick.balance.details
+    assert set(TRANSLATING) <= {p.name for p in full.balance.parameters}
     assert [p.name for p in quick.balance.parameters] == [p.name for p in full.balance.parameters
-                                                          if p.name not in drawn]
+                                                          if p.name not in drawn and p.name not in TRANSLATING]
     values = {p.name: p.value for p in full.balance.parameters}
     for p in quick.balance.parameters:
         assert p.value == pytest.approx(values[p.name], rel=1e-6, abs=1e-9), p.name
@@ -102,6 +109,7 @@ def test_check_path_computes_what_a_reference_may_name(tmp_path):
     quick = run_analyse(load(path), page=False)
     assert [r["name"] for r in quick.references] == ["peak_force_ratio_fig4b", "added_mass_fig3a"]
     assert any(_drawn_design(p.name) for p in quick.balance.parameters)
+    assert any(p.name in TRANSLATING for p in quick.balance.parameters)
 
 
 def test_check_path_keeps_derived_parameters_that_references_may_name():
@@ -155,3 +163,19 @@ def test_prepare_builds_the_spec_validator_before_a_pool_forks():
              "loader.prepare()\nprint(before, Spec.__pydantic_complete__)")
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120).stdout.split()
     assert out == ["False", "True"]
+
+
+def test_check_leaves_the_collector_as_it_found_it(capsys):
+    """check freezes the objects it loaded before checking (gc.freeze: the collector and forked
+    workers leave them alone) and unfreezes them when it returns, for a caller in the same process."""
+    import gc
+
+    from balpipe.cli import main
+
+    assert gc.get_freeze_count() == 0
+    try:
+        main(["check", "specs/scott_russell.yaml"])
+    except SystemExit as exc:
+        assert exc.code in (0, None)
+    assert gc.get_freeze_count() == 0
+    assert "specs/scott_russell.yaml: ok" in capsys.readouterr().out

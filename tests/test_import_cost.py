@@ -57,3 +57,45 @@ def test_check_loads_neither_numpy_ma_nor_numpy_random(args):
     r = subprocess.run([sys.executable, "-c", probe, json.dumps(args)], cwd=ROOT, capture_output=True, text=True,
                        timeout=120)
     assert json.loads(r.stderr.strip().splitlines()[-1]) == []
+
+
+CODE_PROBE = """
+import json, sys
+{action}
+from balpipe import registry
+from balpipe.plugins import Ref
+code = {{f.target.split(":")[0] for item in (*registry.TEMPLATES.values(), *registry.METHODS.values())
+         for f in (getattr(item, k, None) for k in ("build", "balance", "figures", "notation")) if isinstance(f, Ref)}}
+heavy = {heavy!r}
+print(json.dumps({{"code": sorted(m for m in code if m in sys.modules),
+                   "heavy": sorted(m for m in sys.modules if m.split(".")[0] in heavy or m.startswith(
+                       ("balpipe.engine", "balpipe.draw", "balpipe.report", "balpipe.study")))}}), file=sys.stderr)
+"""
+
+
+def code_loaded(action: str) -> dict:
+    """The methods' and templates' code modules (named by their :class:`balpipe.plugins.Ref`) and
+    the heavy libraries and computing layers loaded after ``action``, in a fresh interpreter."""
+    r = subprocess.run([sys.executable, "-c", CODE_PROBE.format(action=action, heavy=HEAVY)], cwd=ROOT,
+                       capture_output=True, text=True, timeout=120)
+    return json.loads(r.stderr.strip().splitlines()[-1])
+
+
+@pytest.mark.parametrize("module", ["balpipe.spec", "balpipe.loader"])
+def test_the_schema_loads_no_methods_code(module):
+    """The spec's unions need the methods' sections, not their code (issue 23 item 4): importing
+    the schema loads no method's or figure's module, no engine, and no heavy library."""
+    assert code_loaded(f"import {module}") == {"code": [], "heavy": []}
+
+
+@pytest.mark.parametrize("spec, code", [
+    ("specs/scott_russell.yaml", ["balpipe.families.slider_crank.counterweights"]),
+    ("specs/paper002_decoupling.yaml", ["balpipe.families.serial_arm.decoupling"]),
+    ("specs/paper004_five_bar.yaml", ["balpipe.families.five_bar.gear_balancing"]),
+])
+def test_check_loads_the_code_of_its_specs_method_only(spec, code):
+    """``balpipe check`` of a spec imports its own method's code and no other's (registry entries
+    are :class:`balpipe.plugins.Ref` objects, resolved on first use), nor any figure module."""
+    found = code_loaded(f"from balpipe.cli import main\ntry:\n    main(['check', {spec!r}])\nexcept SystemExit:\n    pass")
+    assert found["code"] == code
+    assert [m for m in found["heavy"] if not m.startswith(("balpipe.engine", "balpipe.study"))] == []

@@ -13,6 +13,10 @@ two ways (the way MkDocs finds its plugins, with a package scan for runs from th
 Families come out sorted by :attr:`Family.order`, then name; templates and methods keep their
 order within a family. That order is the order of the spec's unions (:mod:`balpipe.spec`), so it
 fixes the JSON Schema and the text of a "which template?" error.
+
+A family's spec sections are classes (the schema needs them), but its computing code, figures
+and notation tables may be :class:`Ref` objects, ``"package.module:name"`` imported on first use: the
+schema (``balpipe check``) then loads no method's code but the one it runs.
 """
 
 from __future__ import annotations
@@ -34,9 +38,39 @@ IN_TREE = "balpipe.families"
 
 
 @dataclass(frozen=True)
+class Ref:
+    """A module-level object named ``"package.module:name"``, imported when first used: calling
+    a ``Ref`` calls the object (a template's ``build``, a method's ``balance``, figures); a table
+    is read through :func:`resolved`."""
+
+    target: str
+
+    def resolve(self) -> Any:
+        """The named object (its module imported now, once)."""
+        return _load(self.target)
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        return _load(self.target)(*args, **kwargs)
+
+
+@lru_cache(maxsize=None)
+def _load(target: str) -> Any:
+    module, _, name = target.partition(":")
+    if not name:
+        raise ValueError(f"a Ref names 'package.module:name', not {target!r}")
+    return getattr(import_module(module), name)
+
+
+def resolved(obj: Any) -> Any:
+    """``obj``, or the object a :class:`Ref` names."""
+    return obj.resolve() if isinstance(obj, Ref) else obj
+
+
+@dataclass(frozen=True)
 class Template:
     """A mechanism template: ``spec`` is its pydantic section (a ``template`` literal names it),
-    ``build(mechanism_spec, laws, t) -> Model``; ``laws`` maps drive names to laws.
+    ``build(mechanism_spec, laws, t) -> Model``; ``laws`` maps drive names to laws. ``build``,
+    ``figures`` and ``notation`` may be :class:`Ref` objects.
     ``figures(study)`` optionally yields extra report figures as (title, svg, caption)."""
 
     name: str
@@ -57,7 +91,9 @@ class Method:
     ``page_only`` names fields of ``spec`` that only add to the page (no error depends on them):
     ``balpipe check`` balances with them set to None. With ``page_aware``, ``balance`` also
     receives ``page=``: False in ``balpipe check`` of a spec without references, where it may
-    leave out parameters, notes and details that no error depends on (designs only drawn)."""
+    leave out parameters, notes and details that no error depends on (designs only drawn).
+    ``balance``, ``figures`` and ``notation`` may be :class:`Ref` objects: the spec section is a class,
+    the computing code is imported when the method runs."""
 
     name: str
     spec: type[Strict]

@@ -10,16 +10,13 @@ from typing import Any
 import numpy as np
 
 from . import units
-from .balancing import force_balance as generic_force
-from .balancing import moment_balance as generic_moment
-from .balancing import partial as generic_partial
-from .balancing import stages as generic_stages
 from .balancing.base import BalanceResult, Stage
 from .balancing.partial_spec import PartialBalance
+from .balancing.specs import ForceBalance, MomentBalance, Stages
 from .model import Law, Model
 from .laws.drives import drive_laws
 from .motion import law_for
-from .plugins import Method, Template, discover
+from .plugins import Method, Ref, Template, discover
 from .sampling import time_grid
 from .spec_parts import DriveSpec, SpecFieldError
 
@@ -28,19 +25,21 @@ __all__ = [
     "template_specs", "time_grid", "unbalanced_model", "motion_model",
 ]
 
-# methods for every template (they read only the model); "none" is the spec's own default
+# methods for every template (they read only the model); "none" is the spec's own default. Their
+# code is imported when a spec uses them (the schema needs only their sections).
+_CODE = "balpipe.balancing"
 GENERIC: tuple[Method, ...] = (
-    Method("force_balance", generic_force.ForceBalance, generic_force.balance, (),
+    Method("force_balance", ForceBalance, Ref(f"{_CODE}.force_balance:balance"), (),
            "force-balance conditions from the momentum + least-mass counterweights", generic=True,
-           notation=generic_force.notation),
-    Method("moment_balance", generic_moment.MomentBalance, generic_moment.balance, (),
+           notation=Ref(f"{_CODE}.force_balance:notation")),
+    Method("moment_balance", MomentBalance, Ref(f"{_CODE}.moment_balance:balance"), (),
            "least-mass counterweights + counter-rotations from the angular momentum", generic=True,
-           notation=generic_moment.notation),
-    Method("stages", generic_stages.Stages, generic_stages.balance, (), "stages written by hand, each adding parts",
-           generic=True, notation=generic_stages.notation),
-    Method("partial_balance", PartialBalance, generic_partial.balance, (),
+           notation=Ref(f"{_CODE}.moment_balance:notation")),
+    Method("stages", Stages, Ref(f"{_CODE}.stages:balance"), (), "stages written by hand, each adding parts",
+           generic=True, notation=Ref(f"{_CODE}.stages:notation")),
+    Method("partial_balance", PartialBalance, Ref(f"{_CODE}.partial:balance"), (),
            "optimal partial balancing (cone programme)", uses_spec=True, generic=True, other_motions=True,
-           notation=generic_partial.notation,
+           notation=Ref(f"{_CODE}.partial:notation"),
            page_only=("fronts",)),  # the Pareto fronts: about 90 % of its time, drawn only on the page
 )
 

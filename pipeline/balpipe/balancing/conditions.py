@@ -22,8 +22,7 @@ import numpy as np
 
 from ..model import Model
 from . import regressor as R
-
-RANK_TOLERANCE = 1e-9
+from .specs import RANK_TOLERANCE
 
 
 @dataclass

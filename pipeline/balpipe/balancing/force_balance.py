@@ -6,65 +6,16 @@ route) and the counterweights of least added mass in the regions the spec allows
 
 from __future__ import annotations
 
-from typing import Literal, Union
-
 import numpy as np
-from pydantic import Field, model_validator
 
 from ..model import Model, Vec2
-from ..spec_parts import SpecFieldError, Strict
-from ..units import Length, PositiveLength, count, number
+from ..spec_parts import SpecFieldError
 from . import conditions as C
 from . import least_mass as LM
 from . import regressor as R
 from .base import BalanceResult, Parameter, Stage
 from .parts import add_counterweight
-
-Point = Union[str, tuple[Length, Length]]
-
-
-class DiscRegionSpec(Strict):
-    """A disc on the body: centre and radius."""
-
-    centre: Point = Field(description="centre, [x, y] in the body frame or a named point of the body")
-    radius: PositiveLength = Field(description="radius")
-
-
-class CounterweightRegionSpec(Strict):
-    """A point-mass counterweight on a body, within one region of the body's frame: ``at`` a
-    fixed point, on a ``segment`` [from, to], or in a ``disc``."""
-
-    body: str = Field(description="the body that carries the counterweight")
-    name: str | None = Field(None, description="name (default: cw_<body>)")
-    at: Point | None = Field(None, description="a fixed position ([x, y] or a named point)")
-    segment: tuple[Point, Point] | None = Field(None, description="anywhere on this segment")
-    disc: DiscRegionSpec | None = Field(None, description="anywhere in this disc")
-
-    @model_validator(mode="after")
-    def _one_region(self):
-        given = [k for k in ("at", "segment", "disc") if getattr(self, k) is not None]
-        if len(given) != 1:
-            raise ValueError(f"give exactly one of at, segment, disc (got {', '.join(given) or 'none'})")
-        return self
-
-
-class FinderSettings(Strict):
-    """How the conditions are found."""
-
-    rank_tolerance: number(gt=0, lt=1e-3) = Field(C.RANK_TOLERANCE, description="singular values below this fraction of the largest are dropped")
-    samples: count(ge=0, le=10_000) = Field(0, description="sampled states (0: 2 x 4 x bodies + 12)")
-    seed: count(ge=0) = Field(0, description="seed of the state sampler")
-    polygon_sides: count(ge=8, le=4096) = Field(LM.POLYGON_SIDES, description="sides of the polygon inscribed in each disc region")
-
-
-class ForceBalance(FinderSettings):
-    """Force-balance conditions of any mechanism from its momentum, and the counterweights of
-    least added mass in the allowed regions."""
-
-    method: Literal["force_balance"] = Field(description="balancing method")
-    counterweights: list[CounterweightRegionSpec] = Field(
-        min_length=1, description="where counterweights may go (one counterweight per entry)"
-    )
+from .specs import CounterweightRegionSpec, FinderSettings, ForceBalance, Point
 
 
 def _point(model: Model, body: str, p: Point, path: tuple) -> Vec2:

@@ -32,8 +32,7 @@ from ..model import Model, Vec2
 from .conditions import ForceConditions, scale_of
 from . import regressor as R
 from . import tie_break
-
-POLYGON_SIDES = 128
+from .specs import POLYGON_SIDES
 
 
 @dataclass(frozen=True)

@@ -18,46 +18,20 @@ the moment at all (the chained counter-rotations of paper 000 and the gears of p
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Literal
 
 import numpy as np
-from pydantic import Field
 
 from ..model import FRAME, Model
-from ..spec_parts import SpecFieldError, Strict
-from ..units import Mass, Number, PositiveLength
+from ..spec_parts import SpecFieldError
 from . import regressor as R
 from . import conditions as C
 from .base import BalanceResult, Parameter, Stage
 from . import least_mass as LM
-from .force_balance import CounterweightRegionSpec, FinderSettings, Point, _point, regions_from_spec
+from .force_balance import _point, regions_from_spec
 from .parts import add_counter_rotation, add_counterweight
+from .specs import CounterRotationSpec, MomentBalance
 
 MOMENT_TOLERANCE = 1e-9  # relative least-squares residual below which the moment counts as cancelled
-
-
-class CounterRotationSpec(Strict):
-    """A counter-rotating disc pivoted on ``carrier`` and geared to ``geared_to``:
-    w_disc - w_carrier = ratio (w_geared - w_carrier). Its inertia is computed."""
-
-    name: str = Field(min_length=1, description="name of the disc (a new body)")
-    carrier: str = Field(FRAME, description="body holding the disc's axis ('frame' for a fixed axis)")
-    at: Point = Field(description="the axis: [x, y] in the carrier's frame (global on the frame) or a named point")
-    geared_to: str = Field(description="the body the disc is geared to")
-    ratio: Number = Field(description="(w_disc - w_carrier) / (w_geared - w_carrier); -r_g / r_disc for an external mesh")
-    mass: Mass = Field(0.0, description="mass of the disc (on its axis; counted by the force balance)")
-    radius: PositiveLength | None = Field(None, description="radius of the disc, for drawing (the mesh is modelled as a couple)")
-
-
-class MomentBalance(FinderSettings):
-    """Force balance by least-mass counterweights, then moment balance by counter-rotating discs
-    whose inertias are solved from the angular-momentum regressor."""
-
-    method: Literal["moment_balance"] = Field(description="balancing method")
-    counterweights: list[CounterweightRegionSpec] = Field(
-        [], description="where counterweights may go; empty: the mechanism must be force balanced already"
-    )
-    counter_rotations: list[CounterRotationSpec] = Field(min_length=1, description="the counter-rotating discs")
 
 
 def add_discs(model: Model, specs: list[CounterRotationSpec], root: tuple) -> Model:

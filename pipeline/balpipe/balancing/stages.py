@@ -5,61 +5,16 @@ replaces the earlier one) or removes them; the first stage is always the mechani
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Literal
 
 import numpy as np
-from pydantic import Field
 
 from ..claim_precision import Rounding, half_unit
 from ..model import Attachment, Model
-from ..spec_parts import SpecFieldError, Strict
-from ..units import Inertia, Length, Mass, PositiveLength, number
+from ..spec_parts import SpecFieldError
 from .base import BalanceResult, Stage
-from .force_balance import Point, _point
-from .moment_balance import CounterRotationSpec, add_discs, set_disc_inertias
-
-
-class PartSpec(Strict):
-    """A rigid part fixed to a body: counterweight, carried gear, payload."""
-
-    body: str = Field(description="the body that carries the part")
-    name: str = Field(min_length=1, description="name, unique on the body (a later stage may change it by name)")
-    mass: Mass = Field(description="mass")
-    position: Point = Field((0.0, 0.0), description="centre of mass, [x, y] in the body frame or a named point")
-    inertia: Inertia = Field(0.0, description="centroidal moment of inertia")
-    kind: Literal["counterweight", "gear", "payload", "part"] = Field("counterweight", description="for drawing and accounting")
-    radius: PositiveLength | None = Field(None, description="drawn as a disc of this radius")
-
-
-class GivenCounterRotation(CounterRotationSpec):
-    """A counter-rotating disc with a given inertia."""
-
-    inertia: Inertia = Field(description="centroidal inertia of the disc")
-
-
-class StageStep(Strict):
-    """One stage: parts added or changed relative to the stage before."""
-
-    name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_\-]+$", description="short name (CSV columns, references)")
-    label: str = Field("", description="label in figures and tables (default: the name)")
-    description: str = Field("", description="what the stage does")
-    balances: Literal["", "force", "moment", "force+moment"] = Field(
-        "", description="what the stage claims to cancel (checked against the analysis)"
-    )
-    parts: list[PartSpec] = Field([], description="parts added (or changed, by body and name)")
-    remove: list[str] = Field([], description="parts removed, as body.name")
-    counter_rotations: list[GivenCounterRotation] = Field([], description="counter-rotating discs added")
-    tolerance: number(gt=0, lt=1) | None = Field(
-        None, description="tolerance of the stage's claims, a fraction of the reference load; default: "
-        "analysis.balance_tolerance plus what the rounding of the entered numbers allows (numbers of "
-        "four or more significant digits are taken as rounded at their last digit)")
-
-
-class Stages(Strict):
-    """Balancing stages written by hand, each relative to the one before."""
-
-    method: Literal["stages"] = Field(description="balancing method")
-    stages: list[StageStep] = Field(min_length=1, description="the stages after the unbalanced one, in order")
+from .force_balance import _point
+from .moment_balance import add_discs, set_disc_inertias
+from .specs import PartSpec, Stages
 
 
 def attach(model: Model, part: PartSpec, path: tuple) -> Model:

@@ -14,6 +14,7 @@ from markupsafe import Markup, escape
 
 from .. import notation as N
 from .. import units
+from ..plugins import resolved
 from ..registry import METHODS, TEMPLATES
 from .inputs import _walk, input_rows
 from .render import num
@@ -26,10 +27,10 @@ def tables_for(mechanism: Any, balancing: Any) -> list[N.Table]:
     out = []
     method = METHODS.get(getattr(balancing, "method", ""))
     if method is not None:
-        out.append(N.table_of(method.notation, balancing))
+        out.append(N.table_of(resolved(method.notation), balancing))
     template = TEMPLATES.get(mechanism.template)
     if template is not None:
-        out.append(N.table_of(template.notation, mechanism))
+        out.append(N.table_of(resolved(template.notation), mechanism))
     out.append(N.COMMON)
     return out
 

@@ -1,7 +1,7 @@
 """The five-bar family: the fixed-sequence 5R with gear-coupled inputs and its gear balancing."""
 
-from ...plugins import Family, Method, Template
-from . import figures, gear_balancing, template
+from ...plugins import Family, Method, Ref, Template
+from . import specs, template
 
 FAMILY = Family(
     name="five_bar",
@@ -9,10 +9,12 @@ FAMILY = Family(
     package=__name__,
     templates=(
         Template("five_bar", template.FiveBarMechanism, template.build,
-                 "five-bar (5R), fixed-sequence with gear-coupled inputs", figures.figures, notation=template.NOTATION),
+                 "five-bar (5R), fixed-sequence with gear-coupled inputs", Ref(f"{__name__}.figures:figures"),
+                 notation=template.NOTATION),
     ),
     methods=(
-        Method("five_bar_gear_balancing", gear_balancing.FiveBarGearBalancing, gear_balancing.balance, ("five_bar",),
-               "counterweights + counter-rotating gears 5, 6, 7 (eqs. 9-21)", notation=gear_balancing.NOTATION),
+        Method("five_bar_gear_balancing", specs.FiveBarGearBalancing, Ref(f"{__name__}.gear_balancing:balance"),
+               ("five_bar",), "counterweights + counter-rotating gears 5, 6, 7 (eqs. 9-21)",
+               notation=Ref(f"{__name__}.gear_balancing:NOTATION")),
     ),
 )

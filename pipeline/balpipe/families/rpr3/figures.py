@@ -133,3 +133,8 @@ def _factor_caption(published_factor: float) -> str:
     return ("Peaks over the motion of every stage. The factor is the counterweights stage's peak shaking "
             f"moment divided by the reference stage's; the paper reports {published_factor:g} (the reference "
             "`counterweights.moment_ratio` compares it with the unbalanced 3-RPR).")
+
+
+#: the figures of the two methods (their :attr:`plugins.Method.figures`, named by the family)
+idler_loop_figures = paper_figures("Fig. 4", "idler_loop", 17)
+scott_russell_figures = paper_figures("Fig. 8", "scott_russell", 28)

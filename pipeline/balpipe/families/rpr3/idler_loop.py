@@ -20,41 +20,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Literal
 
 import numpy as np
-from pydantic import Field
 
 from . import template as rpr3
 from ...model import FRAME, Body, Model, Revolute
-from ...spec_parts import LinkSpec, SpecFieldError, Strict
-from ...units import Length, Sign
+from ...spec_parts import SpecFieldError
 from ...balancing.base import BalanceResult, Parameter, Stage
 from ...balancing.parts import add_counter_rotation, add_counterweight
+from .specs import Rpr3IdlerLoop
 
 PATH = ("balancing",)
-
-
-class IdlerCounterweights(Strict):
-    """Positions of the eight counterweights (signed lengths along the links)."""
-
-    cylinder: Length = Field(description="mcp1 on each cylinder, from A_i towards C_i (rcp1 L1; negative: beyond A_i)")
-    piston: Length = Field(description="mcp2 on each piston, from B_i towards C_i (rcp2 L1; beyond C_i when > L1)")
-    link5: Length = Field(description="mcp5 on link 5, from E towards F (rcp5 L5; negative: beyond E)")
-    link6: Length = Field(description="mcp6 on link 6, from F towards P (rcp6 L6; negative: beyond F)")
-
-
-class Rpr3IdlerLoop(Strict):
-    """Idler loop E-F-P, counterweights (eqs. 5a-d) and chained counter-rotations (eqs. 9a-d)."""
-
-    method: Literal["rpr3_idler_loop"] = Field(description="balancing method")
-    E: tuple[Length, Length] = Field((0.0, 0.0), description="base pivot E of the idler loop (the paper: O)")
-    link5: LinkSpec = Field(description="link 5, EF (length L5, centre of mass r5 L5 from E)")
-    link6: LinkSpec = Field(description="link 6, FP (length L6, centre of mass r6 L6 from F)")
-    branch: Sign = Field(
-        1, description="+1: F on the left of the line E -> P at t = 0, -1: on its right (the paper: -1, F above E)"
-    )
-    counterweights: IdlerCounterweights
 
 
 @dataclass(frozen=True)
@@ -277,7 +253,6 @@ def _notation() -> dict:
         "balancing.counterweights.link5": Sym("r_{cp5} L_5", "counterweight M_{cp5} on link 5, from E towards F (negative: beyond E)"),
         "balancing.counterweights.link6": Sym("r_{cp6} L_6", "counterweight M_{cp6} on link 6, from F towards P (negative: beyond F)"),
     }
-
 
 #: Paper 000's symbols (Sec. 2, Fig. 3, eqs. 4-9) for this method's inputs.
 NOTATION = _notation()

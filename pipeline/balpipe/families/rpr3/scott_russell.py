@@ -23,48 +23,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Literal
 
 import numpy as np
-from pydantic import Field
 
 from . import template as rpr3
 from ...model import FRAME, Body, Model, Revolute
-from ...spec_parts import LinkSpec, SpecFieldError, Strict
-from ...units import Length, Sign
+from ...spec_parts import SpecFieldError
 from ...balancing.base import BalanceResult, Parameter, Stage
 from ...balancing.parts import add_counter_rotation, add_counterweight
 from ...balancing.scott_russell import eq20_lhs
+from .specs import MomentUnknown, Rpr3ScottRussell
 
 PATH = ("balancing",)
-
-
-class ScottRussellCounterweights(Strict):
-    """Positions of the four counterweights of each leg (signed lengths along the links)."""
-
-    crank: Length = Field(description="mcp1 on the crank, from A_i towards B (rcp1 L1; negative: beyond A_i)")
-    coupler: Length = Field(description="mcp2 on the coupler, from B towards C (rcp2 L2; negative: beyond B)")
-    piston: Length = Field(description="mcp3 on the piston, from C towards C_i (rcp3 L3; negative: away from C_i)")
-    cylinder: Length = Field(description="mcp4 on the cylinder, from A_i towards C_i (rcp4 L3; negative: beyond A_i)")
-
-
-MomentUnknown = Literal["crank_inertia", "coupler_inertia", "crank_counterweight_inertia", "coupler_counterweight_inertia"]
-
-
-class Rpr3ScottRussell(Strict):
-    """Scott-Russell legs (eq. 19), counterweights (eqs. 30a-d), eq. 30e, counter-rotations (eq. 30f)."""
-
-    method: Literal["rpr3_scott_russell"] = Field(description="balancing method")
-    crank: LinkSpec = Field(description="link 1, AB, pivoted on the base at A_i (the paper's L1, m1, r1, I1)")
-    coupler: LinkSpec = Field(description="link 2, BC, pinned to the piston at C (L2 = L1, m2, r2, I2)")
-    branch: Sign = Field(1, description="+1: B on the left of the leg axis A_i -> C_i, -1: on its right")
-    counterweights: ScottRussellCounterweights
-    moment_unknown: MomentUnknown | None = Field(
-        None,
-        description="what eq. 30e is solved for: the crank's or coupler's inertia (the link is redesigned "
-        "in every stage), or the inertia of the crank's or coupler's counterweight (a disc); omit to "
-        "keep the design as given (the page then shows eq. 30e's residual)",
-    )
 
 
 @dataclass(frozen=True)
@@ -324,7 +294,6 @@ def _notation() -> dict:
         "balancing.counterweights.cylinder": Sym("r_{cp4} L_3", "counterweight M_{cp4} on the cylinder, from A_i towards C_i (negative: beyond A_i)"),
         "balancing.moment_unknown": setting("unknown", "the inertia that eq. 30e is solved for"),
     }
-
 
 #: Paper 000's symbols (Sec. 3, Figs. 6-7, eqs. 21-30) for this method's inputs; they rename the
 #: 3-RPR's cylinder and piston as Sec. 3 does.

@@ -1,7 +1,7 @@
 """The n-RRR family (paper 001): the planar parallel manipulator and its counter-masses."""
 
-from ...plugins import Family, Method, Template
-from . import counter_masses, figures, template
+from ...plugins import Family, Method, Ref, Template
+from . import specs, template
 
 FAMILY = Family(
     name="rrr4",
@@ -13,8 +13,9 @@ FAMILY = Family(
                  notation=template.NOTATION),
     ),
     methods=(
-        Method("rrr4_counter_masses", counter_masses.RRR4Balancing, counter_masses.balance, ("rrr4",),
+        Method("rrr4_counter_masses", specs.RRR4Balancing, Ref(f"{__name__}.counter_masses:balance"), ("rrr4",),
                "counter-masses: leg by leg (eqs. 8-11), from eq. 17 (Fig. 4a) and eqs. 19/21 (Fig. 6)",
-               notation=counter_masses.NOTATION, figures=figures.figures, page_aware=True),
+               notation=Ref(f"{__name__}.counter_masses:NOTATION"), figures=Ref(f"{__name__}.figures:figures"),
+               page_aware=True),
     ),
 )

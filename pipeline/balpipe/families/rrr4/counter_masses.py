@@ -28,17 +28,13 @@ missing first moment needs; its mass is |missing| / distance.
 
 from __future__ import annotations
 
-import math
 from functools import partial
-from typing import Literal
 
 import numpy as np
-from pydantic import Field
 
 from .template import RRR4Mechanism, corner, mass_parameters, resolve_legs
 from ...model import Model
-from ...spec_parts import SpecFieldError, Strict
-from ...units import Mass, PositiveLength
+from ...spec_parts import SpecFieldError
 from . import conditions as cond
 from . import finder as generic
 from . import topologies as topologies
@@ -47,6 +43,7 @@ from ...balancing.base import BalanceResult, Parameter, Stage
 from ...balancing.conditions import clarity_text
 from ...engine import analyse
 from ...engine.load_reference import load_reference
+from .specs import RRR4Balancing
 
 
 def link_name(ij: str) -> str:
@@ -55,41 +52,6 @@ def link_name(ij: str) -> str:
     from ...notation import symbol_text
 
     return symbol_text(f"l_{{{ij}}}")
-
-
-class CounterMassDistances(Strict):
-    """Distance of each counter-mass from its link's proximal joint."""
-
-    proximal: PositiveLength = Field(description="on the links l_i1, from A_i")
-    distal: PositiveLength = Field(description="on the links l_i2, from B_i")
-
-
-class RRR4Balancing(Strict):
-    """Paper 001's counter-mass balancing of the n-RRR: leg by leg (eqs. 8-11) and, with four
-    legs, from the general conditions (eq. 17) and the special kinematics (eqs. 19, 21)."""
-
-    method: Literal["rrr4_counter_masses"] = Field(description="balancing method")
-    counterweights: CounterMassDistances
-    platform_split: list[Mass] | None = Field(
-        None,
-        description="mu_5i, the platform's point masses at the C_i of the legs present, in leg order "
-        "(eqs. 2-4 must hold); default: the minimum-norm split",
-    )
-    independent: list[Literal[12, 22, 32, 42]] = Field(
-        [],
-        description="distal links l_i2 whose centre of mass along the link stays as built (Sec. II.B-D, "
-        "Figs. 2b-d): mu_5i = -m_i2 p_i2 / l_i2 (eq. 11) instead of a counter-mass, the other mu_5i from "
-        "eqs. 2-4",
-    )
-    topologies: bool = Field(
-        True, description="also build the eq. 17 design (Fig. 4a) and, for fig5a/fig5b kinematics, eq. 19/21's (Fig. 6)"
-    )
-    least_mass: bool = Field(
-        True,
-        description="also build the least-mass design: the generic condition finder's conditions met by one "
-        "counter-mass per link anywhere within the leg-by-leg distances of its proximal joint (linprog)",
-    )
-
 
 LEG_BY_LEG_LABEL = "leg-by-leg counter-masses (Fig. 2a, eqs. 8-11)"
 
@@ -210,8 +172,9 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, page: bool =
     """The stages (unbalanced, leg by leg, least mass, eq. 17's general design, the special
     kinematics' design), their parameters and notes. Without ``page`` (``balpipe check`` of a
     spec without references) the drawn designs of Figs. 3 and 4b (:func:`topology_designs`:
-    parameters, a note, details and their derived peak forces) are left out: no stage and no
-    error depends on them."""
+    parameters, a note, details and their derived peak forces) and the finder's count for
+    translating-platform motions (:func:`finder_stage`) are left out: no stage and no error
+    depends on them."""
     legs = resolve_legs(mech)
     stages = [Stage("unbalanced", "unbalanced", model, f"the {model.name} as given")]
     lbl, params = leg_by_leg(mech, spec, model)
@@ -228,7 +191,7 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, page: bool =
     details: dict = {}
     derived = None
     if spec.least_mass or len(legs) == 4:
-        found = finder_stage(mech, spec, model, lbl, stages, params, notes, details)
+        found = finder_stage(mech, spec, model, lbl, stages, params, notes, details, page)
     if len(legs) == 4:
         g = geometry(mech)
         rows = cond.eq17(g)
@@ -279,7 +242,7 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, page: bool =
                         "sufficient for balance: the special stage meets them with counter-masses on fewer links "
                         "than eq. 17 needs, and the engine finds its shaking force cancelled although eq. 17 does "
                         "not hold. "
-                        + ("They are not all necessary: " if found.translating.count < 8 else "")
+                        + ("They are not all necessary: " if page and found.translating.count < 8 else "")
                         + "the generic finder's count for this motion class (found numerically from its momentum) "
                         "is in the note above."
                     )
@@ -366,14 +329,15 @@ def finder_grid(model: Model, samples: int = 9) -> np.ndarray:
 
 
 def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Model, stages: list,
-                 params: list, notes: list, details: dict) -> generic.FinderCheck:
+                 params: list, notes: list, details: dict, page: bool = True) -> generic.FinderCheck:
     """The generic condition finder on the model (issue 8): its count, eq. 17's rows and the
     leg-by-leg design checked against its space, the translating-platform count of the special
-    kinematics, and (``spec.least_mass``) the least-mass stage after the leg-by-leg one."""
+    kinematics (with ``page`` only: its parameters, note and details are shown, no stage uses
+    it), and (``spec.least_mass``) the least-mass stage after the leg-by-leg one."""
     legs = resolve_legs(mech)
     four = len(legs) == 4
     g = geometry(mech) if four else None
-    special = four and mech.kinematics != "general" and not platform_rotates(model)
+    special = page and four and mech.kinematics != "general" and not platform_rotates(model)
     found = generic.check(model, finder_grid(model), cond.eq17(g) if four else [],
                           cond.special(g, mech.kinematics) if special else None)
     gen = found.general
@@ -472,7 +436,6 @@ def _notation() -> dict:
         "balancing.topologies": setting("eq. 17 / 19 designs", "also build the eq. 17 design (Fig. 4a) and eq. 19/21's (Fig. 6)"),
         "balancing.least_mass": setting("least mass", "also build the least-mass design (generic condition finder + linprog)"),
     }
-
 
 #: Paper 001's symbols (eqs. 2-11, Fig. 2) for this method's inputs.
 NOTATION = _notation()

@@ -1,8 +1,8 @@
 """The serial-arm family: the nR arm, gear decoupling (paper 002) and centre-of-mass motion
 planning (paper 003)."""
 
-from ...plugins import Family, Method, Template
-from . import com_planning, decoupling, figures, template
+from ...plugins import Family, Method, Ref, Template
+from . import specs, template
 
 FAMILY = Family(
     name="serial_arm",
@@ -12,11 +12,11 @@ FAMILY = Family(
         Template("serial_arm", template.SerialArmMechanism, template.build, "serial nR arm", notation=template.notation),
     ),
     methods=(
-        Method("gear_decoupling", decoupling.GearDecoupling, decoupling.balance, ("serial_arm",),
+        Method("gear_decoupling", specs.GearDecoupling, Ref(f"{__name__}.decoupling:balance"), ("serial_arm",),
                "decoupling by gears 1'-2' and mass redistribution, counter-rotating gear 3 (paper 002)",
-               notation=decoupling.NOTATION, figures=figures.decoupling_figures),
-        Method("com_motion_planning", com_planning.ComMotionPlanning, com_planning.balance, ("serial_arm",),
-               "centre-of-mass motion planning, phi optimised (paper 003)", uses_spec=True,
-               notation=com_planning.NOTATION, figures=figures.com_planning_figures),
+               notation=Ref(f"{__name__}.decoupling:NOTATION"), figures=Ref(f"{__name__}.figures:decoupling_figures")),
+        Method("com_motion_planning", specs.ComMotionPlanning, Ref(f"{__name__}.com_planning:balance"),
+               ("serial_arm",), "centre-of-mass motion planning, phi optimised (paper 003)", uses_spec=True,
+               notation=Ref(f"{__name__}.com_planning:NOTATION"), figures=Ref(f"{__name__}.figures:com_planning_figures")),
     ),
 )

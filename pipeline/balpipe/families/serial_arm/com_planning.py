@@ -31,10 +31,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Literal, Union
 
 import numpy as np
-from pydantic import Field
 
 from .template import (
     ArmGeometry,
@@ -55,10 +53,10 @@ from .template import (
 )
 from ...model import Law, Model
 from ...motion import PointToPoint, bang_bang, law_for, quintic
-from ...spec_parts import SpecFieldError, Strict
-from ...units import Angle, Length, PositiveLength, count, number, quantity
+from ...spec_parts import SpecFieldError
 from ...balancing.base import BalanceResult, Parameter, Stage
 from ...sampling import gravity_vector, time_grid
+from .specs import ComMotionPlanning
 
 ROOT = ("balancing",)
 CASES = (
@@ -75,81 +73,6 @@ STYLES = {"ee_quintic": 0, "com_bang_bang_phi_opt": 1, "com_trapezoidal": 2, "co
 #: shaking forces from 48 % up to 62.2 %" and of the moment "from 37.2 % up to 61 %" are case 2
 #: against case 1 (Sec. 3); case 3 trades some of it for bounded torque rates
 HEADLINE = "com_bang_bang_phi_opt"
-
-
-class TestSquare(Strict):
-    """The tested zone of Fig. 2: a square whose edges are divided into ``divisions`` segments by
-    the points P1 .. P(4 divisions), P1 at ``first_corner``, numbered counter-clockwise."""
-
-    centre: tuple[Length, Length] = Field(description="centre E of the square")
-    side: PositiveLength = Field(description="edge length")
-    divisions: count(ge=1, le=50) = Field(4, description="segments per edge")
-    first_corner: Literal["bottom-left", "bottom-right", "top-right", "top-left"] = Field(
-        "bottom-left", description="corner of P1 (the paper's figure is not legible: bottom-left reproduces its list)"
-    )
-
-    def points(self) -> dict[str, tuple[float, float]]:
-        cx, cy = self.centre
-        h = self.side / 2
-        corners = [(-h, -h), (h, -h), (h, h), (-h, h)]  # counter-clockwise from bottom-left
-        start = ("bottom-left", "bottom-right", "top-right", "top-left").index(self.first_corner)
-        corners = corners[start:] + corners[:start]
-        out = {}
-        k = 1
-        for e in range(4):
-            (x0, y0), (x1, y1) = corners[e], corners[(e + 1) % 4]
-            for j in range(self.divisions):
-                s = j / self.divisions
-                out[f"P{k}"] = (cx + x0 + s * (x1 - x0), cy + y0 + s * (y1 - y0))
-                k += 1
-        return out
-
-
-class TrajectorySpec(Strict):
-    """A tip trajectory between two points (names of the test square's points or [x, y])."""
-
-    name: str = Field(min_length=1, description="label of the trajectory")
-    start: Union[str, tuple[Length, Length]] = Field(alias="from", description="start point of the tip")
-    end: Union[str, tuple[Length, Length]] = Field(alias="to", description="end point of the tip")
-
-
-class Orientation(Strict):
-    start: Angle = Field(alias="from", description="phi at the start (the paper: 0 deg)")
-    end: Angle = Field(alias="to", description="phi at the end (the paper: 120 deg)")
-
-
-class PhiOptimisation(Strict):
-    """phi(tau) = phi0 + (phif - phi0) s5(tau) + sum_k c_k 64 tau^3 (1 - tau)^3 (2 tau - 1)^k,
-    k = 0 .. degree - 6: the degree-``degree`` polynomials with phi, phi', phi'' fixed at both ends."""
-
-    degree: count(ge=5, le=14) = Field(8, description="degree of the polynomial (5: the 3-4-5 law, nothing to optimise)")
-    starts: count(ge=1, le=50) = Field(4, description="multi-start: the 3-4-5 law plus starts - 1 random points")
-    seed: count(ge=0) = Field(0, description="seed of the random starting points (numpy default_rng)")
-    spread: quantity("angle", gt=0) = Field(0.5, description="standard deviation of the random starting coefficients (rad)")
-    max_evaluations: count(ge=10, le=100_000) = Field(300, description="objective evaluations per start (Nelder-Mead)")
-    tolerance: number(gt=0) = Field(1e-4, description="Nelder-Mead xatol (rad) and fatol (relative to the start's peak)")
-
-
-class ComMotionPlanning(Strict):
-    """Paper 003: the 3R arm's centre of mass on a bang-bang (and trapezoidal) law, phi optimised."""
-
-    method: Literal["com_motion_planning"] = Field(description="balancing method")
-    test_square: TestSquare | None = Field(None, description="the tested zone (Fig. 2), to name points P1..")
-    trajectories: list[Union[str, TrajectorySpec]] = Field(
-        [],
-        description="tip trajectories, 'PiPj' on the test square or {name, from, to}; empty: the "
-        "template's tip drive (motion.drive.tip)",
-    )
-    orientation: Orientation | None = Field(None, description="phi at both ends of every trajectory (with trajectories)")
-    phi: PhiOptimisation = Field(PhiOptimisation(), description="the law of phi in case 2 and its optimisation")
-    main_trajectory: str | None = Field(
-        None, description="the trajectory shown first: the page's headline, design summary and stage figures, and "
-        "Figs. 3-4 (the paper's figures show P15P7); default the first")
-    torque_rate_limit: number(gt=0) = Field(
-        3e4, description="case 3: largest rate of change of any actuator torque, N m/s (the paper: 3.10^4)"
-    )
-    rate_samples: count(ge=101, le=100_001) = Field(4001, description="case 3: samples on which torque rates are measured (central differences)")
-
 
 # --------------------------------------------------------------------------------------------
 # Laws
@@ -213,7 +136,6 @@ def trapezoidal_acceleration(f: float):
         return A * ss, A * vv, A * a
 
     return profile
-
 
 # --------------------------------------------------------------------------------------------
 # One trajectory
@@ -418,7 +340,6 @@ class _Motion:
 def _simplex(x0: np.ndarray, step: float) -> np.ndarray:
     n = len(x0)
     return np.vstack([x0] + [x0 + step * np.eye(n)[k] for k in range(n)])
-
 
 # --------------------------------------------------------------------------------------------
 # The method
@@ -633,7 +554,6 @@ def _notation() -> dict:
         "balancing.torque_rate_limit": ours("|τ̇|_{max}", "case 3: largest rate of change of any actuator torque (the paper: 3·10^4 N m/s)", unit="N m/s"),
         "balancing.rate_samples": setting("N_{rate}", "case 3: samples on which torque rates are measured"),
     }
-
 
 #: Paper 003's symbols (Sec. 3, Fig. 2) for this method's inputs.
 NOTATION = _notation()

@@ -32,63 +32,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
-from pydantic import Field
 
 from .template import SerialArmMechanism
 from ...model import FRAME, Attachment, Model
-from ...spec_parts import SpecFieldError, Strict
-from ...units import Inertia, Length, Mass, PositiveLength, number
+from ...spec_parts import SpecFieldError
 from ...balancing.base import BalanceResult, Parameter, Stage
 from ...balancing.parts import add_counter_rotation, add_counterweight
+from .specs import GearDecoupling
 
 ROOT = ("balancing",)
-
-
-class Gear1p(Strict):
-    """Gear 1', pivoted on link 1 at C."""
-
-    position: Length = Field(description="l_AC: position of C along link 1 from A (between A and B in the paper)")
-    mass: Mass = Field(0.0, description="m1'")
-    ratio: number(lt=0) = Field(-1.0, description="w1' - w1 = ratio (w2 - w1); -1 for identical gears (the paper)")
-
-
-class Gear2p(Strict):
-    """Gear 2', fixed on link 2 at B."""
-
-    mass: Mass = Field(0.0, description="m2'")
-    inertia: Inertia = Field(0.0, description="I_S2'")
-
-
-class Counterweight(Strict):
-    """A counterweight at ``distance`` from the link's proximal joint, on the ray that cancels the
-    first moment it must cancel; its mass is solved."""
-
-    distance: PositiveLength = Field(description="distance from the joint (A for link 1, B for link 2)")
-    inertia: Inertia = Field(0.0, description="centroidal inertia of the counterweight")
-
-
-class Counterweights(Strict):
-    link1: Counterweight = Field(description="puts the total centre of mass on A (condition 3)")
-    link2: Counterweight = Field(description="puts link 2 + gear 2' centre of mass on B (condition 1)")
-
-
-class FrameGear(Strict):
-    """Gear 3 on the frame meshing with gear 1'' (fixed on link 1 at A), identical: theta3 = -theta1."""
-
-    position: tuple[Length, Length] = Field(description="centre of gear 3 on the frame (its radius is half the distance to A)")
-
-
-class GearDecoupling(Strict):
-    """Paper 002: gear pair 1'-2' and mass redistribution (decoupled, linear dynamics), then gear 3."""
-
-    method: Literal["gear_decoupling"] = Field(description="balancing method")
-    gear_1p: Gear1p = Field(description="gear 1' on link 1 at C (its inertia is solved from condition 2)")
-    gear_2p: Gear2p = Field(Gear2p(), description="gear 2' fixed on link 2 at B")
-    counterweights: Counterweights = Field(description="counterweights whose masses conditions 1 and 3 give")
-    counter_rotation: FrameGear = Field(description="gear 3 on the frame (I3 = J1)")
 
 
 @dataclass(frozen=True)
@@ -283,7 +237,6 @@ def _notation() -> dict:
         "balancing.counter_rotation.position": ours("O_3", "centre of the counter-rotating gear 3 on the frame (I_3 = J_1)"),
     })
     return table
-
 
 #: Paper 002's symbols for this method's inputs and for the 2R arm it balances.
 NOTATION = _notation()

@@ -1,8 +1,8 @@
 """The slider-crank family: the template and the counterweight recipe (with eq. 20's inertia for
 a Scott-Russell mechanism)."""
 
-from ...plugins import Family, Method, Template
-from . import counterweights, template
+from ...plugins import Family, Method, Ref, Template
+from . import specs, template
 
 FAMILY = Family(
     name="slider_crank",
@@ -13,8 +13,8 @@ FAMILY = Family(
                  notation=template.NOTATION),
     ),
     methods=(
-        Method("slider_crank_counterweights", counterweights.SliderCrankCounterweights, counterweights.balance,
+        Method("slider_crank_counterweights", specs.SliderCrankCounterweights, Ref(f"{__name__}.counterweights:balance"),
                ("slider_crank",), "counterweights (+ eq. 20 inertia for Scott-Russell)",
-               notation=counterweights.NOTATION),
+               notation=Ref(f"{__name__}.counterweights:NOTATION")),
     ),
 )

@@ -4,43 +4,13 @@ mechanism without counter-rotations (paper 000, Sec. 3.1, eqs. 11-20)."""
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Literal
-
-from pydantic import Field
 
 from .template import SliderCrankMechanism
 from ...model import Attachment, Model
-from ...spec_parts import SpecFieldError, Strict
-from ...units import Length, Mass
+from ...spec_parts import SpecFieldError
 from ...balancing.base import BalanceResult, Parameter, Stage
 from ...balancing.scott_russell import eq20_lhs
-
-
-class SliderCrankCounterweights(Strict):
-    """Counterweights on the crank and the coupler cancel the shaking force (eq. 15). For the
-    Scott-Russell geometry (offset 0, L1 = L2, eq. 19) the moment condition eq. 20 is then solved
-    for the inertia named by ``moment_unknown``."""
-
-    method: Literal["slider_crank_counterweights"] = Field(description="balancing method")
-    crank_counterweight: Length = Field(
-        description="position of counterweight 1 along the crank from A (the paper's rcp1 L1; "
-        "negative: on the far side of A from B)"
-    )
-    coupler_counterweight: Length = Field(
-        description="position of counterweight 2 along the coupler from B (rcp2 L2; negative: on "
-        "the far side of B from C)"
-    )
-    crank_counterweight_mass: Mass | None = Field(
-        None, description="as built: use this mass instead of eq. 15's (the page then shows what it leaves)"
-    )
-    coupler_counterweight_mass: Mass | None = Field(
-        None, description="as built: use this mass instead of eq. 15's"
-    )
-    moment_unknown: Literal["crank_counterweight_inertia", "coupler_counterweight_inertia"] | None = Field(
-        None,
-        description="Scott-Russell only: the inertia that eq. 20 is solved for, added to that "
-        "counterweight as a disc; omit to stop at force balance",
-    )
+from .specs import SliderCrankCounterweights
 
 
 def _counterweight_masses(mech: SliderCrankMechanism, c1: float, c2: float) -> tuple[float, float]:
@@ -183,7 +153,6 @@ def _notation() -> dict:
         "balancing.coupler_counterweight_mass": Sym("m_{cp2}", "mass of M_2 as built, instead of eq. 15's"),
         "balancing.moment_unknown": setting("unknown", "the inertia that eq. 20 is solved for"),
     }
-
 
 #: Paper 000's symbols (eqs. 14-15, 20) for this method's inputs.
 NOTATION = _notation()
