@@ -67,23 +67,35 @@ class StderrLines:
         return "".join(self._lines)
 
 
-def wait_for_children(process, timeout: float = 300.0, fallback: float = 5.0) -> None:
-    """Wait until the started ``process`` has a child process of its own (Linux: read from
-    ``/proc/PID/task/*/children``); AssertionError when it ends or ``timeout`` seconds pass first.
-    Without that file (not Linux), ``fallback`` seconds instead."""
+def wait_for_children(process, count: int = 1, cpu: float = 0.2, timeout: float = 300.0,
+                      fallback: float = 5.0) -> None:
+    """Wait until the started ``process`` is inside the work of its forked children: ``count``
+    children of its own (Linux: ``/proc/PID/task/*/children``) have each run ``cpu`` seconds
+    (their work, not their start) and its main thread sleeps (waiting for their results). Not
+    at the forks themselves: a Ctrl-C that lands in Python's after-fork handlers in the parent is
+    lost ("Exception ignored in: _releaseLock"). AssertionError when the process ends or
+    ``timeout`` seconds pass first. Without that file (not Linux), ``fallback`` seconds instead."""
     import time
     from pathlib import Path
 
     if not Path(f"/proc/{os.getpid()}/task/{os.getpid()}/children").exists():
         time.sleep(fallback)
         return
+    tick = os.sysconf("SC_CLK_TCK")
+
+    def busy(pid: str) -> bool:  # utime + stime, fields 14 and 15 after the command's parentheses
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / tick >= cpu
+
     end = time.monotonic() + timeout
     while time.monotonic() < end:
-        assert process.poll() is None, f"process {process.pid} ended without starting a child"
+        assert process.poll() is None, f"process {process.pid} ended before its children worked"
         try:
-            if any(f.read_text().split() for f in Path(f"/proc/{process.pid}/task").glob("*/children")):
+            kids = [k for f in Path(f"/proc/{process.pid}/task").glob("*/children") for k in f.read_text().split()]
+            main = Path(f"/proc/{process.pid}/task/{process.pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+            if len(kids) >= count and sum(busy(k) for k in kids) >= count and main == "S":
                 return
-        except OSError:  # a thread that ended between the listing and the read
+        except (OSError, IndexError, ValueError):  # a child or thread that ended between the reads
             pass
         time.sleep(0.05)
-    raise AssertionError(f"process {process.pid} started no child within {timeout} s")
+    raise AssertionError(f"process {process.pid}: no {count} children at work within {timeout} s")

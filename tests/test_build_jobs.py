@@ -129,7 +129,7 @@ def test_ctrl_c_during_a_parallel_simulation_is_clean(tmp_path):
 
     p = subprocess.Popen(balpipe_command("build", spec, "-o", tmp_path / "out", "-j", 2),
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
-    wait_for_children(p)  # inside the simulations: the forked processes that run them have started
+    wait_for_children(p, count=2)  # inside the simulations: the two forked processes run them
     assert p.poll() is None
     os.killpg(p.pid, signal.SIGINT)
     _, err = p.communicate(timeout=60)
