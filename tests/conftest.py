@@ -89,8 +89,10 @@ def _shared_root(tmp_path_factory) -> Path:
 class Shared:
     """Values computed once per run whatever the number of xdist workers: ``get(key, compute)``
     runs ``compute()`` in the first worker that asks, under a lock, and keeps its pickle in the
-    run's shared folder; the other workers load it. A value that cannot be pickled (paper 003's
-    study holds local functions) is computed by each worker that asks."""
+    run's shared folder; the other workers load it. A value that holds local functions (paper
+    003's study: its motion profiles and its ``derived`` hook) is pickled by cloudpickle, which
+    keeps such functions by value (installed with dask.distributed, a test dependency); without
+    it, or when that fails too, each worker that asks computes the value."""
 
     def __init__(self, root: Path):
         self.root = root
@@ -108,9 +110,8 @@ class Shared:
                 return pickle.loads(path.read_bytes())
             if not refused.exists():
                 value = compute()
-                try:
-                    data = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
-                except (pickle.PicklingError, AttributeError, TypeError):
+                data = _pickled(value)
+                if data is None:
                     refused.touch()
                     return value
                 tmp = path.with_suffix(".part")
@@ -118,6 +119,25 @@ class Shared:
                 tmp.replace(path)
                 return value
         return compute()
+
+
+def _pickled(value) -> bytes | None:
+    """``value``'s pickle (pickle, else cloudpickle for local functions), or None. Either loads
+    with :func:`pickle.loads`."""
+    import pickle
+
+    try:
+        return pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+    except (pickle.PicklingError, AttributeError, TypeError):
+        pass
+    try:
+        import cloudpickle
+    except ImportError:
+        return None
+    try:
+        return cloudpickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+    except (pickle.PicklingError, AttributeError, TypeError):
+        return None
 
 
 @pytest.fixture(scope="session")

@@ -126,14 +126,13 @@ def test_ctrl_c_during_a_parallel_simulation_is_clean(tmp_path):
     import signal
     import subprocess
     import sys
-    import time
 
     spec = Path(__file__).resolve().parents[1] / "specs" / "paper000_rpr3_idler_loop.yaml"
-    from _terminal import balpipe_command
+    from _terminal import balpipe_command, wait_for_children
 
     p = subprocess.Popen(balpipe_command("build", spec, "-o", tmp_path / "out", "-j", 2),
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
-    time.sleep(5.0)  # inside the simulations (about 3 s of analysis, then 10-20 s of simulations)
+    wait_for_children(p, count=2)  # inside the simulations: the two forked processes run them
     assert p.poll() is None
     os.killpg(p.pid, signal.SIGINT)
     _, err = p.communicate(timeout=60)

@@ -46,6 +46,20 @@ def _stages(path: str):
     return spec, registry.balance(spec).stages
 
 
+@pytest.fixture
+def balanced(shared):
+    """``balanced(path)``: what :func:`_stages` gives, the balancing done once per run (the
+    tests/conftest.py ``shared`` fixture: paper 003's planner takes seconds, and two tests of each
+    case need it); a fresh copy of the stages for each test."""
+    from pathlib import Path
+
+    def get(path: str):
+        text = Path(path).read_text(encoding="utf-8")
+        return load(path).spec, shared.get(f"balanced stages\n{path}\n{text}", lambda: _stages(path)[1])
+
+    return get
+
+
 def _arrays(an) -> dict[str, np.ndarray]:
     out = {k: getattr(an, k) for k in ("q", "v", "a", "force", "moment", "force_momentum", "moment_momentum",
                                         "com", "momentum", "angular_momentum")}
@@ -63,9 +77,9 @@ def _scale(arrays: dict[str, np.ndarray]) -> dict[str, float]:
 
 
 @pytest.mark.parametrize("case", list(CASES))
-def test_block_path_equals_dense_path(case):
+def test_block_path_equals_dense_path(case, balanced):
     path, kind = CASES[case]
-    spec, stages = _stages(path)
+    spec, stages = balanced(path)
     t = registry.time_grid(spec)
     g, mp = gravity_vector(spec), tuple(spec.analysis.moment_point)
     for stage in stages:
@@ -90,12 +104,12 @@ def test_block_path_equals_dense_path(case):
 
 
 @pytest.mark.parametrize("case", [k for k, (_, kind) in CASES.items() if kind != "dense"])
-def test_block_substitution_equals_dense_solves_at_the_same_positions(case):
+def test_block_substitution_equals_dense_solves_at_the_same_positions(case, balanced):
     """Velocities, accelerations (Phi_q x = b by forward substitution) and multipliers
     (Phi_q^T lambda = Q - M q'' by backward substitution) against the dense batched solves of
     the general path, at the block path's positions: to 1e-12 of each quantity's peak."""
     path, _ = CASES[case]
-    spec, stages = _stages(path)
+    spec, stages = balanced(path)
     t = registry.time_grid(spec)
     g = np.asarray(gravity_vector(spec))
     for stage in stages:

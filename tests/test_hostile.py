@@ -21,7 +21,7 @@ from balpipe import build as build_mod
 from balpipe.cli import main
 from balpipe.loader import SpecErrors, load, load_text
 from _edits import replaced
-from _terminal import balpipe_command
+from _terminal import StderrLines, balpipe_command
 
 ROOT = Path(__file__).resolve().parents[1]
 SPECS = ROOT / "specs"
@@ -469,11 +469,14 @@ def test_interrupt_is_clean_at_any_jobs(tmp_path, sig, code, jobs):
     out = tmp_path / "out"
     old = _old_site(out)
     p = subprocess.Popen(balpipe_command("build", d, "-o", out, "-j", jobs),
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
-    time.sleep(8.0)  # inside the work: the specs are being analysed (the build takes longer)
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    lines = StderrLines(p)
+    # inside the work: the invalid spec is reported, the idler loop is being built (it takes longer)
+    lines.wait_for("a_invalid.yaml: error")
     assert p.poll() is None
     os.killpg(p.pid, sig)  # as a terminal's Ctrl-C does: the whole process group
-    out_s, err = p.communicate(timeout=120)
+    p.wait(timeout=120)
+    err = lines.text()
     assert p.returncode == code, err
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
     lines = err.strip().splitlines()

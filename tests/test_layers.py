@@ -5,6 +5,7 @@ plugins: nothing outside ``balpipe.families`` imports one."""
 from __future__ import annotations
 
 import ast
+import functools
 import shutil
 from collections import defaultdict
 from pathlib import Path
@@ -95,8 +96,16 @@ def imports(src: Path) -> dict[str, set[tuple[str, bool, int]]]:
                         edges[m].add((t, d, ch.lineno))
                 visit(ch, d)
 
-        visit(ast.parse(p.read_text(encoding="utf-8")), False)
+        visit(_tree(p.read_text(encoding="utf-8")), False)
     return edges
+
+
+@functools.lru_cache(maxsize=None)
+def _tree(text: str) -> ast.Module:
+    """The syntax tree of a module's text, parsed once per text in this process: every test reads
+    the same files (a planted copy differs in one or two), and parsing them all is most of a
+    test's time. The trees are only read."""
+    return ast.parse(text)
 
 
 def upward(src: Path) -> list[str]:
@@ -227,7 +236,7 @@ def private_names_across_packages(src: Path) -> list[str]:
     for m, p in mods.items():
         pkg = m if p.name == "__init__.py" else m.rsplit(".", 1)[0]
         mine = _unit(m, p)
-        tree = ast.parse(p.read_text(encoding="utf-8"))
+        tree = _tree(p.read_text(encoding="utf-8"))
         bound: dict[str, str] = {}
 
         def owner(name: str) -> str | None:
@@ -289,7 +298,7 @@ def names_of_families(src: Path, words: set[str]) -> list[str]:
     for m, p in modules(src).items():
         if m.startswith("balpipe.families"):
             continue
-        tree = ast.parse(p.read_text(encoding="utf-8"))
+        tree = _tree(p.read_text(encoding="utf-8"))
         docs = {id(n.body[0].value) for n in ast.walk(tree)
                 if isinstance(n, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and n.body
                 and isinstance(n.body[0], ast.Expr) and isinstance(n.body[0].value, ast.Constant)}

@@ -17,7 +17,7 @@ from balpipe.balancing import partial_motions as PMo
 from balpipe.engine import analyse
 from balpipe.spec import Spec
 from generic_specs import four_bar
-from test_partial import SEGMENTS, _bad, _physical, method
+from test_partial import SEGMENTS, _bad, _physical_many, de_minimum, method
 
 BUDGET = 0.6
 
@@ -94,15 +94,12 @@ def test_two_motion_optimum_is_bracketed_by_the_single_motion_optima(objective):
 
 
 def test_two_motion_optimum_equals_differential_evolution():
-    from scipy.optimize import LinearConstraint, differential_evolution
-
     spec = Spec.model_validate(two_motions(7))
     motions = motions_of(spec)
     _, out, (term,), *_ = P.solve(motions, spec.balancing)
     best = term.value(out.z)
-    f = lambda x: term.value(_physical(motions[0], x))  # noqa: E731
-    res = differential_evolution(f, [(0, 2), (0, 1), (0, 2), (0, 1)], seed=1, tol=1e-14, atol=0, maxiter=3000,
-                                 popsize=30, constraints=LinearConstraint([[1, 0, 1, 0]], 0, BUDGET), polish=False)
+    res = de_minimum(term, lambda X: _physical_many(motions[0], X), [(0, 2), (0, 1), (0, 2), (0, 1)], [1, 0, 1, 0],
+                     BUDGET, seed=1, maxiter=3000, popsize=30)
     assert best <= res.fun * (1 + 1e-7)
     assert abs(res.fun - best) <= 1e-6 * best
 
