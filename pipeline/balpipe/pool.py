@@ -62,6 +62,14 @@ def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any) -> Iter
     pool.shutdown()
 
 
+def stop_now(pool: Any) -> None:
+    """Stop a process pool's workers at once (Ctrl-C, SIGTERM, a failure elsewhere), not when
+    their work ends, and wait for them to be gone."""
+    for proc in list(getattr(pool, "_processes", {}).values()):
+        proc.terminate()
+    pool.shutdown(wait=True, cancel_futures=True)
+
+
 #: processes one spec's independent work may use (:func:`spare`): set by the build for the cores
 #: that fewer specs than cores leave over (:func:`spare_workers`), 1 otherwise
 _SPARE = 1
@@ -91,15 +99,15 @@ def forked(tasks: list[tuple[Callable, tuple]], workers: int, shared: Any) -> li
     task takes the next), ``shared`` inherited by the fork rather than pickled (``fn``, ``args``
     and the results pickle; the parent's objects frozen out of the garbage collector meanwhile,
     so that a child's collection copies none of their pages: 0.2 s of CPU per child on a
-    partial balancing's process). Deterministic tasks give the same results whatever
+    partial balancing's process; the same would serve the simulations' forks,
+    :func:`balpipe.validation_stage._parallel`). Deterministic tasks give the same results whatever
     ``workers``. On any exception (Ctrl-C included) the workers are stopped at once, not when
     their task ends."""
     if workers <= 1 or len(tasks) <= 1:
         return [fn(*a, shared) for fn, a in tasks]
+    import gc
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
-
-    import gc
 
     global _SHARED
     _SHARED = shared
@@ -121,11 +129,3 @@ def forked(tasks: list[tuple[Callable, tuple]], workers: int, shared: Any) -> li
 
 def _call_shared(fn: Callable, args: tuple) -> Any:
     return fn(*args, _SHARED)
-
-
-def stop_now(pool: Any) -> None:
-    """Stop a process pool's workers at once (Ctrl-C, SIGTERM, a failure elsewhere), not when
-    their work ends, and wait for them to be gone."""
-    for proc in list(getattr(pool, "_processes", {}).values()):
-        proc.terminate()
-    pool.shutdown(wait=True, cancel_futures=True)
