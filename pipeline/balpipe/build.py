@@ -293,7 +293,8 @@ def _compute(job: Job) -> Computed:
     try:
         spec, node = load_text(job.text, source)
         loaded = LoadedSpec(job.path, job.text, spec, node)
-        st = runner.analyse(loaded, simulate=job.simulate)
+        with pool.spare_workers(job.sim_workers):  # the cores left over also serve the spec's independent work
+            st = runner.analyse(loaded, simulate=job.simulate)
         extra: dict[str, str] = {}
         if job.simulate and runner.simulate(loaded, st, workers=job.sim_workers):
             from .validation_stage import timing, timing_script

@@ -88,8 +88,30 @@ def tradeoff_front(program: Program, first: Term, second: Term, budget: float, n
     return pts
 
 
+#: the fronts, slowest first: the order forked workers take them in (results.json lists them the other way round)
+FRONTS = ("effort_vs_force", "force_vs_moment", "moment_vs_mass", "force_vs_mass")
+
+
+def _front(name: str, ctx: tuple) -> list[dict]:
+    """One front of :func:`compute` (``ctx``: program, terms, budget, points, mass budgets)."""
+    program, terms, budget, n, masses = ctx
+    force, moment = terms["shaking_force"], terms["shaking_moment"]
+    if name == "force_vs_mass":
+        return mass_front(program, force, masses, terms)
+    if name == "moment_vs_mass":
+        return mass_front(program, moment, masses, terms)
+    if name == "force_vs_moment":
+        return tradeoff_front(program, force, moment, budget, n, terms)
+    return tradeoff_front(program, terms["effort"], force, budget, n, terms)
+
+
 def compute(program: Program, terms: dict[str, Term], budget: float, n: int, max_mass: float | None) -> dict:
-    """Every front and the complete balances' least masses (None where infeasible)."""
+    """Every front and the complete balances' least masses (None where infeasible). The fronts
+    are independent sequences of solves (each starts on a new solver): with spare cores
+    (:func:`balpipe.pool.spare`) they run in forked processes, the trade-off fronts' ends solved
+    here first (once for both, as one after another); the numbers are the same bits."""
+    from .. import pool
+
     force, moment = terms["shaking_force"], terms["shaking_moment"]
     complete_f = least_complete_mass(program, [force])
     complete_fm = least_complete_mass(program, [force, moment])
@@ -100,17 +122,20 @@ def compute(program: Program, terms: dict[str, Term], budget: float, n: int, max
     if complete_f is not None and complete_f[0] <= masses[-1]:  # the front's zero lands on a point
         masses[int(np.argmin(np.abs(masses[1:] - complete_f[0]))) + 1] = complete_f[0]
         masses.sort()
+    names = [f for f in FRONTS if f != "effort_vs_force" or "effort" in terms]
+    workers = pool.spare()
+    if workers > 1:
+        for t in (moment, force, terms.get("effort")):
+            if t is not None:
+                program.least_at(t, budget)
+    fronts = dict(zip(names, pool.forked([(_front, (f,)) for f in names], workers, (program, terms, budget, n, masses))))
     out = {
         "points": n,
         "max_mass": float(top),
         "budget": float(budget),
         "complete_force": None if complete_f is None else point(program.maps, complete_f[1], terms),
         "complete_force_moment": None if complete_fm is None else point(program.maps, complete_fm[1], terms),
-        "force_vs_mass": mass_front(program, force, masses, terms),
-        "moment_vs_mass": mass_front(program, moment, masses, terms),
-        "force_vs_moment": tradeoff_front(program, force, moment, budget, n, terms),
+        **{f: fronts[f] for f in reversed(FRONTS) if f in fronts},
     }
-    if "effort" in terms:
-        out["effort_vs_force"] = tradeoff_front(program, terms["effort"], force, budget, n, terms)
     program.mass_budget.value = float(budget)
     return out

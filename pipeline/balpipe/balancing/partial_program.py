@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import partial_clarabel
 from .partial_maps import Load, Maps
 
 SOLVER_SETTINGS: dict = {"max_iter": 80}  # Clarabel's tolerances (1e-8); zeros are polished; a front point at a boundary may stall
@@ -191,16 +192,17 @@ class Program:
     def solve(self, problem, polish: list[Term] = (), fresh: bool = False) -> Outcome:
         """Solve; the terms of ``polish`` that come out below :data:`ZERO` of their unbalanced
         value are brought to round-off by a least-squares step on their equations (see
-        :func:`polish_zero`). A problem solved again reuses its Clarabel solver (cvxpy updates
-        its data; its equilibration is the first data's) unless ``fresh``: then a new solver
-        is set up on this data, as for a newly compiled problem."""
+        :func:`polish_zero`). A problem solved again reuses its Clarabel solver (its data
+        updated, only ``b`` where nothing else changed: :mod:`.partial_clarabel`; its
+        equilibration is the first data's) unless ``fresh``: then a new solver is set up on
+        this data, as for a newly compiled problem."""
         cp = self.cp
         if fresh:
             problem._solver_cache = {}
         try:
             with warnings.catch_warnings():  # OPTIMAL_INACCURATE is reported in the status instead
                 warnings.simplefilter("ignore", UserWarning)
-                problem.solve(solver=cp.CLARABEL, **SOLVER_SETTINGS)
+                problem.solve(solver=partial_clarabel.solver(), **SOLVER_SETTINGS)
         except cp.error.SolverError as exc:
             return Outcome(None, f"solver error: {exc}", math.inf, 0.0)
         status = problem.status
