@@ -104,8 +104,8 @@ def forked(tasks: list[tuple[Callable, tuple]], workers: int, shared: Any) -> li
     task takes the next), ``shared`` inherited by the fork rather than pickled (``fn``, ``args``
     and the results pickle; the parent's objects frozen out of the garbage collector meanwhile,
     so that a child's collection copies none of their pages: 0.2 s of CPU per child on a
-    partial balancing's process; the same would serve the simulations' forks,
-    :func:`balpipe.validation_stage._parallel`). Deterministic tasks give the same results whatever
+    partial balancing's process). Serves a partial balancing's fronts and a spec's simulations
+    (:func:`balpipe.validation_stage._parallel`). Deterministic tasks give the same results whatever
     ``workers``. On any exception (Ctrl-C included) the workers are stopped at once, not when
     their task ends."""
     if workers <= 1 or len(tasks) <= 1:

@@ -6,8 +6,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
-from . import sim_cache
-from .pool import stop_now
+from . import pool, sim_cache
 from .study import Study, ratio_reference
 from .validate import FreeFloating, ValidationSettings, free_floating, validate
 from .validate.run import model_scale
@@ -83,17 +82,12 @@ class Reactionless:
         ])
 
 
-#: the study being simulated, for forked workers (:func:`_parallel`): inherited, not pickled
-_FORKED: Study | None = None
-
-
-def _stage_runs(k: int, study: Study | None = None):
+def _stage_runs(k: int, study: Study):
     """Validation and torque-driven run of stage ``k`` (relative to the unbalanced inertial peaks
     (the shaking loads' peaks without gravity) of the stage's own reference (Stage.reference: with
     several trajectories, that trajectory's unbalanced stage; else the first stage), floored by
     that model's gross inertial loads (balpipe.load_reference): the same denominators as the
     stage's ratios)."""
-    study = study or _FORKED
     settings = settings_for(study)
     s = study.stages[k]
     ref = ratio_reference(study.reference_stage(s))
@@ -116,57 +110,32 @@ def simulated_model(model):
 
 
 def _floating_run(k: int, base_inertia: float, settings: ValidationSettings | None,
-                  study: Study | None = None) -> FreeFloating:
-    s = (study or _FORKED).stages[k]
+                  study: Study) -> FreeFloating:
+    s = study.stages[k]
     return sim_cache.run(free_floating, simulated_model(s.stage.model), s.analysis, BASE_MASS, base_inertia,
                          settings=settings)
 
 
 def _parallel(study: Study, workers: int, tasks: list[tuple]) -> list:
-    """``fn(*a)`` for every ``(fn, a)`` of ``tasks``, results in that order; in ``workers`` forked
-    processes when more than one, from one pool (a worker that finishes its task takes the next,
-    whatever its kind: no core waits for the slowest stage before the free-frame runs start).
-    Each task runs whole simulations, which are deterministic: the results do not depend on
-    ``workers``."""
+    """``fn(*a, study)`` for every ``(fn, a)`` of ``tasks``, results in that order; in ``workers``
+    forked processes when more than one (:func:`balpipe.pool.forked`: one pool, a worker that
+    finishes its task takes the next, whatever its kind, so no core waits for the slowest stage
+    before the free-frame runs start; the study inherited, not pickled). Each task runs whole
+    simulations, which are deterministic: the results do not depend on ``workers``."""
     if workers <= 1 or len(tasks) <= 1:
         return [fn(*a, study) for fn, a in tasks]
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
-    global _FORKED
-    _FORKED = study
-    pool = ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=multiprocessing.get_context("fork"),
-                               initializer=_quiet_child)
-    try:
-        futures = [pool.submit(_keyed, fn, a) for fn, a in tasks]
-        out = []
-        for f in futures:
-            result, keys = f.result()
-            sim_cache.mark_used(keys)  # the worker's cache keys: the parent's store prunes the rest
-            out.append(result)
-    except BaseException:  # Ctrl-C, SIGTERM, a failure: stop the other simulations now, not at their end
-        stop_now(pool)
-        raise
-    finally:
-        _FORKED = None
-    pool.shutdown()
+    out = []
+    for result, keys in pool.forked([(_keyed, (fn, a)) for fn, a in tasks], workers, study):
+        sim_cache.mark_used(keys)  # the worker's cache keys: the parent's store prunes the rest
+        out.append(result)
     return out
 
 
-def _keyed(fn, a: tuple) -> tuple:
-    """``fn(*a)`` in a forked worker, with the simulation cache keys it used (:mod:`.sim_cache`)."""
+def _keyed(fn, a: tuple, study: Study) -> tuple:
+    """``fn(*a, study)`` in a forked worker, with the simulation cache keys it used (:mod:`.sim_cache`)."""
     before = sim_cache.used()
-    result = fn(*a)
+    result = fn(*a, study)
     return result, sim_cache.used() - before
-
-
-def _quiet_child() -> None:
-    """A forked simulation leaves Ctrl-C to its parent (no traceback of its own) and ends
-    silently on SIGTERM."""
-    import signal
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def simulate_study(study: Study, workers: int = 1) -> None:
