@@ -15,6 +15,8 @@ from balpipe.draw import figures, labels
 from balpipe.report import page
 from balpipe.draw import player
 
+import drawn_svg
+
 SPECS = Path(__file__).resolve().parents[1] / "specs"
 DRAWN = ["paper000_rpr3_idler_loop.yaml", "paper001_4rrr.yaml", "paper002_decoupling.yaml",
          "paper004_five_bar.yaml", "scott_russell.yaml", "custom_four_bar_balancing.yaml"]
@@ -69,26 +71,6 @@ def test_gear_numbers_from_names_else_in_model_order():
 
 # -- the papers' drawings ----------------------------------------------------------------------
 
-def _texts_and_links(fig):
-    """The drawn names' boxes (display pixels, the text alone, not its leader) and the solid
-    pose's links as segments (black lines; ghosts are grey)."""
-    from matplotlib.colors import to_rgba
-    from matplotlib.text import Text
-
-    fig.canvas.draw()
-    renderer = fig.canvas.get_renderer()
-    ax = fig.axes[0]
-    texts = [(t.get_text(), Text.get_window_extent(t, renderer).extents) for t in ax.texts if t.get_text()]
-    to_px = ax.transData.transform
-    segs = []
-    for line in ax.lines:
-        if to_rgba(line.get_color()) == to_rgba("black") and line.get_linestyle() in ("-", "solid") \
-                and len(line.get_xydata()) >= 2:
-            xy = to_px(line.get_xydata())
-            segs += [(tuple(a), tuple(b)) for a, b in zip(xy[:-1], xy[1:])]
-    return texts, segs
-
-
 @pytest.mark.parametrize("name", DRAWN)
 def test_names_on_the_papers_drawings_never_overlap(studies, name):
     st = studies(name)
@@ -96,18 +78,17 @@ def test_names_on_the_papers_drawings_never_overlap(studies, name):
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown])
     numbers = labels.gear_numbers([s.stage.model for s in shown])
     for s in shown:
-        fig, placed = figures.mechanism_drawing(s.stage.model, s.analysis, page.drawn_instants(st), s.stage.label, limits,
-                                                numbers)
-        ax = fig.axes[0]
-        x0, y0, x1, y1 = ax.bbox.extents
-        texts, segs = _texts_and_links(fig)
-        figures.plt.close(fig)
+        canvas, placed = figures.mechanism_drawing(s.stage.model, s.analysis, page.drawn_instants(st), s.stage.label,
+                                                   limits, numbers)
+        x0, y0, x1, y1 = canvas.panels[0].box
+        drawn = drawn_svg.read(canvas.svg("t"))
+        texts, segs = drawn["names"], drawn["links"]
         assert placed, s.stage.name
         for a, b in itertools.combinations(placed, 2):
             assert not labels.overlaps(a.box, b.box), f"{name} {s.stage.name}: {a.request.text!r} over {b.request.text!r}"
-        # as drawn: the names' text boxes, read back from the figure, overlap no other name nor a
-        # link of the solid pose
-        assert len(texts) == len(placed) and segs
+        # as drawn: the names' boxes, read back from the SVG, overlap no other name nor a link of
+        # the solid pose
+        assert sorted(t for t, _ in texts) == sorted(p.request.text for p in placed) and segs
         for (ta, a), (tb, b) in itertools.combinations(texts, 2):
             assert not labels.overlaps(a, b), f"{name} {s.stage.name}: {ta!r} over {tb!r} as drawn"
         crossed = [t for t, box in texts if any(labels.segment_hits_box(sg, box) for sg in segs)]
@@ -260,29 +241,17 @@ def test_player_grid_and_names_in_the_html(studies):
 PAPER001 = ["paper001_4rrr.yaml", "paper001_4rrr_fig6a.yaml", "paper001_4rrr_fig6b.yaml", "paper001_4rrr_fig6c.yaml"]
 
 
-def _drawn_geometry(ax, renderer):
-    """What a panel shows, read back from the figure in display pixels: the boxes of its texts
-    (not the title), its discs (centre, radius), and its links and counter-mass rods as segments
-    (solid lines and the platform's outline; leader lines are not lines of the axes)."""
-    from matplotlib.patches import Circle, Polygon
-    from matplotlib.text import Text
-
-    # Text's own extent: an Annotation's would include its leader line
-    texts = [(t.get_text(), Text.get_window_extent(t, renderer).extents) for t in ax.texts if t.get_text()]
-    to_px = ax.transData.transform
-    discs, segs = [], []
-    for p in ax.patches:
-        if isinstance(p, Circle):
-            c = to_px(p.center)
-            discs.append((c, abs(to_px((p.center[0] + p.radius, p.center[1]))[0] - c[0])))
-        elif isinstance(p, Polygon):
-            xy = to_px(p.get_xy())
-            segs += [(tuple(xy[k]), tuple(xy[(k + 1) % len(xy)])) for k in range(len(xy))]
-    for line in ax.lines:
-        if line.get_linestyle() in ("-", "solid") and len(line.get_xydata()) >= 2 and line.get_linewidth() >= 1.0:
-            xy = to_px(line.get_xydata())
-            segs += [(tuple(a), tuple(b)) for a, b in zip(xy[:-1], xy[1:])]
-    return texts, discs, segs
+def _only(canvas, k: int, prefix: str) -> str:
+    """The SVG of ``canvas`` with only its ``k``-th shown panel."""
+    shown = [p for p in canvas.panels if p.visible]
+    keep = [p.visible for p in canvas.panels]
+    for p in canvas.panels:
+        p.visible = p is shown[k]
+    try:
+        return canvas.svg(prefix)
+    finally:
+        for p, v in zip(canvas.panels, keep):
+            p.visible = v
 
 
 def _disc_hits_box(centre, r, box) -> bool:
@@ -300,11 +269,12 @@ def test_names_on_paper001_drawings_never_overlap(studies, name, monkeypatch):
 
     drawn = []
 
-    def keep(fig, prefix):
-        drawn.append((prefix, fig))
-        return "<svg/>"
+    def keep(panels, prefix):
+        canvas = rrr4.panels_canvas(panels)
+        drawn.append((prefix, canvas))
+        return canvas.svg(prefix)
 
-    monkeypatch.setattr(figures, "to_svg", keep)
+    monkeypatch.setattr(rrr4, "draw_panels", keep)
     st = studies(name)
     rrr4.topology_figure(st)
     checked = rrr4.designs_drawn(st)
@@ -313,17 +283,15 @@ def test_names_on_paper001_drawings_never_overlap(studies, name, monkeypatch):
         rrr4.designs_figure(st, checked, ("Fig. 4b",))
     assert len(drawn) == (3 if checked else 1)
     panels = 0
-    for prefix, fig in drawn:
-        fig.canvas.draw()  # annotations find their positions when drawn
-        renderer = fig.canvas.get_renderer()
+    for prefix, canvas in drawn:
         # at most three panels a row (four: 2 x 2), each as large as the others' (4.2 in)
-        assert fig.get_size_inches()[0] <= 3 * 4.2 + 1e-9, (name, prefix, fig.get_size_inches())
-        for ax in fig.axes:
-            if not ax.axison:
-                continue
+        assert canvas.width <= 3 * 4.2 * 72 + 1e-9, (name, prefix, canvas.width)
+        shown = [p for p in canvas.panels if p.visible]
+        for k, panel in enumerate(shown):
             panels += 1
-            texts, discs, segs = _drawn_geometry(ax, renderer)
-            where = f"{name} {prefix} {ax.get_title()!r}"
+            one = drawn_svg.read(_only(canvas, k, prefix))
+            texts, discs, segs = one["names"], one["discs"], one["links"] + one["outlines"]
+            where = f"{name} {prefix} {panel.title!r}"
             names = [t for t, _ in texts]
             assert {"A1", "A2", "A3", "A4"} <= set(names), (where, names)
             assert discs and segs, where
@@ -334,5 +302,4 @@ def test_names_on_paper001_drawings_never_overlap(studies, name, monkeypatch):
                     assert not _disc_hits_box(c, r, box), f"{where}: {t!r} over a disc at {c}"
                 for sg in segs:
                     assert not labels.segment_hits_box(sg, box), f"{where}: {t!r} over a link {sg}"
-        figures.plt.close(fig)
     assert panels >= 4

@@ -36,20 +36,29 @@ def entries(out: Path, slug: str = "scott_russell") -> dict[str, bytes]:
 
 @pytest.fixture
 def drawn(monkeypatch):
-    """Counts the figures that are drawn (``to_svg`` calls) in this process: in ``draw.figures``
-    and in every balpipe module already imported that bound ``to_svg`` to its own name (e.g.
-    ``report.history_figures``: imported by an earlier test of the same worker, it would
-    otherwise keep calling the uncounted function)."""
+    """Counts the figures that are drawn in this process: matplotlib's (``to_svg`` calls, in
+    ``draw.figures`` and in every balpipe module already imported that bound ``to_svg`` to its
+    own name, e.g. ``report.history_figures``: imported by an earlier test of the same worker,
+    it would otherwise keep calling the uncounted function) and the mechanism drawings
+    (``canvas.Canvas.svg`` calls)."""
+    from balpipe.draw import canvas
+
     calls = []
     real = figures.to_svg
+    real_canvas = canvas.Canvas.svg
 
     def counted(fig, prefix):
         calls.append(prefix)
         return real(fig, prefix)
 
+    def counted_canvas(self, prefix):
+        calls.append(prefix)
+        return real_canvas(self, prefix)
+
     for name, module in list(sys.modules.items()):
         if (name == "balpipe" or name.startswith("balpipe.")) and getattr(module, "to_svg", None) is real:
             monkeypatch.setattr(module, "to_svg", counted)
+    monkeypatch.setattr(canvas.Canvas, "svg", counted_canvas)
     return calls
 
 

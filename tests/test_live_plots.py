@@ -119,6 +119,18 @@ def test_the_loads_have_markers_pymunk_curves_and_the_coincidence_note():
     assert LP.coincide_notes(stages) == ["Coincide in force Fx, force Fy, force |F|: counterweights = counter-rotations"]
 
 
+def test_the_residual_figure_names_curves_drawn_over_each_other():
+    """Two stages whose simulations leave the same residuals draw one curve over the other: the
+    page says which. On a log axis, residuals of 1e-12 and 2e-12 under a 1e-3 peak are no match."""
+    t = np.linspace(0.0, 1.0, 51)
+    big = 1e-3 * (1.0 + np.sin(7 * t) ** 2)
+    rows = [("unbalanced", t, big, big, 10.0, 2.0), ("crank only", t, 1e-12 + 0 * t, big.copy(), 10.0, 2.0),
+            ("balanced", t, 2e-12 + 0 * t, 1e-12 + 0 * t, 10.0, 2.0)]
+    assert LP.residual_notes(LP.residuals(rows)) == ["Coincide in moment residual: unbalanced = crank only"]
+    rows[1] = ("crank only", t, 1e-12 + 0 * t, big * (1 + 1e-3), 10.0, 2.0)
+    assert LP.residual_notes(LP.residuals(rows)) == []
+
+
 def test_a_figure_of_many_curves_keeps_fewer_samples():
     t = np.linspace(0.0, 1.0, 1001)
     panels = [{"key": f"p{i}", "title": f"p{i} (N)", "axis": "(N)"} for i in range(40)]

@@ -18,12 +18,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.layout_engine import PlaceHolderLayoutEngine  # noqa: E402
-from matplotlib.patches import Circle, Polygon  # noqa: E402
 
 from ..model import Model  # noqa: E402
 from . import cache, extremes  # noqa: E402
+from .canvas import Canvas, Label, Panel  # noqa: E402
 from .labels import drawing_span, point_places, repeated_names  # noqa: E402
-from .layout import fixed_layout  # noqa: E402
+from .layout import fixed_layout, text_metrics  # noqa: E402
 from .sleeves import guided_sliders, sleeves  # noqa: E402
 
 plt.rcParams.update({
@@ -113,15 +113,23 @@ def marked(k: int, n: int) -> dict:
             "markevery": (min(n - 1, (k * every) // max(1, len(MARKERS))), every)}
 
 
-def coinciding(curves: list[tuple[str, np.ndarray]], rel: float = 1e-6) -> list[str]:
-    """Groups of curves that agree within ``rel`` of the panel's largest value, as
-    "a = b = c" (each curve in the group of the first it agrees with)."""
+def coinciding(curves: list[tuple[str, np.ndarray]], rel: float = 1e-6, log: bool = False) -> list[str]:
+    """Groups of curves that agree within ``rel`` of the panel's largest value (``log``: of
+    either value at every sample, as a logarithmic axis shows them), as "a = b = c" (each curve
+    in the group of the first it agrees with)."""
     scale = max([float(np.max(np.abs(y))) for _, y in curves] + [0.0]) or 1.0
+
+    def same(a: np.ndarray, b: np.ndarray) -> bool:
+        if a.shape != b.shape:
+            return False
+        if log:
+            return bool(np.all(np.abs(a - b) <= rel * np.maximum(np.abs(a), np.abs(b))))
+        return float(np.max(np.abs(a - b))) <= rel * scale
+
     groups: list[list[int]] = []
     for i, (_, y) in enumerate(curves):
         for g in groups:
-            y0 = curves[g[0]][1]
-            if y0.shape == y.shape and float(np.max(np.abs(y0 - y))) <= rel * scale:
+            if same(curves[g[0]][1], y):
                 g.append(i)
                 break
         else:
@@ -207,16 +215,17 @@ def mechanism_svg(model: Model, poses: np.ndarray, ghosts: list[int] | None, pre
                   limits: tuple[float, float, float, float] | None, numbers: dict[str, str] | None,
                   texts: dict[str, str] | None) -> str:
     """:func:`mechanism_figure` from the body poses (N, bodies, 3) alone: what :mod:`.cache` hashes."""
-    fig, _ = pose_drawing(model, poses, ghosts, title, limits, numbers, texts)
-    return to_svg(fig, prefix)
+    canvas, _ = pose_drawing(model, poses, ghosts, title, limits, numbers, texts)
+    return canvas.svg(prefix)
 
 
 SOLID = {"link": "black", "width": 2.2, "marker": True, "fill": "0.85", "edge": "black", "alpha": 1.0, "z": 3}
 GHOST = {"link": "0.72", "width": 1.6, "marker": False, "fill": "0.94", "edge": "0.72", "alpha": 0.3, "z": 1}
 SLEEVE = 0.018  # half-width of a sleeve / span
+GREEN, RED = "tab:green", "tab:red"
 
 
-def _draw_pose(ax, model: Model, pose_row: np.ndarray, span: float, max_cw: float, guided: set[str],
+def _draw_pose(panel: Panel, model: Model, pose_row: np.ndarray, span: float, max_cw: float, guided: set[str],
                look: dict) -> None:
     """One pose of the mechanism in the style ``look`` (``SOLID`` or ``GHOST``): links, discs,
     counterweights, slider blocks and the sleeves of prismatic pairs between links."""
@@ -225,36 +234,35 @@ def _draw_pose(ax, model: Model, pose_row: np.ndarray, span: float, max_cw: floa
         pose = pose_row[i]
         if b.radius:
             centre, edge = _global_point(pose, (0, 0)), _global_point(pose, (b.radius, 0))
-            ax.add_patch(Circle(centre, b.radius, fill=False, color="tab:green", alpha=a, linewidth=1.2, zorder=z))
-            ax.plot([centre[0], edge[0]], [centre[1], edge[1]], color="tab:green", alpha=a, linewidth=0.8, zorder=z)
+            panel.circle(centre, b.radius, edge=GREEN, alpha=a, width=1.2, z=z)
+            panel.line([centre[0], edge[0]], [centre[1], edge[1]], GREEN, alpha=a, width=0.8, z=z)
         if b.kind == "slider" and b.name not in guided:
             c = _global_point(pose, (0, 0))
             w = 0.06 * span
-            ax.add_patch(Polygon([c + d for d in ((-w, -w / 2), (w, -w / 2), (w, w / 2), (-w, w / 2))], closed=True,
-                                 fill=True, facecolor=look["fill"], edgecolor=look["edge"], zorder=z))
+            panel.polygon([c + d for d in ((-w, -w / 2), (w, -w / 2), (w, w / 2), (-w, w / 2))], fill=look["fill"],
+                          edge=look["edge"], z=z)
         for att in b.attachments:
             if att.kind == "counterweight":
                 g = np.array([_global_point(pose, p) for p in
                               (b.points[b.outline[0]] if b.outline else (0, 0), att.position)])
-                ax.plot(g[:, 0], g[:, 1], color="tab:red", alpha=a, linewidth=1.5, zorder=z)
+                panel.line(g[:, 0], g[:, 1], RED, alpha=a, width=1.5, z=z)
                 r = 0.035 * span * math.sqrt(att.mass / max_cw)
-                ax.add_patch(Circle(_global_point(pose, att.position), r, color="tab:red", alpha=0.6 * a, zorder=z))
+                panel.circle(_global_point(pose, att.position), r, fill=RED, edge=RED, alpha=0.6 * a, z=z)
             elif att.radius:
-                ax.add_patch(Circle(_global_point(pose, att.position), att.radius, fill=False, color="tab:green",
-                                    alpha=a, zorder=z))
+                panel.circle(_global_point(pose, att.position), att.radius, edge=GREEN, alpha=a, z=z)
     # links (a guide's under its sleeve), the sleeves, the rods sliding in them (thinner), joints on top
     outlines = [(b.name in guided, np.array([_global_point(pose_row[i], b.points[p]) for p in b.outline]))
                 for i, b in enumerate(model.bodies) if len(b.outline) >= 2]
+    cls = "link" if look is SOLID else ""
     for g in (g for rod, g in outlines if not rod):
-        ax.plot(g[:, 0], g[:, 1], color=look["link"], linewidth=look["width"], solid_capstyle="round", zorder=z)
+        panel.line(g[:, 0], g[:, 1], look["link"], width=look["width"], cap="round", z=z, cls=cls)
     for ends in sleeves(model, pose_row):
-        ax.add_patch(Polygon(_sleeve_outline(ends, span), closed=True, facecolor=look["fill"], edgecolor=look["edge"],
-                             linewidth=0.9, zorder=z))
+        panel.polygon(_sleeve_outline(ends, span), fill=look["fill"], edge=look["edge"], width=0.9, z=z)
     for g in (g for rod, g in outlines if rod):
-        ax.plot(g[:, 0], g[:, 1], color=look["link"], linewidth=0.75 * look["width"], solid_capstyle="round", zorder=z)
+        panel.line(g[:, 0], g[:, 1], look["link"], width=0.75 * look["width"], cap="round", z=z, cls=cls)
     if look["marker"]:
         for _, g in outlines:
-            ax.plot(g[:, 0], g[:, 1], "o", color="white", markeredgecolor="black", markersize=4, zorder=z + 0.5)
+            panel.markers(g, "o", 4.0, face="white", edge="black", z=z + 0.5)
 
 
 def _sleeve_outline(ends: tuple[np.ndarray, np.ndarray], span: float) -> list[np.ndarray]:
@@ -268,8 +276,8 @@ def _sleeve_outline(ends: tuple[np.ndarray, np.ndarray], span: float) -> list[np
 def mechanism_drawing(model: Model, analysis, ghosts: list[int] | None = None, title: str = "",
                       limits: tuple[float, float, float, float] | None = None,
                       numbers: dict[str, str] | None = None, texts: dict[str, str] | None = None) -> tuple:
-    """The figure of :func:`mechanism_figure` and its placed labels (:class:`labels.Placed`,
-    boxes in display pixels)."""
+    """The drawing of :func:`mechanism_figure` (a :class:`.canvas.Canvas`) and its placed labels
+    (:class:`labels.Placed`, boxes in the canvas's layout points)."""
     return pose_drawing(model, analysis.extra["frame_pose"], ghosts, title, limits, numbers, texts)
 
 
@@ -277,7 +285,8 @@ def pose_drawing(model: Model, poses: np.ndarray, ghosts: list[int] | None = Non
                  limits: tuple[float, float, float, float] | None = None,
                  numbers: dict[str, str] | None = None, texts: dict[str, str] | None = None) -> tuple:
     """:func:`mechanism_drawing` from the body poses (N, bodies, 3) of the analysis."""
-    fig, ax = plt.subplots(figsize=(6.0, 4.6))
+    canvas = Canvas(6.0 * 72, 4.6 * 72)
+    panel = canvas.panels[0]
     ref = extremes.REFERENCE
     if ghosts is None:
         ghosts = extremes.extreme_instants(model, poses)
@@ -290,26 +299,19 @@ def pose_drawing(model: Model, poses: np.ndarray, ghosts: list[int] | None = Non
         for p in b.points.values():
             px = x + np.cos(th) * p[0] - np.sin(th) * p[1]
             py = y + np.sin(th) * p[0] + np.cos(th) * p[1]
-            ax.plot(px, py, color="tab:blue", linewidth=0.5, alpha=0.5, zorder=0.5)
+            panel.line(px, py, "tab:blue", width=0.5, alpha=0.5, z=0.5)
     for k in ghosts:
-        _draw_pose(ax, model, poses[k], span, max_cw, guided, GHOST)
-    _draw_pose(ax, model, poses[ref], span, max_cw, guided, SOLID)
+        _draw_pose(panel, model, poses[k], span, max_cw, guided, GHOST)
+    _draw_pose(panel, model, poses[ref], span, max_cw, guided, SOLID)
     for (a, b) in model.guides:
-        ax.plot([a[0], b[0]], [a[1], b[1]], color="0.3", linewidth=1.0, linestyle="-")
+        panel.line([a[0], b[0]], [a[1], b[1]], "0.3", width=1.0)
     for name, p in model.frame_points.items():
-        ax.plot(p[0], p[1], marker="^", color="black", markersize=9, zorder=4)
-    ax.set_aspect("equal")
-    if limits is not None:
-        x0, y0, x1, y1 = limits
-        ax.set_xlim(x0, x1)
-        ax.set_ylim(y0, y1)
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    if title:
-        ax.set_title(literal(title), fontsize=9)
-    fixed_layout(fig)
-    placed = place_names(fig, ax, model, poses[ref], span, max_cw, numbers, texts=texts)
-    return fig, placed
+        panel.marker(p[0], p[1], "^", 9.0, z=4)
+    panel.limits = limits
+    panel.title = title
+    canvas.layout()
+    placed = place_names(panel, model, poses[ref], span, max_cw, numbers, texts=texts)
+    return canvas, placed
 
 
 LABEL_STYLES = {  # kind -> font size, colour, style, weight
@@ -377,57 +379,76 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
     return out + gears + cws + links, segs, keep
 
 
-def place_names(fig, ax, model: Model, pose_row: np.ndarray, span: float, max_cw: float,
-                 numbers: dict[str, str] | None, disc: float = 0.035, kinds: tuple[str, ...] | None = None,
-                 marks: list | tuple = (), texts: dict[str, str] | None = None) -> list:
+def place_names(panel: Panel, model: Model, pose_row: np.ndarray, span: float, max_cw: float,
+                numbers: dict[str, str] | None, disc: float = 0.035, kinds: tuple[str, ...] | None = None,
+                marks: list | tuple = (), texts: dict[str, str] | None = None) -> list:
     """Names of the spec at one instant (every body point once per place, every link, every
-    counterweight, every gear's number), placed in display pixels by :func:`labels.place` so
-    that no two overlap, avoiding the links and markers; a displaced name gets a leader line.
-    Call it once the figure's layout is final. ``disc``: as :func:`name_requests`; ``kinds``: only
-    these kinds of names (``LABEL_STYLES``' keys; all when None); ``marks``: further points drawn
-    (model coordinates) to keep clear, e.g. centres of mass; ``texts``: name -> the text drawn
-    (a paper's notation)."""
+    counterweight, every gear's number), placed on a laid-out ``panel`` by :func:`labels.place`
+    so that no two overlap, avoiding the links and markers; a displaced name gets a leader line.
+    ``disc``: as :func:`name_requests`; ``kinds``: only these kinds of names (``LABEL_STYLES``'
+    keys; all when None); ``marks``: further points drawn (model coordinates) to keep clear,
+    e.g. centres of mass; ``texts``: name -> the text drawn (a paper's notation)."""
     from . import labels as lb
 
     numbers = numbers if numbers is not None else lb.gear_numbers([model])
     items, segs, keep = name_requests(model, pose_row, span, max_cw, numbers, disc)
     items = [((texts or {}).get(t, t), a, k) for t, a, k in items if kinds is None or k in kinds]
     keep = keep + [(np.asarray(p, dtype=float), None) for p in marks]
-    return place_items(fig, ax, items, segs, keep)
+    placed = placement(items, segs, keep, panel.to_px, 1.0, panel.box,
+                       lambda text, kind: text_metrics(text, *_font(kind))[:2])
+    for pl in placed:
+        size, color, fstyle, weight = LABEL_STYLES[pl.request.kind]
+        panel.name(Label(pl.request.text, pl.centre, pl.request.anchor if pl.displaced else None, size, color,
+                         fstyle, weight))
+    return placed
 
 
-def place_items(fig, ax, items: list, segs: list, keep: list) -> list:
-    """Names placed by :func:`labels.place` and drawn (a displaced one with a leader line):
-    ``items`` (text, anchor, kind) in data coordinates, ``kind`` a key of ``LABEL_STYLES``, in
-    placing order; ``segs``: lines to keep clear ((x, y), (x, y)); ``keep``: markers and discs as
-    (centre, radius), radius None for a point marker, -1 for a pivot's triangle. Call it once
-    the figure's layout is final; returns the :class:`labels.Placed` (display pixels)."""
-    from matplotlib.font_manager import FontProperties
+def _font(kind: str) -> tuple[float, str, str]:
+    size, _, fstyle, weight = LABEL_STYLES[kind]
+    return size, fstyle, weight
 
+
+def placement(items: list, segs: list, keep: list, to_px, unit: float, bounds: tuple, measure) -> list:
+    """Where :func:`labels.place` puts ``items`` (text, anchor, kind) given in model coordinates,
+    in placing order: ``to_px`` maps model coordinates to the drawing's units (``unit`` of them
+    a point), ``bounds`` the drawing area in those units, ``measure(text, kind)`` a text's width
+    and height in them; ``segs``: lines to keep clear ((x, y), (x, y)); ``keep``: markers and
+    discs as (centre, radius), radius None for a point marker, -1 for a pivot's triangle."""
     from . import labels as lb
 
-    ax.apply_aspect()
-    to_px = ax.transData.transform
-    renderer = fig.canvas.get_renderer()
-    pad = 2.0 * fig.dpi / 72.0
-    dot = 3.0 * fig.dpi / 72.0
+    pad, dot = 2.0 * unit, 3.0 * unit
     blocks = []
     for c, r in keep:
         x, y = to_px(c)
-        rr = dot if r is None else 5.0 * fig.dpi / 72.0 if r < 0 else \
+        rr = dot if r is None else 5.0 * unit if r < 0 else \
             max(dot, abs(float(to_px(c + np.array([r, 0.0]))[0]) - float(x)))
         blocks.append((float(x) - rr, float(y) - rr, float(x) + rr, float(y) + rr))
     requests = []
     for text, anchor, kind in items:
-        size, _, fstyle, weight = LABEL_STYLES[kind]
-        prop = FontProperties(family="DejaVu Sans", size=size, style=fstyle, weight=weight)
-        w, h, _ = renderer.get_text_width_height_descent(str(text), prop, ismath=False)
+        w, h = measure(str(text), kind)
         x, y = float(to_px(anchor)[0]), float(to_px(anchor)[1])
         own = [0.5 * (b[2] - b[0]) for b in blocks if b[0] <= x <= b[2] and b[1] <= y <= b[3]]
         requests.append(lb.Request(str(text), (x, y), float(w) + 2 * pad, float(h) + pad, kind, max(own + [0.0])))
     seg_px = [(tuple(map(float, to_px(a))), tuple(map(float, to_px(b)))) for a, b in segs]
-    x0, y0, x1, y1 = ax.bbox.extents
-    placed = lb.place(requests, seg_px, blocks, bounds=(float(x0), float(y0), float(x1), float(y1)), gap=pad)
+    return lb.place(requests, seg_px, blocks, bounds=tuple(float(v) for v in bounds), gap=pad)
+
+
+def place_items(fig, ax, items: list, segs: list, keep: list) -> list:
+    """:func:`placement` on a matplotlib axes whose layout is final, the names drawn as
+    annotations (a displaced one with a leader line); returns the :class:`labels.Placed`
+    (display pixels)."""
+    from matplotlib.font_manager import FontProperties
+
+    ax.apply_aspect()
+    renderer = fig.canvas.get_renderer()
+
+    def measure(text: str, kind: str) -> tuple[float, float]:
+        size, fstyle, weight = _font(kind)
+        prop = FontProperties(family="DejaVu Sans", size=size, style=fstyle, weight=weight)
+        w, h, _ = renderer.get_text_width_height_descent(text, prop, ismath=False)
+        return float(w), float(h)
+
+    placed = placement(items, segs, keep, ax.transData.transform, fig.dpi / 72.0, ax.bbox.extents, measure)
     to_pt = 72.0 / fig.dpi
     for (text, anchor, kind), pl in zip(items, placed):
         size, color, fstyle, weight = LABEL_STYLES[kind]

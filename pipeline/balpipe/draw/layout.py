@@ -44,6 +44,15 @@ def text_size(text: str, size: float, math: bool = False) -> tuple[float, float]
     return float(w), float(h)
 
 
+@lru_cache(maxsize=8192)
+def text_metrics(text: str, size: float, style: str = "normal", weight: str = "normal") -> tuple[float, float, float]:
+    """Width, height and descent (pt) of one line of ``text`` shown literally (no mathtext) in
+    DejaVu Sans at ``size`` pt, in ``style`` and ``weight``: what :mod:`.canvas` lays out."""
+    prop = FontProperties(family="DejaVu Sans", size=size, style=style, weight=weight)
+    w, h, d = _renderer().get_text_width_height_descent(text, prop, ismath=False)
+    return float(w), float(h), float(d)
+
+
 def _points(size) -> float:
     return float(FontProperties(size=size).get_size_in_points())
 

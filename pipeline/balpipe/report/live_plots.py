@@ -41,12 +41,28 @@ def coincide_notes(stages: list) -> list[str]:
     """'Coincide in force Fx, force |F|: a = b' per group of stages whose loads agree within 1e-6 of a
     panel's largest value (:func:`balpipe.draw.figures.coinciding`), with the panels where they
     do; ``stages``: (label, analysis)."""
+    return coincide_in([(title.split(" (")[0].replace("shaking ", ""), [(label, fn(an.force, an.moment))
+                                                                         for label, an in stages])
+                        for _, title, _, fn in LOADS])
+
+
+def coincide_in(panels: list[tuple[str, list[tuple[str, np.ndarray]]]], log: bool = False) -> list[str]:
+    """'Coincide in a, b: x = y' per group of curves that agree (:func:`balpipe.draw.figures.coinciding`,
+    ``log``: sample by sample, as on a logarithmic axis), with the panels where they do; ``panels``:
+    (name, its curves as (label, values))."""
     notes: dict[str, list[str]] = {}
-    for key, title, _, fn in LOADS:
-        same = figures.coinciding([(label, fn(an.force, an.moment)) for label, an in stages])
+    for name, curves in panels:
+        same = figures.coinciding(curves, log=log)
         if same:
-            notes.setdefault("; ".join(same), []).append(title.split(" (")[0].replace("shaking ", ""))
+            notes.setdefault("; ".join(same), []).append(name)
     return [f"Coincide in {', '.join(where)}: {groups}" for groups, where in notes.items()]
+
+
+def residual_notes(c: Curves) -> list[str]:
+    """:func:`coincide_in` for the residual figure (:func:`residuals`): stages whose residuals
+    agree at every sample draw one curve over the other, and the page says which."""
+    return coincide_in([(p["title"].split(" |")[0].lower(), [(label, curves[p["key"]]) for label, curves in c.stages])
+                        for p in c.panels], log=True)
 
 
 def efforts(stages: list, units: dict, marks: list | None = None, shown: dict | None = None) -> Curves:

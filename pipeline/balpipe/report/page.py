@@ -83,8 +83,10 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
     vals = [s for s in shown_stages(study) if s.validation is not None]
     if vals:
         rows, caption = residual_rows(study, vals)
-        residuals.append(("Residuals of the simulation",
-                          live.html("residuals", live_plots.residuals(rows), live_plots.SIMULATED), caption))
+        res = live_plots.residuals(rows)
+        residuals.append(("Residuals of the simulation", live.html("residuals", res, live_plots.SIMULATED) + "".join(
+            f'<p class="muted coincide">{markupsafe.escape(note)}</p>' for note in live_plots.residual_notes(res)),
+            caption))
     if study.reactionless is not None:
         r = study.reactionless
         drift.append(("Frame drift and rotation",

@@ -98,13 +98,12 @@ DISC = 0.05  # the heaviest counter-mass's disc radius / the span of the base pi
 NAMED = ("pivot", "link")  # the names a panel carries: base pivots A1-A4 and links, as the paper: l11 for link11
 
 
-def _draw(ax, model, poses, span: float, max_cw: float, title: str) -> list:
-    """One panel: ``model`` at the body poses ``poses`` (the engine's frame poses at t = 0): links,
-    joints, pivots, each body's centre of mass (cross), counter-masses as red discs of area
-    proportional to mass (``max_cw`` has the largest), the total centre of mass (star). Returns the
-    points marked (centres of mass) for :func:`_name` to keep clear."""
-    from matplotlib.patches import Circle, Polygon
-
+def _draw(panel, model, poses, span: float, max_cw: float, title: str) -> list:
+    """One panel (:class:`balpipe.draw.canvas.Panel`): ``model`` at the body poses ``poses`` (the
+    engine's frame poses at t = 0): links, joints, pivots, each body's centre of mass (cross),
+    counter-masses as red discs of area proportional to mass (``max_cw`` has the largest), the
+    total centre of mass (star). Returns the points marked (centres of mass) for :func:`_name`
+    to keep clear."""
     total, weighted, marks = 0.0, np.zeros(2), []
     for k, b in enumerate(model.bodies):
         x, y, th = poses[k]
@@ -112,45 +111,42 @@ def _draw(ax, model, poses, span: float, max_cw: float, title: str) -> list:
         g = lambda p: np.array([x, y]) + R @ np.asarray(p, dtype=float)  # noqa: E731
         pts = np.array([g(b.points[n]) for n in b.outline])
         if b.kind == "platform":
-            ax.add_patch(Polygon(pts[:-1], closed=True, facecolor="0.9", edgecolor="black", linewidth=1.5))
+            panel.polygon(pts[:-1], fill="0.9", edge="black", width=1.5, z=1.0)
         else:
-            ax.plot(pts[:, 0], pts[:, 1], color="black", linewidth=2.0, solid_capstyle="round")
-        ax.plot(pts[:, 0], pts[:, 1], "o", color="white", markeredgecolor="black", markersize=4)
+            panel.line(pts[:, 0], pts[:, 1], "black", width=2.0, cap="round", cls="link")
+        panel.markers(pts, "o", 4.0, face="white", edge="black")
         for a in b.attachments:
             if a.kind != "counterweight":
                 continue
             root = g(b.points[b.outline[0]])
             pos = g(a.position)
-            ax.plot([root[0], pos[0]], [root[1], pos[1]], color="tab:red", linewidth=1.2)
-            ax.add_patch(Circle(pos, DISC * span * math.sqrt(a.mass / max_cw), color="tab:red", alpha=0.6))
+            panel.line([root[0], pos[0]], [root[1], pos[1]], "tab:red", width=1.2)
+            panel.circle(pos, DISC * span * math.sqrt(a.mass / max_cw), fill="tab:red", edge="tab:red", alpha=0.6)
         m, c, _ = b.mass_properties()
         gc = g(c)
         total, weighted = total + m, weighted + m * gc
-        ax.plot(gc[0], gc[1], "x", color="tab:blue", markersize=5)
+        panel.marker(gc[0], gc[1], "x", 5.0, face="tab:blue")
         marks.append(gc)
     for name, p in model.frame_points.items():
-        ax.plot(p[0], p[1], marker="^", color="black", markersize=8)
+        panel.marker(p[0], p[1], "^", 8.0)
     com = weighted / max(total, 1e-300)
     marks.append(com)
-    ax.plot(com[0], com[1], "*", color="tab:purple", markersize=11)
-    ax.set_title(title, fontsize=8)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (m)", fontsize=7)
-    ax.set_ylabel("y (m)", fontsize=7)
-    ax.tick_params(labelsize=7)
+    panel.marker(com[0], com[1], "*", 11.0, face="tab:purple")
+    panel.title, panel.title_size = title, 8.0
+    panel.label_size = panel.tick_size = 7.0
     return marks
 
 
-def _name(fig, ax, model, poses, span: float, max_cw: float, marks: list) -> list:
+def _name(panel, model, poses, span: float, max_cw: float, marks: list) -> list:
     """The panel's names (:data:`NAMED`), placed by the report's label placer
-    (:func:`balpipe.report.figures.place_names`, :func:`balpipe.report.labels.place`): no two
+    (:func:`balpipe.draw.figures.place_names`, :func:`balpipe.draw.labels.place`): no two
     overlap, and each keeps clear of the links, counter-mass discs, pivots, joints and the centres
-    of mass ``marks`` where the panel leaves room. Call once the figure's layout is final."""
+    of mass ``marks`` where the panel leaves room. Call once the drawing is laid out."""
     from ...draw.figures import place_names
 
     # the paper's l_ij, as the page's tables and drawings write it (balpipe.notation.Names)
     paper = {b.name: Names((NOTATION,)).text("part", b.name) for b in model.bodies if b.name.startswith("link")}
-    return place_names(fig, ax, model, np.asarray(poses, dtype=float), span, max_cw, {}, disc=DISC, kinds=NAMED,
+    return place_names(panel, model, np.asarray(poses, dtype=float), span, max_cw, {}, disc=DISC, kinds=NAMED,
                        marks=marks, texts=paper)
 
 
@@ -179,22 +175,28 @@ def panels_svg(panels: list[tuple], prefix: str) -> str:
 
 
 def draw_panels(panels: list[tuple], prefix: str) -> str:
-    """:func:`panels_svg`, drawn by :func:`_draw` with one disc scale for the whole figure, then
-    named by :func:`_name`."""
-    from ...draw.figures import plt, to_svg
-    from ...draw.layout import fixed_layout
+    """:func:`panels_svg`, drawn by :func:`_draw` on one :class:`balpipe.draw.canvas.Canvas` with
+    one disc scale for the whole figure, then named by :func:`_name`."""
+    return panels_canvas(panels).svg(prefix)
+
+
+def panels_canvas(panels: list[tuple]):
+    """The laid-out and named :class:`balpipe.draw.canvas.Canvas` of :func:`draw_panels`: each
+    panel 4.2 in square."""
+    from ...draw.canvas import Canvas
 
     cols = grid_columns(len(panels))
     rows = (len(panels) + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.2 * rows), squeeze=False)
+    canvas = Canvas(4.2 * 72 * cols, 4.2 * 72 * rows, rows, cols)
     max_cw = max([m for model, _, _ in panels for m in _counter_masses(model)] + [1e-12])
-    for ax in list(axes.flat)[len(panels):]:
-        ax.axis("off")
-    marks = [_draw(ax, model, poses, _span(model), max_cw, title) for ax, (model, poses, title) in zip(axes.flat, panels)]
-    fixed_layout(fig)
-    for ax, (model, poses, _), mk in zip(axes.flat, panels, marks):
-        _name(fig, ax, model, poses, _span(model), max_cw, mk)
-    return to_svg(fig, prefix)
+    for panel in canvas.panels[len(panels):]:
+        panel.visible = False
+    marks = [_draw(panel, model, poses, _span(model), max_cw, title)
+             for panel, (model, poses, title) in zip(canvas.panels, panels)]
+    canvas.layout()
+    for panel, (model, poses, _), mk in zip(canvas.panels, panels, marks):
+        _name(panel, model, poses, _span(model), max_cw, mk)
+    return canvas
 
 
 def topology_title(study) -> str:
