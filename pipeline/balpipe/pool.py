@@ -13,9 +13,31 @@ from typing import Any, Callable, Iterable, Iterator
 
 def worker_init() -> None:
     """Workers leave Ctrl-C to the main process (no traceback from each worker); SIGTERM ends
-    them silently (its default action)."""
+    them silently (its default action). A worker forked while Ctrl-C was held
+    (:func:`sigint_held`) lets it through again once it ignores it."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+@contextmanager
+def sigint_held() -> Iterator[None]:
+    """Ctrl-C held back while workers are forked, delivered when the block ends: a worker is
+    never interrupted before :func:`worker_init` tells it to ignore Ctrl-C, and the main process
+    still gets a Ctrl-C pressed meanwhile (ignoring it instead, as the pools once did, lost it)."""
+    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        try:
+            yield
+        finally:
+            signal.signal(signal.SIGINT, previous)
+        return
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 
 def usable_cores() -> int:
@@ -50,17 +72,13 @@ def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any,
         return
     from concurrent.futures import ProcessPoolExecutor  # multiprocessing: only when there is a pool
 
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # forked workers start ignoring it
-    pool = ProcessPoolExecutor(max_workers=min(jobs, len(items)), initializer=worker_init)
     start = sorted(range(len(items)), key=lambda i: -cost(items[i])) if cost is not None else range(len(items))
+    pool = ProcessPoolExecutor(max_workers=min(jobs, len(items)), initializer=worker_init)
     try:
-        submitted = {i: pool.submit(fn, items[i], *args) for i in start}
-        futures = [submitted[i] for i in range(len(items))]
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    try:
-        for f in futures:
-            yield f.result()
+        with sigint_held():  # the workers are forked here; a Ctrl-C meanwhile arrives as it ends
+            submitted = {i: pool.submit(fn, items[i], *args) for i in start}
+        for i in range(len(items)):
+            yield submitted[i].result()
     except BaseException:
         stop_now(pool)
         raise
@@ -120,7 +138,8 @@ def forked(tasks: list[tuple[Callable, tuple]], workers: int, shared: Any) -> li
     pool = ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=multiprocessing.get_context("fork"),
                                initializer=worker_init)
     try:
-        futures = [pool.submit(_call_shared, fn, a) for fn, a in tasks]
+        with sigint_held():  # the workers are forked here
+            futures = [pool.submit(_call_shared, fn, a) for fn, a in tasks]
         out = [f.result() for f in futures]
     except BaseException:
         stop_now(pool)
