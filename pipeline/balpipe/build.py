@@ -562,6 +562,11 @@ def _run_on_cluster(address: str, todo: list[Path], opts: Options, progress, out
         from distributed import Client
     except ImportError:
         raise SchedulerError("--scheduler needs dask.distributed (pip install 'balpipe[sweep]')") from None
+    from .cluster import unreachable
+
+    why = unreachable(address)
+    if why is not None:
+        raise SchedulerError(f"cannot reach the dask scheduler at {address}: {why}")
     try:
         client = Client(address, timeout="20s")
     except (OSError, TimeoutError, ValueError) as exc:

@@ -61,6 +61,12 @@ def run(args) -> int:
         except ImportError:
             print("balpipe: error: --scheduler needs dask.distributed (pip install 'balpipe[sweep]')", file=sys.stderr)
             return EXIT_USAGE
+        from ..cluster import unreachable
+
+        why = unreachable(args.scheduler)
+        if why is not None:
+            print(f"balpipe: error: cannot reach the dask scheduler at {args.scheduler}: {why}", file=sys.stderr)
+            return EXIT_USAGE
     try:
         p = plan(args.spec, args.vary, args.sample, args.designs, args.seed, args.max_designs, args.stage)
     except (SweepError, SpecErrors) as exc:
