@@ -16,6 +16,11 @@ from pathlib import Path
 
 import yaml
 
+try:
+    from yaml import CSafeLoader as _Parser  # libyaml: the events without Python's scanner
+except ImportError:  # pragma: no cover - PyYAML without libyaml
+    from yaml import SafeLoader as _Parser  # type: ignore[assignment]
+
 #: seconds that a plain spec's check takes (load, balance, analyse): most specs of specs/
 PLAIN = 0.05
 #: the (section, key) pairs whose scalar values name the template and the method
@@ -42,11 +47,9 @@ def declared_names(text: str) -> dict[tuple[str, str], str]:
     """The scalar values of ``mechanism: {template: ...}`` and ``balancing: {method: ...}`` in a
     spec's text, by (section, key), read from its YAML events (a stack of the open collections:
     for a mapping, the key whose value is being read; None while a key is expected)."""
-    from .loader import _Loader
-
     found: dict[tuple[str, str], str] = {}
     stack: list[list] = []  # [is a mapping, its current key or None]
-    for ev in yaml.parse(text, Loader=_Loader):
+    for ev in yaml.parse(text, Loader=_Parser):
         if isinstance(ev, yaml.CollectionStartEvent):
             stack.append([isinstance(ev, yaml.MappingStartEvent), None])
         elif isinstance(ev, yaml.CollectionEndEvent):
