@@ -48,6 +48,16 @@ def test_what_cannot_be_read_costs_a_plain_spec(tmp_path, text):
     p.write_bytes(text.encode("utf-8", "surrogateescape"))
     assert check_cost(p) == PLAIN
     assert check_cost(tmp_path / "gone.yaml") == PLAIN
+    assert check_cost(tmp_path) == PLAIN
+
+
+def test_a_pipe_is_not_read(tmp_path):
+    """The parent never blocks on a named pipe given as a spec (its worker reports it)."""
+    import os
+
+    fifo = tmp_path / "pipe.yaml"
+    os.mkfifo(fifo)
+    assert check_cost(fifo) == PLAIN
 
 
 def test_check_starts_the_costliest_first_and_reports_in_the_specs_order(tmp_path, monkeypatch, capsys):

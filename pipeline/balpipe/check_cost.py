@@ -12,6 +12,7 @@ Only the order in which the specs start depends on it, never what check says nor
 
 from __future__ import annotations
 
+import stat
 from pathlib import Path
 
 import yaml
@@ -33,7 +34,8 @@ def check_cost(path: Path) -> float:
     from .loader import MAX_FILE_BYTES
 
     try:
-        if path.stat().st_size > MAX_FILE_BYTES:
+        st = path.stat()
+        if not stat.S_ISREG(st.st_mode) or st.st_size > MAX_FILE_BYTES:  # a pipe would block here
             return PLAIN
         names = declared_names(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError):
