@@ -180,3 +180,26 @@ def test_check_leaves_the_collector_as_it_found_it(capsys):
         assert exc.code in (0, None)
     assert gc.get_freeze_count() == 0
     assert "specs/scott_russell.yaml: ok" in capsys.readouterr().out
+
+
+def test_velocities_and_accelerations_factorise_a_redundant_jacobian_once_to_the_bit(monkeypatch):
+    """With redundant drivers the engine's general path solves for q' and q'' by one QR
+    factorisation of the Jacobian (it used to factorise the same matrix twice): the same bits."""
+    from balpipe.engine import kinematics
+
+    spec, stages = _stages(RRR4)
+    t = time_grid(spec)
+    engine.clear_cache()
+    c = compiled(stages[0].model)
+    q = analyse(stages[0].model, t).q.reshape(len(t), -1)
+    J = constraints.jacobian(c, with_frame(q))[:, :, 3:]
+    assert J.shape[1] > J.shape[2]  # redundant: the QR branch
+    calls = []
+    real_qr = np.linalg.qr
+    monkeypatch.setattr(np.linalg, "qr", lambda *a, **k: calls.append(1) or real_qr(*a, **k))
+    v, a = kinematics._vel_acc(c, q, t)
+    assert len(calls) == 1
+    monkeypatch.setattr(kinematics, "_factors", lambda J: None)  # each solve factorises again
+    v2, a2 = kinematics._vel_acc(c, q, t)
+    assert len(calls) == 3
+    assert v.tobytes() == v2.tobytes() and a.tobytes() == a2.tobytes()

@@ -35,7 +35,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     # L5 presentation
     ("balpipe.report",),
     # L6 commands
-    ("balpipe.build", "balpipe.diff", "balpipe.history", "balpipe.sweep", "balpipe.site_earlier", "balpipe.spec_files"),
+    ("balpipe.build", "balpipe.diff", "balpipe.history", "balpipe.sweep", "balpipe.site_earlier", "balpipe.spec_files",
+     "balpipe.check_cost"),
     # L7 command line
     ("balpipe.cli", "balpipe.__main__"),
 )

@@ -71,7 +71,9 @@ class Template:
     """A mechanism template: ``spec`` is its pydantic section (a ``template`` literal names it),
     ``build(mechanism_spec, laws, t) -> Model``; ``laws`` maps drive names to laws. ``build``,
     ``figures`` and ``notation`` may be :class:`Ref` objects.
-    ``figures(study)`` optionally yields extra report figures as (title, svg, caption)."""
+    ``figures(study)`` optionally yields extra report figures as (title, svg, caption).
+    ``check_cost`` (as :attr:`Method.check_cost`): a hint for the order in which ``balpipe check``
+    starts its specs (:mod:`balpipe.check_cost`), never a limit."""
 
     name: str
     spec: type[Strict]
@@ -79,6 +81,7 @@ class Template:
     label: str
     figures: Callable[..., Any] | None = None
     notation: Any = None  # the papers' symbols of the inputs: a table or table(mechanism_spec) (balpipe.notation)
+    check_cost: float = 0.0  # seconds that ``balpipe check`` of a spec of this template takes beyond a plain one's
 
 
 @dataclass(frozen=True)
@@ -93,7 +96,10 @@ class Method:
     receives ``page=``: False in ``balpipe check`` of a spec without references, where it may
     leave out parameters, notes and details that no error depends on (designs only drawn).
     ``balance``, ``figures`` and ``notation`` may be :class:`Ref` objects: the spec section is a class,
-    the computing code is imported when the method runs."""
+    the computing code is imported when the method runs. ``check_cost``: the seconds (on one
+    core, measured) that checking a spec with this method takes beyond a plain spec's few
+    hundredths; ``balpipe check`` starts its costliest specs first (:mod:`balpipe.check_cost`),
+    so that a long one does not start last and leave the other cores idle at the end."""
 
     name: str
     spec: type[Strict]
@@ -109,6 +115,7 @@ class Method:
     figures: Callable[..., Any] | None = None
     page_only: tuple[str, ...] = ()
     page_aware: bool = False  # balance(..., page=bool): whether the page's outputs are wanted
+    check_cost: float = 0.0  # seconds that ``balpipe check`` of a spec with this method takes beyond a plain one's
 
 
 @dataclass(frozen=True)

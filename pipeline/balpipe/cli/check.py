@@ -45,10 +45,12 @@ def run(args) -> int:
     """Everything ``build`` checks before simulating: schema, units, limits, geometry, the
     balancing, the analysis of every stage (singular motions), the references, and the paths and
     values of a ``sweep:`` block. Keeps going past a spec that fails. With several specs, in
-    ``--jobs`` processes; the messages come in the specs' order whatever the number."""
+    ``--jobs`` processes, the costliest started first (:func:`balpipe.check_cost.check_cost`);
+    the messages come in the specs' order whatever the number."""
     import gc
 
     from .. import loader, runner  # noqa: F401  (loaded once here, before the workers fork)
+    from ..check_cost import check_cost
     from ..pool import default_jobs, in_order
     from ..spec_files import clashes, find_specs
 
@@ -68,7 +70,8 @@ def run(args) -> int:
     # copying their pages (the objects made from here on are collected as usual)
     gc.freeze()
     try:
-        bad, crashed = _report(in_order(_check_item, [(f, clash.get(f)) for f in files], jobs))
+        bad, crashed = _report(in_order(_check_item, [(f, clash.get(f)) for f in files], jobs,
+                                        cost=lambda item: check_cost(item[0])))
     finally:
         gc.unfreeze()  # as it was for a caller in the same process (tests)
     bad += len(problems)

@@ -10,7 +10,8 @@ FAMILY = Family(
     templates=(
         Template("rrr4", template.RRR4Mechanism, template.build,
                  "planar n-RRR parallel manipulator (4-RRR of paper 001, legs removable)",
-                 notation=template.NOTATION),
+                 notation=template.NOTATION,
+                 check_cost=0.4),  # redundant actuation: the engine's general (dense) path
     ),
     methods=(
         Method("rrr4_counter_masses", specs.RRR4Balancing, Ref(f"{__name__}.counter_masses:balance"), ("rrr4",),

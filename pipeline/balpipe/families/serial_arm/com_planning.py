@@ -197,10 +197,15 @@ class Planner:
     # -- fast path ---------------------------------------------------------------------------
     def loads(self, motion: TaskMotion, mode: int, t: np.ndarray | None = None, check: bool = False):
         """Shaking force (N, 2), moment (N,) and the joint solution along a centre-of-mass motion."""
-        sol = JointSolution(self.com, motion, mode, self.t if t is None else t, check=check)
-        st = absolute_state(self.arm, sol.th, sol.thd, sol.thdd)
+        sol, st = self.state(motion, mode, t, check)
         F, M = shaking_loads(self.arm, st, self.gravity, self.point)
         return F, M, sol, st
+
+    def state(self, motion: TaskMotion, mode: int, t: np.ndarray | None = None, check: bool = False):
+        """The joint solution and the links' state along a centre-of-mass motion (:meth:`loads`
+        without the shaking loads: what the ramp's torque rates need)."""
+        sol = JointSolution(self.com, motion, mode, self.t if t is None else t, check=check)
+        return sol, absolute_state(self.arm, sol.th, sol.thd, sol.thdd)
 
     def objective(self, plan: Plan, path: tuple):
         """The optimiser's objective c -> max |M| over the analysis grid with the CoM on the
@@ -287,7 +292,7 @@ class Planner:
             ramps = [np.linspace(a, b, 64) for a, b in ((0.0, f), (0.5 - f, 0.5 + f), (1.0 - f, 1.0))]
             tt = np.unique(np.concatenate([uniform, self.T * np.concatenate(ramps)]))
             motion = _com_motion(plan, trapezoidal_acceleration(f), self.T, phi, path)
-            _, _, sol, st = self.loads(motion, plan.com_mode, tt)
+            _, st = self.state(motion, plan.com_mode, tt)
             tau = joint_torques(self.arm, st, self.gravity)
             return float(np.max(np.abs(np.gradient(tau, tt, axis=0))))
 
