@@ -172,3 +172,22 @@ def test_what_cannot_be_keyed_is_run_not_cached(tmp_path):
         assert sim_cache.run(local, 1) == 3  # a function inside another: not a module's name
         assert sim_cache.run(len, [object()]) == 1  # an argument that is not plain data
     assert store.used == set() and not (tmp_path / ".cache" / "sims" / "spec").exists()
+
+
+def test_keys_do_not_see_what_a_law_memoised():
+    """A serial arm's joint laws keep their inverse kinematics per time grid (a memo field,
+    ``content_cache.MEMO``): a key is the same before and after a law was evaluated. (Paper
+    003's torque-driven runs were keyed differently when the prescribed-motion run before them
+    had been simulated, filling the memo, than when it had been served: a rebuild ran them all.)"""
+    from balpipe.families.serial_arm import template as serial_arm
+    from balpipe.motion import PointToPoint, quintic
+
+    chain = serial_arm.Chain((0.0, 0.0), ((0.5, 0.0), (0.3, 0.0), (0.1, 0.0)))
+    laws = tuple(PointToPoint(a, b, 1.0, quintic) for a, b in ((0.3, 0.5), (0.2, 0.4), (0.0, 1.0)))
+    joint = serial_arm.joint_laws(chain, serial_arm.TaskMotion(laws, "tip"), 1)
+    before = content_cache.key(sim_cache.run, (joint,), {}, "salt")
+    joint[0](np.linspace(0, 1, 11))
+    assert joint[0]._cache  # the memo holds the solution now
+    assert content_cache.key(sim_cache.run, (joint,), {}, "salt") == before
+    other = serial_arm.joint_laws(chain, serial_arm.TaskMotion(laws, "tip"), -1)  # the other working mode
+    assert content_cache.key(sim_cache.run, (other,), {}, "salt") != before

@@ -8,8 +8,8 @@ reads it instead of computing it again. Three caches use it: the figures (:mod:`
 Keys
     :func:`key` hashes a function's module and name, its arguments and a salt (balpipe's code
     hash, and what else the result depends on). Arguments are fed by :func:`feed`: numbers,
-    strings, bytes, numpy arrays, lists, tuples, dicts (in their order), sets, enums, dataclasses,
-    pydantic models (their JSON), and functions: a named function by its module and name (its
+    strings, bytes, numpy arrays, lists, tuples, dicts (in their order), sets, enums, dataclasses
+    (their fields, less those marked :data:`MEMO`), pydantic models (their JSON), and functions: a named function by its module and name (its
     code is balpipe's, which the salt covers), its defaults and the values its closure captured.
     Anything else (a lambda, an arbitrary object) is :class:`Unhashable`: such a result is
     computed, never cached.
@@ -48,6 +48,10 @@ from .fsutil import TMP_MARK, remove_path, write_file_atomic
 
 #: the caches' folder in the output folder; never part of the published site
 CACHE_DIR = ".cache"
+#: a dataclass field's metadata key marking a memo (``field(metadata={MEMO: True})``): what the
+#: object computed and kept for itself (a law's solutions per time grid), not an input; left out
+#: of keys, so that a key does not depend on what was evaluated before it was asked for
+MEMO = "balpipe_memo"
 #: a kind's folder of lock files (:meth:`PickleStore.lock`); :func:`prune_specs` leaves it alone
 LOCKS = ".locks"
 
@@ -108,7 +112,7 @@ def feed(h, x: Any) -> None:
     elif dataclasses.is_dataclass(x) and not isinstance(x, type):
         cls = type(x)
         h.update(b"C" + f"{cls.__module__}.{cls.__qualname__}".encode() + b"\0")
-        fields = dataclasses.fields(x)
+        fields = [f for f in dataclasses.fields(x) if not f.metadata.get(MEMO)]
         h.update(struct.pack("<Q", len(fields)))
         for f in fields:
             h.update(f.name.encode() + b"=")
