@@ -9,8 +9,9 @@ Keys
     :func:`key` hashes a function's module and name, its arguments and a salt (balpipe's code
     hash, and what else the result depends on). Arguments are fed by :func:`feed`: numbers,
     strings, bytes, numpy arrays, lists, tuples, dicts (in their order), sets, enums, dataclasses
-    (their fields, less those marked :data:`MEMO`), pydantic models (their JSON), and functions: a named function by its module and name (its
-    code is balpipe's, which the salt covers), its defaults and the values its closure captured.
+    (their fields, less those marked :data:`MEMO`), pydantic models (their JSON), and functions:
+    a named function by its module and name (its code is balpipe's, which the salt covers), its
+    defaults and the values its closure captured.
     Anything else (a lambda, an arbitrary object) is :class:`Unhashable`: such a result is
     computed, never cached.
 
