@@ -32,7 +32,11 @@ with this version, and prints the ratio this / REV of every phase. Run from the 
 ``--warm`` times instead a rebuild of each spec whose text changed where nothing is computed
 from it (a comment appended; issue 23's "one spec changed"): each spec is built once untimed
 into its output folder from a copy of its folder, its copy changed, and built again, timed.
-Where the figures are cached by content (``balpipe.draw.cache``) the second build draws none.
+Where the figures, simulations and balancing searches are cached by content
+(``balpipe.draw.cache``, ``balpipe.sim_cache``, ``balpipe.balance_cache``) the second build
+computes none of them. (The driver's wrappers carry the wrapped function's module and name, so
+that a cache keys a wrapped function as itself: the simulations' cache refuses an unnamed
+closure, and before this a warm build here ran every simulation again.)
 """
 
 from __future__ import annotations
@@ -69,7 +73,7 @@ PHASES = ["import", "load", "balance", "analyse", "validate", "torque", "reactio
           "write", "other", "total"]
 
 DRIVER = r'''
-import importlib, importlib.util, json, os, sys, time
+import functools, importlib, importlib.util, json, os, sys, time
 clock = time.process_time if os.environ.get("BENCH_CLOCK") == "cpu" else time.perf_counter
 t_start = clock()
 import balpipe
@@ -90,6 +94,7 @@ def wrap(module, name, phase):
         fn = getattr(mod, name)
     except (ImportError, AttributeError):
         return
+    @functools.wraps(fn)  # fn's module and name: a content cache keys the wrapper as fn, not as a closure it refuses
     def timed(*a, **k):
         t0 = clock()
         stack.append(0.0)

@@ -328,8 +328,8 @@ def _unchanged(out: Path, old: dict[str, str]) -> None:
     for k, v in old.items():
         assert (out / k).read_text() == v
     # no temporaries left behind (the figure cache's folder is no temporary; one in it would be)
-    left = [p for p in out.rglob(".*") if p.name != ".balpipe.lock" and p != out / ".cache"
-            and p != out / ".cache" / "sims" / ".locks"]  # the simulation cache's lock files (sim_cache.py)
+    locks = {out / ".cache" / kind / ".locks" for kind in ("sims", "balance")}  # sim_cache.py's, balance_cache.py's
+    left = [p for p in out.rglob(".*") if p.name != ".balpipe.lock" and p != out / ".cache" and p not in locks]
     assert not left, left
 
 

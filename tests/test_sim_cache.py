@@ -6,8 +6,6 @@ the keys of forked workers are kept; two processes needing one simulation run it
 
 from __future__ import annotations
 
-import multiprocessing
-import time
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +16,8 @@ from balpipe.build import Options, build
 from balpipe.loader import load
 from balpipe.study import run as run_study
 from balpipe.validation_stage import simulated_model
+import _content_caches as caches
+from _content_caches import DAMAGES, build_ok, computed_once_by_two_processes, entry_damaged, record_puts
 from _edits import replaced
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -28,37 +28,24 @@ DESCRIPTION = "The slider-crank of Fig. 5 with the Scott-Russell geometry"
 @pytest.fixture
 def simulated(monkeypatch):
     """The simulations that ran (not served from the cache) in this process: their keys."""
-    ran: list[str] = []
-    real = sim_cache.Store.put
-
-    def put(self, k, value):
-        ran.append(k)
-        return real(self, k, value)
-
-    monkeypatch.setattr(sim_cache.Store, "put", put)
-    return ran
+    return record_puts(monkeypatch, sim_cache.Store)
 
 
 def write_spec(folder: Path, text: str = QUICK, name: str = "scott_russell") -> Path:
-    folder.mkdir(exist_ok=True)
-    (folder / f"{name}.yaml").write_text(text)
-    return folder
+    return caches.write_spec(folder, text, name)
 
 
 def run(specs: Path, out: Path, **kw) -> list:
-    outcomes = build([str(specs)], Options(out, simulate=True, **kw), jobs=1)
-    assert all(o.status == "ok" for o in outcomes), [o.message for o in outcomes]
-    return outcomes
+    return build_ok(specs, out, True, **kw)
 
 
 def sims(out: Path, slug: str = "scott_russell") -> dict[str, bytes]:
-    folder = out / ".cache" / "sims" / slug
-    return {p.name: p.read_bytes() for p in sorted(folder.iterdir())} if folder.is_dir() else {}
+    return caches.entries(out, "sims", slug)
 
 
 def page(out: Path, slug: str = "scott_russell") -> tuple[bytes, bytes]:
     """What a simulation feeds (timing.js, the run times, excepted): the page and results.json."""
-    return (out / slug / "index.html").read_bytes(), (out / slug / "results.json").read_bytes()
+    return caches.page(out, slug)
 
 
 def test_a_rebuild_of_unchanged_stages_runs_no_simulation(tmp_path, simulated):
@@ -107,13 +94,7 @@ def test_another_spec_with_the_same_stages_reuses_their_simulations(tmp_path, si
     assert sims(out, "copy") == first  # copied into its own folder: scott_russell's changes cannot take them away
 
 
-def entry_damaged(good: bytes, damage: str) -> bytes:
-    head, body = good.split(b"\n", 1)
-    return {"truncated": good[: len(good) // 2], "flipped": head + b"\n" + body[:-1] + bytes([body[-1] ^ 1]),
-            "no header": body}[damage]
-
-
-@pytest.mark.parametrize("damage", ["truncated", "flipped", "no header"])
+@pytest.mark.parametrize("damage", DAMAGES)
 def test_a_damaged_entry_is_simulated_again(tmp_path, simulated, damage):
     specs = write_spec(tmp_path / "specs")
     out = tmp_path / "out"
@@ -177,31 +158,8 @@ def test_keys_see_the_model_and_not_its_spec_locations():
     assert k(st.stages[1].stage.model) != k(s.stage.model)
 
 
-def _slow_square(x: float, log: str) -> float:
-    with open(log, "a") as f:
-        f.write("ran\n")
-    time.sleep(1.0)
-    return x * x
-
-
-def _in_child(out: str, log: str, q) -> None:
-    store = sim_cache.Store(Path(out), "spec", "salt")
-    with sim_cache.using(store):
-        q.put(sim_cache.run(_slow_square, 3.0, log))
-
-
 def test_two_processes_needing_one_simulation_run_it_once(tmp_path):
-    (tmp_path / "out").mkdir()  # the output folder, as a build has it
-    log = tmp_path / "log"
-    ctx = multiprocessing.get_context("fork")
-    q = ctx.Queue()
-    procs = [ctx.Process(target=_in_child, args=(str(tmp_path / "out"), str(log), q)) for _ in range(2)]
-    for p in procs:
-        p.start()
-    for p in procs:
-        p.join(30)
-    assert [q.get(timeout=5), q.get(timeout=5)] == [9.0, 9.0]
-    assert log.read_text() == "ran\n"  # the second waited for the first's entry
+    computed_once_by_two_processes(sim_cache, tmp_path / "out", tmp_path / "log")
 
 
 def test_what_cannot_be_keyed_is_run_not_cached(tmp_path):
@@ -214,3 +172,22 @@ def test_what_cannot_be_keyed_is_run_not_cached(tmp_path):
         assert sim_cache.run(local, 1) == 3  # a function inside another: not a module's name
         assert sim_cache.run(len, [object()]) == 1  # an argument that is not plain data
     assert store.used == set() and not (tmp_path / ".cache" / "sims" / "spec").exists()
+
+
+def test_keys_do_not_see_what_a_law_memoised():
+    """A serial arm's joint laws keep their inverse kinematics per time grid (a memo field,
+    ``content_cache.MEMO``): a key is the same before and after a law was evaluated. (Paper
+    003's torque-driven runs were keyed differently when the prescribed-motion run before them
+    had been simulated, filling the memo, than when it had been served: a rebuild ran them all.)"""
+    from balpipe.families.serial_arm import template as serial_arm
+    from balpipe.motion import PointToPoint, quintic
+
+    chain = serial_arm.Chain((0.0, 0.0), ((0.5, 0.0), (0.3, 0.0), (0.1, 0.0)))
+    laws = tuple(PointToPoint(a, b, 1.0, quintic) for a, b in ((0.3, 0.5), (0.2, 0.4), (0.0, 1.0)))
+    joint = serial_arm.joint_laws(chain, serial_arm.TaskMotion(laws, "tip"), 1)
+    before = content_cache.key(sim_cache.run, (joint,), {}, "salt")
+    joint[0](np.linspace(0, 1, 11))
+    assert joint[0]._cache  # the memo holds the solution now
+    assert content_cache.key(sim_cache.run, (joint,), {}, "salt") == before
+    other = serial_arm.joint_laws(chain, serial_arm.TaskMotion(laws, "tip"), -1)  # the other working mode
+    assert content_cache.key(sim_cache.run, (other,), {}, "salt") != before

@@ -165,10 +165,12 @@ class Job:
     history_files: dict[str, str]
     sim_workers: int = 1  # the stages' simulations in that many processes (the same results)
     #: the output folder whose caches the figures are drawn through (draw/cache.py:
-    #: <out>/.cache/figures/<slug>/) and the simulations run through (sim_cache.py:
-    #: <out>/.cache/sims/<slug>/); None (a dask worker, which has no access to it): all computed
+    #: <out>/.cache/figures/<slug>/), the simulations run through (sim_cache.py:
+    #: <out>/.cache/sims/<slug>/) and the balancing's searches computed through
+    #: (balance_cache.py: <out>/.cache/balance/<slug>/); None (a dask worker, which has no
+    #: access to it): all computed
     figure_cache: Path | None = None
-    redraw: bool = False  # --force: every figure drawn and simulation run, its cache entry rewritten
+    redraw: bool = False  # --force: every figure drawn, simulation run and search computed, its cache entry rewritten
     figure_keys: frozenset[str] = frozenset()  # the cache entries the planning used (history figures): kept
 
 
@@ -260,10 +262,11 @@ def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outc
 
 def compute(job: Job) -> Computed:
     """Balance, analyse, validate and render one spec; never raises (errors become the result).
-    With ``job.figure_cache``, the figures and the simulations come from that folder's caches
-    where their inputs are unchanged (:mod:`balpipe.draw.cache`, :mod:`balpipe.sim_cache`), and
-    the spec's entries this build did not use are removed when its page is made."""
-    from . import sim_cache
+    With ``job.figure_cache``, the figures, the simulations and the balancing's searches come
+    from that folder's caches where their inputs are unchanged (:mod:`balpipe.draw.cache`,
+    :mod:`balpipe.sim_cache`, :mod:`balpipe.balance_cache`), and the spec's entries this build
+    did not use are removed when its page is made."""
+    from . import balance_cache, sim_cache
     from .draw import cache
 
     slug = slug_for(job.path)
@@ -271,10 +274,12 @@ def compute(job: Job) -> Computed:
         cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw, used=set(job.figure_keys))
     sims = None if job.figure_cache is None or not job.simulate else \
         sim_cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw)
-    with cache.using(store), sim_cache.using(sims):
+    searches = None if job.figure_cache is None else \
+        balance_cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw)
+    with cache.using(store), sim_cache.using(sims), balance_cache.using(searches):
         done = _compute(job)
     if done.status in ("ok", "failed"):
-        for used in (store, sims):
+        for used in (store, sims, searches):
             if used is not None:
                 used.prune()
     return done
@@ -467,10 +472,13 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
             remove_temporaries(opts.out)
             raise
         built = [o for o in outcomes if o.slug]
-        if any(not o.skipped for o in built):  # the figure caches of specs that have no page any more
+        if any(not o.skipped for o in built):  # the caches of specs that have no page any more
+            from . import content_cache
+            from .balance_cache import BALANCE
             from .draw.cache import prune_specs
 
             prune_specs(opts.out, {o.slug for o in built})
+            content_cache.prune_specs(opts.out, {o.slug for o in built}, BALANCE)
         earlier = earlier_pages(opts.out, {o.slug for o in built}, page_hash)
         key = site_key(opts.out, built) if not earlier else ""
         if not (key and _site_is_current(opts.out, key)):

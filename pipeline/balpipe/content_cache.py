@@ -1,15 +1,17 @@
 """Results cached by content in the output folder (issue 23, "Fast"): what a build computed from
 some inputs is kept under the SHA-256 of those inputs, so that a build whose inputs did not change
-reads it instead of computing it again. Two caches use it: the figures (:mod:`balpipe.draw.cache`,
-``<out>/.cache/figures/``) and the pymunk simulations (:mod:`balpipe.sim_cache`,
-``<out>/.cache/sims/``).
+reads it instead of computing it again. Three caches use it: the figures (:mod:`balpipe.draw.cache`,
+``<out>/.cache/figures/``), the pymunk simulations (:mod:`balpipe.sim_cache`,
+``<out>/.cache/sims/``) and the balancing's numerical searches (:mod:`balpipe.balance_cache`,
+``<out>/.cache/balance/``).
 
 Keys
     :func:`key` hashes a function's module and name, its arguments and a salt (balpipe's code
     hash, and what else the result depends on). Arguments are fed by :func:`feed`: numbers,
-    strings, bytes, numpy arrays, lists, tuples, dicts (in their order), sets, enums, dataclasses,
-    pydantic models (their JSON), and functions: a named function by its module and name (its
-    code is balpipe's, which the salt covers), its defaults and the values its closure captured.
+    strings, bytes, numpy arrays, lists, tuples, dicts (in their order), sets, enums, dataclasses
+    (their fields, less those marked :data:`MEMO`), pydantic models (their JSON), and functions:
+    a named function by its module and name (its code is balpipe's, which the salt covers), its
+    defaults and the values its closure captured.
     Anything else (a lambda, an arbitrary object) is :class:`Unhashable`: such a result is
     computed, never cached.
 
@@ -19,6 +21,12 @@ Entries
     written atomically (:func:`balpipe.fsutil.write_file_atomic`); a symlink anywhere on the way
     is never followed. :meth:`Store.prune` removes the spec's entries that its build did not use;
     :func:`prune_specs` the folders of specs that have no page any more.
+
+Results as objects
+    :class:`PickleStore` keeps any picklable result (a pickle is exact: the same floats, arrays,
+    dicts in their order); :class:`Active` is the store a build makes active for one kind, and
+    :meth:`Active.run` computes a function's result through it, holding a lock per key (another
+    process that needs the same key waits for it, then reads it).
 """
 
 from __future__ import annotations
@@ -27,11 +35,13 @@ import dataclasses
 import enum
 import hashlib
 import os
+import pickle
 import re
 import struct
 import types
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Callable, ClassVar
+from typing import Any, Callable, ClassVar, Iterator
 
 import numpy as np
 
@@ -39,6 +49,12 @@ from .fsutil import TMP_MARK, remove_path, write_file_atomic
 
 #: the caches' folder in the output folder; never part of the published site
 CACHE_DIR = ".cache"
+#: a dataclass field's metadata key marking a memo (``field(metadata={MEMO: True})``): what the
+#: object computed and kept for itself (a law's solutions per time grid), not an input; left out
+#: of keys, so that a key does not depend on what was evaluated before it was asked for
+MEMO = "balpipe_memo"
+#: a kind's folder of lock files (:meth:`PickleStore.lock`); :func:`prune_specs` leaves it alone
+LOCKS = ".locks"
 
 
 class Unhashable(TypeError):
@@ -97,7 +113,7 @@ def feed(h, x: Any) -> None:
     elif dataclasses.is_dataclass(x) and not isinstance(x, type):
         cls = type(x)
         h.update(b"C" + f"{cls.__module__}.{cls.__qualname__}".encode() + b"\0")
-        fields = dataclasses.fields(x)
+        fields = [f for f in dataclasses.fields(x) if not f.metadata.get(MEMO)]
         h.update(struct.pack("<Q", len(fields)))
         for f in fields:
             h.update(f.name.encode() + b"=")
@@ -294,6 +310,106 @@ class Store:
                     pass
 
 
+@dataclasses.dataclass
+class PickleStore(Store):
+    """A store whose values are Python objects, kept as pickles (``.pickle`` entries): a value
+    read back is equal to the one stored, bit for bit (floats, numpy arrays, dicts in their
+    order). A subclass names the :attr:`KIND` and the :attr:`HEADER`."""
+
+    SUFFIX: ClassVar[str] = ".pickle"
+
+    held: int = dataclasses.field(default=0, repr=False)  # locks this process holds (:meth:`lock`)
+
+    def get(self, k: str) -> Any | None:
+        """The value of key ``k`` (:meth:`Store.get_bytes`: this spec's entry or another
+        spec's), or None."""
+        data = self.get_bytes(k)
+        if data is None:
+            return None
+        try:
+            return pickle.loads(data)
+        except Exception:  # an entry of an older layout: computed again
+            return None
+
+    def put(self, k: str, value: Any) -> None:
+        try:
+            data = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+        except Exception:  # a value that cannot be pickled is simply not kept
+            return
+        self.put_bytes(k, data)
+
+    @contextmanager
+    def lock(self, k: str) -> Iterator[None]:
+        """Held while key ``k`` is looked up and, if missing, computed: another process that
+        needs it waits, then finds it. One lock file per first two hex digits of the key (at
+        most 256 files, in ``<kind>/.locks/``); a computation that asks for another key while
+        this process holds a lock takes none (two processes never wait on each other); without
+        a lockable folder, no lock (each process computes)."""
+        import fcntl
+
+        folder = safe_folder(self.out, (CACHE_DIR, self.KIND, LOCKS), create=True) if not self.held else None
+        fd = None
+        if folder is not None:
+            try:
+                fd = os.open(folder / k[:2], os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o666)
+                fcntl.flock(fd, fcntl.LOCK_EX)
+            except OSError:
+                if fd is not None:
+                    os.close(fd)
+                fd = None
+        self.held += 1
+        try:
+            yield
+        finally:
+            self.held -= 1
+            if fd is not None:
+                fcntl.flock(fd, fcntl.LOCK_UN)
+                os.close(fd)
+
+
+class Active:
+    """The :class:`PickleStore` of one kind that the running build computes through (None:
+    everything computed, no cache). One per kind, a module global, so that forked workers
+    inherit it. ``environment()``: what the kind's results depend on besides balpipe's code and
+    a function's arguments (the versions of the libraries that compute them), part of every key."""
+
+    def __init__(self, environment: Callable[[], str]) -> None:
+        self.store: PickleStore | None = None
+        self.environment = environment
+
+    @contextmanager
+    def using(self, store: PickleStore | None) -> Iterator[PickleStore | None]:
+        """Compute the block's results through ``store`` (None: compute them all, no cache)."""
+        previous, self.store = self.store, store
+        try:
+            yield store
+        finally:
+            self.store = previous
+
+    def used(self) -> set[str]:
+        """The keys the active store was asked for in this process (a forked worker's go back to
+        the parent with its results: :meth:`mark_used`)."""
+        return set(self.store.used) if self.store is not None else set()
+
+    def mark_used(self, keys: set[str]) -> None:
+        if self.store is not None:
+            self.store.used |= keys
+
+    def run(self, fn: Callable[..., Any], args: tuple, kwargs: dict) -> Any:
+        """``fn(*args, **kwargs)`` from the active store when it holds it (the object computed
+        then, unpickled), else computed and stored. Without a store, or for inputs that cannot be
+        keyed (:class:`Unhashable`): computed."""
+        store = self.store
+        if store is None:
+            return fn(*args, **kwargs)
+        try:
+            k = key(fn, args, kwargs, f"{store.salt}\0{self.environment()}")
+        except Unhashable:
+            return fn(*args, **kwargs)
+        with store.lock(k):
+            return store.serve(k, lambda: fn(*args, **kwargs))
+
+
 def prune_specs(out: Path, pages: set[str], kind: str) -> None:
     """Remove the ``kind`` cache folders of specs that have no page folder in ``out`` any more
     (a spec deleted or renamed), keeping those of ``pages`` (this build's specs)."""
@@ -307,7 +423,7 @@ def prune_specs(out: Path, pages: set[str], kind: str) -> None:
     for e in entries:
         page = out / e.name
         if e.name.startswith("."):
-            continue  # the cache's own files (the simulations' locks)
+            continue  # the cache's own files (the locks)
         if e.name not in pages and not (page.is_dir() and not page.is_symlink()):
             try:
                 remove_path(e)

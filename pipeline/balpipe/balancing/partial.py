@@ -10,7 +10,8 @@ largest of its per-motion measures (:mod:`.partial_motions`).
 
 Stages: ``unbalanced``, ``partial`` (the optimum's parts added). The details for results.json hold
 the objective achieved, each term, the active constraints, the budget's sensitivity (the dual
-value: d objective / d mass budget), the fronts and, per motion, the terms, caps and peaks.
+value: d objective / d mass budget), the fronts (read from the build's cache when their inputs
+did not change: :mod:`balpipe.balance_cache`) and, per motion, the terms, caps and peaks.
 
 Requests that cannot be met are located errors before any stage is analysed: a region outside
 its link (farther than :data:`REACH` x the link's size from the link's frame origin), a non-convex
@@ -26,6 +27,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from .. import balance_cache
 from ..model import Model
 from ..notation import COMMON, ours, setting
 from ..spec_parts import SpecFieldError
@@ -228,7 +230,8 @@ def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None
         "motions": PMo.per_motion(motions, PMo.names(method), objective, caps, std, z),
     }
     if method.fronts is not None:
-        details["fronts"] = PF.compute(program, std, method.budget.mass, method.fronts.points, method.fronts.max_mass)
+        details["fronts"] = balance_cache.run(PF.fronts, maps, method.budget.inertia, std, method.budget.mass,
+                                              method.fronts.points, method.fronts.max_mass)
     params = [Parameter(f"{r['name']}.{k}", r[k], u, "cone programme (Clarabel)", f"{r['name']} on {r['body']}")
               for r in details["design"] for k, u in (("mass", "kg"), ("x", "m"), ("y", "m"), ("inertia", "kg m^2"))
               if k in r]

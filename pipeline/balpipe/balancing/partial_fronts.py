@@ -9,6 +9,10 @@ point re-solves without re-compiling):
 and the least added mass of complete balancing in the same regions along the analysed motion
 (the force, and the force and the moment together), where it exists: the loads set to zero as
 linear equations (:func:`.least_mass.independent_equations`), the added mass minimised.
+
+:func:`fronts` computes them from plain data (the load maps and the settings) on a programme of
+its own, so that a build reads them from its cache when those did not change
+(:mod:`balpipe.balance_cache`).
 """
 
 from __future__ import annotations
@@ -139,3 +143,13 @@ def compute(program: Program, terms: dict[str, Term], budget: float, n: int, max
     }
     program.mass_budget.value = float(budget)
     return out
+
+
+def fronts(maps: Maps, inertia_budget: float | None, terms: dict[str, Term], budget: float, n: int,
+           max_mass: float | None) -> dict:
+    """:func:`compute` on a new :class:`Program` of ``maps`` (the spec's motion's; ``terms`` may
+    span several motions) with ``inertia_budget``: a function of plain data (the maps, the
+    terms' load maps, the numbers), which :func:`balpipe.balance_cache.run` can key. Every
+    problem of :func:`compute` is a new one on the programme's variables, so a new programme
+    gives the numbers of the one the optimum was solved on."""
+    return compute(Program(maps, inertia_budget), terms, budget, n, max_mass)

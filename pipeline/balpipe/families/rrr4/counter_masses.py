@@ -39,6 +39,7 @@ from . import conditions as cond
 from . import finder as generic
 from . import topologies as topologies
 from .placement import realise
+from ... import balance_cache
 from ...balancing.base import BalanceResult, Parameter, Stage
 from ...balancing.conditions import clarity_text
 from ...engine import analyse
@@ -312,14 +313,19 @@ def design_loads(designs: list[topologies.Design], rows: list[dict], stages: lis
     ref = load_reference(base.stage.model, an0).force
     out = []
     for d, row in zip(designs, rows, strict=True):
-        an = analyse(d.model, an0.t, an0.gravity, an0.moment_point)
-        peak = an.max_inertial_force
+        peak = balance_cache.run(peak_inertial_force, d.model, an0.t, an0.gravity, an0.moment_point)
         ratio = peak / ref if ref > 0 else 0.0
         row["peak_inertial_force"] = peak
         row["force_ratio"] = ratio
         out.append(Parameter(f"peak_force_ratio_{topologies.tag(d.figure)}", ratio, "", "engine",
                              f"peak inertial shaking force of {topologies.whose(d.figure)} / the reference force"))
     return out
+
+
+def peak_inertial_force(model: Model, t: np.ndarray, gravity, moment_point) -> float:
+    """The peak inertial shaking force of ``model`` analysed by the engine on ``t`` (a function of
+    plain data: :func:`design_loads` reads it from the build's cache, :mod:`balpipe.balance_cache`)."""
+    return analyse(model, t, gravity, moment_point).max_inertial_force
 
 
 def finder_grid(model: Model, samples: int = 9) -> np.ndarray:
@@ -338,8 +344,8 @@ def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Mo
     four = len(legs) == 4
     g = geometry(mech) if four else None
     special = page and four and mech.kinematics != "general" and not platform_rotates(model)
-    found = generic.check(model, finder_grid(model), cond.eq17(g) if four else [],
-                          cond.special(g, mech.kinematics) if special else None)
+    found = balance_cache.run(generic.check, model, finder_grid(model), cond.eq17(g) if four else [],
+                              cond.special(g, mech.kinematics) if special else None)  # the build's cache
     gen = found.general
     src = "counted from the momentum at reachable states"
     params += [

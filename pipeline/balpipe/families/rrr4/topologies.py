@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .template import mass_parameters
+from ... import balance_cache
 from ...model import Model
 from . import conditions as cond
 from .placement import realise
@@ -178,7 +179,7 @@ def design(model: Model, g: cond.Geometry, kept: tuple[str, ...], proximal: floa
            assumed: str) -> Design:
     """The bodies ``kept`` as built, one counter-mass on every other link (:func:`solve_counter_masses`)."""
     links = [b for b in BODIES[:-1] if b not in kept]
-    targets = solve_counter_masses(model, g, links, proximal, distal)
+    targets = balance_cache.run(solve_counter_masses, model, g, links, proximal, distal)  # the build's cache
     return Design(figure, kept, realise_all(model, targets, proximal, distal, figure), assumed)
 
 

@@ -28,6 +28,7 @@ import numpy as np
 from pydantic import Field
 
 from ... import units
+from ...content_cache import MEMO
 from ...joint_laws import PoseJointLaw, body_point, dyad_rates
 from ...laws.drives import drive_laws, path_laws
 from ...model import FRAME, Attachment, Body, Driver, Law, Model, Revolute
@@ -349,13 +350,14 @@ def task_jacobian(chain: Chain, q: np.ndarray) -> np.ndarray:
 @dataclass(eq=False)
 class JointLaw(PoseJointLaw):
     """Joint ``index`` of a task-space motion, as a scalar law for a driver. The laws of one
-    motion share ``_cache``: one inverse-kinematics solution per time grid for every joint."""
+    motion share ``_cache``: one inverse-kinematics solution per time grid for every joint (a
+    memo, left out of the caches' keys: :data:`balpipe.content_cache.MEMO`)."""
 
     chain: Chain
     motion: TaskMotion
     mode: int
     index: int
-    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+    _cache: dict = field(default_factory=dict, repr=False, compare=False, metadata={MEMO: True})
 
     @property
     def coordinate(self) -> int:

@@ -1,0 +1,66 @@
+"""The balancing's numerical searches cached by content (issue 23, "Fast"): a spec rebuilt after
+a change that no search reads (a comment, the description, another design) does not search again.
+
+What is cached is a pure function of plain data, called through :func:`run`, never a whole
+balancing result (its stages hold models whose motion laws are closures): a partial balancing's
+Pareto fronts (:func:`balpipe.balancing.partial_fronts.fronts`, from the load maps, the budget and
+the fronts' settings: about 90 % of its time), and the 4-RRR's searches (the counter-masses of a
+drawn topology, :func:`balpipe.families.rrr4.topologies.solve_counter_masses`; the condition
+finder's check, :func:`balpipe.families.rrr4.finder.check`; a design's peak shaking force,
+:func:`balpipe.families.rrr4.counter_masses.peak_inertial_force`). The key
+(:func:`balpipe.content_cache.key`) is the function's name and arguments, balpipe's code hash
+and the versions of the libraries that compute the numbers (numpy, scipy, cvxpy, Clarabel); the
+result is kept as a pickle in ``<out>/.cache/balance/<slug>/<sha256>.pickle``, looked up in the
+spec's folder, then in the other specs' of the same output folder, with the checksum, atomic
+writes, refusal of symlinks, pruning and per-key locks of :class:`balpipe.content_cache.PickleStore`.
+
+A served result is the object that was computed, unpickled: the same bits. ``balpipe build``
+uses the cache (with ``--no-sim`` too: the balancing is the same); ``--force`` computes every
+search again and rewrites its entry; ``--scheduler``, ``balpipe check``, ``sweep`` and ``diff``
+do not use it (no store active: :func:`run` computes).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import Any, Callable, ClassVar
+
+from . import content_cache
+
+BALANCE = "balance"
+#: the libraries whose versions are part of every key (they produce the numbers)
+LIBRARIES = ("numpy", "scipy", "cvxpy", "clarabel")
+
+
+class Store(content_cache.PickleStore):
+    """The balancing cache of one spec (:class:`balpipe.content_cache.PickleStore`, entries
+    ``.pickle``, locks in ``balance/.locks/``); ``computed``: the searches run."""
+
+    KIND: ClassVar[str] = BALANCE
+    HEADER: ClassVar[bytes] = b"balpipe-balance-1 "
+
+
+@lru_cache(maxsize=1)
+def environment() -> str:
+    """The installed versions of :data:`LIBRARIES`, read from their metadata (cvxpy is not
+    imported for a spec that does not solve a cone programme)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    def installed(name: str) -> str:
+        try:
+            return version(name)
+        except PackageNotFoundError:
+            return "-"
+
+    return "\0".join(f"{name} {installed(name)}" for name in LIBRARIES)
+
+
+#: the store of :func:`using`: a module global, as the simulations' (:mod:`balpipe.sim_cache`)
+ACTIVE = content_cache.Active(environment)
+using = ACTIVE.using  # compute the block's searches through a store (None: compute them all, no cache)
+
+
+def run(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+    """``fn(*args, **kwargs)``, a balancing search, from the active store when it holds it, else
+    computed and stored. Without a store, or for inputs that cannot be keyed: computed."""
+    return ACTIVE.run(fn, args, kwargs)
