@@ -475,10 +475,11 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
         if any(not o.skipped for o in built):  # the caches of specs that have no page any more
             from . import content_cache
             from .balance_cache import BALANCE
-            from .draw.cache import prune_specs
+            from .draw.cache import FIGURES
+            from .sim_cache import SIMS
 
-            prune_specs(opts.out, {o.slug for o in built})
-            content_cache.prune_specs(opts.out, {o.slug for o in built}, BALANCE)
+            for kind in (FIGURES, SIMS, BALANCE):
+                content_cache.prune_specs(opts.out, {o.slug for o in built}, kind)
         earlier = earlier_pages(opts.out, {o.slug for o in built}, page_hash)
         key = site_key(opts.out, built) if not earlier else ""
         if not (key and _site_is_current(opts.out, key)):

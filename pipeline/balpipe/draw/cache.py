@@ -92,15 +92,6 @@ class Store(content_cache.Store):
         self.put_bytes(k, svg.encode("utf-8"))
 
 
-def prune_specs(out: Path, pages: set[str]) -> None:
-    """Remove the figure and simulation caches of specs that have no page folder in ``out`` any
-    more (a spec deleted or renamed), keeping those of ``pages`` (this build's specs)."""
-    from ..sim_cache import SIMS
-
-    for kind in (FIGURES, SIMS):
-        content_cache.prune_specs(out, pages, kind)
-
-
 @contextmanager
 def using(store: Store | None) -> Iterator[Store | None]:
     """Draw the figures of the block through ``store`` (None: draw them all, no cache)."""
