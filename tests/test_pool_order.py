@@ -85,3 +85,14 @@ def test_a_ctrl_c_during_the_pools_start_stops_its_workers_at_once(monkeypatch):
     with pytest.raises(KeyboardInterrupt):
         list(pool.in_order(_sleep, [30.0, 30.0], 2))
     assert time.perf_counter() - start < 10.0
+
+
+def test_the_pools_fork_on_linux_whatever_pythons_default():
+    """Workers inherit what the parent loaded (Python 3.14 defaults to forkserver on Linux)."""
+    import sys
+
+    import pytest
+
+    if sys.platform != "linux":
+        pytest.skip("fork is the start method on Linux only")
+    assert pool._context().get_start_method() == "fork"

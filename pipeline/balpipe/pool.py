@@ -73,7 +73,7 @@ def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any,
     from concurrent.futures import ProcessPoolExecutor  # multiprocessing: only when there is a pool
 
     start = sorted(range(len(items)), key=lambda i: -cost(items[i])) if cost is not None else range(len(items))
-    pool = ProcessPoolExecutor(max_workers=min(jobs, len(items)), initializer=worker_init)
+    pool = ProcessPoolExecutor(max_workers=min(jobs, len(items)), mp_context=_context(), initializer=worker_init)
     try:
         with sigint_held():  # the workers are forked here; a Ctrl-C meanwhile arrives as it ends
             submitted = {i: pool.submit(fn, items[i], *args) for i in start}
@@ -83,6 +83,16 @@ def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any,
         stop_now(pool)
         raise
     pool.shutdown()
+
+
+def _context() -> Any:
+    """The pools' start method: fork on Linux, where the workers inherit the modules and schemas
+    already loaded (Python 3.14 makes forkserver the default there, which would load them again
+    in every worker); the platform's default elsewhere (macOS and Windows spawn)."""
+    import multiprocessing
+    import sys
+
+    return multiprocessing.get_context("fork" if sys.platform == "linux" else None)
 
 
 def stop_now(pool: Any) -> None:
