@@ -183,15 +183,22 @@
     host.uplots = f.plots;  // the drawn plots, for the console and the browser tests
     all.push(f);
     if (!d.x) figures.push(f);
-    // follow the host's width (the window, or a collapsed section opened): resize after the
-    // observer's callback, never inside it
-    let last = host.clientWidth, pending = 0;
-    new ResizeObserver(() => {
-      if (host.clientWidth === last || host.clientWidth === 0 || printing) return;
-      last = host.clientWidth;
+    // follow the host's width (the window, or a collapsed section opened), and take each panel's
+    // width once the page is laid out (a plot drawn while the layout was not final, narrower
+    // than its panel, is widened when the page has loaded): resize after the observer's
+    // callback, never inside it, only the plots whose panel's width differs from theirs
+    let pending = 0;
+    const refit = () => {
+      if (host.clientWidth === 0 || printing) return;
       cancelAnimationFrame(pending);
-      pending = requestAnimationFrame(() => { f.plots.forEach(u => u.setSize({ width: width(u.root.parentNode), height: HEIGHT })); follow(f); });
-    }).observe(host);
+      pending = requestAnimationFrame(() => {
+        const stale = f.plots.filter(u => !u.root.parentNode.hidden && u.width !== width(u.root.parentNode));
+        stale.forEach(u => u.setSize({ width: width(u.root.parentNode), height: HEIGHT }));
+        if (stale.length) follow(f);
+      });
+    };
+    new ResizeObserver(refit).observe(host);
+    if (document.readyState === "complete") refit(); else addEventListener("load", refit);
   });
   // printing: every panel drawn again for the paper (see the top), with the screen plot's curves
   // shown or hidden and its time range (a zoom), no cursor; a legend without values
