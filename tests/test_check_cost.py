@@ -39,6 +39,9 @@ def test_declared_costs_order_the_repository_specs():
     assert max(costs, key=costs.get) == PAPER003.name
     assert check_cost(PAPER003) > check_cost(RRR4) > check_cost(PLAIN_SPEC) == PLAIN
     assert registry.METHODS["com_motion_planning"].check_cost > registry.TEMPLATES["rrr4"].check_cost > 0
+    # a partial balancing solves its optimum's cone programme in check too
+    assert check_cost(SPECS / "partial_offset_slider_crank.yaml") > check_cost(PLAIN_SPEC)
+    assert check_cost(PAPER003) > check_cost(SPECS / "partial_paper000_rpr3.yaml")
 
 
 @pytest.mark.parametrize("text", ["mechanism: [unclosed\n", "mechanism: {template: nothing_known}\n",
