@@ -98,17 +98,63 @@ def test_sweep_on_an_unreachable_scheduler_is_a_usage_error_told_at_once(tmp_pat
     assert time.perf_counter() - start < 15.0 and not (tmp_path / "sw").exists()
 
 
-def test_the_probe_tells_refused_from_listening_and_leaves_other_protocols_to_dask():
+def test_the_probe_tells_a_scheduler_from_a_silent_service_and_leaves_other_protocols_to_dask():
+    """A dask scheduler greets a new connection first: a service that greets passes the probe, one
+    that accepts and says nothing (where dask's client would wait for ever) or closes at once
+    does not, nor a refused port."""
     import socket
+    import threading
 
     from balpipe.cluster import unreachable
 
-    srv = socket.socket()
-    srv.bind(("127.0.0.1", 0))
-    srv.listen()
-    port = srv.getsockname()[1]
-    assert unreachable(f"tcp://127.0.0.1:{port}") is None and unreachable(f"127.0.0.1:{port}") is None
+    def serve(greet: bytes | None) -> tuple[socket.socket, int]:
+        srv = socket.socket()
+        srv.bind(("127.0.0.1", 0))
+        srv.listen()
+
+        def answer() -> None:
+            conn, _ = srv.accept()
+            if greet is None:
+                conn.close()  # closes at once
+            else:
+                conn.sendall(greet)
+                time.sleep(1.0)
+                conn.close()
+
+        if greet != b"":
+            threading.Thread(target=answer, daemon=True).start()
+        return srv, srv.getsockname()[1]
+
+    srv, port = serve(b"\x01handshake")
+    assert unreachable(f"tcp://127.0.0.1:{port}", timeout=2.0) is None
+    srv.close()
+    srv, port = serve(b"")  # listens, never accepts nor writes
+    assert "sent no dask handshake within 0.5 s" in unreachable(f"127.0.0.1:{port}", timeout=0.5)
+    srv.close()
+    srv, port = serve(None)
+    assert "closed the connection at once" in unreachable(f"tcp://127.0.0.1:{port}", timeout=2.0)
     srv.close()
     assert unreachable(f"tcp://127.0.0.1:{port}") == "Connection refused"
     assert unreachable("inproc://x") is None and unreachable("tls://127.0.0.1:9") is None
     assert "out of range" in unreachable("tcp://127.0.0.1:99999")
+
+
+def test_a_build_on_a_service_that_is_no_scheduler_is_a_usage_error_not_a_hang(tmp_path):
+    """dask's client waits for ever for the handshake of a service that accepts and says nothing;
+    balpipe says what listens there in the probe's 5 s."""
+    import socket
+
+    pytest.importorskip("distributed")
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen()
+    port = srv.getsockname()[1]
+    start = time.perf_counter()
+    try:
+        r = balpipe("build", str(ROOT / "specs" / SPECS[0]), "-o", str(tmp_path / "a"), "--no-sim",
+                    "--scheduler", f"tcp://127.0.0.1:{port}")
+    finally:
+        srv.close()
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    assert f"cannot reach the dask scheduler at tcp://127.0.0.1:{port}: a service listens there" in r.stderr
+    assert time.perf_counter() - start < 30.0
