@@ -205,3 +205,30 @@ def test_a_search_inside_a_locked_one_takes_no_second_lock(tmp_path):
     if p.is_alive():
         p.kill()
     assert p.exitcode == 0
+
+
+def test_paper003s_phi_optimisation_is_read_on_a_rebuild(tmp_path, stored, monkeypatch):
+    """paper 003's phi optimisation (Nelder-Mead per trajectory, ~2 s) is a search of the cache:
+    a rebuild after a comment optimises nothing and writes the same page; the note still counts
+    the objective's evaluations (read with the searches)."""
+    from balpipe.families.serial_arm import com_planning as CP
+
+    runs = []
+    real = CP.Planner.optimise_phi
+    monkeypatch.setattr(CP.Planner, "optimise_phi", lambda self, *a: runs.append(1) or real(self, *a))
+    text = (ROOT / "specs" / "paper003_com_planning.yaml").read_text()
+    text = replaced(replaced(text, "trajectories: [P1P13, P2P12, P3P11, P4P10, P5P9, P15P7, P14P8, P13P9]",
+                             "trajectories: [P1P13, P15P7]"), "samples: 501", "samples: 101")
+    specs = write_spec(tmp_path / "specs", text, "p3")
+    out = tmp_path / "out"
+    run(specs, out)
+    assert len(runs) == 2 and len(stored) == 2  # one search per trajectory
+    runs.clear(), stored.clear()
+    write_spec(specs, text + "\n# a comment\n", "p3")
+    (o,) = run(specs, out)
+    assert not o.skipped and runs == [] and stored == []
+    results = (out / "p3" / "results.json").read_text()
+    assert "0 objective evaluations" not in results and " objective evaluations in all for 2 trajectories" in results
+    fresh = tmp_path / "fresh"
+    run(specs, fresh)
+    assert page(out, "p3") == page(fresh, "p3")

@@ -7,7 +7,8 @@ Pareto fronts (:func:`balpipe.balancing.partial_fronts.fronts`, from the load ma
 the fronts' settings: about 90 % of its time), and the 4-RRR's searches (the counter-masses of a
 drawn topology, :func:`balpipe.families.rrr4.topologies.solve_counter_masses`; the condition
 finder's check, :func:`balpipe.families.rrr4.finder.check`; a design's peak shaking force,
-:func:`balpipe.families.rrr4.counter_masses.peak_inertial_force`). The key
+:func:`balpipe.families.rrr4.counter_masses.peak_inertial_force`), and paper 003's phi
+optimisation (:func:`balpipe.families.serial_arm.com_planning.phi_search`). The key
 (:func:`balpipe.content_cache.key`) is the function's name and arguments, balpipe's code hash
 and the versions of the libraries that compute the numbers (numpy, scipy, cvxpy, Clarabel); the
 result is kept as a pickle in ``<out>/.cache/balance/<slug>/<sha256>.pickle``, looked up in the

@@ -30,7 +30,7 @@ engine analyses only the final stages (tests check that both agree to 1e-9).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -51,6 +51,7 @@ from .template import (
     tip_chain,
     with_joint_laws,
 )
+from ... import balance_cache
 from ...model import Law, Model
 from ...motion import PointToPoint, bang_bang, law_for, quintic
 from ...spec_parts import SpecFieldError
@@ -413,7 +414,8 @@ def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, s
         JointSolution(planner.tip, TaskMotion(tip_laws, "tip", path, name), mech.working_mode, t)
         JointSolution(planner.com, _com_motion(plan, bang_bang, T, PhiPolynomial(start[2], end[2], T), path),
                       plan.com_mode, t)
-        planner.optimise_phi(plan, path)
+        plan.phi_coefficients, plan.phi_peak_start, plan.phi_peak_best, plan.evaluations = balance_cache.run(
+            phi_search, model, mech, method, T, t, planner.gravity, planner.point, replace(plan), path)
         planner.ramp(plan, PhiPolynomial(start[2], end[2], T, plan.phi_coefficients), path)
         plan.models = planner.stages(plan, law_name, path)
         plans.append(plan)
@@ -445,6 +447,16 @@ def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, s
     # the main trajectory's stages first: the page's headline, design card and stage figures show it
     stages.sort(key=lambda s: s.group != main)
     return BalanceResult(params, stages, notes, derived=lambda results: derived(results, plans, T, m_total))
+
+
+def phi_search(model: Model, mech: SerialArmMechanism, method: ComMotionPlanning, T: float, t: np.ndarray,
+               gravity: tuple, point: tuple, plan: Plan, path: tuple) -> tuple[tuple[float, ...], float, float, int]:
+    """:meth:`Planner.optimise_phi` of one trajectory (``plan`` as :meth:`Planner.plan` made it,
+    updated here) as a function of plain data: what the build's balancing cache keys and keeps
+    (:mod:`balpipe.balance_cache`; about 2 s of paper 003's balancing). Returns phi's
+    coefficients, the peak moments at the start and at the optimum, and the evaluations."""
+    Planner(model, mech, method, T, t, gravity, point).optimise_phi(plan, path)
+    return plan.phi_coefficients, plan.phi_peak_start, plan.phi_peak_best, plan.evaluations
 
 
 def main_trajectory(method: ComMotionPlanning, trajectories: list) -> str:
@@ -496,7 +508,7 @@ def _method_note(method: ComMotionPlanning, planner: Planner, plans: list[Plan],
         f"coefficients); objective the peak |M| on the analysis grid ({len(planner.t)} samples), by the explicit "
         f"serial dynamics; scipy.optimize.minimize Nelder-Mead from {o.starts} starts (the 3-4-5 law and "
         f"{o.starts - 1} normal random points, sd {o.spread} rad, numpy default_rng({o.seed})), at most "
-        f"{o.max_evaluations} evaluations per start, xatol {o.tolerance}; {planner.calls} objective evaluations in "
+        f"{o.max_evaluations} evaluations per start, xatol {o.tolerance}; {sum(p.evaluations for p in plans)} objective evaluations in "
         f"all for {len(plans)} trajectories (benchmarks/bench_paper003.py times them). Case 3: the shortest ramps (bisection on "
         f"f) for which every joint's torque rate, by central differences on {method.rate_samples} samples and 64 "
         f"in each ramp, stays "
