@@ -70,15 +70,25 @@ def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any,
         for item in items:
             yield fn(item, *args)
         return
-    from concurrent.futures import ProcessPoolExecutor  # multiprocessing: only when there is a pool
-
     start = sorted(range(len(items)), key=lambda i: -cost(items[i])) if cost is not None else range(len(items))
-    pool = ProcessPoolExecutor(max_workers=min(jobs, len(items)), mp_context=_context(), initializer=worker_init)
-    try:
+    with _pool(min(jobs, len(items)), _context()) as pool:
         with sigint_held():  # the workers are forked here; a Ctrl-C meanwhile arrives as it ends
             submitted = {i: pool.submit(fn, items[i], *args) for i in start}
         for i in range(len(items)):
             yield submitted[i].result()
+
+
+@contextmanager
+def _pool(workers: int, context: Any) -> Iterator[Any]:
+    """A process pool of ``workers`` started by ``context``, its workers set up by
+    :func:`worker_init` (submit inside :func:`sigint_held`: they are forked then); on any
+    exception in the block (Ctrl-C included) they are stopped at once (:func:`stop_now`), else
+    shut down once their work is done. multiprocessing is imported only when there is a pool."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=worker_init)
+    try:
+        yield pool
     except BaseException:
         stop_now(pool)
         raise
@@ -140,25 +150,18 @@ def forked(tasks: list[tuple[Callable, tuple]], workers: int, shared: Any) -> li
         return [fn(*a, shared) for fn, a in tasks]
     import gc
     import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
 
     global _SHARED
     _SHARED = shared
     gc.freeze()  # the parent's objects out of the children's collections: no copy of their pages
-    pool = ProcessPoolExecutor(max_workers=min(workers, len(tasks)), mp_context=multiprocessing.get_context("fork"),
-                               initializer=worker_init)
     try:
-        with sigint_held():  # the workers are forked here
-            futures = [pool.submit(_call_shared, fn, a) for fn, a in tasks]
-        out = [f.result() for f in futures]
-    except BaseException:
-        stop_now(pool)
-        raise
+        with _pool(min(workers, len(tasks)), multiprocessing.get_context("fork")) as pool:
+            with sigint_held():  # the workers are forked here
+                futures = [pool.submit(_call_shared, fn, a) for fn, a in tasks]
+            return [f.result() for f in futures]
     finally:
         _SHARED = None
         gc.unfreeze()
-    pool.shutdown()
-    return out
 
 
 def _call_shared(fn: Callable, args: tuple) -> Any:
