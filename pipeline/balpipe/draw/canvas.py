@@ -25,7 +25,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .layout import PAD, text_metrics
+from .layout import PAD, lines_size, text_metrics
 
 FONT = "'DejaVu Sans', 'Bitstream Vera Sans', sans-serif"
 TICK = 3.5  # tick length and label pad (pt), matplotlib's defaults
@@ -197,18 +197,13 @@ class Panel:
         dx, dy = (hi[0] - lo[0]) or 1.0, (hi[1] - lo[1]) or 1.0
         return (lo[0] - MARGIN * dx, lo[1] - MARGIN * dy, hi[0] + MARGIN * dx, hi[1] + MARGIN * dy)
 
-    def _text(self, text: str, size: float) -> tuple[float, float]:
-        lines = text.split("\n")
-        sizes = [text_metrics(line or " ", size)[:2] for line in lines]
-        return max(w for w, _ in sizes), sum(h for _, h in sizes) + 0.2 * size * (len(lines) - 1)
-
     def _margins(self, xt: list[float], yt: list[float], xstep: float, ystep: float) -> tuple[float, float, float, float]:
         """Left, right, bottom, top: what sticks out of the box (pt)."""
         yw = max([text_metrics(tick_label(v, ystep), self.tick_size)[0] for v in yt] + [0.0])
         xh = max([text_metrics(tick_label(v, xstep), self.tick_size)[1] for v in xt] + [0.0])
-        left = yw + 2 * TICK + (self._text(self.ylabel, self.label_size)[1] + 4.0 if self.ylabel else 0.0)
-        bottom = xh + 2 * TICK + (self._text(self.xlabel, self.label_size)[1] + 4.0 if self.xlabel else 0.0)
-        top = self._text(self.title, self.title_size)[1] + 6.0 if self.title else 0.0
+        left = yw + 2 * TICK + (lines_size(self.ylabel, self.label_size)[1] + 4.0 if self.ylabel else 0.0)
+        bottom = xh + 2 * TICK + (lines_size(self.xlabel, self.label_size)[1] + 4.0 if self.xlabel else 0.0)
+        top = lines_size(self.title, self.title_size)[1] + 6.0 if self.title else 0.0
         right = 0.5 * text_metrics(tick_label(xt[-1], xstep), self.tick_size)[0] if xt else 0.0
         return left, right, bottom, top
 

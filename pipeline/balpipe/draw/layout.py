@@ -39,8 +39,10 @@ def _renderer():
 def text_size(text: str, size: float, math: bool = False) -> tuple[float, float]:
     """Width and height (pt) of ``text`` in DejaVu Sans at ``size`` pt, as matplotlib lays it out
     (``math``: as mathtext)."""
+    if not math:
+        return text_metrics(text, size)[:2]
     prop = FontProperties(family="DejaVu Sans", size=size)
-    w, h, _ = _renderer().get_text_width_height_descent(text, prop, ismath=math)
+    w, h, _ = _renderer().get_text_width_height_descent(text, prop, ismath=True)
     return float(w), float(h)
 
 
@@ -57,13 +59,19 @@ def _points(size) -> float:
     return float(FontProperties(size=size).get_size_in_points())
 
 
+def lines_size(text: str, size: float) -> tuple[float, float]:
+    """Width and height (pt) of a text of one or more lines shown literally: the widest line,
+    the lines' heights and matplotlib's spacing of 0.2 font sizes between them."""
+    lines = text.split("\n")
+    sizes = [text_size(line or " ", size) for line in lines]
+    return max(w for w, _ in sizes), sum(h for _, h in sizes) + 0.2 * size * (len(lines) - 1)
+
+
 def _measure(text: str, size: float) -> tuple[float, float]:
     """Width and height (pt) of one text as drawn (mathtext between '$' measured as such)."""
     if text.count("$") - text.count("\\$") >= 2:
         return text_size(text, size, math=True)
-    lines = text.split("\n")
-    sizes = [text_size(line or " ", size) for line in lines]
-    return max(w for w, _ in sizes), sum(h for _, h in sizes) + 0.2 * size * (len(lines) - 1)
+    return lines_size(text, size)
 
 
 def _tick_texts(axis) -> tuple[list[str], str]:
