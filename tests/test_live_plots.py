@@ -296,3 +296,86 @@ def test_each_panel_carries_its_round_off_floor(study):
     data = LV.data(LP.loads(_stages(study)))
     force = next(p for p in data["panels"] if p["key"] == "F")
     assert force["key"] == "F" and force["floor"] > 0
+
+
+def _live(html: str, name: str) -> dict:
+    """The JSON of the live figure ``#live-<name>`` in ``html`` (no static SVG beside it)."""
+    assert html.startswith(f'<div class="live" id="live-{name}"><noscript>') and "<svg" not in html
+    start = html.index(f'data-live="live-{name}">') + len(f'data-live="live-{name}">')
+    return json.loads(html[start:html.rindex("</script>")])
+
+
+def _figure(st, title: str) -> str:
+    return next(body for t, body, _ in st.extra_figures() if t == title)
+
+
+def test_the_prismatic_forces_are_live_on_log_axes_with_the_unbounded_samples_left_out(studies):
+    """The 3-RPR's axial forces of prismatic actuators (the family's own figure): a log panel per
+    leg, the unbalanced stage thin black and the last stage thick grey, |f_i| of
+    ``prismatic_equivalent`` at the kept samples; no value (null) where a force is unbounded (NaN,
+    at the parallel singularity of phi = 0) or zero."""
+    from balpipe.families.rpr3 import figures as F
+    from balpipe.families.rpr3.template import pose_of, prismatic_equivalent
+
+    st = studies("paper000_rpr3_idler_loop.yaml")
+    data = _live(_figure(st, "Axial forces that prismatic actuators would need"), "rpr3-prismatic")
+    assert [(p["key"], p["log"]) for p in data["panels"]] == [("leg1", True), ("leg2", True), ("leg3", True)]
+    assert data["grid"] is True
+    last = [s for s in st.stages if ":" not in s.stage.name][-1]
+    pose = pose_of(st.unbalanced.stage.model)
+    nulls = 0
+    for series, s, style in zip(data["series"], (st.stages[0], last), F.PRISMATIC_STYLES):
+        assert series["label"] == s.stage.label
+        assert {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(style)
+        an = s.analysis
+        f = np.abs(prismatic_equivalent(st.spec.mechanism, pose, an.t,
+                                        np.stack([an.efforts[f"theta{i}"] for i in (1, 2, 3)], axis=1)))
+        k = _kept(data, an.t)
+        for i in range(3):
+            shown = series["y"][f"leg{i + 1}"]
+            ok = np.isfinite(f[k, i]) & (f[k, i] > 0)
+            assert [v is None for v in shown] == list(~ok)
+            nulls += int(np.sum(~ok))
+            _close([v for v in shown if v is not None], f[k, i][ok])
+    assert nulls >= 6  # the singular first sample, a gap in every leg's curve of both stages
+    assert series["width"] > data["series"][0]["width"]  # the grey line is the thick one, drawn first
+    assert data["draw"][0] == 1
+
+
+def test_the_decoupled_arms_mass_matrix_along_the_motion_is_live(studies):
+    """Paper 002's mass matrix along the motion: panels D11, D12, D22, a curve per stage in its
+    line style of the page with the engine's joint-space mass matrix; the decoupled arm's D12 is 0
+    and its D11, D22 constant."""
+    from balpipe.balancing.base import style_index
+    from balpipe.engine.joint_space import mass_matrix
+
+    st = studies("paper002_decoupling.yaml")
+    data = _live(_figure(st, "Mass matrix along the motion"), "decoupling-mass")
+    assert [p["key"] for p in data["panels"]] == ["D11", "D12", "D22"]
+    by = {s.stage.name: s for s in st.stages}
+    for series, name in zip(data["series"], ("unbalanced", "decoupled")):
+        s = by[name]
+        assert series["label"] == s.stage.label
+        assert {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(style_index(st.stages, s))
+        M = mass_matrix(s.stage.model, s.analysis.t)[1]
+        k = _kept(data, s.analysis.t)
+        floor = {p["key"]: p["floor"] for p in data["panels"]}
+        for key, (i, j) in (("D11", (0, 0)), ("D12", (0, 1)), ("D22", (1, 1))):
+            _close(series["y"][key], M[k, i, j], floor[key])
+    decoupled = data["series"][1]["y"]
+    assert set(decoupled["D12"]) == {0.0} and len(set(decoupled["D11"])) == 1 and len(set(decoupled["D22"])) == 1
+    assert len(set(data["series"][0]["y"]["D12"])) > 1  # coupled before
+
+
+def test_the_five_bars_input_angles_are_live(studies):
+    """Paper 004's Figs. 8-9: theta1 and theta2 of the analysis (template.input_angles), a panel
+    each, at the kept samples."""
+    from balpipe.families.five_bar.template import input_angles
+
+    st = studies("paper004_five_bar.yaml")
+    data = _live(_figure(st, "Input angles (Figs. 8-9)"), "fivebar-angles")
+    assert [p["title"] for p in data["panels"]] == ["theta1 (rad)", "theta2 (rad)"]
+    an = st.stages[0].analysis
+    k = _kept(data, an.t)
+    for key, th in zip(("theta1", "theta2"), input_angles(an)):
+        _close(data["series"][0]["y"][key], th[k])

@@ -45,8 +45,14 @@ def _round(values, floor: float = 0.0) -> list[float | None]:
     panel's round-off ``floor`` (:func:`_floor`) as 0: the plot cannot tell it from 0 and the
     hover reads "0 (< tolerance)" either way, and a balanced stage's 1.23457e-13 costs 12 bytes
     a sample."""
-    return [(0.0 if abs(v) <= floor else float(f"{v + 0.0:.6g}")) if np.isfinite(v) else None
-            for v in np.asarray(values, dtype=float)]
+    a = np.asarray(values, dtype=float).ravel() + 0.0  # + 0.0: no "-0"
+    finite = np.isfinite(a)
+    out = np.zeros(a.shape)
+    kept = finite & (np.abs(a) > floor)
+    if kept.any():  # one format string for all, one parse (both correctly rounded): as float(f"{v:.6g}") each
+        out[kept] = np.array((("%.6g " * int(kept.sum())) % tuple(a[kept].tolist())).split(), dtype=float)
+    shown = out.tolist()
+    return shown if finite.all() else [v if ok else None for v, ok in zip(shown, finite.tolist())]
 
 
 ROUND_OFF = 1e-9  # of a panel's largest value: what the hover shows as 0 (< tolerance), as the tables do

@@ -9,8 +9,8 @@ from .template import gripper_path, input_angles, segment_distance
 
 
 def figures(study):
-    """Report figures of the template: the gripper path (Fig. 7) and the input angles (Figs. 8-9),
-    drawn through the figure cache (:mod:`balpipe.draw.cache`)."""
+    """Report figures of the template: the gripper path (Fig. 7, drawn through the figure cache,
+    :mod:`balpipe.draw.cache`) and the input angles (Figs. 8-9, drawn by the browser)."""
     from ...draw import cache
 
     first = study.stages[0]
@@ -30,7 +30,7 @@ def figures(study):
     th1, th2 = input_angles(an)
     yield (
         "Input angles (Figs. 8-9)",
-        cache.svg(angles_svg, an.t, th1, th2),
+        angles_html(an.t, th1, th2),
         "theta1 follows the motion law; theta2 follows it through gears 1', 5, 2' (theta2 - theta2i = "
         "U21 (theta1 - theta1i))." if coupled
         else f"Both inputs follow the inverse kinematics of the {'given' if on_path else 'straight'} path.",
@@ -58,15 +58,12 @@ def path_svg(C: np.ndarray, on_path: bool) -> str:
     return to_svg(fig, "fivebar-path")
 
 
-def angles_svg(t: np.ndarray, th1: np.ndarray, th2: np.ndarray) -> str:
-    """The two input angles over time, one panel each."""
-    from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
-    from ...draw.layout import fixed_layout
+def angles_html(t: np.ndarray, th1: np.ndarray, th2: np.ndarray) -> str:
+    """The two input angles over time ``t``, a panel each, in a black line; drawn by the browser
+    (:func:`balpipe.draw.live.html`, element ``#live-fivebar-angles``)."""
+    from ...draw import live
 
-    fig, axes = plt.subplots(1, 2, figsize=(8.4, 2.8))
-    for ax, th, name in ((axes[0], th1, "theta1"), (axes[1], th2, "theta2")):
-        ax.plot(t, th, color="black", linewidth=1.4)
-        ax.set_title(f"{name} (rad)", fontsize=9)
-        ax.set_xlabel("time (s)")
-    fixed_layout(fig)
-    return to_svg(fig, "fivebar-angles")
+    curves = live.Curves(t, [("input angles", {"theta1": th1, "theta2": th2})],
+                         [{"key": k, "title": f"{k} (rad)", "axis": f"{k} (rad)"} for k in ("theta1", "theta2")], [],
+                         styles=[{"color": "black", "linestyle": "-", "linewidth": 1.4}], grid=True)
+    return live.html("fivebar-angles", curves)

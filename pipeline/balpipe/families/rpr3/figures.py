@@ -66,18 +66,16 @@ def paper_figures(number: str, linkage: str, published_factor: float):
 
 
 def _prismatic_forces_figure(study):
-    from ...draw import cache
-
     mech = study.spec.mechanism
     pose = pose_of(study.unbalanced.stage.model)
     runs = []
     for s in (study.stages[0], _own(study)[-1]):
         an = s.analysis
         tau = np.stack([an.efforts[f"theta{i}"] for i in (1, 2, 3)], axis=1)
-        runs.append((s.stage.label, an.t, prismatic_equivalent(mech, pose, an.t, tau)))
+        runs.append((s.stage.label, prismatic_equivalent(mech, pose, an.t, tau)))
     return (
         "Axial forces that prismatic actuators would need",
-        cache.svg(prismatic_forces_svg, runs),
+        prismatic_forces_html(study.stages[0].analysis.t, runs),
         "The same motion driven by actuators at the prismatic pairs B_i instead of the revolutes A_i: "
         "J_p^T f = J_r^T tau (the same generalised force on the platform). Where the three leg lines meet "
         "in one point (a parallel singularity of prismatic actuation, at phi = 0 for a platform homothetic "
@@ -85,21 +83,23 @@ def _prismatic_forces_figure(study):
     )
 
 
-def prismatic_forces_svg(runs: list[tuple[str, np.ndarray, np.ndarray]]) -> str:
-    """|axial force| of each leg over time, one line per (stage label, t, forces (N, 3)):
-    the first solid black, the second thick grey (drawn through :mod:`balpipe.draw.cache`)."""
-    from ...draw.figures import plt, to_svg  # matplotlib only when a report is drawn
-    from ...draw.layout import fixed_layout
+#: the two runs' lines: the unbalanced stage thin black, the last stage thick grey
+PRISMATIC_STYLES = ({"color": "black", "linestyle": "-", "linewidth": 1.3},
+                    {"color": "0.6", "linestyle": "-", "linewidth": 2.2})
 
-    fig, axes = plt.subplots(1, 3, figsize=(10.5, 2.9), sharey=True)
-    for k, (label, t, f) in enumerate(runs):
-        for i, ax in enumerate(axes):
-            ax.semilogy(t, np.abs(f[:, i]), color=("black", "0.6")[k], linewidth=(1.3, 2.2)[k], label=label)
-            ax.set_title(f"|axial force| of leg {i + 1} (N)", fontsize=9)
-            ax.set_xlabel("time (s)")
-    axes[0].legend(fontsize=7)
-    fixed_layout(fig)
-    return to_svg(fig, "rpr3-prismatic")
+
+def prismatic_forces_html(t: np.ndarray, runs: list[tuple[str, np.ndarray]]) -> str:
+    """|axial force| of each leg over time ``t`` on logarithmic axes, a panel per leg, a line per
+    (stage label, forces (N, 3)) in :data:`PRISMATIC_STYLES`; drawn by the browser
+    (:func:`balpipe.draw.live.html`, element ``#live-rpr3-prismatic``), no value where a force
+    is unbounded (NaN) or zero."""
+    from ...draw import live
+
+    curves = live.Curves(t, [(label, {f"leg{i + 1}": np.abs(f[:, i]) for i in range(3)}) for label, f in runs],
+                         [{"key": f"leg{i + 1}", "title": f"|axial force| of leg {i + 1} (N)",
+                           "axis": f"|f{i + 1}| (N)", "log": True} for i in range(3)], [],
+                         styles=list(PRISMATIC_STYLES[:len(runs)]), grid=True)
+    return live.html("rpr3-prismatic", curves)
 
 
 def _factor_table(study, linkage: str) -> str:

@@ -68,9 +68,8 @@ def decoupling_figures(study):
         "(m_b, c_b from B, I_b); the numbers are computed from the stages' models.",
     )
     stages = [by["unbalanced"], by["decoupled"]]
-    rows = [(s.stage.label, style_index(study.stages, s), s.analysis.t, mass_matrix(s.stage.model, s.analysis.t)[1])
-            for s in stages]
-    yield ("Mass matrix along the motion", cache.svg(mass_matrix_svg, rows),
+    rows = [(s.stage.label, style_index(study.stages, s), mass_matrix(s.stage.model, s.analysis.t)[1]) for s in stages]
+    yield ("Mass matrix along the motion", mass_matrix_html(stages[0].analysis.t, rows),
            "Entries of the joint-space mass matrix computed by the engine from each stage's model "
            "(D = Vᵀ diag(m, m, I) V, V the body velocities per unit joint rate): the decoupled arm's is "
            "constant and diagonal.")
@@ -87,20 +86,20 @@ def decoupling_figures(study):
               if study.spec.analysis.gravity else "."))
 
 
-def mass_matrix_svg(rows: list[tuple]) -> str:
-    """D11, D12, D22 over time, one line per (stage label, style index, t, D (N, 2, 2))."""
-    from ...draw.figures import plt, style, to_svg  # matplotlib only when a report is drawn
-    from ...draw.layout import fixed_layout
+#: the mass matrix's panels: key, entry (row, column), title
+MASS_PANELS = (("D11", (0, 0), "D₁₁ (kg m²)"), ("D12", (0, 1), "D₁₂ (kg m²)"), ("D22", (1, 1), "D₂₂ (kg m²)"))
 
-    fig, axes = plt.subplots(1, 3, figsize=(9.6, 2.8))
-    for label, k, t, M in rows:
-        for ax, (i, j, name) in zip(axes, ((0, 0, "D₁₁"), (0, 1, "D₁₂"), (1, 1, "D₂₂"))):
-            ax.plot(t, M[:, i, j], label=label, **style(k))
-            ax.set_title(f"{name} (kg m²)", fontsize=9)
-            ax.set_xlabel("time (s)")
-    axes[0].legend(fontsize=7)
-    fixed_layout(fig)
-    return to_svg(fig, "decoupling-mass")
+
+def mass_matrix_html(t: np.ndarray, rows: list[tuple]) -> str:
+    """D11, D12, D22 over time ``t``, a panel each, a line per (stage label, style index, D (N, 2,
+    2)) in its stage's style; drawn by the browser (:func:`balpipe.draw.live.html`, element
+    ``#live-decoupling-mass``)."""
+    from ...draw import live
+
+    curves = live.Curves(t, [(label, {key: M[:, i, j] for key, (i, j), _ in MASS_PANELS}) for label, _, M in rows],
+                         [{"key": key, "title": title, "axis": title} for key, _, title in MASS_PANELS], [],
+                         styles=[k for _, k, _ in rows], grid=True)
+    return live.html("decoupling-mass", curves)
 
 
 def torque_acceleration_svg(runs: list[tuple], J: tuple[float, float]) -> str:
