@@ -379,3 +379,49 @@ def test_the_five_bars_input_angles_are_live(studies):
     k = _kept(data, an.t)
     for key, th in zip(("theta1", "theta2"), input_angles(an)):
         _close(data["series"][0]["y"][key], th[k])
+
+
+def test_paper_003s_other_trajectories_are_live_one_curve_per_case_in_its_style(studies):
+    """The trajectories Figs. 3-4 do not show: a pair of panels (|F|, M) per trajectory, a curve per
+    case with that trajectory's stage's values, in the case's line style, which is the same on
+    every trajectory (the style order of each trajectory's stages)."""
+    from balpipe.balancing.base import style_index
+    from balpipe.families.serial_arm.com_planning import CASES
+
+    st = studies("paper003_com_planning.yaml")
+    main = st.stages[0].stage.group
+    others = sorted({s.stage.group for s in st.stages} - {main})
+    data = _live(_figure(st, f"Shaking force and moment on the other {len(others)} trajectories"), "com-loads")
+    assert sorted(p["key"] for p in data["panels"]) == sorted(f"{q} {g}" for g in others for q in "FM")
+    labels = dict(CASES)
+    assert sorted(x["label"] for x in data["series"]) == sorted(labels.values())
+    for series in data["series"]:
+        case = next(key for key, label in labels.items() if label == series["label"])
+        for g in others:
+            s = next(x for x in st.stages if x.stage.name == f"{g}_{case}")
+            assert {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(style_index(st.stages, s))
+            k = _kept(data, s.analysis.t)
+            floor = {p["key"]: p["floor"] for p in data["panels"]}
+            _close(series["y"][f"F {g}"], np.linalg.norm(s.analysis.force, axis=1)[k], floor[f"F {g}"])
+            _close(series["y"][f"M {g}"], s.analysis.moment[k], floor[f"M {g}"])
+
+
+def test_paper_003s_optimised_orientation_is_live_from_each_plans_ends(studies):
+    """φ(t) of case 2 per trajectory and the 3-4-5 law, live: each trajectory's curve runs from its
+    plan's start orientation to its end orientation (degrees), in a colour of its own; the 3-4-5
+    law in the line style of the stage that uses it."""
+    from balpipe.balancing.base import style_index
+    from balpipe.families.serial_arm.com_planning import replan
+
+    st = studies("paper003_com_planning.yaml")
+    data = _live(_figure(st, "Optimised end-effector orientation φ"), "com-phi")
+    _, plans = replan(st.spec, {p.name: p.value for p in st.balance.parameters})
+    *trajectories, law = data["series"]
+    assert [x["label"] for x in trajectories] == [p.name for p in plans] and law["label"] == "3-4-5 law"
+    assert len({x["stroke"] for x in trajectories}) == len(plans)
+    for x, p in zip(trajectories, plans):
+        phi = x["y"]["phi"]
+        assert phi[0] == pytest.approx(np.degrees(p.start[2]), abs=1e-4) and phi[-1] == pytest.approx(np.degrees(p.end[2]), abs=1e-4)
+    main = st.stages[0].stage.group
+    uses = next(s for s in st.stages if s.stage.name == f"{main}_com_bang_bang")
+    assert {key: law[key] for key in ("stroke", "dash", "width")} == LV.line_style(style_index(st.stages, uses))

@@ -156,8 +156,6 @@ def _pct(x: float) -> str:
 
 def com_planning_figures(study):
     """Paper 003's figures: the peaks per trajectory, Figs. 2-4, the other trajectories, phi."""
-    from ...draw import cache
-
     params = _params(study)
     planner, plans = replan(study.spec, params)
     by = _main(study)
@@ -173,26 +171,23 @@ def com_planning_figures(study):
             for p in plans]
     phi5 = PhiPolynomial(plans[0].start[2], plans[0].end[2], planner.T)
     k345 = style_index(study.stages, by[_prefix(main) + "com_bang_bang"])
-    svg = cache.svg(phi_svg, t, phis, np.degrees(phi5(t)[0]), k345)
     method = study.spec.balancing
-    yield ("Optimised end-effector orientation φ", svg,
+    yield ("Optimised end-effector orientation φ", phi_html(t, phis, np.degrees(phi5(t)[0]), k345),
            f"φ(t) of case 2 per trajectory (degree {method.phi.degree}, ends fixed), and the 3-4-5 law it starts "
            "from, in the line style of the stage that uses it.")
 
 
-def phi_svg(t: np.ndarray, phis: list[tuple[str, np.ndarray]], phi345: np.ndarray, k345: int) -> str:
-    """φ (deg) over time per (trajectory, values), each in its colour, and the 3-4-5 law in the
-    line style ``k345`` of the stage that uses it."""
-    from ...draw.figures import legend_below, plt, style, to_svg  # matplotlib only when a report is drawn
+def phi_html(t: np.ndarray, phis: list[tuple[str, np.ndarray]], phi345: np.ndarray, k345: int) -> str:
+    """φ (deg) over time per (trajectory, values), each in its colour (:data:`TRAJECTORY_COLOURS`),
+    and the 3-4-5 law in the line style ``k345`` of the stage that uses it; drawn by the browser
+    (:func:`balpipe.draw.live.html`, element ``#live-com-phi``)."""
+    from ...draw import live
 
-    fig, ax = plt.subplots(figsize=(6.0, 3.0))
-    for k, (name, phi) in enumerate(phis):
-        ax.plot(t, phi, label=name, linewidth=1.0, color=TRAJECTORY_COLOURS[k % len(TRAJECTORY_COLOURS)])
-    ax.plot(t, phi345, label="3-4-5 law", **style(k345))
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel("φ (deg)")
-    legend_below(fig, ax, fontsize=7)  # under the axes: never over a curve
-    return to_svg(fig, "com-phi")
+    curves = live.Curves(t, [(name, {"phi": phi}) for name, phi in phis] + [("3-4-5 law", {"phi": phi345})],
+                         [{"key": "phi", "title": "", "axis": "φ (deg)"}], [],
+                         styles=[{"color": TRAJECTORY_COLOURS[k % len(TRAJECTORY_COLOURS)], "linestyle": "-",
+                                  "linewidth": 1.0} for k in range(len(phis))] + [k345])
+    return live.html("com-phi", curves)
 
 
 def _prefix(name: str) -> str:
@@ -273,45 +268,27 @@ def _figs_3_4(study, main: str, by: dict):
 
 
 def _other_trajectories(study, plans, by: dict) -> tuple[str, str, str]:
-    """|F| and M of every stage on the trajectories that Figs. 3-4 do not show, one row each."""
-    from ...draw import cache
+    """|F| and M of every stage on the trajectories that Figs. 3-4 do not show, a pair of panels
+    each; a curve per case, in the case's line style of this page (the same on every trajectory);
+    drawn by the browser (:func:`balpipe.draw.live.html`, element ``#live-com-loads``)."""
+    from ...draw import live
 
     n = len(plans)
-    rows = []
+    cases = [key for key, _ in sorted(CASES, key=lambda kl: STYLES[kl[0]])]
+    panels, curves = [], {key: {} for key in cases}
     for p in plans:
         pre = _prefix(p.name)
-        curves = []
-        for key, _ in sorted(CASES, key=lambda kl: STYLES[kl[0]]):
-            s = by[pre + key]
-            curves.append((s.stage.label.split(" · ")[-1], style_index(study.stages, s), s.analysis.t,
-                           np.linalg.norm(s.analysis.force, axis=1), s.analysis.moment))
-        rows.append((p.name, curves))
-    return (f"Shaking force and moment on the other {n} trajectories", cache.svg(other_trajectories_svg, rows),
+        panels += [{"key": f"F {p.name}", "title": f"{p.name}: shaking force |F| (N)", "axis": "|F| (N)"},
+                   {"key": f"M {p.name}", "title": f"{p.name}: shaking moment M (N m)", "axis": "M (N m)"}]
+        for key in cases:
+            an = by[pre + key].analysis
+            curves[key].update({f"F {p.name}": np.linalg.norm(an.force, axis=1), f"M {p.name}": an.moment})
+    first = [by[_prefix(plans[0].name) + key] for key in cases]
+    figure = live.Curves(first[0].analysis.t, [(s.stage.label.split(" · ")[-1], curves[key]) for key, s in zip(cases, first)],
+                         panels, [], styles=[style_index(study.stages, s) for s in first], grid=True)
+    return (f"Shaking force and moment on the other {n} trajectories", live.html("com-loads", figure),
             "The same quantities as Figs. 3-4 on the trajectories the paper does not plot, every stage in its line "
-            "style of this page (the legend under the plot). Moment about the base joint, horizontal plane.")
-
-
-def other_trajectories_svg(rows: list[tuple[str, list[tuple]]]) -> str:
-    """One row of panels (|F|, M) per (trajectory, curves), each curve (label, style index, t,
-    |F|, M); the legend under the plot."""
-    from ...draw.figures import plt, style, to_svg  # matplotlib only when a report is drawn
-    from ...draw.layout import fixed_layout
-
-    n = len(rows)
-    fig, axes = plt.subplots(n, 2, figsize=(9.0, 2.1 * n + 0.4), squeeze=False)
-    for r, (name, curves) in enumerate(rows):
-        for label, k, t, F, M in curves:
-            st = style(k)
-            axes[r, 0].plot(t, F, label=label, **st)
-            axes[r, 1].plot(t, M, label=label, **st)
-        axes[r, 0].set_title(f"{name}: shaking force |F| (N)", fontsize=8)
-        axes[r, 1].set_title(f"{name}: shaking moment M (N m)", fontsize=8)
-    for ax in axes[-1]:
-        ax.set_xlabel("time (s)")
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=7, frameon=False)
-    fixed_layout(fig, rect=(0, 0.05 if n > 2 else 0.12, 1, 1))
-    return to_svg(fig, "com-loads")
+            "style of this page. Moment about the base joint, horizontal plane.")
 
 
 def _square_figure(study, planner, plans, main: str) -> tuple[str, str, str]:
