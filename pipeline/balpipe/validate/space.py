@@ -65,8 +65,20 @@ Drivers (the dead-beat recipe)
     * prismatic joint: a second ``GrooveJoint`` across the axis, moved along it with the law
       (its force and the guide's act at the same point, so momentum is conserved; a pivot with
       a moving anchor puts the two ends of its impulse ~ v dt apart);
-    * x / y of a body point: a ``GrooveJoint`` on the frame, the vertical (horizontal) line at
-      the law's value, the point as anchor.
+    * x and y of one body point (a path law): one ``PivotJoint`` between the frame and the
+      point, its anchor on the frame moved to the laws' values. Two perpendicular grooves on one
+      point (below) do not hold it: Chipmunk's groove solves a two-dimensional impulse and keeps
+      its component across the groove, which then depends on the sliding along it, and each
+      groove slides along the other at the point's speed. On the five-bar of
+      ``custom_five_bar_circle.yaml`` the grooves left residuals of 5.7e-4 (force) and 1.5e-3
+      (moment) of the reference at 200 iterations, the pivot 9.3e-7 and 2.0e-6 at 100; on a
+      five-bar with longer distal links (0.34 m on 0.22 m proximal links, pivots 0.16 m apart) the
+      grooves let the mechanism come apart within 0.07 s at any iteration count or step, the pivot
+      follows it to 2.8e-4 of its size (``tests/test_validation_power.py``). On a free base the
+      two grooves stay: a moving anchor would put the two ends of the impulse ~ v dt apart, a
+      spurious couple on the base;
+    * x or y of a body point alone: a ``GrooveJoint`` on the frame, the vertical (horizontal)
+      line at the law's value, the point as anchor.
 """
 
 from __future__ import annotations
@@ -98,7 +110,7 @@ class _Drive:
 
     name: str
     driver: Driver
-    kind: str  # "phase" (a GearJoint's phase) or "groove" (a groove across an axis)
+    kind: str  # "phase" (a GearJoint's phase), "groove" (a groove across an axis), "anchor_x"/"anchor_y" (a pivot's frame anchor)
     constraint: pymunk.Constraint
     scale: float = 1.0
     offset: float = 0.0
@@ -110,6 +122,10 @@ class _Drive:
         c = self.constraint
         if self.kind == "phase":
             c.phase = self.offset + self.scale * value
+        elif self.kind == "anchor_x":  # a point's x: its pivot's anchor on the frame
+            c.anchor_a = (value, c.anchor_a[1])
+        elif self.kind == "anchor_y":
+            c.anchor_a = (c.anchor_a[0], value)
         else:  # groove: line through axis-coordinate `value`, perpendicular to axis
             ax, L = self.axis, self.half_length
             n = (-ax[1], ax[0])
@@ -471,6 +487,8 @@ def build_space(
         else:  # pragma: no cover
             raise TypeError(jt)
 
+    pivots: dict[tuple, pymunk.PivotJoint] = {}
+    paired = set() if floating else _paired_points(model)
     for d in model.drivers:
         if not drive:
             if not model.actuators:  # named actuators apply the efforts instead (below)
@@ -489,6 +507,14 @@ def build_space(
         elif kind == "angle":
             c, s, o = angle_joint({d.target[1]: 1.0}, 0.0, 0.0)
             sim.drives.append(_Drive(d.name, d, "phase", c, scale=s, offset=o))
+        elif kind in ("x", "y") and d.target[1:] in paired:
+            key = d.target[1:]
+            if key not in pivots:  # x and y of one point: one pivot on the frame (see the module)
+                point = model.body(key[0]).point(key[1]) if len(key) > 1 else (0.0, 0.0)
+                pivots[key] = add(pymunk.PivotJoint(base, pb[key[0]], (0.0, 0.0), local(key[0], point)), 0.0)
+            dr = _Drive(d.name, d, "anchor_" + kind, pivots[key])
+            dr.set(float(d.law(np.array([0.0]))[0][0]))
+            sim.drives.append(dr)
         elif kind in ("x", "y"):
             body = d.target[1]
             point = model.body(body).point(d.target[2]) if len(d.target) > 2 else (0.0, 0.0)
@@ -502,6 +528,12 @@ def build_space(
     if not drive:  # motors at named joints (Model.actuators): their efforts, the engine's
         sim.actuators += [_actuator(model, Driver(a.name, ("joint", a.joint), None), pb, local) for a in model.actuators]
     return sim
+
+
+def _paired_points(model: Model) -> set[tuple]:
+    """The (body, point) targets driven in both x and y (one pivot drives each)."""
+    x = {d.target[1:] for d in model.drivers if d.target[0] == "x"}
+    return x & {d.target[1:] for d in model.drivers if d.target[0] == "y"}
 
 
 def _actuator(model: Model, d: Driver, pb: dict, local) -> _Actuator:
