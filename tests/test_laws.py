@@ -168,6 +168,20 @@ def test_path_pieces_are_continuous_and_arc_length_parametrised():
         paths.polyline([(0, 0), (0.01, 0), (0.01, 0.01)], 0.05)
 
 
+def test_sharp_corners_are_where_the_tangent_turns_at_once():
+    """paths.corners: a polyline without corner radius turns at each interior point (arc length,
+    signed turn, point); rounded corners, lines, arcs and circles have none."""
+    sharp = paths.polyline([(0, 0), (0.3, 0), (0.3, 0.2), (0.0, 0.35)], 0.0)
+    found = paths.corners(sharp)
+    assert [(s, p) for s, _, p in found] == [(pytest.approx(0.3), (0.3, 0.0)), (pytest.approx(0.5), (0.3, 0.2))]
+    assert found[0][1] == pytest.approx(math.pi / 2)  # left
+    assert found[1][1] == pytest.approx(math.pi / 2 - math.atan2(0.15, 0.3))  # up, then up-left
+    assert paths.corners(paths.polyline([(0, 0), (0.3, 0), (0.3, 0.2)], 0.05)) == []
+    assert paths.corners(paths.line((0, 0), (1, 1))) == []
+    assert paths.corners(paths.arc((0, 0), 0.1, 0.0, 2 * math.pi)) == []
+    assert paths.corners(paths.polyline([(0, 0), (0.3, 0), (0.6, 0)], 0.0)) == []  # straight on: no corner
+
+
 @pytest.mark.parametrize("seed", range(3))
 def test_path_motion_derivatives_and_circle_laps(seed):
     rng = np.random.default_rng(seed)

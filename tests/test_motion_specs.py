@@ -297,3 +297,96 @@ def test_a_serial_arms_tip_on_a_circle(tmp_path):
     tip = pose[:, :2] + 0.30 * np.stack([np.cos(pose[:, 2]), np.sin(pose[:, 2])], axis=1)
     assert np.allclose(np.hypot(tip[:, 0] - 0.3, tip[:, 1] - 0.25), 0.08, atol=1e-9)
     assert tip[0] == pytest.approx([0.38, 0.25], abs=1e-9) and tip[-1] == pytest.approx([0.38, 0.25], abs=1e-9)
+
+
+FIVE_BAR_ON = """\
+name: five-bar on a polyline
+mechanism:
+  template: five_bar
+  pivots: {{A1: [-0.08 m, 0 m], A2: [0.08 m, 0 m]}}
+  links:
+    proximal: {{length: 0.22 m, mass: 0.9 kg, com: 0.11 m, inertia: 0.0045 kg m^2}}
+    distal:   {{length: 0.34 m, mass: 0.6 kg, com: 0.17 m, inertia: 0.0062 kg m^2}}
+  working_modes: [+1, -1]
+motion:
+  duration: {duration}
+  drive:
+    gripper:
+      law: path
+      path: {{type: polyline, points: [[-0.10 m, 0.42 m], [-0.10 m, 0.36 m], [0.12 m, 0.36 m]]{radius}}}
+      timing: {timing}
+analysis: {{samples: 201}}
+validation: {{enabled: false}}
+"""
+
+
+def _located(tmp_path, text: str):
+    """The first located error of ``text``'s spec, raised where check and build meet it (the laws
+    are built with the model)."""
+    path = tmp_path / "s.yaml"
+    path.write_text(text, encoding="utf-8")
+    loaded = load(path)
+    with pytest.raises(Exception) as err:
+        run(loaded.spec)
+    return loaded.error(err.value).errors[0]
+
+
+def test_a_sharp_corner_passed_at_speed_is_a_located_error(tmp_path):
+    """A polyline without a corner radius, timed by a point-to-point law that passes the corner
+    moving: the velocity would turn at once (an infinite acceleration, which the sampled
+    analysis would not show): an error at the path naming the corner, the speed and the time."""
+    from balpipe.motion import PointToPoint, quintic
+
+    e = _located(tmp_path, FIVE_BAR_ON.format(duration="0.4 s", radius="", timing="{law: quintic}"))
+    assert e.path == "motion.drive.gripper.path" and e.line == 14  # the path: line
+    assert "turns 90 deg at (-0.1, 0.36) m with no rounded corner" in e.message
+    # the speed there: s' of the quintic law over the path (0.06 + 0.22 m) where s = 0.06 m
+    law = PointToPoint(0.0, 0.28, 0.4, quintic)
+    t = np.linspace(0, 0.4, 400001)
+    tc = t[np.argmin(np.abs(law(t)[0] - 0.06))]
+    assert f"passes at {law(np.array([tc]))[1][0]:.4g} m/s (t = {tc:.4g} s)" in e.message
+    assert "corner_radius" in e.message
+
+
+def test_a_sharp_corner_is_accepted_where_the_timing_stops_and_rounded_corners_anywhere():
+    stop = ("{law: cycle, from: 0 m, segments: [{law: quintic, to: 0.06 m, duration: 0.2 s}, "
+            "{law: dwell, duration: 0.05 s}, {law: quintic, to: 0.28 m, duration: 0.25 s}]}")
+    spec, _ = load_text(FIVE_BAR_ON.format(duration="0.5 s", radius="", timing=stop), "s.yaml")
+    an = run(spec).unbalanced.analysis  # the gripper stops at the corner, then turns
+    assert np.isfinite(an.moment).all() and an.max_force > 0
+    spec, _ = load_text(FIVE_BAR_ON.format(duration="0.4 s", radius=", corner_radius: 15 mm", timing="{law: quintic}"), "s.yaml")
+    assert run(spec).unbalanced.analysis.max_force > 0
+
+
+def test_a_sharp_corner_on_a_path_with_heading_is_an_error_even_where_the_timing_stops(tmp_path):
+    """With heading, the pose's angle follows the tangent: at a sharp corner it would jump by the
+    turn, whatever the speed (here the timing stops at the corner)."""
+    e = _located(tmp_path, """\
+name: 3R hand on a polyline
+mechanism:
+  template: custom
+  bodies:
+    - {name: l1, mass: 1, com: [0.15, 0], inertia: 0.01, pose: [0, 0, 0.3], points: {O: [0, 0], A: [0.3, 0]}}
+    - {name: l2, mass: 1, com: [0.12, 0], inertia: 0.01, pose: [0.28660, 0.08866, 1.9], points: {A: [0, 0], B: [0.25, 0]}}
+    - {name: l3, mass: 0.5, com: [0.05, 0], inertia: 0.001, pose: [0.20577, 0.32529, 0], points: {B: [0, 0], T: [0.1, 0]}}
+  joints:
+    - {type: revolute, name: O, a: frame, b: l1, point_a: [0, 0], point_b: O}
+    - {type: revolute, name: A, a: l1, b: l2, point_a: A, point_b: A}
+    - {type: revolute, name: B, a: l2, b: l3, point_a: B, point_b: B}
+  drivers:
+    - {name: tx, body: l3, coordinate: x, point: T}
+    - {name: ty, body: l3, coordinate: y, point: T}
+    - {name: ta, body: l3, coordinate: angle}
+motion:
+  duration: 1 s
+  drive:
+    hand:
+      law: path
+      components: [tx, ty, ta]
+      heading: true
+      path: {type: polyline, points: [[0.30577, 0.32529], [0.38, 0.32529], [0.38, 0.25]]}
+      timing: {law: cycle, from: 0 m, segments: [{law: quintic, to: 0.07423 m, duration: 0.5 s}, {law: quintic, to: 0.14952 m, duration: 0.5 s}]}
+analysis: {samples: 101}
+validation: {enabled: false}
+""")
+    assert e.path == "motion.drive.hand.path" and "the heading" in e.message and "jump by that much" in e.message, e

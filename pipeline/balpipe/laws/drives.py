@@ -433,7 +433,55 @@ def path_motion(drive: PathDrive, path: tuple, duration: float) -> geometry.Path
             raise SpecFieldError(path + ("timing",), (
                 f"the arc length reaches {s[k]:.4g} m at t = {duration * k / 2000:.4g} s, outside the path "
                 f"(0 to {g.length:.4g} m long); shorten the motion or lengthen the path"))
+    _check_corners(g, timing, duration, drive.heading, path)
     return geometry.PathMotion(g, timing, drive.heading, drive.angle)
+
+
+CORNER_SPEED = 1e-6  # of the path's mean speed (length / duration): a sharp corner passed faster is an error
+
+
+def _check_corners(g: geometry.Path, timing: Law, duration: float, heading: bool, path: tuple) -> None:
+    """A sharp corner (:func:`.paths.corners`) that the point passes at speed, or any sharp corner
+    of a path whose heading drives an angle, asks for an infinite acceleration: an error naming
+    the corner, the speed and the time (the analysis would miss the impulse there, and no finite
+    effort gives it)."""
+    found = geometry.corners(g)
+    if not found:
+        return
+    t = np.linspace(0.0, duration, 2001)
+    s = timing(t)[0]
+    for sc, turn, point in found:
+        where = (f"the path turns {math.degrees(abs(turn)):.4g} deg at ({point[0]:.4g}, {point[1]:.4g}) m "
+                 "with no rounded corner")
+        if heading:
+            raise SpecFieldError(path + ("path",), f"{where}: the heading (an angle that follows the tangent) would "
+                                 f"jump by that much at once; give the path a corner_radius")
+        for k in np.flatnonzero((s[:-1] - sc) * (s[1:] - sc) <= 0.0):
+            tc = _crossing(timing, sc, float(t[k]), float(t[k + 1]))
+            v = float(timing(np.array([tc]))[1][0])
+            if abs(v) > CORNER_SPEED * g.length / duration:
+                raise SpecFieldError(path + ("path",), (
+                    f"{where}, which the timing passes at {abs(v):.4g} m/s (t = {tc:.4g} s): the velocity would "
+                    "turn at once there, an infinite acceleration that no finite effort gives and the analysis "
+                    "cannot show; give the path a corner_radius, or a timing that stops at the corner"))
+
+
+def _crossing(timing: Law, sc: float, a: float, b: float) -> float:
+    """The time in [a, b] where the arc length ``timing`` reaches ``sc`` (bisection; it is
+    reached there)."""
+    fa = float(timing(np.array([a]))[0][0]) - sc
+    if fa == 0.0:
+        return a
+    for _ in range(60):
+        m = 0.5 * (a + b)
+        fm = float(timing(np.array([m]))[0][0]) - sc
+        if fm == 0.0:
+            return m
+        if (fm < 0.0) == (fa < 0.0):
+            a, fa = m, fm
+        else:
+            b = m
+    return 0.5 * (a + b)
 
 
 def drive_laws(name: str, drive: Any, dims: dict[str, str], motion: Any) -> dict[str, Law]:

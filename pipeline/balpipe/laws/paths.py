@@ -86,6 +86,21 @@ class Path:
         return P, np.stack([np.cos(H), np.sin(H)], axis=-1), K, H
 
 
+def corners(path: Path) -> list[tuple[float, float, tuple[float, float]]]:
+    """The sharp corners of ``path`` (a polyline without corner radius): (arc length, turn of the
+    tangent in rad, point) wherever a piece does not start along the heading the previous one
+    ends with. A point passing one at speed v would turn its velocity at once: an infinite
+    acceleration."""
+    out = []
+    s = 0.0
+    for a, b in zip(path.pieces, path.pieces[1:]):
+        s += a.length
+        turn = math.remainder(b.angle - (a.angle + a.curvature * a.length), 2 * math.pi)
+        if abs(turn) > 1e-9:
+            out.append((s, turn, b.start))
+    return out
+
+
 def line(a, b) -> Path:
     d = (b[0] - a[0], b[1] - a[1])
     L = math.hypot(*d)
