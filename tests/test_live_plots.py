@@ -425,3 +425,15 @@ def test_paper_003s_optimised_orientation_is_live_from_each_plans_ends(studies):
     main = st.stages[0].stage.group
     uses = next(s for s in st.stages if s.stage.name == f"{main}_com_bang_bang")
     assert {key: law[key] for key in ("stroke", "dash", "width")} == LV.line_style(style_index(st.stages, uses))
+
+
+def test_a_log_panel_keeps_sixteen_decades_below_its_largest_value():
+    """A residual of 8e-322 (a zero's round-off) next to 1e-4 gave uPlot 318 decades, and it drew
+    no plot at all: a log panel has no value below LOG_RANGE (1e-16) of its largest, nor at or
+    below 0; the values above are kept to their 6 digits."""
+    t = np.linspace(0.0, 1.0, 5)
+    y = np.array([8.2e-322, 3.0e-21, 2.0e-20, 1.0e-4, 0.0])
+    c = LV.Curves(t, [("a", {"r": y})], [{"key": "r", "title": "", "axis": "", "log": True}], [])
+    shown = LV.data(c)["series"][0]["y"]["r"]
+    assert LV.LOG_RANGE == 1e-16
+    assert shown == [None, None, 2e-20, 1e-4, None]

@@ -552,8 +552,9 @@ def hover(page, plot, min_width: int = 200) -> list[str]:
     """Move the mouse over a live plot (a .live-plot), 40 % along its time axis, and read its
     legend: the time and every curve's value there. The plot must be drawn, its plotting area
     wider than ``min_width`` px."""
-    plot.scroll_into_view_if_needed()
-    box = plot.locator(".u-over").bounding_box()
+    over = plot.locator(".u-over")  # the plotting area itself: a legend of many curves (paper 003's
+    over.scroll_into_view_if_needed()  # 96 at 400 px) makes the plot taller than the window
+    box = over.bounding_box()
     assert box and box["width"] > min_width, f"no interactive plot drawn ({box})"
     page.mouse.move(box["x"] + box["width"] * 0.4, box["y"] + box["height"] * 0.5)
     return plot.evaluate(_LEGEND_VALUES)

@@ -58,13 +58,23 @@ def _round(values, floor: float = 0.0) -> list[float | None]:
 ROUND_OFF = 1e-9  # of a panel's largest value: what the hover shows as 0 (< tolerance), as the tables do
 
 
+#: a log panel's values down to this fraction of its largest (the round-off of a double below it:
+#: a residual of 8e-322 is a zero's), below which it has none; uPlot drew no plot at all on the
+#: 318 decades that one such value gave a residual panel of custom_pick_and_place_cycle.yaml
+LOG_RANGE = 1e-16
+
+
+def _peak(c: Curves, key: str) -> float:
+    """The panel's largest |value| over every stage (0 when it has none)."""
+    return max((float(np.nanmax(np.abs(np.asarray(curves[key], dtype=float)), initial=0.0))
+                for _, curves in c.stages if key in curves), default=0.0)
+
+
 def _floor(c: Curves, key: str) -> float:
     """The panel's round-off floor: :data:`ROUND_OFF` of its largest |value| over every stage
     (0 when it has none), below which the hover reads "0 (< tolerance)" instead of a number
     such as 1.9e-13 N m (a balanced stage's residual)."""
-    peaks = [np.nanmax(np.abs(np.asarray(curves[key], dtype=float)), initial=0.0)
-             for _, curves in c.stages if key in curves]
-    return float(f"{ROUND_OFF * max(peaks, default=0.0):.3g}")
+    return float(f"{ROUND_OFF * _peak(c, key):.3g}")
 
 
 def line_style(k: int | dict) -> dict:
@@ -119,12 +129,13 @@ def data(c: Curves) -> dict:
     k = (np.arange(len(t)) if c.x_axis else
          _thin(len(t), sum(p["key"] in curves for _, curves in c.stages for p in c.panels)))
     # a panel on a log axis (``"log": True``: residuals) keeps its small values, which are what it
-    # shows, and has no value at or below 0 (null: a gap)
+    # shows, down to :data:`LOG_RANGE` of its largest; none at or below that (null: a gap)
     floors = {p["key"]: 0.0 if p.get("log") else _floor(c, p["key"]) for p in c.panels}
+    cuts = {p["key"]: LOG_RANGE * _peak(c, p["key"]) for p in c.panels if p.get("log")}
 
     def values(p: dict, y) -> list:
         out = _round(np.asarray(y, dtype=float)[k], floors[p["key"]])
-        return [v if v is None or v > 0 else None for v in out] if p.get("log") else out
+        return [v if v is not None and v > cuts[p["key"]] else None for v in out] if p.get("log") else out
 
     series = [{"label": label, "y": {p["key"]: values(p, curves[p["key"]]) for p in c.panels if p["key"] in curves},
                **line_style(n)}
