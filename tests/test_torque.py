@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from balpipe.engine import analyse
+from balpipe.motion import PointToPoint, quintic
 from balpipe.validate import ValidationSettings, simulate
 from balpipe.validate.torque import CALIBRATION_FACTOR, floored_model, torque_driven
 
@@ -180,7 +181,7 @@ def _jumpy_arm(profile, accel_fraction: float | None = None):
 
 @pytest.mark.parametrize("fraction", [0.3, 0.2371])  # corners inside a step's velocity window, off any step
 def test_jump_times_are_the_laws_acceleration_corners(fraction):
-    from balpipe.validate.torque import jump_times
+    from balpipe.validate.settings import jump_times
 
     model = _jumpy_arm(None, fraction)
     times = np.linspace(0.0, 0.5, 1001)
@@ -208,3 +209,28 @@ def test_a_jump_of_the_effort_inside_a_step_gets_its_impulse(fraction):
     for name, e in plan.efforts.items():
         lo, hi = sorted(side[name])
         assert lo - 1e-12 <= e[k] <= hi + 1e-12 and hi - lo > 1e-3 * np.max(np.abs(e))
+
+
+def test_a_paths_rounded_corner_has_two_jumps_not_the_steps_where_its_acceleration_turns():
+    """A point on a polyline with a 15 mm rounded corner, timed by a quintic law: its x and y
+    accelerations jump where the arc starts and ends (the centripetal term), and turn fast but
+    smoothly along the arc. Only the two jumps are jumps (settings._jumps: the validation leaves
+    out the samples around them and restarts the solver there); the arc's steps, hundreds of
+    which a change of 50 x the median flagged, are not (the pymunk check compared 256 of the
+    label applicator's 401 samples, 396 since)."""
+    from types import SimpleNamespace
+
+    from balpipe.laws import paths
+    from balpipe.validate.settings import _jumps, jump_times
+
+    g = paths.polyline([(-0.10, 0.42), (-0.10, 0.36), (0.12, 0.36)], 0.015)
+    motion = paths.PathMotion(g, PointToPoint(0.0, g.length, 0.4, quintic), heading=False)
+    model = SimpleNamespace(drivers=[SimpleNamespace(law=paths.PathComponent(motion, k)) for k in (0, 1)])
+    times = np.linspace(0.0, 0.4, 1201)
+    found = jump_times(model, times)
+    arc = [s for s, piece in zip(np.cumsum([0.0] + [p.length for p in g.pieces]), g.pieces) if piece.curvature]
+    assert len(arc) == 1
+    ends = [arc[0], arc[0] + g.pieces[1].length]  # arc lengths where the arc starts and ends
+    law = PointToPoint(0.0, g.length, 0.4, quintic)
+    assert law(np.array(found))[0] == pytest.approx(ends, abs=1e-12)
+    assert _jumps(model, times) == [int(np.searchsorted(times, t)) for t in found]

@@ -101,18 +101,53 @@ def _step_grid(t: np.ndarray, dt_target: float) -> tuple[float, int, np.ndarray 
     return (t1 - t0) / n, n, None
 
 
-def _jumps(model: Model, times: np.ndarray) -> list[int]:
-    """Indices k where some law's acceleration jumps between times[k-1] and times[k]."""
-    out: set[int] = set()
-    for d in model.drivers:
-        a = np.asarray(d.law(times)[2], dtype=float)
+JUMP = 1e-3  # an acceleration step above this fraction of a law's largest acceleration is a jump
+
+
+def _located_jumps(model: Model, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(k, t_j) of every acceleration jump of a driver law between times[k-1] and times[k]. The
+    intervals where some law's acceleration changes by more than 50 times the median change are
+    candidates; each is bisected (all at once) down to round-off and kept where the acceleration
+    still steps by more than :data:`JUMP` of the law's largest across the last interval: a fast
+    but smooth change (a path's arc, where the acceleration turns with the tangent) shrinks to
+    nothing and is no jump."""
+    cand: set[int] = set()
+    laws = [d.law for d in model.drivers]
+    accs = [np.asarray(law(times)[2], dtype=float) for law in laws]
+    for a in accs:
         if len(a) < 3:
             continue
         diff = np.abs(np.diff(a))
         tiny = 1e-9 * (float(np.max(np.abs(a))) or 1.0)
-        out.update(int(k) + 1 for k in np.flatnonzero(diff > 50.0 * float(np.median(diff)) + tiny))
-    return sorted(out)
+        cand.update(int(k) + 1 for k in np.flatnonzero(diff > 50.0 * float(np.median(diff)) + tiny))
+    ks = np.asarray(sorted(cand), dtype=int)
+    if ks.size == 0:
+        return ks, np.zeros(0)
+    scale = np.array([float(np.max(np.abs(a))) or 1.0 for a in accs])
 
+    def acc(t: np.ndarray) -> np.ndarray:  # (laws, intervals), in units of each law's largest
+        return np.array([np.asarray(law(t)[2], dtype=float).reshape(-1) for law in laws]) / scale[:, None]
+
+    a, b = times[ks - 1].astype(float), times[ks].astype(float)
+    fa, fb = acc(a), acc(b)
+    for _ in range(60):
+        m = 0.5 * (a + b)
+        fm = acc(m)
+        left = np.max(np.abs(fm - fa), axis=0) >= np.max(np.abs(fb - fm), axis=0)  # the step is in [a, m]
+        b, fb = np.where(left, m, b), np.where(left, fm, fb)
+        a, fa = np.where(left, a, m), np.where(left, fa, fm)
+    real = np.max(np.abs(fb - fa), axis=0) > JUMP
+    return ks[real], (0.5 * (a + b))[real]
+
+
+def _jumps(model: Model, times: np.ndarray) -> list[int]:
+    """Indices k where some law's acceleration jumps between times[k-1] and times[k]."""
+    return _located_jumps(model, times)[0].tolist()
+
+
+def jump_times(model: Model, times: np.ndarray) -> list[float]:
+    """The instants (to round-off) where some driver law's acceleration jumps."""
+    return _located_jumps(model, times)[1].tolist()
 
 
 def _law_kinds(model: Model, times: np.ndarray) -> list[str]:

@@ -54,7 +54,7 @@ from ..model import Attachment, Model
 from .loads import _on_grid  # the same sampling of the loads as the position-driven check
 from .run import SimulationRun, model_scale, simulate
 from .extend import continued
-from .settings import HEALTH_LIMIT, ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings
+from .settings import HEALTH_LIMIT, ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings, jump_times
 from .space import build_space
 from .verdict import Verdict
 
@@ -230,35 +230,6 @@ def _plan(model: Model, analysis: Analysis, settings: ValidationSettings, analyt
     travel = _travel(analytic_model, t)
     return _Plan(model, analytic_model, sim_model, floored, efforts, share, notes, travel, dt, nsteps, idx, n, times,
                  int(it_default or ITERATIONS))
-
-
-JUMP = 1e-3  # an acceleration step above this fraction of a law's largest acceleration is a jump
-
-
-def jump_times(model: Model, times: np.ndarray) -> list[float]:
-    """The instants where some driver law's acceleration jumps: in each interval of ``times``
-    that :func:`.settings._jumps` flags, bisection (all intervals at once) down to round-off,
-    kept where the acceleration still steps by more than :data:`JUMP` of the law's largest
-    across the last interval (a fast but smooth change shrinks to nothing)."""
-    ks = np.asarray(_jumps(model, times), dtype=int)
-    if ks.size == 0:
-        return []
-    laws = [d.law for d in model.drivers]
-    scale = np.array([float(np.max(np.abs(np.asarray(law(times)[2], dtype=float)))) or 1.0 for law in laws])
-
-    def acc(t: np.ndarray) -> np.ndarray:  # (laws, intervals) / scale
-        return np.array([np.asarray(law(t)[2], dtype=float).reshape(-1) for law in laws]) / scale[:, None]
-
-    a, b = times[ks - 1].astype(float), times[ks].astype(float)
-    fa, fb = acc(a), acc(b)
-    for _ in range(60):
-        m = 0.5 * (a + b)
-        fm = acc(m)
-        left = np.max(np.abs(fm - fa), axis=0) >= np.max(np.abs(fb - fm), axis=0)  # the step is in [a, m]
-        b, fb = np.where(left, m, b), np.where(left, fm, fb)
-        a, fa = np.where(left, a, m), np.where(left, fa, fm)
-    real = np.max(np.abs(fb - fa), axis=0) > JUMP
-    return (0.5 * (a + b))[real].tolist()
 
 
 def _average_jumps(efforts: dict[str, np.ndarray], model: Model, analysis: Analysis, times: np.ndarray,
