@@ -18,9 +18,10 @@ Method
     whose velocity window holds the jump gets the window's mean effort (:func:`_average_jumps`):
     the effort at the step's time alone gave that window the wrong impulse, up to the jump
     times dt, and the open-loop run carried it to the end (paper 003's bang-bang plans tracked
-    to 4e-4 .. 8.8e-4 of the travel against the 1e-3 tolerance, 2.4e-7 .. 2.0e-6 since). The run starts like the
-    position-driven one (one step before t0, so that the first step lands on q(t0) with the
-    velocity of t0 + dt/2) and uses its time step and converged solver iterations. Bodies that
+    to 4e-4 .. 8.8e-4 of the travel against the 1e-3 tolerance, 2.4e-7 .. 2.0e-6 since). The
+    run starts like the position-driven one (one step before t0, so that the first step lands
+    on q(t0) with the velocity of t0 + dt/2) and uses its time step and converged solver
+    iterations; a run that starts moving leaves its first sample out of the load residuals. Bodies that
     pymunk cannot simulate massless (mass or moment below ``mass_floor`` of the largest) get
     the floor as a real part of the body: the efforts are computed for the model with those
     floor parts, so the floors are compensated exactly and their share of the effort is
