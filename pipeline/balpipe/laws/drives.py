@@ -425,32 +425,29 @@ def path_motion(drive: PathDrive, path: tuple, duration: float) -> geometry.Path
         timing: Law = PointToPoint(0.0, g.length, duration, _profile(t.law, t.accel_fraction))
     else:
         timing = scalar_law(t, "length", path + ("timing",), duration)
-    if not g.closed:
-        s = timing(np.linspace(0.0, duration, 2001))[0]
+    if not g.closed:  # (a closed path, a circle, has no end to overrun and no corner)
+        t = np.linspace(0.0, duration, 2001)
+        s = timing(t)[0]
         over = np.flatnonzero((s < -1e-9 * g.length) | (s > g.length * (1 + 1e-9)))
         if over.size:
             k = int(over[0])
             raise SpecFieldError(path + ("timing",), (
-                f"the arc length reaches {s[k]:.4g} m at t = {duration * k / 2000:.4g} s, outside the path "
+                f"the arc length reaches {s[k]:.4g} m at t = {t[k]:.4g} s, outside the path "
                 f"(0 to {g.length:.4g} m long); shorten the motion or lengthen the path"))
-    _check_corners(g, timing, duration, drive.heading, path)
+        _check_corners(g, timing, t, s, drive.heading, path)
     return geometry.PathMotion(g, timing, drive.heading, drive.angle)
 
 
 CORNER_SPEED = 1e-6  # of the path's mean speed (length / duration): a sharp corner passed faster is an error
 
 
-def _check_corners(g: geometry.Path, timing: Law, duration: float, heading: bool, path: tuple) -> None:
+def _check_corners(g: geometry.Path, timing: Law, t: np.ndarray, s: np.ndarray, heading: bool, path: tuple) -> None:
     """A sharp corner (:func:`.paths.corners`) that the point passes at speed, or any sharp corner
     of a path whose heading drives an angle, asks for an infinite acceleration: an error naming
     the corner, the speed and the time (the analysis would miss the impulse there, and no finite
-    effort gives it)."""
-    found = geometry.corners(g)
-    if not found:
-        return
-    t = np.linspace(0.0, duration, 2001)
-    s = timing(t)[0]
-    for sc, turn, point in found:
+    effort gives it). ``s``: the arc length at the times ``t`` over the motion."""
+    duration = float(t[-1] - t[0])
+    for sc, turn, point in geometry.corners(g):
         where = (f"the path turns {math.degrees(abs(turn)):.4g} deg at ({point[0]:.4g}, {point[1]:.4g}) m "
                  "with no rounded corner")
         if heading:
