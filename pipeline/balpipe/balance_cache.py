@@ -23,7 +23,6 @@ do not use it (no store active: :func:`run` computes).
 
 from __future__ import annotations
 
-from functools import lru_cache
 from typing import Any, Callable, ClassVar
 
 from . import content_cache
@@ -41,19 +40,10 @@ class Store(content_cache.PickleStore):
     HEADER: ClassVar[bytes] = b"balpipe-balance-1 "
 
 
-@lru_cache(maxsize=1)
 def environment() -> str:
-    """The installed versions of :data:`LIBRARIES`, read from their metadata (cvxpy is not
-    imported for a spec that does not solve a cone programme)."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    def installed(name: str) -> str:
-        try:
-            return version(name)
-        except PackageNotFoundError:
-            return "-"
-
-    return "\0".join(f"{name} {installed(name)}" for name in LIBRARIES)
+    """The installed versions of :data:`LIBRARIES` (from their metadata: cvxpy is not imported for
+    a spec that does not solve a cone programme)."""
+    return content_cache.library_versions(LIBRARIES)
 
 
 #: the store of :func:`using`: a module global, as the simulations' (:mod:`balpipe.sim_cache`)

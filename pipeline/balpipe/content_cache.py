@@ -40,6 +40,7 @@ import re
 import struct
 import types
 from contextlib import contextmanager
+from functools import lru_cache
 from pathlib import Path
 from typing import Any, Callable, ClassVar, Iterator
 
@@ -365,6 +366,22 @@ class PickleStore(Store):
             if fd is not None:
                 fcntl.flock(fd, fcntl.LOCK_UN)
                 os.close(fd)
+
+
+@lru_cache(maxsize=8)
+def library_versions(names: tuple[str, ...]) -> str:
+    """``"name version"`` of each installed distribution of ``names``, joined by NUL (``-`` for
+    one not installed), read from their metadata: nothing is imported. What a cached kind's
+    results depend on besides balpipe's code and a function's arguments (:class:`Active`)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    def installed(name: str) -> str:
+        try:
+            return version(name)
+        except PackageNotFoundError:
+            return "-"
+
+    return "\0".join(f"{name} {installed(name)}" for name in names)
 
 
 class Active:

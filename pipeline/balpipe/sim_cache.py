@@ -21,7 +21,6 @@ damaged entry is computed again).
 
 from __future__ import annotations
 
-from functools import lru_cache
 from typing import Any, Callable, ClassVar
 
 from . import content_cache
@@ -38,14 +37,14 @@ class Store(content_cache.PickleStore):
     HEADER: ClassVar[bytes] = b"balpipe-sim-1 "
 
 
-@lru_cache(maxsize=1)
-def environment() -> str:
-    """What a simulation depends on besides balpipe's code and its inputs: pymunk's and numpy's
-    versions."""
-    import numpy
-    import pymunk
+#: the libraries whose versions are part of every key (they produce the numbers)
+LIBRARIES = ("pymunk", "numpy")
 
-    return f"pymunk {pymunk.version}\0numpy {numpy.__version__}"
+
+def environment() -> str:
+    """What a simulation depends on besides balpipe's code and its inputs: the installed versions
+    of :data:`LIBRARIES`."""
+    return content_cache.library_versions(LIBRARIES)
 
 
 #: the store of :func:`using`: a module global, so that forked simulation workers inherit it
