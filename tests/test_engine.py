@@ -166,3 +166,38 @@ def test_joint_reactions_balance_each_body():
     # the frame takes minus the pivot force at A and minus the guide's normal force
     frame_load = -np.stack([an.reactions["A"]["Fx"], an.reactions["A"]["Fy"] + N], axis=1)
     assert np.allclose(frame_load, an.force, atol=1e-9 * an.max_force)
+
+
+@pytest.mark.parametrize("seed", [None, 0, 1, 2, 3])
+def test_a_grid_inside_the_motion_lies_on_the_branch_of_the_whole_motion(seed):
+    """Model.initial is the pose at t = 0: a few samples far inside the motion (the torque-driven
+    run's efforts at a law's jump) are reached from there by continuation, not assembled on
+    their own. Assembled at t[0] from the initial pose, the offset slider-crank at 293 deg of its
+    crank (seed None) put the slider on the other side of the crank, where a mechanism that
+    never changes branch cannot be. Random slider-cranks (seeded): every random sparse grid
+    agrees with the whole motion's samples."""
+    from conftest import slider_crank_spec
+
+    if seed is None:
+        spec = slider_crank_spec(law="trapezoidal", duration=0.5)
+        data = spec.model_dump(mode="json", exclude_none=True)
+        data["mechanism"].update(offset=0.03, crank={"length": 0.2, "mass": 1.2, "com": 0.1, "inertia": 0.004},
+                                 coupler={"length": 0.3, "mass": 0.9, "com": 0.15, "inertia": 0.00675},
+                                 slider={"mass": 0.6})
+        data["motion"]["drive"] = {"crank": {"from": 0.0, "to": 2 * math.pi}}
+        spec = Spec.model_validate(data)
+        t = np.linspace(0.0, 0.5, 1001)
+        grids = [t[[730]], t[[729, 731]], t[[270, 730]], t[500:]]
+    else:
+        rng = np.random.default_rng(300 + seed)
+        spec = slider_crank_spec(rng, law="trapezoidal")
+        t = np.linspace(0.0, spec.motion.duration, 601)
+        grids = [np.sort(rng.choice(np.arange(1, 601), size=n, replace=False)) for n in (1, 2, 3, 5)]
+        grids = [t[g] for g in grids] + [t[300:]]
+    model = registry.balance(spec).stages[0].model
+    whole = analyse(model, t)
+    for sub in grids:
+        part = analyse(model, sub)
+        idx = np.searchsorted(t, sub)
+        assert np.allclose(part.q, whole.q[idx], atol=1e-9), (seed, sub)
+        assert np.allclose(part.efforts["crank"], whole.efforts["crank"][idx], atol=1e-9 * np.max(np.abs(whole.efforts["crank"])))

@@ -15,6 +15,7 @@ _TOL = 1e-12
 _MAX_ITER = 25
 _COND_LIMIT = 1e11
 _COARSE = 17  # samples followed by continuation before the batched refinement
+_GAP = 3.0  # a continuation step longer than this many 1/16 of the grid's span gets times between
 _JUMP = 0.2  # rad: a refined angle this far from its interpolated guess may be another branch
 
 
@@ -176,37 +177,32 @@ def follow_motion(c: Compiled, t: np.ndarray, ops=None) -> np.ndarray:
     """:func:`solve_positions` without the regularity check (the caller makes it). ``ops``: the
     Newton-Raphson and velocity solves (:class:`DenseOps`, or
     :class:`.newton_blocks.BlockOps`); by default the block ones where ``c`` has been decomposed
-    (:func:`_ops`). Either gives the same motion (same branch, to the Newton tolerance)."""
+    (:func:`_ops`). Either gives the same motion (same branch, to the Newton tolerance).
+
+    The model's initial pose is its pose at t = 0 (:class:`balpipe.model.Model`): a grid that
+    starts later (a few samples inside the motion) is reached from t = 0 by continuation
+    (:func:`_lead`), so that it lies on the branch of the whole motion. Assembled at t[0] from
+    the initial pose instead, an offset slider-crank at 293 deg of its crank put the slider on
+    the other side of the crank (the torque-driven run's efforts at a law's jump came from
+    that mirror image)."""
     if ops is None:
         ops = _ops(c, t)
     _check_square(c)
     N = len(t)
-    q, ok, _ = ops.newton(c.q0[None, :], t[:1], max_iter=50)
+    start = min(float(t[0]), 0.0)
+    q, ok, _ = ops.newton(c.q0[None, :], np.array([start]) if start != t[0] else t[:1], max_iter=50)
     if not ok[0]:
         err = AnalysisError(
-            "cannot assemble the mechanism at t = 0: " + str(_fail_position(c, q[0], float(t[0]))).split(": ", 1)[1],
-            float(t[0]),
+            f"cannot assemble the mechanism at t = {start:g}: " + str(_fail_position(c, q[0], start)).split(": ", 1)[1],
+            start,
         )
         err.q = q[0]
         raise err
-    _check_redundancy(c, q[0], float(t[0]))
-    coarse_idx = spread_indices(N, _COARSE)
-    tc = t[coarse_idx]
-    qc = np.zeros((len(tc), q.shape[1]))
-    vc = np.zeros_like(qc)
-    ac = np.zeros(qc.shape[1])
-    qc[0] = q[0]
-    for k in range(len(tc)):
-        if k > 0:
-            h = tc[k] - tc[k - 1]
-            guess = qc[k - 1] + vc[k - 1] * h + 0.5 * ac * h * h
-            sol, ok_k, _ = ops.newton(guess[None, :], tc[k : k + 1])
-            if not ok_k[0]:
-                # substep the continuation before giving up
-                sol = _substep(c, qc[k - 1], tc[k - 1], tc[k], ops=ops)
-            qc[k] = sol[0]
-        v, ac = ops.vel_acc(qc[k : k + 1], tc[k : k + 1])
-        vc[k], ac = v[0], ac[0]
+    _check_redundancy(c, q[0], start)
+    if start != t[0]:
+        q = _lead(c, q[0], np.linspace(start, float(t[0]), _COARSE), ops)[None, :]
+    tc = _coarse_times(t)
+    qc, vc = _continue(c, q[0], tc, ops)
     # Hermite interpolation to the full grid
     seg = np.clip(np.searchsorted(tc, t, side="right") - 1, 0, len(tc) - 2) if len(tc) > 1 else np.zeros(N, int)
     if len(tc) > 1:
@@ -223,6 +219,53 @@ def follow_motion(c: Compiled, t: np.ndarray, ops=None) -> np.ndarray:
         prev = k - 1
         qall[k] = _substep(c, qall[prev], t[prev], t[k], ops=ops)[0]
     return qall
+
+
+def _coarse_times(t: np.ndarray) -> np.ndarray:
+    """The times the continuation follows: :data:`_COARSE` samples of ``t`` spread over it, and
+    where two of them are more than :data:`_GAP` times the even spacing (span / 16) apart (a
+    sparse grid: a few times far inside the motion), times between them at that spacing. An
+    evenly spread grid of 9 or more samples (every analysis of a motion; the balancing
+    regressors' 9 states along it) has no such gap: its continuation is unchanged."""
+    tc = t[spread_indices(len(t), _COARSE)]
+    if len(tc) < 2:
+        return tc
+    step = float(tc[-1] - tc[0]) / (_COARSE - 1)
+    gaps = np.diff(tc)
+    if step <= 0 or not np.any(gaps > _GAP * step):
+        return tc
+    parts = [tc[:1]]
+    for a, b, g in zip(tc[:-1], tc[1:], gaps):
+        if g > _GAP * step:
+            parts.append(np.linspace(a, b, int(np.ceil(g / step)) + 1)[1:-1])
+        parts.append(np.array([b]))
+    return np.concatenate(parts)
+
+
+def _continue(c: Compiled, q0: np.ndarray, tc: np.ndarray, ops) -> tuple[np.ndarray, np.ndarray]:
+    """Positions and velocities at the times ``tc`` followed from ``q0`` (the pose at tc[0]) by
+    a second-order predictor and Newton-Raphson, substepped where a step does not converge."""
+    qc = np.zeros((len(tc), q0.shape[0]))
+    vc = np.zeros_like(qc)
+    ac = np.zeros(qc.shape[1])
+    qc[0] = q0
+    for k in range(len(tc)):
+        if k > 0:
+            h = tc[k] - tc[k - 1]
+            guess = qc[k - 1] + vc[k - 1] * h + 0.5 * ac * h * h
+            sol, ok_k, _ = ops.newton(guess[None, :], tc[k : k + 1])
+            if not ok_k[0]:
+                # substep the continuation before giving up
+                sol = _substep(c, qc[k - 1], tc[k - 1], tc[k], ops=ops)
+            qc[k] = sol[0]
+        v, ac = ops.vel_acc(qc[k : k + 1], tc[k : k + 1])
+        vc[k], ac = v[0], ac[0]
+    return qc, vc
+
+
+def _lead(c: Compiled, q0: np.ndarray, times: np.ndarray, ops) -> np.ndarray:
+    """The pose at ``times[-1]`` followed from ``q0`` (the pose at ``times[0]``) along ``times``."""
+    return _continue(c, q0, times, ops)[0][-1]
 
 
 def _substep(c: Compiled, q: np.ndarray, ta: float, tb: float, depth: int = 0, ops=None) -> np.ndarray:
