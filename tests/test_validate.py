@@ -270,9 +270,17 @@ def test_massless_gears_use_floors_without_changing_the_loads():
 
 def test_bang_bang_law_corners_are_extrapolated():
     """Acceleration jumps (t0, T/2, T): the samples there take the simulated loads of the side
-    the law's value belongs to."""
-    v, _ = check(planetary(profile=bang_bang))
+    the law's value belongs to, extrapolated from the nearest steps outside the ones the jump
+    spoils (loads.SPOILED_BEFORE .. SPOILED_AFTER); the other samples among those are left
+    out: with 4 steps per sample, the one after t0 (4 steps after its jump) and the one after
+    T/2 (the law's value at T/2 is the braking side: its jump is on T/2's own step)."""
+    model = planetary(profile=bang_bang)
+    a = analyse(model, GRID)
+    v = validate(model, a, (a.max_force, a.max_moment))
+    assert v.passed and v.force_residual < 1e-3 and v.moment_residual < 1e-3, v.reasons
+    assert round(float(GRID[1] - GRID[0]) / v.dt) == 4
     assert v.extrapolated_samples == 3
+    assert np.flatnonzero(~v.measured).tolist() == [1, 126] and v.excluded_samples == 2
 
 
 def test_moment_point_other_than_origin():
@@ -439,3 +447,32 @@ def test_trapezoidal_law_corners_between_samples_are_left_out_and_counted():
         assert v.passed, v.reasons
         assert 0 < v.excluded_samples <= 16
         assert v.force_residual < 0.01 and v.moment_residual < 0.01
+
+
+@pytest.mark.parametrize("kind", ["left", "right"])
+def test_a_jump_sample_is_extrapolated_from_the_steps_the_jump_leaves_alone(kind):
+    """_on_grid on a synthetic run: loads linear on each side of an acceleration jump on sample 5
+    (step 20 of a step a second, a sample every 4 steps), and garbage on the steps the jump
+    spoils. The jump's sample gets its side's line exactly (extrapolated from the nearest clean
+    steps), the other samples among the spoiled steps are left out, the rest are read as they
+    are. (The 3-RPR's counter-rotations on a bang-bang law failed at 9.4 % of the reference
+    moment from the second and third steps after the jump, which its gears had not settled.)"""
+    from types import SimpleNamespace
+
+    from balpipe.validate.loads import SPOILED_AFTER, SPOILED_BEFORE, _on_grid
+
+    steps = np.arange(41.0)
+    k = 21 if kind == "left" else 20  # the jump is between steps k - 1 and k
+    line = np.where(steps < k, 2.0 + 0.1 * steps, 10.0 - 0.3 * steps)
+    spoiled = (steps >= k - SPOILED_BEFORE) & (steps <= k + SPOILED_AFTER)
+    load = np.where(spoiled, 1e3 * np.sin(steps), line)
+    run = SimpleNamespace(t=steps, force=np.column_stack([load, -load]), moment=load)
+    t = steps[::4]
+    kinds = ["smooth"] * len(t)
+    kinds[5] = kind
+    F, M, measured, extrapolated = _on_grid(run, SimpleNamespace(t=t), np.arange(0, 41, 4), kinds, 0, [k])
+    side = 2.0 + 0.1 * 20 if kind == "left" else 10.0 - 0.3 * 20
+    assert extrapolated == 1 and M[5] == pytest.approx(side, abs=1e-12) and F[5].tolist() == pytest.approx([side, -side])
+    left_out = [i for i in range(len(t)) if spoiled[4 * i] and i != 5]
+    assert np.flatnonzero(~measured).tolist() == left_out and left_out
+    assert np.array_equal(M[measured & (np.arange(len(t)) != 5)], line[::4][measured & (np.arange(len(t)) != 5)])
