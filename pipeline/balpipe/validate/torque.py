@@ -52,7 +52,7 @@ import numpy as np
 
 from ..engine import Analysis, analyse
 from ..model import Attachment, Model
-from .loads import _on_grid  # the same sampling of the loads as the position-driven check
+from .loads import _on_grid, loads_at  # the same sampling of the loads as the position-driven check
 from .run import SimulationRun, model_scale, simulate
 from .extend import continued, is_moving_start
 from .settings import HEALTH_LIMIT, ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings, jump_times
@@ -332,7 +332,9 @@ def _torque_driven_once(
     if skip:
         notes.append("moving at the start: the first sample is left out of the load residuals (pymunk's first step "
                      "lacks the correction of a running simulation)")
-    F, M, measured, _ = _on_grid(main, analysis, idx, kinds, skip, _jumps(analytic_model, main.t))
+    exact = loads_at(analytic_model, analysis)
+    F, M, measured, _ = _on_grid(main, analysis, idx, kinds, skip, _jumps(analytic_model, main.t),
+                                 lambda steps: exact(main.t[steps]))
     ferr = np.linalg.norm(F - analysis.force, axis=1)[measured]
     merr = np.abs(M - analysis.moment)[measured]
     fres = float(np.max(ferr)) / F0 if ferr.size else math.inf
