@@ -510,3 +510,25 @@ def test_random_slider_cranks_on_laws_with_corners_pass_every_stage(law, seed):
         corners = [i for i, k in enumerate(_law_kinds(s.stage.model, v.t)) if k != "smooth" and v.measured[i]]
         others = np.delete(np.abs(v.moment_error), corners)[np.delete(v.measured, corners)]
         assert corners and np.max(err) <= 10 * np.max(others), (s.stage.name, np.max(err), np.max(others))
+
+
+def test_a_fast_smooth_rise_is_no_kink_and_its_ends_are():
+    """A cam's 3-4-5 rise to 90 deg on 0.35 of a 0.5 s period, two periods: the jerk jumps where
+    the rises and returns start and end (0, 0.175, 0.25, 0.425 s, ...) and nowhere else. The
+    former test (a change of the jerk across the sample above 1e-9 of the largest acceleration)
+    took the rises' fast but smooth snap for kinks: 180 of 501 samples, each extrapolated from
+    steps across the true kink (an offset slider-crank's counterweights failed at 1.08e-2 of the
+    reference moment; 1.6e-3 since)."""
+    from types import SimpleNamespace
+
+    from balpipe.laws.periodic import Cam
+
+    law = Cam(0.0, math.pi / 2, 0.5, profile="quintic", rise=0.35, dwell_high=0.15, ret=0.35)
+    model = SimpleNamespace(drivers=[SimpleNamespace(law=law)])
+    times = np.linspace(0.0, 1.0, 501)
+    kinds = _law_kinds(model, times)
+    corners = {round(t, 6) for t in (0.0, 0.175, 0.25, 0.425, 0.5, 0.675, 0.75, 0.925, 1.0)}
+    flagged = [round(float(t), 6) for t, k in zip(times, kinds) if k != "smooth"]
+    assert flagged and set(flagged) <= corners, flagged
+    assert {0.0, 0.25, 0.5, 0.75} <= set(flagged)  # the corners on samples (0.175 falls between)
+    assert all(k in ("smooth", "kink") for k in kinds)

@@ -165,11 +165,18 @@ def _law_kinds(model: Model, times: np.ndarray) -> list[str]:
         a_m, a_0, a_p = (np.asarray(x, dtype=float) for x in (a_m, a_0, a_p))
         scale = float(np.max(np.abs(a_0))) or 1.0
         # a smooth law changes its acceleration by ~ jerk * delta ~ 1e-6 scale across the
-        # sample, and its jerk by ~ 1e-6 jerk: a thousand times that is a corner
+        # sample: a thousand times that is a jump
         dm, dp = a_0 - a_m, a_p - a_0
         jump = np.maximum(np.abs(dm), np.abs(dp)) > 1e-3 * scale
         left_ok = np.abs(dm) <= 1e-3 * scale
-        kink = np.abs(dp - dm) > 1e-9 * scale
+        # its jerk changes across the sample by snap * delta, a kink's by the jerk's jump: a
+        # kink is a change of more than 1e-3 of the law's largest jerk (at least scale / T).
+        # (Not 1e-9 of the acceleration: the snap of a fast rise inside a long motion passed
+        # that, and a cam's 3-4-5 rises of 0.175 s in a 1 s motion were 180 "kinks", each
+        # extrapolated from steps across the true kink at the rise's end.)
+        smooth_jerk = np.maximum(np.abs(dm), np.abs(dp))[~jump] / delta
+        jerk_scale = max(float(np.max(smooth_jerk)) if smooth_jerk.size else 0.0, scale / T)
+        kink = np.abs(dp - dm) / delta > 1e-3 * jerk_scale
         for i in range(len(times)):
             if jump[i]:
                 side = "left" if left_ok[i] else "right"
