@@ -72,6 +72,18 @@ class ValidationSettings:
 
 
 
+#: halvings of the step tried on a run that fails on its numbers alone (position-driven residuals,
+#: torque-driven tracking), while each shrinks its error as an integration error shrinks
+MAX_HALVINGS = 3
+#: how much a halving must shrink the error for it to be the step's (second order: 4x)
+STEP_ERROR_RATIO = 3.0
+
+
+def step_trail(trail: list[tuple[float, float]]) -> str:
+    """``[(dt, error), ...]`` as the notes give it: "0.007 at 0.625 ms, 0.0017 at 0.3125 ms"."""
+    return ", ".join(f"{e:.2g} at {1e3 * dt:.4g} ms" for dt, e in trail)
+
+
 def default_settings(model: Model, analysis: Analysis) -> tuple[float, int]:
     """Default (dt, iterations) for a model and motion.
 

@@ -55,7 +55,8 @@ from ..model import Attachment, Model
 from .loads import _on_grid, loads_at  # the same sampling of the loads as the position-driven check
 from .run import SimulationRun, model_scale, simulate
 from .extend import continued, is_moving_start
-from .settings import HEALTH_LIMIT, ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings, jump_times
+from .settings import (HEALTH_LIMIT, ITERATIONS, MAX_HALVINGS, STEP_ERROR_RATIO, ValidationSettings, _jumps, _law_kinds,
+                       _step_grid, default_settings, jump_times, step_trail)
 from .space import build_space
 from .verdict import Verdict
 
@@ -410,24 +411,19 @@ def torque_driven(
     return _finer_steps(r, model, analysis, settings, kw)
 
 
-#: halvings of the step tried on a torque-driven run whose tracking error fails
-MAX_HALVINGS = 3
-#: how much a halving must shrink the tracking error for it to be the step's (second order: 4x)
-STEP_ERROR_RATIO = 3.0
-
-
 def _finer_steps(r: TorqueDriven, model: Model, analysis: Analysis, settings: ValidationSettings,
                  kw: dict) -> TorqueDriven:
     """A run that fails on its tracking error alone is run again at half the step while the
     error shrinks as the integrator's does (at least :data:`STEP_ERROR_RATIO` times per
     halving; it is second order), up to :data:`MAX_HALVINGS` times; the last such run is kept and
     says so. An error that does not shrink is the efforts' (a model error): the first run is kept,
-    with the finer step's error in its notes. Open loop, a step's error is carried and amplified
+    with the finer step's error in its notes. Not where ``settings.dt`` is given (a spec's
+    ``validation.dt``): that step is the one used. Open loop, a step's error is carried and amplified
     to the end: a Stephenson six-bar on a cam law with dwells, two cycles, tracked to 7.0e-3 of
     its travel at the position-driven check's step (0.625 ms), 1.7e-3 at half of it."""
     tol = settings.tracking_tolerance
-    if r.passed or not math.isfinite(r.tracking_error_max) or r.tracking_error_max <= tol:
-        return r
+    if r.passed or settings.dt or not math.isfinite(r.tracking_error_max) or r.tracking_error_max <= tol:
+        return r  # a step the spec gives (validation.dt) is the step used
     trail = [(r.dt, r.tracking_error_max)]
     best, spent = r, r.timing.get("total_s", 0.0)
     for _ in range(MAX_HALVINGS):
@@ -439,7 +435,7 @@ def _finer_steps(r: TorqueDriven, model: Model, analysis: Analysis, settings: Va
         best = finer
         if best.tracking_error_max <= tol:
             break
-    steps = ", ".join(f"{e:.2g} at {1e3 * dt:.4g} ms" for dt, e in trail)
+    steps = step_trail(trail)
     if best is r:
         r.notes.append(f"tracking error {steps}: a finer step does not shrink it as an integration error shrinks")
     else:
