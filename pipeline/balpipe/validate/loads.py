@@ -139,8 +139,8 @@ from ..engine import Analysis, analyse
 from ..model import Model
 from .extend import continued, settling_steps
 from .run import SimulationRun, model_scale, _relative_poses, _run_adaptive
-from .settings import (MAX_HALVINGS, MAX_ITERATIONS, STEP_ERROR_RATIO, ValidationSettings, _jumps, _law_kinds,
-                       _step_grid, default_settings, step_trail)
+from .settings import (MAX_ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings,
+                       halve_while_shrinking)
 from .verdict import Verdict
 
 @dataclass
@@ -356,8 +356,8 @@ def validate(
     reference=None,
 ) -> StageValidation:
     """:func:`_validate_once`; a run that fails on its residuals is run again at half the step
-    while each halving shrinks its largest residual at least :data:`STEP_ERROR_RATIO` times (the
-    momentum differences are second order in the step), up to :data:`MAX_HALVINGS` times, and
+    while each halving shrinks its largest residual at least :data:`.settings.STEP_ERROR_RATIO` times (the
+    momentum differences are second order in the step), up to :data:`.settings.MAX_HALVINGS` times, and
     the last such run is kept, saying so; a residual that does not shrink is the design's or the
     analysis' and fails as it was, its notes giving the finer step's residual. Not where
     ``settings.dt`` is given (a spec's ``validation.dt``): that step is the one used. The slider-driven
@@ -372,24 +372,9 @@ def validate(
 
     if v.passed or settings.dt or not math.isfinite(worst(v)) or worst(v) <= settings.tolerance:
         return v  # a step the spec gives (validation.dt) is the step used
-    trail, best, spent = [(v.dt, worst(v))], v, v.timing.get("total_s", 0.0)
-    for _ in range(MAX_HALVINGS):
-        finer = _validate_once(model, analysis, unbalanced_peaks, replace(settings, dt=best.dt / 2.0), expect, reference)
-        spent += finer.timing.get("total_s", 0.0)
-        trail.append((finer.dt, worst(finer)))
-        if not worst(finer) * STEP_ERROR_RATIO <= worst(best):
-            break
-        best = finer
-        if best.passed:
-            break
-    if best is v:
-        v.notes.append(f"largest residual {step_trail(trail)}: a finer step does not shrink it as an integration "
-                       "error shrinks")
-    else:
-        best.notes.append(f"largest residual {step_trail(trail)} (the step's error, second order): kept the run at "
-                          f"{1e3 * best.dt:.4g} ms")
-    best.timing["total_s"] = spent
-    return best
+    return halve_while_shrinking(
+        v, lambda dt: _validate_once(model, analysis, unbalanced_peaks, replace(settings, dt=dt), expect, reference),
+        worst, lambda x: x.passed, "largest residual")
 
 
 def _validate_once(

@@ -79,9 +79,31 @@ MAX_HALVINGS = 3
 STEP_ERROR_RATIO = 3.0
 
 
-def step_trail(trail: list[tuple[float, float]]) -> str:
-    """``[(dt, error), ...]`` as the notes give it: "0.007 at 0.625 ms, 0.0017 at 0.3125 ms"."""
-    return ", ".join(f"{e:.2g} at {1e3 * dt:.4g} ms" for dt, e in trail)
+def halve_while_shrinking(first, rerun, error, good, what: str):
+    """The run at a finer step, where ``first`` fails on its numbers alone (``error(first)``
+    finite): ``rerun(dt)`` at half the step while each halving shrinks ``error`` at least
+    :data:`STEP_ERROR_RATIO` times (an integration error of second order shrinks 4x), up to
+    :data:`MAX_HALVINGS` times or until ``good(run)``. Returns the last run that shrank so, with a
+    note of each step's ``what`` ("tracking error 0.007 at 0.625 ms, 0.0017 at 0.3125 ms (the
+    step's error, second order): kept the run at 0.3125 ms"), or ``first`` noted that a finer step
+    does not shrink it. Runs have ``dt``, ``notes`` and ``timing["total_s"]`` (summed)."""
+    trail, best, spent = [(first.dt, error(first))], first, first.timing.get("total_s", 0.0)
+    for _ in range(MAX_HALVINGS):
+        finer = rerun(best.dt / 2.0)
+        spent += finer.timing.get("total_s", 0.0)
+        trail.append((finer.dt, error(finer)))
+        if not error(finer) * STEP_ERROR_RATIO <= error(best):
+            break
+        best = finer
+        if good(best):
+            break
+    steps = ", ".join(f"{e:.2g} at {1e3 * dt:.4g} ms" for dt, e in trail)
+    if best is first:
+        first.notes.append(f"{what} {steps}: a finer step does not shrink it as an integration error shrinks")
+    else:
+        best.notes.append(f"{what} {steps} (the step's error, second order): kept the run at {1e3 * best.dt:.4g} ms")
+    best.timing["total_s"] = spent
+    return best
 
 
 def default_settings(model: Model, analysis: Analysis) -> tuple[float, int]:

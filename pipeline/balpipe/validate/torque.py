@@ -55,8 +55,8 @@ from ..model import Attachment, Model
 from .loads import _on_grid, loads_at  # the same sampling of the loads as the position-driven check
 from .run import SimulationRun, model_scale, simulate
 from .extend import continued, is_moving_start
-from .settings import (HEALTH_LIMIT, ITERATIONS, MAX_HALVINGS, STEP_ERROR_RATIO, ValidationSettings, _jumps, _law_kinds,
-                       _step_grid, default_settings, jump_times, step_trail)
+from .settings import (HEALTH_LIMIT, ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings,
+                       halve_while_shrinking, jump_times)
 from .space import build_space
 from .verdict import Verdict
 
@@ -414,8 +414,8 @@ def torque_driven(
 def _finer_steps(r: TorqueDriven, model: Model, analysis: Analysis, settings: ValidationSettings,
                  kw: dict) -> TorqueDriven:
     """A run that fails on its tracking error alone is run again at half the step while the
-    error shrinks as the integrator's does (at least :data:`STEP_ERROR_RATIO` times per
-    halving; it is second order), up to :data:`MAX_HALVINGS` times; the last such run is kept and
+    error shrinks as the integrator's does (at least :data:`.settings.STEP_ERROR_RATIO` times per
+    halving; it is second order), up to :data:`.settings.MAX_HALVINGS` times; the last such run is kept and
     says so. An error that does not shrink is the efforts' (a model error): the first run is kept,
     with the finer step's error in its notes. Not where ``settings.dt`` is given (a spec's
     ``validation.dt``): that step is the one used. Open loop, a step's error is carried and amplified
@@ -424,22 +424,6 @@ def _finer_steps(r: TorqueDriven, model: Model, analysis: Analysis, settings: Va
     tol = settings.tracking_tolerance
     if r.passed or settings.dt or not math.isfinite(r.tracking_error_max) or r.tracking_error_max <= tol:
         return r  # a step the spec gives (validation.dt) is the step used
-    trail = [(r.dt, r.tracking_error_max)]
-    best, spent = r, r.timing.get("total_s", 0.0)
-    for _ in range(MAX_HALVINGS):
-        finer = _torque_driven_once(model, analysis, settings, **{**kw, "dt": best.dt / 2.0, "plan": None})
-        spent += finer.timing.get("total_s", 0.0)
-        trail.append((finer.dt, finer.tracking_error_max))
-        if not finer.tracking_error_max * STEP_ERROR_RATIO <= best.tracking_error_max:
-            break
-        best = finer
-        if best.tracking_error_max <= tol:
-            break
-    steps = step_trail(trail)
-    if best is r:
-        r.notes.append(f"tracking error {steps}: a finer step does not shrink it as an integration error shrinks")
-    else:
-        best.notes.append(f"tracking error {steps} (the step's error, second order): kept the run at "
-                          f"{1e3 * best.dt:.4g} ms")
-    best.timing["total_s"] = spent
-    return best
+    return halve_while_shrinking(
+        r, lambda dt: _torque_driven_once(model, analysis, settings, **{**kw, "dt": dt, "plan": None}),
+        lambda x: x.tracking_error_max, lambda x: x.tracking_error_max <= tol, "tracking error")
