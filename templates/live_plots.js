@@ -23,17 +23,24 @@
   }
   // an axis's tick labels: uPlot's own (at most 3 decimals: a residual of 1e-5 read "0"), in
   // exponent form when the ticks are all below 1e-3 or from 1e6; on a log axis (p.log) the powers
-  // of ten only
+  // of ten only, every k-th of them so that labels stay LOG_LABEL_PX apart (a residual over 15
+  // decades had a label every 9 px, overprinted). The plotting area's height is the plot's less
+  // its title and time axis (the canvas is not sized yet when uPlot first asks for labels)
   const num = uPlot.fmtNum || (v => String(v));
+  const LOG_LABEL_PX = 14, TITLE_AND_AXIS_PX = 100;
   function ticks(log) {
     return (u, vals) => {
       const big = Math.max(0, ...vals.map(v => Math.abs(v || 0)));
       const exp = big !== 0 && (big < 1e-3 || big >= 1e6);
+      const sc = u.scales.y || {};
+      const decades = log && sc.min > 0 && sc.max > sc.min ? Math.log10(sc.max / sc.min) : 1;
+      const every = Math.max(1, Math.ceil(decades * LOG_LABEL_PX / Math.max(u.height - TITLE_AND_AXIS_PX, 40)));
       return vals.map(v => {
         if (v == null) return "";
         if (!log) return exp && v !== 0 ? v.toExponential(1) : num(v);
         const e = Math.round(Math.log10(v));
-        return Math.abs(Math.log10(v) - e) > 1e-6 ? "" : Math.abs(e) >= 3 ? "1e" + e : num(v);
+        if (Math.abs(Math.log10(v) - e) > 1e-6 || e % every !== 0) return "";
+        return Math.abs(e) >= 3 ? "1e" + e : num(v);
       });
     };
   }

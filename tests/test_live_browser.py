@@ -147,6 +147,11 @@ def simulated_site(tmp_path_factory) -> Path:
 
 
 _TICKS = "el => el.uplots.map(u => u.axes[1]._values.filter(v => v !== ''))"
+# per plot: the decades its y axis spans and the CSS px between neighbouring tick labels
+_LABEL_GAPS = """el => el.uplots.map(u => {
+  const ys = u.axes[1]._splits.filter((s, i) => u.axes[1]._values[i] !== '').map(s => u.valToPos(s, 'y'));
+  return [Math.log10(u.scales.y.max / u.scales.y.min), ys.slice(1).map((y, i) => Math.abs(y - ys[i]))];
+})"""
 
 
 def test_the_simulations_figures_are_interactive_with_readable_axes(simulated_site, browser):
@@ -203,3 +208,21 @@ def test_a_plot_drawn_before_the_layout_was_final_takes_its_panels_width(live_si
     fills = p.evaluate(_FILLS)
     assert len(fills) >= 4 and all(plot > 300 for _, _, plot in fills), fills
     assert not w.problems, w.problems
+
+
+def test_a_log_axis_over_many_decades_labels_every_kth_decade(tmp_path, browser):
+    """The pick-and-place cycle's residuals span 14 decades (a balanced stage's round-off against
+    the unbalanced peak): a label at every decade put them 10 px apart, overprinted; every k-th
+    decade keeps them at least 14 px apart (the paper 3-RPR's prismatic forces, 11 decades in a
+    shorter panel, were 13 px apart)."""
+    spec = tmp_path / "custom_pick_and_place_cycle.yaml"
+    spec.write_text((SPECS / "custom_pick_and_place_cycle.yaml").read_text())
+    out = tmp_path / "site"
+    outcomes = build([str(spec)], Options(out=out, simulate=True))
+    assert all(o.status == "ok" for o in outcomes), [o.message for o in outcomes]
+    w, p, d = _open(browser, out, "custom_pick_and_place_cycle", "live-residuals")
+    host = p.locator("#live-residuals")
+    host.scroll_into_view_if_needed()
+    spans = host.evaluate(_LABEL_GAPS)
+    assert max(decades for decades, _ in spans) > 12, spans
+    assert all(len(gaps) >= 3 and min(gaps) >= 13.5 for _, gaps in spans), spans
