@@ -190,7 +190,7 @@ def follow_motion(c: Compiled, t: np.ndarray, ops=None) -> np.ndarray:
     _check_square(c)
     N = len(t)
     start = min(float(t[0]), 0.0)
-    q, ok, _ = ops.newton(c.q0[None, :], np.array([start]) if start != t[0] else t[:1], max_iter=50)
+    q, ok, _ = ops.newton(c.q0[None, :], np.array([start]), max_iter=50)
     if not ok[0]:
         err = AnalysisError(
             f"cannot assemble the mechanism at t = {start:g}: " + str(_fail_position(c, q[0], start)).split(": ", 1)[1],

@@ -377,14 +377,8 @@ def validate(
         worst, lambda x: x.passed, "largest residual")
 
 
-def _validate_once(
-    model: Model,
-    analysis: Analysis,
-    unbalanced_peaks: tuple[float, float],
-    settings: ValidationSettings | None = None,
-    expect: tuple[str, ...] = (),
-    reference=None,
-) -> StageValidation:
+def _validate_once(model: Model, analysis: Analysis, unbalanced_peaks: tuple[float, float],
+                   settings: ValidationSettings, expect: tuple[str, ...], reference) -> StageValidation:
     """Simulate ``model`` in pymunk along ``analysis``' motion and compare the loads.
 
     ``unbalanced_peaks`` = (F0, M0): the unbalanced stage's analytic peak force and moment,
@@ -395,7 +389,6 @@ def _validate_once(
     :class:`balpipe.load_reference.LoadReference`, whose loads then replace ``unbalanced_peaks``
     as the denominators (the unbalanced peaks floored by the model's gross inertial loads).
     """
-    settings = settings or ValidationSettings()
     wall0 = time.perf_counter()
     model = continued(model, analysis)
     dt_default, it_default = default_settings(model, analysis)
