@@ -1,5 +1,5 @@
 """``balpipe --help`` and ``balpipe check`` of a spec load only what they need (issue 23 item 4):
-no scipy, matplotlib, pymunk, jinja2, cvxpy or dask. Each runs in a fresh interpreter, so what
+no scipy, matplotlib, pymunk, jinja2, cvxpy, Clarabel or dask. Each runs in a fresh interpreter, so what
 another test imported cannot hide an import."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-HEAVY = ("scipy", "matplotlib", "pymunk", "jinja2", "cvxpy", "distributed", "dask")
+HEAVY = ("scipy", "matplotlib", "pymunk", "jinja2", "cvxpy", "clarabel", "distributed", "dask")
 
 PROBE = """
 import json, sys

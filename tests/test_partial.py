@@ -15,6 +15,7 @@ from balpipe import registry, study
 from balpipe.balancing import partial as P
 from balpipe.balancing import partial_fronts as PF
 from balpipe.balancing import partial_maps as PM
+from balpipe.balancing.partial_active import ActiveProgram
 from balpipe.engine import analyse
 from balpipe.spec import Spec
 from balpipe.spec_parts import SpecFieldError
@@ -253,35 +254,71 @@ def test_budget_sensitivity_is_the_fronts_slope():
     maps = setup(spec)
     program, out, terms, *_ = P.solve(maps, spec.balancing)
     h = 1e-4
-    prob, *_ = program.problem(terms)
-    program.mass_budget.value = 0.5 + h
-    up = program.solve(prob).objective
+    up = program.solve(terms, 0.5 + h).objective
     assert out.budget_dual < 0
     assert out.budget_dual == pytest.approx((up - out.objective) / h, rel=1e-3)
 
 
-def test_fronts_reuse_one_compiled_problem_per_term_with_the_same_numbers():
-    """Program.least_at re-solves the one compiled problem of its term (after a front solved it at
-    other budgets) by a new solver: bit for bit the optimum of a problem compiled for it alone; a
-    second front asking for the same optimum gets it without solving again."""
+def test_the_tradeoff_fronts_ends_are_the_least_of_each_term_solved_once():
+    """ActiveProgram.least_at solves each term's optimum at a budget once (both trade-off fronts
+    and forked workers share it); the trade-off front runs from one end to the other."""
     rng = np.random.default_rng(5)
     spec = Spec.model_validate(four_bar(rng, method(SEGMENTS + [POLYGON], budget=0.6)))
     maps = setup(spec)
-    program = P.Program(maps)
+    program = ActiveProgram(maps)
     terms = P.standard_terms(maps)
     force, moment = terms["shaking_force"], terms["shaking_moment"]
     front = PF.mass_front(program, force, np.linspace(0.0, 1.2, 4), terms)
-    assert len(front) == 4 and program.least(force) is program.least(force)
+    assert len(front) == 4
     for term in (force, moment):
-        program.mass_budget.value = 0.6
-        ref = program.solve(program.problem([term])[0], polish=[term])
         got = program.least_at(term, 0.6)
-        assert np.array_equal(got.z, ref.z) and (got.objective, got.budget_dual) == (ref.objective, ref.budget_dual)
         assert program.least_at(term, 0.6) is got
-    # the trade-off front's ends are those optima
+        assert got.objective == pytest.approx(ActiveProgram(maps).solve([term], 0.6).objective, rel=1e-9, abs=1e-12)
     pts = PF.tradeoff_front(program, force, moment, 0.6, 3, terms)
     assert pts[0]["cap"] == pytest.approx(moment.value(program.least_at(moment, 0.6).z), rel=1e-12)
     assert pts[-1]["shaking_force"] == pytest.approx(force.value(program.least_at(force, 0.6).z), rel=1e-6)
+    assert pts[0]["shaking_force"] >= pts[1]["shaking_force"] >= pts[-1]["shaking_force"] * (1 - 1e-9)
+
+
+def test_fronts_report_the_pareto_designs_not_any_optimal_one():
+    """Where several designs share a front point's optimum, the front reports the one a designer
+    would pick: past the complete force balance, the force front's designs are the least
+    complete balance (not a heavier one that leaves budget unused); the trade-off front ends at
+    the least second term of the designs where the first is least; no point dominates another."""
+    rng = np.random.default_rng(12)
+    spec = Spec.model_validate(four_bar(rng, method(DISCS, budget=0.6)))  # discs: the force can be balanced
+    maps = setup(spec)
+    program = ActiveProgram(maps)
+    terms = P.standard_terms(maps)
+    force, effort = terms["shaking_force"], terms["effort"]
+    complete = PF.least_complete_mass(program, [force])
+    assert complete is not None
+    masses = np.array([0.5, 1.0, 1.5, 2.0]) * complete[0]
+    front = PF.mass_front(program, force, masses, terms)
+    for p in front[2:]:  # budgets past the complete balance
+        assert p["shaking_force"] <= 1e-7 * force.scale
+        assert p["added_mass"] == pytest.approx(complete[0], rel=1e-6)
+    assert front[0]["added_mass"] == pytest.approx(masses[0], rel=1e-6)  # short of it, the budget is used
+    pts = PF.tradeoff_front(program, effort, force, 0.6, 6, terms)
+    least_effort = program.least_at(effort, 0.6)
+    assert pts[-1]["cap"] <= force.value(least_effort.z) * (1 + 1e-7)
+    assert pts[-1]["effort"] == pytest.approx(effort.value(least_effort.z), rel=1e-6)
+    for p, q in zip(pts, pts[1:]):
+        assert q["cap"] >= p["cap"] and q["effort"] <= p["effort"] * (1 + 1e-7)
+        assert not (q["effort"] < p["effort"] * (1 - 1e-7) and q["shaking_force"] < p["shaking_force"] * (1 - 1e-7) - 1e-9)
+
+
+def test_an_optimum_below_the_budget_is_its_lightest_design():
+    """A budget larger than the complete force balance needs: the optimum (zero force) is the
+    least-mass complete balance, not a heavier design that spends the budget."""
+    rng = np.random.default_rng(12)
+    spec = Spec.model_validate(four_bar(rng, method(DISCS, budget=5.0)))
+    maps = setup(spec)
+    program, out, terms, _ = P.solve(maps, spec.balancing)
+    complete = PF.least_complete_mass(ActiveProgram(maps), [terms[0]])
+    assert terms[0].value(out.z) <= 1e-7 * terms[0].scale
+    assert maps.added_mass(out.z) == pytest.approx(complete[0], rel=1e-6)
+    assert maps.added_mass(out.z) < 0.5 * 5.0
 
 
 def test_scaling_masses_scales_the_optimal_loads():
@@ -348,10 +385,15 @@ def test_non_convex_polygon_and_unknown_joint_are_located():
     assert err.value.path == ("balancing", "objective", 0, "joint")
 
 
-def test_spec_module_does_not_load_cvxpy():
-    code = "import sys, balpipe.spec, balpipe.registry; print('cvxpy' in sys.modules)"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "False"
+def test_a_partial_balancing_loads_no_cvxpy_and_the_spec_no_solver():
+    """The cone programmes go to Clarabel directly (cvxpy is the tests' reference only); the spec
+    module loads no solver at all."""
+    code = ("import sys, balpipe.spec, balpipe.registry; print('clarabel' in sys.modules);"
+            "from balpipe.loader import load; balpipe.registry.balance(load(sys.argv[1]).spec);"
+            "print('clarabel' in sys.modules, 'cvxpy' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code, str(ROOT / "specs" / "partial_offset_slider_crank.yaml")],
+                         capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False", "True", "False"]
 
 
 def test_documented_example_runs():

@@ -12,6 +12,7 @@ from balpipe import build as build_mod
 from balpipe import pool
 from balpipe.balancing import partial as P
 from balpipe.balancing import partial_fronts as PF
+from balpipe.balancing.partial_active import ActiveProgram
 from balpipe.spec import Spec
 from generic_specs import four_bar
 from test_partial import POLYGON, SEGMENTS, method, setup
@@ -34,7 +35,7 @@ def test_fronts_on_two_workers_equal_the_fronts_one_after_another(monkeypatch):
     for workers in (1, 2):
         maps = setup(spec)
         with pool.spare_workers(workers):
-            out.append(PF.compute(P.Program(maps), P.standard_terms(maps), 0.7, 6, None))
+            out.append(PF.compute(ActiveProgram(maps), P.standard_terms(maps), 0.7, 6, None))
     assert seen == [1, 2]
     assert pool.spare() == 1  # the block's setting undone
     assert list(out[0]) == ["points", "max_mass", "budget", "complete_force", "complete_force_moment",

@@ -10,7 +10,7 @@ finder's check, :func:`balpipe.families.rrr4.finder.check`; a design's peak shak
 :func:`balpipe.families.rrr4.counter_masses.peak_inertial_force`), and paper 003's phi
 optimisation (:func:`balpipe.families.serial_arm.com_planning.phi_search`). The key
 (:func:`balpipe.content_cache.key`) is the function's name and arguments, balpipe's code hash
-and the versions of the libraries that compute the numbers (numpy, scipy, cvxpy, Clarabel); the
+and the versions of the libraries that compute the numbers (numpy, scipy, Clarabel); the
 result is kept as a pickle in ``<out>/.cache/balance/<slug>/<sha256>.pickle``, looked up in the
 spec's folder, then in the other specs' of the same output folder, with the checksum, atomic
 writes, refusal of symlinks, pruning and per-key locks of :class:`balpipe.content_cache.PickleStore`.
@@ -29,7 +29,7 @@ from . import content_cache
 
 BALANCE = "balance"
 #: the libraries whose versions are part of every key (they produce the numbers)
-LIBRARIES = ("numpy", "scipy", "cvxpy", "clarabel")
+LIBRARIES = ("numpy", "scipy", "clarabel")
 
 
 class Store(content_cache.PickleStore):
@@ -41,8 +41,8 @@ class Store(content_cache.PickleStore):
 
 
 def environment() -> str:
-    """The installed versions of :data:`LIBRARIES` (from their metadata: cvxpy is not imported for
-    a spec that does not solve a cone programme)."""
+    """The installed versions of :data:`LIBRARIES` (from their metadata: Clarabel is not imported
+    for a spec that does not solve a cone programme)."""
     return content_cache.library_versions(LIBRARIES)
 
 

@@ -1,6 +1,6 @@
 """The ``partial_balance`` method, for any model (``custom`` included): counterweights in regions
 of named links and counter-rotating discs chosen by a second-order cone programme
-(:mod:`.partial_program`) on the affine maps of the loads (:mod:`.partial_maps`), to global
+(:mod:`.partial_program`, solved by :mod:`.partial_active`) on the affine maps of the loads (:mod:`.partial_maps`), to global
 optimality at the analysed motion; Pareto fronts (:mod:`.partial_fronts`) for the page.
 
 Several motions at once (``motions``: the same machine at other speeds, other trajectories): each
@@ -37,7 +37,8 @@ from .base import BalanceResult, Parameter, Stage
 from .force_balance import _point, counterweight_notation, regions_from_spec
 from .moment_balance import add_discs, counter_rotation_notation
 from .partial_maps import NO_PART, DiscVars, Maps, PartVars, build
-from .partial_program import Program, Term
+from .partial_active import ActiveProgram
+from .partial_program import Term
 from .partial_spec import PartialBalance, PartialCounterweightSpec
 from .regressor import model_size
 
@@ -123,17 +124,9 @@ def standard_terms(maps: Maps | Sequence[Maps]) -> dict[str, Term]:
     return out
 
 
-def _infeasible(program: Program, caps: list, method: PartialBalance) -> SpecFieldError:
+def _infeasible(program: ActiveProgram, caps: list, method: PartialBalance) -> SpecFieldError:
     """Why nothing meets the caps within the budget: the least mass that does, if any."""
-    cp = program.cp
-    masses = sum((program.z[p.col] for p in program.maps.parts), start=0.0)
-    program.mass_budget.value = PF.UNBOUNDED
-    cons = list(program.base)
-    for t, b in caps:
-        e, c = program.expression(t)
-        cons += c + [e <= b]
-    prob = cp.Problem(cp.Minimize(masses), cons)
-    out = program.solve(prob)
+    out = program.least_mass(caps=caps)
     what = "; ".join(f"{t.label} <= {b:g} x unbalanced" for t, b in caps)
     if out.z is None:
         return SpecFieldError(ROOT + ("caps",), f"no design of these parts (within their bounds) meets the caps ({what}) at any added mass")
@@ -144,23 +137,27 @@ def _infeasible(program: Program, caps: list, method: PartialBalance) -> SpecFie
 
 def solve(maps: Maps | Sequence[Maps], method: PartialBalance):
     """The optimum over one motion's maps or several: (program, outcome, objective terms, caps as
-    (term, bound), the caps' constraints)."""
-    program = Program(_motions(maps)[0], method.budget.inertia)
+    (term, bound)). Where it leaves part of the budget unused (more mass would not help), the
+    design is the lightest with each objective term at its optimal value and the caps met, not
+    whichever of the optimal designs the solver returned."""
+    program = ActiveProgram(_motions(maps)[0], method.budget.inertia)
     objective = [term_of(maps, t, t.weight) for t in method.objective]
     caps = []
     for c in method.caps:
         t = term_of(maps, c)
         caps.append((t, c.at_most if c.relative else c.at_most / t.scale))
-    prob, cap_cons, _ = program.problem(objective, caps)
-    program.mass_budget.value = float(method.budget.mass)
-    out = program.solve(prob, polish=objective)
+    budget = float(method.budget.mass)
+    out = program.solve(objective, budget, eps=caps, polish=objective)
     if out.z is None:
         raise _infeasible(program, caps, method) if caps else SpecFieldError(
             ROOT + ("budget", "mass"), f"no design within the budget ({out.status})")
-    return program, out, objective, caps, cap_cons
+    if program.maps.added_mass(out.z) < budget - PF.UNUSED * max(budget, 1.0):  # the lightest of the optimal designs
+        kept = [(t, t.value(out.z) / t.scale) for t in objective]
+        out = replace(out, z=PF.least_mass_within(program, kept, out.z, caps))
+    return program, out, objective, caps
 
 
-def active_constraints(program: Program, z: np.ndarray, method: PartialBalance, caps: list) -> list[str]:
+def active_constraints(program: ActiveProgram, z: np.ndarray, method: PartialBalance, caps: list) -> list[str]:
     maps = program.maps
     out = []
     if maps.added_mass(z) >= method.budget.mass * (1 - ACTIVE) - 1e-12:
@@ -169,10 +166,9 @@ def active_constraints(program: Program, z: np.ndarray, method: PartialBalance, 
         used = sum(z[p.col + 3] for p in maps.parts) + sum(z[d.col] for d in maps.discs)
         if used >= method.budget.inertia * (1 - ACTIVE) - 1e-15:
             out.append(f"inertia budget ({method.budget.inertia:.6g} kg m^2)")
-    for name, _, bound in program.part_caps:
-        col = next((p.col for p in maps.parts if p.name == name), None)
-        col = col if col is not None else next(d.col for d in maps.discs if d.name == name)
-        if z[col] >= bound * (1 - ACTIVE):
+    bounds = [(p.name, p.col, p.max_mass) for p in maps.parts] + [(d.name, d.col, d.max_inertia) for d in maps.discs]
+    for name, col, bound in bounds:
+        if bound is not None and z[col] >= bound * (1 - ACTIVE):
             out.append(f"{name} at its bound ({bound:.6g})")
     for t, bound in caps:
         if t.value(z) / t.scale >= bound * (1 - ACTIVE):
@@ -207,7 +203,7 @@ def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None
     grid of each of ``method.motions`` (:func:`balpipe.registry.motion_model`)."""
     motions = motion_maps(model, t, method, spec, models)
     maps = motions[0]
-    program, out, objective, caps, _ = solve(motions, method)
+    program, out, objective, caps = solve(motions, method)
     z = out.z
     std = standard_terms(motions)
     design = maps.design(z)
@@ -225,7 +221,7 @@ def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None
         "peaks": {k: v.value(z) for k, v in std.items()},
         "unbalanced": {k: v.scale for k, v in std.items()},
         "status": out.status,
-        "solver": "cvxpy + Clarabel",
+        "solver": "Clarabel, active samples",
         "design": design_table(maps, z),
         "motions": PMo.per_motion(motions, PMo.names(method), objective, caps, std, z),
     }
@@ -246,7 +242,7 @@ def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None
         f"{len(motions)} motions ({', '.join(f'{n}: {len(m.t)} samples' for n, m in zip(PMo.names(method), motions))}; "
         "a term is the largest of its values on each motion)")
     notes = [
-        "Optimal partial balancing by a second-order cone programme (cvxpy, Clarabel) over "
+        "Optimal partial balancing by a second-order cone programme (Clarabel) over "
         f"{over}: objective {' + '.join(f'{x.weight:g} x {x.label}' for x in objective)} "
         f"(each divided by its unbalanced value) = {details['objective']:.6g} with {details['added_mass']:.6g} kg added; "
         f"active: {', '.join(active) or 'none'}; d objective / d budget = {out.budget_dual:.4g} per kg."

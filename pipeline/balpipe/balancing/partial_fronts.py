@@ -1,6 +1,6 @@
-"""Pareto fronts of a partial balancing, each a sequence of cone programmes on one compiled problem
-(epsilon-constraint: the mass budget or a cap on the other load is a cvxpy parameter, so each
-point re-solves without re-compiling):
+"""Pareto fronts of a partial balancing, each a sequence of cone programmes (epsilon-constraint:
+the mass budget, or a cap on the other load), solved on their active samples
+(:class:`.partial_active.ActiveProgram`: a front's points share the samples they need):
 
 * shaking force against added mass, and shaking moment against added mass (budget 0 .. max);
 * shaking force against shaking moment, and actuator effort against shaking force, at the spec's
@@ -12,7 +12,9 @@ linear equations (:func:`.least_mass.independent_equations`), the added mass min
 
 :func:`fronts` computes them from plain data (the load maps and the settings) on a programme of
 its own, so that a build reads them from its cache when those did not change
-(:mod:`balpipe.balance_cache`).
+(:mod:`balpipe.balance_cache`). Every optimum is the whole programme's to Clarabel's tolerance
+(1e-10 of the unbalanced loads, 1e-8 where it stalls); the loads reported are the designs' own,
+on every sample.
 """
 
 from __future__ import annotations
@@ -20,11 +22,12 @@ from __future__ import annotations
 import numpy as np
 
 from .least_mass import independent_equations
+from .partial_active import UNBOUNDED, ActiveProgram
 from .partial_maps import Maps
-from .partial_program import Program, Term
+from .partial_program import ZERO, Term
 
-UNBOUNDED = 1e9  # kg: the mass budget when a programme should not be limited by it
 RELAX = (1e-9, 1e-7, 1e-5)  # relative slack on an epsilon-constraint, tried in turn
+UNUSED = 1e-6  # a budget that the optimum leaves this fraction (of the budget, or of 1 kg) unused
 
 
 def point(maps: Maps, z: np.ndarray, terms: dict[str, Term]) -> dict:
@@ -34,20 +37,15 @@ def point(maps: Maps, z: np.ndarray, terms: dict[str, Term]) -> dict:
     return out
 
 
-def least_complete_mass(program: Program, terms: list[Term]) -> tuple[float, np.ndarray] | None:
+def least_complete_mass(program: ActiveProgram, terms: list[Term]) -> tuple[float, np.ndarray] | None:
     """(least added mass, design) with every load of ``terms`` zero at every sample, or None."""
-    cp = program.cp
     maps = program.maps
     A = np.concatenate([L.A.reshape(-1, maps.nz) for t in terms for L in t.maps])
     b = np.concatenate([L.b.reshape(-1) for t in terms for L in t.maps])
     Ar, br, inconsistent = independent_equations(A, -b)
     if inconsistent:
         return None
-    scale = max(float(np.max(np.abs(Ar))), 1e-300)
-    masses = sum((program.z[p.col] for p in maps.parts), start=0.0)
-    prob = cp.Problem(cp.Minimize(masses), program.base + [(Ar / scale) @ program.z == br / scale])
-    program.mass_budget.value = UNBOUNDED
-    out = program.solve(prob, polish=[Term(tuple(L for t in terms for L in t.maps), "peak")])
+    out = program.least_mass(Ar, br, polish=[Term(tuple(L for t in terms for L in t.maps), "peak")])
     if out.z is None:
         return None
     worst = max(t.value(out.z) / t.scale for t in terms)
@@ -56,40 +54,87 @@ def least_complete_mass(program: Program, terms: list[Term]) -> tuple[float, np.
     return maps.added_mass(out.z), out.z
 
 
-def mass_front(program: Program, term: Term, masses: np.ndarray, terms: dict[str, Term]) -> list[dict]:
-    """min ``term`` for each mass budget (:meth:`Program.least`'s problem: a new solver at the
-    first budget, its data updated at the others)."""
-    prob = program.least(term)
+def mass_front(program: ActiveProgram, term: Term, masses: np.ndarray, terms: dict[str, Term]) -> list[dict]:
+    """min ``term`` for each mass budget; where the optimum leaves part of the budget unused
+    (more mass would not lower ``term``: past the complete balance, say), the design of least
+    added mass with that optimum (:func:`_least_mass_at`), not an arbitrary one of them."""
     pts = []
-    for k, M in enumerate(masses):
-        program.mass_budget.value = float(M)
-        out = program.solve(prob, polish=[term], fresh=k == 0)
-        if out.z is not None:
-            pts.append({"budget": float(M), **point(program.maps, out.z, terms), "sensitivity": out.budget_dual * term.scale})
+    for M in masses:
+        out = program.solve([term], float(M), polish=[term])
+        if out.z is None:
+            continue
+        z = out.z
+        if program.maps.added_mass(z) < float(M) - UNUSED * max(float(M), 1.0):
+            z = _least_mass_at(program, term, term.value(z) / term.scale, z)
+        pts.append({"budget": float(M), **point(program.maps, z, terms), "sensitivity": out.budget_dual * term.scale})
     return pts
 
 
-def tradeoff_front(program: Program, first: Term, second: Term, budget: float, n: int,
+def _least_mass_at(program: ActiveProgram, term: Term, value: float, z: np.ndarray) -> np.ndarray:
+    """The design of least added mass whose ``term`` is at most ``value`` (in units of its scale;
+    a value polished to zero: the least complete balance of ``term``, its equations on every
+    sample), or ``z`` if that fails."""
+    if value <= ZERO:
+        complete = least_complete_mass(program, [term])
+        if complete is not None:
+            return complete[1]
+    return least_mass_within(program, [(term, value)], z)
+
+
+def least_mass_within(program: ActiveProgram, kept: list[tuple[Term, float]], z: np.ndarray,
+                      caps: list[tuple[Term, float]] = ()) -> np.ndarray:
+    """The design of least added mass whose terms are at most their values in ``kept`` (units of
+    their scales; relaxed by :data:`RELAX` in turn, as a bound that is an optimum itself is met
+    only to the solver's tolerance) and that meets ``caps`` as they are, or ``z`` if none is found."""
+    for slack in RELAX:
+        bounds = [(t, v * (1 + slack) + slack) for t, v in kept] + list(caps)
+        out = program.least_mass(caps=bounds, polish=[kept[0][0]])
+        if out.z is not None:
+            return out.z
+    return z
+
+
+def tradeoff_front(program: ActiveProgram, first: Term, second: Term, budget: float, n: int,
                    terms: dict[str, Term]) -> list[dict]:
-    """min ``first`` s.t. ``second`` <= eps, eps from the least ``second`` to its value where
-    ``first`` is least, at the mass ``budget`` (those two optima by :meth:`Program.least_at`: the
-    mass fronts' compiled problems, each optimum solved once for both trade-off fronts)."""
+    """min ``first`` s.t. ``second`` <= eps at the mass ``budget``, eps from the least ``second``
+    to the least ``second`` of the designs where ``first`` is least (the front's two ends: the
+    optima by :meth:`ActiveProgram.least_at`, each solved once for both trade-off fronts; the
+    second end then by :func:`_least_second`, since several designs may share the least
+    ``first`` and only the best of them for ``second`` is on the front). A point whose design
+    leaves part of the budget unused is the least added mass with its two values."""
     lo, hi = program.least_at(second, budget), program.least_at(first, budget)
-    program.mass_budget.value = float(budget)
     if lo.z is None or hi.z is None:
         return []
-    a, b = second.value(lo.z) / second.scale, second.value(hi.z) / second.scale
-    prob, _, (eps,) = program.problem([first], eps=[second])
+    end = _least_second(program, first, second, budget, first.value(hi.z) / first.scale)
+    a, b = second.value(lo.z) / second.scale, second.value(end.z) / second.scale
     pts = []
     for e in np.linspace(a, max(a, b), n):
-        for slack in RELAX:  # the first cap is the least value itself: feasible only to the solver's tolerance
-            eps.value = float(e) * (1 + slack) + slack
-            out = program.solve(prob, polish=[first])
-            if out.z is not None:
-                break
-        if out.z is not None:
-            pts.append({"cap": float(e) * second.scale, **point(program.maps, out.z, terms)})
+        out = _capped(program, [first], budget, second, float(e))
+        if out.z is None:
+            continue
+        z = out.z
+        if program.maps.added_mass(z) < budget - UNUSED * max(budget, 1.0):
+            z = least_mass_within(program, [(first, first.value(z) / first.scale),
+                                             (second, second.value(z) / second.scale)], z)
+        pts.append({"cap": float(e) * second.scale, **point(program.maps, z, terms)})
     return pts
+
+
+def _capped(program: ActiveProgram, objective: list[Term], budget: float, capped: Term, bound: float):
+    """min ``objective`` s.t. ``capped`` / its scale <= ``bound``: a bound that is the least value
+    itself is met only to the solver's tolerance, so it is relaxed by :data:`RELAX` in turn."""
+    for slack in RELAX:
+        out = program.solve(objective, budget, eps=[(capped, bound * (1 + slack) + slack)], polish=objective)
+        if out.z is not None:
+            break
+    return out
+
+
+def _least_second(program: ActiveProgram, first: Term, second: Term, budget: float, least: float):
+    """The design of least ``second`` among those whose ``first`` is ``least`` (its least value,
+    in units of its scale), at the mass ``budget``: the trade-off front's end."""
+    out = _capped(program, [second], budget, first, least)
+    return out if out.z is not None else program.least_at(first, budget)
 
 
 #: the fronts, slowest first: the order forked workers take them in (results.json lists them the other way round)
@@ -97,8 +142,11 @@ FRONTS = ("effort_vs_force", "force_vs_moment", "moment_vs_mass", "force_vs_mass
 
 
 def _front(name: str, ctx: tuple) -> list[dict]:
-    """One front of :func:`compute` (``ctx``: program, terms, budget, points, mass budgets)."""
-    program, terms, budget, n, masses = ctx
+    """One front of :func:`compute` (``ctx``: program, terms, budget, points, mass budgets, the
+    programme's samples to start from: every front starts from the same ones, in this process or
+    a forked one, so that its numbers do not depend on the fronts solved before it)."""
+    program, terms, budget, n, masses, start = ctx
+    program.active = dict(start)
     force, moment = terms["shaking_force"], terms["shaking_moment"]
     if name == "force_vs_mass":
         return mass_front(program, force, masses, terms)
@@ -109,11 +157,11 @@ def _front(name: str, ctx: tuple) -> list[dict]:
     return tradeoff_front(program, terms["effort"], force, budget, n, terms)
 
 
-def compute(program: Program, terms: dict[str, Term], budget: float, n: int, max_mass: float | None) -> dict:
+def compute(program: ActiveProgram, terms: dict[str, Term], budget: float, n: int, max_mass: float | None) -> dict:
     """Every front and the complete balances' least masses (None where infeasible). The fronts
-    are independent sequences of solves (each starts on a new solver): with spare cores
+    are independent sequences of solves, each from the same samples: with spare cores
     (:func:`balpipe.pool.spare`) they run in forked processes, the trade-off fronts' ends solved
-    here first (once for both, as one after another); the numbers are the same bits."""
+    here first (once for both); the numbers are the same bits whatever the cores."""
     from .. import pool
 
     force, moment = terms["shaking_force"], terms["shaking_moment"]
@@ -127,12 +175,11 @@ def compute(program: Program, terms: dict[str, Term], budget: float, n: int, max
         masses[int(np.argmin(np.abs(masses[1:] - complete_f[0]))) + 1] = complete_f[0]
         masses.sort()
     names = [f for f in FRONTS if f != "effort_vs_force" or "effort" in terms]
-    workers = pool.spare()
-    if workers > 1:
-        for t in (moment, force, terms.get("effort")):
-            if t is not None:
-                program.least_at(t, budget)
-    fronts = dict(zip(names, pool.forked([(_front, (f,)) for f in names], workers, (program, terms, budget, n, masses))))
+    for t in (moment, force, terms.get("effort")):  # the trade-off fronts' ends, solved once for both
+        if t is not None:
+            program.least_at(t, budget)
+    ctx = (program, terms, budget, n, masses, dict(program.active))
+    fronts = dict(zip(names, pool.forked([(_front, (f,)) for f in names], pool.spare(), ctx)))
     out = {
         "points": n,
         "max_mass": float(top),
@@ -141,15 +188,12 @@ def compute(program: Program, terms: dict[str, Term], budget: float, n: int, max
         "complete_force_moment": None if complete_fm is None else point(program.maps, complete_fm[1], terms),
         **{f: fronts[f] for f in reversed(FRONTS) if f in fronts},
     }
-    program.mass_budget.value = float(budget)
     return out
 
 
 def fronts(maps: Maps, inertia_budget: float | None, terms: dict[str, Term], budget: float, n: int,
            max_mass: float | None) -> dict:
-    """:func:`compute` on a new :class:`Program` of ``maps`` (the spec's motion's; ``terms`` may
-    span several motions) with ``inertia_budget``: a function of plain data (the maps, the
-    terms' load maps, the numbers), which :func:`balpipe.balance_cache.run` can key. Every
-    problem of :func:`compute` is a new one on the programme's variables, so a new programme
-    gives the numbers of the one the optimum was solved on."""
-    return compute(Program(maps, inertia_budget), terms, budget, n, max_mass)
+    """:func:`compute` on a new :class:`ActiveProgram` of ``maps`` (the spec's motion's; ``terms``
+    may span several motions) with ``inertia_budget``: a function of plain data (the maps, the
+    terms' load maps, the numbers), which :func:`balpipe.balance_cache.run` can key."""
+    return compute(ActiveProgram(maps, inertia_budget), terms, budget, n, max_mass)

@@ -7,7 +7,8 @@ motions is the largest of its per-motion measures (a peak is then the peak over 
 every motion; an RMS the largest of the motions' RMS, each over its own samples, so a motion's
 weight does not depend on how finely it is sampled), divided by that largest measure of the
 unbalanced mechanism; a cap holds on every motion. The programme stays a second-order cone
-programme (one epigraph per motion and load, :meth:`.partial_program.Program.expression`).
+programme (every motion's cones bounded by the term's one epigraph variable,
+:meth:`.partial_active.ActiveProgram._term_rows`).
 
 Here: the other motions' models (located errors before any analysis), and the report per motion
 (each term and cap, and the peaks, on that motion alone).

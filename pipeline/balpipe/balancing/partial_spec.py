@@ -1,7 +1,7 @@
 """The spec of the ``partial_balance`` method (DESIGN.md, "Partial balancing is a cone program"):
 the parts the optimiser may add, what it minimises, and under which budget and caps.
 
-This module only describes the input; :mod:`.partial` solves it (cvxpy is not imported here)."""
+This module only describes the input; :mod:`.partial` solves it (no solver is imported here)."""
 
 from __future__ import annotations
 
