@@ -22,9 +22,18 @@ def _law_values(prim, t: np.ndarray):
     return prim.law(t)
 
 
-def residual(c: Compiled, qx: np.ndarray, t: np.ndarray) -> np.ndarray:
+def law_positions(c: Compiled, t: np.ndarray) -> list[np.ndarray | None]:
+    """Each primitive's driving law f(t) (None for a coincidence): what :func:`residual` subtracts,
+    evaluated once for the iterations of a Newton-Raphson solve at the same times."""
+    return [None if isinstance(p, _Coincident) else _law_values(p, t)[0] for p in c.prims]
+
+
+def residual(c: Compiled, qx: np.ndarray, t: np.ndarray, laws: list | None = None) -> np.ndarray:
     """Phi(q, t), shape (N, m). The revolute rows of every joint at once (:func:`revolute_rows`),
-    the same arithmetic as one joint at a time, so the same bits."""
+    the same arithmetic as one joint at a time, so the same bits; ``laws``: :func:`law_positions`
+    at ``t`` (the same values, not evaluated again)."""
+    if laws is None:
+        laws = law_positions(c, t)
     rev = revolute_rows(c)
     out = np.empty((qx.shape[0], len(c.row_owner)))
     if rev is not None:
@@ -32,18 +41,16 @@ def residual(c: Compiled, qx: np.ndarray, t: np.ndarray) -> np.ndarray:
         Ai, Aj = _rotate_all(qx[:, rev.ti], rev.si), _rotate_all(qx[:, rev.tj], rev.sj)
         out[:, rev.rows] = ri + Ai - rj - Aj
     row = 0
-    for p in c.prims:
+    for p, f in zip(c.prims, laws):
         if isinstance(p, _Coincident):
             if rev is None:
                 ri, thi = _split(qx, p.i)
                 rj, thj = _split(qx, p.j)
                 out[:, row : row + 2] = ri + rotate(thi, p.si) - rj - rotate(thj, p.sj)
         elif isinstance(p, _Angle):
-            f = _law_values(p, t)[0]
             val = sum(v * qx[:, 3 * k + 2] for k, v in p.coeffs) - p.const - f
             out[:, row] = val
         else:
-            f = _law_values(p, t)[0]
             ri, thi = _split(qx, p.i)
             rj, thj = _split(qx, p.j)
             e = rotate(thi, p.a)

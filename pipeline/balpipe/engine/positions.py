@@ -7,7 +7,7 @@ import numpy as np
 
 from ..sampling import spread_indices
 from .compile import Compiled
-from .constraints import with_frame, jacobian, residual
+from .constraints import with_frame, jacobian, law_positions, residual
 from .errors import AnalysisError
 from .kinematics import _solve_rect, _vel_acc
 
@@ -61,9 +61,10 @@ def newton_raphson(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _M
     """Batched Newton-Raphson. Returns (q, converged mask, residual norms)."""
     q = q.copy()
     norms = np.full(len(t), np.inf)
+    laws = law_positions(c, t)  # the drivers' f(t): the same at every iteration
     for _ in range(max_iter):
         qx = with_frame(q)
-        phi = residual(c, qx, t)
+        phi = residual(c, qx, t, laws)
         norms = np.abs(phi).max(axis=1)
         todo = ~(norms < _TOL)
         if not todo.any():
@@ -75,7 +76,7 @@ def newton_raphson(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _M
             dq = np.stack([np.linalg.lstsq(Jk, -pk, rcond=None)[0] for Jk, pk in zip(J, phi[todo])])
         q[todo] += dq
     qx = with_frame(q)
-    norms = np.abs(residual(c, qx, t)).max(axis=1)
+    norms = np.abs(residual(c, qx, t, laws)).max(axis=1)
     return q, norms < 1e-9, norms
 
 
