@@ -537,3 +537,19 @@ def test_a_part_at_the_solvers_round_off_is_no_part():
     assert [row["mass"] for row in P.design_table(maps, z)[:2]] == [0.6, 0.0]
     z[b.col : b.col + 4] *= 1e-4 / 2e-8 * 0.6
     assert b.name in {att.name for body in maps.design(z).bodies for att in body.attachments}
+
+
+def test_a_fronts_caption_says_where_more_budget_would_not_help():
+    """Past the least-mass complete force balance, the force front's points are that design; the
+    caption says how many budgets that concerns (the moment front, using its whole budget, not)."""
+    from balpipe.loader import load
+    from balpipe.report import partial_figures as PFG
+
+    st = study.run(load(ROOT / "specs" / "custom_four_bar_partial.yaml").spec)
+    det = st.balance.details["partial_balance"]
+    spare = [p for p in det["fronts"]["force_vs_mass"] if p["added_mass"] < p["budget"] * (1 - 1e-6)]
+    complete = det["fronts"]["complete_force"]["added_mass"]
+    assert spare and all(p["added_mass"] == pytest.approx(complete, rel=1e-6) for p in spare)
+    captions = {title: caption for title, _, caption in PFG.figures(st)}
+    assert f"At {len(spare)} of the budgets more mass would not lower it" in captions["Shaking force against added mass"]
+    assert "more mass would not lower it" not in captions["Shaking moment against added mass"]

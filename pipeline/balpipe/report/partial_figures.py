@@ -99,8 +99,11 @@ def figures(study) -> list[tuple[str, str, str]]:
         svg = live.html(f"partial_{key}", front_curves(pts, x, y, marks),
                         'its designs are in <a href="results.json">results.json</a> '
                         '(<code>balancing_details.partial_balance.fronts</code>)')
+        spare = sum(1 for p in pts if "budget" in p and p["added_mass"] < p["budget"] * (1 - 1e-6) - 1e-9)
+        lightest = (f" At {spare} of the budgets more mass would not lower it: there the point is the lightest of "
+                    "the optimal designs, its added mass below the budget." if spare else "")
         caption = (f"{len(pts)} points, each {what}, solved to global optimality {where} "
-                   "(second-order cone programme, Clarabel). Markers: the least-mass complete balances in the same "
+                   f"(second-order cone programme, Clarabel).{lightest} Markers: the least-mass complete balances in the same "
                    f"regions along {'this motion' if n == 1 else 'these motions'}, where they exist, and {marked}. "
                    + headline(study, det) + " Interactive where JavaScript runs: hover a design for its "
                    f"{AXES[x].split(' (')[0]} and {AXES[y].split(' (')[0]}, drag across to zoom (double-click "
