@@ -38,6 +38,26 @@ def test_a_spec_costs_its_text_length(tmp_path):
     assert spec_cost(long) > spec_cost(short) > 0 and spec_cost(tmp_path / "gone.yaml") == 0.0
 
 
+def test_without_the_simulation_a_spec_costs_its_methods_work_too():
+    """--no-sim: the 4-RRR's short spec (2-3 s of balancing and design analyses) and paper 003's
+    start before the longest texts of plain specs; with the simulation the text alone orders them;
+    an unreadable or unknown spec costs its text (or nothing), never an error."""
+    specs = Path(__file__).resolve().parents[1] / "specs"
+    heavy = [specs / "paper001_4rrr_fig6a.yaml", specs / "paper003_com_planning.yaml"]
+    plain = [specs / "custom_stephenson_six_bar_120rpm.yaml", specs / "custom_3rrr_motors.yaml"]
+    assert min(spec_cost(p, simulate=False) for p in heavy) > max(spec_cost(p, simulate=False) for p in plain)
+    assert spec_cost(heavy[0]) < spec_cost(plain[0])  # by the text: the order with the simulation
+    assert spec_cost(Path(__file__).parent / "does_not_exist.yaml", simulate=False) == 0.0
+
+
+def test_an_unknown_method_costs_only_its_text(tmp_path):
+    p = tmp_path / "x.yaml"
+    p.write_text("mechanism: {template: nowhere}\nbalancing: {method: nothing}\n" + "# pad\n" * 100)
+    assert spec_cost(p, simulate=False) == p.stat().st_size / 5000.0
+    p.write_text("mechanism: [unclosed\n")
+    assert spec_cost(p, simulate=False) == p.stat().st_size / 5000.0
+
+
 def _interrupt_main_thread() -> None:
     """Ctrl-C to this process's main thread (where Python runs its handler), as a terminal sends it."""
     import signal

@@ -539,7 +539,7 @@ def _run(todo: list[Path], opts: Options, jobs: int, progress, outcomes: list[Ou
         start = time.perf_counter()
         known[p] = (up_to_date(p, opts), time.perf_counter() - start)
     rest = [p for p in todo if known[p][0] is None]
-    built = pool.in_order(build_one, rest, jobs, opts, cost=spec_cost)
+    built = pool.in_order(build_one, rest, jobs, opts, cost=lambda p: spec_cost(p, opts.simulate))
     for k, p in enumerate(todo):
         previous, seconds = known[p]
         o = next(built) if previous is None else _unchanged(p, slug_for(p), opts.out / slug_for(p), previous, seconds)
@@ -548,15 +548,24 @@ def _run(todo: list[Path], opts: Options, jobs: int, progress, outcomes: list[Ou
             progress(k + 1, total, o)
 
 
-def spec_cost(path: Path) -> float:
+def spec_cost(path: Path, simulate: bool = True) -> float:
     """A spec's expected build work, to start the longest first (:func:`balpipe.pool.in_order`):
-    the length of its text, which grows with its stages, comparisons and references. Measured on
-    specs/ (24 specs, 2 processes, the build benchmark's times): 86.2 s for the longest texts
-    first against 92.2 s in name order and 85.7 s for the true longest-first order."""
+    the length of its text, which grows with its stages, comparisons and references (measured on
+    specs/, 24 specs, 2 processes: 86.2 s for the longest texts first against 92.2 s in name
+    order and 85.7 s for the true longest-first order). Without the simulation the balancing and
+    the figures weigh more: a second per 5000 characters, plus the ``build_cost`` its template and
+    method declare (:func:`balpipe.check_cost.declared_cost`); by the text alone the four 4-RRR
+    specs (2-3 s each, short texts) started 14th to 18th of 24, and one core ran the last of them
+    alone for 1.4 s (--no-sim 11.7 s; 11.0 s in the order by the true times)."""
     try:
-        return float(path.stat().st_size)
+        size = float(path.stat().st_size)
     except OSError:
         return 0.0
+    if simulate:
+        return size
+    from .check_cost import declared_cost
+
+    return size / 5000.0 + declared_cost(path, "build_cost")
 
 
 def _installed_code_hash() -> str:

@@ -1,6 +1,7 @@
 """A spec's expected ``balpipe check`` work, so that the check's process pool starts the costliest
 specs first (:func:`balpipe.pool.in_order`'s ``cost``: longest processing time first). Without it
-paper 003's spec, ten times the work of most, started 19th of 24 and ran alone at the end.
+paper 003's spec, ten times the work of most, started 19th of 24 and ran alone at the end. The
+same hints, ``build_cost``, order ``balpipe build --no-sim`` (:func:`balpipe.build.spec_cost`).
 
 The estimate is :data:`PLAIN` plus the ``check_cost`` that the spec's template and balancing method
 declare (:class:`balpipe.plugins.Template`, :class:`balpipe.plugins.Method`: seconds on one core,
@@ -30,19 +31,25 @@ _NAMES = (("mechanism", "template"), ("balancing", "method"))
 
 def check_cost(path: Path) -> float:
     """The expected seconds of ``balpipe check`` of the spec at ``path`` (see the module)."""
+    return PLAIN + declared_cost(path, "check_cost")
+
+
+def declared_cost(path: Path, hint: str) -> float:
+    """The sum of the ``hint`` attribute (``check_cost`` or ``build_cost``) of the template and
+    the method that the spec at ``path`` names; 0 where it cannot be read or names neither."""
     from . import registry
     from .loader import MAX_FILE_BYTES
 
     try:
         st = path.stat()
         if not stat.S_ISREG(st.st_mode) or st.st_size > MAX_FILE_BYTES:  # a pipe would block here
-            return PLAIN
+            return 0.0
         names = declared_names(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError):
-        return PLAIN
+        return 0.0
     template = registry.TEMPLATES.get(names.get(_NAMES[0], ""))
     method = registry.METHODS.get(names.get(_NAMES[1], ""))
-    return PLAIN + sum(item.check_cost for item in (template, method) if item is not None)
+    return sum(getattr(item, hint) for item in (template, method) if item is not None)
 
 
 def declared_names(text: str) -> dict[tuple[str, str], str]:

@@ -72,8 +72,9 @@ class Template:
     ``build(mechanism_spec, laws, t) -> Model``; ``laws`` maps drive names to laws. ``build``,
     ``figures`` and ``notation`` may be :class:`Ref` objects.
     ``figures(study)`` optionally yields extra report figures as (title, svg, caption).
-    ``check_cost`` (as :attr:`Method.check_cost`): a hint for the order in which ``balpipe check``
-    starts its specs (:mod:`balpipe.check_cost`), never a limit."""
+    ``check_cost`` and ``build_cost`` (as :attr:`Method.check_cost`, :attr:`Method.build_cost`):
+    hints for the order in which ``balpipe check`` and ``balpipe build`` start their specs
+    (:mod:`balpipe.check_cost`), never a limit."""
 
     name: str
     spec: type[Strict]
@@ -82,6 +83,7 @@ class Template:
     figures: Callable[..., Any] | None = None
     notation: Any = None  # the papers' symbols of the inputs: a table or table(mechanism_spec) (balpipe.notation)
     check_cost: float = 0.0  # seconds that ``balpipe check`` of a spec of this template takes beyond a plain one's
+    build_cost: float = 0.0  # seconds that ``balpipe build --no-sim`` of such a spec takes beyond its text's estimate
 
 
 @dataclass(frozen=True)
@@ -99,7 +101,9 @@ class Method:
     the computing code is imported when the method runs. ``check_cost``: the seconds (on one
     core, measured) that checking a spec with this method takes beyond a plain spec's few
     hundredths; ``balpipe check`` starts its costliest specs first (:mod:`balpipe.check_cost`),
-    so that a long one does not start last and leave the other cores idle at the end."""
+    so that a long one does not start last and leave the other cores idle at the end.
+    ``build_cost``: the same for ``balpipe build --no-sim``, beyond the estimate from the spec's
+    text (:func:`balpipe.build.spec_cost`)."""
 
     name: str
     spec: type[Strict]
@@ -116,6 +120,7 @@ class Method:
     page_only: tuple[str, ...] = ()
     page_aware: bool = False  # balance(..., page=bool): whether the page's outputs are wanted
     check_cost: float = 0.0  # seconds that ``balpipe check`` of a spec with this method takes beyond a plain one's
+    build_cost: float = 0.0  # seconds that ``balpipe build --no-sim`` of such a spec takes beyond its text's estimate
 
 
 @dataclass(frozen=True)
