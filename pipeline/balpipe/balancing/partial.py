@@ -1,7 +1,8 @@
 """The ``partial_balance`` method, for any model (``custom`` included): counterweights in regions
 of named links and counter-rotating discs chosen by a second-order cone programme
-(:mod:`.partial_program`, solved by :mod:`.partial_active`) on the affine maps of the loads (:mod:`.partial_maps`), to global
-optimality at the analysed motion; Pareto fronts (:mod:`.partial_fronts`) for the page.
+(:mod:`.partial_program`, solved by :mod:`.partial_active`) on the affine maps of the loads
+(:mod:`.partial_maps`), to global optimality at the analysed motion; Pareto fronts
+(:mod:`.partial_fronts`) for the page.
 
 Several motions at once (``motions``: the same machine at other speeds, other trajectories): each
 is analysed on its own time grid (the registry rebuilds the unbalanced model with its laws), its

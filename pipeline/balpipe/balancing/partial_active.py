@@ -201,8 +201,9 @@ class ActiveProgram:
     def solve(self, objective: list[Term], mass_budget: float, eps: list[tuple[Term, float]] = (),
               polish: list[Term] = ()) -> Outcome:
         """min sum w_i term_i / scale_i s.t. the base constraints, added mass <= ``mass_budget`` and
-        each ``eps`` term / its scale <= its bound; the terms of ``polish`` below :data:`ZERO` of
-        their unbalanced value polished to zero as :meth:`.partial_program.Program.solve` does."""
+        each ``eps`` term / its scale <= its bound; the terms of ``polish`` that come out below
+        :data:`ZERO` of their unbalanced value are brought to round-off
+        (:func:`.partial_program.polish_zero`), the design realised (:meth:`.partial_maps.Maps.realised`)."""
         return self._solve(list(objective), list(eps), mass_budget, None, polish)
 
     def least_at(self, term: Term, budget: float) -> Outcome:
