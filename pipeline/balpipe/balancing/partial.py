@@ -152,9 +152,8 @@ def solve(maps: Maps | Sequence[Maps], method: PartialBalance):
     if out.z is None:
         raise _infeasible(program, caps, method) if caps else SpecFieldError(
             ROOT + ("budget", "mass"), f"no design within the budget ({out.status})")
-    if program.maps.added_mass(out.z) < budget - PF.UNUSED * max(budget, 1.0):  # the lightest of the optimal designs
-        kept = [(t, t.value(out.z) / t.scale) for t in objective]
-        out = replace(out, z=PF.least_mass_within(program, kept, out.z, caps))
+    if program.unused(out.z, budget):  # the lightest of the optimal designs
+        out = replace(out, z=program.lightest([(t, t.value(out.z) / t.scale) for t in objective], out.z, caps))
     return program, out, objective, caps
 
 

@@ -31,6 +31,8 @@ from .partial_maps import Maps
 from .partial_program import FALLBACK_SETTINGS, SOLVER_SETTINGS, ZERO, Outcome, Term, polish_zero, variable_scale
 
 UNBOUNDED = 1e9  # kg: the mass budget when a programme should not be limited by it
+RELAX = (1e-9, 1e-7, 1e-5)  # relative slack on a bound that is an optimum itself, tried in turn
+UNUSED = 1e-6  # a budget that a design leaves this fraction (of the budget, or of 1 kg) unused
 #: a sample is missing from a programme when its load exceeds the bound by this fraction of the
 #: term's unbalanced value: ten times Clarabel's tolerance, below which its answers do not separate
 CHECK = 1e-9
@@ -225,6 +227,20 @@ class ActiveProgram:
             equations = (A / scale, b / scale)
         return self._solve([], list(caps), UNBOUNDED, equations, polish)
 
+    def unused(self, z: np.ndarray, budget: float) -> bool:
+        """Whether design ``z`` leaves part of the mass ``budget`` unused (by :data:`UNUSED`): more
+        mass would not improve its optimum, and other optimal designs are lighter."""
+        return self.maps.added_mass(z) < budget - UNUSED * max(budget, 1.0)
+
+    def lightest(self, kept: list[tuple[Term, float]], z: np.ndarray, caps: list[tuple[Term, float]] = ()) -> np.ndarray:
+        """The design of least added mass whose terms are at most their values in ``kept`` (units
+        of their scales; relaxed by :data:`RELAX` in turn, as a bound that is an optimum itself is
+        met only to the solver's tolerance) and that meets ``caps`` as they are, or ``z`` if none
+        is found."""
+        out = relaxed(lambda slack: self.least_mass(
+            caps=[(t, v * (1 + slack) + slack) for t, v in kept] + list(caps), polish=[kept[0][0]]))
+        return out.z if out.z is not None else z
+
     def _solve(self, objective: list[Term], eps: list[tuple[Term, float]], mass_budget: float,
                equations: tuple[np.ndarray, np.ndarray] | None, polish) -> Outcome:
         """The optimum by the exchange loop (without ``objective``, the least added mass)."""
@@ -279,6 +295,16 @@ class ActiveProgram:
             bounds = [(t, x[self.n + j]) for j, t in enumerate(terms[:objective])] + eps
             if not any([self._missing(t, bound, z) for t, bound in bounds]):
                 return res
+
+
+def relaxed(attempt) -> Outcome:
+    """``attempt(slack)`` for each slack of :data:`RELAX` until one gives a design: the first that
+    does, else the last answer."""
+    for slack in RELAX:
+        out = attempt(slack)
+        if out.z is not None:
+            break
+    return out
 
 
 def _settings(values: dict):

@@ -22,12 +22,9 @@ from __future__ import annotations
 import numpy as np
 
 from .least_mass import independent_equations
-from .partial_active import UNBOUNDED, ActiveProgram
+from .partial_active import UNBOUNDED, ActiveProgram, relaxed
 from .partial_maps import Maps
 from .partial_program import ZERO, Term
-
-RELAX = (1e-9, 1e-7, 1e-5)  # relative slack on an epsilon-constraint, tried in turn
-UNUSED = 1e-6  # a budget that the optimum leaves this fraction (of the budget, or of 1 kg) unused
 
 
 def point(maps: Maps, z: np.ndarray, terms: dict[str, Term]) -> dict:
@@ -64,7 +61,7 @@ def mass_front(program: ActiveProgram, term: Term, masses: np.ndarray, terms: di
         if out.z is None:
             continue
         z = out.z
-        if program.maps.added_mass(z) < float(M) - UNUSED * max(float(M), 1.0):
+        if program.unused(z, float(M)):
             z = _least_mass_at(program, term, term.value(z) / term.scale, z)
         pts.append({"budget": float(M), **point(program.maps, z, terms), "sensitivity": out.budget_dual * term.scale})
     return pts
@@ -78,20 +75,7 @@ def _least_mass_at(program: ActiveProgram, term: Term, value: float, z: np.ndarr
         complete = least_complete_mass(program, [term])
         if complete is not None:
             return complete[1]
-    return least_mass_within(program, [(term, value)], z)
-
-
-def least_mass_within(program: ActiveProgram, kept: list[tuple[Term, float]], z: np.ndarray,
-                      caps: list[tuple[Term, float]] = ()) -> np.ndarray:
-    """The design of least added mass whose terms are at most their values in ``kept`` (units of
-    their scales; relaxed by :data:`RELAX` in turn, as a bound that is an optimum itself is met
-    only to the solver's tolerance) and that meets ``caps`` as they are, or ``z`` if none is found."""
-    for slack in RELAX:
-        bounds = [(t, v * (1 + slack) + slack) for t, v in kept] + list(caps)
-        out = program.least_mass(caps=bounds, polish=[kept[0][0]])
-        if out.z is not None:
-            return out.z
-    return z
+    return program.lightest([(term, value)], z)
 
 
 def tradeoff_front(program: ActiveProgram, first: Term, second: Term, budget: float, n: int,
@@ -113,21 +97,17 @@ def tradeoff_front(program: ActiveProgram, first: Term, second: Term, budget: fl
         if out.z is None:
             continue
         z = out.z
-        if program.maps.added_mass(z) < budget - UNUSED * max(budget, 1.0):
-            z = least_mass_within(program, [(first, first.value(z) / first.scale),
-                                             (second, second.value(z) / second.scale)], z)
+        if program.unused(z, budget):
+            z = program.lightest([(first, first.value(z) / first.scale), (second, second.value(z) / second.scale)], z)
         pts.append({"cap": float(e) * second.scale, **point(program.maps, z, terms)})
     return pts
 
 
 def _capped(program: ActiveProgram, objective: list[Term], budget: float, capped: Term, bound: float):
     """min ``objective`` s.t. ``capped`` / its scale <= ``bound``: a bound that is the least value
-    itself is met only to the solver's tolerance, so it is relaxed by :data:`RELAX` in turn."""
-    for slack in RELAX:
-        out = program.solve(objective, budget, eps=[(capped, bound * (1 + slack) + slack)], polish=objective)
-        if out.z is not None:
-            break
-    return out
+    itself is met only to the solver's tolerance, so it is relaxed in turn (:func:`.partial_active.relaxed`)."""
+    return relaxed(lambda slack: program.solve(objective, budget, eps=[(capped, bound * (1 + slack) + slack)],
+                                               polish=objective))
 
 
 def _least_second(program: ActiveProgram, first: Term, second: Term, budget: float, least: float):
