@@ -44,6 +44,16 @@
       });
     };
   }
+  // a plot at least as tall as its value axis's label needs: uPlot centres the label along the
+  // plotting area and the canvas clips it ("peak actuator effort (N m or N)" lost its unit in a
+  // 240 px plot); the label is measured in the font it is drawn in
+  const LABEL_FONT = 'bold 12px system-ui,-apple-system,"Segoe UI",Roboto,"Helvetica Neue",Arial,sans-serif';
+  let measurer = null;
+  function plotHeight(label) {
+    measurer = measurer || document.createElement("canvas").getContext("2d");
+    measurer.font = LABEL_FONT;
+    return Math.max(HEIGHT, Math.ceil(measurer.measureText(label || "").width) + TITLE_AND_AXIS_PX);
+  }
   // the canvas's device pixels per CSS pixel: the screen's, or PRINT_RATIO in a plot drawn for print
   const ratio = u => u.ctx.canvas.width / u.width || 1;
   // kinematic warnings (time, label): dotted vertical lines, labelled along them
@@ -119,7 +129,7 @@
       f.plots.forEach((u, i) => {
         const el = u.root.parentNode;
         el.hidden = sel.value !== "all" && sel.value !== String(i);
-        if (!el.hidden) u.setSize({ width: Math.max(240, el.clientWidth), height: HEIGHT });
+        if (!el.hidden) u.setSize({ width: Math.max(240, el.clientWidth), height: u.height });
       });
       host.dataset.shown = sel.value;
       follow(f);
@@ -151,9 +161,9 @@
       }, d.x ? { spanGaps: true, points: { show: true, size: s.points ? 10 : 5, width: 1.5, fill: "#fff" } } : {},
          s.points ? { paths: () => null } : {})));
       const opts = Object.assign({
-        title: p.title, width: w, height: HEIGHT,
+        title: p.title, width: w, height: plotHeight(p.axis),
         scales: p.log ? { x: { time: false }, y: { distr: 3 } } : { x: { time: false } },  // p.log: a log10 axis
-        axes: [{ label: d.x || "time (s)" }, { label: p.axis, size: 64, values: ticks(!!p.log) }],
+        axes: [{ label: d.x || "time (s)" }, { label: p.axis, labelFont: LABEL_FONT, size: 64, values: ticks(!!p.log) }],
         series: series,
         cursor: { sync: { key: src.dataset.live } },
         plugins: (d.marks.length ? [marksPlugin(d.marks)] : []).concat(drawn.some(s => s.marker) ? [markersPlugin(drawn)] : []),
@@ -200,7 +210,7 @@
       cancelAnimationFrame(pending);
       pending = requestAnimationFrame(() => {
         const stale = f.plots.filter(u => !u.root.parentNode.hidden && u.width !== width(u.root.parentNode));
-        stale.forEach(u => u.setSize({ width: width(u.root.parentNode), height: HEIGHT }));
+        stale.forEach(u => u.setSize({ width: width(u.root.parentNode), height: u.height }));
         if (stale.length) follow(f);
       });
     };

@@ -226,3 +226,29 @@ def test_a_log_axis_over_many_decades_labels_every_kth_decade(tmp_path, browser)
     spans = host.evaluate(_LABEL_GAPS)
     assert max(decades for decades, _ in spans) > 12, spans
     assert all(len(gaps) >= 3 and min(gaps) >= 13.5 for _, gaps in spans), spans
+
+
+# per plot: its value axis's label, the label's width in the font it is drawn in, and the height
+# of the plotting area it is centred along (CSS px)
+_LABEL_FITS = """el => el.uplots.map(u => {
+  const c = document.createElement('canvas').getContext('2d');
+  const f = u.axes[1].labelFont;  // uPlot keeps [css font, size, size x ratio]
+  c.font = Array.isArray(f) ? f[0] : f;
+  const r = u.ctx.canvas.width / u.width;
+  return [u.axes[1].label, c.measureText(u.axes[1].label).width, u.bbox.height / r];
+})"""
+
+
+def test_a_value_axis_label_fits_along_its_plot(live_site, browser):
+    """Every front's value axis label is drawn whole: the plot is tall enough for it (the
+    effort front's "peak actuator effort (N m or N)" lost its unit in a 240 px plot)."""
+    w, p, _ = _open(browser, live_site, "partial_offset_slider_crank", "live-partial_effort_vs_force")
+    checked = []
+    for figure in ("live-partial_force_vs_mass", "live-partial_moment_vs_mass", "live-partial_effort_vs_force"):
+        host = p.locator(f"#{figure}")
+        host.scroll_into_view_if_needed()
+        for label, width, height in host.evaluate(_LABEL_FITS):
+            checked.append(label)
+            assert width <= height, (figure, label, width, height)
+    assert "peak actuator effort (N m or N)" in checked
+    assert not w.problems, "\n".join(w.problems)
