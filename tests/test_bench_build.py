@@ -76,6 +76,15 @@ def test_results_numbers_compares_every_number_to_a_relative_tolerance(tmp_path,
     assert (c.numbers, c.identical, c.problems) == (3, 2, ["/code_hash: 'abc' and 'def'"])
     assert r.compare(a, far, 1e-9).problems[0].startswith("/x: 1.0 and 1.00000001")
     assert r.compare(a, {**a, "y": [2.0]}, 1e-9).problems == ["/y: lengths 2 and 1"]
+    tiny, moved = {"r": 1e-13}, {"r": 3e-13}  # round-off of a balanced stage: 100 % relative
+    assert r.compare(tiny, moved, 1e-9).problems and not r.compare(tiny, moved, 1e-9, floor=1e-12).problems
+    assert r.compare(tiny, moved, 1e-9, floor=1e-12).floored == 1
+    assert r.compare(tiny, moved, 1e-9, floor=1e-14).problems  # the floor is absolute, not a pass for all
+    newer = {**a, "added": 7.0}
+    assert r.compare(a, newer, 1e-9).problems == ["/: keys differ: ['added']"]
+    c = r.compare(a, newer, 1e-9, common=True)
+    assert not c.problems and c.one_sided == ["/: keys differ: ['added']"] and c.numbers == 3
+    assert r.compare(a, {**far, "added": 7.0}, 1e-9, common=True).problems  # common keys still compared
     for d, v in (("A", a), ("B", near), ("C", far)):
         (tmp_path / d / "spec").mkdir(parents=True)
         (tmp_path / d / "spec" / "results.json").write_text(json.dumps(v))

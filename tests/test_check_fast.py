@@ -1,8 +1,8 @@
 """``balpipe check`` does less than ``build`` for the same verdicts (issue 23, "check in a
-blink"): the stages of one geometry share its motion on the engine's general path
-(:func:`balpipe.engine.shared_motions`, check only), the page-only diagnostics (condition
-numbers, dead centres) are skipped, and the engine's revolute rows, evaluated for every joint at
-once, are the per-joint arithmetic to the last bit (``build``'s output is unchanged)."""
+blink"): the page-only diagnostics (condition numbers, dead centres) are skipped, and the
+engine's revolute rows, evaluated for every joint at once, are the per-joint arithmetic to the
+last bit (``build``'s output is unchanged). The stages of one geometry sharing its motion on the
+general path, for both commands: tests/test_engine_shared.py."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from balpipe import engine, registry
-from balpipe.engine import analyse, compiled, constraints, shared
+from balpipe.engine import analyse, compiled, constraints
 from balpipe.engine.constraints import with_frame
 from balpipe.loader import load
 from balpipe.runner import analyse as run_analyse
@@ -23,50 +23,6 @@ RRR4 = "specs/paper001_4rrr.yaml"  # redundant actuation: the general (dense) pa
 def _stages(path: str):
     spec = load(path).spec
     return spec, registry.balance(spec).stages
-
-
-def test_stages_share_the_motion_of_their_geometry_within_the_block():
-    spec, stages = _stages(RRR4)
-    t = time_grid(spec)
-    g, mp = gravity_vector(spec), tuple(spec.analysis.moment_point)
-    engine.clear_cache()
-    fresh = [analyse(s.model, t, g, mp) for s in stages]
-    before = dict(shared.STATS)
-    with engine.shared_motions():
-        mine = [analyse(s.model, t, g, mp) for s in stages]
-    assert shared.STATS["solved"] - before["solved"] == 1  # one continuation, every other stage shared
-    assert shared.STATS["shared"] - before["shared"] == len(stages) - 1
-    assert shared.STATS["rejected"] == before["rejected"]
-    for s, a, b in zip(stages, mine, fresh):
-        qa, qb = a.q, b.q
-        assert np.abs(qa - qb).max() <= 1e-9 * np.abs(qb).max(), s.name
-        assert np.abs(a.force - b.force).max() <= 1e-9 * max(np.abs(b.force).max(), 1.0), s.name
-        assert a.extra["condition"] == pytest.approx(b.extra["condition"], rel=1e-6)
-    analyse(stages[1].model, t, g, mp)  # outside the block: nothing shared any more
-    assert shared.STATS["shared"] - before["shared"] == len(stages) - 1
-
-
-def test_a_shared_motion_that_does_not_solve_the_model_is_rejected(monkeypatch):
-    """A motion that is not the model's (here: shifted by 0.5 rad) fails the branch guard; the
-    continuation runs and gives the model's own motion."""
-    spec, stages = _stages(RRR4)
-    t = time_grid(spec)
-    engine.clear_cache()
-    ref = analyse(stages[1].model, t).q
-    real = shared._from_shared
-
-    def shifted(c, t, frame):
-        bad = frame.copy()
-        bad[:, 2::3] += 0.5
-        return real(c, t, bad)
-
-    monkeypatch.setattr(shared, "_from_shared", shifted)
-    before = dict(shared.STATS)
-    with engine.shared_motions():
-        analyse(stages[0].model, t)
-        q = analyse(stages[1].model, t).q
-    assert shared.STATS["rejected"] - before["rejected"] == 1
-    assert np.abs(q - ref).max() <= 1e-9 * np.abs(ref).max()
 
 
 def _drawn_design(name: str) -> bool:

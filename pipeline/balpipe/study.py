@@ -3,7 +3,6 @@ checks and references. No files are written here (see :mod:`balpipe.build`)."""
 
 from __future__ import annotations
 
-import contextlib
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -13,7 +12,7 @@ import numpy as np
 from . import actuation, assembly, dead_centres, loop_closure, realisable, registry
 from .balancing.base import BalanceResult, Stage
 from .claim_precision import claim_tolerances
-from .engine import Analysis, AnalysisError, analyse, shared_motions
+from .engine import Analysis, AnalysisError, analyse
 from .engine.load_reference import LoadReference, load_reference
 from .sampling import gravity_vector  # noqa: F401  (balpipe.study.gravity_vector, as before)
 from .spec import Spec
@@ -236,15 +235,7 @@ def run(spec: Spec, page: bool = True) -> Study:
     ``page``, what only the page shows is not computed (:func:`.registry.balance`), nor the
     condition numbers, near-singular notes and dead-centre warnings (``checks`` then has
     ``max_condition_number`` None), nor the parameters of the method's ``derived`` hook unless
-    the spec has references (which may name them): none of them makes a spec invalid; and the stages and designs
-    of one geometry share its motion on the engine's general path
-    (:func:`.engine.shared_motions`: the same errors, numbers equal to the Newton tolerance only,
-    which ``balpipe check`` does not write)."""
-    with (contextlib.nullcontext() if page else shared_motions()):
-        return _run(spec, page)
-
-
-def _run(spec: Spec, page: bool) -> Study:
+    the spec has references (which may name them): none of them makes a spec invalid."""
     model = registry.unbalanced_model(spec)
     if model.sources:  # a spec that gives its own poses (custom): the assembly must confirm them
         assembly.check(model, float(registry.time_grid(spec)[0]))

@@ -38,18 +38,17 @@ Modules, one job each: :mod:`.compile` (primitives, :func:`compile_model`), :mod
 :func:`analyse`), :mod:`.structure` and :mod:`.fastpath` (the block-triangular path),
 :mod:`.warmstart` (a new geometry of a closed loop solved from fixed anchors:
 :func:`record_anchors`, :func:`warm_start`), :mod:`.shared` (the general path's models of one
-geometry sharing its motion, for ``balpipe check`` only: :func:`shared_motions`).
+geometry placed in its frame motion, solved once).
 """
 
 from .analysis import Analysis, analyse, clear_cache, compiled
 from .compile import Compiled, compile_model
 from .constraints import acceleration_rhs, jacobian, residual, velocity_rhs
 from .errors import AnalysisError
-from .shared import shared_motions
 from .warmstart import Anchors, record as record_anchors, warm_start
 from .positions import condition_numbers, follow_motion, redundancy, solve_positions
 
 __all__ = [
     "Analysis", "AnalysisError", "Anchors", "Compiled", "acceleration_rhs", "analyse", "clear_cache", "compile_model", "compiled", "jacobian",
-    "record_anchors", "redundancy", "residual", "shared_motions", "solve_positions", "velocity_rhs", "warm_start",
+    "record_anchors", "redundancy", "residual", "solve_positions", "velocity_rhs", "warm_start",
 ]

@@ -143,6 +143,7 @@ def clear_cache() -> None:
     _COMPILED.clear()
     structure._CACHE.clear()
     fastpath._MOTIONS.clear()
+    shared.clear()
 
 
 def analyse(
@@ -176,7 +177,7 @@ def analyse(
         except fastpath.Fallback:
             kin = None
     if kin is None:
-        q = shared.positions(c, t)  # solve_positions, or a shared motion (balpipe check only)
+        q = shared.positions(c, t)  # placed in the frame motion of its geometry (solved once)
         v, a = _vel_acc(c, q, t)
         cond = c.condition
         condition = None

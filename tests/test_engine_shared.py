@@ -1,0 +1,119 @@
+"""The engine's general (dense) path places every model of one geometry in the frame motion of
+that geometry, solved once on the frame model (:mod:`balpipe.engine.shared`, issue 23): the
+stages and mass designs of a redundantly actuated 4-RRR share one continuation, each stage's
+numbers agree with its own continuation to the Newton tolerance, and they depend only on the
+geometry and the stage's masses, never on which stage ran first."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from balpipe import engine, registry
+from balpipe.engine import analyse, compiled, shared
+from balpipe.engine.positions import solve_positions
+from balpipe.loader import load
+from balpipe.sampling import time_grid
+from balpipe.study import gravity_vector
+
+RRR4 = "specs/paper001_4rrr.yaml"  # redundant actuation: the general (dense) path
+
+
+@pytest.fixture(scope="module")
+def rrr4():
+    spec = load(RRR4).spec
+    return spec, registry.balance(spec).stages, time_grid(spec)
+
+
+def _offsets(model) -> bool:
+    return bool(np.any(compiled(model).com_local))
+
+
+def test_stages_share_one_frame_motion_and_agree_with_their_own_continuation(rrr4):
+    spec, stages, t = rrr4
+    g, mp = gravity_vector(spec), tuple(spec.analysis.moment_point)
+    engine.clear_cache()
+    before = dict(shared.STATS)
+    mine = [analyse(s.model, t, g, mp) for s in stages]
+    placed = sum(_offsets(s.model) for s in stages)
+    assert placed >= 3
+    assert shared.STATS["solved"] - before["solved"] == 1  # one continuation, on the frame model
+    assert shared.STATS["shared"] - before["shared"] == placed
+    assert shared.STATS["rejected"] == before["rejected"]
+    ref = np.abs(mine[0].force).max()
+    for s, a in zip(stages, mine):
+        own = solve_positions(engine.compile_model(s.model), t)  # the stage's own continuation
+        assert np.abs(a.q.reshape(len(t), -1) - own).max() <= 1e-10 * np.abs(own).max(), s.name
+    engine.clear_cache()
+    with pytest.MonkeyPatch.context() as m:  # every stage by its own continuation
+        m.setattr(shared, "frame_motion", lambda c, t: None)
+        alone = [analyse(s.model, t, g, mp) for s in stages]
+    for s, a, b in zip(stages, mine, alone):
+        assert np.abs(a.force - b.force).max() <= 1e-9 * ref, s.name
+        assert np.abs(a.moment - b.moment).max() <= 1e-9 * np.abs(b.moment).max(), s.name
+        for name in b.efforts:
+            assert np.abs(a.efforts[name] - b.efforts[name]).max() <= 1e-9 * np.abs(b.efforts[name]).max()
+        assert a.extra["condition"] == pytest.approx(b.extra["condition"], rel=1e-6)
+
+
+def test_a_stage_gets_the_same_bits_whatever_ran_before(rrr4):
+    spec, stages, t = rrr4
+    last = stages[-1].model
+    engine.clear_cache()
+    first = analyse(last, t)
+    engine.clear_cache()
+    for s in stages[:-1]:
+        analyse(s.model, t)
+    after = analyse(last, t)
+    for name in ("q", "v", "a", "force", "moment"):
+        assert getattr(first, name).tobytes() == getattr(after, name).tobytes(), name
+
+
+def test_a_model_with_its_masses_at_the_frames_is_its_own_continuation(rrr4):
+    """Its own frame model: no placement, the continuation's bits."""
+    _, stages, t = rrr4
+    model = engine.fastpath.frame_model(stages[0].model)
+    engine.clear_cache()
+    assert not _offsets(model)
+    before = dict(shared.STATS)
+    q = analyse(model, t).q.reshape(len(t), -1)
+    assert shared.STATS == before
+    assert q.tobytes() == solve_positions(engine.compile_model(model), t).tobytes()
+
+
+def test_a_frame_motion_that_does_not_solve_the_model_is_rejected(rrr4, monkeypatch):
+    """A motion that is not the model's (here: shifted by 0.5 rad) fails the branch guard; the
+    model's own continuation runs."""
+    _, stages, t = rrr4
+    model = stages[1].model
+    engine.clear_cache()
+    own = solve_positions(engine.compile_model(model), t)
+    real = shared._from_shared
+
+    def shifted(c, t, frame):
+        bad = frame.copy()
+        bad[:, 2::3] += 0.5
+        return real(c, t, bad)
+
+    monkeypatch.setattr(shared, "_from_shared", shifted)
+    before = dict(shared.STATS)
+    q = analyse(model, t).q.reshape(len(t), -1)
+    assert shared.STATS["rejected"] - before["rejected"] == 1
+    assert q.tobytes() == own.tobytes()
+
+
+def test_other_laws_are_another_motion(rrr4):
+    """The key holds the drivers' laws by identity: a stage given another law object (here an equal
+    copy) solves its own frame motion."""
+    _, stages, t = rrr4
+    model = stages[1].model
+    engine.clear_cache()
+    before = dict(shared.STATS)
+    analyse(model, t)
+    law = model.drivers[0].law
+    other = dataclasses.replace(model, drivers=(dataclasses.replace(model.drivers[0], law=dataclasses.replace(law)),
+                                                 *model.drivers[1:]))
+    analyse(other, t)
+    assert shared.STATS["solved"] - before["solved"] == 2
