@@ -179,8 +179,8 @@ def analyse(
     if kin is None:
         q = shared.positions(c, t)  # placed in the frame motion of its geometry (solved once)
         v, a = _vel_acc(c, q, t)
-        cond = c.condition
-        condition = None
+        cond = c.condition  # None where the screen showed the motion regular: computed when read
+        condition = None if cond is not None else functools.partial(condition_numbers, c, q)
     else:
         q, v, a = kin.X[3:-1].T, kin.V[3:-1].T, kin.A[3:-1].T
         cond = None

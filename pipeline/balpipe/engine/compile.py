@@ -73,7 +73,7 @@ class Compiled:
     driver_rows: dict[str, int]
     joint_rows: dict[str, list[int]]
     q0: np.ndarray  # (3 nb,) initial guess
-    condition: np.ndarray | None = None  # condition numbers of Phi_q along the last motion solved
+    condition: np.ndarray | None = None  # condition numbers of Phi_q along the last motion solved (None: shown regular)
     meshes: list = field(default_factory=list)  # _Mesh: gear pairs that pass tooth forces
     fast: object = None  # the block-triangular path's data (:func:`.fastpath.prepare`), made once
     com_local: np.ndarray | None = None  # (nb, 2) centres of mass in the bodies' own frames

@@ -38,7 +38,7 @@ _KEPT = 16
 
 
 def positions(c: Compiled, t: np.ndarray) -> np.ndarray:
-    """:func:`.positions.solve_positions` of ``c`` along ``t`` (``c.condition`` set), its centres
+    """:func:`.positions.solve_positions` of ``c`` along ``t`` (``c.condition`` set, or None), its centres
     of mass placed in the frame motion of its geometry (see the module)."""
     if not np.any(c.com_local):
         return solve_positions(c, t)  # its own frame model: the continuation itself
@@ -47,7 +47,7 @@ def positions(c: Compiled, t: np.ndarray) -> np.ndarray:
         q = _from_shared(c, t, frame)
         if q is not None:
             STATS["shared"] += 1
-            c.condition = _check_regular(c, q, t)
+            c.condition = _check_regular(c, q, t, screen=True)
             return q
         STATS["rejected"] += 1
     return solve_positions(c, t)
