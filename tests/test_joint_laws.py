@@ -114,3 +114,14 @@ def test_dyad_rates_recover_the_link_rates(rng):
     one = np.ones(1)
     w1, *_ = dyad_rates(1.0, one, 0 * one, 1.0, one, 0 * one, 0 * one, (one, one), (one, one))
     assert not np.all(np.isfinite(w1))
+
+
+def test_body_point_by_components_is_body_point(rng):
+    """:func:`body_point_xy` gives body_point's columns, bit for bit."""
+    from balpipe.joint_laws import body_point_xy
+
+    for _ in range(5):
+        pose = tuple(tuple(rng.normal(size=50) * 10.0 ** rng.integers(-3, 3) for _ in range(3)) for _ in range(3))
+        c = rng.normal(size=2)
+        for whole, (x, y) in zip(body_point(pose, c), body_point_xy(pose, c), strict=True):
+            assert whole[:, 0].tobytes() == x.tobytes() and whole[:, 1].tobytes() == y.tobytes()

@@ -228,3 +228,34 @@ def test_decoupling_and_planning_need_their_arms(rng):
                      counter_rotation={"position": [0, -0.2]})
     with pytest.raises(SpecFieldError, match="balances a 2R arm"):
         registry.balance(three)
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 5])
+def test_absolute_state_positions_by_the_chain_and_its_layout(rng, n):
+    """Centres of mass and proximal joints by the chain written sample by sample (point = base +
+    sum of R(theta_i) (l_i, 0) over the previous links + R(theta_k) c_k), and accelerations by
+    central differences of those positions; every field an (N, n) C-ordered array."""
+    from balpipe.families.serial_arm.template import absolute_state
+
+    arm = ArmGeometry((0.1, -0.2), tuple(rng.uniform(0.2, 0.6, n)), tuple(rng.uniform(0.5, 5, n)),
+                      tuple(tuple(c) for c in rng.uniform(-0.1, 0.3, (n, 2))), tuple(rng.uniform(0.01, 0.2, n)))
+    w0, w1, w2 = rng.uniform(-2, 2, (3, n))
+    th = lambda t: w0 + w1 * t[:, None] + w2 * np.sin(3 * t)[:, None]  # noqa: E731
+    thd = lambda t: w1 + 3 * w2 * np.cos(3 * t)[:, None]  # noqa: E731
+    thdd = lambda t: -9 * w2 * np.sin(3 * t)[:, None]  # noqa: E731
+    t, h = np.linspace(0.0, 1.0, 41), 1e-4
+    st = absolute_state(arm, th(t), thd(t), thdd(t))
+    for f in ("rx", "ry", "ax", "ay", "ox", "oy"):
+        a = getattr(st, f)
+        assert a.shape == (len(t), n) and a.flags.c_contiguous
+    for i, tk in enumerate(t):
+        a = th(np.array([tk]))[0]
+        o = np.array(arm.base, dtype=float)
+        for k in range(n):
+            R = np.array([[math.cos(a[k]), -math.sin(a[k])], [math.sin(a[k]), math.cos(a[k])]])
+            assert np.allclose([st.ox[i, k], st.oy[i, k]], o, atol=1e-14)
+            assert np.allclose([st.rx[i, k], st.ry[i, k]], o + R @ np.asarray(arm.coms[k]), atol=1e-14)
+            o = o + R @ np.array([arm.lengths[k], 0.0])
+    p, m = absolute_state(arm, th(t + h), thd(t + h), thdd(t + h)), absolute_state(arm, th(t - h), thd(t - h), thdd(t - h))
+    assert np.allclose(st.ax, (p.rx - 2 * st.rx + m.rx) / h**2, atol=1e-5)
+    assert np.allclose(st.ay, (p.ry - 2 * st.ry + m.ry) / h**2, atol=1e-5)

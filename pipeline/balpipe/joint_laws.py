@@ -6,9 +6,10 @@ q(t), q'(t), q''(t) by inverse kinematics with exact derivatives (chain rule); t
 analyses the mechanism as any joint-driven one. Two pieces are the same for every such template
 and live here:
 
-* :func:`body_point`: a point fixed in a moving body, with its velocity and acceleration, from the
-  body's pose laws: C = P + R(phi) c, C' = P' + phi' J R(phi) c,
-  C'' = P'' + phi'' J R(phi) c - phi'^2 R(phi) c (J: the rotation by +90 deg);
+* :func:`body_point` (:func:`body_point_xy`: by components): a point fixed in a moving body,
+  with its velocity and acceleration, from the body's pose laws: C = P + R(phi) c,
+  C' = P' + phi' J R(phi) c, C'' = P'' + phi'' J R(phi) c - phi'^2 R(phi) c (J: the rotation by
+  +90 deg);
 * :class:`PoseJointLaw`: a driver's law that is one coordinate of such an inverse-kinematics
   solution. The template says how to solve a time grid for all the coordinates at once
   (:meth:`PoseJointLaw.solve`) and which coordinate the law is (:attr:`PoseJointLaw.coordinate`);
@@ -40,14 +41,18 @@ def body_point(pose: tuple[Triple, Triple, Triple], c) -> Triple:
     """(N, 2) position, velocity and acceleration of the point with local coordinates ``c`` of a
     body whose frame has the pose (x, y, phi), each given with its two derivatives (the values
     of the pose laws): C = P + R c, C' = P' + phi' J R c, C'' = P'' + phi'' J R c - phi'^2 R c."""
+    return tuple(np.stack(xy, axis=-1) for xy in body_point_xy(pose, c))
+
+
+def body_point_xy(pose: tuple[Triple, Triple, Triple], c) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+    """:func:`body_point` as ((x, y), (x', y'), (x'', y'')), each an (N,) array (the same
+    values, half the time where the caller wants the components)."""
     (x, xd, xdd), (y, yd, ydd), (f, fd, fdd) = pose
     cf, sf = np.cos(f), np.sin(f)
-    rc = np.stack([cf * c[0] - sf * c[1], sf * c[0] + cf * c[1]], axis=-1)
-    jrc = np.stack([-rc[:, 1], rc[:, 0]], axis=-1)
-    C = np.stack([x, y], axis=-1) + rc
-    Cd = np.stack([xd, yd], axis=-1) + fd[:, None] * jrc
-    Cdd = np.stack([xdd, ydd], axis=-1) + fdd[:, None] * jrc - (fd**2)[:, None] * rc
-    return C, Cd, Cdd
+    rx, ry = cf * c[0] - sf * c[1], sf * c[0] + cf * c[1]  # R c
+    jx, jy = -ry, rx  # J R c
+    w2 = fd**2
+    return ((x + rx, y + ry), (xd + fd * jx, yd + fd * jy), (xdd + fdd * jx - w2 * rx, ydd + fdd * jy - w2 * ry))
 
 
 def dyad_rates(a: float, c1, s1, b: float, c2, s2, det, Cd, Cdd) -> tuple[np.ndarray, ...]:

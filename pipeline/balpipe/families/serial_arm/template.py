@@ -29,7 +29,7 @@ from pydantic import Field
 
 from ... import units
 from ...content_cache import MEMO
-from ...joint_laws import PoseJointLaw, body_point, dyad_rates
+from ...joint_laws import PoseJointLaw, body_point_xy, dyad_rates
 from ...laws.drives import drive_laws, path_laws
 from ...model import FRAME, Attachment, Body, Driver, Law, Model, Revolute
 from ...motion import law_for
@@ -273,8 +273,7 @@ def absolute_motion(chain: Chain, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray
     if n == 3:
         phi, phid, phidd = x[:, 2], xd[:, 2], xdd[:, 2]
         # W: the point -v3 of the last link's frame placed at the target, phi its angle
-        W, Wd, Wdd = body_point(((Wx, Wdx, Wddx), (Wy, Wdy, Wddy), (phi, phid, phidd)), -v[2])
-        Wx, Wy, Wdx, Wdy, Wddx, Wddy = W[:, 0], W[:, 1], Wd[:, 0], Wd[:, 1], Wdd[:, 0], Wdd[:, 1]
+        (Wx, Wy), (Wdx, Wdy), (Wddx, Wddy) = body_point_xy(((Wx, Wdx, Wddx), (Wy, Wdy, Wddy), (phi, phid, phidd)), -v[2])
     elif n != 2:
         raise ValueError("task-space motions need a 2R or 3R chain")
     a, b = math.hypot(*v[0]), math.hypot(*v[1])
@@ -469,27 +468,39 @@ def arm_state(arm: ArmGeometry, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) 
 
 
 def absolute_state(arm: ArmGeometry, th: np.ndarray, thd: np.ndarray, thdd: np.ndarray) -> ArmState:
-    """Positions and accelerations of the centres of mass from the absolute link angles:
-    (R u)'' = theta'' perp(R u) - theta'^2 R u for every vector u fixed in a link."""
-    c, s = np.cos(th), np.sin(th)
-    L = np.asarray(arm.lengths)
-    cm = np.asarray(arm.coms)
-    w2 = thd * thd
+    """Positions and accelerations of the centres of mass from the absolute link angles (N, n):
+    (R u)'' = theta'' perp(R u) - theta'^2 R u for every vector u fixed in a link. Computed link
+    by link on (n, N) rows, so that every operation runs along the samples (paper 003's
+    optimiser calls it thousands of times on three links); the fields are (N, n)."""
+    t, w, acc = (np.ascontiguousarray(a.T) for a in (th, thd, thdd))
+    c, s = np.cos(t), np.sin(t)
+    L = np.asarray(arm.lengths, dtype=float)[:, None]
+    cm = np.asarray(arm.coms, dtype=float)
+    cx, cy = cm[:, :1], cm[:, 1:]
+    w2 = w * w
     segx, segy = c * L, s * L
-    rcx, rcy = c * cm[:, 0] - s * cm[:, 1], s * cm[:, 0] + c * cm[:, 1]
-    sax, say = -thdd * segy - w2 * segx, thdd * segx - w2 * segy
-    rax, ray = -thdd * rcy - w2 * rcx, thdd * rcx - w2 * rcy
-    ox = np.empty_like(segx)
-    oy = np.empty_like(segy)
-    oax = np.empty_like(segx)
-    oay = np.empty_like(segy)
-    ox[:, 0], oy[:, 0], oax[:, 0], oay[:, 0] = arm.base[0], arm.base[1], 0.0, 0.0
-    if arm.n > 1:
-        ox[:, 1:] = arm.base[0] + np.cumsum(segx[:, :-1], axis=1)
-        oy[:, 1:] = arm.base[1] + np.cumsum(segy[:, :-1], axis=1)
-        oax[:, 1:] = np.cumsum(sax[:, :-1], axis=1)
-        oay[:, 1:] = np.cumsum(say[:, :-1], axis=1)
-    return ArmState(ox + rcx, oy + rcy, oax + rax, oay + ray, ox, oy, thdd)
+    rcx, rcy = c * cx - s * cy, s * cx + c * cy
+    sax, say = -acc * segy - w2 * segx, acc * segx - w2 * segy
+    rax, ray = -acc * rcy - w2 * rcx, acc * rcx - w2 * rcy
+    ox, oy = _proximal(segx, arm.base[0]), _proximal(segy, arm.base[1])
+    oax, oay = _proximal(sax), _proximal(say)
+
+    def back(a: np.ndarray) -> np.ndarray:
+        return np.ascontiguousarray(a.T)
+
+    return ArmState(back(ox + rcx), back(oy + rcy), back(oax + rax), back(oay + ray), back(ox), back(oy), thdd)
+
+
+def _proximal(seg: np.ndarray, start: float | None = None) -> np.ndarray:
+    """Rows (n, N) of the links' proximal joints: row k is ``start`` plus the sum of the rows
+    before k of ``seg`` (row 0: ``start``, or 0), added in order as np.cumsum adds them."""
+    out = np.empty_like(seg)
+    out[0] = 0.0 if start is None else start
+    total = None
+    for k in range(1, len(seg)):
+        total = seg[0] if k == 1 else total + seg[k - 1]
+        out[k] = total if start is None else start + total
+    return out
 
 
 def shaking_loads(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0), point=(0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
