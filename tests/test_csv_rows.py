@@ -1,0 +1,32 @@
+"""The time-series CSV's number text (:func:`balpipe.report.results.csv_rows`): each distinct
+column formatted once, the same text as one %.12g format per row."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from balpipe.report.results import csv_rows
+
+
+def _per_row(columns: list[np.ndarray]) -> str:
+    data = np.column_stack(columns) + 0.0
+    row = ",".join(["%.12g"] * data.shape[1]) + "\n"
+    return "".join(row % tuple(r) for r in data.tolist())
+
+
+def test_same_text_as_a_format_per_row_with_repeated_and_awkward_columns(rng):
+    n = 37
+    base = [rng.normal(size=n) * 10.0 ** rng.integers(-15, 15, size=n) for _ in range(6)]
+    awkward = np.array([0.0, -0.0, np.nan, np.inf, -np.inf, 1e-300, -5e-324, 123456789012345.0, 1 / 3] * 5)[:n]
+    ints = np.arange(n)  # an integer column is written as its float values
+    columns = [base[0], base[1], base[0].copy(), awkward, base[2], ints, awkward.copy(), -base[1], base[3]]
+    text = csv_rows(columns)
+    assert text == _per_row(columns)
+    assert "-0," not in text and ",-0\n" not in text  # no negative zero
+    assert text.count("\n") == n and all(line.count(",") == len(columns) - 1 for line in text.splitlines())
+
+
+def test_one_row_one_column_and_no_rows():
+    assert csv_rows([np.array([2.5])]) == "2.5\n"
+    assert csv_rows([np.array([]), np.array([])]) == ""
+    assert csv_rows([]) == ""
