@@ -24,6 +24,8 @@ parameters. Eqs. 19 (Fig. 5a) and 21 (Fig. 5b) are sums of eq. 17's rows, as Sec
 
 from __future__ import annotations
 
+import functools
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,7 +53,14 @@ class LinearCondition:
     coefficients: dict[str, float]
 
     def residual(self, params: dict[str, float]) -> float:
-        return float(sum(c * params[k] for k, c in self.coefficients.items()))
+        """sum(coefficient x parameter), added in the coefficients' order (an optimiser's
+        constraint: called some 10^5 times a build, hence the cached terms)."""
+        keys, coefficients = self._terms
+        return float(sum(map(operator.mul, coefficients, map(params.__getitem__, keys))))
+
+    @functools.cached_property
+    def _terms(self) -> tuple[tuple[str, ...], tuple[float, ...]]:
+        return tuple(self.coefficients), tuple(self.coefficients.values())
 
     def scale(self, params: dict[str, float]) -> float:
         """Largest |coefficient x parameter| term: the size a residual is compared with."""

@@ -145,13 +145,16 @@ def solve_counter_masses(model: Model, g: cond.Geometry, links: list[str], proxi
     dist = np.array([_distance(ij, proximal, distal) for ij in links])
     scale = max(abs(r.scale(base)) for r in rows)
 
-    def residual(s: np.ndarray) -> np.ndarray:
-        S = s.reshape(-1, 2)
+    names = [(f"m{ij}", f"m{ij}p{ij}", f"m{ij}q{ij}") for ij in links]
+    spans = dist.tolist()
+
+    def residual(s: np.ndarray) -> np.ndarray:  # SLSQP's constraint: ~3000 calls a design
+        S = np.asarray(s, dtype=float).reshape(-1, 2)
         p = dict(base)
-        for k, ij in enumerate(links):
-            p[f"m{ij}"] += float(np.hypot(*S[k])) / dist[k]
-            p[f"m{ij}p{ij}"] += S[k, 0]
-            p[f"m{ij}q{ij}"] += S[k, 1]
+        for (m, mp, mq), h, d, (sx, sy) in zip(names, np.hypot(S[:, 0], S[:, 1]).tolist(), spans, S.tolist()):
+            p[m] += h / d
+            p[mp] += sx
+            p[mq] += sy
         return np.array([c.residual(p) for c in rows])
 
     def jacobian(s: np.ndarray) -> np.ndarray:
