@@ -48,7 +48,7 @@ def test_stages_share_one_frame_motion_and_agree_with_their_own_continuation(rrr
         assert np.abs(a.q.reshape(len(t), -1) - own).max() <= 1e-10 * np.abs(own).max(), s.name
     engine.clear_cache()
     with pytest.MonkeyPatch.context() as m:  # every stage by its own continuation
-        m.setattr(shared, "frame_motion", lambda c, t: None)
+        m.setattr(shared, "_frame_entry", lambda c, t: [None, None, None])
         alone = [analyse(s.model, t, g, mp) for s in stages]
     for s, a, b in zip(stages, mine, alone):
         assert np.abs(a.force - b.force).max() <= 1e-9 * ref, s.name
@@ -117,3 +117,26 @@ def test_other_laws_are_another_motion(rrr4):
                                                  *model.drivers[1:]))
     analyse(other, t)
     assert shared.STATS["solved"] - before["solved"] == 2
+
+
+def test_placed_rates_are_the_models_own_solves_to_round_off(rrr4):
+    """The velocities and accelerations placed from the frame motion's satisfy the stage's own
+    velocity and acceleration equations and agree with its own solves (one QR per sample)."""
+    from balpipe.engine.constraints import acceleration_rhs, jacobian, velocity_rhs, with_frame
+    from balpipe.engine.kinematics import _vel_acc
+
+    spec, stages, t = rrr4
+    engine.clear_cache()
+    for s in stages:
+        if not _offsets(s.model):
+            continue
+        an = analyse(s.model, t)
+        c = compiled(s.model)
+        q, v, a = (x.reshape(len(t), -1) for x in (an.q, an.v, an.a))
+        own_v, own_a = _vel_acc(c, q, t)
+        assert np.abs(v - own_v).max() <= 1e-10 * np.abs(own_v).max(), s.name
+        assert np.abs(a - own_a).max() <= 1e-10 * np.abs(own_a).max(), s.name
+        J = jacobian(c, with_frame(q))[:, :, 3:]
+        nu, gamma = velocity_rhs(c, t), acceleration_rhs(c, with_frame(q), with_frame(v), t)
+        assert np.abs(np.einsum("nij,nj->ni", J, v) - nu).max() <= 1e-10 * np.abs(nu).max(), s.name
+        assert np.abs(np.einsum("nij,nj->ni", J, a) - gamma).max() <= 1e-9 * np.abs(gamma).max(), s.name

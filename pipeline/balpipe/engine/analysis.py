@@ -14,7 +14,6 @@ from . import fastpath, shared, structure
 from .compile import Compiled, compile_model
 from .constraints import with_frame, jacobian
 from .dynamics import joint_reactions, solve_multipliers, radial_tooth_loads, tooth_rows, actuation_condition
-from .kinematics import _vel_acc
 from .positions import condition_numbers, redundancy
 
 
@@ -177,8 +176,7 @@ def analyse(
         except fastpath.Fallback:
             kin = None
     if kin is None:
-        q = shared.positions(c, t)  # placed in the frame motion of its geometry (solved once)
-        v, a = _vel_acc(c, q, t)
+        q, v, a = shared.kinematics(c, t)  # placed in the frame motion of its geometry (solved once)
         cond = c.condition  # None where the screen showed the motion regular: computed when read
         condition = None if cond is not None else functools.partial(condition_numbers, c, q)
     else:

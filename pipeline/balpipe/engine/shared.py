@@ -13,11 +13,15 @@ continuation (no iteration where the residual is already below its 1e-12): accep
 sample converges and no angle moves by the continuation's branch guard; otherwise, or when the
 frame model cannot be followed, the continuation runs on the model itself, which raises the
 model's own located error. The regularity check (a singular configuration is an error) runs on
-the model's own Jacobian either way, so the same specs fail, with the same messages.
+the model's own Jacobian either way, so the same specs fail, with the same messages. The
+velocities and accelerations of an accepted model are placed too (:func:`kinematics`): the
+frames' are solved once per geometry (one QR factorisation per sample of the frame model's
+Jacobian instead of one per model), and a centre of mass at c in its body's frame moves with
+r' = r_f' + w perp(R c), r'' = r_f'' + alpha perp(R c) - w^2 R c, exact kinematics.
 
 A model whose centres of mass are at its frames' origins is its own frame model: its positions
-are the continuation's, bit for bit. The others' agree with their own continuation to the Newton
-tolerance (the position solve of a 4-RRR stage moved its results by < 1e-12 relative), and
+are the continuation's, and its rates its own solves, bit for bit. The others' agree with their
+own continuation and solves to round-off (a 4-RRR stage's loads to < 1e-12 of their peaks), and
 depend only on the geometry and on their own mass properties. Counts of what happened are in
 :data:`STATS`.
 """
@@ -29,38 +33,60 @@ import numpy as np
 from .compile import Compiled, compile_model
 from .errors import AnalysisError
 from .fastpath import _place as place, frame_model
+from .kinematics import _vel_acc
 from .positions import _JUMP, DenseOps, _check_regular, follow_motion, newton_raphson, solve_positions
 from .warmstart import motion_key
 
 STATS = {"shared": 0, "solved": 0, "rejected": 0}
-_MOTIONS: dict[tuple, tuple[list, np.ndarray | None]] = {}  # motion key -> (laws kept alive, frame motion or None)
+_MOTIONS: dict[tuple, list] = {}  # motion key -> [laws kept alive, frame motion or None, its (v, a) or None]
 _KEPT = 16
 
 
 def positions(c: Compiled, t: np.ndarray) -> np.ndarray:
     """:func:`.positions.solve_positions` of ``c`` along ``t`` (``c.condition`` set, or None), its centres
     of mass placed in the frame motion of its geometry (see the module)."""
+    return _positions(c, t)[0]
+
+
+def kinematics(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Positions, velocities and accelerations (N, 3 nb) of ``c`` along ``t``: :func:`positions`,
+    and the rates placed from the frame motion's where the positions were (see the module), else
+    solved on ``c``'s own Jacobian (:func:`.kinematics._vel_acc`)."""
+    q, entry = _positions(c, t)
+    if entry is None:
+        return (q, *_vel_acc(c, q, t))
+    if entry[2] is None:
+        entry[2] = _vel_acc(c.frame, entry[1], t)  # once per geometry and grid
+    return (q, *_place_rates(entry[1], *entry[2], c.com_local))
+
+
+def _positions(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, list | None]:
+    """:func:`positions` and the shared entry they were placed from (None: solved on ``c``)."""
     if not np.any(c.com_local):
-        return solve_positions(c, t)  # its own frame model: the continuation itself
-    frame = frame_motion(c, t)
-    if frame is not None:
-        q = _from_shared(c, t, frame)
+        return solve_positions(c, t), None  # its own frame model: the continuation itself
+    entry = _frame_entry(c, t)
+    if entry[1] is not None:
+        q = _from_shared(c, t, entry[1])
         if q is not None:
             STATS["shared"] += 1
             c.condition = _check_regular(c, q, t, screen=True)
-            return q
+            return q, entry
         STATS["rejected"] += 1
-    return solve_positions(c, t)
+    return solve_positions(c, t), None
 
 
 def frame_motion(c: Compiled, t: np.ndarray) -> np.ndarray | None:
     """The motion (N, 3 nb) of ``c``'s bodies' frames along ``t`` by the continuation on its frame
     model, solved once per :func:`.warmstart.motion_key`; None where the frame model cannot be
     followed (the caller's continuation then reports the model's own error)."""
+    return _frame_entry(c, t)[1]
+
+
+def _frame_entry(c: Compiled, t: np.ndarray) -> list:
     key = motion_key(c, t)
     hit = _MOTIONS.get(key)
     if hit is not None:
-        return hit[1]
+        return hit
     if c.frame is None:
         c.frame = compile_model(frame_model(c.model))
     fc = c.frame
@@ -71,8 +97,25 @@ def frame_motion(c: Compiled, t: np.ndarray) -> np.ndarray | None:
         frame = None
     if len(_MOTIONS) >= _KEPT:
         _MOTIONS.clear()
-    _MOTIONS[key] = ([d.law for d in c.model.drivers], frame)  # the laws kept alive: their ids key
-    return frame
+    entry = _MOTIONS[key] = [[d.law for d in c.model.drivers], frame, None]  # the laws kept alive: their ids key
+    return entry
+
+
+def _place_rates(frame: np.ndarray, vf: np.ndarray, af: np.ndarray, com: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Velocities and accelerations (N, 3 nb) of the points at ``com`` (nb, 2) of bodies whose
+    frames move with ``frame``, ``vf``, ``af``: r' = r_f' + w perp(R c),
+    r'' = r_f'' + alpha perp(R c) - w^2 R c; the angles' rates are the frames'."""
+    th, w, al = frame[:, 2::3], vf[:, 2::3], af[:, 2::3]
+    cos, sin = np.cos(th), np.sin(th)
+    rx = cos * com[:, 0] - sin * com[:, 1]
+    ry = sin * com[:, 0] + cos * com[:, 1]
+    v, a = vf.copy(), af.copy()
+    w2 = w * w
+    v[:, 0::3] -= w * ry
+    v[:, 1::3] += w * rx
+    a[:, 0::3] -= al * ry + w2 * rx
+    a[:, 1::3] += al * rx - w2 * ry
+    return v, a
 
 
 def clear() -> None:
