@@ -48,7 +48,7 @@ def test_stages_share_one_frame_motion_and_agree_with_their_own_continuation(rrr
         assert np.abs(a.q.reshape(len(t), -1) - own).max() <= 1e-10 * np.abs(own).max(), s.name
     engine.clear_cache()
     with pytest.MonkeyPatch.context() as m:  # every stage by its own continuation
-        m.setattr(shared, "_frame_entry", lambda c, t: [None, None, None])
+        m.setattr(shared, "_frame_entry", lambda c, t: [None, None, None, None, None])
         alone = [analyse(s.model, t, g, mp) for s in stages]
     for s, a, b in zip(stages, mine, alone):
         assert np.abs(a.force - b.force).max() <= 1e-9 * ref, s.name
@@ -140,3 +140,33 @@ def test_placed_rates_are_the_models_own_solves_to_round_off(rrr4):
         nu, gamma = velocity_rhs(c, t), acceleration_rhs(c, with_frame(q), with_frame(v), t)
         assert np.abs(np.einsum("nij,nj->ni", J, v) - nu).max() <= 1e-10 * np.abs(nu).max(), s.name
         assert np.abs(np.einsum("nij,nj->ni", J, a) - gamma).max() <= 1e-9 * np.abs(gamma).max(), s.name
+
+
+def test_placed_models_multipliers_by_their_geometrys_map(rrr4):
+    """A placed stage's multipliers come from the frame model's map with the generalised forces
+    moved to the frames' origins: they solve the stage's own Phi_q^T lambda = rhs and equal its
+    own least-norm-efforts solution to 1e-9 of their peak; joint reactions and efforts follow."""
+    from balpipe.engine.constraints import jacobian, with_frame
+    from balpipe.engine.dynamics import solve_multipliers
+
+    spec, stages, t = rrr4
+    engine.clear_cache()
+    used = 0
+    for s in stages:
+        c = compiled(s.model)
+        q, v, a, placed = shared.kinematics(c, t)
+        rhs = -np.stack([c.mass, c.mass, c.inertia], axis=1).reshape(1, -1) * a
+        got = shared.multipliers(c, placed, rhs)
+        if not _offsets(s.model):
+            assert placed is None and got is None
+            continue
+        used += 1
+        lam, J0 = got
+        J = jacobian(c, with_frame(q))
+        own = solve_multipliers(c, J[:, :, 3:], rhs)
+        peak = np.abs(own).max()
+        assert np.abs(lam - own).max() <= 1e-9 * peak, s.name
+        residual = np.einsum("nmk,nm->nk", J[:, :, 3:], lam) - rhs
+        assert np.abs(residual).max() <= 1e-9 * np.abs(rhs).max(), s.name
+        assert np.array_equal(J0, J[:, :, :3])  # the frame's columns do not see the masses
+    assert used >= 3

@@ -175,8 +175,9 @@ def analyse(
             kin = fastpath.kinematics(c, c.fast, t)
         except fastpath.Fallback:
             kin = None
+    placed = None
     if kin is None:
-        q, v, a = shared.kinematics(c, t)  # placed in the frame motion of its geometry (solved once)
+        q, v, a, placed = shared.kinematics(c, t)  # placed in the frame motion of its geometry (solved once)
         cond = c.condition  # None where the screen showed the motion regular: computed when read
         condition = None if cond is not None else functools.partial(condition_numbers, c, q)
     else:
@@ -193,20 +194,26 @@ def analyse(
         mesh_geo: list = []
         gen0 = fastpath.frame_load(c.fast, kin.vals, lamT)
     else:
-        qx = with_frame(q)
-        J = jacobian(cd, qx)
-        mesh_geo = tooth_rows(cd, qx, J)  # gear meshes with pitch radii act by tooth forces
-        Jf, J0 = J[:, :, 3:], J[:, :, :3]
         Q = np.zeros_like(q)
         Q[:, 0::3] = c.mass * g[0]
         Q[:, 1::3] = c.mass * g[1]
         rhs = Q - Mdiag * a
-        if c.dynamics is not None:
-            actuation = actuation_condition(cd, Jf, t)
-            rates = {name: np.einsum("nk,nk->n", Jf[:, row, :], v) for name, row in cd.driver_rows.items()}
-        lam = solve_multipliers(cd, Jf, rhs)
-        lam, radial_on_frame = radial_tooth_loads(cd, mesh_geo, lam)
-        gen0 = -np.einsum("nmk,nm->nk", J0, lam) + radial_on_frame  # load on the frame: Fx, Fy, M_O
+        by_frame = shared.multipliers(c, placed, rhs)  # a placed model: its geometry's map, made once
+        if by_frame is not None:
+            lam, J0 = by_frame
+            mesh_geo = []
+            gen0 = -np.einsum("nmk,nm->nk", J0, lam)  # load on the frame: Fx, Fy, M_O
+        else:
+            qx = with_frame(q)
+            J = jacobian(cd, qx)
+            mesh_geo = tooth_rows(cd, qx, J)  # gear meshes with pitch radii act by tooth forces
+            Jf, J0 = J[:, :, 3:], J[:, :, :3]
+            if c.dynamics is not None:
+                actuation = actuation_condition(cd, Jf, t)
+                rates = {name: np.einsum("nk,nk->n", Jf[:, row, :], v) for name, row in cd.driver_rows.items()}
+            lam = solve_multipliers(cd, Jf, rhs)
+            lam, radial_on_frame = radial_tooth_loads(cd, mesh_geo, lam)
+            gen0 = -np.einsum("nmk,nm->nk", J0, lam) + radial_on_frame  # load on the frame: Fx, Fy, M_O
     P = np.asarray(moment_point, dtype=float)
     force = gen0[:, :2]
     moment_O = gen0[:, 2]

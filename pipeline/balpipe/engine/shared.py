@@ -33,12 +33,14 @@ import numpy as np
 from .compile import Compiled, compile_model
 from .errors import AnalysisError
 from .fastpath import _place as place, frame_model
+from .constraints import jacobian, with_frame
+from .dynamics import multiplier_map
 from .kinematics import _vel_acc
 from .positions import _JUMP, DenseOps, _check_regular, follow_motion, newton_raphson, solve_positions
 from .warmstart import motion_key
 
 STATS = {"shared": 0, "solved": 0, "rejected": 0}
-_MOTIONS: dict[tuple, list] = {}  # motion key -> [laws kept alive, frame motion or None, its (v, a) or None]
+_MOTIONS: dict[tuple, list] = {}  # motion key -> [laws kept alive, frame motion or None, its (v, a), frame model, (K, J0)]
 _KEPT = 16
 
 
@@ -48,16 +50,40 @@ def positions(c: Compiled, t: np.ndarray) -> np.ndarray:
     return _positions(c, t)[0]
 
 
-def kinematics(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def kinematics(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, list | None]:
     """Positions, velocities and accelerations (N, 3 nb) of ``c`` along ``t``: :func:`positions`,
     and the rates placed from the frame motion's where the positions were (see the module), else
-    solved on ``c``'s own Jacobian (:func:`.kinematics._vel_acc`)."""
+    solved on ``c``'s own Jacobian (:func:`.kinematics._vel_acc`); and the shared entry they
+    were placed from (for :func:`multipliers`), or None."""
     q, entry = _positions(c, t)
     if entry is None:
-        return (q, *_vel_acc(c, q, t))
+        return (q, *_vel_acc(c, q, t), None)
     if entry[2] is None:
-        entry[2] = _vel_acc(c.frame, entry[1], t)  # once per geometry and grid
-    return (q, *_place_rates(entry[1], *entry[2], c.com_local))
+        entry[2] = _vel_acc(entry[3], entry[1], t)  # once per geometry and grid
+    return (q, *_place_rates(entry[1], *entry[2], c.com_local), entry)
+
+
+def multipliers(c: Compiled, entry: list | None, rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The multipliers (N, m) of Phi_q^T lambda = ``rhs`` for a model placed in the frame motion
+    of ``entry`` (:func:`kinematics`), and the frame's columns J0 (N, m, 3) of Phi_q, from the
+    frame model's map (:func:`.dynamics.multiplier_map`, made once per geometry and grid): the
+    model's Jacobian is the frame model's times T^-1 (a centre of mass at R c from its frame's
+    origin: dr = dr_f + dphi perp(R c)), so Phi_q^T lambda = rhs is J_f^T lambda = T^T rhs, the
+    generalised forces moved to the frames' origins (the moment gains r x F). None where the
+    model has gear meshes or named actuators (their own rows and tooth forces), or no entry."""
+    if entry is None or c.meshes or c.dynamics is not None:
+        return None
+    fc = entry[3]
+    if fc.meshes or fc.dynamics is not None or fc.row_owner != c.row_owner or fc.driver_rows != c.driver_rows:
+        return None
+    if entry[4] is None:
+        J = jacobian(fc, with_frame(entry[1]))
+        entry[4] = (multiplier_map(fc, J[:, :, 3:]), J[:, :, :3])  # once per geometry and grid
+    K, J0 = entry[4]
+    rx, ry = _arms(entry[1], c.com_local)
+    moved = rhs.copy()
+    moved[:, 2::3] += rx * rhs[:, 1::3] - ry * rhs[:, 0::3]
+    return np.einsum("nmk,nk->nm", K, moved), J0
 
 
 def _positions(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, list | None]:
@@ -97,7 +123,7 @@ def _frame_entry(c: Compiled, t: np.ndarray) -> list:
         frame = None
     if len(_MOTIONS) >= _KEPT:
         _MOTIONS.clear()
-    entry = _MOTIONS[key] = [[d.law for d in c.model.drivers], frame, None]  # the laws kept alive: their ids key
+    entry = _MOTIONS[key] = [[d.law for d in c.model.drivers], frame, None, fc, None]  # the laws kept alive: their ids key
     return entry
 
 
@@ -105,10 +131,8 @@ def _place_rates(frame: np.ndarray, vf: np.ndarray, af: np.ndarray, com: np.ndar
     """Velocities and accelerations (N, 3 nb) of the points at ``com`` (nb, 2) of bodies whose
     frames move with ``frame``, ``vf``, ``af``: r' = r_f' + w perp(R c),
     r'' = r_f'' + alpha perp(R c) - w^2 R c; the angles' rates are the frames'."""
-    th, w, al = frame[:, 2::3], vf[:, 2::3], af[:, 2::3]
-    cos, sin = np.cos(th), np.sin(th)
-    rx = cos * com[:, 0] - sin * com[:, 1]
-    ry = sin * com[:, 0] + cos * com[:, 1]
+    w, al = vf[:, 2::3], af[:, 2::3]
+    rx, ry = _arms(frame, com)
     v, a = vf.copy(), af.copy()
     w2 = w * w
     v[:, 0::3] -= w * ry
@@ -116,6 +140,13 @@ def _place_rates(frame: np.ndarray, vf: np.ndarray, af: np.ndarray, com: np.ndar
     a[:, 0::3] -= al * ry + w2 * rx
     a[:, 1::3] += al * rx - w2 * ry
     return v, a
+
+
+def _arms(frame: np.ndarray, com: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """R(phi) c (N, nb) of every body: its centre of mass from its frame's origin."""
+    th = frame[:, 2::3]
+    cos, sin = np.cos(th), np.sin(th)
+    return cos * com[:, 0] - sin * com[:, 1], sin * com[:, 0] + cos * com[:, 1]
 
 
 def clear() -> None:
