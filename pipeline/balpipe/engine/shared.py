@@ -17,7 +17,9 @@ the model's own Jacobian either way, so the same specs fail, with the same messa
 velocities and accelerations of an accepted model are placed too (:func:`kinematics`): the
 frames' are solved once per geometry (one QR factorisation per sample of the frame model's
 Jacobian instead of one per model), and a centre of mass at c in its body's frame moves with
-r' = r_f' + w perp(R c), r'' = r_f'' + alpha perp(R c) - w^2 R c, exact kinematics.
+r' = r_f' + w perp(R c), r'' = r_f'' + alpha perp(R c) - w^2 R c, exact kinematics; and so are
+their Lagrange multipliers where the model has no gear meshes or named actuators
+(:func:`multipliers`: the frame model's map, the generalised forces moved to the frames' origins).
 
 A model whose centres of mass are at its frames' origins is its own frame model: its positions
 are the continuation's, and its rates its own solves, bit for bit. The others' agree with their
