@@ -48,7 +48,7 @@ def test_stages_share_one_frame_motion_and_agree_with_their_own_continuation(rrr
         assert np.abs(a.q.reshape(len(t), -1) - own).max() <= 1e-10 * np.abs(own).max(), s.name
     engine.clear_cache()
     with pytest.MonkeyPatch.context() as m:  # every stage by its own continuation
-        m.setattr(shared, "_frame_entry", lambda c, t: [None, None, None, None, None])
+        m.setattr(shared, "_frame_entry", lambda c, t: shared._Shared([], None, None))
         alone = [analyse(s.model, t, g, mp) for s in stages]
     for s, a, b in zip(stages, mine, alone):
         assert np.abs(a.force - b.force).max() <= 1e-9 * ref, s.name

@@ -138,20 +138,10 @@ def actuation_condition(c: Compiled, Jf: np.ndarray, t: np.ndarray) -> np.ndarra
 
 def multiplier_map(c: Compiled, Jf: np.ndarray) -> np.ndarray:
     """K (N, m, n) with lambda = K rhs the multipliers of :func:`solve_multipliers` for every
-    right-hand side (the same linear map: the unique solution of a square system; with redundant
-    actuation the least-norm solution Q1 R1^-T rhs moved along the null space Q2 to the least-norm
-    efforts, K = (I - Q2 (S Q2)^+ S) Q1 R1^-T, S the driver rows). For models that share one
-    factorisation (:func:`.shared.multipliers`)."""
-    A = np.transpose(Jf, (0, 2, 1))  # (N, n, m)
-    n, m = A.shape[1], A.shape[2]
-    if m == n:
-        return np.linalg.inv(A)
-    Q, R = np.linalg.qr(Jf, mode="complete")
-    eye = np.broadcast_to(np.eye(n), (len(Jf), n, n))
-    P = Q[:, :, :n] @ np.linalg.solve(np.transpose(R[:, :n, :], (0, 2, 1)), eye)  # Q1 R1^-T
-    null = Q[:, :, n:]
-    drv = sorted(c.driver_rows.values())
-    return P - null @ (np.linalg.pinv(null[:, drv, :]) @ P[:, drv, :])
+    right-hand side: that solve applied to the n unit right-hand sides at once. For models that
+    share one factorisation (:func:`.shared.multipliers`)."""
+    n = Jf.shape[2]
+    return solve_multipliers(c, Jf, np.broadcast_to(np.eye(n), (len(Jf), n, n)))
 
 
 def solve_multipliers(c: Compiled, Jf: np.ndarray, rhs: np.ndarray) -> np.ndarray:

@@ -203,12 +203,18 @@ def _frame_compiled(c: Compiled) -> Compiled:
 
 def _place(frame: np.ndarray, com: np.ndarray) -> np.ndarray:
     """Coordinates (N, 3 nb) of the points at ``com`` (nb, 2) in the bodies' frames ``frame``."""
+    rx, ry = _arms(frame, com)
+    q = frame.copy()
+    q[:, 0::3] += rx
+    q[:, 1::3] += ry
+    return q
+
+
+def _arms(frame: np.ndarray, com: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """R(phi) c (N, nb), x and y: the points at ``com`` (nb, 2) from their frames' origins."""
     th = frame[:, 2::3]
     cos, sin = np.cos(th), np.sin(th)
-    q = frame.copy()
-    q[:, 0::3] += cos * com[:, 0] - sin * com[:, 1]
-    q[:, 1::3] += sin * com[:, 0] + cos * com[:, 1]
-    return q
+    return cos * com[:, 0] - sin * com[:, 1], sin * com[:, 0] + cos * com[:, 1]
 
 
 def _screen(c: Compiled, p: Prepared, vals: np.ndarray, inverses: dict, X: np.ndarray, t: np.ndarray) -> None:

@@ -30,11 +30,13 @@ depend only on the geometry and on their own mass properties. Counts of what hap
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .compile import Compiled, compile_model
 from .errors import AnalysisError
-from .fastpath import _place as place, frame_model
+from .fastpath import _arms, _place as place, frame_model
 from .constraints import jacobian, with_frame
 from .dynamics import multiplier_map
 from .kinematics import _vel_acc
@@ -42,8 +44,24 @@ from .positions import _JUMP, DenseOps, _check_regular, follow_motion, newton_ra
 from .warmstart import motion_key
 
 STATS = {"shared": 0, "solved": 0, "rejected": 0}
-_MOTIONS: dict[tuple, list] = {}  # motion key -> [laws kept alive, frame motion or None, its (v, a), frame model, (K, J0)]
 _KEPT = 16
+
+
+@dataclass
+class _Shared:
+    """What the models of one geometry and grid share: the frame model ``fc``, its motion
+    (None where it cannot be followed), and, made when first needed, its rates and its
+    multiplier map with the frame's Jacobian columns. ``laws``: the drivers' laws, kept alive
+    (their ids are part of the key)."""
+
+    laws: list
+    fc: Compiled
+    frame: np.ndarray | None
+    rates: tuple[np.ndarray, np.ndarray] | None = None
+    dynamics: tuple[np.ndarray, np.ndarray] | None = None
+
+
+_MOTIONS: dict[tuple, _Shared] = {}  # motion key -> what its models share
 
 
 def positions(c: Compiled, t: np.ndarray) -> np.ndarray:
@@ -52,7 +70,7 @@ def positions(c: Compiled, t: np.ndarray) -> np.ndarray:
     return _positions(c, t)[0]
 
 
-def kinematics(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, list | None]:
+def kinematics(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, _Shared | None]:
     """Positions, velocities and accelerations (N, 3 nb) of ``c`` along ``t``: :func:`positions`,
     and the rates placed from the frame motion's where the positions were (see the module), else
     solved on ``c``'s own Jacobian (:func:`.kinematics._vel_acc`); and the shared entry they
@@ -60,12 +78,12 @@ def kinematics(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.n
     q, entry = _positions(c, t)
     if entry is None:
         return (q, *_vel_acc(c, q, t), None)
-    if entry[2] is None:
-        entry[2] = _vel_acc(entry[3], entry[1], t)  # once per geometry and grid
-    return (q, *_place_rates(entry[1], *entry[2], c.com_local), entry)
+    if entry.rates is None:
+        entry.rates = _vel_acc(entry.fc, entry.frame, t)  # once per geometry and grid
+    return (q, *_place_rates(entry.frame, *entry.rates, c.com_local), entry)
 
 
-def multipliers(c: Compiled, entry: list | None, rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+def multipliers(c: Compiled, entry: _Shared | None, rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """The multipliers (N, m) of Phi_q^T lambda = ``rhs`` for a model placed in the frame motion
     of ``entry`` (:func:`kinematics`), and the frame's columns J0 (N, m, 3) of Phi_q, from the
     frame model's map (:func:`.dynamics.multiplier_map`, made once per geometry and grid): the
@@ -75,26 +93,26 @@ def multipliers(c: Compiled, entry: list | None, rhs: np.ndarray) -> tuple[np.nd
     model has gear meshes or named actuators (their own rows and tooth forces), or no entry."""
     if entry is None or c.meshes or c.dynamics is not None:
         return None
-    fc = entry[3]
+    fc = entry.fc
     if fc.meshes or fc.dynamics is not None or fc.row_owner != c.row_owner or fc.driver_rows != c.driver_rows:
         return None
-    if entry[4] is None:
-        J = jacobian(fc, with_frame(entry[1]))
-        entry[4] = (multiplier_map(fc, J[:, :, 3:]), J[:, :, :3])  # once per geometry and grid
-    K, J0 = entry[4]
-    rx, ry = _arms(entry[1], c.com_local)
+    if entry.dynamics is None:
+        J = jacobian(fc, with_frame(entry.frame))
+        entry.dynamics = (multiplier_map(fc, J[:, :, 3:]), J[:, :, :3])  # once per geometry and grid
+    K, J0 = entry.dynamics
+    rx, ry = _arms(entry.frame, c.com_local)
     moved = rhs.copy()
     moved[:, 2::3] += rx * rhs[:, 1::3] - ry * rhs[:, 0::3]
     return np.einsum("nmk,nk->nm", K, moved), J0
 
 
-def _positions(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, list | None]:
+def _positions(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, _Shared | None]:
     """:func:`positions` and the shared entry they were placed from (None: solved on ``c``)."""
     if not np.any(c.com_local):
         return solve_positions(c, t), None  # its own frame model: the continuation itself
     entry = _frame_entry(c, t)
-    if entry[1] is not None:
-        q = _from_shared(c, t, entry[1])
+    if entry.frame is not None:
+        q = _from_shared(c, t, entry.frame)
         if q is not None:
             STATS["shared"] += 1
             c.condition = _check_regular(c, q, t, screen=True)
@@ -107,10 +125,10 @@ def frame_motion(c: Compiled, t: np.ndarray) -> np.ndarray | None:
     """The motion (N, 3 nb) of ``c``'s bodies' frames along ``t`` by the continuation on its frame
     model, solved once per :func:`.warmstart.motion_key`; None where the frame model cannot be
     followed (the caller's continuation then reports the model's own error)."""
-    return _frame_entry(c, t)[1]
+    return _frame_entry(c, t).frame
 
 
-def _frame_entry(c: Compiled, t: np.ndarray) -> list:
+def _frame_entry(c: Compiled, t: np.ndarray) -> _Shared:
     key = motion_key(c, t)
     hit = _MOTIONS.get(key)
     if hit is not None:
@@ -125,7 +143,7 @@ def _frame_entry(c: Compiled, t: np.ndarray) -> list:
         frame = None
     if len(_MOTIONS) >= _KEPT:
         _MOTIONS.clear()
-    entry = _MOTIONS[key] = [[d.law for d in c.model.drivers], frame, None, fc, None]  # the laws kept alive: their ids key
+    entry = _MOTIONS[key] = _Shared([d.law for d in c.model.drivers], fc, frame)
     return entry
 
 
@@ -142,13 +160,6 @@ def _place_rates(frame: np.ndarray, vf: np.ndarray, af: np.ndarray, com: np.ndar
     a[:, 0::3] -= al * ry + w2 * rx
     a[:, 1::3] += al * rx - w2 * ry
     return v, a
-
-
-def _arms(frame: np.ndarray, com: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """R(phi) c (N, nb) of every body: its centre of mass from its frame's origin."""
-    th = frame[:, 2::3]
-    cos, sin = np.cos(th), np.sin(th)
-    return cos * com[:, 0] - sin * com[:, 1], sin * com[:, 0] + cos * com[:, 1]
 
 
 def clear() -> None:
