@@ -65,3 +65,22 @@ def test_table_of_contents_links_every_h2():
     assert '<a href="#balancing-stages-section">' in out and '<h2 id="balancing-stages-section">' in out
     assert toc.add_toc('<!--toc--><section id="history"><h2>History</h2></section>').count('id="history"') == 1
     assert toc.add_toc("<h2>x</h2>") == "<h2>x</h2>"  # no marker, no change
+
+
+def test_page_ids_are_the_word_bounded_id_attributes():
+    """toc.page_ids is re.findall(r'\bid="([^"]+)"') as a set, on the cases where a literal scan
+    could differ: an id attribute inside another name (grid=, data_id=), one starting inside a
+    rejected one's value, the start of the text, non-ASCII word characters, and random text."""
+    import random
+    import re
+
+    def reference(page):
+        return set(re.findall(r'\bid="([^"]+)"', page))
+
+    cases = ['id="a" x', 'grid="b" <p id="c">', 'grid="foo id="bar"', 'data_id="u" data-id="v"',
+             'éid="w" -id="z"', 'id=""', '<a\nid="n1">', 'xid="id="q"']
+    rng = random.Random(0)
+    alphabet = ['id="', "i", "d", "=", '"', " ", "g", "_", "-", "é", "x"]
+    cases += ["".join(rng.choice(alphabet) for _ in range(rng.randint(0, 40))) for _ in range(3000)]
+    for page in cases:
+        assert toc.page_ids(page) == reference(page), page
