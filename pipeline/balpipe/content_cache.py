@@ -76,61 +76,132 @@ def callable_name(fn: Any, closures: bool = False) -> str:
 
 def feed(h, x: Any) -> None:
     """Feed ``x`` into the hash ``h``, every value tagged with its type so that no two different
-    inputs give the same bytes (1 and 1.0 and '1' and [1] differ; dicts in their order)."""
-    if x is None:
-        h.update(b"N")
-    elif x is True or x is False:
-        h.update(b"T" if x else b"F")
-    elif isinstance(x, np.ndarray) or isinstance(x, np.generic):
-        a = np.asarray(x)
-        if a.dtype.hasobject:
-            raise Unhashable(f"a numpy array of objects ({a.dtype}) cannot be hashed")
-        data = np.ascontiguousarray(a).tobytes()
-        h.update(b"A" + a.dtype.str.encode() + repr(a.shape).encode() + struct.pack("<Q", len(data)))
-        h.update(data)
-    elif isinstance(x, enum.Enum):
-        h.update(b"E" + type(x).__qualname__.encode() + b"." + x.name.encode() + b"\0")
-    elif isinstance(x, int):
-        h.update(b"I" + str(int(x)).encode() + b"\0")
-    elif isinstance(x, float):
-        h.update(b"R" + float(x).hex().encode() + b"\0")
-    elif isinstance(x, str):
-        b = x.encode("utf-8", "surrogatepass")
-        h.update(b"S" + struct.pack("<Q", len(b)) + b)
-    elif isinstance(x, bytes):
-        h.update(b"B" + struct.pack("<Q", len(x)) + x)
-    elif isinstance(x, (list, tuple)):
-        h.update((b"L" if isinstance(x, list) else b"U") + struct.pack("<Q", len(x)))
-        for v in x:
-            feed(h, v)
-    elif isinstance(x, dict):
-        h.update(b"M" + struct.pack("<Q", len(x)))
-        for k, v in x.items():
-            feed(h, k)
-            feed(h, v)
-    elif isinstance(x, (set, frozenset)):
-        parts = sorted(hashlib.sha256(digest_of(v)).digest() for v in x)
-        h.update(b"Z" + struct.pack("<Q", len(parts)) + b"".join(parts))
-    elif dataclasses.is_dataclass(x) and not isinstance(x, type):
-        cls = type(x)
-        h.update(b"C" + f"{cls.__module__}.{cls.__qualname__}".encode() + b"\0")
-        fields = [f for f in dataclasses.fields(x) if not f.metadata.get(MEMO)]
-        h.update(struct.pack("<Q", len(fields)))
-        for f in fields:
-            h.update(f.name.encode() + b"=")
-            feed(h, getattr(x, f.name))
-    elif isinstance(x, types.FunctionType):
-        # a motion law's profile (motion.quintic) or a closure of one (its captured values)
-        h.update(b"f" + callable_name(x, closures=True).encode() + b"\0")
-        feed(h, x.__defaults__)
-        feed(h, x.__kwdefaults__)
-        feed(h, tuple(c.cell_contents for c in (x.__closure__ or ())))
-    elif hasattr(type(x), "model_fields") and hasattr(x, "model_dump_json"):  # a pydantic model of a spec
-        cls = type(x)
-        h.update(b"P" + f"{cls.__module__}.{cls.__qualname__}".encode() + b"\0")
-        feed(h, x.model_dump_json())
-    else:
-        raise Unhashable(f"an input of type {type(x).__qualname__} cannot be hashed; pass plain data")
+    inputs give the same bytes (1 and 1.0 and '1' and [1] differ; dicts in their order).
+
+    The bytes, by the first kind that ``x`` is: None ``N``; a bool ``T``/``F``; a numpy array or
+    scalar ``A`` dtype shape length, then its bytes (C order); an enum ``E`` class ``.`` name; an
+    int ``I`` digits; a float ``R`` hex; a str ``S`` length UTF-8; bytes ``B`` length bytes; a
+    list ``L``, a tuple ``U``, length then each item; a dict ``M`` length then each key and value;
+    a set ``Z`` length and its items' sorted SHA-256s; a dataclass ``C`` class, field count, then
+    ``name=`` value for each field not marked :data:`MEMO`; a function ``f`` name, defaults, closure
+    values; a pydantic model ``P`` class and its JSON. The kind depends on the type alone, so it is
+    found once per type (:func:`_feeder`) and kept (some 110000 values a build of specs/)."""
+    f = _FEEDERS.get(type(x))
+    if f is None:
+        f = _FEEDERS[type(x)] = _feeder(type(x))
+    f(h, x)
+
+
+def _feed_none(h, x: Any) -> None:
+    h.update(b"N")
+
+
+def _feed_bool(h, x: Any) -> None:
+    h.update(b"T" if x else b"F")
+
+
+def _feed_array(h, x: Any) -> None:
+    a = np.asarray(x)
+    if a.dtype.hasobject:
+        raise Unhashable(f"a numpy array of objects ({a.dtype}) cannot be hashed")
+    data = np.ascontiguousarray(a).tobytes()
+    h.update(b"A" + a.dtype.str.encode() + repr(a.shape).encode() + struct.pack("<Q", len(data)))
+    h.update(data)
+
+
+def _feed_enum(h, x: Any) -> None:
+    h.update(b"E" + type(x).__qualname__.encode() + b"." + x.name.encode() + b"\0")
+
+
+def _feed_int(h, x: Any) -> None:
+    h.update(b"I" + str(int(x)).encode() + b"\0")
+
+
+def _feed_float(h, x: Any) -> None:
+    h.update(b"R" + float(x).hex().encode() + b"\0")
+
+
+def _feed_str(h, x: Any) -> None:
+    b = x.encode("utf-8", "surrogatepass")
+    h.update(b"S" + struct.pack("<Q", len(b)) + b)
+
+
+def _feed_bytes(h, x: Any) -> None:
+    h.update(b"B" + struct.pack("<Q", len(x)) + x)
+
+
+def _feed_items(h, x: Any) -> None:
+    h.update((b"L" if isinstance(x, list) else b"U") + struct.pack("<Q", len(x)))
+    for v in x:
+        feed(h, v)
+
+
+def _feed_dict(h, x: Any) -> None:
+    h.update(b"M" + struct.pack("<Q", len(x)))
+    for k, v in x.items():
+        feed(h, k)
+        feed(h, v)
+
+
+def _feed_set(h, x: Any) -> None:
+    parts = sorted(hashlib.sha256(digest_of(v)).digest() for v in x)
+    h.update(b"Z" + struct.pack("<Q", len(parts)) + b"".join(parts))
+
+
+def _feed_function(h, x: Any) -> None:
+    # a motion law's profile (motion.quintic) or a closure of one (its captured values)
+    h.update(b"f" + callable_name(x, closures=True).encode() + b"\0")
+    feed(h, x.__defaults__)
+    feed(h, x.__kwdefaults__)
+    feed(h, tuple(c.cell_contents for c in (x.__closure__ or ())))
+
+
+def _feed_pydantic(h, x: Any) -> None:  # a pydantic model of a spec
+    cls = type(x)
+    h.update(b"P" + f"{cls.__module__}.{cls.__qualname__}".encode() + b"\0")
+    feed(h, x.model_dump_json())
+
+
+def _dataclass_feeder(cls: type) -> Callable[[Any, Any], None]:
+    """The feeder of a dataclass: its class and its fields less the memos, named once."""
+    names = [f.name for f in dataclasses.fields(cls) if not f.metadata.get(MEMO)]
+    head = b"C" + f"{cls.__module__}.{cls.__qualname__}".encode() + b"\0" + struct.pack("<Q", len(names))
+    labels = [(name, name.encode() + b"=") for name in names]
+
+    def fields(h, x: Any) -> None:
+        h.update(head)
+        for name, label in labels:
+            h.update(label)
+            feed(h, getattr(x, name))
+
+    return fields
+
+
+def _unhashable(h, x: Any) -> None:
+    raise Unhashable(f"an input of type {type(x).__qualname__} cannot be hashed; pass plain data")
+
+
+def _feeder(cls: type) -> Callable[[Any, Any], None]:
+    """How :func:`feed` writes a value of type ``cls``: the first kind of its list that ``cls`` is."""
+    if cls is type(None):
+        return _feed_none
+    if cls is bool:
+        return _feed_bool
+    for kinds, fn in (((np.ndarray, np.generic), _feed_array), (enum.Enum, _feed_enum), (int, _feed_int),
+                      (float, _feed_float), (str, _feed_str), (bytes, _feed_bytes), ((list, tuple), _feed_items),
+                      (dict, _feed_dict), ((set, frozenset), _feed_set)):
+        if issubclass(cls, kinds):
+            return fn
+    if dataclasses.is_dataclass(cls) and not issubclass(cls, type):
+        return _dataclass_feeder(cls)
+    if issubclass(cls, types.FunctionType):
+        return _feed_function
+    if hasattr(cls, "model_fields") and hasattr(cls, "model_dump_json"):
+        return _feed_pydantic
+    return _unhashable
+
+
+_FEEDERS: dict[type, Callable[[Any, Any], None]] = {}
 
 
 def digest_of(x: Any) -> bytes:
