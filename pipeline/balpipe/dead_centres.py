@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from . import dyads
-from .engine import Analysis, compile_model
+from .engine import Analysis, compile_model, condition_peak
 from .model import Model
 
 TRANSMISSION_LIMIT = math.radians(10.0)
@@ -80,17 +80,17 @@ def find(model: Model, an: Analysis, stage: str = "") -> list[dict]:
             })
     for key, what in (("condition", "the constraint Jacobian of the prescribed motion is ill-conditioned"),
                       ("actuation_condition", "the actuators lose control of the mechanism (the actuated system is ill-conditioned)")):
-        if key not in an.extra:
+        found = condition_peak(an.extra, key)
+        if found is None:
             continue
-        cond = np.asarray(an.extra[key], dtype=float)
-        k = int(np.argmax(cond))
-        if cond[k] > CONDITION_LIMIT:
+        k, cond = found
+        if cond > CONDITION_LIMIT:
             out.append({
                 "kind": "singular" if key == "condition" else "actuation", "time": float(an.t[k]),
-                "value": float(cond[k]), "limit": CONDITION_LIMIT, "configuration": _configuration(model, an, k),
+                "value": cond, "limit": CONDITION_LIMIT, "configuration": _configuration(model, an, k),
                 "effort_spike": spike,
                 "message": f"{where}near a singular configuration at t = {an.t[k]:.4g} s: {what} (condition number "
-                           f"{cond[k]:.3g}, warned above {CONDITION_LIMIT:.0e})" + _spike_text(spike),
+                           f"{cond:.3g}, warned above {CONDITION_LIMIT:.0e})" + _spike_text(spike),
             })
     return out
 

@@ -12,7 +12,7 @@ import numpy as np
 from . import actuation, assembly, dead_centres, loop_closure, realisable, registry
 from .balancing.base import BalanceResult, Stage
 from .claim_precision import claim_tolerances
-from .engine import Analysis, AnalysisError, analyse
+from .engine import Analysis, AnalysisError, analyse, condition_peak
 from .engine.load_reference import LoadReference, load_reference
 from .sampling import gravity_vector  # noqa: F401  (balpipe.study.gravity_vector, as before)
 from .spec import Spec
@@ -214,20 +214,21 @@ def _decimals(x: float) -> int:
 
 
 def near_singular_note(stages: list[StageResult], balance: BalanceResult, problems: list[str]) -> float:
-    """The largest condition number of the constraint Jacobian over the stages' motions (an SVD
-    per sample, computed here when the engine's block path has not); above
+    """The largest condition number of the constraint Jacobian over the stages' motions (SVDs of
+    the samples where it can be, :func:`.engine.condition_peak`, computed here when the engine's
+    path has not computed them all); above
     :data:`NEAR_SINGULAR`, a note of the accuracy lost there, also appended to the balance
     ``problems`` (in place). Only the page shows them: ``balpipe check`` skips this."""
-    worst = max(stages, key=lambda s: float(np.max(s.analysis.extra["condition"])))
-    cond = worst.analysis.extra["condition"]
-    k = int(np.argmax(cond))
-    if float(cond[k]) > NEAR_SINGULAR:
+    peaks = [condition_peak(s.analysis.extra) for s in stages]
+    i = max(range(len(stages)), key=lambda i: peaks[i][1])  # the first stage of the largest
+    k, cond = peaks[i]
+    if cond > NEAR_SINGULAR:
         where = (f"the motion passes near a singular configuration (condition number of the constraint "
-                 f"Jacobian {cond[k]:.3g} at t = {worst.analysis.t[k]:.4g} s): accelerations there lose about "
-                 f"{min(1.0, cond[k] ** 2 * 1e-16):.1g} of their relative accuracy")
+                 f"Jacobian {cond:.3g} at t = {stages[i].analysis.t[k]:.4g} s): accelerations there lose about "
+                 f"{min(1.0, cond ** 2 * 1e-16):.1g} of their relative accuracy")
         balance.notes.append(where[0].upper() + where[1:] + ".")
         problems[:] = [p + f"; {where}" if "should cancel" in p else p for p in problems]
-    return float(cond[k])
+    return cond
 
 
 def run(spec: Spec, page: bool = True) -> Study:

@@ -38,10 +38,11 @@ Modules, one job each: :mod:`.compile` (primitives, :func:`compile_model`), :mod
 :func:`analyse`), :mod:`.structure` and :mod:`.fastpath` (the block-triangular path),
 :mod:`.warmstart` (a new geometry of a closed loop solved from fixed anchors:
 :func:`record_anchors`, :func:`warm_start`), :mod:`.shared` (the general path's models of one
-geometry placed in its frame motion, solved once).
+geometry placed in its frame motion, solved once), :mod:`.conditioning` (the largest condition
+number of a motion, with SVDs only where it can be: :func:`condition_peak`).
 """
 
-from .analysis import Analysis, analyse, clear_cache, compiled
+from .analysis import Analysis, analyse, clear_cache, compiled, condition_peak
 from .compile import Compiled, compile_model
 from .constraints import acceleration_rhs, jacobian, residual, velocity_rhs
 from .errors import AnalysisError
@@ -49,6 +50,6 @@ from .warmstart import Anchors, record as record_anchors, warm_start
 from .positions import condition_numbers, follow_motion, redundancy, solve_positions
 
 __all__ = [
-    "Analysis", "AnalysisError", "Anchors", "Compiled", "acceleration_rhs", "analyse", "clear_cache", "compile_model", "compiled", "jacobian",
+    "Analysis", "AnalysisError", "Anchors", "Compiled", "acceleration_rhs", "analyse", "clear_cache", "compile_model", "compiled", "condition_peak", "jacobian",
     "record_anchors", "redundancy", "residual", "solve_positions", "velocity_rhs", "warm_start",
 ]

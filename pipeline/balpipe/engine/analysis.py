@@ -14,6 +14,7 @@ from . import fastpath, shared, structure
 from .compile import Compiled, compile_model
 from .constraints import with_frame, jacobian
 from .dynamics import joint_reactions, solve_multipliers, radial_tooth_loads, tooth_rows, actuation_condition
+from .conditioning import motion_peak
 from .positions import condition_numbers, redundancy
 
 
@@ -96,11 +97,23 @@ class Analysis:
 
 class _Extra(dict):
     """``Analysis.extra``, whose ``condition`` entry (the condition numbers of Phi_q along the
-    motion, an SVD per sample) is computed when first read. Pickles as a plain dict."""
+    motion, an SVD per sample) is computed when first read, and whose peak alone
+    (:func:`condition_peak`) needs fewer SVDs. Pickles as a plain dict."""
 
-    def __init__(self, data: dict, condition):
+    def __init__(self, data: dict, condition, peak=None):
         super().__init__(data)
         self._condition = condition
+        self._peak = peak  # () -> (k, cond[k]): :func:`.conditioning.motion_peak`
+        self._found: tuple[int, float] | None = None
+
+    def condition_peak(self) -> tuple[int, float]:
+        """(k, cond[k]) of the first largest condition number: from the array when it has been
+        read, else by :func:`.conditioning.motion_peak` (kept)."""
+        if dict.__contains__(self, "condition") or self._peak is None:
+            return _argmax(self["condition"])
+        if self._found is None:
+            self._found = self._peak()
+        return self._found
 
     def __missing__(self, key):
         if key == "condition" and self._condition is not None:
@@ -118,6 +131,22 @@ class _Extra(dict):
         if self._condition is not None:
             self["condition"]
         return (dict, (dict(self),))
+
+
+def _argmax(values) -> tuple[int, float]:
+    v = np.asarray(values, dtype=float)
+    k = int(np.argmax(v))
+    return k, float(v[k])
+
+
+def condition_peak(extra: dict, key: str = "condition") -> tuple[int, float] | None:
+    """The first sample k of the largest value of ``extra[key]`` (``"condition"``, the condition
+    numbers of Phi_q, or ``"actuation_condition"``) and that value, None without that entry. The
+    condition numbers' peak of an analysis (whose ``extra`` is not a pickled copy) takes SVDs only
+    where it can be (:func:`.conditioning.peak`): the same sample and value as the whole array's."""
+    if key == "condition" and isinstance(extra, _Extra) and "condition" in extra:
+        return extra.condition_peak()
+    return _argmax(extra[key]) if key in extra else None
 
 
 _COMPILED: dict[int, tuple[weakref.ref, Compiled]] = {}
@@ -184,6 +213,7 @@ def analyse(
         q, v, a = kin.X[3:-1].T, kin.V[3:-1].T, kin.A[3:-1].T
         cond = None
         condition = functools.partial(condition_numbers, c, q)
+    peak = None if condition is None else functools.partial(motion_peak, c, q)
     cd = c.dynamics or c  # the system of the inverse dynamics: the actuators' rows, or the drivers'
     if kin is not None and not c.meshes and c.dynamics is None:
         rhsT = -Mdiag.T * kin.A[3:-1]
@@ -250,5 +280,5 @@ def analyse(
                       "redundant_actuators": redundancy(cd),
                       "actuated": c.dynamics is not None,
                       **({"actuation_condition": actuation, "actuator_rates": rates} if actuation is not None else {}), **({"condition": cond} if cond is not None else {})},
-                     condition),
+                     condition, peak),
     )

@@ -111,7 +111,11 @@ def condition_numbers(c: Compiled, q: np.ndarray) -> np.ndarray:
 
 
 def _condition(J: np.ndarray) -> np.ndarray:
-    s = np.linalg.svd(J, compute_uv=False)
+    return condition_of(np.linalg.svd(J, compute_uv=False))
+
+
+def condition_of(s: np.ndarray) -> np.ndarray:
+    """Condition numbers from singular values (N, n) in decreasing order."""
     return s[:, 0] / np.maximum(s[:, -1], 1e-300)
 
 

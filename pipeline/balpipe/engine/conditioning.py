@@ -1,0 +1,82 @@
+"""The largest condition number of Phi_q along a motion, and where it is, with SVDs only where the
+peak can be.
+
+A page reports the largest condition number over its stages' motions and where it occurs
+(:func:`balpipe.study.near_singular_note`, :func:`balpipe.dead_centres.find`): the peak of
+:func:`.positions.condition_numbers`, an SVD per sample. :func:`peak` finds the same sample and
+the same value, bit for bit, from SVDs of a subset: every :data:`STRIDE`-th sample first, then
+every sample whose condition number these do not show to be below the largest found.
+
+The bound is Weyl's inequality for singular values, |sigma_k(A) - sigma_k(B)| <= ||A - B||_2 <=
+||A - B||_F (Golub and Van Loan, *Matrix Computations*, 4th ed., Cor. 8.6.2): with J_j a sample
+whose SVD is known and d >= ||J_i - J_j||_F, sigma_max(J_i) <= sigma_max(J_j) + d and
+sigma_min(J_i) >= sigma_min(J_j) - d; d is the sum of the steps ||J_k+1 - J_k||_F between the
+two samples (the triangle inequality: one difference of consecutive samples, not one per pair). The SVD computed in floating point is the exact one of a
+matrix within a small multiple of eps ||J|| (backward stability), so the computed values of both
+samples are within :data:`ROUNDING` ||J||_F of the exact ones; the bound adds that for both. A
+sample is skipped only when the bound from its nearer known neighbour on either side, with a
+relative margin of 1e-9 for the rounding of the bound itself, is below the largest computed
+value: its computed condition number could not have reached it, so the first sample of the
+largest value is the one :func:`numpy.argmax` finds among all of them. (On the specs of specs/
+the SVDs of a build fall from 55698 to about 22000: a motion whose condition number barely
+varies, as many do, needs most of its samples.)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .compile import Compiled
+from .constraints import jacobian, with_frame
+from .positions import _condition, condition_of
+
+#: the samples whose SVD is computed first: every STRIDE-th one and the last
+STRIDE = 8
+#: a bound on the distance of a computed singular value from the exact one, per unit of ||J||_F
+#: (a generous multiple of LAPACK's backward error, p(m, n) eps with p a low-degree polynomial)
+ROUNDING = 1e-9
+#: below this many samples every SVD is computed
+SMALL = 4 * STRIDE
+
+
+def peak(J: np.ndarray) -> tuple[int, float]:
+    """The first sample k of the largest 2-norm condition number of J (N, m, n), m >= n, and that
+    number: ``k = argmax(cond)``, ``cond[k]`` with ``cond = positions._condition(J)``, the same
+    floats."""
+    N = J.shape[0]
+    if N < SMALL or not np.all(np.isfinite(J)):
+        cond = _condition(J)
+        k = int(np.argmax(cond))
+        return k, float(cond[k])
+    known = np.unique(np.r_[np.arange(0, N, STRIDE), N - 1])
+    s = np.linalg.svd(J[known], compute_uv=False)
+    smax, smin = np.full(N, np.nan), np.full(N, np.nan)
+    smax[known], smin[known] = s[:, 0], s[:, -1]
+    cond = np.full(N, -np.inf)
+    cond[known] = condition_of(s)
+    best = float(np.max(cond[known]))
+    norm = np.sqrt(np.einsum("nij,nij->n", J, J))
+    D = np.diff(J, axis=0)
+    path = np.concatenate([[0.0], np.cumsum(np.sqrt(np.einsum("nij,nij->n", D, D)))])  # arc length in ||.||_F
+    slack = N * np.finfo(float).eps * path[-1]  # the rounding of the sums
+    after = np.searchsorted(known, np.arange(N))  # known[after] >= i
+    upper = np.full(N, np.inf)
+    for side in (known[np.maximum(after - 1, 0)], known[np.minimum(after, len(known) - 1)]):
+        # ||J_i - J_j|| <= the path's length between them (the triangle inequality, step by step)
+        d = np.abs(path - path[side]) * (1 + 1e-9) + slack + ROUNDING * (norm + norm[side])
+        low = smin[side] - d
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = np.where(low > 0, (smax[side] + d) / low, np.inf)
+        upper = np.minimum(upper, bound)
+    upper[known] = -np.inf
+    rest = np.flatnonzero(~(upper * (1 + 1e-9) < best))
+    if rest.size:
+        cond[rest] = _condition(J[rest])
+    k = int(np.argmax(cond))
+    return k, float(cond[k])
+
+
+def motion_peak(c: Compiled, q: np.ndarray) -> tuple[int, float]:
+    """:func:`peak` of Phi_q at positions q (N, 3 nb): the peak of
+    :func:`.positions.condition_numbers` ``(c, q)``."""
+    return peak(jacobian(c, with_frame(q))[:, :, 3:])
