@@ -28,6 +28,12 @@ def law_positions(c: Compiled, t: np.ndarray) -> list[np.ndarray | None]:
     return [None if isinstance(p, _Coincident) else _law_values(p, t)[0] for p in c.prims]
 
 
+def law_triples(c: Compiled, t: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
+    """Each primitive's (f, f', f'') at times t (None for a coincidence): :func:`law_positions`
+    with the derivatives that :func:`velocity_rhs` and :func:`acceleration_rhs` take."""
+    return [None if isinstance(p, _Coincident) else _law_values(p, t) for p in c.prims]
+
+
 def residual(c: Compiled, qx: np.ndarray, t: np.ndarray, laws: list | None = None) -> np.ndarray:
     """Phi(q, t), shape (N, m). The revolute rows of every joint at once (:func:`revolute_rows`),
     the same arithmetic as one joint at a time, so the same bits; ``laws``: :func:`law_positions`
@@ -80,7 +86,7 @@ def jacobian(c: Compiled, qx: np.ndarray) -> np.ndarray:
         J[:, r0, rev.tj] = 0.0 - Pj[..., 0]
         J[:, r1, rev.tj] = 0.0 - Pj[..., 1]
     row = 0
-    for p in c.prims:
+    for k, p in enumerate(c.prims):
         if isinstance(p, _Coincident):
             if rev is None:
                 _, thi = _split(qx, p.i)
@@ -158,20 +164,21 @@ def _rotate_all(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
     return out
 
 
-def velocity_rhs(c: Compiled, t: np.ndarray) -> np.ndarray:
-    """nu = -Phi_t, shape (N, m)."""
+def velocity_rhs(c: Compiled, t: np.ndarray, laws: list | None = None) -> np.ndarray:
+    """nu = -Phi_t, shape (N, m). ``laws``: :func:`law_triples` at ``t`` (evaluated when not given)."""
     out = []
-    for p in c.prims:
+    for k, p in enumerate(c.prims):
         if p.rows == 2:
             out.append(np.zeros((len(t), 2)))
         else:
-            out.append(_law_values(p, t)[1][:, None])
+            out.append((_law_values(p, t) if laws is None else laws[k])[1][:, None])
     return np.concatenate(out, axis=1)
 
 
-def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray) -> np.ndarray:
+def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray, laws: list | None = None) -> np.ndarray:
     """gamma = Phi_q q'' (everything in Phi'' but the q'' terms, moved to the right), (N, m);
-    the revolute rows for every joint at once, as in :func:`residual`."""
+    the revolute rows for every joint at once, as in :func:`residual`. ``laws``: :func:`law_triples`
+    at ``t`` (evaluated when not given)."""
     rev = revolute_rows(c)
     out = np.empty((qx.shape[0], len(c.row_owner)))
     if rev is not None:
@@ -179,7 +186,7 @@ def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray)
         Ai, Aj = _rotate_all(qx[:, rev.ti], rev.si), _rotate_all(qx[:, rev.tj], rev.sj)
         out[:, rev.rows] = (wi**2)[..., None] * Ai - (wj**2)[..., None] * Aj
     row = 0
-    for p in c.prims:
+    for k, p in enumerate(c.prims):
         if isinstance(p, _Coincident):
             if rev is None:
                 _, thi = _split(qx, p.i)
@@ -187,7 +194,7 @@ def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray)
                 wi, wj = vx[:, 3 * p.i + 2], vx[:, 3 * p.j + 2]
                 out[:, row : row + 2] = (wi**2)[:, None] * rotate(thi, p.si) - (wj**2)[:, None] * rotate(thj, p.sj)
         elif isinstance(p, _Angle):
-            out[:, row] = _law_values(p, t)[2]
+            out[:, row] = (_law_values(p, t) if laws is None else laws[k])[2]
         else:
             ri, thi = _split(qx, p.i)
             rj, thj = _split(qx, p.j)
@@ -202,7 +209,7 @@ def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray)
                 + 2 * wi * np.sum(_perp(e) * dd, axis=1)
                 + np.sum(e * (-(wj**2)[:, None] * Asj + (wi**2)[:, None] * Asi), axis=1)
             )
-            out[:, row] = _law_values(p, t)[2] - quad
+            out[:, row] = (_law_values(p, t) if laws is None else laws[k])[2] - quad
         row += p.rows
     return out
 

@@ -24,12 +24,13 @@ def _factors(J: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     return None if J.shape[-2] == J.shape[-1] else np.linalg.qr(J)
 
 
-def _vel_acc(c: Compiled, q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _vel_acc(c: Compiled, q: np.ndarray, t: np.ndarray, laws: list | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Velocities and accelerations (N, n) at positions q: one Jacobian and, with redundant
-    drivers, one QR factorisation for both solves (the same numbers as factorising it twice)."""
+    drivers, one QR factorisation for both solves (the same numbers as factorising it twice).
+    ``laws``: :func:`.constraints.law_triples` at ``t`` (evaluated when not given)."""
     qx = with_frame(q)
     J = jacobian(c, qx)[:, :, 3:]
     qr = _factors(J)
-    v = _solve_rect(J, velocity_rhs(c, t), qr)
-    a = _solve_rect(J, acceleration_rhs(c, qx, with_frame(v), t), qr)
+    v = _solve_rect(J, velocity_rhs(c, t, laws), qr)
+    a = _solve_rect(J, acceleration_rhs(c, qx, with_frame(v), t, laws), qr)
     return v, a

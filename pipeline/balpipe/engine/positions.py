@@ -7,7 +7,7 @@ import numpy as np
 
 from ..sampling import spread_indices
 from .compile import Compiled
-from .constraints import with_frame, jacobian, law_positions, residual
+from .constraints import with_frame, jacobian, law_positions, law_triples, residual
 from .errors import AnalysisError
 from .kinematics import _solve_rect, _vel_acc
 
@@ -57,11 +57,14 @@ def _check_redundancy(c: Compiled, q: np.ndarray, t: float) -> None:
         )
 
 
-def newton_raphson(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER):
-    """Batched Newton-Raphson. Returns (q, converged mask, residual norms)."""
+def newton_raphson(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER,
+                   laws: list | None = None):
+    """Batched Newton-Raphson. Returns (q, converged mask, residual norms). ``laws``: the
+    drivers' f(t), :func:`.constraints.law_positions` (evaluated here when not given)."""
     q = q.copy()
     norms = np.full(len(t), np.inf)
-    laws = law_positions(c, t)  # the drivers' f(t): the same at every iteration
+    if laws is None:
+        laws = law_positions(c, t)  # the drivers' f(t): the same at every iteration
     for _ in range(max_iter):
         qx = with_frame(q)
         phi = residual(c, qx, t, laws)
@@ -172,16 +175,39 @@ def _check_regular(c: Compiled, q: np.ndarray, t: np.ndarray, screen: bool = Fal
 
 class DenseOps:
     """The general path's solves: :func:`newton_raphson` and :func:`.kinematics._vel_acc` on every
-    sample's full Jacobian (:func:`.constraints.jacobian`)."""
+    sample's full Jacobian (:func:`.constraints.jacobian`).
 
-    def __init__(self, c: Compiled):
+    ``t``: the motion's time grid, whose drivers' values are then evaluated once and taken for
+    the grid itself and for single times on it (the continuation's steps: a 4-RRR's driver laws
+    solve the legs' inverse kinematics, 60 % of a step when evaluated one time at a time), as
+    :class:`.newton_blocks.BlockOps` does."""
+
+    def __init__(self, c: Compiled, t: np.ndarray | None = None):
         self.c = c
+        self._grid = t
+        self._where = None if t is None else {x: k for k, x in enumerate(t.tolist())}
+        self._table: list | None = None  # law_triples on the grid, made when first needed
+
+    def _laws(self, t: np.ndarray) -> list | None:
+        """:func:`.constraints.law_triples` at ``t`` from the grid's table (the grid itself, or a
+        single time on it), else None (the callee evaluates them)."""
+        if self._grid is None:
+            return None
+        k = self._where.get(float(t[0])) if len(t) == 1 else None
+        if t is not self._grid and k is None:
+            return None
+        if self._table is None:
+            self._table = law_triples(self.c, self._grid)
+        if t is self._grid:
+            return self._table
+        return [None if f is None else (f[0][k : k + 1], f[1][k : k + 1], f[2][k : k + 1]) for f in self._table]
 
     def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER):
-        return newton_raphson(self.c, q, t, max_iter)
+        laws = self._laws(t)
+        return newton_raphson(self.c, q, t, max_iter, None if laws is None else [None if f is None else f[0] for f in laws])
 
     def vel_acc(self, q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return _vel_acc(self.c, q, t)
+        return _vel_acc(self.c, q, t, self._laws(t))
 
 
 def _ops(c: Compiled, t: np.ndarray):
@@ -193,7 +219,7 @@ def _ops(c: Compiled, t: np.ndarray):
         from .newton_blocks import BlockOps
 
         return BlockOps(c, p.vz, p.dec, t)
-    return DenseOps(c)
+    return DenseOps(c, t)
 
 
 def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
@@ -207,7 +233,7 @@ def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
     :func:`condition_numbers` gives them, as the block path does). Always the general path's
     dense solves (:class:`DenseOps`): the reference the block path is tested against.
     """
-    qall = follow_motion(c, t, DenseOps(c))
+    qall = follow_motion(c, t, DenseOps(c, t))
     c.condition = _check_regular(c, qall, t, screen=True)
     return qall
 

@@ -137,7 +137,7 @@ def _frame_entry(c: Compiled, t: np.ndarray) -> _Shared:
         c.frame = compile_model(frame_model(c.model))
     fc = c.frame
     try:
-        frame = follow_motion(fc, t, DenseOps(fc))
+        frame = follow_motion(fc, t, DenseOps(fc, t))
         STATS["solved"] += 1
     except (AnalysisError, np.linalg.LinAlgError):
         frame = None
