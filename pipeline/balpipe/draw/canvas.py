@@ -179,8 +179,10 @@ class Panel:
         """Model coordinates -> layout pt (y up)."""
         a = np.asarray(xy, dtype=float)
         s = self.scale
-        return np.stack([self.box[0] + (a[..., 0] - self.view[0]) * s, self.box[1] + (a[..., 1] - self.view[1]) * s],
-                        axis=-1)
+        out = np.empty(a.shape[:-1] + (2,))  # np.stack's result without its overhead (23000 calls a build)
+        out[..., 0] = self.box[0] + (a[..., 0] - self.view[0]) * s
+        out[..., 1] = self.box[1] + (a[..., 1] - self.view[1]) * s
+        return out
 
     def name(self, label: Label) -> None:
         """A name placed in layout pt (:func:`balpipe.draw.figures.place_items`)."""
