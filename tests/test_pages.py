@@ -84,3 +84,20 @@ def test_page_ids_are_the_word_bounded_id_attributes():
     cases += ["".join(rng.choice(alphabet) for _ in range(rng.randint(0, 40))) for _ in range(3000)]
     for page in cases:
         assert toc.page_ids(page) == reference(page), page
+
+
+def test_an_effort_and_its_unit_stay_on_one_line(pages):
+    """The stage tables give each driver's peak effort with its unit ("0.9462 N m"): value and
+    unit in one span that does not wrap (td.num may wrap between drivers, never inside "N m")."""
+    import re
+
+    page = pages("paper001_4rrr.yaml")
+    cells = re.findall(r"<td class=\"num\">([^<]*<span class=\"sym\".*?)</td>", page)
+    efforts = [c for c in cells if " N m" in c]
+    assert efforts, "no per-driver effort cell found"
+    for c in efforts:  # every "N m" of the cell closes a span that holds its value
+        assert len(re.findall(r'<span class="qty">[0-9.e+-]+ N m</span>', c)) == c.count(" N m"), c
+    import pathlib
+
+    css = (pathlib.Path(__file__).resolve().parents[1] / "templates" / "style.css").read_text()
+    assert re.search(r"span\.qty\s*\{\s*white-space:\s*nowrap", css)
