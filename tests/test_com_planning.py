@@ -413,3 +413,43 @@ def test_the_index_names_the_main_motion_its_costs_come_from(tmp_path):
     page = (tmp_path / "site" / "two" / "index.html").read_text(encoding="utf-8")
     assert ("Design summary: P15P7 · case 2: CoM bang-bang + φ optimised against P15P7 · case 1: end-effector quintic"
             in page)
+
+
+def test_an_arm_of_ones_own_is_not_said_to_be_the_papers(tmp_path):
+    """A spec without ``paper`` planned by the same method (an engineer's arm): its figures are
+    titled by what they show, "drawn as Fig. N of paper 003", never "Fig. N of paper 003:", its
+    stages are not "not in the paper", and the page and the index call the headline stage the
+    method's result, not the one the paper publishes; the paper's own page keeps its wording."""
+    from balpipe.build import Outcome
+    from balpipe.loader import load_text
+    from balpipe.report import site
+    from balpipe.report.page import render_page
+    from balpipe.report.results import results_dict
+
+    st = study.run(load_text(SINGLE, "one.yaml")[0])
+    assert st.spec.paper is None
+    titles = [f[0] for f in st.extra_figures()]
+    assert "The tested trajectories (drawn as Fig. 2 of paper 003)" in titles
+    assert any(t.startswith("Variations of the shaking moment") and t.endswith("(drawn as Fig. 4 of paper 003)") for t in titles)
+    assert not any("of paper 003:" in t or "the paper's Sec. 3" in t for t in titles)
+    assert not any("not in the paper" in s.stage.label for s in st.stages)
+    res = results_dict(st, "one.yaml", "h", False)
+    page = render_page(st, res, SINGLE)
+    box = page[page.index('id="verdict"'):page.index("Per stage")]
+    assert "the stage the method gives as its result" in box and "paper publishes" not in box
+    assert "published 48 %" not in page and "These are the line styles of the paper whose method balances this spec" in page
+    out = tmp_path / "site"
+    (out / "one").mkdir(parents=True)
+    (out / "one" / "index.html").write_text("", encoding="utf-8")
+    site.write_site(out, [Outcome("one.yaml", "one", "ok", results=res)])
+    cell = (out / "index.html").read_text(encoding="utf-8")
+    cell = cell[cell.index('data-spec="one"'):]
+    assert "the method's result" in cell and "the stage the paper publishes" not in cell
+
+
+def test_the_papers_own_page_keeps_the_papers_wording(paper):
+    spec, st, p = paper
+    titles = [f[0] for f in st.extra_figures()]
+    assert {"Fig. 2 of paper 003: the tested trajectories", "Fig. 3 of paper 003: variations of the shaking forces, "
+            "trajectory P15P7", "Fig. 4 of paper 003: variations of the shaking moment, trajectory P15P7"} <= set(titles)
+    assert sum("(not in the paper)" in s.stage.label for s in st.stages) == len(spec.balancing.trajectories)

@@ -109,8 +109,11 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
     # a method that gives its stages the paper's line styles (Stage.style): said in the legend
     paper_styles = styled(shown_stages(study))
     return {"loads": loads, "joints": joints, "joints_chosen": joint_curves.choose is not None, "loads_key": key[:1].upper() + key[1:],
-            "styles_note": "These are the paper's line styles for the stages it plots, so the figures titled with the "
-                           "paper's numbers draw each stage as every other figure does" if paper_styles else "",
+            "styles_note": ("" if not paper_styles else
+                            "These are the paper's line styles for the stages it plots, so the figures titled with the "
+                            "paper's numbers draw each stage as every other figure does" if study.spec.paper else
+                            "These are the line styles of the paper whose method balances this spec, so the figures "
+                            "drawn as that paper's draw each stage as every other figure does"),
             "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 

@@ -423,6 +423,8 @@ def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, s
         for key, label in CASES:
             if key == "ee_quintic" and law_name != "quintic":
                 label = f"end-effector {law_name}"
+            if not str(spec.paper or "").startswith("003"):  # an arm of one's own: no paper to be absent from
+                label = label.replace(" (not in the paper)", "")
             stages.append(Stage(
                 prefix + key, f"{name} · {label}" if name else label, plan.models[key],
                 _description(key, plan, method), reference=prefix + "ee_quintic", group=name, style=STYLES[key],

@@ -29,6 +29,19 @@ from .decoupling import mass_matrix_2r
 TRAJECTORY_COLOURS = ("C1", "C2", "C3", "C4", "C5", "C6", "C8", "C9", "tab:olive", "tab:cyan")
 
 
+def _titled(study, paper: str, figure: str, text: str) -> str:
+    """A figure's title: "Fig. 2 of paper 003: the tested trajectories" on that paper's own page;
+    on the page of another spec the same method balances (an engineer's own arm) the text alone,
+    saying which figure of the paper it is drawn as (its page lists no figure of the paper)."""
+    if _is_paper(study, paper):
+        return f"{figure} of paper {paper}: {text}"
+    return f"{text[0].upper()}{text[1:]} (drawn as {figure} of paper {paper})"
+
+
+def _is_paper(study, paper: str) -> bool:
+    return (study.spec.paper or "").split(":")[0].strip() == paper
+
+
 def _main(study) -> dict:
     """The main design's stage results by name (a ``compare`` design's are named design:stage)."""
     return {s.stage.name: s for s in study.stages if ":" not in s.stage.name}
@@ -140,7 +153,7 @@ def _paper002_fig2(study, un):
                          [{"key": "F", "title": "(a) Fˢʰ (N), eq. 15", "axis": "Fˢʰ (N)"},
                           {"key": "M", "title": "(b) Mˢʰ (N m), eq. 16", "axis": "Mˢʰ (N m)"}], [],
                          styles=[style_index(study.stages, un)])
-    return ("Fig. 2 of paper 002: shaking force and shaking moment of the unbalanced manipulator",
+    return (_titled(study, "002", "Fig. 2", "shaking force and shaking moment of the unbalanced manipulator"),
             live.html("p002fig2", curves),
             f"Stage '{un.stage.label}' in its line style of this page, from the analysis of this spec: Fˢʰ = "
             "√(F₁₀ₓ² + F₁₀ᵧ²), the reaction force on the frame, and Mˢʰ = −τ₁, about joint A." + apart)
@@ -218,13 +231,16 @@ def _peaks_table(study, plans, by, params) -> tuple[str, str, str]:
     mmin, mmax = params["moment_reduction_min"], params["moment_reduction_max"]
     head = ("<table><tr><th>Case</th><th>Peak |F| (N)</th><th>|F| reduction vs case 1</th><th>Peak |M| (N m)</th>"
             "<th>|M| reduction vs case 1</th><th>Peak |τ| (N m)</th><th>Peak |dτ/dt| (N m/s)</th></tr>")
+    paper = _is_paper(study, "003")
     summary = (f'<tr><th colspan="7">All trajectories, case 2 (CoM bang-bang + φ optimised) vs case 1: force '
-               f'reduction {_pct(fmin)} to {_pct(fmax)} (published 48 % to 62.2 %); moment reduction {_pct(mmin)} to '
-               f'{_pct(mmax)} (published 37.2 % to 61 %)</th></tr>')
-    return ("Peak loads per trajectory (the paper's Sec. 3 results)", head + "".join(rows) + summary + "</table>",
+               f'reduction {_pct(fmin)} to {_pct(fmax)}{" (published 48 % to 62.2 %)" if paper else ""}; moment '
+               f'reduction {_pct(mmin)} to {_pct(mmax)}{" (published 37.2 % to 61 %)" if paper else ""}</th></tr>')
+    return ("Peak loads per trajectory" + (" (the paper's Sec. 3 results)" if paper else ""),
+            head + "".join(rows) + summary + "</table>",
             "Computed by the engine for every stage; reductions are 1 − peak / peak of the same trajectory's case 1 "
-            "(end-effector quintic). The paper gives only the ranges over its eight trajectories; the duration "
-            f"({study.spec.motion.duration:g} s here) does not change the ratios (all loads scale with 1/T²) but does "
+            "(end-effector quintic). " + ("The paper gives only the ranges over its eight trajectories; the duration "
+                                         if paper else "The duration ")
+            + f"({study.spec.motion.duration:g} s here) does not change the ratios (all loads scale with 1/T²) but does "
             "change case 3 (the torque-rate limit). In a horizontal plane the shaking moment about the base joint is "
             "minus joint 1's torque (paper 002, eq. 16), hence equal peaks. Torque rates: case 1 by central "
             f"differences on the analysis grid, case 3 on {method.rate_samples} samples and 64 in each ramp (the ramp search).")
@@ -258,13 +274,17 @@ def _figs_3_4(study, main: str, by: dict):
         curves = live.Curves(stages[0].analysis.t, [(s.stage.label.split(" · ")[-1], {"y": fn(s.analysis)}) for s in stages],
                              [{"key": "y", "title": "", "axis": ylabel}], [],
                              styles=[style_index(study.stages, s) for s in stages])
-        yield (f"Fig. {number} of paper 003: variations of the {what}, trajectory {main}",
+        paper = _is_paper(study, "003")
+        yield (_titled(study, "003", f"Fig. {number}", f"variations of the {what}, trajectory {main}"),
                live.html(prefix, curves),
-               f"Trajectory {main}, the one the paper's Figs. 3-4 show; case 1 (black full line), case 2 (black dashed "
-               "line) and case 3 (grey full line), the paper's line styles and these stages' styles on the whole page. "
+               f"Trajectory {main}, " + ("the one the paper's Figs. 3-4 show" if paper else "this spec's main trajectory")
+               + "; case 1 (black full line), case 2 (black dashed line) and case 3 (grey full line), "
+               + ("the paper's line styles" if paper else "the line styles of paper 003's Figs. 3-4")
+               + " and these stages' styles on the whole page. "
                + ("Moment about the base joint, horizontal plane. " if number == "4" else "")
-               + "The stage the paper does not draw (CoM bang-bang with φ on the 3-4-5 law) is in the table above and "
-               "in the page's stage figures. Computed by the engine from this spec.")
+               + ("The stage the paper does not draw" if paper else "The fourth stage")
+               + " (CoM bang-bang with φ on the 3-4-5 law) is in the table above and in the page's stage figures. "
+               "Computed by the engine from this spec.")
 
 
 def _other_trajectories(study, plans, by: dict) -> tuple[str, str, str]:
@@ -287,8 +307,9 @@ def _other_trajectories(study, plans, by: dict) -> tuple[str, str, str]:
     figure = live.Curves(first[0].analysis.t, [(s.stage.label.split(" · ")[-1], curves[key]) for key, s in zip(cases, first)],
                          panels, [], styles=[style_index(study.stages, s) for s in first], grid=True)
     return (f"Shaking force and moment on the other {n} trajectories", live.html("com-loads", figure),
-            "The same quantities as Figs. 3-4 on the trajectories the paper does not plot, every stage in its line "
-            "style of this page. Moment about the base joint, horizontal plane.")
+            ("The same quantities as Figs. 3-4 on the trajectories the paper does not plot" if _is_paper(study, "003")
+             else "The same quantities on the spec's other trajectories")
+            + ", every stage in its line style of this page. Moment about the base joint, horizontal plane.")
 
 
 def _square_figure(study, planner, plans, main: str) -> tuple[str, str, str]:
@@ -305,10 +326,10 @@ def _square_figure(study, planner, plans, main: str) -> tuple[str, str, str]:
     for L, a in zip(planner.arm.lengths, np.cumsum(p0.q_start)):
         pts.append(pts[-1] + L * np.array([math.cos(a), math.sin(a)]))
     svg = cache.svg(square_svg, square, paths, np.array(pts), tuple(planner.arm.base), p0.name)
+    reading = " (our reading of the figure, which reproduces the paper's list of segments)" if _is_paper(study, "003") else ""
     zone = (f"side {sq.side:g} m, centre E = ({sq.centre[0]:g}, {sq.centre[1]:g}) m; points P1.. numbered "
-            f"counter-clockwise from P1 at the {sq.first_corner} corner (our reading of the figure, which reproduces "
-            "the paper's list of segments)") if sq is not None else "no test square in the spec"
-    return ("Fig. 2 of paper 003: the tested trajectories", svg,
+            f"counter-clockwise from P1 at the {sq.first_corner} corner{reading}") if sq is not None else "no test square in the spec"
+    return (_titled(study, "003", "Fig. 2", "the tested trajectories"), svg,
             f"Grey: the tested zone ({zone}). Arrows: the tip's straight paths of case 1; dashed: the centre of mass' "
             "straight paths of cases 2-3, each trajectory in a colour of its own. Base joint: triangle.")
 
