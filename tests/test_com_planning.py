@@ -325,12 +325,23 @@ def test_the_headline_shows_the_trajectory_of_the_papers_figures(paper):
     assert {s.stage.group for s in shown_stages(st)} == {"P15P7"}
 
 
+def _index_entry(tmp_path, slug: str, res: dict) -> str:
+    """The site index written for one built spec (``results``: its results.json), from its entry on."""
+    from balpipe.build import Outcome
+    from balpipe.report import site
+
+    out = tmp_path / "site"
+    (out / slug).mkdir(parents=True)
+    (out / slug / "index.html").write_text("", encoding="utf-8")
+    site.write_site(out, [Outcome(f"{slug}.yaml", slug, "ok", results=res)])
+    html = (out / "index.html").read_text(encoding="utf-8")
+    return html[html.index(f'data-spec="{slug}"'):]
+
+
 def test_the_verdict_judges_case_2_whose_reductions_the_paper_publishes(paper, tmp_path):
     """Issue 22: the paper's published reductions are case 2 against case 1, so the headline
     verdict (results.json and the index) is case 2's on every trajectory, not that of case 3 after
     it; the index and the page say which case it is; every stage keeps its own verdict."""
-    from balpipe.build import Outcome
-    from balpipe.report import site
     from balpipe.report.results import results_dict
 
     spec, st, p = paper
@@ -343,12 +354,7 @@ def test_the_verdict_judges_case_2_whose_reductions_the_paper_publishes(paper, t
     assert v["force"]["ratio_min"] == min(s["force_ratio"] for s in case2)
     assert v["moment"]["ratio"] == max(s["moment_ratio"] for s in case2)
     assert all(s["name"] in v["stages"] for s in res["stages"] if s["name"].endswith("_com_trapezoidal"))
-    out = tmp_path / "site"
-    (out / "paper003_com_planning").mkdir(parents=True)
-    (out / "paper003_com_planning" / "index.html").write_text("", encoding="utf-8")
-    site.write_site(out, [Outcome("paper003_com_planning.yaml", "paper003_com_planning", "ok", results=res)])
-    html = (out / "index.html").read_text(encoding="utf-8")
-    cell = html[html.index('data-spec="paper003_com_planning"'):]
+    cell = _index_entry(tmp_path, "paper003_com_planning", res)
     assert "on P15P7 · case 2: CoM bang-bang + φ optimised, the stage the paper publishes" in cell
     assert f"force {v['force']['text']}" in cell and "reduced by" in v["force"]["text"]
     from balpipe.report.page import render_page
@@ -420,9 +426,7 @@ def test_an_arm_of_ones_own_is_not_said_to_be_the_papers(tmp_path):
     titled by what they show, "drawn as Fig. N of paper 003", never "Fig. N of paper 003:", its
     stages are not "not in the paper", and the page and the index call the headline stage the
     method's result, not the one the paper publishes; the paper's own page keeps its wording."""
-    from balpipe.build import Outcome
     from balpipe.loader import load_text
-    from balpipe.report import site
     from balpipe.report.page import render_page
     from balpipe.report.results import results_dict
 
@@ -438,12 +442,7 @@ def test_an_arm_of_ones_own_is_not_said_to_be_the_papers(tmp_path):
     box = page[page.index('id="verdict"'):page.index("Per stage")]
     assert "the stage the method gives as its result" in box and "paper publishes" not in box
     assert "published 48 %" not in page and "These are the line styles of the paper whose method balances this spec" in page
-    out = tmp_path / "site"
-    (out / "one").mkdir(parents=True)
-    (out / "one" / "index.html").write_text("", encoding="utf-8")
-    site.write_site(out, [Outcome("one.yaml", "one", "ok", results=res)])
-    cell = (out / "index.html").read_text(encoding="utf-8")
-    cell = cell[cell.index('data-spec="one"'):]
+    cell = _index_entry(tmp_path, "one", res)
     assert "the method's result" in cell and "the stage the paper publishes" not in cell
 
 
