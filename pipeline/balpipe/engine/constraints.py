@@ -86,7 +86,7 @@ def jacobian(c: Compiled, qx: np.ndarray) -> np.ndarray:
         J[:, r0, rev.tj] = 0.0 - Pj[..., 0]
         J[:, r1, rev.tj] = 0.0 - Pj[..., 1]
     row = 0
-    for k, p in enumerate(c.prims):
+    for p in c.prims:
         if isinstance(p, _Coincident):
             if rev is None:
                 _, thi = _split(qx, p.i)
