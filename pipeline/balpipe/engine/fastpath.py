@@ -190,7 +190,7 @@ def frame_model(model: Model) -> Model:
 def _frame_compiled(c: Compiled) -> Compiled:
     """The compiled frame model of ``c`` (``c`` itself when its centres of mass are at the
     frames' origins), prepared for the block path; kept on ``c`` (the general path may have
-    compiled it first, unprepared: :func:`.shared.frame_motion`)."""
+    compiled it first, unprepared: :func:`.shared.kinematics`)."""
     if c.frame is None:
         if not np.any(c.com_local):
             c.frame = c

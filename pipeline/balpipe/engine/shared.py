@@ -64,17 +64,13 @@ class _Shared:
 _MOTIONS: dict[tuple, _Shared] = {}  # motion key -> what its models share
 
 
-def positions(c: Compiled, t: np.ndarray) -> np.ndarray:
-    """:func:`.positions.solve_positions` of ``c`` along ``t`` (``c.condition`` set, or None), its centres
-    of mass placed in the frame motion of its geometry (see the module)."""
-    return _positions(c, t)[0]
-
-
 def kinematics(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, _Shared | None]:
-    """Positions, velocities and accelerations (N, 3 nb) of ``c`` along ``t``: :func:`positions`,
-    and the rates placed from the frame motion's where the positions were (see the module), else
-    solved on ``c``'s own Jacobian (:func:`.kinematics._vel_acc`); and the shared entry they
-    were placed from (for :func:`multipliers`), or None."""
+    """Positions, velocities and accelerations (N, 3 nb) of ``c`` along ``t``: the positions of
+    :func:`.positions.solve_positions` (``c.condition`` set, or None) with the centres of mass
+    placed in the frame motion of its geometry where that motion is accepted (see the module),
+    and the rates placed from the frame motion's where the positions were, else solved on
+    ``c``'s own Jacobian (:func:`.kinematics._vel_acc`); and the shared entry they were placed
+    from (for :func:`multipliers`), or None."""
     q, entry = _positions(c, t)
     if entry is None:
         return (q, *_vel_acc(c, q, t), None)
@@ -107,7 +103,8 @@ def multipliers(c: Compiled, entry: _Shared | None, rhs: np.ndarray) -> tuple[np
 
 
 def _positions(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, _Shared | None]:
-    """:func:`positions` and the shared entry they were placed from (None: solved on ``c``)."""
+    """:func:`kinematics`' positions and the shared entry they were placed from (None: solved on
+    ``c``)."""
     if not np.any(c.com_local):
         return solve_positions(c, t), None  # its own frame model: the continuation itself
     entry = _frame_entry(c, t)
@@ -119,13 +116,6 @@ def _positions(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, _Shared | None]:
             return q, entry
         STATS["rejected"] += 1
     return solve_positions(c, t), None
-
-
-def frame_motion(c: Compiled, t: np.ndarray) -> np.ndarray | None:
-    """The motion (N, 3 nb) of ``c``'s bodies' frames along ``t`` by the continuation on its frame
-    model, solved once per :func:`.warmstart.motion_key`; None where the frame model cannot be
-    followed (the caller's continuation then reports the model's own error)."""
-    return _frame_entry(c, t).frame
 
 
 def _frame_entry(c: Compiled, t: np.ndarray) -> _Shared:
