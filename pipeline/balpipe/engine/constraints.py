@@ -4,6 +4,7 @@ velocity (nu) and acceleration (gamma) equations, vectorised over samples (Haug,
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, Callable
 
 import numpy as np
 
@@ -32,6 +33,27 @@ def law_triples(c: Compiled, t: np.ndarray) -> list[tuple[np.ndarray, np.ndarray
     """Each primitive's (f, f', f'') at times t (None for a coincidence): :func:`law_positions`
     with the derivatives that :func:`velocity_rhs` and :func:`acceleration_rhs` take."""
     return [None if isinstance(p, _Coincident) else _law_values(p, t) for p in c.prims]
+
+
+class GridLaws:
+    """The drivers' values on a motion's time grid, made once when first needed
+    (``evaluate(grid)``): the whole table for the grid itself, its row for a single time on it
+    (``row(table, k)``: the continuation's steps), None for any other times (the caller
+    evaluates those). Shared by the general path's and the block path's solves
+    (:class:`.positions.DenseOps`, :class:`.newton_blocks.BlockOps`), whose tables differ."""
+
+    def __init__(self, grid: np.ndarray, evaluate: Callable[[np.ndarray], Any], row: Callable[[Any, int], Any]):
+        self.grid, self._evaluate, self._row = grid, evaluate, row
+        self._where = {x: k for k, x in enumerate(grid.tolist())}
+        self._table = None
+
+    def at(self, t: np.ndarray):
+        k = self._where.get(float(t[0])) if len(t) == 1 else None
+        if t is not self.grid and k is None:
+            return None
+        if self._table is None:
+            self._table = self._evaluate(self.grid)
+        return self._table if t is self.grid else self._row(self._table, k)
 
 
 def residual(c: Compiled, qx: np.ndarray, t: np.ndarray, laws: list | None = None) -> np.ndarray:

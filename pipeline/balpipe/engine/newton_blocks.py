@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from .compile import Compiled
-from .constraints import with_frame, jacobian
+from .constraints import GridLaws, with_frame, jacobian
 from .kinematics import _solve_rect, _vel_acc
 from .structure import Decomposition, invert_blocks, solve
 from .vectorised import State, Vectorised, acceleration_rhs, jacobian_values, law_table, residual, velocity_rhs
@@ -34,13 +34,18 @@ _DENSE_ENTRIES = 20_000  # samples x n^2 up to which the dense scattered Jacobia
 _POLISH = 1e-14  # closed loops: one more Newton step where the residual exceeds this (:func:`polish`)
 
 
+def _table_row(table: tuple[np.ndarray, np.ndarray, np.ndarray], k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sample k of :func:`.vectorised.law_table`'s table, as the table of that time alone."""
+    return table[0][:, k : k + 1], table[1][:, k : k + 1], table[2][:, k : k + 1]
+
+
 class BlockOps:
     """The continuation's solves for a model with a square, structurally regular Jacobian."""
 
     def __init__(self, c: Compiled, vz: Vectorised, dec: Decomposition, t: np.ndarray | None = None):
         """``t``: the time grid of the motion, whose law values are then evaluated once."""
         self.c, self.vz, self.dec = c, vz, dec
-        self._grid = None if t is None else (t, law_table(vz, t), {x: k for k, x in enumerate(t.tolist())})
+        self._grid = None if t is None else GridLaws(t, lambda grid: law_table(vz, grid), _table_row)
         free = np.flatnonzero(vz.cols >= 3)
         self._free, self._frow, self._fcol = free, vz.rows[free], vz.cols[free] - 3
         self.n = vz.ncol - 3
@@ -63,15 +68,8 @@ class BlockOps:
     def _laws(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """:func:`.vectorised.law_table` at times t: taken from the table of the whole grid
         (made once) for the grid itself and for single times on it (the coarse steps)."""
-        if self._grid is not None:
-            grid, table, where = self._grid
-            if t is grid:
-                return table
-            if len(t) == 1:
-                k = where.get(float(t[0]))
-                if k is not None:
-                    return table[0][:, k : k + 1], table[1][:, k : k + 1], table[2][:, k : k + 1]
-        return law_table(self.vz, t)
+        found = None if self._grid is None else self._grid.at(t)
+        return law_table(self.vz, t) if found is None else found
 
     def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = 25):
         """Batched Newton-Raphson from q (N, n) at times t (N,). Returns (q, converged mask,

@@ -3,11 +3,13 @@ Phi(q, t) = 0, with the regularity (singularity) check."""
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ..sampling import spread_indices
 from .compile import Compiled
-from .constraints import with_frame, jacobian, law_positions, law_triples, residual
+from .constraints import GridLaws, with_frame, jacobian, law_positions, law_triples, residual
 from .errors import AnalysisError
 from .kinematics import _solve_rect, _vel_acc
 
@@ -184,23 +186,12 @@ class DenseOps:
 
     def __init__(self, c: Compiled, t: np.ndarray | None = None):
         self.c = c
-        self._grid = t
-        self._where = None if t is None else {x: k for k, x in enumerate(t.tolist())}
-        self._table: list | None = None  # law_triples on the grid, made when first needed
+        self._grid = None if t is None else GridLaws(t, functools.partial(law_triples, c), _triples_row)
 
     def _laws(self, t: np.ndarray) -> list | None:
         """:func:`.constraints.law_triples` at ``t`` from the grid's table (the grid itself, or a
         single time on it), else None (the callee evaluates them)."""
-        if self._grid is None:
-            return None
-        k = self._where.get(float(t[0])) if len(t) == 1 else None
-        if t is not self._grid and k is None:
-            return None
-        if self._table is None:
-            self._table = law_triples(self.c, self._grid)
-        if t is self._grid:
-            return self._table
-        return [None if f is None else (f[0][k : k + 1], f[1][k : k + 1], f[2][k : k + 1]) for f in self._table]
+        return None if self._grid is None else self._grid.at(t)
 
     def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER):
         laws = self._laws(t)
@@ -208,6 +199,11 @@ class DenseOps:
 
     def vel_acc(self, q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return _vel_acc(self.c, q, t, self._laws(t))
+
+
+def _triples_row(table: list, k: int) -> list:
+    """Sample k of :func:`.constraints.law_triples`' table, as the table of that time alone."""
+    return [None if f is None else (f[0][k : k + 1], f[1][k : k + 1], f[2][k : k + 1]) for f in table]
 
 
 def _ops(c: Compiled, t: np.ndarray):
