@@ -9,6 +9,12 @@ from pydantic import BaseModel, ConfigDict, Field
 from .units import Inertia, Length, Mass, PositiveLength, Rate, RateRate, number
 
 
+def paper_id(paper: str | None) -> str:
+    """A spec's ``paper`` field to the paper's number: '000: complete shaking ...' -> '000'; ''
+    without a paper."""
+    return (paper or "").split(":", 1)[0].strip()
+
+
 class SpecFieldError(ValueError):
     """A semantic error found after schema validation, attached to a field path of the spec.
 

@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..spec_parts import paper_id  # noqa: F401  (citations.paper_id, as before)
+
 
 @dataclass(frozen=True)
 class Citation:
@@ -54,11 +56,6 @@ PAPERS = {
                           "Engineering (MCM'25), Paris, France, Paper No. ICMIE 110",
                     year="2025", doi="10.11159/icmie25.110"),
 }
-
-
-def paper_id(paper: str | None) -> str:
-    """'000: complete shaking ...' -> '000'; '' without a paper."""
-    return (paper or "").split(":", 1)[0].strip()
 
 
 def cite(paper: str | None) -> str:

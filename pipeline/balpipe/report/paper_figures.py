@@ -20,6 +20,7 @@ import numpy as np
 
 from ..balancing.base import style_index
 from ..draw import live
+from ..spec_parts import paper_id
 
 #: per paper, the figure numbers its pages reproduce (a number covers its panels: "6" by "6a")
 FIGURES = {
@@ -73,13 +74,9 @@ def _k(study, stage) -> int:
     return style_index(study.stages, stage)
 
 
-def paper_id(study) -> str:
-    return (study.spec.paper or "").split(":", 1)[0].strip()
-
-
 def own_figures(study) -> list[tuple[str, str, str]]:
     """The panels drawn here as the paper numbers them, (title, svg, caption)."""
-    if paper_id(study) == "004":
+    if paper_id(study.spec.paper) == "004":
         return _paper004(study)
     return []
 

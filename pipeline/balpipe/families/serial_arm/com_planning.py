@@ -54,7 +54,7 @@ from .template import (
 from ... import balance_cache
 from ...model import Law, Model
 from ...motion import PointToPoint, bang_bang, law_for, quintic
-from ...spec_parts import SpecFieldError
+from ...spec_parts import SpecFieldError, paper_id
 from ...balancing.base import BalanceResult, Parameter, Stage
 from ...sampling import gravity_vector, time_grid
 from .specs import ComMotionPlanning
@@ -423,7 +423,7 @@ def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, s
         for key, label in CASES:
             if key == "ee_quintic" and law_name != "quintic":
                 label = f"end-effector {law_name}"
-            if not str(spec.paper or "").startswith("003"):  # an arm of one's own: no paper to be absent from
+            if paper_id(spec.paper) != "003":  # an arm of one's own: no paper to be absent from
                 label = label.replace(" (not in the paper)", "")
             stages.append(Stage(
                 prefix + key, f"{name} · {label}" if name else label, plan.models[key],

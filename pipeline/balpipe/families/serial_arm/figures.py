@@ -21,6 +21,7 @@ import math
 import numpy as np
 
 from ...balancing.base import style_index
+from ...spec_parts import paper_id
 from .com_planning import CASES, STYLES, PhiPolynomial, replan
 from .decoupling import mass_matrix_2r
 
@@ -39,7 +40,7 @@ def _titled(study, paper: str, figure: str, text: str) -> str:
 
 
 def _is_paper(study, paper: str) -> bool:
-    return (study.spec.paper or "").split(":")[0].strip() == paper
+    return paper_id(study.spec.paper) == paper
 
 
 def _main(study) -> dict:
