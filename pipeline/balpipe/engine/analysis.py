@@ -3,7 +3,6 @@ both routes to the shaking loads."""
 
 from __future__ import annotations
 
-import functools
 import weakref
 from dataclasses import dataclass, field
 
@@ -97,38 +96,38 @@ class Analysis:
 
 class _Extra(dict):
     """``Analysis.extra``, whose ``condition`` entry (the condition numbers of Phi_q along the
-    motion, an SVD per sample) is computed when first read, and whose peak alone
+    motion, an SVD per sample) is computed when first read from ``motion`` (the compiled model
+    and its positions; None when the entry is given), and whose peak alone
     (:func:`condition_peak`) needs fewer SVDs. Pickles as a plain dict."""
 
-    def __init__(self, data: dict, condition, peak=None):
+    def __init__(self, data: dict, motion: tuple[Compiled, np.ndarray] | None):
         super().__init__(data)
-        self._condition = condition
-        self._peak = peak  # () -> (k, cond[k]): :func:`.conditioning.motion_peak`
+        self._motion = motion
         self._found: tuple[int, float] | None = None
 
     def condition_peak(self) -> tuple[int, float]:
         """(k, cond[k]) of the first largest condition number: from the array when it has been
         read, else by :func:`.conditioning.motion_peak` (kept)."""
-        if dict.__contains__(self, "condition") or self._peak is None:
+        if dict.__contains__(self, "condition") or self._motion is None:
             return _argmax(self["condition"])
         if self._found is None:
-            self._found = self._peak()
+            self._found = motion_peak(*self._motion)
         return self._found
 
     def __missing__(self, key):
-        if key == "condition" and self._condition is not None:
-            self["condition"] = value = self._condition()
+        if key == "condition" and self._motion is not None:
+            self["condition"] = value = condition_numbers(*self._motion)
             return value
         raise KeyError(key)
 
     def __contains__(self, key) -> bool:
-        return super().__contains__(key) or (key == "condition" and self._condition is not None)
+        return super().__contains__(key) or (key == "condition" and self._motion is not None)
 
     def get(self, key, default=None):
         return self[key] if key in self else default
 
     def __reduce__(self):
-        if self._condition is not None:
+        if self._motion is not None:
             self["condition"]
         return (dict, (dict(self),))
 
@@ -208,12 +207,9 @@ def analyse(
     if kin is None:
         q, v, a, placed = shared.kinematics(c, t)  # placed in the frame motion of its geometry (solved once)
         cond = c.condition  # None where the screen showed the motion regular: computed when read
-        condition = None if cond is not None else functools.partial(condition_numbers, c, q)
     else:
         q, v, a = kin.X[3:-1].T, kin.V[3:-1].T, kin.A[3:-1].T
-        cond = None
-        condition = functools.partial(condition_numbers, c, q)
-    peak = None if condition is None else functools.partial(motion_peak, c, q)
+        cond = None  # the block path's: computed when read
     cd = c.dynamics or c  # the system of the inverse dynamics: the actuators' rows, or the drivers'
     if kin is not None and not c.meshes and c.dynamics is None:
         rhsT = -Mdiag.T * kin.A[3:-1]
@@ -280,5 +276,5 @@ def analyse(
                       "redundant_actuators": redundancy(cd),
                       "actuated": c.dynamics is not None,
                       **({"actuation_condition": actuation, "actuator_rates": rates} if actuation is not None else {}), **({"condition": cond} if cond is not None else {})},
-                     condition, peak),
+                     None if cond is not None else (c, q)),
     )
