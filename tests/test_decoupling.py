@@ -178,3 +178,12 @@ def test_the_methods_figures_come_from_the_study_not_a_closure(paper):
     assert d12.endswith("<td><code>0</code></td></tr>")  # decoupled: D12 = 0 (round-off reads 0)
     assert f"<code>{J['J1']:.6g}</code>" in table and f"<code>{J['J2']:.6g}</code>" in table
     assert {"Mass matrix along the motion", "Torque against acceleration (eqs. 17-18)"} <= set(figs)
+
+
+def test_the_counterweights_inertias_are_said_to_be_the_specs_choice(paper):
+    """The conditions fix only the redistributed links' inertias: the note says the counterweights'
+    own are the spec's choice, true of the paper's spec and of an arm of one's own alike."""
+    spec, st, p = paper
+    note = [n for n in st.balance.notes if n.startswith("The counterweights carry the centroidal inertias")]
+    assert len(note) == 1
+    assert "the counterweights' own are the spec's choice" in note[0] and "chosen to give them" not in note[0]

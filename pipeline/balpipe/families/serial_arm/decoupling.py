@@ -173,7 +173,8 @@ def balance(mech: SerialArmMechanism, method: GearDecoupling, model: Model) -> B
     if cw.link1.inertia or cw.link2.inertia:
         notes.append(
             "The counterweights carry the centroidal inertias the spec gives (balancing.counterweights): "
-            "the paper lists only the redistributed links' inertias, so these are chosen to give them."
+            "the decoupling conditions fix only the redistributed links' inertias (paper 002 lists only "
+            "those), so the counterweights' own are the spec's choice."
         )
 
     stages = [
