@@ -33,7 +33,7 @@ with this version, and prints the ratio this / REV of every phase. Run from the 
 from it (a comment appended; issue 23's "one spec changed"): each spec is built once untimed
 into its output folder from a copy of its folder, its copy changed, and built again, timed.
 Where the figures, simulations and balancing searches are cached by content
-(``balpipe.draw.cache``, ``balpipe.sim_cache``, ``balpipe.balance_cache``) the second build
+(``balpipe.cache.figures``, ``balpipe.cache.simulation``, ``balpipe.cache.balance``) the second build
 computes none of them. (The driver's wrappers carry the wrapped function's module and name, so
 that a cache keys a wrapped function as itself: the simulations' cache refuses an unnamed
 closure, and before this a warm build here ran every simulation again.)

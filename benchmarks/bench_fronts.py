@@ -3,11 +3,11 @@ Prints numbers; asserts nothing.
 
     python benchmarks/bench_fronts.py [spec.yaml ...]      # default: the partial specs of specs/
 
-For each spec, the fronts of its partial balancing (:func:`balpipe.balancing.partial_fronts.compute`:
+For each spec, the fronts of its partial balancing (:func:`balpipe.balancing.partial.fronts.compute`:
 the complete balances' least masses, four fronts and their ends) are computed twice in this process:
 
 * as the build computes them: each programme on its active samples
-  (:class:`balpipe.balancing.partial_active.ActiveProgram`);
+  (:class:`balpipe.balancing.partial.active.ActiveProgram`);
 * the same programmes on every time sample (the exchange loop switched off: every sample in
   every programme from the start), the reference.
 
@@ -39,7 +39,7 @@ MINIMISED = {"force_vs_mass": "shaking_force", "moment_vs_mass": "shaking_moment
 def captured(spec_path: Path) -> tuple:
     """The arguments the spec's balancing passes to ``partial_fronts.compute`` (by running it)."""
     from balpipe import registry
-    from balpipe.balancing import partial_fronts as PF
+    from balpipe.balancing.partial import fronts as PF
     from balpipe.loader import load
 
     seen = []
@@ -58,8 +58,8 @@ def captured(spec_path: Path) -> tuple:
 
 
 def timed(args: tuple, every_sample: bool) -> tuple[dict, float, int]:
-    from balpipe.balancing import partial_active as PA
-    from balpipe.balancing import partial_fronts as PF
+    from balpipe.balancing.partial import active as PA
+    from balpipe.balancing.partial import fronts as PF
 
     maps, inertia, terms, budget, n, max_mass = args
     solves = [0]

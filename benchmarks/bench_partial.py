@@ -6,7 +6,7 @@ On specs/custom_four_bar_partial.yaml (401 samples, three counterweights):
 
 1. the force front (least peak shaking force against added mass, ``--points`` budgets) by the cone
    programme: one engine analysis for the affine maps, then the programme of each point solved by
-   Clarabel on its active samples (:mod:`balpipe.balancing.partial_active`), each point globally
+   Clarabel on its active samples (:mod:`balpipe.balancing.partial.active`), each point globally
    optimal;
 2. the same front by sampling: ``balpipe sweep`` (:func:`balpipe.sweep.run`, in this process) of
    ``--designs`` random designs of the same counterweights (masses and positions in the same
@@ -33,12 +33,12 @@ SPEC = ROOT / "specs" / "custom_four_bar_partial.yaml"
 
 def cone_front(points: int) -> tuple[list[dict], dict]:
     from balpipe import registry
-    from balpipe.balancing import partial as P
-    from balpipe.balancing import partial_fronts as PF
-    from balpipe.balancing import partial_maps as PM
+    from balpipe.balancing.partial import method as P
+    from balpipe.balancing.partial import fronts as PF
+    from balpipe.balancing.partial import maps as PM
     from balpipe.loader import load
 
-    from balpipe.balancing.partial_active import ActiveProgram
+    from balpipe.balancing.partial.active import ActiveProgram
 
     t0 = time.perf_counter()
     import clarabel  # noqa: F401  (its import is a one-off cost of the process, timed apart)

@@ -26,7 +26,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 IGNORED_KEYS = {"balpipe_version", "input_hash", "code_hash", "timing", "seconds", "elapsed"}
 IGNORED_FILES = {"timing.json", "timing.js", ".balpipe.lock"}
-IGNORED_DIRS = {".cache"}  # the build's figure cache (balpipe.draw.cache), not part of the site
+IGNORED_DIRS = {".cache"}  # the build's figure cache (balpipe.cache.figures), not part of the site
 # the index's site key hashes the code (balpipe.build.site_key starts from code_hash)
 SITE_KEY = re.compile(rb'(<meta name="balpipe-site-key" content=")[0-9a-f]*(")')
 

@@ -1,4 +1,4 @@
-"""What the tests of the caches by content share (``balpipe.sim_cache``, ``balpipe.balance_cache``):
+"""What the tests of the caches by content share (``balpipe.cache.simulation``, ``balpipe.cache.balance``):
 damaged entries, and two processes that need one entry at the same time."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 from types import ModuleType
 
-from balpipe import content_cache
+from balpipe.cache import content as content_cache
 
 DAMAGES = ("truncated", "flipped", "no header")
 
@@ -50,7 +50,7 @@ def computed_once_by_two_processes(cache: ModuleType, out: Path, log: Path) -> N
 
 
 def record_puts(monkeypatch, store: type) -> list[str]:
-    """The keys whose results ``store`` (a :class:`balpipe.content_cache.Store` class) computes
+    """The keys whose results ``store`` (a :class:`balpipe.cache.content.Store` class) computes
     and stores in this process from now on (what it did not serve from its entries)."""
     keys: list[str] = []
     real = store.put

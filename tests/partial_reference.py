@@ -1,11 +1,11 @@
 """The partial balancing's cone programme written with cvxpy, on every time sample: the reference
-that :class:`balpipe.balancing.partial_active.ActiveProgram` (the same programme written for
+that :class:`balpipe.balancing.partial.active.ActiveProgram` (the same programme written for
 Clarabel by hand, solved on its active samples) is compared with. cvxpy compiles the constraints
 itself (its own canonicalisation of the rotated cone, the norms and the epigraphs), so an error
 in the hand-written rows shows as a different optimum.
 
 This was balpipe's own formulation until the fronts moved to the active samples (issue 23); the
-constraints are those of :mod:`balpipe.balancing.partial_program`'s docstring.
+constraints are those of :mod:`balpipe.balancing.partial.program`'s docstring.
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ import warnings
 
 import numpy as np
 
-from balpipe.balancing.partial_maps import Maps
-from balpipe.balancing.partial_program import SOLVER_SETTINGS, ZERO, Outcome, Term, polish_zero, variable_scale
+from balpipe.balancing.partial.maps import Maps
+from balpipe.balancing.partial.program import SOLVER_SETTINGS, ZERO, Outcome, Term, polish_zero, variable_scale
 
 
 class Program:
@@ -114,7 +114,7 @@ class Program:
     def solve(self, problem, polish: list[Term] = ()) -> Outcome:
         """Solve with cvxpy's own Clarabel interface, on every sample; the terms of ``polish`` below
         :data:`ZERO` of their unbalanced value polished to zero, the design realised, as
-        :meth:`balpipe.balancing.partial_active.ActiveProgram.solve` does."""
+        :meth:`balpipe.balancing.partial.active.ActiveProgram.solve` does."""
         cp = self.cp
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)

@@ -326,7 +326,7 @@ def test_five_bar_virtual_gripper_forces_only_when_asked():
     assert not model.actuators
     an = analyse(model, registry.time_grid(s))
     assert sorted(an.efforts) == ["gripper_x", "gripper_y"]
-    from balpipe import actuation
+    from balpipe.diagnose import actuation
 
     assert "Virtual efforts" in actuation.virtual_note(model)
     assert actuation.virtual_note(model_of(five_bar_spec())[1]) is None

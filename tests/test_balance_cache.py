@@ -1,4 +1,4 @@
-"""Issue 23: the balancing's numerical searches cached by content (``balpipe.balance_cache``). A
+"""Issue 23: the balancing's numerical searches cached by content (``balpipe.cache.balance``). A
 rebuild whose searches' inputs did not change computes none of them (the partial balancing's
 fronts, the 4-RRR's topology counter-masses, finder check and design peaks) and writes the same
 results and page, byte for byte, as a build without the cache; a changed input, a damaged entry,
@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pytest
 
-from balpipe import balance_cache, content_cache
+from balpipe.cache import balance as balance_cache, content as content_cache
 from balpipe.balancing import conditions as C
-from balpipe.balancing import partial_fronts as PF
+from balpipe.balancing.partial import fronts as PF
 from balpipe.families.rrr4 import counter_masses
 import _content_caches as caches
 from _content_caches import DAMAGES, build_ok, computed_once_by_two_processes, entry_damaged, record_puts
@@ -32,7 +32,7 @@ DESCRIPTION = "The offset slider-crank of offset_slider_crank.yaml"
 
 @pytest.fixture
 def fronts(monkeypatch):
-    """How many times the fronts were computed (:func:`balpipe.balancing.partial_fronts.compute`
+    """How many times the fronts were computed (:func:`balpipe.balancing.partial.fronts.compute`
     called) in this process."""
     calls: list[int] = []
     real = PF.compute

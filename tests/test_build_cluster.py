@@ -105,7 +105,7 @@ def test_the_probe_tells_a_scheduler_from_a_silent_service_and_leaves_other_prot
     import socket
     import threading
 
-    from balpipe.cluster import unreachable
+    from balpipe.runtime.cluster import unreachable
 
     def serve(greet: bytes | None) -> tuple[socket.socket, int]:
         srv = socket.socket()

@@ -10,9 +10,9 @@ import pytest
 
 from _edits import replaced
 from balpipe import build as build_mod
-from balpipe import pool as pool_mod
+from balpipe.runtime import pool as pool_mod
 from balpipe.build import Options, build
-from balpipe.pool import default_jobs, usable_cores
+from balpipe.runtime.pool import default_jobs, usable_cores
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"
 

@@ -1,5 +1,5 @@
 """``balpipe check`` starts its costliest specs first (issue 23, "check in a blink"): a spec's cost
-is what its template and method declare (:mod:`balpipe.check_cost`), read from the YAML events
+is what its template and method declare (:mod:`balpipe.site_files.check_cost`), read from the YAML events
 without loading the spec; the messages still come in the specs' order."""
 
 from __future__ import annotations
@@ -9,8 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from balpipe import pool, registry
-from balpipe.check_cost import PLAIN, check_cost, declared_names
+from balpipe.runtime import pool
+from balpipe import registry
+from balpipe.site_files.check_cost import PLAIN, check_cost, declared_names
 from balpipe.cli import main
 
 SPECS = Path(__file__).resolve().parents[1] / "specs"

@@ -14,7 +14,7 @@ from balpipe.engine import analyse, compiled, constraints
 from balpipe.engine.constraints import with_frame
 from balpipe.loader import load
 from balpipe.runner import analyse as run_analyse
-from balpipe.sampling import spread_indices, time_grid
+from balpipe.mechanics.sampling import spread_indices, time_grid
 from balpipe.study import gravity_vector
 
 RRR4 = "specs/paper001_4rrr.yaml"  # redundant actuation: the general (dense) path

@@ -71,7 +71,7 @@ def test_jobs_below_one_is_a_usage_error(folder):
 
 
 def test_check_and_sweep_never_compute_the_fronts(tmp_path, monkeypatch, capsys):
-    from balpipe.balancing import partial_fronts
+    from balpipe.balancing.partial import fronts as partial_fronts
     from balpipe.cli import main
 
     def refuse(*a, **k):

@@ -11,7 +11,7 @@ import balpipe  # noqa: F401
 import numpy as np
 import pytest
 
-from balpipe.claim_precision import half_unit
+from balpipe.mechanics.claim_precision import half_unit
 from balpipe.cli import main
 from balpipe.loader import load_text
 from balpipe.study import run

@@ -1,4 +1,4 @@
-"""The content caches' keys (balpipe.content_cache.feed): the bytes fed for every kind of input
+"""The content caches' keys (balpipe.cache.content.feed): the bytes fed for every kind of input
 are those of the format's first implementation, kept below as the reference (one isinstance
 chain per value), on the specs' own models, stages and laws and on hand-made values of every
 kind; a key that changed would make every existing cache entry unreachable."""
@@ -16,8 +16,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balpipe import content_cache, loader, registry
-from balpipe.content_cache import MEMO, Unhashable, callable_name
+from balpipe.cache import content as content_cache
+from balpipe import loader, registry
+from balpipe.cache.content import MEMO, Unhashable, callable_name
 
 SPECS = sorted((Path(__file__).resolve().parents[1] / "specs").glob("*.yaml"))
 

@@ -15,7 +15,7 @@ from balpipe import engine, registry
 from balpipe.engine import analyse, compiled, shared
 from balpipe.engine.positions import solve_positions
 from balpipe.loader import load
-from balpipe.sampling import time_grid
+from balpipe.mechanics.sampling import time_grid
 from balpipe.study import gravity_vector
 
 RRR4 = "specs/paper001_4rrr.yaml"  # redundant actuation: the general (dense) path

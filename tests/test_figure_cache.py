@@ -1,4 +1,4 @@
-"""Issue 23, item 3: the figures cached by content (``balpipe.draw.cache``). A hit is the SVG a
+"""Issue 23, item 3: the figures cached by content (``balpipe.cache.figures``). A hit is the SVG a
 fresh drawing gives, byte for byte; a changed input misses; a damaged entry is redrawn, never
 served; ``--force`` redraws and rewrites; a build keeps only the entries it used; a symlink in the
 cache is never followed; the cache is invisible in the site."""
@@ -14,7 +14,8 @@ import pytest
 
 from balpipe import build as build_mod
 from balpipe.build import Options, build
-from balpipe.draw import cache, figures
+from balpipe.cache import figures as cache
+from balpipe.draw import figures
 from _edits import replaced
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -39,7 +39,7 @@ def test_a_command_loads_no_heavy_library_it_does_not_use(args):
 
 @pytest.mark.parametrize("args", [["--help"], ["check", "--help"], ["sweep", "--help"], ["--version"]])
 def test_help_loads_neither_numpy_nor_pydantic(args):
-    """The help states the sweep's limit (balpipe.sweep_limit) without the spec schema."""
+    """The help states the sweep's limit (balpipe.MAX_DESIGNS) without the spec schema."""
     probe = PROBE.format(heavy=HEAVY + ("numpy", "pydantic"))
     r = subprocess.run([sys.executable, "-c", probe, json.dumps(args)], cwd=ROOT, capture_output=True, text=True,
                        timeout=120)
@@ -50,7 +50,7 @@ def test_help_loads_neither_numpy_nor_pydantic(args):
                                   ["check", "specs/offset_slider_crank.yaml", "specs/paper002_decoupling.yaml"]])
 def test_check_loads_neither_numpy_ma_nor_numpy_random(args):
     """``np.unique`` imports numpy.ma (~90 ms) and the dead-centre search numpy.random: the
-    engine spreads its continuation's samples without it (:func:`balpipe.sampling.spread_indices`)
+    engine spreads its continuation's samples without it (:func:`balpipe.mechanics.sampling.spread_indices`)
     and check leaves the page's diagnostics out. The sweep's planner only for a spec with a
     ``sweep:`` block."""
     probe = PROBE.format(heavy=HEAVY + ("numpy.ma", "numpy.random", "balpipe.sweep"))

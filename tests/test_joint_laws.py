@@ -1,4 +1,4 @@
-"""The generic joint laws of pose-driven templates (balpipe.joint_laws): a body point's motion
+"""The generic joint laws of pose-driven templates (balpipe.mechanics.joint_laws): a body point's motion
 from the pose laws, and the per-grid solution shared by a template's joint laws."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from balpipe.joint_laws import KEEP, PoseJointLaw, body_point
+from balpipe.mechanics.joint_laws import KEEP, PoseJointLaw, body_point
 from balpipe.families.rpr3 import template as rpr3
 from balpipe.families.rrr4 import template as rrr4
 from balpipe.families.serial_arm import template as serial_arm
@@ -92,7 +92,7 @@ def test_dyad_rates_recover_the_link_rates(rng):
     """Two links at angles alpha_k(t) (random quadratics): from the end point's velocity and
     acceleration the dyad's rates and accelerations are the alpha_k' and alpha_k''; a stretched
     dyad gives non-finite values, no exception (the templates check the configuration)."""
-    from balpipe.joint_laws import dyad_rates
+    from balpipe.mechanics.joint_laws import dyad_rates
 
     t = np.linspace(0, 1, 50)
     for _ in range(5):
@@ -118,7 +118,7 @@ def test_dyad_rates_recover_the_link_rates(rng):
 
 def test_body_point_by_components_is_body_point(rng):
     """:func:`body_point_xy` gives body_point's columns, bit for bit."""
-    from balpipe.joint_laws import body_point_xy
+    from balpipe.mechanics.joint_laws import body_point_xy
 
     for _ in range(5):
         pose = tuple(tuple(rng.normal(size=50) * 10.0 ** rng.integers(-3, 3) for _ in range(3)) for _ in range(3))

@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 import yaml
 
-from balpipe import assembly, dead_centres, dyads, registry, study
+from balpipe.diagnose import assembly, dead_centres, dyads
+from balpipe import registry, study
 from balpipe.engine import compile_model
 from balpipe.loader import SpecErrors, load, load_text
 

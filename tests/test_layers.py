@@ -1,4 +1,4 @@
-"""balpipe's layers (issue 19): a module imports only from its own layer or the layers below it,
+"""balpipe's layers: a module imports only from its own layer or the layers below it,
 deferred (in-function) imports included, and the import graph has no cycle. Families are
 plugins: nothing outside ``balpipe.families`` imports one."""
 
@@ -14,18 +14,19 @@ import pytest
 
 SRC = Path(__file__).resolve().parents[1] / "pipeline"
 
-# lowest first; a module belongs to the layer of its longest matching prefix
+# Lowest first. Each entry is a top-level module (``balpipe.units``) or a folder (``balpipe.engine``, its
+# modules and sub-folders with it): the layer of a module is the one entry naming it or its
+# nearest folder. The bare package is its ``__init__`` only; a module that is in no entry fails.
 LAYERS: tuple[tuple[str, ...], ...] = (
-    # L0 core data and maths
-    ("balpipe", "balpipe.units", "balpipe.model", "balpipe.motion", "balpipe.meshes", "balpipe.joint_laws",
-     "balpipe.realisable", "balpipe.notation", "balpipe.sampling", "balpipe.fsutil", "balpipe.drivers", "balpipe.laws",
-     "balpipe.motion_outputs", "balpipe.claim_precision", "balpipe.sweep_limit", "balpipe.pool"),
-    # L1 computation (and the kinematic diagnosis on top of the engine: dyads, dead centres)
-    ("balpipe.engine", "balpipe.validate", "balpipe.dyads", "balpipe.dead_centres"),
-    # L2 contracts and drawing (laws.drives, laws.motion_spec: the motion's spec sections; actuators, loop closure and
-    # the assembly branch: checks that locate their errors in the spec)
-    ("balpipe.spec_parts", "balpipe.vary", "balpipe.balancing", "balpipe.draw", "balpipe.plugins", "balpipe.registry",
-     "balpipe.laws.drives", "balpipe.laws.motion_spec", "balpipe.actuation", "balpipe.loop_closure", "balpipe.assembly"),
+    # L0 core data and maths: the vocabulary, the planar mechanics below the engine, where work runs, the caches
+    ("balpipe", "balpipe.units", "balpipe.model", "balpipe.motion", "balpipe.notation",
+     "balpipe.mechanics", "balpipe.runtime", "balpipe.cache"),
+    # L1 computation: the engine and the pymunk validation
+    ("balpipe.engine", "balpipe.validate"),
+    # L2 contracts and drawing: spec parts, the motion laws and their spec sections, the balancing methods, drawing,
+    # families' registry, kinematic diagnosis located in the spec
+    ("balpipe.spec_parts", "balpipe.vary", "balpipe.plugins", "balpipe.registry",
+     "balpipe.laws", "balpipe.balancing", "balpipe.draw", "balpipe.diagnose"),
     # L3 families (plugins)
     ("balpipe.families",),
     # L3' the schema
@@ -35,22 +36,29 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     # L5 presentation
     ("balpipe.report",),
     # L6 commands
-    ("balpipe.build", "balpipe.diff", "balpipe.history", "balpipe.sweep", "balpipe.site_earlier", "balpipe.spec_files",
-     "balpipe.check_cost"),
+    ("balpipe.build", "balpipe.diff", "balpipe.history", "balpipe.sweep", "balpipe.site_files"),
     # L7 command line
     ("balpipe.cli", "balpipe.__main__"),
 )
 
+#: the top level holds the vocabulary and the pipeline's spine; everything else lives in a folder
+MAX_LOOSE_MODULES = 20
 
-def layer_of(module: str) -> int:
-    best, found = -1, None
-    for k, prefixes in enumerate(LAYERS):
-        for p in prefixes:
-            if (module == p or module.startswith(p + ".")) and len(p) > best:
-                best, found = len(p), k
-    if found is None:
-        raise AssertionError(f"{module} is in no layer: add it to tests/test_layers.py LAYERS")
-    return found
+
+def layer_of(module: str, src: Path = SRC) -> int:
+    """The layer of ``module``: the entry equal to it, else the entry of its nearest folder
+    (``balpipe.engine.compile`` -> ``balpipe.engine``). The package itself (``balpipe``) names its
+    ``__init__`` only, never a module below it; a top-level module is never matched by prefix."""
+    found = [k for k, entries in enumerate(LAYERS) if module in entries]
+    name = module
+    while not found and name.count(".") > 1:
+        name = name.rsplit(".", 1)[0]
+        found = [k for k, entries in enumerate(LAYERS) if name in entries]
+    if not found:
+        raise AssertionError(f"{module} is in no layer: add it (or its folder) to tests/test_layers.py LAYERS")
+    if len(found) > 1:
+        raise AssertionError(f"{module} is listed in layers {found}")
+    return found[0]
 
 
 def modules(src: Path) -> dict[str, Path]:
@@ -167,6 +175,40 @@ def test_every_module_has_a_layer():
         layer_of(m)
 
 
+def test_every_entry_is_listed_once_and_exists():
+    entries = [e for layer in LAYERS for e in layer]
+    assert len(entries) == len(set(entries))
+    mods = modules(SRC)
+    assert [e for e in entries if e not in mods] == []
+
+
+def test_a_folder_is_one_layer_and_a_loose_module_is_listed_by_name():
+    """Every entry that is a folder holds only its own modules; no entry is a module inside a
+    listed folder (that would make a folder span two layers)."""
+    mods = modules(SRC)
+    folders = {e for layer in LAYERS for e in layer if e != "balpipe" and (SRC / Path(*e.split("."))).is_dir()}
+    nested = [e for layer in LAYERS for e in layer for f in folders if e != f and e.startswith(f + ".")]
+    assert nested == []
+    loose = [m for m, p in mods.items() if p.parent == SRC / "balpipe" and p.name != "__init__.py"]
+    assert len(loose) + 1 <= MAX_LOOSE_MODULES, sorted(loose)  # + the package's __init__
+
+
+def test_a_planted_unlisted_module_fails(tree_copy: Path):
+    """A new top-level module that no entry names is in no layer: the bare package does not
+    swallow it, and neither does a folder for a top-level file."""
+    (tree_copy / "balpipe" / "stray.py").write_text("X = 1\n")
+    with pytest.raises(AssertionError, match="balpipe.stray is in no layer"):
+        for m in modules(tree_copy):
+            layer_of(m, tree_copy)
+
+
+def test_a_planted_upward_import_from_a_folder_fails(tree_copy: Path):
+    """A module of a low folder (mechanics, L0) importing the pipeline (L4) is refused."""
+    meshes = tree_copy / "balpipe" / "mechanics" / "meshes.py"
+    meshes.write_text(meshes.read_text(encoding="utf-8") + "\n\ndef _planted():\n    from ..study import Study\n")
+    assert any(b.startswith("balpipe.mechanics.meshes:") and "balpipe.study (deferred)" in b for b in upward(tree_copy))
+
+
 def test_no_upward_import():
     assert upward(SRC) == []
 
@@ -207,11 +249,11 @@ def test_a_planted_cycle_fails(tree_copy: Path):
 
 def test_a_planted_cycle_within_one_layer_fails(tree_copy: Path):
     """Two modules of one layer importing each other: no upward import, still a cycle."""
-    meshes = tree_copy / "balpipe" / "meshes.py"
-    meshes.write_text(meshes.read_text(encoding="utf-8") + "\n\ndef _planted():\n    from . import notation\n")
+    meshes = tree_copy / "balpipe" / "mechanics" / "meshes.py"
+    meshes.write_text(meshes.read_text(encoding="utf-8") + "\n\ndef _planted():\n    from .. import notation\n")
     notation = tree_copy / "balpipe" / "notation.py"
-    notation.write_text(notation.read_text(encoding="utf-8") + "\nfrom . import meshes  # noqa\n")
-    assert ["balpipe.meshes", "balpipe.notation"] in cycles(tree_copy)
+    notation.write_text(notation.read_text(encoding="utf-8") + "\nfrom .mechanics import meshes  # noqa\n")
+    assert ["balpipe.mechanics.meshes", "balpipe.notation"] in cycles(tree_copy)
 
 
 def test_a_planted_family_import_in_the_core_fails(tree_copy: Path):
@@ -319,3 +361,34 @@ def test_a_planted_family_name_in_the_core_fails(tree_copy: Path):
     study = tree_copy / "balpipe" / "study.py"
     study.write_text(study.read_text(encoding="utf-8") + '\n\ndef _planted(spec):\n    return spec.mechanism.template == "rrr4"\n')
     assert any(b.startswith("balpipe.study:") for b in names_of_families(tree_copy, _family_words()))
+
+
+def _docs_layers() -> dict[int, str]:
+    """The layer list of docs/development.md: its text from each ``L<k>`` line to the next."""
+    import re
+
+    text = (SRC.parent / "docs" / "development.md").read_text(encoding="utf-8")
+    block = text[text.index("  L0  "): text.index("templates/ ")]
+    parts = re.split(r"^  (L\d'?) +", block, flags=re.M)[1:]
+    order = [f"L{k}" for k in range(4)] + ["L3'"] + [f"L{k}" for k in range(4, 8)]
+    return {order.index(parts[i]): parts[i + 1] for i in range(0, len(parts), 2)}
+
+
+def test_the_docs_list_every_entry_in_its_layer():
+    """docs/development.md names every entry of LAYERS in that entry's layer (a folder as
+    ``name/``), so the documented architecture is the tested one."""
+    import re
+
+    docs = _docs_layers()
+    assert len(docs) == len(LAYERS)
+    missing = []
+    for k, entries in enumerate(LAYERS):
+        for e in entries:
+            if e == "balpipe":
+                continue
+            short = e.split(".", 1)[1]
+            folder = (SRC / Path(*e.split("."))).is_dir()
+            pattern = rf"(?<![\w/]){re.escape(short)}/" if folder else rf"(?<![\w/.]){re.escape(short)}(?![\w/])"
+            if not re.search(pattern, docs[k]):
+                missing.append(f"L{k}: {e}")
+    assert missing == []

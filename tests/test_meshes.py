@@ -18,7 +18,7 @@ import pytest
 from balpipe import registry
 from balpipe.engine import analyse
 from balpipe.loader import load, load_text
-from balpipe.meshes import mesh_geometry
+from balpipe.mechanics.meshes import mesh_geometry
 from balpipe.model import FRAME, Body, Driver, Gear, Model, Revolute
 from balpipe.motion import PROFILES, PointToPoint
 from balpipe.report.results import joint_load_table, timeseries_csv

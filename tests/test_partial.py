@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from balpipe import registry, study
-from balpipe.balancing import partial as P
-from balpipe.balancing import partial_fronts as PF
-from balpipe.balancing import partial_maps as PM
-from balpipe.balancing.partial_active import ActiveProgram
+from balpipe.balancing.partial import method as P
+from balpipe.balancing.partial import fronts as PF
+from balpipe.balancing.partial import maps as PM
+from balpipe.balancing.partial.active import ActiveProgram
 from balpipe.engine import analyse
 from balpipe.spec import Spec
 from balpipe.spec_parts import SpecFieldError

@@ -9,10 +9,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from balpipe.balancing import partial as P
-from balpipe.balancing import partial_active as PA
+from balpipe.balancing.partial import method as P
+from balpipe.balancing.partial import active as PA
 from balpipe.balancing.least_mass import independent_equations
-from balpipe.balancing.partial_program import Term
+from balpipe.balancing.partial.program import Term
 from balpipe.spec import Spec
 from generic_specs import four_bar
 from test_partial import DISC, POLYGON, SEGMENTS, method, setup

@@ -9,10 +9,10 @@ import numpy as np
 
 from _edits import replaced
 from balpipe import build as build_mod
-from balpipe import pool
-from balpipe.balancing import partial as P
-from balpipe.balancing import partial_fronts as PF
-from balpipe.balancing.partial_active import ActiveProgram
+from balpipe.runtime import pool
+from balpipe.balancing.partial import method as P
+from balpipe.balancing.partial import fronts as PF
+from balpipe.balancing.partial.active import ActiveProgram
 from balpipe.spec import Spec
 from generic_specs import four_bar
 from test_partial import POLYGON, SEGMENTS, method, setup
@@ -21,7 +21,7 @@ SPECS = Path(__file__).resolve().parents[1] / "specs"
 
 
 def _spy(monkeypatch) -> list:
-    """The ``workers`` of every call of :func:`balpipe.pool.forked` (the real one runs)."""
+    """The ``workers`` of every call of :func:`balpipe.runtime.pool.forked` (the real one runs)."""
     seen = []
     real = pool.forked
     monkeypatch.setattr(pool, "forked", lambda tasks, workers, shared: seen.append(workers) or real(tasks, workers, shared))

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from balpipe import registry
-from balpipe.balancing import partial as P
-from balpipe.balancing import partial_motions as PMo
+from balpipe.balancing.partial import method as P
+from balpipe.balancing.partial import motions as PMo
 from balpipe.engine import analyse
 from balpipe.spec import Spec
 from generic_specs import four_bar

@@ -6,7 +6,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from balpipe import pool
+from balpipe.runtime import pool
 from balpipe.build import spec_cost
 
 

@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balpipe import realisable, registry
+from balpipe.mechanics import realisable
+from balpipe import registry
 from balpipe.engine import analyse
 from balpipe.loader import load_text
 from balpipe.model import FRAME, Attachment, Body, Driver, Model, Revolute

@@ -1,4 +1,4 @@
-"""Issue 23: the pymunk simulations cached by content (``balpipe.sim_cache``). A rebuild whose
+"""Issue 23: the pymunk simulations cached by content (``balpipe.cache.simulation``). A rebuild whose
 stages did not change runs no simulation and writes the same results and page, byte for byte; a
 changed stage is simulated again, the unchanged ones are not; another spec with the same stage
 reuses its simulation; a damaged entry is simulated again; ``--force`` simulates everything;
@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from balpipe import content_cache, sim_cache
+from balpipe.cache import content as content_cache, simulation as sim_cache
 from balpipe.build import Options, build
 from balpipe.loader import load
 from balpipe.study import run as run_study

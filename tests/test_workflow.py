@@ -77,7 +77,7 @@ def test_workflow_structure():
         if s.get("uses", "").startswith("actions/upload-artifact"):
             assert s["if"] == "github.event_name == 'pull_request'"
     # what is published (the Pages site, the pull request's artifact) is reports/ without the
-    # build's figure cache (balpipe.draw.cache), which actions/cache keeps in reports/.cache
+    # build's figure cache (balpipe.cache.figures), which actions/cache keeps in reports/.cache
     i_site = next(i for i, r in enumerate(runs) if "--exclude=./.cache" in r)
     assert i_build < i_site and "reports" in runs[i_site] and "_site" in runs[i_site]
     uploads = [s for s in steps if s.get("uses", "").split("@")[0] in ("actions/upload-pages-artifact",

@@ -13,3 +13,8 @@ __version__ = "0.1.0"
 
 #: the entry-point group of mechanism families (:mod:`balpipe.plugins`)
 FAMILY_GROUP = "balpipe.families"
+
+#: the largest sweep balpipe runs unless told otherwise: the spec's ``sweep.max_designs``
+#: (:mod:`balpipe.sweep_spec`) and ``balpipe sweep --max-designs``, here so that ``balpipe --help``
+#: states it without loading pydantic or numpy
+MAX_DESIGNS = 100_000

@@ -26,11 +26,12 @@ from importlib import resources
 from importlib.util import find_spec
 from pathlib import Path
 
-from . import FAMILY_GROUP, pool
+from . import FAMILY_GROUP
+from .runtime import pool
 from .report import history_file
-from .fsutil import remove_path, remove_temporaries, tmp_name, write_atomic_dir, write_file_atomic, write_new
-from .site_earlier import earlier_pages
-from .spec_files import MAX_SLUG, clash_notes, clashes, find_specs, slug_for  # noqa: F401  (build.find_specs, build.slug_for as before)
+from .runtime.fsutil import remove_path, remove_temporaries, tmp_name, write_atomic_dir, write_file_atomic, write_new
+from .site_files.site_earlier import earlier_pages
+from .site_files.spec_files import MAX_SLUG, clash_notes, clashes, find_specs, slug_for  # noqa: F401  (build.find_specs, build.slug_for as before)
 
 # The phases' modules (numpy, pydantic, matplotlib, jinja2) are imported when a spec is computed,
 # not when an unchanged site is checked (issue 23: a rebuild with nothing changed in 0.3 s). The
@@ -234,7 +235,7 @@ def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outc
     """Read one spec and decide: an :class:`Outcome` when there is nothing to compute (invalid,
     or unchanged since the last build), else the :class:`Job` that computes it. The history
     figures of the page (drawn here, where the page folder is read) and, with ``figure_cache``,
-    the job's figures go through the output folder's figure cache (:mod:`balpipe.draw.cache`)."""
+    the job's figures go through the output folder's figure cache (:mod:`balpipe.cache.figures`)."""
     from .loader import SpecErrors
 
     start = time.perf_counter()
@@ -249,7 +250,7 @@ def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outc
         previous = _read_results(target)
         if previous is not None and previous.get("input_hash") == h:
             return _unchanged(path, slug, target, previous, time.perf_counter() - start)
-    from .draw import cache
+    from .cache import figures as cache
     from .report import history_page
 
     store = cache.Store(opts.out, slug, code_hash(), reuse=not opts.force) if figure_cache else None
@@ -263,11 +264,11 @@ def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outc
 def compute(job: Job) -> Computed:
     """Balance, analyse, validate and render one spec; never raises (errors become the result).
     With ``job.figure_cache``, the figures, the simulations and the balancing's searches come
-    from that folder's caches where their inputs are unchanged (:mod:`balpipe.draw.cache`,
-    :mod:`balpipe.sim_cache`, :mod:`balpipe.balance_cache`), and the spec's entries this build
+    from that folder's caches where their inputs are unchanged (:mod:`balpipe.cache.figures`,
+    :mod:`balpipe.cache.simulation`, :mod:`balpipe.cache.balance`), and the spec's entries this build
     did not use are removed when its page is made."""
-    from . import balance_cache, sim_cache
-    from .draw import cache
+    from .cache import balance as balance_cache, simulation as sim_cache
+    from .cache import figures as cache
 
     slug = slug_for(job.path)
     store = None if job.figure_cache is None else \
@@ -473,10 +474,10 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
             raise
         built = [o for o in outcomes if o.slug]
         if any(not o.skipped for o in built):  # the caches of specs that have no page any more
-            from . import content_cache
-            from .balance_cache import BALANCE
-            from .draw.cache import FIGURES
-            from .sim_cache import SIMS
+            from .cache import content as content_cache
+            from .cache.balance import BALANCE
+            from .cache.figures import FIGURES
+            from .cache.simulation import SIMS
 
             for kind in (FIGURES, SIMS, BALANCE):
                 content_cache.prune_specs(opts.out, {o.slug for o in built}, kind)
@@ -549,12 +550,12 @@ def _run(todo: list[Path], opts: Options, jobs: int, progress, outcomes: list[Ou
 
 
 def spec_cost(path: Path, simulate: bool = True) -> float:
-    """A spec's expected build work, to start the longest first (:func:`balpipe.pool.in_order`):
+    """A spec's expected build work, to start the longest first (:func:`balpipe.runtime.pool.in_order`):
     the length of its text, which grows with its stages, comparisons and references (measured on
     specs/, 24 specs, 2 processes: 86.2 s for the longest texts first against 92.2 s in name
     order and 85.7 s for the true longest-first order). Without the simulation the balancing and
     the figures weigh more: a second per 5000 characters, plus the ``build_cost`` its template and
-    method declare (:func:`balpipe.check_cost.declared_cost`); by the text alone the four 4-RRR
+    method declare (:func:`balpipe.site_files.check_cost.declared_cost`); by the text alone the four 4-RRR
     specs (2-3 s each, short texts) started 14th to 18th of 24, and one core ran the last of them
     alone for 1.4 s (--no-sim 11.7 s; 11.0 s in the order by the true times)."""
     try:
@@ -563,7 +564,7 @@ def spec_cost(path: Path, simulate: bool = True) -> float:
         return 0.0
     if simulate:
         return size
-    from .check_cost import declared_cost
+    from .site_files.check_cost import declared_cost
 
     return size / 5000.0 + declared_cost(path, "build_cost")
 
@@ -580,7 +581,7 @@ def _run_on_cluster(address: str, todo: list[Path], opts: Options, progress, out
         from distributed import Client
     except ImportError:
         raise SchedulerError("--scheduler needs dask.distributed (pip install 'balpipe[sweep]')") from None
-    from .cluster import unreachable
+    from .runtime.cluster import unreachable
 
     why = unreachable(address)
     if why is not None:

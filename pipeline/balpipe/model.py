@@ -136,7 +136,7 @@ class Gear:
     None means "as assembled in the initial pose". ``radius_a``/``radius_b`` are the pitch
     radii: given, the mesh passes its tooth force (tangential from the mesh torque, radial
     from ``pressure_angle``) between the gears, whose bearings on the carrier then carry it
-    (:mod:`balpipe.meshes`); omitted (a belt), the pair acts as a couple only.
+    (:mod:`balpipe.mechanics.meshes`); omitted (a belt), the pair acts as a couple only.
     """
 
     name: str

@@ -74,7 +74,7 @@ class Template:
     ``figures(study)`` optionally yields extra report figures as (title, svg, caption).
     ``check_cost`` and ``build_cost`` (as :attr:`Method.check_cost`, :attr:`Method.build_cost`):
     hints for the order in which ``balpipe check`` and ``balpipe build`` start their specs
-    (:mod:`balpipe.check_cost`), never a limit."""
+    (:mod:`balpipe.site_files.check_cost`), never a limit."""
 
     name: str
     spec: type[Strict]
@@ -100,7 +100,7 @@ class Method:
     ``balance``, ``figures`` and ``notation`` may be :class:`Ref` objects: the spec section is a class,
     the computing code is imported when the method runs. ``check_cost``: the seconds (on one
     core, measured) that checking a spec with this method takes beyond a plain spec's few
-    hundredths; ``balpipe check`` starts its costliest specs first (:mod:`balpipe.check_cost`),
+    hundredths; ``balpipe check`` starts its costliest specs first (:mod:`balpipe.site_files.check_cost`),
     so that a long one does not start last and leave the other cores idle at the end.
     ``build_cost``: the same for ``balpipe build --no-sim``, beyond the estimate from the spec's
     text (:func:`balpipe.build.spec_cost`)."""

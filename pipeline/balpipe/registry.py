@@ -11,13 +11,13 @@ import numpy as np
 
 from . import units
 from .balancing.base import BalanceResult, Stage
-from .balancing.partial_spec import PartialBalance
+from .balancing.partial.spec import PartialBalance
 from .balancing.specs import ForceBalance, MomentBalance, Stages
 from .model import Law, Model
 from .laws.drives import drive_laws
 from .motion import law_for
 from .plugins import Method, Ref, Template, discover
-from .sampling import time_grid
+from .mechanics.sampling import time_grid
 from .spec_parts import DriveSpec, SpecFieldError
 
 __all__ = [
@@ -37,9 +37,9 @@ GENERIC: tuple[Method, ...] = (
            notation=Ref(f"{_CODE}.moment_balance:notation")),
     Method("stages", Stages, Ref(f"{_CODE}.stages:balance"), (), "stages written by hand, each adding parts",
            generic=True, notation=Ref(f"{_CODE}.stages:notation")),
-    Method("partial_balance", PartialBalance, Ref(f"{_CODE}.partial:balance"), (),
+    Method("partial_balance", PartialBalance, Ref(f"{_CODE}.partial.method:balance"), (),
            "optimal partial balancing (cone programme)", uses_spec=True, generic=True, other_motions=True,
-           notation=Ref(f"{_CODE}.partial:notation"),
+           notation=Ref(f"{_CODE}.partial.method:notation"),
            page_only=("fronts",),  # the Pareto fronts: about 90 % of its time, drawn only on the page
            check_cost=0.5,  # the optimum's cone programme (Clarabel): 0.1-1 s beyond a plain spec
            build_cost=0.3),  # and the fronts: 0.3-1.2 s a spec

@@ -9,12 +9,14 @@ from typing import Any
 
 import numpy as np
 
-from . import actuation, assembly, dead_centres, loop_closure, realisable, registry
+from .diagnose import actuation, assembly, dead_centres, loop_closure
+from .mechanics import realisable
+from . import registry
 from .balancing.base import BalanceResult, Stage
-from .claim_precision import claim_tolerances
+from .mechanics.claim_precision import claim_tolerances
 from .engine import Analysis, AnalysisError, analyse, condition_peak
 from .engine.load_reference import LoadReference, load_reference
-from .sampling import gravity_vector  # noqa: F401  (balpipe.study.gravity_vector, as before)
+from .mechanics.sampling import gravity_vector  # noqa: F401  (balpipe.study.gravity_vector, as before)
 from .spec import Spec
 from .spec_parts import SpecFieldError
 
@@ -44,7 +46,7 @@ class Study:
     checks: dict
     problems: list[str] = field(default_factory=list)
     reactionless: Any = None
-    warnings: list[dict] = field(default_factory=list)  # dead centres and singularities (balpipe.dead_centres)
+    warnings: list[dict] = field(default_factory=list)  # dead centres and singularities (balpipe.diagnose.dead_centres)
 
     @property
     def unbalanced(self) -> StageResult:
@@ -127,7 +129,7 @@ def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float, override
     part of the loads (the shaking loads less the moving links' weight and its moment, which a
     force-balanced mechanism keeps constant); without gravity that is the loads themselves.
     They divide by :func:`ratio_reference` (the unbalanced peaks, or their floor). The claims
-    are judged at the stage's own tolerances (:func:`balpipe.claim_precision.claim_tolerances`:
+    are judged at the stage's own tolerances (:func:`balpipe.mechanics.claim_precision.claim_tolerances`:
     ``tol`` for computed designs, the precision of the entered numbers for designs typed by
     hand, or ``overrides[stage]``)."""
     ref = ratio_reference(unbalanced)

@@ -27,7 +27,7 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, BeforeValidator, Field, WithJsonSchema, model_validator
 
 from .spec_parts import Strict
-from .sweep_limit import MAX_DESIGNS
+from . import MAX_DESIGNS
 from .units import count
 from .vary import SweepError, parse_vary
 

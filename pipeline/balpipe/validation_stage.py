@@ -6,7 +6,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
-from . import pool, sim_cache
+from .runtime import pool
+from .cache import simulation as sim_cache
 from .study import Study, ratio_reference
 from .validate import FreeFloating, ValidationSettings, free_floating, validate
 from .validate.run import model_scale
@@ -118,7 +119,7 @@ def _floating_run(k: int, base_inertia: float, settings: ValidationSettings | No
 
 def _parallel(study: Study, workers: int, tasks: list[tuple]) -> list:
     """``fn(*a, study)`` for every ``(fn, a)`` of ``tasks``, results in that order; in ``workers``
-    forked processes when more than one (:func:`balpipe.pool.forked`: one pool, a worker that
+    forked processes when more than one (:func:`balpipe.runtime.pool.forked`: one pool, a worker that
     finishes its task takes the next, whatever its kind, so no core waits for the slowest stage
     before the free-frame runs start; the study inherited, not pickled). Each task runs whole
     simulations, which are deterministic: the results do not depend on ``workers``."""

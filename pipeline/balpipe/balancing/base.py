@@ -34,8 +34,8 @@ class Stage:
     balances: str = ""
     reference: str | None = None  # the stage its ratios refer to (default: the first stage)
     group: str = ""  # stages of one motion (a spec with several motions groups them, e.g. per trajectory)
-    tolerance: float | None = None  # the claims' tolerance set by the spec (default: balpipe.claim_precision)
-    rounding: tuple = ()  # balpipe.claim_precision.Rounding of the numbers entered by hand
+    tolerance: float | None = None  # the claims' tolerance set by the spec (default: balpipe.mechanics.claim_precision)
+    rounding: tuple = ()  # balpipe.mechanics.claim_precision.Rounding of the numbers entered by hand
     # the stage's line style on the page, draw.figures.style(k) (default: its place in its group):
     # a method whose paper states its figures' line styles gives them, so that one style means
     # one stage on the whole page, the paper's figures included (issue 22)

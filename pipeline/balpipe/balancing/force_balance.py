@@ -18,7 +18,10 @@ from .parts import add_counterweight
 from .specs import CounterweightRegionSpec, FinderSettings, ForceBalance, Point
 
 
-def _point(model: Model, body: str, p: Point, path: tuple) -> Vec2:
+def body_point(model: Model, body: str, p: Point, path: tuple) -> Vec2:
+    """The coordinates, in ``body``'s frame, of a spec point: an (x, y) pair as given, or the name
+    of one of the body's points. Raises :class:`SpecFieldError` at ``path`` for an unknown body or
+    point."""
     if not isinstance(p, str):
         return (float(p[0]), float(p[1]))
     try:
@@ -42,12 +45,12 @@ def regions_from_spec(model: Model, specs: list[CounterweightRegionSpec], root: 
             raise SpecFieldError(path + ("name",), f"counterweight name {name!r} used twice: name them")
         seen.add(name)
         if s.at is not None:
-            out.append(LM.Region(name, s.body, "point", (_point(model, s.body, s.at, path + ("at",)),)))
+            out.append(LM.Region(name, s.body, "point", (body_point(model, s.body, s.at, path + ("at",)),)))
         elif s.segment is not None:
-            pts = tuple(_point(model, s.body, p, path + ("segment", i)) for i, p in enumerate(s.segment))
+            pts = tuple(body_point(model, s.body, p, path + ("segment", i)) for i, p in enumerate(s.segment))
             out.append(LM.Region(name, s.body, "segment", pts))
         else:
-            c = _point(model, s.body, s.disc.centre, path + ("disc", "centre"))
+            c = body_point(model, s.body, s.disc.centre, path + ("disc", "centre"))
             out.append(LM.Region(name, s.body, "disc", (c,), s.disc.radius))
     return out
 

@@ -27,7 +27,7 @@ from . import regressor as R
 from . import conditions as C
 from .base import BalanceResult, Parameter, Stage
 from . import least_mass as LM
-from .force_balance import _point, regions_from_spec
+from .force_balance import body_point, regions_from_spec
 from .parts import add_counter_rotation, add_counterweight
 from .specs import CounterRotationSpec, MomentBalance
 
@@ -45,7 +45,7 @@ def add_discs(model: Model, specs: list[CounterRotationSpec], root: tuple) -> Mo
             v = getattr(s, key)
             if v != FRAME and v not in names:
                 raise SpecFieldError(path + (key,), f"unknown body {v!r} (bodies: {', '.join(names)}, frame)")
-        at = _point(model, s.carrier, s.at, path + ("at",)) if s.carrier != FRAME or not isinstance(s.at, str) else tuple(model.frame_points.get(s.at, (np.nan, np.nan)))
+        at = body_point(model, s.carrier, s.at, path + ("at",)) if s.carrier != FRAME or not isinstance(s.at, str) else tuple(model.frame_points.get(s.at, (np.nan, np.nan)))
         if not np.all(np.isfinite(at)):
             raise SpecFieldError(path + ("at",), f"the frame has no point {s.at!r}")
         try:
@@ -147,7 +147,7 @@ def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> Balance
         cw_model = cw_model.replace_body(balanced.body(b.name))
     for s in method.counter_rotations:
         if s.mass > 0 and s.carrier != FRAME:
-            at = _point(model, s.carrier, s.at, ())
+            at = body_point(model, s.carrier, s.at, ())
             cw_model = add_counterweight(cw_model, s.carrier, f"{s.name} (mass)", s.mass, at)
     cancelled = residual <= MOMENT_TOLERANCE
     params = [Parameter("force_conditions", cond.count, "", "counted from the momentum at reachable states", "independent force-balance conditions"),

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from ..meshes import DEFAULT_PRESSURE_ANGLE
+from ..mechanics.meshes import DEFAULT_PRESSURE_ANGLE
 from ..model import FRAME, Attachment, Body, Gear, Model, Revolute, Vec2, rot
 
 
@@ -51,7 +51,7 @@ def add_counter_rotation(
     mass on the pivot; ``radius``/``radius_geared`` are the pitch radii: given both, the mesh
     passes its tooth force (radial part from ``pressure_angle``) to the disc's pivot and to the
     geared body's bearing on the carrier, which must then be r + r_geared apart (external mesh,
-    ratio < 0) or |r - r_geared| (internal); omitted, the mesh is a couple (:mod:`balpipe.meshes`).
+    ratio < 0) or |r - r_geared| (internal); omitted, the mesh is a couple (:mod:`balpipe.mechanics.meshes`).
     """
     if not math.isfinite(ratio) or ratio == 0:
         raise ValueError(f"counter-rotation {name!r}: the gear ratio must be finite and non-zero, got {ratio}")

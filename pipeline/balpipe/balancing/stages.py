@@ -8,11 +8,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..claim_precision import Rounding, half_unit
+from ..mechanics.claim_precision import Rounding, half_unit
 from ..model import Attachment, Model
 from ..spec_parts import SpecFieldError
 from .base import BalanceResult, Stage
-from .force_balance import _point
+from .force_balance import body_point
 from .moment_balance import add_discs, set_disc_inertias
 from .specs import PartSpec, Stages
 
@@ -23,7 +23,7 @@ def attach(model: Model, part: PartSpec, path: tuple) -> Model:
         body = model.body(part.body)
     except KeyError:
         raise SpecFieldError(path + ("body",), f"unknown body {part.body!r} (bodies: {', '.join(b.name for b in model.bodies)})") from None
-    pos = _point(model, part.body, part.position, path + ("position",))
+    pos = body_point(model, part.body, part.position, path + ("position",))
     new = Attachment(part.name, part.mass, pos, part.inertia, part.kind, part.radius)
     kept = tuple(a for a in body.attachments if a.name != part.name)
     return model.replace_body(replace(body, attachments=kept + (new,)))

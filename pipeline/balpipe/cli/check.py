@@ -45,14 +45,14 @@ def run(args) -> int:
     """Everything ``build`` checks before simulating: schema, units, limits, geometry, the
     balancing, the analysis of every stage (singular motions), the references, and the paths and
     values of a ``sweep:`` block. Keeps going past a spec that fails. With several specs, in
-    ``--jobs`` processes, the costliest started first (:func:`balpipe.check_cost.check_cost`);
+    ``--jobs`` processes, the costliest started first (:func:`balpipe.site_files.check_cost.check_cost`);
     the messages come in the specs' order whatever the number."""
     import gc
 
     from .. import loader, runner  # noqa: F401  (loaded once here, before the workers fork)
-    from ..check_cost import check_cost
-    from ..pool import default_jobs, in_order
-    from ..spec_files import clashes, find_specs
+    from ..site_files.check_cost import check_cost
+    from ..runtime.pool import default_jobs, in_order
+    from ..site_files.spec_files import clashes, find_specs
 
     problem = paths_jobs_problem(args.paths, args.jobs)
     if problem:

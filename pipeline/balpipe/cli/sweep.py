@@ -9,7 +9,7 @@ from .common import EXIT_FAILED, EXIT_OK, EXIT_USAGE
 
 
 def add_parser(sub) -> None:
-    from ..sweep_limit import MAX_DESIGNS  # the limit alone: no pydantic, numpy or sweep machinery for --help
+    from .. import MAX_DESIGNS  # the limit alone: no pydantic, numpy or sweep machinery for --help
 
     s = sub.add_parser(
         "sweep", help="sweep numeric spec fields; table, Pareto fronts, design specs",
@@ -61,7 +61,7 @@ def run(args) -> int:
         except ImportError:
             print("balpipe: error: --scheduler needs dask.distributed (pip install 'balpipe[sweep]')", file=sys.stderr)
             return EXIT_USAGE
-        from ..cluster import unreachable
+        from ..runtime.cluster import unreachable
 
         why = unreachable(args.scheduler)
         if why is not None:

@@ -20,7 +20,8 @@ import numpy as np  # noqa: E402
 from matplotlib.layout_engine import PlaceHolderLayoutEngine  # noqa: E402
 
 from ..model import Model  # noqa: E402
-from . import cache, extremes  # noqa: E402
+from ..cache import figures as cache
+from . import extremes  # noqa: E402
 from .canvas import Canvas, Label, Panel  # noqa: E402
 from .labels import drawing_span, point_places, repeated_names  # noqa: E402
 from .layout import fixed_layout, text_metrics  # noqa: E402

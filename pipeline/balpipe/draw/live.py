@@ -24,7 +24,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..sampling import spread_indices
+from ..mechanics.sampling import spread_indices
 from . import figures
 
 POINTS = 400  # samples a curve keeps at most

@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from ..model import Model
-from ..sampling import spread_indices
+from ..mechanics.sampling import spread_indices
 from .labels import drawing_span, point_name_counts, point_places, repeated_names
 from .sleeves import guided_sliders, sleeves
 

@@ -27,7 +27,7 @@ loads are computed twice, independently:
 
 (a) reactions: F_sh, M_sh = -Phi_{q0}^T lambda (all frame joints, actuator reactions and gear
     mesh couples on the frame); a gear pair with pitch radii has its row rewritten as tooth
-    forces at the pitch point for the dynamics (:func:`.dynamics.tooth_rows`, :mod:`balpipe.meshes`), so
+    forces at the pitch point for the dynamics (:func:`.dynamics.tooth_rows`, :mod:`balpipe.mechanics.meshes`), so
     that its bearings carry the tooth force;
 (b) momentum: F_sh = sum m g - dP/dt, M_O = sum r x m g - dH_O/dt.
 

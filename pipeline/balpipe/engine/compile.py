@@ -7,7 +7,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..meshes import mesh_geometry
+from ..mechanics.meshes import mesh_geometry
 from ..model import FRAME, Driver, Gear, Model, Prismatic, Revolute, pose_of_com
 
 
@@ -209,7 +209,7 @@ def _actuated(c: Compiled, joints: dict, idx, local) -> Compiled | None:
 
 @dataclass
 class _Mesh:
-    """A gear pair with pitch radii (see :mod:`balpipe.meshes`), indexed for the engine."""
+    """A gear pair with pitch radii (see :mod:`balpipe.mechanics.meshes`), indexed for the engine."""
 
     name: str
     row: int  # the gear's constraint row

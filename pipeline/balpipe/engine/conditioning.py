@@ -2,7 +2,7 @@
 peak can be.
 
 A page reports the largest condition number over its stages' motions and where it occurs
-(:func:`balpipe.study.near_singular_note`, :func:`balpipe.dead_centres.find`): the peak of
+(:func:`balpipe.study.near_singular_note`, :func:`balpipe.diagnose.dead_centres.find`): the peak of
 :func:`.positions.condition_numbers`, an SVD per sample. :func:`peak` finds the same sample and
 the same value, bit for bit, from SVDs of a subset: every :data:`STRIDE`-th sample first, then
 every sample whose condition number these do not show to be below the largest found.

@@ -7,7 +7,7 @@ import functools
 
 import numpy as np
 
-from ..sampling import spread_indices
+from ..mechanics.sampling import spread_indices
 from .compile import Compiled
 from .constraints import GridLaws, with_frame, jacobian, law_positions, law_triples, residual
 from .errors import AnalysisError
@@ -106,7 +106,7 @@ def _fail_position(c: Compiled, q: np.ndarray, t: float) -> AnalysisError:
         t,
         c.row_owner[worst],
     )
-    err.q = q  # the configuration reached, for a diagnosis of the loop (balpipe.loop_closure)
+    err.q = q  # the configuration reached, for a diagnosis of the loop (balpipe.diagnose.loop_closure)
     return err
 
 

@@ -4,7 +4,7 @@ and bearings by). Pure functions of ``results.json``'s rows (``actuators``, ``co
 ``stages``, ``moving_mass``).
 
 Added inertia counts only the parts that can be built: a stage with a negative mass or inertia
-(:mod:`balpipe.realisable`) is flagged instead, its "added inertia" never shown as a cost.
+(:mod:`balpipe.mechanics.realisable`) is flagged instead, its "added inertia" never shown as a cost.
 """
 
 from __future__ import annotations

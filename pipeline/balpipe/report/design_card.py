@@ -1,7 +1,7 @@
 """The design summary card at the top of a study page: the parts the spec's main design adds to
 the unbalanced mechanism (name, mass, position, inertia) and what they cost, as factors
 (:mod:`balpipe.report.costs`). A part with a negative mass or centroidal inertia cannot be built
-(:mod:`balpipe.realisable`): it is flagged, and its inertia is never counted as a cost.
+(:mod:`balpipe.mechanics.realisable`): it is flagged, and its inertia is never counted as a cost.
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ The x axis is the sequence of commits, oldest left, labelled with their short ha
 history table of the page gives each commit's date and subject. A commit whose spec is invalid
 or crashed has no point (a gap), and its label is red, as is the label of a commit whose spec
 fails a check or the pymunk validation. The figures are drawn through the figure cache
-(:mod:`balpipe.draw.cache`): a build re-renders a page's history section without redrawing them.
+(:mod:`balpipe.cache.figures`): a build re-renders a page's history section without redrawing them.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ..draw import cache  # noqa: E402
+from ..cache import figures as cache  # noqa: E402
 from ..draw.figures import style, to_svg  # noqa: E402
 
 MAX_LABELS = 16

@@ -5,7 +5,7 @@ from __future__ import annotations
 import markupsafe
 import numpy as np
 
-from .. import realisable
+from ..mechanics import realisable
 from ..balancing.base import in_style_order, styled
 from ..laws.drives import law_names
 from ..study import Study, ratio_reference

@@ -1,4 +1,4 @@
-"""Figures of an optimal partial balancing (:mod:`balpipe.balancing.partial`): its Pareto fronts,
+"""Figures of an optimal partial balancing (:mod:`balpipe.balancing.partial.method`): its Pareto fronts,
 with the chosen design, the least-mass complete balancing in the same regions and every analysed
 stage of the study (the compared designs, e.g. the paper's complete balancing) marked."""
 

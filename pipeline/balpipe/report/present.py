@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..drivers import driver_unit  # noqa: F401  (present.driver_unit, as before)
+from ..mechanics.drivers import driver_unit  # noqa: F401  (present.driver_unit, as before)
 from ..model import Model
 
 

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
-from ..motion_outputs import motion_columns
+from ..mechanics.motion_outputs import motion_columns
 from ..study import Study, stage_metrics
 from . import present
 from .notation_table import names_for
@@ -69,7 +69,7 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
         "checks": study.checks,
         "references": study.references,
         "notes": study.balance.notes,
-        "warnings": study.warnings,  # dead centres and singularities (balpipe.dead_centres)
+        "warnings": study.warnings,  # dead centres and singularities (balpipe.diagnose.dead_centres)
         "validation": validation if simulated else None,
         "reactionless": study.reactionless.to_json() if study.reactionless is not None else None,
         "torque_driven": {s.stage.name: s.torque.to_json() for s in study.stages if s.torque is not None}
@@ -170,7 +170,7 @@ def timeseries_csv(study: Study) -> str:
     """One row per sample: t, then per stage Fx, Fy, |F|, M (about the moment point), every
     actuator effort, every joint reaction (see :func:`balpipe.engine.dynamics.joint_reactions`), the
     total centre of mass, every body's pose and every named point's path with their velocities
-    (:func:`balpipe.motion_outputs.motion_columns`); SI units, 12 significant digits."""
+    (:func:`balpipe.mechanics.motion_outputs.motion_columns`); SI units, 12 significant digits."""
     cols: list[tuple[str, np.ndarray]] = [("t_s", study.unbalanced.analysis.t)]
     for s in study.stages:
         an, n = s.analysis, s.stage.name

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..fsutil import write_file_atomic  # replaced in one step, never through a planted symlink
+from ..runtime.fsutil import write_file_atomic  # replaced in one step, never through a planted symlink
 from . import citations, site_filter, verdict
 from .costs import factor_text
 from .render import environment, num, printable, ratio
@@ -167,7 +167,7 @@ def _costs(results: dict, first: dict, last: dict) -> dict:
 
 def write_site(out: Path, outcomes: list, earlier: list = (), site_key: str = "") -> None:
     """The site's index (and its navigation script): this build's ``outcomes`` and the pages of
-    ``earlier`` builds still in ``out`` (:func:`balpipe.site_earlier.earlier_pages`). ``site_key``
+    ``earlier`` builds still in ``out`` (:func:`balpipe.site_files.site_earlier.earlier_pages`). ``site_key``
     (:func:`balpipe.build.site_key`) is written into the index's head, so that a build with
     nothing changed can leave the index as it is."""
     entries = [_entry(out, o) for o in sorted(outcomes, key=lambda o: o.source)]

@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from ..sampling import spread_indices
+from ..mechanics.sampling import spread_indices
 
 TOL = 1e-11  # relative: the prediction at the check designs must agree with the full build
 CHECKS = 3   # designs of the sweep itself built in full as checks (besides the upper corner)

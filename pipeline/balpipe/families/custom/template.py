@@ -11,8 +11,8 @@ from typing import Annotated, Literal, Union
 import numpy as np
 from pydantic import Field
 
-from ... import actuation
-from ...meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle, mesh_geometry
+from ...diagnose import actuation
+from ...mechanics.meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle, mesh_geometry
 from ...model import FRAME, Attachment, Body, Driver, Gear, Model, Prismatic, Revolute
 from ...spec_parts import SpecFieldError, Strict
 from ...units import Angle, Inertia, Length, Mass, Number, PositiveLength

@@ -10,8 +10,8 @@ from .template import gripper_path, input_angles, segment_distance
 
 def figures(study):
     """Report figures of the template: the gripper path (Fig. 7, drawn through the figure cache,
-    :mod:`balpipe.draw.cache`) and the input angles (Figs. 8-9, drawn by the browser)."""
-    from ...draw import cache
+    :mod:`balpipe.cache.figures`) and the input angles (Figs. 8-9, drawn by the browser)."""
+    from ...cache import figures as cache
 
     first = study.stages[0]
     an, model = first.analysis, first.stage.model

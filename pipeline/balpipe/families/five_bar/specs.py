@@ -9,7 +9,7 @@ from typing import Literal
 from pydantic import Field
 
 from .template import GearPart
-from ...meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
+from ...mechanics.meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
 from ...spec_parts import Strict
 from ...units import Inertia, Length, Mass, number
 

@@ -34,9 +34,10 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ... import actuation, units
+from ...diagnose import actuation
+from ... import units
 from ...laws.drives import path_laws
-from ...meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
+from ...mechanics.meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
 from ...model import FRAME, Attachment, Body, Driver, Gear, Law, Model, Revolute
 from ...motion import law_for
 from ...spec_parts import LinkSpec, SpecFieldError, Strict

@@ -110,7 +110,7 @@ def _factor_table(study, linkage: str) -> str:
             f"<tr><td>{s.stage.label}</td><td>{an.max_force:.6g}</td><td>{an.max_moment:.6g}</td>"
             f"<td>{s.max_effort:.6g}</td><td>{s.added_mass:.6g}</td><td>{s.added_inertia:.6g}</td></tr>"
         )
-    from ...drivers import driver_unit
+    from ...mechanics.drivers import driver_unit
 
     model = study.unbalanced.stage.model
     units = sorted({driver_unit(model, d.name) for d in model.drivers}) or ["N m or N"]

@@ -33,7 +33,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
-from ...joint_laws import PoseJointLaw, body_point
+from ...mechanics.joint_laws import PoseJointLaw, body_point
 from ...model import FRAME, Body, Driver, Law, Model, Prismatic, Revolute
 from ...spec_parts import SpecFieldError, Strict
 from ...units import Inertia, Length, Mass, PositiveLength
@@ -125,7 +125,7 @@ class Pose:
     def joint_point(self, c: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """C(t), C'(t), C''(t) (N, 2) of the platform point with local coordinates ``c``:
         C = P + R(phi) c, C' = P' + phi' J R c, C'' = P'' + phi'' J R c - phi'^2 R c
-        (:func:`balpipe.joint_laws.body_point`)."""
+        (:func:`balpipe.mechanics.joint_laws.body_point`)."""
         return body_point((self.x(t), self.y(t), self.phi(t)), c)
 
 

@@ -39,7 +39,7 @@ from . import conditions as cond
 from . import finder as generic
 from . import topologies as topologies
 from .placement import realise
-from ... import balance_cache
+from ...cache import balance as balance_cache
 from ...balancing.base import BalanceResult, Parameter, Stage
 from ...balancing.conditions import clarity_text
 from ...engine import analyse
@@ -324,7 +324,7 @@ def design_loads(designs: list[topologies.Design], rows: list[dict], stages: lis
 
 def peak_inertial_force(model: Model, t: np.ndarray, gravity, moment_point) -> float:
     """The peak inertial shaking force of ``model`` analysed by the engine on ``t`` (a function of
-    plain data: :func:`design_loads` reads it from the build's cache, :mod:`balpipe.balance_cache`)."""
+    plain data: :func:`design_loads` reads it from the build's cache, :mod:`balpipe.cache.balance`)."""
     return analyse(model, t, gravity, moment_point).max_inertial_force
 
 

@@ -167,8 +167,8 @@ def grid_columns(n: int) -> int:
 
 def panels_svg(panels: list[tuple], prefix: str) -> str:
     """One figure of ``panels`` (model, body poses, title), at most three a row (:func:`grid_columns`),
-    drawn by :func:`draw_panels` through the figure cache (:mod:`balpipe.draw.cache`)."""
-    from ...draw import cache
+    drawn by :func:`draw_panels` through the figure cache (:mod:`balpipe.cache.figures`)."""
+    from ...cache import figures as cache
     from ...draw.figures import drawn_model
 
     return cache.svg(draw_panels, [(drawn_model(model), poses, title) for model, poses, title in panels], prefix)

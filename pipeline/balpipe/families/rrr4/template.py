@@ -35,7 +35,7 @@ import numpy as np
 from pydantic import Field
 
 from ... import units
-from ...joint_laws import PoseJointLaw, body_point, dyad_rates
+from ...mechanics.joint_laws import PoseJointLaw, body_point, dyad_rates
 from ...laws.drives import path_laws
 from ...model import FRAME, Body, Driver, Law, Model, Revolute
 from ...motion import law_for

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .template import mass_parameters
-from ... import balance_cache
+from ...cache import balance as balance_cache
 from ...model import Model
 from . import conditions as cond
 from .placement import realise

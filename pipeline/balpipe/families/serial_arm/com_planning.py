@@ -51,12 +51,12 @@ from .template import (
     tip_chain,
     with_joint_laws,
 )
-from ... import balance_cache
+from ...cache import balance as balance_cache
 from ...model import Law, Model
 from ...motion import PointToPoint, bang_bang, law_for, quintic
 from ...spec_parts import SpecFieldError, paper_id
 from ...balancing.base import BalanceResult, Parameter, Stage
-from ...sampling import gravity_vector, time_grid
+from ...mechanics.sampling import gravity_vector, time_grid
 from .specs import ComMotionPlanning
 
 ROOT = ("balancing",)
@@ -455,7 +455,7 @@ def phi_search(model: Model, mech: SerialArmMechanism, method: ComMotionPlanning
                gravity: tuple, point: tuple, plan: Plan, path: tuple) -> tuple[tuple[float, ...], float, float, int]:
     """:meth:`Planner.optimise_phi` of one trajectory (``plan`` as :meth:`Planner.plan` made it,
     updated here) as a function of plain data: what the build's balancing cache keys and keeps
-    (:mod:`balpipe.balance_cache`; about 2 s of paper 003's balancing). Returns phi's
+    (:mod:`balpipe.cache.balance`; about 2 s of paper 003's balancing). Returns phi's
     coefficients, the peak moments at the start and at the optimum, and the evaluations."""
     Planner(model, mech, method, T, t, gravity, point).optimise_phi(plan, path)
     return plan.phi_coefficients, plan.phi_peak_start, plan.phi_peak_best, plan.evaluations

@@ -59,7 +59,7 @@ def _params(study) -> dict:
 def decoupling_figures(study):
     """Paper 002's figures: Fig. 2, the mass matrix before and after (its entries and along the
     motion), torque against acceleration."""
-    from ...draw import cache
+    from ...cache import figures as cache
     from ...engine.joint_space import mass_matrix
 
     by = _main(study)
@@ -316,7 +316,7 @@ def _other_trajectories(study, plans, by: dict) -> tuple[str, str, str]:
 def _square_figure(study, planner, plans, main: str) -> tuple[str, str, str]:
     """Fig. 2 of paper 003: the tested square, its points P_i, the tip's and the centre of mass'
     straight paths of every trajectory, and the arm at the start of the main trajectory."""
-    from ...draw import cache
+    from ...cache import figures as cache
 
     method = study.spec.balancing
     sq = method.test_square

@@ -28,8 +28,8 @@ import numpy as np
 from pydantic import Field
 
 from ... import units
-from ...content_cache import MEMO
-from ...joint_laws import PoseJointLaw, body_point_xy, dyad_rates
+from ...cache.content import MEMO
+from ...mechanics.joint_laws import PoseJointLaw, body_point_xy, dyad_rates
 from ...laws.drives import drive_laws, path_laws
 from ...model import FRAME, Attachment, Body, Driver, Law, Model, Revolute
 from ...motion import law_for
@@ -350,7 +350,7 @@ def task_jacobian(chain: Chain, q: np.ndarray) -> np.ndarray:
 class JointLaw(PoseJointLaw):
     """Joint ``index`` of a task-space motion, as a scalar law for a driver. The laws of one
     motion share ``_cache``: one inverse-kinematics solution per time grid for every joint (a
-    memo, left out of the caches' keys: :data:`balpipe.content_cache.MEMO`)."""
+    memo, left out of the caches' keys: :data:`balpipe.cache.content.MEMO`)."""
 
     chain: Chain
     motion: TaskMotion

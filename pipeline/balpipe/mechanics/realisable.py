@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .model import Model
+from ..model import Model
 
 
 @dataclass(frozen=True)

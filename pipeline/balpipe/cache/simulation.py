@@ -4,10 +4,10 @@ in another one of the same output folder (paper 000's idler-loop stages appear i
 
 A simulation is a deterministic function of its inputs (the model with its drivers' laws, the
 analysis it is measured against, the settings, the reference loads), balpipe's code and pymunk's
-version (and numpy's): :func:`run` keys it by all of them (:func:`balpipe.content_cache.key`) and keeps its
+version (and numpy's): :func:`run` keys it by all of them (:func:`balpipe.cache.content.key`) and keeps its
 result (the run's dataclass, pickled) in ``<out>/.cache/sims/<slug>/<sha256>.pickle``. A key is
 looked up in the spec's own folder, then in the other specs' folders (copied into its own when
-found there: :class:`balpipe.content_cache.Store`). While one process computes a
+found there: :class:`balpipe.cache.content.Store`). While one process computes a
 key, another that needs the same key waits for it (a lock file per key prefix, ``.locks/``),
 so that a cold build of several specs runs a shared simulation once. What :func:`run` cannot
 key (a lambda in a model) is simulated, never cached.
@@ -23,13 +23,13 @@ from __future__ import annotations
 
 from typing import Any, Callable, ClassVar
 
-from . import content_cache
+from . import content as content_cache
 
 SIMS = "sims"
 
 
 class Store(content_cache.PickleStore):
-    """The simulation cache of one spec (:class:`balpipe.content_cache.PickleStore`, entries
+    """The simulation cache of one spec (:class:`balpipe.cache.content.PickleStore`, entries
     ``.pickle``, locks in ``sims/.locks/``); ``computed``: the simulations run, for tests and the
     benchmark."""
 

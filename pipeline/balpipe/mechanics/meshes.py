@@ -31,8 +31,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .model import FRAME, Gear, Model, Revolute, Vec2
-from .units import quantity
+from ..model import FRAME, Gear, Model, Revolute, Vec2
+from ..units import quantity
 
 #: a pressure angle in [0, 90) deg, default 20 deg (standard involute gears)
 PressureAngle = quantity("angle", ge=0.0, lt=math.pi / 2)

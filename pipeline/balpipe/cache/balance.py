@@ -3,17 +3,17 @@ a change that no search reads (a comment, the description, another design) does 
 
 What is cached is a pure function of plain data, called through :func:`run`, never a whole
 balancing result (its stages hold models whose motion laws are closures): a partial balancing's
-Pareto fronts (:func:`balpipe.balancing.partial_fronts.fronts`, from the load maps, the budget and
+Pareto fronts (:func:`balpipe.balancing.partial.fronts.fronts`, from the load maps, the budget and
 the fronts' settings: about 90 % of its time), and the 4-RRR's searches (the counter-masses of a
 drawn topology, :func:`balpipe.families.rrr4.topologies.solve_counter_masses`; the condition
 finder's check, :func:`balpipe.families.rrr4.finder.check`; a design's peak shaking force,
 :func:`balpipe.families.rrr4.counter_masses.peak_inertial_force`), and paper 003's phi
 optimisation (:func:`balpipe.families.serial_arm.com_planning.phi_search`). The key
-(:func:`balpipe.content_cache.key`) is the function's name and arguments, balpipe's code hash
+(:func:`balpipe.cache.content.key`) is the function's name and arguments, balpipe's code hash
 and the versions of the libraries that compute the numbers (numpy, scipy, Clarabel); the
 result is kept as a pickle in ``<out>/.cache/balance/<slug>/<sha256>.pickle``, looked up in the
 spec's folder, then in the other specs' of the same output folder, with the checksum, atomic
-writes, refusal of symlinks, pruning and per-key locks of :class:`balpipe.content_cache.PickleStore`.
+writes, refusal of symlinks, pruning and per-key locks of :class:`balpipe.cache.content.PickleStore`.
 
 A served result is the object that was computed, unpickled: the same bits. ``balpipe build``
 uses the cache (with ``--no-sim`` too: the balancing is the same); ``--force`` computes every
@@ -25,7 +25,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, ClassVar
 
-from . import content_cache
+from . import content as content_cache
 
 BALANCE = "balance"
 #: the libraries whose versions are part of every key (they produce the numbers)
@@ -33,7 +33,7 @@ LIBRARIES = ("numpy", "scipy", "clarabel")
 
 
 class Store(content_cache.PickleStore):
-    """The balancing cache of one spec (:class:`balpipe.content_cache.PickleStore`, entries
+    """The balancing cache of one spec (:class:`balpipe.cache.content.PickleStore`, entries
     ``.pickle``, locks in ``balance/.locks/``); ``computed``: the searches run."""
 
     KIND: ClassVar[str] = BALANCE
@@ -46,7 +46,7 @@ def environment() -> str:
     return content_cache.library_versions(LIBRARIES)
 
 
-#: the store of :func:`using`: a module global, as the simulations' (:mod:`balpipe.sim_cache`)
+#: the store of :func:`using`: a module global, as the simulations' (:mod:`balpipe.cache.simulation`)
 ACTIVE = content_cache.Active(environment)
 using = ACTIVE.using  # compute the block's searches through a store (None: compute them all, no cache)
 

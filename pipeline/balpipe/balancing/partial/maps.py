@@ -25,11 +25,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..engine.dynamics import joint_reactions
-from .mass_sweep import MassSweep
-from ..model import Model, Prismatic, Revolute
-from .parts import add_counterweight
-from .regressor import parameters
+from ...engine.dynamics import joint_reactions
+from ..mass_sweep import MassSweep
+from ...model import Model, Prismatic, Revolute
+from ..parts import add_counterweight
+from ..regressor import parameters
 
 JOINT_COMPONENTS = {"revolute": ("Fx", "Fy"), "prismatic": ("N",), "gear": ("T",)}
 

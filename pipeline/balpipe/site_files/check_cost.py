@@ -1,5 +1,5 @@
 """A spec's expected ``balpipe check`` work, so that the check's process pool starts the costliest
-specs first (:func:`balpipe.pool.in_order`'s ``cost``: longest processing time first). Without it
+specs first (:func:`balpipe.runtime.pool.in_order`'s ``cost``: longest processing time first). Without it
 paper 003's spec, ten times the work of most, started 19th of 24 and ran alone at the end. The
 same hints, ``build_cost``, order ``balpipe build --no-sim`` (:func:`balpipe.build.spec_cost`).
 
@@ -37,8 +37,8 @@ def check_cost(path: Path) -> float:
 def declared_cost(path: Path, hint: str) -> float:
     """The sum of the ``hint`` attribute (``check_cost`` or ``build_cost``) of the template and
     the method that the spec at ``path`` names; 0 where it cannot be read or names neither."""
-    from . import registry
-    from .loader import MAX_FILE_BYTES
+    from .. import registry
+    from ..loader import MAX_FILE_BYTES
 
     try:
         st = path.stat()

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .model import Model, Prismatic, Revolute
+from ..model import Model, Prismatic, Revolute
 
 
 def effort_unit(model: Model, name: str) -> str | None:

@@ -34,7 +34,7 @@ class Earlier:
 def spec_changed(folder: Path, results: dict, page_hash: PageHash) -> str:
     """Why an earlier page no longer shows its spec ('' when it still does): ``page_hash`` is the
     hash a build would give the spec now (:func:`balpipe.build.page_hash`)."""
-    from .loader import SpecErrors, load
+    from ..loader import SpecErrors, load
 
     source = Path(results.get("source") or "")
     if not source.is_file():

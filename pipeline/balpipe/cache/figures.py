@@ -11,10 +11,10 @@ arguments that were hashed, so an entry can only be served for the inputs it was
 
 Entries live in ``<out>/.cache/figures/<slug>/<sha256>.svg``, each a header line with the
 SHA-256 of the SVG that follows (a truncated or damaged entry is redrawn, never served),
-written atomically (:func:`balpipe.fsutil.write_file_atomic`); a symlink anywhere on the way
+written atomically (:func:`balpipe.runtime.fsutil.write_file_atomic`); a symlink anywhere on the way
 (the cache folders or the entry) is never followed: the figure is drawn and nothing is read or
 written there. A key missing from the spec's folder is looked up in the other specs' folders
-(two specs drawing the same figure draw it once; :class:`balpipe.content_cache.Store`).
+(two specs drawing the same figure draw it once; :class:`balpipe.cache.content.Store`).
 After a spec's page is built, :meth:`Store.prune` removes the entries of that
 spec that its build did not use. Without an active store (``--scheduler``, ``balpipe diff``, a
 test) :func:`svg` just draws.
@@ -29,8 +29,8 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any, Callable, ClassVar, Iterator
 
-from .. import content_cache
-from ..content_cache import CACHE_DIR, Unhashable  # noqa: F401  (the figure cache's names)
+from . import content as content_cache
+from .content import CACHE_DIR, Unhashable  # noqa: F401  (the figure cache's names)
 
 FIGURES = "figures"
 _HEADER = "balpipe-figure-1 "
@@ -54,7 +54,7 @@ def _digest(version: str, rc: str) -> str:
 
 
 def key(fn: Callable[..., str], args: tuple, kwargs: dict, salt: str) -> str:
-    """The SHA-256 (hex) of a figure (:func:`balpipe.content_cache.key`): ``fn``'s module and
+    """The SHA-256 (hex) of a figure (:func:`balpipe.cache.content.key`): ``fn``'s module and
     name, ``args`` and ``kwargs``, ``salt`` and the :func:`environment`. ``fn`` must be a
     module-level function: :class:`Unhashable` otherwise, as for an argument that is not plain
     data."""
@@ -66,7 +66,7 @@ def _pack(svg: str) -> str:
 
 
 class Store(content_cache.Store):
-    """The figure cache of one spec (:class:`balpipe.content_cache.Store`, entries ``.svg``);
+    """The figure cache of one spec (:class:`balpipe.cache.content.Store`, entries ``.svg``);
     ``drawn``: the figures drawn, for tests and the benchmark."""
 
     KIND: ClassVar[str] = FIGURES

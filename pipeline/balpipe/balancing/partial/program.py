@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .partial_maps import Load, Maps
+from .maps import Load, Maps
 
 #: Clarabel's settings: tolerances of 1e-10 (its defaults 1e-8), "almost solved" at its default
 #: tolerances (instead of 5e-5): a flat optimum's design is as sure as its objective to ~sqrt(tol)

@@ -27,8 +27,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .partial_maps import Maps
-from .partial_program import FALLBACK_SETTINGS, SOLVER_SETTINGS, ZERO, Outcome, Term, polish_zero, variable_scale
+from .maps import Maps
+from .program import FALLBACK_SETTINGS, SOLVER_SETTINGS, ZERO, Outcome, Term, polish_zero, variable_scale
 
 UNBOUNDED = 1e9  # kg: the mass budget when a programme should not be limited by it
 RELAX = (1e-9, 1e-7, 1e-5)  # relative slack on a bound that is an optimum itself, tried in turn

@@ -19,10 +19,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .engine import Compiled, jacobian
-from .engine.constraints import with_frame
-from .engine.structure import maximum_matching, strong_components
-from .model import FRAME, Model, Revolute
+from ..engine import Compiled, jacobian
+from ..engine.constraints import with_frame
+from ..engine.structure import maximum_matching, strong_components
+from ..model import FRAME, Model, Revolute
 
 
 @dataclass(frozen=True)

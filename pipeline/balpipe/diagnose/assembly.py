@@ -8,7 +8,7 @@ confirm the poses: a body that ends more than :data:`ANGLE_TOLERANCE` away in an
 than :data:`POSITION_TOLERANCE` of the mechanism's size away in position, means the poses were
 far from every assembly (or between two branches), and the spec is refused at that body's
 ``pose``, with the pose that was reached. A loop that cannot close at all is named by
-:mod:`balpipe.loop_closure`. The branch then stays the same along the motion (the analysis
+:mod:`balpipe.diagnose.loop_closure`. The branch then stays the same along the motion (the analysis
 follows it continuously and refuses a singular configuration, where it could switch).
 
 The check runs when a spec is built or checked (:func:`balpipe.study.run`), not in design
@@ -23,10 +23,10 @@ import math
 import numpy as np
 
 from . import loop_closure
-from .engine import AnalysisError, compile_model
-from .engine.positions import newton_raphson
-from .model import Model
-from .spec_parts import SpecFieldError
+from ..engine import AnalysisError, compile_model
+from ..engine.positions import newton_raphson
+from ..model import Model
+from ..spec_parts import SpecFieldError
 
 ANGLE_TOLERANCE = math.radians(30.0)
 POSITION_TOLERANCE = 0.1  # fraction of the mechanism's size (its largest point distance from a body origin)

@@ -12,7 +12,7 @@ linear equations (:func:`.least_mass.independent_equations`), the added mass min
 
 :func:`fronts` computes them from plain data (the load maps and the settings) on a programme of
 its own, so that a build reads them from its cache when those did not change
-(:mod:`balpipe.balance_cache`). Every optimum is the whole programme's to Clarabel's tolerance
+(:mod:`balpipe.cache.balance`). Every optimum is the whole programme's to Clarabel's tolerance
 (1e-10 of the unbalanced loads, 1e-8 where it stalls); the loads reported are the designs' own,
 on every sample.
 """
@@ -21,10 +21,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .least_mass import independent_equations
-from .partial_active import UNBOUNDED, ActiveProgram, relaxed
-from .partial_maps import Maps
-from .partial_program import ZERO, Term
+from ..least_mass import independent_equations
+from .active import UNBOUNDED, ActiveProgram, relaxed
+from .maps import Maps
+from .program import ZERO, Term
 
 
 def point(maps: Maps, z: np.ndarray, terms: dict[str, Term]) -> dict:
@@ -140,9 +140,9 @@ def _front(name: str, ctx: tuple) -> list[dict]:
 def compute(program: ActiveProgram, terms: dict[str, Term], budget: float, n: int, max_mass: float | None) -> dict:
     """Every front and the complete balances' least masses (None where infeasible). The fronts
     are independent sequences of solves, each from the same samples: with spare cores
-    (:func:`balpipe.pool.spare`) they run in forked processes, the trade-off fronts' ends solved
+    (:func:`balpipe.runtime.pool.spare`) they run in forked processes, the trade-off fronts' ends solved
     here first (once for both); the numbers are the same bits whatever the cores."""
-    from .. import pool
+    from ...runtime import pool
 
     force, moment = terms["shaking_force"], terms["shaking_moment"]
     complete_f = least_complete_mass(program, [force])
@@ -175,5 +175,5 @@ def fronts(maps: Maps, inertia_budget: float | None, terms: dict[str, Term], bud
            max_mass: float | None) -> dict:
     """:func:`compute` on a new :class:`ActiveProgram` of ``maps`` (the spec's motion's; ``terms``
     may span several motions) with ``inertia_budget``: a function of plain data (the maps, the
-    terms' load maps, the numbers), which :func:`balpipe.balance_cache.run` can key."""
+    terms' load maps, the numbers), which :func:`balpipe.cache.balance.run` can key."""
     return compute(ActiveProgram(maps, inertia_budget), terms, budget, n, max_mass)

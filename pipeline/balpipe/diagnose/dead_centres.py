@@ -2,7 +2,7 @@
 
 Three measures, each with its stated threshold, on the stage's own analysis:
 
-* the transmission angle of every RRR dyad of the prescribed motion (:mod:`balpipe.dyads`):
+* the transmission angle of every RRR dyad of the prescribed motion (:mod:`balpipe.diagnose.dyads`):
   the angle at its middle joint between its two links, folded into [0, 90] deg. At 0 the dyad
   is stretched or folded (a dead centre): its ends no longer determine its motion and the
   forces through it grow like 1 / sin(angle). Warned below :data:`TRANSMISSION_LIMIT`;
@@ -23,8 +23,8 @@ import math
 import numpy as np
 
 from . import dyads
-from .engine import Analysis, compile_model, condition_peak
-from .model import Model
+from ..engine import Analysis, compile_model, condition_peak
+from ..model import Model
 
 TRANSMISSION_LIMIT = math.radians(10.0)
 CONDITION_LIMIT = 1e4

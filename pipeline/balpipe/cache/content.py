@@ -1,8 +1,8 @@
 """Results cached by content in the output folder (issue 23, "Fast"): what a build computed from
 some inputs is kept under the SHA-256 of those inputs, so that a build whose inputs did not change
-reads it instead of computing it again. Three caches use it: the figures (:mod:`balpipe.draw.cache`,
-``<out>/.cache/figures/``), the pymunk simulations (:mod:`balpipe.sim_cache`,
-``<out>/.cache/sims/``) and the balancing's numerical searches (:mod:`balpipe.balance_cache`,
+reads it instead of computing it again. Three caches use it: the figures (:mod:`balpipe.cache.figures`,
+``<out>/.cache/figures/``), the pymunk simulations (:mod:`balpipe.cache.simulation`,
+``<out>/.cache/sims/``) and the balancing's numerical searches (:mod:`balpipe.cache.balance`,
 ``<out>/.cache/balance/``).
 
 Keys
@@ -18,7 +18,7 @@ Keys
 Entries
     ``<out>/.cache/<kind>/<slug>/<sha256><suffix>``: a header line with the SHA-256 of the
     payload that follows (a truncated or damaged entry is computed again, never served),
-    written atomically (:func:`balpipe.fsutil.write_file_atomic`); a symlink anywhere on the way
+    written atomically (:func:`balpipe.runtime.fsutil.write_file_atomic`); a symlink anywhere on the way
     is never followed. :meth:`Store.prune` removes the spec's entries that its build did not use;
     :func:`prune_specs` the folders of specs that have no page any more.
 
@@ -46,7 +46,7 @@ from typing import Any, Callable, ClassVar, Iterator
 
 import numpy as np
 
-from .fsutil import TMP_MARK, remove_path, write_file_atomic
+from ..runtime.fsutil import TMP_MARK, remove_path, write_file_atomic
 
 #: the caches' folder in the output folder; never part of the published site
 CACHE_DIR = ".cache"

@@ -9,10 +9,10 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
-from ..laws.motion_spec import Motion
-from ..spec_parts import Strict
-from ..units import Inertia, Mass, count, number
-from .specs import CounterRotationSpec, CounterweightRegionSpec, Point
+from ...laws.motion_spec import Motion
+from ...spec_parts import Strict
+from ...units import Inertia, Mass, count, number
+from ..specs import CounterRotationSpec, CounterweightRegionSpec, Point
 
 LOADS = ("shaking_force", "shaking_moment", "effort", "joint")
 MAIN_MOTION = "motion"  # the name of the spec's own motion in the report

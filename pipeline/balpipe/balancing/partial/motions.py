@@ -20,11 +20,11 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ..model import Model
-from ..spec_parts import SpecFieldError
-from .partial_maps import Maps
-from .partial_program import Term
-from .partial_spec import MAIN_MOTION, PartialBalance
+from ...model import Model
+from ...spec_parts import SpecFieldError
+from .maps import Maps
+from .program import Term
+from .spec import MAIN_MOTION, PartialBalance
 
 
 def names(method: PartialBalance) -> list[str]:

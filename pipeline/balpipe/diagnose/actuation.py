@@ -13,8 +13,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from .model import Actuator, Gear, Model, Prismatic
-from .spec_parts import SpecFieldError
+from ..model import Actuator, Gear, Model, Prismatic
+from ..spec_parts import SpecFieldError
 
 DESCRIPTION = (
     "joints that carry the motors (revolute: torque in N m; prismatic: force in N), distinct from "

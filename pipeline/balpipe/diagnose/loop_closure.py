@@ -1,7 +1,7 @@
 """A loop that cannot close, named as an engineer would (issue 20, item 4).
 
 When the position analysis fails (at assembly or on the way), the configuration where it
-stopped is split into the blocks of its constraint equations (:mod:`balpipe.dyads`); the first
+stopped is split into the blocks of its constraint equations (:mod:`balpipe.diagnose.dyads`); the first
 block that is not closed is the loop to blame. An RRR dyad is diagnosed from its lengths: its
 two ends are d apart, its links l_i and l_j long, and it closes only when
 |l_i - l_j| <= d <= l_i + l_j; the message gives the length each link would need and the one it
@@ -16,11 +16,11 @@ import math
 import numpy as np
 
 from . import dyads
-from .engine import AnalysisError, Compiled, compile_model, jacobian, residual
-from .engine.constraints import with_frame
-from .engine.positions import follow_motion
-from .model import Model
-from .spec_parts import SpecFieldError
+from ..engine import AnalysisError, Compiled, compile_model, jacobian, residual
+from ..engine.constraints import with_frame
+from ..engine.positions import follow_motion
+from ..model import Model
+from ..spec_parts import SpecFieldError
 
 CLOSED = 1e-9  # residual (m or rad) below which a block counts as closed
 

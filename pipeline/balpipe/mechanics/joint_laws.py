@@ -29,7 +29,7 @@ from typing import Callable
 
 import numpy as np
 
-from .model import Law
+from ..model import Law
 
 Triple = tuple[np.ndarray, np.ndarray, np.ndarray]  # values, first and second time derivatives
 

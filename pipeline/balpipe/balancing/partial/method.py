@@ -12,7 +12,7 @@ largest of its per-motion measures (:mod:`.partial_motions`).
 Stages: ``unbalanced``, ``partial`` (the optimum's parts added). The details for results.json hold
 the objective achieved, each term, the active constraints, the budget's sensitivity (the dual
 value: d objective / d mass budget), the fronts (read from the build's cache when their inputs
-did not change: :mod:`balpipe.balance_cache`) and, per motion, the terms, caps and peaks.
+did not change: :mod:`balpipe.cache.balance`) and, per motion, the terms, caps and peaks.
 
 Requests that cannot be met are located errors before any stage is analysed: a region outside
 its link (farther than :data:`REACH` x the link's size from the link's frame origin), a non-convex
@@ -28,20 +28,20 @@ from dataclasses import replace
 
 import numpy as np
 
-from .. import balance_cache
-from ..model import Model
-from ..notation import COMMON, ours, setting
-from ..spec_parts import SpecFieldError
-from . import partial_fronts as PF
-from . import partial_motions as PMo
-from .base import BalanceResult, Parameter, Stage
-from .force_balance import _point, counterweight_notation, regions_from_spec
-from .moment_balance import add_discs, counter_rotation_notation
-from .partial_maps import NO_PART, DiscVars, Maps, PartVars, build
-from .partial_active import ActiveProgram
-from .partial_program import Term
-from .partial_spec import PartialBalance, PartialCounterweightSpec
-from .regressor import model_size
+from ...cache import balance as balance_cache
+from ...model import Model
+from ...notation import COMMON, ours, setting
+from ...spec_parts import SpecFieldError
+from . import fronts as PF
+from . import motions as PMo
+from ..base import BalanceResult, Parameter, Stage
+from ..force_balance import body_point, counterweight_notation, regions_from_spec
+from ..moment_balance import add_discs, counter_rotation_notation
+from .maps import NO_PART, DiscVars, Maps, PartVars, build
+from .active import ActiveProgram
+from .program import Term
+from .spec import PartialBalance, PartialCounterweightSpec
+from ..regressor import model_size
 
 REACH = 2.0  # a region must lie within this multiple of its link's size from the link's origin
 ACTIVE = 1e-6  # relative slack below which a constraint is reported active
@@ -55,7 +55,7 @@ def _link_size(model: Model, body: str) -> float:
 
 
 def _polygon(model: Model, s: PartialCounterweightSpec, path: tuple) -> tuple:
-    V = np.array([_point(model, s.body, p, path + ("polygon", i)) for i, p in enumerate(s.polygon)])
+    V = np.array([body_point(model, s.body, p, path + ("polygon", i)) for i, p in enumerate(s.polygon)])
     e = np.roll(V, -1, axis=0) - V
     turn = e[:, 0] * np.roll(e, -1, axis=0)[:, 1] - e[:, 1] * np.roll(e, -1, axis=0)[:, 0]
     if not (np.all(turn > 0) or np.all(turn < 0)):

@@ -1,0 +1,3 @@
+"""Planar mechanics below the engine: gear meshes, pose-driven joint laws, whether a stage can be
+built, time grids and gravity, drivers' effort units, the time series' positions, the precision a
+claim is judged at. Imports only the core vocabulary (units, model, motion)."""
