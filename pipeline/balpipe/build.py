@@ -34,7 +34,7 @@ from .site_files.site_earlier import earlier_pages
 from .site_files.spec_files import MAX_SLUG, clash_notes, clashes, find_specs, slug_for  # noqa: F401  (build.find_specs, build.slug_for as before)
 
 # The phases' modules (numpy, pydantic, matplotlib, jinja2) are imported when a spec is computed,
-# not when an unchanged site is checked (issue 23: a rebuild with nothing changed in 0.3 s). The
+# not when an unchanged site is checked (a rebuild with nothing changed takes 0.3 s). The
 # names below stay this module's, so that a caller (the build benchmark) can wrap them.
 
 

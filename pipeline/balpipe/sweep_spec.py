@@ -1,5 +1,5 @@
 """The optional ``sweep:`` block of a spec: what ``balpipe sweep SPEC`` varies when no ``--vary``
-is given (issue 13, item 3). ``balpipe build`` ignores the block; the sweep's own command-line
+is given. ``balpipe build`` ignores the block; the sweep's own command-line
 flags override it (``--vary`` replaces the whole ``vary`` mapping).
 
 .. code-block:: yaml

@@ -38,7 +38,7 @@ class Stage:
     rounding: tuple = ()  # balpipe.mechanics.claim_precision.Rounding of the numbers entered by hand
     # the stage's line style on the page, draw.figures.style(k) (default: its place in its group):
     # a method whose paper states its figures' line styles gives them, so that one style means
-    # one stage on the whole page, the paper's figures included (issue 22)
+    # one stage on the whole page, the paper's figures included
     style: int | None = None
     # the stage whose numbers the paper publishes (paper 003: case 2 against case 1, while case 3
     # follows it): the verdict's headline for its motion (default: the motion's last stage),

@@ -1,4 +1,5 @@
-"""Mass-parameter sweeps without re-analysis (issue 13, item 2).
+"""Mass-parameter sweeps without re-analysis: every load is linear in the mass parameters, so one
+kinematic analysis serves every mass.
 
 At fixed geometry (joint points, initial poses, drivers, time grid) the kinematics of every
 body's *frame* do not depend on the masses. Every load the engine computes is linear in each

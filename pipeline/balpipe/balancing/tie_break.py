@@ -1,4 +1,4 @@
-"""The stated tie-break among least-mass designs (issue 20, item 8).
+"""The stated tie-break among least-mass designs: the same spec always gets the same design.
 
 The least-mass programme (:mod:`.least_mass`) is a linear programme: its optimum is often a
 whole face of designs of the same total mass (a symmetric mechanism has its mirror images, and

@@ -1,4 +1,4 @@
-"""The balancing's numerical searches cached by content (issue 23, "Fast"): a spec rebuilt after
+"""The balancing's numerical searches cached by content: a spec rebuilt after
 a change that no search reads (a comment, the description, another design) does not search again.
 
 What is cached is a pure function of plain data, called through :func:`run`, never a whole

@@ -1,4 +1,4 @@
-"""Results cached by content in the output folder (issue 23, "Fast"): what a build computed from
+"""Results cached by content in the output folder: what a build computed from
 some inputs is kept under the SHA-256 of those inputs, so that a build whose inputs did not change
 reads it instead of computing it again. Three caches use it: the figures (:mod:`balpipe.cache.figures`,
 ``<out>/.cache/figures/``), the pymunk simulations (:mod:`balpipe.cache.simulation`,

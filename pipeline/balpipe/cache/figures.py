@@ -1,5 +1,5 @@
-"""Figures cached by content (issue 23, "Fast": a changed spec whose figures did not change
-redraws none of them).
+"""Figures cached by content: a changed spec whose figures did not change redraws none of
+them.
 
 A figure is drawn by a module-level function of plain data (numbers, strings, numpy arrays,
 lists, tuples, dicts, dataclasses such as :class:`balpipe.model.Body`), called through

@@ -1,4 +1,4 @@
-"""The pymunk simulations cached by content (issue 23, "Fast"): a stage whose model, motion,
+"""The pymunk simulations cached by content: a stage whose model, motion,
 reference loads and validation settings did not change is not simulated again, in this spec or
 in another one of the same output folder (paper 000's idler-loop stages appear in three specs).
 

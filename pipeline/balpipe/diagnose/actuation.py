@@ -1,4 +1,5 @@
-"""Actuated joints named by a spec, distinct from the prescribed coordinates (issue 20, item 2).
+"""Actuated joints named by a spec, distinct from the prescribed coordinates: the
+motors' efforts are computed at the joints that carry them.
 
 A spec prescribes what moves (its drivers: joint laws, a point, a pose) and may name the joints
 that carry the motors (``mechanism.actuators``). The engine then computes the motors' efforts

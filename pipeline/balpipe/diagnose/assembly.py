@@ -1,4 +1,5 @@
-"""The assembly branch of a custom spec, chosen on purpose (issue 20, item 5).
+"""The assembly branch of a custom spec, chosen on purpose: the branch
+of the spec's representative poses, or a located error at the pose that was not confirmed.
 
 Rule: a custom spec's bodies' ``pose`` fields are a representative pose of the mechanism at
 t = 0. balpipe assembles it by Newton-Raphson from those poses, with the drivers at their

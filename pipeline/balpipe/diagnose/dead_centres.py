@@ -1,4 +1,5 @@
-"""Warnings of a motion that passes near a dead centre or a singularity (issue 20, item 4).
+"""Warnings of a motion that passes near a dead centre or a singularity, each
+with its stated threshold.
 
 Three measures, each with its stated threshold, on the stage's own analysis:
 

@@ -1,5 +1,5 @@
 """The loops of a mechanism as an engineer names them: the blocks of its constraint equations,
-and the RRR dyads among them (issue 20, item 4).
+and the RRR dyads among them.
 
 The constraint Jacobian of the prescribed motion (joints and drivers) is put in block-triangular
 form (:mod:`balpipe.engine.structure`: a maximum matching, then the strongly connected

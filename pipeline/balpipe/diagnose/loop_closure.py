@@ -1,4 +1,5 @@
-"""A loop that cannot close, named as an engineer would (issue 20, item 4).
+"""A loop that cannot close, named as an engineer would: its joints and
+bodies, and for an RRR dyad the length a link would need and the field that sets it.
 
 When the position analysis fails (at assembly or on the way), the configuration where it
 stopped is split into the blocks of its constraint equations (:mod:`balpipe.diagnose.dyads`); the first

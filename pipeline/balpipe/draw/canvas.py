@@ -1,4 +1,5 @@
-"""Drawings of mechanisms written straight to SVG, without a matplotlib figure (issue 23, "Fast").
+"""Drawings of mechanisms written straight to SVG, without a matplotlib figure: the look of the
+report's other figures without the cost of building and serialising artists.
 
 A report draws about a hundred mechanisms (the stages' poses, paper 001's topology panels); as
 matplotlib figures each cost about 0.2 s, most of it in building and serialising artists. A

@@ -1,4 +1,5 @@
-"""A fixed layout for a grid of matplotlib axes, computed instead of searched (issue 23).
+"""A fixed layout for a grid of matplotlib axes, computed instead of searched: tight_layout's
+margins without laying the figure out.
 
 ``fig.tight_layout()`` lays every tick label, axis label and title out and asks each for its
 drawn box (about a second a figure here, as long as drawing it). :func:`fixed_layout` gives the

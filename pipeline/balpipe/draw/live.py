@@ -1,12 +1,12 @@
-"""Interactive plots (issue 22): the curves of a time-series figure as JSON, drawn in the browser
+"""Interactive plots: the curves of a time-series figure as JSON, drawn in the browser
 by uPlot (MIT, https://github.com/leeoniya/uPlot, shipped inside the page as
 ``templates/uplot.iife.min.js``, about 50 KB: no network, works from ``file://``) with one
 script for every figure (``templates/live_plots.js``): hover shows the time and every curve's
 value, drag to zoom (double-click resets), a click on a legend entry hides its curve; where the
 page has a player, its time moves every plot's cursor and a click in a plot sets the player's
 time. Printing prints these plots themselves, redrawn at the printed width and a pixel ratio that
-prints sharply (``live_plots.js``); no static figure of the same curves is written (issue 22: it
-doubled a page's weight and its build time). Without JavaScript a line in the plot's place says
+prints sharply (``live_plots.js``); no static figure of the same curves is written (it would
+double a page's weight and its build time). Without JavaScript a line in the plot's place says
 where the numbers are (:data:`NUMBERS`).
 
 A figure's curves are a :class:`Curves`; :func:`data` thins them to at most :data:`POINTS`

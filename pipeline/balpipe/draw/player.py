@@ -177,7 +177,7 @@ def digits(scale: float, size: float) -> tuple[int, int]:
     rounding moves no drawn point by more than :data:`PIXEL` (half the last kept digit times
     the scale, or times the panel's size for an angle). A 0.6 m mechanism in a 300 px panel
     keeps 4 decimals of a position and 4 of an angle instead of 6: the same drawing, about a
-    third fewer bytes (issue 22: a page's weight)."""
+    third fewer bytes in a page."""
     position = max(0, math.ceil(math.log10(scale / (2 * PIXEL))))
     angle = max(0, math.ceil(math.log10(size / (2 * PIXEL))))
     return position, angle

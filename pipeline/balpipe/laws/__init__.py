@@ -1,5 +1,5 @@
-"""Motion laws for real machines (issue 20), beside the point-to-point laws of
-:mod:`balpipe.motion`. Every law is a :class:`balpipe.model.Law`: a function of time returning
+"""Motion laws for real machines (constant speed, cams, cycles of segments, tables, paths),
+beside the point-to-point laws of :mod:`balpipe.motion`. Every law is a :class:`balpipe.model.Law`: a function of time returning
 q, q', q'' with exact derivatives, vectorised over t.
 
 * :mod:`.periodic`: constant speed (steady state, or from rest on a ramp), cam laws (cycloidal,

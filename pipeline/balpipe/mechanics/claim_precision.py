@@ -1,4 +1,5 @@
-"""Claims judged at the design's precision (issue 20, item 7).
+"""Claims judged at the design's precision: a computed design at round-off, a design typed by
+hand within the rounding of its own numbers.
 
 A stage claims to cancel the shaking force (moment) when its inertial peak is at most a
 tolerance times the reference load. Computed designs are exact to round-off and keep the

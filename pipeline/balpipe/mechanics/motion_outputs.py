@@ -1,4 +1,4 @@
-"""Positions in the outputs (issue 20, item 6): every body's pose, every named point's path
+"""Positions in the outputs: every body's pose, every named point's path
 and the total centre of mass, with their velocities, from one analysis.
 
 Nothing is re-derived from the drawing or the report: the engine's frame poses (x_O, y_O,

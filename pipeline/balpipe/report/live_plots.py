@@ -2,8 +2,8 @@
 loads, and the simulation's residuals, tracking errors and free-frame drift) for the interactive
 plots of :mod:`balpipe.draw.live`: a builder per figure kind (:func:`loads`, :func:`efforts`,
 :func:`joints`, :func:`residuals`, :func:`tracking`, :func:`drift`), each giving its
-:class:`~balpipe.draw.live.Curves`. The browser draws them: no matplotlib (issue 23: the three
-simulation figures were 13.5 s of matplotlib in a build of specs/).
+:class:`~balpipe.draw.live.Curves`. The browser draws them: no matplotlib (as matplotlib figures, the
+three simulation figures were 13.5 s of a build of specs/).
 """
 
 from __future__ import annotations

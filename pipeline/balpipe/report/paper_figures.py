@@ -1,4 +1,4 @@
-"""The papers' figures one for one (issue 22): which of a paper's figure numbers a page
+"""The papers' figures one for one: which of a paper's figure numbers a page
 reproduces, read from its figure titles ("Fig. 8 of paper 000", "Figs. 2a, 4a, 6b", "Figs. 3-4"),
 and the panels that the generic pages did not draw as the paper numbers them:
 

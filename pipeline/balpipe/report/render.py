@@ -85,7 +85,7 @@ _UNIT_POWERS = (("kg m^2", "kg m²"), ("/s^2", "/s²"), ("m^2", "m²"))
 def typeset(value):
     """Every value a template writes, with the units of free text (notes, captions, messages,
     which the balancing code writes in the specs' ASCII form 'kg m^2') in their display form,
-    so one page never shows 'kg m^2' beside 'kg m²' (issue 22, point 10). Only plain text:
+    so one page never shows 'kg m^2' beside 'kg m²'. Only plain text:
     markup (drawings, scripts, data) passes unchanged, as does every other value."""
     if not isinstance(value, str) or isinstance(value, markupsafe.Markup) or "^2" not in value:
         return value

@@ -1,5 +1,5 @@
 """Pages of earlier builds in the same output folder: building some specs into an existing site
-keeps the others listed on the index (issue 22).
+keeps the others listed on the index.
 
 A folder of the site with an ``index.html`` and a ``results.json`` that this build did not
 touch is an earlier page. It stays on the index, marked as built earlier, and *stale* when its

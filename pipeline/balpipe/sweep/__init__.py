@@ -1,4 +1,4 @@
-"""Design sweeps over numeric spec fields (issue 13, item 3): ``balpipe sweep SPEC --vary PATH=RANGE``.
+"""Design sweeps over numeric spec fields: ``balpipe sweep SPEC --vary PATH=RANGE``.
 
 A sweep varies fields of one spec (dotted paths, e.g. ``mechanism.crank.mass``), builds every
 design's model and balancing, and analyses the chosen stage (default: the last stage of the

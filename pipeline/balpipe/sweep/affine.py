@@ -1,4 +1,5 @@
-"""Mass-only sweeps without building every design (issue 13, item 3, end-to-end speed).
+"""Mass-only sweeps without building every design: k + 1 designs built for k varied fields,
+the affinity checked against designs built in full.
 
 When the varied fields change only mass parameters at fixed geometry, each design's parameter
 vectors p (chosen stage and unbalanced stage; (m, mx, my, J) per body, as

@@ -52,7 +52,7 @@ Defaults and why (measured with pymunk 7.3.1 on a 2-core machine)
       3 start-up steps at 500 the Scott-Russell "full" stage had a 2 % error at t0). Fixed
       counts do not fit all: the 2R arm diverges at 10 iterations with dead-beat joints, the
       Scott-Russell "full" stage needs 3200 (its moment is 2 % off at 400). Cost of a step
-      (issue 23, pymunk 7.3.1, CPU time): 8 us at 100 iterations on paper 003's arm (a
+      (pymunk 7.3.1, CPU time): 8 us at 100 iterations on paper 003's arm (a
       torque-driven run of 5001 steps in 0.04 s, 0.11 s before the batched state read and the
       drivers' targets and actuators' torques computed before the loop), 0.63 ms at 1600 on
       the 3-RPR with counter-rotations, nearly all of it Chipmunk's solver. Where the solver converges slowly the iterations are what the stage

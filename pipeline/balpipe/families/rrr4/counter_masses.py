@@ -336,7 +336,7 @@ def finder_grid(model: Model, samples: int = 9) -> np.ndarray:
 
 def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Model, stages: list,
                  params: list, notes: list, details: dict, page: bool = True) -> generic.FinderCheck:
-    """The generic condition finder on the model (issue 8): its count, eq. 17's rows and the
+    """The generic condition finder on the model: its count, eq. 17's rows and the
     leg-by-leg design checked against its space, the translating-platform count of the special
     kinematics (with ``page`` only: its parameters, note and details are shown, no stage uses
     it), and (``spec.least_mass``) the least-mass stage after the leg-by-leg one."""

@@ -48,7 +48,7 @@ def conditions_table(study) -> str | None:
 
 def finder_table(study) -> str | None:
     """An HTML table: the generic condition finder's counts beside the paper's, eq. 17's rows in
-    its space, the leg-by-leg and least-mass counter-masses side by side (issue 8)."""
+    its space, the leg-by-leg and least-mass counter-masses side by side."""
     det = study.balance.details
     if "finder" not in det:
         return None

@@ -1,5 +1,5 @@
 """Paper 001's printed conditions against the generic condition finder, and the least-mass
-counter-masses of the 4-RRR (issue 8: the 4-RRR acceptance).
+counter-masses of the 4-RRR: every printed condition is checked to lie in the finder's space.
 
 The finder (:func:`balpipe.balancing.conditions.find`) works on the model's parameters
 ``m[body]``, ``mx[body]``, ``my[body]`` (mass and first moments in the body frame). The 4-RRR's
