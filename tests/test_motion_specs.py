@@ -175,9 +175,7 @@ def test_bad_tables_are_located_errors_through_the_cli(tmp_path, capsys, csv, ro
         assert f"crank.csv:{row}:" in line
 
 
-def test_path_components_of_a_custom_point(tmp_path):
-    """A path feeding two body-coordinate drivers of a custom mechanism (a 2R arm's tip)."""
-    text = """\
+TWO_R_TIP = """\
 name: 2R tip on a polyline
 mechanism:
   template: custom
@@ -201,6 +199,11 @@ motion:
 analysis: {samples: 201}
 validation: {enabled: false}
 """
+
+
+def test_path_components_of_a_custom_point(tmp_path):
+    """A path feeding two body-coordinate drivers of a custom mechanism (a 2R arm's tip)."""
+    text = TWO_R_TIP
     spec, _ = load_text(text, str(tmp_path / "s.yaml"))
     study = run(spec)
     an = study.unbalanced.analysis

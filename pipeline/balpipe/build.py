@@ -29,6 +29,7 @@ from pathlib import Path
 from . import FAMILY_GROUP
 from .runtime import pool
 from .report import history_file
+from .runtime.inputs import MAX_TABLE_BYTES, InputFileError, read_input_text
 from .runtime.fsutil import remove_path, remove_temporaries, tmp_name, write_atomic_dir, write_file_atomic, write_new
 from .site_files.site_earlier import earlier_pages
 from .site_files.spec_files import MAX_SLUG, clash_notes, clashes, find_specs, slug_for  # noqa: F401  (build.find_specs, build.slug_for as before)
@@ -224,9 +225,9 @@ def up_to_date(path: Path, opts: Options) -> dict | None:
         return None
     try:
         text = path.read_text(encoding="utf-8")
-        tables = "".join(f"\0table {f}\0" + (path.parent / f).read_text(encoding="utf-8")
+        tables = "".join(f"\0table {f}\0" + read_input_text(path.parent, f, MAX_TABLE_BYTES, "table")
                          for f in previous.get("input_tables") or [])
-    except (OSError, UnicodeDecodeError, TypeError):
+    except (OSError, UnicodeDecodeError, TypeError, InputFileError):
         return None
     return previous if _mixed_hash(text + tables, target, opts.simulate) == previous["input_hash"] else None
 

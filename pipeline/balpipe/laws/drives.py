@@ -19,6 +19,7 @@ from pydantic import Discriminator, Field, PrivateAttr, Tag
 from .. import units
 from ..model import Law
 from ..motion import PROFILES, PointToPoint, Polynomial, trapezoidal
+from ..runtime.inputs import MAX_TABLE_BYTES, InputFileError, read_input_text  # noqa: F401  (drives.MAX_TABLE_BYTES as before)
 from ..spec_parts import DriveSpec, SpecFieldError, Strict
 from ..units import Angle, Duration, Length, PositiveLength, Rate, RateRate, number
 from . import cycle as cycle_laws
@@ -26,8 +27,6 @@ from . import paths as geometry
 from .periodic import Cam, ConstantSpeed, Fourier, cam_jumps
 from .table import Tabulated, TableError, parse_table
 
-#: largest CSV table read (bytes)
-MAX_TABLE_BYTES = 20_000_000
 #: relative size of a state jump at a join that counts as a jump (of the segment's own scale)
 JOIN_TOLERANCE = 1e-9
 
@@ -534,18 +533,16 @@ def motion_sections(spec: Any):
 
 def read_tables(spec: Any, folder: FilePath) -> None:
     """Read the CSV file of every table drive of ``spec``'s motions (relative to ``folder``, the
-    spec's), keeping its text on the drive; a missing file is a located error."""
+    spec's), keeping its text on the drive. The file is read by
+    :func:`balpipe.runtime.inputs.read_input_text`: only a regular file inside the spec's folder,
+    at most :data:`MAX_TABLE_BYTES`; anything else is a located error that quotes none of it."""
     for root, motion in motion_sections(spec):
         for name, drive in motion.drive.items():
             for sub, d in _tables(drive, root + ("drive", name)):
-                f = folder / d.file
                 try:
-                    if f.stat().st_size > MAX_TABLE_BYTES:
-                        raise SpecFieldError(sub + ("file",), f"the table {d.file!r} is larger than {MAX_TABLE_BYTES // 10**6} MB")
-                    d._text = f.read_text(encoding="utf-8")
-                except (OSError, UnicodeDecodeError) as exc:
-                    reason = getattr(exc, "strerror", None) or str(exc)
-                    raise SpecFieldError(sub + ("file",), f"cannot read the table {d.file!r}: {reason}") from None
+                    d._text = read_input_text(folder, d.file, MAX_TABLE_BYTES, "table")
+                except InputFileError as exc:
+                    raise SpecFieldError(sub + ("file",), str(exc)) from None
 
 
 def table_texts(spec: Any) -> str:

@@ -7,8 +7,10 @@ increasing. The law is a cubic spline through the rows (scipy's ``CubicSpline``,
 (``make_smoothing_spline`` with the given penalty); q' and q'' are the spline's own derivatives,
 so they are consistent with q to round-off. scipy is imported here only, when a table is built.
 
-Errors are :class:`TableError` with the CSV row (1-based, the header is row 1): a missing file,
-a row that is not numbers, times not increasing, a table too coarse for a spline.
+Errors are :class:`TableError` with the CSV row (1-based, the header is row 1): a row that is not
+numbers, times not increasing, a table too coarse for a spline. A message quotes the column
+names (at most 40 characters each) and numbers it parsed, never a row's text: a table's content
+does not reach a message or a published page.
 """
 
 from __future__ import annotations
@@ -59,7 +61,13 @@ def _column(header: list[str], want: str | None, default: int, what: str) -> tup
     for k, (n, u) in enumerate(names):
         if n == want:
             return k, u
-    raise TableError(f"no column {want!r} in the header (columns: {', '.join(n for n, _ in names)})", 1)
+    raise TableError(f"no column {want!r} in the header (columns: {', '.join(_name(n) for n, _ in names)})", 1)
+
+
+def _name(cell: str) -> str:
+    """A column name as a message quotes it: stripped, at most 40 characters."""
+    cell = cell.strip()
+    return cell if len(cell) <= 40 else cell[:39] + "…"
 
 
 def parse_table(text: str, dimension: str, time_column: str | None = None,
@@ -81,18 +89,19 @@ def parse_table(text: str, dimension: str, time_column: str | None = None,
         try:
             factors.append(units.parse(f"1 {unit}", dim))
         except ValueError as exc:
-            raise TableError(f"column {col.strip()!r}: {exc}", head_row) from None
+            raise TableError(f"column {_name(col)!r}: {exc}", head_row) from None
     ts, qs, rows = [], [], []
     for row, cells in lines[1:]:
         try:
             tv, qv = float(cells[it]), float(cells[iv])
         except (ValueError, IndexError):
-            raise TableError(f"expected numbers in the columns {header[it].strip()!r} and {header[iv].strip()!r}, "
-                             f"got {', '.join(cells)[:60]!r}", row) from None
+            # the cells are not quoted: a table's text is never echoed into a message (or a page)
+            raise TableError(f"expected numbers in the columns {_name(header[it])!r} and {_name(header[iv])!r} "
+                             f"(the row has {len(cells)} cell(s))", row) from None
         if not (np.isfinite(tv) and np.isfinite(qv)):
             raise TableError("not a finite number", row)
         if ts and not tv * factors[0] > ts[-1]:
-            raise TableError(f"times must increase: t = {cells[it].strip()} after {ts[-1] / factors[0]:g} on row {rows[-1]}", row)
+            raise TableError(f"times must increase: t = {tv:g} after {ts[-1] / factors[0]:g} on row {rows[-1]}", row)
         ts.append(tv * factors[0])
         qs.append(qv * factors[1])
         rows.append(row)
