@@ -59,8 +59,8 @@ def test_the_issues_counterweight_passes_at_its_precision_and_a_10_percent_error
     assert st.ok, st.problems
     from balpipe.study import stage_metrics
     cw = stage_metrics(st.stages[1], st.stages[0], 1e-9)
-    assert 1e-9 < cw["force_ratio"] <= cw["force_tolerance"] < 1e-4  # not round-off, but within its precision
-    assert "cw.mass = 1.53333 kg" in cw["tolerance_source"]
+    assert 1e-9 < cw.force_ratio <= cw.force_tolerance < 1e-4  # not round-off, but within its precision
+    assert "cw.mass = 1.53333 kg" in cw.tolerance_source
     assert any("judged at the tolerance" in n and "achieved" in n for n in st.balance.notes)
     bad = run(spec(cw=f"{1.53333 * 1.1:.6g} kg"))
     assert not bad.ok and "should cancel the shaking force" in bad.problems[0] and "tolerance" in bad.problems[0]
@@ -98,7 +98,7 @@ def test_computed_designs_keep_1e_9():
     st = run(load_text(text, "s.yaml")[0])
     from balpipe.study import stage_metrics
     m = stage_metrics(st.stages[1], st.stages[0], 1e-9)
-    assert m["force_tolerance"] == 1e-9 and m["tolerance_source"] == "analysis.balance_tolerance" and st.ok
+    assert m.force_tolerance == 1e-9 and m.tolerance_source == "analysis.balance_tolerance" and st.ok
 
 
 def test_build_exit_0_and_results_state_the_tolerance(tmp_path, capsys):

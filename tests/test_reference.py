@@ -32,12 +32,12 @@ def test_balanced_one_stage_spec_has_no_false_failure():
     assert an.max_force < 1e-12 and an.max_moment < 1e-12  # already balanced: round-off
     assert st.problems == []
     m = study.stage_metrics(st.unbalanced, st.unbalanced, 1e-9)
-    assert m["force_ratio"] < 1e-12 and m["moment_ratio"] < 1e-12
+    assert m.force_ratio < 1e-12 and m.moment_ratio < 1e-12
     ref = st.reference
     assert ref.force_basis == "floor" and ref.moment_basis == "floor"
     assert ref.force == pytest.approx(FLOOR_FRACTION * ref.force_scale)
     assert st.checks["reactions_vs_momentum"] < 1e-9
-    assert m["force_balanced"] and m["moment_balanced"]
+    assert m.force_balanced and m.moment_balanced
     assert st.checks["reference"]["force_basis"] == "floor"
 
 

@@ -359,8 +359,8 @@ def test_idler_loop_reproduces_the_paper(idler):
     m = {s.stage.name: study.stage_metrics(s, idler.unbalanced, TOL) for s in idler.stages}
     assert idler.unbalanced.analysis.max_force == pytest.approx(34.39, abs=0.01)
     assert idler.unbalanced.analysis.max_moment == pytest.approx(1.439, abs=0.001)
-    assert abs(m["counterweights"]["moment_ratio"] - 17) <= 0.5
-    assert m["counter_rotations"]["force_ratio"] <= TOL and m["counter_rotations"]["moment_ratio"] <= TOL
+    assert abs(m["counterweights"].moment_ratio - 17) <= 0.5
+    assert m["counter_rotations"].force_ratio <= TOL and m["counter_rotations"].moment_ratio <= TOL
     assert idler.ok and all(r["status"] == "agrees" for r in idler.references)
 
 

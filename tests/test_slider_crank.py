@@ -155,8 +155,8 @@ def test_with_gravity_a_force_balanced_stage_keeps_exactly_its_weight(rng):
     st = study.run(slider_crank_spec(rng, gravity=True))
     m = study.stage_metrics(st.stages[1], st.stages[0], 1e-9)
     weight = st.stages[1].stage.model.total_mass() * 9.80665
-    assert m["force_balanced"] and m["max_inertial_force"] <= 1e-9 * st.stages[0].analysis.max_inertial_force
-    assert m["max_shaking_force"] == pytest.approx(weight, rel=1e-12)
+    assert m.force_balanced and m.max_inertial_force <= 1e-9 * st.stages[0].analysis.max_inertial_force
+    assert m.max_shaking_force == pytest.approx(weight, rel=1e-12)
 
 
 # --- issue 7, item 1: the slider translates, so its centre-of-mass offset drops out of eq. 15 ---

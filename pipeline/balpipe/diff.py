@@ -21,7 +21,7 @@ from typing import Any
 from . import runner
 from .loader import LoadedSpec, SpecError, SpecErrors, load, load_text
 from .report.results import json_safe
-from .study import Study, stage_metrics
+from .study import Study
 
 ROUND_OFF = 1e-9  # ratios to the unbalanced peak below this are cancelled loads
 # readable names and units of the stage results (the JSON keeps the keys)
@@ -161,14 +161,13 @@ def compare(a: Side, b: Side) -> dict:
         row = _change(x.value if x else None, y.value if y else None)
         row.update({"name": name, "unit": (x or y).unit, "source": (x or y).source})
         params.append(row)
-    tol_a, tol_b = a.loaded.spec.analysis.balance_tolerance, b.loaded.spec.analysis.balance_tolerance
-    ma = {s.stage.name: stage_metrics(s, a.study.reference_stage(s), tol_a, a.loaded.spec.analysis.claim_tolerance) for s in a.study.stages}
-    mb = {s.stage.name: stage_metrics(s, b.study.reference_stage(s), tol_b, b.loaded.spec.analysis.claim_tolerance) for s in b.study.stages}
+    ma = {s.stage.name: s.metrics for s in a.study.stages}
+    mb = {s.stage.name: s.metrics for s in b.study.stages}
     stages = []
     for name in list(ma) + [n for n in mb if n not in ma]:
         row: dict[str, Any] = {"name": name}
         for key in STAGE_KEYS:
-            row[key] = _change(ma.get(name, {}).get(key), mb.get(name, {}).get(key))
+            row[key] = _change(*(getattr(m[name], key) if name in m else None for m in (ma, mb)))
         va = next((s.validation for s in a.study.stages if s.stage.name == name), None)
         vb = next((s.validation for s in b.study.stages if s.stage.name == name), None)
         if va is not None or vb is not None:

@@ -4,7 +4,7 @@ checks and references. No files are written here (see :mod:`balpipe.build`)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -29,6 +29,15 @@ class StageResult:
     added_inertia: float
     validation: Any = None  # balpipe.validate.StageValidation, when simulated
     torque: Any = None  # balpipe.validate.torque.TorqueDriven, when simulated
+    _metrics: StageMetrics | None = field(default=None, repr=False)  # set once by run()
+
+    @property
+    def metrics(self) -> StageMetrics:
+        """The stage's peaks, ratios, claim and costs, computed once by :func:`run`: what
+        ``results.json``, the pages and ``balpipe diff`` read."""
+        if self._metrics is None:
+            raise RuntimeError(f"stage {self.stage.name!r}: its metrics are computed by balpipe.study.run")
+        return self._metrics
 
     @property
     def max_effort(self) -> float:
@@ -124,7 +133,52 @@ def ratio_reference(unbalanced: StageResult) -> LoadReference:
     return load_reference(unbalanced.stage.model, unbalanced.analysis)
 
 
-def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float, overrides: dict | None = None) -> dict:
+@dataclass(frozen=True)
+class StageMetrics:
+    """Peaks, ratios, claim and costs of one stage, computed once by :func:`run` (see
+    :func:`stage_metrics`) and read by ``results.json``, the pages and ``balpipe diff``. The
+    field names are the keys of a stage's row in ``results.json`` (:meth:`to_json`);
+    ``reference_loads`` (the denominators of the ratios) is not one of them."""
+
+    name: str
+    label: str
+    description: str
+    balances: str
+    headline: bool
+    max_shaking_force: float
+    max_shaking_moment: float
+    max_inertial_force: float
+    max_inertial_moment: float
+    force_ratio: float
+    moment_ratio: float
+    force_balanced: bool
+    moment_balanced: bool
+    force_tolerance: float
+    moment_tolerance: float
+    tolerance_source: str
+    max_actuator_effort: float
+    added_mass: float
+    added_inertia: float
+    reactions_vs_momentum_force: float
+    reactions_vs_momentum_moment: float
+    realisable: bool
+    not_realisable: str
+    not_realisable_parts: str
+    reference: str
+    reference_loads: LoadReference = field(repr=False, compare=False)
+
+    def to_json(self) -> dict[str, Any]:
+        """The stage's row of ``results.json`` (``stages[]``)."""
+        return {f.name: getattr(self, f.name) for f in fields(self) if f.name != "reference_loads"}
+
+    def number(self, key: str) -> float | None:
+        """The row's field ``key`` as a float, None when it is not a number (a reference's
+        ``stage.metric``)."""
+        value = self.to_json().get(key)
+        return float(value) if isinstance(value, (int, float)) else None
+
+
+def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float, overrides: dict | None = None) -> StageMetrics:
     """Peaks, ratios and balance of one stage. Ratios and the balance criterion use the inertial
     part of the loads (the shaking loads less the moving links' weight and its moment, which a
     force-balanced mechanism keeps constant); without gravity that is the loads themselves.
@@ -138,48 +192,49 @@ def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float, override
     F, M = sr.analysis.max_inertial_force, sr.analysis.max_inertial_moment
     df, dm = sr.analysis.route_difference()
     not_realisable = realisable.verdict(sr.stage.model)
-    return {
-        "name": sr.stage.name,
-        "label": sr.stage.label,
-        "description": sr.stage.description,
-        "balances": sr.stage.balances,
-        "headline": sr.stage.headline,
-        "max_shaking_force": sr.analysis.max_force,
-        "max_shaking_moment": sr.analysis.max_moment,
-        "max_inertial_force": F,
-        "max_inertial_moment": M,
-        "force_ratio": F / F0 if F0 > 0 else 0.0,
-        "moment_ratio": M / M0 if M0 > 0 else 0.0,
-        "force_balanced": F <= claim["force"] * F0,
-        "moment_balanced": M <= claim["moment"] * M0,
-        "force_tolerance": claim["force"],
-        "moment_tolerance": claim["moment"],
-        "tolerance_source": claim["source"],
-        "max_actuator_effort": sr.max_effort,
-        "added_mass": sr.added_mass,
-        "added_inertia": sr.added_inertia,
-        "reactions_vs_momentum_force": df / F0 if F0 > 0 else df,
-        "reactions_vs_momentum_moment": dm / M0 if M0 > 0 else dm,
-        "realisable": not not_realisable,
-        "not_realisable": not_realisable,
-        "not_realisable_parts": realisable.details(sr.stage.model),
-        "reference": unbalanced.stage.name,
-    }
+    return StageMetrics(
+        name=sr.stage.name,
+        label=sr.stage.label,
+        description=sr.stage.description,
+        balances=sr.stage.balances,
+        headline=sr.stage.headline,
+        max_shaking_force=sr.analysis.max_force,
+        max_shaking_moment=sr.analysis.max_moment,
+        max_inertial_force=F,
+        max_inertial_moment=M,
+        force_ratio=F / F0 if F0 > 0 else 0.0,
+        moment_ratio=M / M0 if M0 > 0 else 0.0,
+        force_balanced=F <= claim["force"] * F0,
+        moment_balanced=M <= claim["moment"] * M0,
+        force_tolerance=claim["force"],
+        moment_tolerance=claim["moment"],
+        tolerance_source=claim["source"],
+        max_actuator_effort=sr.max_effort,
+        added_mass=sr.added_mass,
+        added_inertia=sr.added_inertia,
+        reactions_vs_momentum_force=df / F0 if F0 > 0 else df,
+        reactions_vs_momentum_moment=dm / M0 if M0 > 0 else dm,
+        realisable=not not_realisable,
+        not_realisable=not_realisable,
+        not_realisable_parts=realisable.details(sr.stage.model),
+        reference=unbalanced.stage.name,
+        reference_loads=ref,
+    )
 
 
-def _lookup(name: str, balance: BalanceResult, metrics: list[dict]) -> float | None:
+def _lookup(name: str, balance: BalanceResult, metrics: list[StageMetrics]) -> float | None:
     for p in balance.parameters:
         if p.name == name:
             return p.value
     if "." in name:
         stage, key = name.split(".", 1)
         for m in metrics:
-            if m["name"] == stage and isinstance(m.get(key), (int, float)):
-                return float(m[key])
+            if m.name == stage and m.number(key) is not None:
+                return m.number(key)
     return None
 
 
-def compare_references(spec: Spec, balance: BalanceResult, metrics: list[dict]) -> list[dict]:
+def compare_references(spec: Spec, balance: BalanceResult, metrics: list[StageMetrics]) -> list[dict]:
     """Published vs computed: 'agrees' within the reference's relative tolerance (and the
     rounding of the printed digits), 'differs' otherwise, 'unknown' if nothing computes it."""
     out = []
@@ -253,23 +308,26 @@ def run(spec: Spec, page: bool = True) -> Study:
         if name not in {s.stage.name for s in stages}:
             raise SpecFieldError(("analysis", "claim_tolerance", name),
                                  f"no stage {name!r} (stages: {', '.join(s.stage.name for s in stages)})")
-    metrics = [stage_metrics(s, reference_of(stages, s), tol, overrides) for s in stages]
+    for s in stages:
+        s._metrics = stage_metrics(s, reference_of(stages, s), tol, overrides)
+    metrics = [s.metrics for s in stages]
     if balance.derived is not None and (page or spec.references):  # the page's, and what a reference may name
         balance.parameters.extend(balance.derived(stages))
     problems = []
-    rvm = max(max(m["reactions_vs_momentum_force"], m["reactions_vs_momentum_moment"]) for m in metrics)
+    rvm = max(max(m.reactions_vs_momentum_force, m.reactions_vs_momentum_moment) for m in metrics)
     if not rvm <= 1e-9 or not math.isfinite(rvm):
         problems.append(f"reactions and momentum disagree by {rvm:.3g} of the reference load (limit 1e-9)")
     for m in metrics:
+        row = m.to_json()
         for what in ("force", "moment"):
-            if what in m["balances"] and not m[f"{what}_balanced"]:
-                problems.append(f"stage {m['name']!r} should cancel the shaking {what} but keeps {m[f'{what}_ratio']:.3g} "
-                                f"of it (tolerance {m[f'{what}_tolerance']:.3g}: {m['tolerance_source']})")
-        claimed = [w for w in ("force", "moment") if w in m["balances"]]
-        if claimed and m["tolerance_source"] != "analysis.balance_tolerance":
-            balance.notes.append(f"Stage {m['label']!r}: its claim is judged at the tolerance " + ", ".join(
-                f"{m[f'{w}_tolerance']:.3g} of the reference {w} (achieved {m[f'{w}_ratio']:.3g})" for w in claimed)
-                + f", set by the {m['tolerance_source']}" + ("" if m["tolerance_source"] == "spec" else
+            if what in m.balances and not row[f"{what}_balanced"]:
+                problems.append(f"stage {m.name!r} should cancel the shaking {what} but keeps {row[f'{what}_ratio']:.3g} "
+                                f"of it (tolerance {row[f'{what}_tolerance']:.3g}: {m.tolerance_source})")
+        claimed = [w for w in ("force", "moment") if w in m.balances]
+        if claimed and m.tolerance_source != "analysis.balance_tolerance":
+            balance.notes.append(f"Stage {m.label!r}: its claim is judged at the tolerance " + ", ".join(
+                f"{row[f'{w}_tolerance']:.3g} of the reference {w} (achieved {row[f'{w}_ratio']:.3g})" for w in claimed)
+                + f", set by the {m.tolerance_source}" + ("" if m.tolerance_source == "spec" else
                 " (each rounded at its last digit, the worst case carried through the loads)") + ".")
     max_condition = near_singular_note(stages, balance, problems) if page else None
     redundant = max(int(s.analysis.extra.get("redundant_actuators", 0)) for s in stages)

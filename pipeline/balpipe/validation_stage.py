@@ -8,7 +8,7 @@ from dataclasses import dataclass, field, replace
 
 from .runtime import pool
 from .cache import simulation as sim_cache
-from .study import Study, ratio_reference
+from .study import Study
 from .validate import FreeFloating, ValidationSettings, free_floating, validate
 from .validate.run import model_scale
 from .validate.torque import torque_driven
@@ -91,7 +91,7 @@ def _stage_runs(k: int, study: Study):
     stage's ratios)."""
     settings = settings_for(study)
     s = study.stages[k]
-    ref = ratio_reference(study.reference_stage(s))
+    ref = s.metrics.reference_loads
     F0, M0 = ref.force_peak, ref.moment_peak
     expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
     model = simulated_model(s.stage.model)

@@ -5,10 +5,9 @@ from __future__ import annotations
 import markupsafe
 import numpy as np
 
-from ..mechanics import realisable
 from ..balancing.base import in_style_order, styled
 from ..laws.drives import law_names
-from ..study import Study, ratio_reference
+from ..study import Study
 from ..draw import extremes, figures, labels, live, sleeves
 from . import citations, live_plots, paper_figures, partial_figures, present, sections, toc
 from .design_card import design_card
@@ -136,7 +135,7 @@ def residual_rows(study: Study, stages: list) -> tuple[list, str]:
     rows = []
     for s in stages:
         rs = study.reference_stage(s)
-        ref = ratio_reference(rs)
+        ref = s.metrics.reference_loads
         refs.setdefault(rs.stage.name, (rs.stage.label, ref, []))[2].append(s.stage.label)
         rows.append((s.stage.label, s.validation.t, s.validation.force_error, s.validation.moment_error,
                      ref.force, ref.moment))
@@ -175,7 +174,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                 "dt": v.dt, "steps": v.steps, "iterations": v.iterations, "tolerance": v.tolerance,
                 "reasons": "; ".join(v.reasons), "notes": "; ".join(v.notes),
                 "excluded": v.excluded_samples, "version": v.pymunk_version,
-                "not_realisable": realisable.verdict(s.stage.model),
+                "not_realisable": s.metrics.not_realisable,
             })
     torque_rows = []
     for s in study.stages:

@@ -10,7 +10,7 @@ import numpy as np
 
 from .. import __version__
 from ..mechanics.motion_outputs import motion_columns
-from ..study import Study, stage_metrics
+from ..study import Study
 from . import present
 from .notation_table import names_for
 from .verdict import verdict
@@ -38,11 +38,7 @@ def json_safe(x: Any) -> Any:
 
 def results_dict(study: Study, source: str, input_hash: str, simulated: bool) -> dict:
     spec = study.spec
-    tol = spec.analysis.balance_tolerance
-    stages = []
-    for s in study.stages:
-        m = stage_metrics(s, study.reference_stage(s), tol, spec.analysis.claim_tolerance)
-        stages.append(m)
+    stages = [s.metrics.to_json() for s in study.stages]
     validation = {}
     for s in study.stages:
         if s.validation is not None:
@@ -75,7 +71,7 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
         "torque_driven": {s.stage.name: s.torque.to_json() for s in study.stages if s.torque is not None}
         if simulated else None,
     }
-    out["comparison"] = comparison(study, stages)
+    out["comparison"] = comparison(study)
     # what balancing costs a motor: peak, RMS effort and peak power per stage and driver
     out["actuators"] = present.effort_rows(
         [(s.stage.name, s.stage.label, s.stage.model, s.analysis) for s in study.stages])
@@ -98,26 +94,27 @@ def verdict_of(study: Study, out: dict) -> dict:
     return verdict(out, weights)
 
 
-def comparison(study: Study, metrics: list[dict]) -> dict:
+def comparison(study: Study) -> dict:
     """Every stage (the main design's and those of ``compare``) side by side: what it adds and
     what it costs. Joint loads are the peak bearing load over the revolute joints (and the
     normal force of prismatic pairs), with the joint that carries it."""
     table = joint_load_table(study)
     rows = []
     before: dict[str, float] = {}  # per design: peak moment of its latest stage without counter-rotations
-    for s, m in zip(study.stages, metrics):
+    for s in study.stages:
+        m = s.metrics
         loads = [(row["peaks"].get(s.stage.name, 0.0), row["joint"]) for row in table if row["unit"] == "N"]
         peak, joint = max(loads) if loads else (0.0, "")
         design, _, stage = s.stage.name.rpartition(":")
         discs = counter_rotations(s.stage.model, study.unbalanced.stage.model)
         if discs == 0:
-            before[design or "main"] = m["max_shaking_moment"]
+            before[design or "main"] = m.max_shaking_moment
         rows.append({
             "stage": s.stage.name, "label": s.stage.label, "design": design or "main", "balances": s.stage.balances,
-            "added_mass": m["added_mass"], "added_inertia": m["added_inertia"],
-            "max_actuator_effort": m["max_actuator_effort"], "max_joint_load": peak, "max_joint_load_joint": joint,
-            "max_shaking_force": m["max_shaking_force"], "max_shaking_moment": m["max_shaking_moment"],
-            "force_ratio": m["force_ratio"], "moment_ratio": m["moment_ratio"],
+            "added_mass": m.added_mass, "added_inertia": m.added_inertia,
+            "max_actuator_effort": m.max_actuator_effort, "max_joint_load": peak, "max_joint_load_joint": joint,
+            "max_shaking_force": m.max_shaking_force, "max_shaking_moment": m.max_shaking_moment,
+            "force_ratio": m.force_ratio, "moment_ratio": m.moment_ratio,
             "counter_rotations": discs,
             "moment_before_counter_rotations": before.get(design or "main", study.unbalanced.analysis.max_moment),
         })

@@ -1,7 +1,7 @@
 """Did balancing work, and what did it cost? The ``verdict`` object of ``results.json``.
 
 "Built and cross-checked" (the build's status, the validation) says nothing about whether a
-stage balanced anything. This module reads a study's result rows (:func:`balpipe.study.stage_metrics`:
+stage balanced anything. This module reads a study's result rows (:class:`balpipe.study.StageMetrics` as results.json writes them:
 peaks and ratios of the *inertial* loads to the stage's reference, the stage's claim) and says,
 per stage and per spec, for the force and for the moment each: *cancelled* (at most the balance
 tolerance of the reference), *reduced by x*, *unchanged* (within :data:`UNCHANGED`) or
