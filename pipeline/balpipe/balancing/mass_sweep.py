@@ -28,9 +28,9 @@ import numpy as np
 
 from .regressor import dynamics_regressor, parameters, shaking_regressor, states_from_analysis
 from ..engine import analyse, compile_model, jacobian
-from ..engine.compile import rotate
 from ..engine.constraints import with_frame
 from ..engine.dynamics import joint_reactions, solve_multipliers, radial_tooth_loads, tooth_rows
+from ..mechanics.planar import rotate
 from ..model import Model
 
 CHUNK = 512  # designs per block of the batched products (bounds the memory: CHUNK x N x rows)

@@ -32,6 +32,7 @@ import numpy as np
 from ..engine import Compiled, compile_model, jacobian, solve_positions
 from ..engine.constraints import with_frame
 from ..engine.positions import newton_raphson
+from ..mechanics.planar import cross
 from ..model import Law, Model
 
 MIN_CONDITION = 1e-7  # smallest / largest singular value of a kept configuration's Jacobian
@@ -238,10 +239,6 @@ def _columns(states: States, point: tuple[float, float] = (0.0, 0.0)):
     return r, rd, e1, e2, de1, de2, w
 
 
-def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
-
-
 def linear_regressor(states: States) -> np.ndarray:
     """Y_P (2 S, 3 nb): rows Px, Py per sample, columns m, mx, my per body."""
     r, rd, e1, e2, de1, de2, w = _columns(states)
@@ -253,7 +250,7 @@ def linear_regressor(states: States) -> np.ndarray:
 def angular_regressor(states: States, point: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
     """Y_H (S, 4 nb): angular momentum about ``point``, columns m, mx, my, J per body."""
     r, rd, e1, e2, de1, de2, w = _columns(states, point)
-    cols = [_cross(r, rd), _cross(r, de1) + _cross(e1, rd), _cross(r, de2) + _cross(e2, rd), w]
+    cols = [cross(r, rd), cross(r, de1) + cross(e1, rd), cross(r, de2) + cross(e2, rd), w]
     S, nb = w.shape
     return np.stack(cols, axis=2).reshape(S, 4 * nb)
 
@@ -317,9 +314,9 @@ def shaking_regressor(states: States, gravity: tuple[float, float] = (0.0, 0.0),
     gS = np.broadcast_to(g, rdd.shape)
     YF = np.stack([gS - rdd, -dde1, -dde2, np.zeros_like(rdd)], axis=2)  # (S, nb, 4, 2)
     YM = np.stack([
-        _cross(r, gS) - _cross(r, rdd),
-        _cross(e1, gS) - _cross(r, dde1) - _cross(e1, rdd),
-        _cross(e2, gS) - _cross(r, dde2) - _cross(e2, rdd),
+        cross(r, gS) - cross(r, rdd),
+        cross(e1, gS) - cross(r, dde1) - cross(e1, rdd),
+        cross(e2, gS) - cross(r, dde2) - cross(e2, rdd),
         -al,
     ], axis=2)  # (S, nb, 4)
     return np.transpose(YF, (0, 3, 1, 2)).reshape(S, 2, 4 * nb), YM.reshape(S, 4 * nb)
@@ -342,7 +339,7 @@ def dynamics_regressor(states: States, gravity: tuple[float, float] = (0.0, 0.0)
         Y[:, k, 0:2, k, 0] = a[:, k]
         Y[:, k, 0:2, k, 1] = dde1[:, k]
         Y[:, k, 0:2, k, 2] = dde2[:, k]
-        Y[:, k, 2, k, 1] = _cross(e1[:, k], a[:, k])
-        Y[:, k, 2, k, 2] = _cross(e2[:, k], a[:, k])
+        Y[:, k, 2, k, 1] = cross(e1[:, k], a[:, k])
+        Y[:, k, 2, k, 2] = cross(e2[:, k], a[:, k])
         Y[:, k, 2, k, 3] = al[:, k]
     return Y.reshape(S, 3 * nb, 4 * nb)

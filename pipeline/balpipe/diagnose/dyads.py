@@ -22,6 +22,7 @@ import numpy as np
 from ..engine import Compiled, jacobian
 from ..engine.constraints import with_frame
 from ..engine.structure import maximum_matching, strong_components
+from ..mechanics.planar import world_point
 from ..model import FRAME, Model, Revolute
 
 
@@ -125,9 +126,7 @@ def end_points(model: Model, d: Dyad, frame_pose: dict[str, np.ndarray]) -> tupl
             n = len(next(iter(frame_pose.values())))
             out.append(np.broadcast_to(p, (n, 2)).copy())
             continue
-        pose = frame_pose[other]
-        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
-        out.append(np.stack([pose[:, 0] + c * p[0] - s * p[1], pose[:, 1] + s * p[0] + c * p[1]], axis=1))
+        out.append(world_point(frame_pose[other], p))
     return out[0], out[1]
 
 

@@ -19,6 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.layout_engine import PlaceHolderLayoutEngine  # noqa: E402
 
+from ..mechanics.planar import world_point  # noqa: E402
 from ..model import Model  # noqa: E402
 from ..cache import figures as cache
 from . import extremes  # noqa: E402
@@ -182,12 +183,6 @@ def effort_axis(unit: str) -> str:
     return {"N m": "torque (N m)", "N": "force (N)"}.get(unit, "effort")
 
 
-def _global_point(pose, p) -> np.ndarray:
-    x, y, th = pose
-    c, s = math.cos(th), math.sin(th)
-    return np.array([x + c * p[0] - s * p[1], y + s * p[0] + c * p[1]])
-
-
 def mechanism_figure(model: Model, analysis, ghosts: list[int] | None = None, prefix: str = "mech",
                      title: str = "", limits: tuple[float, float, float, float] | None = None,
                      numbers: dict[str, str] | None = None, texts: dict[str, str] | None = None) -> str:
@@ -234,25 +229,25 @@ def _draw_pose(panel: Panel, model: Model, pose_row: np.ndarray, span: float, ma
     for i, b in enumerate(model.bodies):
         pose = pose_row[i]
         if b.radius:
-            centre, edge = _global_point(pose, (0, 0)), _global_point(pose, (b.radius, 0))
+            centre, edge = world_point(pose, (0, 0)), world_point(pose, (b.radius, 0))
             panel.circle(centre, b.radius, edge=GREEN, alpha=a, width=1.2, z=z)
             panel.line([centre[0], edge[0]], [centre[1], edge[1]], GREEN, alpha=a, width=0.8, z=z)
         if b.kind == "slider" and b.name not in guided:
-            c = _global_point(pose, (0, 0))
+            c = world_point(pose, (0, 0))
             w = 0.06 * span
             panel.polygon([c + d for d in ((-w, -w / 2), (w, -w / 2), (w, w / 2), (-w, w / 2))], fill=look["fill"],
                           edge=look["edge"], z=z)
         for att in b.attachments:
             if att.kind == "counterweight":
-                g = np.array([_global_point(pose, p) for p in
+                g = np.array([world_point(pose, p) for p in
                               (b.points[b.outline[0]] if b.outline else (0, 0), att.position)])
                 panel.line(g[:, 0], g[:, 1], RED, alpha=a, width=1.5, z=z)
                 r = 0.035 * span * math.sqrt(att.mass / max_cw)
-                panel.circle(_global_point(pose, att.position), r, fill=RED, edge=RED, alpha=0.6 * a, z=z)
+                panel.circle(world_point(pose, att.position), r, fill=RED, edge=RED, alpha=0.6 * a, z=z)
             elif att.radius:
-                panel.circle(_global_point(pose, att.position), att.radius, edge=GREEN, alpha=a, z=z)
+                panel.circle(world_point(pose, att.position), att.radius, edge=GREEN, alpha=a, z=z)
     # links (a guide's under its sleeve), the sleeves, the rods sliding in them (thinner), joints on top
-    outlines = [(b.name in guided, np.array([_global_point(pose_row[i], b.points[p]) for p in b.outline]))
+    outlines = [(b.name in guided, np.array([world_point(pose_row[i], b.points[p]) for p in b.outline]))
                 for i, b in enumerate(model.bodies) if len(b.outline) >= 2]
     cls = "link" if look is SOLID else ""
     for g in (g for rod, g in outlines if not rod):
@@ -352,21 +347,21 @@ def name_requests(model: Model, pose_row: np.ndarray, span: float, max_cw: float
     for i, b in enumerate(model.bodies):
         pose = pose_row[i]
         if b.kind == "slider" and b.name not in guided:
-            keep.append((_global_point(pose, (0, 0)), 0.06 * span))  # the slider's block
+            keep.append((world_point(pose, (0, 0)), 0.06 * span))  # the slider's block
         if b.radius:
-            rim = _global_point(pose, (0, 0)) + b.radius * np.array([math.sqrt(0.5), math.sqrt(0.5)])
+            rim = world_point(pose, (0, 0)) + b.radius * np.array([math.sqrt(0.5), math.sqrt(0.5)])
             gears.append((numbers.get(b.name, b.name), rim, "gear"))
         for a in b.attachments:
-            c = _global_point(pose, a.position)
+            c = world_point(pose, a.position)
             if a.kind == "counterweight":
                 cws.append((a.name, c, "counterweight"))
                 keep.append((c, disc * span * math.sqrt(a.mass / max_cw)))
-                root = _global_point(pose, b.points[b.outline[0]] if b.outline else (0, 0))
+                root = world_point(pose, b.points[b.outline[0]] if b.outline else (0, 0))
                 segs.append((root, c))
             elif a.radius:
                 gears.append((numbers.get(a.name, a.name), c + a.radius * np.array([math.sqrt(0.5), math.sqrt(0.5)]),
                               "gear"))
-        pts = [_global_point(pose, b.points[p]) for p in b.outline]
+        pts = [world_point(pose, b.points[p]) for p in b.outline]
         segs += list(zip(pts[:-1], pts[1:]))
         if len(pts) >= 2:
             unique = [q for k, q in enumerate(pts) if not any(np.allclose(q, r) for r in pts[:k])]

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..mechanics.planar import world_point
 from ..model import Model
 
 Box = tuple[float, float, float, float]  # x0, y0, x1, y1 (y up)
@@ -233,10 +234,9 @@ def point_places(model: Model, pose_row, span: float) -> list[tuple[str, np.ndar
     for i, b in enumerate(model.bodies):
         if b.kind == "gear" and b.radius:
             continue
-        x, y, th = (float(v) for v in pose_row[i])
-        c, s = math.cos(th), math.sin(th)
+        pose = tuple(float(v) for v in pose_row[i])
         for name, p in b.points.items():
-            g = np.array([x + c * p[0] - s * p[1], y + s * p[0] + c * p[1]])
+            g = world_point(pose, p)
             key = place_key(g, span)
             if key in pivots:
                 continue

@@ -23,18 +23,13 @@ import math
 
 import numpy as np
 
+from ..mechanics.planar import world_point
 from ..model import Model, Prismatic
 
 
 def _local_points(body) -> list[tuple[float, float]]:
     names = body.outline if len(body.outline) >= 2 else tuple(body.points)
     return [tuple(body.points[n]) for n in names] or [(0.0, 0.0)]
-
-
-def _to_global(pose, p) -> np.ndarray:
-    x, y, th = pose
-    c, s = math.cos(th), math.sin(th)
-    return np.array([x + c * p[0] - s * p[1], y + s * p[0] + c * p[1]])
 
 
 def _to_local(pose, q: np.ndarray) -> np.ndarray:
@@ -65,8 +60,8 @@ def sleeves(model: Model, pose_row: np.ndarray) -> list[tuple[np.ndarray, np.nda
         u = np.array(j.axis, dtype=float) / math.hypot(*j.axis)
         o = np.array(j.point_guide, dtype=float)
         own = [float(np.dot(np.array(p) - o, u)) for p in _local_points(model.bodies[g])]
-        rod = [float(np.dot(_to_local(pose_row[g], _to_global(pose_row[s], p)) - o, u))
+        rod = [float(np.dot(_to_local(pose_row[g], world_point(pose_row[s], p)) - o, u))
                for p in _local_points(model.bodies[s])]
         lo, hi = min(min(own), max(rod)), max(max(own), min(rod))
-        out.append((_to_global(pose_row[g], o + lo * u), _to_global(pose_row[g], o + hi * u)))
+        out.append((world_point(pose_row[g], o + lo * u), world_point(pose_row[g], o + hi * u)))
     return out

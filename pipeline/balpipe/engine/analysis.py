@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..mechanics.planar import cross
 from ..model import Model
 from . import fastpath, shared, structure
 from .compile import Compiled, compile_model
@@ -249,7 +250,6 @@ def analyse(
     qb, vb, ab = q.reshape(-1, nb, 3), v.reshape(-1, nb, 3), a.reshape(-1, nb, 3)
     m, I = c.mass, c.inertia
     r, rd, rdd = qb[:, :, :2], vb[:, :, :2], ab[:, :, :2]
-    cross = lambda u, w: u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]  # noqa: E731
     dP = np.einsum("k,nkd->nd", m, rdd)
     dH = np.einsum("k,nk->n", m, cross(r, rdd)) + ab[:, :, 2] @ I
     weight = m.sum() * g

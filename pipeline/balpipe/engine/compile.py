@@ -19,15 +19,6 @@ def _perp(v: np.ndarray) -> np.ndarray:
     return out
 
 
-def rotate(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """A(theta) s for theta (N,), s (2,) -> (N, 2)."""
-    c, si = np.cos(theta), np.sin(theta)
-    out = np.empty(theta.shape + (2,))
-    out[..., 0] = c * s[0] - si * s[1]
-    out[..., 1] = si * s[0] + c * s[1]
-    return out
-
-
 @dataclass
 class _Coincident:
     owner: str

@@ -8,7 +8,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .compile import Compiled, _Angle, _Coincident, _perp, rotate
+from ..mechanics.planar import rotate
+from .compile import Compiled, _Angle, _Coincident, _perp
 
 
 def _split(q: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -66,7 +67,7 @@ def residual(c: Compiled, qx: np.ndarray, t: np.ndarray, laws: list | None = Non
     out = np.empty((qx.shape[0], len(c.row_owner)))
     if rev is not None:
         ri, rj = qx[:, rev.xi], qx[:, rev.xj]
-        Ai, Aj = _rotate_all(qx[:, rev.ti], rev.si), _rotate_all(qx[:, rev.tj], rev.sj)
+        Ai, Aj = rotate(qx[:, rev.ti], rev.si), rotate(qx[:, rev.tj], rev.sj)
         out[:, rev.rows] = ri + Ai - rj - Aj
     row = 0
     for p, f in zip(c.prims, laws):
@@ -101,8 +102,8 @@ def jacobian(c: Compiled, qx: np.ndarray) -> np.ndarray:
         for a, r in ((0, r0), (1, r1)):
             J[:, r, rev.xi[:, a]] = 0.0 + 1.0
             J[:, r, rev.xj[:, a]] = 0.0 - 1.0
-        Pi = _perp(_rotate_all(qx[:, rev.ti], rev.si))
-        Pj = _perp(_rotate_all(qx[:, rev.tj], rev.sj))
+        Pi = _perp(rotate(qx[:, rev.ti], rev.si))
+        Pj = _perp(rotate(qx[:, rev.tj], rev.sj))
         J[:, r0, rev.ti] = 0.0 + Pi[..., 0]
         J[:, r1, rev.ti] = 0.0 + Pi[..., 1]
         J[:, r0, rev.tj] = 0.0 - Pj[..., 0]
@@ -176,16 +177,6 @@ def _revolute_rows(prims: list) -> RevoluteRows | None:
                         np.array([p.sj for p in idx], dtype=float))
 
 
-def _rotate_all(theta: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """A(theta_k) s_k for theta (N, K), s (K, 2) -> (N, K, 2): :func:`.compile.rotate` of every
-    joint at once (the same operations)."""
-    c, si = np.cos(theta), np.sin(theta)
-    out = np.empty(theta.shape + (2,))
-    out[..., 0] = c * s[:, 0] - si * s[:, 1]
-    out[..., 1] = si * s[:, 0] + c * s[:, 1]
-    return out
-
-
 def velocity_rhs(c: Compiled, t: np.ndarray, laws: list | None = None) -> np.ndarray:
     """nu = -Phi_t, shape (N, m). ``laws``: :func:`law_triples` at ``t`` (evaluated when not given)."""
     out = []
@@ -205,7 +196,7 @@ def acceleration_rhs(c: Compiled, qx: np.ndarray, vx: np.ndarray, t: np.ndarray,
     out = np.empty((qx.shape[0], len(c.row_owner)))
     if rev is not None:
         wi, wj = vx[:, rev.ti], vx[:, rev.tj]
-        Ai, Aj = _rotate_all(qx[:, rev.ti], rev.si), _rotate_all(qx[:, rev.tj], rev.sj)
+        Ai, Aj = rotate(qx[:, rev.ti], rev.si), rotate(qx[:, rev.tj], rev.sj)
         out[:, rev.rows] = (wi**2)[..., None] * Ai - (wj**2)[..., None] * Aj
     row = 0
     for k, p in enumerate(c.prims):

@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import Model, Prismatic, Revolute
-from .compile import Compiled, _perp, rotate
+from ..mechanics.planar import cross, rotate
+from .compile import Compiled, _perp
 from .constraints import _split
 from .errors import AnalysisError
 
@@ -37,7 +38,7 @@ def tooth_rows(c: Compiled, qx: np.ndarray, J: np.ndarray) -> list[dict[str, np.
             rk, _ = _split(qx, k)
             arm = P - rk
             J[:, m.row, 3 * k : 3 * k + 2] += sign * t
-            J[:, m.row, 3 * k + 2] += sign * (arm[:, 0] * t[:, 1] - arm[:, 1] * t[:, 0])
+            J[:, m.row, 3 * k + 2] += sign * cross(arm, t)
         geo.append({"u": u, "t": t, "P": P, "Ob": Ob})
     return geo
 
@@ -65,7 +66,7 @@ def radial_tooth_loads(
             if k == 0:
                 P = g["P"]
                 on_frame[:, :2] += f
-                on_frame[:, 2] += P[:, 0] * f[:, 1] - P[:, 1] * f[:, 0]
+                on_frame[:, 2] += cross(P, f)
     return lam, on_frame
 
 
@@ -94,7 +95,7 @@ def joint_reactions(
             m, g = tooth[jt.name]
             F = -lam[:, rows[0]][:, None] * g["t"]  # tangential tooth force on b
             arm = g["P"] - g["Ob"]
-            T = arm[:, 0] * F[:, 1] - arm[:, 1] * F[:, 0]
+            T = cross(arm, F)
             out[jt.name] = {"T": T, "Ft": T / m.pitch_b, "Fr": np.abs(lam[:, rows[0]]) * m.tan_alpha}
         else:
             out[jt.name] = {"T": -lam[:, rows[0]]}

@@ -28,6 +28,8 @@ from decimal import Decimal
 
 import numpy as np
 
+from .planar import cross
+
 #: numbers with at least this many significant digits are taken as rounded at their last digit
 ROUNDED_DIGITS = 4
 
@@ -62,10 +64,6 @@ class Rounding:
         return not (self.mass or self.x or self.y or self.inertia)
 
 
-def _cross(u: np.ndarray, w: np.ndarray) -> np.ndarray:
-    return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
-
-
 def rounding_bounds(model, an, roundings: tuple[Rounding, ...]) -> tuple[float, float]:
     """Peak over the motion of the worst-case change of the inertial shaking force (N) and
     moment (N m, about the analysis' moment point) that the roundings allow."""
@@ -91,14 +89,14 @@ def rounding_bounds(model, an, roundings: tuple[Rounding, ...]) -> tuple[float, 
         rP = fp[:, k, :2] + dp
         aP = aO + al[:, None] * J(dp) - (w**2)[:, None] * dp
         dF += np.hypot(aP[:, 0], aP[:, 1]) * r.mass
-        dM += np.abs(_cross(rP - O, aP)) * r.mass
+        dM += np.abs(cross(rP - O, aP)) * r.mass
         for e, h in (((c, s), r.x), ((-s, c), r.y)):  # R e_x, R e_y
             if not h:
                 continue
             Re = np.stack(e, axis=1)
             da = al[:, None] * J(Re) - (w**2)[:, None] * Re  # d a_P / d p_i
             dF += part.mass * np.hypot(da[:, 0], da[:, 1]) * h
-            dM += part.mass * np.abs(_cross(Re, aP) + _cross(rP - O, da)) * h
+            dM += part.mass * np.abs(cross(Re, aP) + cross(rP - O, da)) * h
     return float(np.max(dF)) if N else 0.0, float(np.max(dM)) if N else 0.0
 
 

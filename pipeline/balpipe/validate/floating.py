@@ -23,8 +23,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..engine import Analysis
+from ..mechanics.planar import cross, rotate
 from ..model import Attachment, Model
-from .run import _cross, model_scale, _rotate, _run_adaptive
+from .run import model_scale, _run_adaptive
 from .settings import ValidationSettings, _step_grid, default_settings
 
 #: the small masses tried in turn, times ``small_mass``: the smallest that pymunk holds together
@@ -133,13 +134,13 @@ def _conservation_solution(model: Model, analysis: Analysis, mb: float, ib: floa
     d = q[:, :, :2] - s[:, None, :]
     dd = v[:, :, :2] - sd[:, None, :]
     dB = centre[None, :] - s
-    num = np.einsum("k,nk->n", m, _cross(d, dd)) + mb * _cross(dB, -sd) + v[:, :, 2] @ inertia
+    num = np.einsum("k,nk->n", m, cross(d, dd)) + mb * cross(dB, -sd) + v[:, :, 2] @ inertia
     den = np.einsum("k,nk->n", m, np.sum(d**2, axis=-1)) + mb * np.sum(dB**2, axis=-1) + inertia.sum() + ib
     phid = (num[0] - num) / den
     phi = np.concatenate([[0.0], np.cumsum(0.5 * (phid[1:] + phid[:-1]) * np.diff(t))])
     p0 = np.einsum("k,kd->d", m, v[0, :, :2])
     rG = s[0][None, :] + np.outer(t - t[0], p0 / M)
-    origin = rG - _rotate(phi, s)
+    origin = rG - rotate(phi, s)
     return phi, origin
 
 
@@ -210,7 +211,7 @@ def free_floating(
             "the free base; conservation solution used"
         )
     phi_ref, origin_ref = _conservation_solution(model, analysis, float(base_mass), bi, centre)
-    drift_ref = origin_ref + _rotate(phi_ref, np.broadcast_to(centre, origin_ref.shape)) - centre
+    drift_ref = origin_ref + rotate(phi_ref, np.broadcast_to(centre, origin_ref.shape)) - centre
     if simulate_pymunk:
         dt_default, it_default = default_settings(model, analysis)
         dt, nsteps, idx = _step_grid(t, settings.dt or dt_default)
@@ -246,7 +247,7 @@ def free_floating(
                         + (f"; with {', '.join(failed)} of the mechanism's mass pymunk did not hold together" if failed else "")
                     )
                     phi_ref, origin_ref = _conservation_solution(sim_model, analysis, float(base_mass), bi, centre)
-                    drift_ref = origin_ref + _rotate(phi_ref, np.broadcast_to(centre, origin_ref.shape)) - centre
+                    drift_ref = origin_ref + rotate(phi_ref, np.broadcast_to(centre, origin_ref.shape)) - centre
                 else:
                     notes += run_notes
                 break
@@ -270,19 +271,19 @@ def free_floating(
     else:
         base = np.column_stack([origin_ref, phi_ref])
         poses = analysis.q.copy()
-        poses[:, :, :2] = origin_ref[:, None, :] + _rotate(phi_ref[:, None], analysis.q[:, :, :2])
+        poses[:, :, :2] = origin_ref[:, None, :] + rotate(phi_ref[:, None], analysis.q[:, :, :2])
         poses[:, :, 2] = analysis.q[:, :, 2] + phi_ref[:, None]
         method = "momentum"
         momentum_drift = (0.0, 0.0)
     for k, b in enumerate(sim_model.bodies):  # centre-of-mass poses -> body frame poses
         cl = np.asarray(b.mass_properties()[1])
-        poses[:, k, :2] -= _rotate(poses[:, k, 2], cl)
-    drift = base[:, :2] + _rotate(base[:, 2], np.broadcast_to(centre, base[:, :2].shape)) - centre
+        poses[:, k, :2] -= rotate(poses[:, k, 2], cl)
+    drift = base[:, :2] + rotate(base[:, 2], np.broadcast_to(centre, base[:, :2].shape)) - centre
     rotation = base[:, 2].copy()
     extra = {}
     if massless_ref is not None:
         phi0, origin0 = massless_ref
-        drift0 = origin0 + _rotate(phi0, np.broadcast_to(centre, origin0.shape)) - centre
+        drift0 = origin0 + rotate(phi0, np.broadcast_to(centre, origin0.shape)) - centre
         extra = {
             "small_masses": small,
             "small_mass_fraction": fraction,

@@ -17,6 +17,7 @@ import pymunk
 import pymunk.batch
 
 from ..engine import Analysis
+from ..mechanics.planar import rotate
 from ..model import FRAME, Gear, Model, Prismatic, Revolute
 from .extend import is_periodic_moving, start_state
 from .feedforward import inertial_forces, periodic_times
@@ -348,7 +349,7 @@ def _check_apart(states: np.ndarray, nb: int, base: int | None, q_ref: np.ndarra
     at the times ``t`` (m,)."""
     frame = states[:, base, :3] if base is not None else np.zeros((len(states), 3))
     q = states[:, :nb, :3]
-    rel = _rotate(-frame[:, None, 2], q[:, :, :2] - frame[:, None, :2])
+    rel = rotate(-frame[:, None, 2], q[:, :, :2] - frame[:, None, :2])
     dev_p = np.max(np.abs(rel - q_ref[:, :, :2]), axis=(1, 2)) / abort[1]
     dev_a = np.max(np.abs(q[:, :, 2] - frame[:, None, 2] - q_ref[:, :, 2]), axis=1)
     bad = ~((dev_p <= abort[0]) & (dev_a <= abort[0]))
@@ -363,7 +364,7 @@ def _relative_poses(run: SimulationRun, idx: np.ndarray | None, t: np.ndarray) -
     q = run.poses[idx].copy()
     base = run.base[idx]
     rel = q[:, :, :2] - base[:, None, :2]
-    q[:, :, :2] = _rotate(-base[:, None, 2], rel)
+    q[:, :, :2] = rotate(-base[:, None, 2], rel)
     q[:, :, 2] -= base[:, None, 2]
     return q
 
@@ -480,11 +481,4 @@ def model_scale(analysis: Analysis) -> float:
 
 
 
-def _rotate(phi: np.ndarray, x: np.ndarray) -> np.ndarray:
-    c, s = np.cos(phi), np.sin(phi)
-    return np.stack([c * x[..., 0] - s * x[..., 1], s * x[..., 0] + c * x[..., 1]], -1)
-
-
-def _cross(u: np.ndarray, w: np.ndarray) -> np.ndarray:
-    return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
 

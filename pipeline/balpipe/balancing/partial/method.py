@@ -29,6 +29,7 @@ from dataclasses import replace
 import numpy as np
 
 from ...cache import balance as balance_cache
+from ...mechanics.planar import cross
 from ...model import Model
 from ...notation import COMMON, ours, setting
 from ...spec_parts import SpecFieldError
@@ -57,7 +58,7 @@ def _link_size(model: Model, body: str) -> float:
 def _polygon(model: Model, s: PartialCounterweightSpec, path: tuple) -> tuple:
     V = np.array([body_point(model, s.body, p, path + ("polygon", i)) for i, p in enumerate(s.polygon)])
     e = np.roll(V, -1, axis=0) - V
-    turn = e[:, 0] * np.roll(e, -1, axis=0)[:, 1] - e[:, 1] * np.roll(e, -1, axis=0)[:, 0]
+    turn = cross(e, np.roll(e, -1, axis=0))
     if not (np.all(turn > 0) or np.all(turn < 0)):
         raise SpecFieldError(path + ("polygon",), "the polygon must be convex with its vertices in order (no three collinear)")
     return tuple(map(tuple, V))

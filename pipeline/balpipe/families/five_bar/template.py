@@ -38,6 +38,7 @@ from ...diagnose import actuation
 from ... import units
 from ...laws.drives import path_laws
 from ...mechanics.meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
+from ...mechanics.planar import bar_body, cross, wrap_angle, world_point
 from ...model import FRAME, Attachment, Body, Driver, Gear, Law, Model, Revolute
 from ...motion import law_for
 from ...spec_parts import LinkSpec, SpecFieldError, Strict
@@ -252,11 +253,6 @@ class CoupledInput(Law):
         return self.law(t)
 
 
-def _wrap(a: float) -> float:
-    """Angle difference in (-pi, pi]: the shorter rotation."""
-    return math.pi - (math.pi - a) % (2 * math.pi)
-
-
 def gripper_positions(motion) -> tuple[tuple[float, float], tuple[float, float]]:
     """motion.drive.gripper's from/to as points in m."""
     for name in motion.drive:
@@ -287,7 +283,7 @@ def synthesise(mech: FiveBarMechanism, start, end) -> Synthesis:
     """Input angles, U21, gear radii and the gripper path check for one pair of positions."""
     th1i, th2i = inverse_kinematics(mech, start, GRIPPER_PATH + ("from",))
     th1f, th2f = inverse_kinematics(mech, end, GRIPPER_PATH + ("to",))
-    d1, d2 = _wrap(th1f - th1i), _wrap(th2f - th2i)
+    d1, d2 = wrap_angle(th1f - th1i), wrap_angle(th2f - th2i)
     th1f, th2f = th1i + d1, th2i + d2
     to = GRIPPER_PATH + ("to",)
     if math.hypot(end[0] - start[0], end[1] - start[1]) == 0.0:
@@ -358,13 +354,6 @@ def segment_distance(P: np.ndarray, S: np.ndarray, E: np.ndarray) -> np.ndarray:
 # Model
 
 
-def _link(name: str, link: LinkSpec, a: str, b: str, attachments=()) -> Body:
-    return Body(
-        name, link.mass, (link.com, link.com_offset), link.inertia,
-        {a: (0.0, 0.0), b: (link.length, 0.0)}, attachments=tuple(attachments), outline=(a, b),
-    )
-
-
 def build(mech: FiveBarMechanism, laws: dict, t: np.ndarray) -> Model:
     """The unbalanced five-bar: links 1-4 (+ gears 1', 2' on links 1, 2 and the idler 5 on the
     frame with its two meshes, carrier the frame, when coupled), driven at A1 (coupled) or at
@@ -387,10 +376,10 @@ def build(mech: FiveBarMechanism, laws: dict, t: np.ndarray) -> Model:
         th1, th2 = inverse_kinematics(mech, C0, GRIPPER_PATH + ("from",))
         extra_links = ((), ())
     B1, B2 = elbows(mech, th1, th2)
-    link1 = _link("link1", p1, "A1", "B1", extra_links[0])
-    link2 = _link("link2", p2, "A2", "B2", extra_links[1])
-    link3 = _link("link3", d1, "B1", "C")
-    link4 = _link("link4", d2, "B2", "C")
+    link1 = bar_body("link1", p1, "A1", "B1", p1.length, extra_links[0])
+    link2 = bar_body("link2", p2, "A2", "B2", p2.length, extra_links[1])
+    link3 = bar_body("link3", d1, "B1", "C", d1.length)
+    link4 = bar_body("link4", d2, "B2", "C", d2.length)
     ang = lambda P, Q: math.atan2(Q[1] - P[1], Q[0] - P[0])  # noqa: E731
     initial = {
         "link1": (A1[0], A1[1], th1),
@@ -453,9 +442,9 @@ def _check_straight_path(mech: FiveBarMechanism, C: np.ndarray, t: np.ndarray) -
         th.append(inverse_leg(Aj, lp.length, ld.length, C, sigma))
     B1, B2 = elbows(mech, th[0], th[1])
     e, c = B2 - B1, C - B1
-    cross = e[:, 0] * c[:, 1] - e[:, 1] * c[:, 0]
-    if np.any(np.sign(cross) != np.sign(cross[0])) or np.any(cross == 0):
-        k = int(np.argmax(np.sign(cross) != np.sign(cross[0])))
+    side = cross(e, c)
+    if np.any(np.sign(side) != np.sign(side[0])) or np.any(side == 0):
+        k = int(np.argmax(np.sign(side) != np.sign(side[0])))
         raise SpecFieldError(
             GRIPPER_PATH + ("to",),
             f"the straight path crosses a parallel singularity (B1, C, B2 aligned) near t = {t[k]:.4g} s",
@@ -471,8 +460,7 @@ def gripper_path(analysis, model: Model) -> np.ndarray:
     k = analysis.names.index("link3")
     pose = analysis.extra["frame_pose"][:, k]
     cx, cy = model.body("link3").point("C")
-    c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
-    return np.stack([pose[:, 0] + c * cx - s * cy, pose[:, 1] + s * cx + c * cy], axis=1)
+    return world_point(pose, (cx, cy))
 
 
 def input_angles(analysis) -> tuple[np.ndarray, np.ndarray]:

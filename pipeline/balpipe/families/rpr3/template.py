@@ -34,6 +34,7 @@ import numpy as np
 from pydantic import Field
 
 from ...mechanics.joint_laws import PoseJointLaw, body_point
+from ...mechanics.planar import cross
 from ...model import FRAME, Body, Driver, Law, Model, Prismatic, Revolute
 from ...spec_parts import SpecFieldError, Strict
 from ...units import Inertia, Length, Mass, PositiveLength
@@ -137,7 +138,6 @@ def leg_coordinates(A: np.ndarray, C, Cd, Cdd) -> dict[str, np.ndarray]:
     rho = np.hypot(d[:, 0], d[:, 1])
     rhod = (d * Cd).sum(1) / rho
     rhodd = ((Cd * Cd).sum(1) + (d * Cdd).sum(1) - rhod**2) / rho
-    cross = lambda a, b: a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]  # noqa: E731
     th = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
     thd = cross(d, Cd) / rho**2
     thdd = cross(d, Cdd) / rho**2 - 2 * rhod * thd / rho

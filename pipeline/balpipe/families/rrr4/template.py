@@ -36,6 +36,7 @@ from pydantic import Field
 
 from ... import units
 from ...mechanics.joint_laws import PoseJointLaw, body_point, dyad_rates
+from ...mechanics.planar import bar_body, wrap_angle
 from ...laws.drives import path_laws
 from ...model import FRAME, Body, Driver, Law, Model, Revolute
 from ...motion import law_for
@@ -214,10 +215,6 @@ class LegMotion:
     a2: np.ndarray
 
 
-def _wrap(a):
-    return np.pi - np.mod(np.pi - a, 2 * np.pi)
-
-
 def corner_motion(mech: RRR4Mechanism, i: int, pose) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """C_i(t), its velocity and acceleration (N, 2) from the pose laws' values."""
     return body_point(pose, corner(mech, i))
@@ -238,8 +235,8 @@ def leg_motion(leg: Leg, C, Cd, Cdd, ref: tuple[float, float] | None = None) -> 
     B = np.asarray(leg.A) + leg.l1 * np.stack([np.cos(th1), np.sin(th1)], axis=-1)
     th2 = np.arctan2(C[:, 1] - B[:, 1], C[:, 0] - B[:, 0])
     if ref is not None:
-        th1 = ref[0] + _wrap(th1 - ref[0])
-        th2 = ref[1] + _wrap(th2 - ref[1])
+        th1 = ref[0] + wrap_angle(th1 - ref[0])
+        th2 = ref[1] + wrap_angle(th2 - ref[1])
     c1, s1, c2, s2 = np.cos(th1), np.sin(th1), np.cos(th2), np.sin(th2)
     # l1 perp(e1) w1 + l2 perp(e2) w2 = C' and its derivative (det = l1 l2 sin(theta2 - theta1))
     det = leg.l1 * leg.l2 * (c1 * s2 - s1 * c2)
@@ -301,11 +298,6 @@ def check_workspace(mech: RRR4Mechanism, legs: dict[int, Leg], pose_laws, t: np.
 # Model
 
 
-def link_body(name: str, link: RRRLink, length: float, a: str, b: str) -> Body:
-    return Body(name, link.mass, (link.com, link.com_offset), link.inertia,
-                {a: (0.0, 0.0), b: (length, 0.0)}, outline=(a, b))
-
-
 def platform_body(mech: RRR4Mechanism) -> Body:
     p = mech.platform
     pts = {f"C{i}": tuple(float(v) for v in corner(mech, i)) for i in LEGS}
@@ -355,8 +347,8 @@ def build(mech: RRR4Mechanism, laws: dict, t: np.ndarray) -> Model:
                 raise SpecFieldError(PLATFORM_PATH + ("to",), f"link l{i}{n} turns by 180 deg or more from its "
                                      f"initial angle (at t = {tt[k]:.4g} s); split the motion into shorter moves")
         B = (leg.A[0] + leg.l1 * math.cos(th1), leg.A[1] + leg.l1 * math.sin(th1))
-        bodies += [link_body(f"link{i}1", leg.proximal, leg.l1, f"A{i}", f"B{i}"),
-                   link_body(f"link{i}2", leg.distal, leg.l2, f"B{i}", f"C{i}")]
+        bodies += [bar_body(f"link{i}1", leg.proximal, f"A{i}", f"B{i}", leg.l1),
+                   bar_body(f"link{i}2", leg.distal, f"B{i}", f"C{i}", leg.l2)]
         initial[f"link{i}1"] = (leg.A[0], leg.A[1], th1)
         initial[f"link{i}2"] = (B[0], B[1], th2)
         joints += [

@@ -238,7 +238,7 @@ def arms_cross(model: Model) -> bool:
         a, c = (np.array([x, y]) + R @ np.asarray(b.points[n], float) for n in b.outline[:2])
         segs[b.name] = (a, c)
 
-    def cross(p, q):
+    def segments_cross(p, q):
         (a, b), (c, d) = p, q
 
         def orient(u, v, w):
@@ -248,7 +248,7 @@ def arms_cross(model: Model) -> bool:
         return o1 * o2 < 0 and o3 * o4 < 0
 
     names = sorted(segs)
-    return any(cross(segs[u], segs[v]) for u, v in itertools.combinations(names, 2) if u[4] != v[4])
+    return any(segments_cross(segs[u], segs[v]) for u, v in itertools.combinations(names, 2) if u[4] != v[4])
 
 
 def fig6_label(kinematics: str, crossing: bool) -> str:

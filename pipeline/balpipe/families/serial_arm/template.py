@@ -30,6 +30,7 @@ from pydantic import Field
 from ... import units
 from ...cache.content import MEMO
 from ...mechanics.joint_laws import PoseJointLaw, body_point_xy, dyad_rates
+from ...mechanics.planar import bar_body
 from ...laws.drives import drive_laws, path_laws
 from ...model import FRAME, Attachment, Body, Driver, Law, Model, Revolute
 from ...motion import law_for
@@ -387,8 +388,7 @@ def link_body(k: int, n: int, link: LinkSpec, payload: Payload | None) -> Body:
     if k == n and payload is not None and (payload.mass > 0 or payload.inertia > 0):
         pos = tuple(payload.position) if payload.position is not None else (link.length, 0.0)
         att = (Attachment("payload", payload.mass, pos, payload.inertia, "payload"),)
-    return Body(f"link{k}", link.mass, (link.com, link.com_offset), link.inertia,
-                {f"J{k}": (0.0, 0.0), distal: (link.length, 0.0)}, attachments=att, outline=(f"J{k}", distal))
+    return bar_body(f"link{k}", link, f"J{k}", distal, link.length, att)
 
 
 def frame_poses(arm_base, lengths, q) -> dict[str, tuple[float, float, float]]:

@@ -13,6 +13,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field
 
+from ...mechanics.planar import bar_body
 from ...model import FRAME, Body, Driver, Model, Prismatic, Revolute
 from ...spec_parts import BodySpec, LinkSpec, SpecFieldError, Strict
 from ...units import Length, Sign
@@ -32,13 +33,6 @@ class SliderCrankMechanism(Strict):
     def drives(self) -> dict[str, str]:
         """Coordinates that can be driven, with their dimension."""
         return {"crank": "angle", "slider": "length"}
-
-
-def _link_body(name: str, link: LinkSpec, a: str, b: str) -> Body:
-    return Body(
-        name, link.mass, (link.com, link.com_offset), link.inertia,
-        {a: (0.0, 0.0), b: (link.length, 0.0)}, outline=(a, b),
-    )
 
 
 def crank_angles(mech: SliderCrankMechanism, slider_x: np.ndarray) -> np.ndarray:
@@ -87,8 +81,8 @@ def build(mech: SliderCrankMechanism, laws: dict, t: np.ndarray) -> Model:
     dy = a - L1 * math.sin(th0)
     cx = B[0] + mech.branch * math.sqrt(max(L2**2 - dy**2, 0.0))
     phi0 = math.atan2(A[1] + a - B[1], cx - B[0])
-    crank = _link_body("crank", mech.crank, "A", "B")
-    coupler = _link_body("coupler", mech.coupler, "B", "C")
+    crank = bar_body("crank", mech.crank, "A", "B", mech.crank.length)
+    coupler = bar_body("coupler", mech.coupler, "B", "C", mech.coupler.length)
     slider = Body("slider", mech.slider.mass, tuple(mech.slider.com), mech.slider.inertia, {"C": (0.0, 0.0)}, kind="slider")
     guide_origin = (float(A[0]), float(A[1] + a))
     joints = (
