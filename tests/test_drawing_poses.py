@@ -14,6 +14,7 @@ import pytest
 
 from balpipe.build import Options, build
 from balpipe.draw import extremes, figures, sleeves
+from balpipe.mechanics.planar import world_point
 from balpipe.model import Body, Model, Prismatic, Revolute
 from balpipe.report import page
 
@@ -99,9 +100,9 @@ def test_every_3rpr_leg_is_one_piece_from_base_pivot_to_platform_at_every_sample
             row = poses[k]
             for n, (start, end) in enumerate(sleeves.sleeves(m, row), start=1):
                 A = np.array(m.frame_points[f"A{n}"])
-                C = figures._global_point(row[idx["platform"]], m.body("platform").points[f"C{n}"])
-                B = figures._global_point(row[idx[f"piston{n}"]], m.body(f"piston{n}").points["B"])
-                rod_end = figures._global_point(row[idx[f"piston{n}"]], m.body(f"piston{n}").points["C"])
+                C = world_point(row[idx["platform"]], m.body("platform").points[f"C{n}"])
+                B = world_point(row[idx[f"piston{n}"]], m.body(f"piston{n}").points["B"])
+                rod_end = world_point(row[idx[f"piston{n}"]], m.body(f"piston{n}").points["C"])
                 u = (C - A) / np.linalg.norm(C - A)
                 assert np.linalg.norm(start - A) < 1e-9  # the sleeve sits on the pivot
                 assert np.linalg.norm(rod_end - C) < 1e-6  # the rod is pinned to the platform
