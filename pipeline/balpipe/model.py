@@ -200,6 +200,10 @@ class Model:
     point or a pose). Given: the drivers only prescribe the motion, and the efforts are the
     actuators' (:mod:`balpipe.engine.dynamics`). ``sources`` maps body, joint, driver and
     actuator names to the spec field that defines them, for located errors.
+
+    ``loads``: force elements, applied loads and joint friction
+    (:mod:`balpipe.mechanics.loads`); balancing stages keep them (they only add parts), and the
+    engine counts them in the efforts, reactions and frame loads, never in the shaking loads.
     """
 
     name: str
@@ -210,6 +214,7 @@ class Model:
     frame_points: dict[str, Vec2] = field(default_factory=dict)
     guides: tuple[tuple[Vec2, Vec2], ...] = ()
     actuators: tuple[Actuator, ...] = ()
+    loads: tuple = ()
     sources: dict[str, tuple] = field(default_factory=dict, compare=False)
 
     def body(self, name: str) -> Body:

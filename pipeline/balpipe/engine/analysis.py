@@ -15,6 +15,8 @@ from .compile import Compiled, compile_model
 from .constraints import with_frame, jacobian
 from .dynamics import joint_reactions, solve_multipliers, radial_tooth_loads, tooth_rows, actuation_condition
 from .conditioning import motion_peak
+from .errors import AnalysisError
+from .loads import solve as solve_loads, terms as load_terms
 from .positions import condition_numbers, redundancy
 
 
@@ -48,6 +50,19 @@ class Analysis:
     moment_point: tuple[float, float]
     gravity: tuple[float, float]
     extra: dict = field(default_factory=dict)
+    frame_force: np.ndarray | None = None
+    frame_moment: np.ndarray | None = None
+    loads: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+
+    @property
+    def frame_load(self) -> tuple[np.ndarray, np.ndarray]:
+        """What the frame feels, force (N, 2) and moment (N,) about the moment point: the
+        bearing and slideway reactions, the motors' reactions and the frame-side reactions of
+        internal loads. It equals the shaking load plus the external loads (the same as the
+        shaking load without external loads, :mod:`.loads`)."""
+        if self.frame_force is None:
+            return self.force, self.moment
+        return self.frame_force, self.frame_moment
 
     @property
     def max_force(self) -> float:
@@ -212,14 +227,19 @@ def analyse(
         q, v, a = kin.X[3:-1].T, kin.V[3:-1].T, kin.A[3:-1].T
         cond = None  # the block path's: computed when read
     cd = c.dynamics or c  # the system of the inverse dynamics: the actuators' rows, or the drivers'
+    lt = load_terms(model, c, t, q, v) if model.loads else None
+    mesh_geo: list = []
+    radial_on_frame = None
     if kin is not None and not c.meshes and c.dynamics is None:
         rhsT = -Mdiag.T * kin.A[3:-1]
         rhsT[0::3] += (c.mass * g[0])[:, None]
         rhsT[1::3] += (c.mass * g[1])[:, None]
-        lamT = fastpath.multipliers(c.fast, kin, rhsT)
-        lam = lamT.T
-        mesh_geo: list = []
-        gen0 = fastpath.frame_load(c.fast, kin.vals, lamT)
+
+        def solver(rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            lamT = fastpath.multipliers(c.fast, kin, rhs.T)
+            return lamT.T, fastpath.frame_load(c.fast, kin.vals, lamT)
+
+        rhs = rhsT.T
     else:
         Q = np.zeros_like(q)
         Q[:, 0::3] = c.mass * g[0]
@@ -227,9 +247,11 @@ def analyse(
         rhs = Q - Mdiag * a
         by_frame = shared.multipliers(c, placed, rhs)  # a placed model: its geometry's map, made once
         if by_frame is not None:
-            lam, J0 = by_frame
-            mesh_geo = []
-            gen0 = -np.einsum("nmk,nm->nk", J0, lam)  # load on the frame: Fx, Fy, M_O
+            J0, base = by_frame[1], rhs
+
+            def solver(rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                lam = by_frame[0] if rhs is base else shared.multipliers(c, placed, rhs)[0]
+                return lam, -np.einsum("nmk,nm->nk", J0, lam)  # load on the frame: Fx, Fy, M_O
         else:
             qx = with_frame(q)
             J = jacobian(cd, qx)
@@ -238,9 +260,23 @@ def analyse(
             if c.dynamics is not None:
                 actuation = actuation_condition(cd, Jf, t)
                 rates = {name: np.einsum("nk,nk->n", Jf[:, row, :], v) for name, row in cd.driver_rows.items()}
-            lam = solve_multipliers(cd, Jf, rhs)
-            lam, radial_on_frame = radial_tooth_loads(cd, mesh_geo, lam)
-            gen0 = -np.einsum("nmk,nm->nk", J0, lam) + radial_on_frame  # load on the frame: Fx, Fy, M_O
+
+            def solver(rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                lam = solve_multipliers(cd, Jf, rhs)
+                return lam, -np.einsum("nmk,nm->nk", J0, lam)  # load on the frame: Fx, Fy, M_O
+    if lt is None:
+        lam, gen0 = solver(rhs)
+    else:
+        if lt.coulomb and mesh_geo:
+            raise AnalysisError("Coulomb friction in a model whose gear meshes carry tooth forces is not supported: "
+                                "give the friction as viscous, or the gears without pitch radii", float(t[0]))
+        lam, gen0 = solve_loads(lt, rhs, solver)
+    if mesh_geo:
+        lam, radial_on_frame = radial_tooth_loads(cd, mesh_geo, lam)
+        gen0 = gen0 + radial_on_frame
+    frame_gen = gen0
+    if lt is not None:
+        gen0 = gen0 - lt.external  # the shaking load: the frame load less the external loads
     P = np.asarray(moment_point, dtype=float)
     force = gen0[:, :2]
     moment_O = gen0[:, 2]
@@ -272,6 +308,9 @@ def analyse(
         force_momentum=force_mom, moment_momentum=about_P(moment_mom, force_mom),
         efforts=efforts, reactions=reactions, com=com, momentum=momentum, angular_momentum=ang,
         moment_point=(float(P[0]), float(P[1])), gravity=(float(g[0]), float(g[1])),
+        frame_force=None if lt is None else frame_gen[:, :2],
+        frame_moment=None if lt is None else about_P(frame_gen[:, 2], frame_gen[:, :2]),
+        loads={} if lt is None else lt.series,
         extra=_Extra({"frame_pose": frame_pose, "total_mass": float(m.sum()),
                       "redundant_actuators": redundancy(cd),
                       "actuated": c.dynamics is not None,
