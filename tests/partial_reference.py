@@ -79,8 +79,9 @@ class Program:
         for L in term.maps:
             A, b = L.A / term.scale, L.b / term.scale
             comps = [A[:, k, :] @ self.z + b[:, k] for k in range(A.shape[1])]
-            if term.kind == "rms":
-                out.append(cp.norm(cp.hstack(comps), 2) / math.sqrt(A.shape[0]))
+            if term.kind == "rms":  # the time average: the samples weighted by the trapezoidal rule
+                r = np.sqrt(L.weights)
+                out.append(cp.norm(cp.hstack([cp.multiply(r, c) for c in comps]), 2))
                 continue
             u = cp.Variable()
             if len(comps) == 1:

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .maps import Maps
+from .polish import polish
 from .program import FALLBACK_SETTINGS, SOLVER_SETTINGS, ZERO, Outcome, Term, polish_zero, variable_scale
 
 UNBOUNDED = 1e9  # kg: the mass budget when a programme should not be limited by it
@@ -174,11 +175,12 @@ class ActiveProgram:
                 G[:, 0, col] = 1.0
                 G[:, 1:, :nz] = A
                 rows.add_cones(G, np.concatenate([np.zeros((len(S), 1)), b], axis=1))
-            else:
+            else:  # the time average: each sample's components times the root of its weight
+                r = np.sqrt(L.weights)
                 G = np.zeros((A.shape[0] * A.shape[1] + 1, rows.n))
-                G[0, col] = math.sqrt(A.shape[0])
-                G[1:, :nz] = A.reshape(-1, nz)
-                rows.add("soc", G, np.r_[0.0, b.reshape(-1)])
+                G[0, col] = 1.0
+                G[1:, :nz] = (A * r[:, None, None]).reshape(-1, nz)
+                rows.add("soc", G, np.r_[0.0, (b * r[:, None]).reshape(-1)])
 
     def _missing(self, term: Term, bound: float, z: np.ndarray) -> bool:
         """Adds to ``term``'s sets the samples that exceed ``bound`` (in units of its scale) at ``z``;
@@ -241,6 +243,18 @@ class ActiveProgram:
             caps=[(t, v * (1 + slack) + slack) for t, v in kept] + list(caps), polish=[kept[0][0]]))
         return out.z if out.z is not None else z
 
+    def lightest_alike(self, term: Term, z: np.ndarray, caps: list[tuple[Term, float]] = ()) -> Outcome:
+        """The design of least added mass whose load of ``term`` equals design ``z``'s at every
+        sample, meeting ``caps`` (its ``z`` None if none is found). An RMS of one load is a Euclidean norm
+        of its samples, strictly convex in them: its optimal designs are exactly those with the
+        optimum's load at every sample (linear equations), so the lightest optimal design is exact,
+        where :meth:`lightest`'s bound relaxed by eps would move it by about sqrt(eps)."""
+        nz = self.maps.nz
+        A = np.concatenate([L.A.reshape(-1, nz) for L in term.maps])
+        _, S, Vt = np.linalg.svd(A, full_matrices=False)
+        E = Vt[S > 1e-12 * S[0]]  # the row space of the load's map: the same equations, independent
+        return self.least_mass(E, E @ z, caps=list(caps), polish=[term])
+
     def _solve(self, objective: list[Term], eps: list[tuple[Term, float]], mass_budget: float,
                equations: tuple[np.ndarray, np.ndarray] | None, polish) -> Outcome:
         """The optimum by the exchange loop (without ``objective``, the least added mass)."""
@@ -258,21 +272,42 @@ class ActiveProgram:
             rows.add("zero", G, -equations[1])
         for j, (_, bound) in enumerate(eps):
             rows.add("nonneg", -np.eye(n)[self.n + len(objective) + j], bound)
-        res = self._exchange(q, rows, objective + [e[0] for e in eps], eps, mass_budget)
+        terms = objective + [e[0] for e in eps]
+        res, data, cones = self._exchange(q, rows, terms, eps, mass_budget)
         status = STATUS.get(str(res.status), "solver_error")
         if status not in ANSWERED:
             return Outcome(None, status, math.inf, 0.0)
-        z = self.D * np.asarray(res.x)[: self.maps.nz]
+        x, precision = self._polished(res, data, cones, terms, eps)
+        z = self.D * x[: self.maps.nz]
         for t in polish:
             if t.value(z) <= ZERO * t.scale:
                 z = polish_zero(self.maps, t, z)
-        return Outcome(self.maps.realised(z), status, float(res.obj_val), -float(res.z[self.budget_row]))
+        return Outcome(self.maps.realised(z), status, float(q @ x), -float(res.z[self.budget_row]), precision)
+
+    def _polished(self, res, data, cones: list[tuple[str, int]], terms: list[Term],
+                  eps: list[tuple[Term, float]]) -> tuple[np.ndarray, float | None]:
+        """Clarabel's answer polished on its active set (:func:`.polish.polish`: the design exact
+        to round-off, not to the solver's tolerance, where the objective is smooth at the optimum)
+        and its relative error, if the polished design meets every term's bound on every sample and
+        is no worse; else Clarabel's answer and None."""
+        x = np.asarray(res.x, dtype=float)
+        _, q, A, b, _ = data
+        out = polish(q, A, b, cones, x, np.asarray(res.s, dtype=float), np.asarray(res.z, dtype=float))
+        if out is None or q @ out[0] > q @ x + 1e-9 * max(1.0, abs(float(q @ x))):
+            return x, None
+        z = self.D * out[0][: self.maps.nz]
+        objective = len(terms) - len(eps)
+        bounds = [(t, out[0][self.n + j]) for j, t in enumerate(terms[:objective])] + list(eps)
+        if any(t.value(z) / t.scale > bound + CHECK for t, bound in bounds):
+            return x, None
+        return out
 
     def _exchange(self, q: np.ndarray, rows: Rows, terms: list[Term], eps: list[tuple[Term, float]],
                   mass_budget: float):
         """Clarabel's answer to min q' x on ``rows`` and the terms' cones on their
         samples, the samples grown until every sample meets its bound (the terms of ``eps`` their
-        caps, the others their epigraph variables), or its answer without a solution."""
+        caps, the others their epigraph variables), or its answer without a solution; with the
+        programme's data and its cones (unmerged)."""
         import clarabel
         import scipy.sparse as sp
 
@@ -289,12 +324,12 @@ class ActiveProgram:
             if STATUS.get(str(res.status), "solver_error") in STALLED:
                 res = clarabel.DefaultSolver(*data, _settings(FALLBACK_SETTINGS)).solve()
             if STATUS.get(str(res.status)) not in ANSWERED:
-                return res
+                return res, data, full.cones
             x = np.asarray(res.x)
             z = self.D * x[: self.maps.nz]
             bounds = [(t, x[self.n + j]) for j, t in enumerate(terms[:objective])] + eps
             if not any([self._missing(t, bound, z) for t, bound in bounds]):
-                return res
+                return res, data, full.cones
 
 
 def _widened(G: np.ndarray, n: int) -> np.ndarray:

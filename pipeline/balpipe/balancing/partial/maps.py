@@ -63,16 +63,39 @@ class DiscVars:
     col: int
 
 
+def time_weights(t: np.ndarray) -> np.ndarray:
+    """The trapezoidal rule's weights of the samples ``t``, summing to 1: sum w_n f(t_n) is the time
+    average of f over [t_0, t_N-1]. On a whole cycle sampled uniformly, both ends included, the end
+    samples (one instant) count once together, so the average of a periodic f is exact for every
+    harmonic below the sampling's Nyquist order (the plain mean of the samples counts that instant
+    twice: an RMS-optimal counterweight off by ~1/N)."""
+    t = np.asarray(t, dtype=float)
+    if len(t) < 2 or t[-1] <= t[0]:
+        return np.full(len(t), 1.0 / max(len(t), 1))
+    d = np.diff(t)
+    w = np.zeros(len(t))
+    w[:-1] += d / 2
+    w[1:] += d / 2
+    return w / w.sum()
+
+
 @dataclass
 class Load:
     """One load over the samples: components ``A @ z + b`` (A (N, k, nz), b (N, k)); ``b0`` the
-    unbalanced mechanism's (no parts, no discs); the value per sample is the components' norm."""
+    unbalanced mechanism's (no parts, no discs); the value per sample is the components' norm.
+    ``w`` the samples' time weights (:func:`time_weights`; uniform when not given): an RMS is the
+    root of the time average of the squared value."""
 
     name: str
     unit: str
     A: np.ndarray
     b: np.ndarray
     b0: np.ndarray
+    w: np.ndarray | None = None
+
+    @property
+    def weights(self) -> np.ndarray:
+        return np.full(self.A.shape[0], 1.0 / self.A.shape[0]) if self.w is None else self.w
 
     def samples(self, z: np.ndarray) -> np.ndarray:
         """|load| per sample for the design z (or designs, rows of z: (D, N))."""
@@ -82,11 +105,11 @@ class Load:
 
     def measure(self, kind: str, z: np.ndarray) -> np.ndarray | float:
         s = self.samples(z)
-        return s.max(axis=-1) if kind == "peak" else np.sqrt(np.mean(s * s, axis=-1))
+        return s.max(axis=-1) if kind == "peak" else np.sqrt((s * s) @ self.weights)
 
     def unbalanced(self, kind: str) -> float:
         s = np.sqrt(np.sum(self.b0 * self.b0, axis=-1))
-        return float(s.max() if kind == "peak" else math.sqrt(float(np.mean(s * s))))
+        return float(s.max() if kind == "peak" else math.sqrt(float((s * s) @ self.weights)))
 
 
 @dataclass
@@ -194,7 +217,8 @@ def build(model: Model, unbalanced: Model, t: np.ndarray, parts: list[PartVars],
         Ys[f"effort:{d}"] = (sweep.G[:, k : k + 1, :], "N or N m")
     for name, Y in _joint_maps(sweep).items():
         Ys[f"joint:{name}"] = (Y, "N or N m")
-    loads = {name: Load(name, unit, Y @ G, Y @ p0, Y @ p_unb) for name, (Y, unit) in Ys.items()}
+    w = time_weights(t)
+    loads = {name: Load(name, unit, Y @ G, Y @ p0, Y @ p_unb, w) for name, (Y, unit) in Ys.items()}
     moving = {}  # a body is at rest when its frame neither accelerates (m column less the weight) nor turns
     for k, b in enumerate(model.bodies):
         acc = sweep.YF[:, :, 4 * k] - np.asarray(gravity, dtype=float)

@@ -141,7 +141,8 @@ def solve(maps: Maps | Sequence[Maps], method: PartialBalance):
     """The optimum over one motion's maps or several: (program, outcome, objective terms, caps as
     (term, bound)). Where it leaves part of the budget unused (more mass would not help), the
     design is the lightest with each objective term at its optimal value and the caps met, not
-    whichever of the optimal designs the solver returned."""
+    whichever of the optimal designs the solver returned (for one RMS term, exactly: the designs
+    with the optimum's load at every sample, :meth:`.active.ActiveProgram.lightest_alike`)."""
     program = ActiveProgram(_motions(maps)[0], method.budget.inertia)
     objective = [term_of(maps, t, t.weight) for t in method.objective]
     caps = []
@@ -154,7 +155,14 @@ def solve(maps: Maps | Sequence[Maps], method: PartialBalance):
         raise _infeasible(program, caps, method) if caps else SpecFieldError(
             ROOT + ("budget", "mass"), f"no design within the budget ({out.status})")
     if program.unused(out.z, budget):  # the lightest of the optimal designs
-        out = replace(out, z=program.lightest([(t, t.value(out.z) / t.scale) for t in objective], out.z, caps))
+        alike = None
+        if len(objective) == 1 and objective[0].kind == "rms" and len(objective[0].maps) == 1:
+            alike = program.lightest_alike(objective[0], out.z, caps)
+        if alike is not None and alike.z is not None:
+            out = replace(out, z=alike.z, precision=alike.precision)
+        else:  # the objective's bound relaxed by the solver's tolerance: the design to about its root
+            out = replace(out, z=program.lightest([(t, t.value(out.z) / t.scale) for t in objective], out.z, caps),
+                          precision=None)
     return program, out, objective, caps
 
 
@@ -223,13 +231,16 @@ def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None
         "unbalanced": {k: v.scale for k, v in std.items()},
         "status": out.status,
         "solver": "Clarabel, active samples",
+        "precision": precision_text(out.precision),
+        "relative_error": out.precision,
         "design": design_table(maps, z),
         "motions": PMo.per_motion(motions, PMo.names(method), objective, caps, std, z),
     }
     if method.fronts is not None:
         details["fronts"] = balance_cache.run(PF.fronts, maps, method.budget.inertia, std, method.budget.mass,
                                               method.fronts.points, method.fronts.max_mass)
-    params = [Parameter(f"{r['name']}.{k}", r[k], u, "cone programme (Clarabel)", f"{r['name']} on {r['body']}")
+    source = f"cone programme (Clarabel), {precision_text(out.precision)}"
+    params = [Parameter(f"{r['name']}.{k}", r[k], u, source, f"{r['name']} on {r['body']}")
               for r in details["design"] for k, u in (("mass", "kg"), ("x", "m"), ("y", "m"), ("inertia", "kg m^2"))
               if k in r]
     params += [
@@ -246,7 +257,8 @@ def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None
         "Optimal partial balancing by a second-order cone programme (Clarabel) over "
         f"{over}: objective {' + '.join(f'{x.weight:g} x {x.label}' for x in objective)} "
         f"(each divided by its unbalanced value) = {details['objective']:.6g} with {details['added_mass']:.6g} kg added; "
-        f"active: {', '.join(active) or 'none'}; d objective / d budget = {out.budget_dual:.4g} per kg."
+        f"active: {', '.join(active) or 'none'}; d objective / d budget = {out.budget_dual:.4g} per kg; "
+        f"the design {precision_text(out.precision)}."
     ] + PMo.notes(details["motions"])
     label = method.label or "partial balance"
     stages = [Stage("unbalanced", "unbalanced", model, "the mechanism as given"),
@@ -254,6 +266,15 @@ def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None
                     if len(motions) == 1 else f"parts chosen by the cone programme (global optimum over {len(motions)} "
                     "motions; analysed and validated on the spec's motion)")]
     return BalanceResult(params, stages, notes, details={"partial_balance": details})
+
+
+def precision_text(error: float | None) -> str:
+    """How exact a design is: polished on its active set, its relative error bounded by ``error``;
+    else the interior-point solver's own (its tolerance, 1e-10, on the objective)."""
+    if error is not None:
+        return f"exact to {max(error, 1e-16):.0e} (relative; optimality equations solved on the active set)"
+    return ("to the solver's tolerance (objective to 1e-10; a design where the optimum is flat to about "
+            "its square root, 1e-5)")
 
 
 def design_table(maps: Maps, z: np.ndarray) -> list[dict]:

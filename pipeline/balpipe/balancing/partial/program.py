@@ -61,12 +61,15 @@ class Term:
 @dataclass
 class Outcome:
     """A solved programme: the design ``z`` (None when infeasible), the status, the objective
-    (dimensionless), the mass budget's dual value (d objective / d budget, per kg, <= 0)."""
+    (dimensionless), the mass budget's dual value (d objective / d budget, per kg, <= 0) and the
+    design's relative precision where it was polished on its active set (None: the solver's
+    tolerance, about its square root where the optimum is flat)."""
 
     z: np.ndarray | None
     status: str
     objective: float
     budget_dual: float
+    precision: float | None = None
 
 
 def variable_scale(maps: Maps) -> np.ndarray:
