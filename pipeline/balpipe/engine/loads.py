@@ -26,18 +26,15 @@ from typing import Callable
 import numpy as np
 
 from ..mechanics.loads import Anchor, AppliedLoad, ForceElement, JointFriction, LoadTable, TorsionElement
+from ..mechanics.planar import cross, rotate
 from ..model import Model, Prismatic, Revolute
-from .compile import Compiled, _perp, rotate
+from .compile import Compiled, _perp
 from .errors import AnalysisError
 
 Solver = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 
 #: Newton iterations of the Coulomb friction before it is declared self-locking
 MAX_ITERATIONS = 60
-
-
-def _cross(u: np.ndarray, w: np.ndarray) -> np.ndarray:
-    return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
 
 
 @dataclass
@@ -84,10 +81,10 @@ class _Acc:
         frame = self.frame if frame is None else frame
         if k is None:
             frame[:, :2] += F
-            frame[:, 2] += _cross(P, F)
+            frame[:, 2] += cross(P, F)
         else:
             Q[:, 3 * k: 3 * k + 2] += F
-            Q[:, 3 * k + 2] += _cross(P - self.q[:, 3 * k: 3 * k + 2], F)
+            Q[:, 3 * k + 2] += cross(P - self.q[:, 3 * k: 3 * k + 2], F)
 
     def torque(self, k: int | None, T: np.ndarray, Q: np.ndarray | None = None,
                frame: np.ndarray | None = None) -> None:
@@ -101,7 +98,7 @@ class _Acc:
     def outside(self, P: np.ndarray | None, F: np.ndarray | None, T: np.ndarray | None = None) -> None:
         if F is not None:
             self.external[:, :2] += F
-            self.external[:, 2] += _cross(P, F)
+            self.external[:, 2] += cross(P, F)
         if T is not None:
             self.external[:, 2] += T
 
