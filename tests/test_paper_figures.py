@@ -153,7 +153,8 @@ def test_stage_styles_apply_only_to_a_complete_set_of_the_main_designs_stages():
     from balpipe.balancing.base import in_style_order, style_index, styled
 
     def r(name, style):
-        return NS(stage=NS(name=name, style=style, group=""))
+        design, _, _ = name.rpartition(":")  # this test's shorthand: a compared design's stage as design:stage
+        return NS(stage=NS(name=name, style=style, group="", design=design or None))
 
     main = [r("unbalanced", 0), r("linkage", 3), r("counterweights", 1), r("counter_rotations", 2)]
     other = [r("b:unbalanced", 0), r("b:counterweights", 1)]

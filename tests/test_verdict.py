@@ -28,8 +28,12 @@ def stage(name, balances="", f=1.0, m=1.0, ref="unbalanced", tol=1e-9, realisabl
 
 
 def results(*stages, refs=()):
-    return {"status": "ok", "stages": [stage("unbalanced")] + list(stages), "references": list(refs),
-            "moving_mass": 2.0, "actuators": [], "comparison": {"rows": []}}
+    """A results.json of ``stages``; a stage given ``design=`` is one of that compared design (its
+    ``comparison`` row says so, as results.json's do)."""
+    stages = [stage("unbalanced")] + list(stages)
+    rows = [{"stage": s["name"], "design": s.pop("design", "main")} for s in stages]
+    return {"status": "ok", "stages": stages, "references": list(refs),
+            "moving_mass": 2.0, "actuators": [], "comparison": {"rows": rows}}
 
 
 def test_moment_worse_after_a_stage_claiming_moment_balance_is_never_positive():
@@ -72,9 +76,11 @@ def test_unclaimed_worse_final_stage_is_a_warning_and_references_count():
 
 def test_headline_from_the_main_design_never_a_compared_one():
     r = results(stage("cw", "force", f=1e-13, m=2.0), stage("cr", "force+moment", f=1e-13, m=1e-13),
-                stage("other:cw", "force", f=0.4, m=1.1))
+                stage("other:cw", "force", f=0.4, m=1.1, design="other"))
     v = V.verdict(r)
     assert [g["final"] for g in v["motions"]] == ["cr"]
+    assert V.verdict(r, main={"unbalanced", "cw", "cr"}) == v  # the study's own list, as results.json gives it
+    assert [g["final"] for g in V.verdict(r, main={"unbalanced", "cw", "cr", "other:cw"})["motions"]] == ["other:cw"]
     assert v["force"]["outcome"] == "cancelled" and v["moment"]["outcome"] == "cancelled"
     assert "other:cw" in v["stages"]  # judged, but not the spec's headline
 
@@ -116,7 +122,10 @@ def test_results_json_carries_the_verdict_with_the_main_designs_costs(four_bar):
     v = r["verdict"]
     assert set(v) >= {"level", "text", "force", "moment", "references", "motions", "stages"}
     g = v["motions"][0]
-    assert g["final"] == "counter_rotations" and ":" not in g["final"]  # not crank_only:crank_cw
+    assert g["final"] == "counter_rotations"  # not crank_only:crank_cw
+    design = {row["stage"]: row["design"] for row in r["comparison"]["rows"]}
+    assert design[g["final"]] == "main" and design["crank_only:crank_cw"] == "crank_only"
+    assert next(s for s in study.stages if s.stage.name == "crank_only:crank_cw").stage.design == "crank_only"
     assert v["level"] == "good"
     main = next(s for s in r["stages"] if s["name"] == g["final"])
     assert g["force"][1] == main["max_inertial_force"] and g["moment"][1] == main["max_inertial_moment"]
@@ -152,7 +161,7 @@ def test_methods_on_one_mechanism_side_by_side():
     def entry(title, method, *st):
         r = results(*st)
         r.update({"mechanism": "rpr3", "method": method, "comparison": {"rows": [
-            {"stage": s["name"], "counter_rotations": 3} for s in r["stages"]]}})
+            {"stage": s["name"], "design": "main", "counter_rotations": 3} for s in r["stages"]]}})
         return {"title": title, "link": f"{title}/index.html", "results": r, "verdict": V.verdict(r)}
 
     a = entry("idler", "idler_loop", stage("cr", "force+moment", f=1e-13, m=1e-13))

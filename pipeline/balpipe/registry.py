@@ -156,7 +156,8 @@ def balance(spec: Any, balancing: Any = None, page: bool = True) -> BalanceResul
 
 def balance_designs(spec: Any, page: bool = True) -> BalanceResult:
     """:func:`balance`, then the stages of every design in ``spec.compare`` after the main
-    design's, named ``design:stage`` (their unbalanced stage, the same model, is dropped);
+    design's, each with its :attr:`Stage.design` and named ``design:stage`` on the page and in
+    results.json (their unbalanced stage, the same model, is dropped);
     parameters are prefixed the same way and details go to ``details["compare"][design]``;
     ``page`` as in :func:`balance`."""
     main = balance(spec, page=page)
@@ -175,7 +176,7 @@ def balance_designs(spec: Any, page: bool = True) -> BalanceResult:
                 path = ("compare", k) + path
             raise SpecFieldError(path, f"design {d.name!r}: {exc.message}") from None
         for s in res.stages[1:]:
-            stages.append(replace(s, name=f"{d.name}:{s.name}", label=f"{d.label or d.name}: {s.label}"))
+            stages.append(replace(s, name=f"{d.name}:{s.name}", label=f"{d.label or d.name}: {s.label}", design=d.name))
         params += [replace(p, name=f"{d.name}:{p.name}") for p in res.parameters]
         notes += [f"{d.label or d.name}: {n}" for n in res.notes]
         details["compare"][d.name] = res.details

@@ -44,6 +44,9 @@ class Stage:
     # follows it): the verdict's headline for its motion (default: the motion's last stage),
     # balpipe.report.verdict.headline_stage
     headline: bool = False
+    # the design of ``spec.compare`` the stage belongs to (its name; its stage is then named
+    # "design:stage" on the page and in results.json), None for the main design's
+    design: str | None = None
 
 
 @dataclass(frozen=True)
@@ -62,20 +65,20 @@ def styled(results: list) -> bool:
     """Whether the method gave the main design's stages of ``results`` their line styles
     (:attr:`Stage.style`): each has one, and they are 0 .. n-1 (a partial balancing that wraps a
     paper's method, whose own stages have none, keeps the order of its stages)."""
-    styles = [r.stage.style for r in results if ":" not in r.stage.name]
+    styles = [r.stage.style for r in results if r.stage.design is None]
     return bool(styles) and None not in styles and sorted(styles) == list(range(len(styles)))
 
 
 def in_style_order(results: list) -> list:
     """Stage results (anything with a ``.stage``) in the order of their line styles on the page:
     when :func:`styled`, the main design's stages by :attr:`Stage.style`, then those of the
-    compared designs (named design:stage) in their order; else in their order. Item k of the
+    compared designs (:attr:`Stage.design`) in their order; else in their order. Item k of the
     list is drawn in ``draw.figures.style(k)`` in every figure of a page, the generic ones and
     the paper's."""
     if not styled(results):
         return list(results)
-    main = sorted((r for r in results if ":" not in r.stage.name), key=lambda r: r.stage.style)
-    return main + [r for r in results if ":" in r.stage.name]
+    main = sorted((r for r in results if r.stage.design is None), key=lambda r: r.stage.style)
+    return main + [r for r in results if r.stage.design is not None]
 
 
 def style_index(results: list, r) -> int:

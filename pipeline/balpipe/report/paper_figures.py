@@ -84,7 +84,7 @@ def own_figures(study) -> list[tuple[str, str, str]]:
 def _paper004(study) -> list[tuple[str, str, str]]:
     un = study.unbalanced
     an = un.analysis
-    force_only = next((s for s in study.stages if s.stage.balances == "force" and ":" not in s.stage.name), None)
+    force_only = next((s for s in study.stages if s.stage.balances == "force" and s.stage.design is None), None)
     k0 = _k(study, un)
     out = [
         ("Fig. 10a of paper 004: shaking force along x (N)",

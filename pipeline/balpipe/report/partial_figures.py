@@ -58,7 +58,7 @@ def _marks(study, det: dict, x: str, y: str) -> list[tuple[str, float, float]]:
         # the fronts' peaks are over every motion, the stages' analyses over the spec's motion
         # alone: mark only what is measured as the fronts are, the unbalanced mechanism and the
         # chosen design (the method's own peaks over every motion)
-        chosen = [s for s in study.stages if ":" not in s.stage.name][-1]
+        chosen = [s for s in study.stages if s.stage.design is None][-1]
         for label, peaks, mass in ((study.unbalanced.stage.label, det["unbalanced"], 0.0),
                                    (chosen.stage.label, det["peaks"], det["added_mass"])):
             values = {"added_mass": mass, **peaks}

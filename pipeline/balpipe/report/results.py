@@ -91,7 +91,7 @@ def verdict_of(study: Study, out: dict) -> dict:
     weight (total moving mass x g, N) is given apart from its inertial loads."""
     g = math.hypot(*study.unbalanced.analysis.gravity)
     weights = {s.stage.name: s.analysis.extra["total_mass"] * g for s in study.stages} if g else None
-    return verdict(out, weights)
+    return verdict(out, weights, main={s.stage.name for s in study.stages if s.stage.design is None})
 
 
 def comparison(study: Study) -> dict:
@@ -100,15 +100,15 @@ def comparison(study: Study) -> dict:
     normal force of prismatic pairs), with the joint that carries it."""
     table = joint_load_table(study)
     rows = []
-    before: dict[str, float] = {}  # per design: peak moment of its latest stage without counter-rotations
+    before: dict[str | None, float] = {}  # per design: peak moment of its latest stage without counter-rotations
     for s in study.stages:
         m = s.metrics
         loads = [(row["peaks"].get(s.stage.name, 0.0), row["joint"]) for row in table if row["unit"] == "N"]
         peak, joint = max(loads) if loads else (0.0, "")
-        design, _, stage = s.stage.name.rpartition(":")
+        design = s.stage.design
         discs = counter_rotations(s.stage.model, study.unbalanced.stage.model)
         if discs == 0:
-            before[design or "main"] = m.max_shaking_moment
+            before[design] = m.max_shaking_moment
         rows.append({
             "stage": s.stage.name, "label": s.stage.label, "design": design or "main", "balances": s.stage.balances,
             "added_mass": m.added_mass, "added_inertia": m.added_inertia,
@@ -116,7 +116,7 @@ def comparison(study: Study) -> dict:
             "max_shaking_force": m.max_shaking_force, "max_shaking_moment": m.max_shaking_moment,
             "force_ratio": m.force_ratio, "moment_ratio": m.moment_ratio,
             "counter_rotations": discs,
-            "moment_before_counter_rotations": before.get(design or "main", study.unbalanced.analysis.max_moment),
+            "moment_before_counter_rotations": before.get(design, study.unbalanced.analysis.max_moment),
         })
     return {"reference": study.unbalanced.stage.name, "rows": rows}
 

@@ -16,7 +16,7 @@ reproduce), ``neutral`` (nothing changed), ``good``. A spec's level is the worst
 design's headline stages (below), of its stages' claims and of its references: a spec whose |M|
 gets worse after a stage that claims moment balance is never ``good``.
 
-The headline numbers come from the spec's main design (stages named without ``design:``), one
+The headline numbers come from the spec's main design (not a design of ``compare``), one
 row per motion (the stages sharing a reference stage); a compared design never stands in. Per
 motion the headline is the stage whose numbers the paper publishes where the method declares one
 (:attr:`balpipe.balancing.base.Stage.headline`; paper 003: case 2, not the case 3 after it), else
@@ -112,19 +112,24 @@ def stage_verdict(stage: dict, weight: float | None = None, reference: dict | No
     }
 
 
-def is_main(stage: dict) -> bool:
-    """A stage of the spec's main design (those of ``compare`` are named 'design:stage')."""
-    return ":" not in stage["name"]
+def main_design(results: dict) -> set[str]:
+    """The names of the stages of the spec's main design, from the ``comparison`` rows of a
+    results.json (their ``design`` is "main"); every stage when it has none."""
+    rows = (results.get("comparison") or {}).get("rows")
+    if not rows:
+        return {s["name"] for s in results.get("stages") or []}
+    return {r["stage"] for r in rows if r.get("design") == "main"}
 
 
-def motions(stages: list[dict]) -> list[tuple[dict, list[dict]]]:
-    """The main design's stages per motion: (reference stage, the stages measured against it), in
-    the spec's order. One motion for most specs; one per trajectory for paper 003's."""
+def motions(stages: list[dict], main: set[str]) -> list[tuple[dict, list[dict]]]:
+    """The main design's stages (those named in ``main``) per motion: (reference stage, the stages
+    measured against it), in the spec's order. One motion for most specs; one per trajectory for
+    paper 003's."""
     out: dict[str, tuple[dict, list[dict]]] = {}
     by_name = {s["name"]: s for s in stages}
     for s in stages:
         ref = s.get("reference") or stages[0]["name"]
-        if ref == s["name"] or not is_main(s):
+        if ref == s["name"] or s["name"] not in main:
             continue
         out.setdefault(ref, (by_name.get(ref, stages[0]), []))[1].append(s)
     return list(out.values())
@@ -178,10 +183,10 @@ def _span(outs: list[dict]) -> dict:
             "text": f"{text} (over {len(outs)} motions)"}
 
 
-def verdict(results: dict, weights: dict[str, float] | None = None) -> dict[str, Any]:
+def verdict(results: dict, weights: dict[str, float] | None = None, main: set[str] | None = None) -> dict[str, Any]:
     """The ``verdict`` object of ``results.json`` from its other fields (``stages``,
     ``references``, ``status``); ``weights``: per stage name, the moving links' weight (N), with
-    gravity on."""
+    gravity on; ``main``: the names of the main design's stages (default: :func:`main_design`)."""
     weights = weights or {}
     stages = results.get("stages") or []
     per_stage = {}
@@ -191,7 +196,7 @@ def verdict(results: dict, weights: dict[str, float] | None = None) -> dict[str,
             continue  # a reference: nothing to judge
         per_stage[s["name"]] = stage_verdict(s, weights.get(s["name"]), by_name.get(s.get("reference", stages[0]["name"])))
     groups = []
-    for ref, members in motions(stages):
+    for ref, members in motions(stages, main if main is not None else main_design(results)):
         final, declared = headline_stage(members)
         v = per_stage[final["name"]]
         groups.append({

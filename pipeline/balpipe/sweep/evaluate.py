@@ -18,8 +18,8 @@ def _validate(data: dict):
 
 
 def _pick_stage(result, stage: str | None):
-    if stage is None:  # the main method's last stage (compared designs prefix theirs with "name:")
-        return [s for s in result.stages if ":" not in s.name][-1]
+    if stage is None:  # the main method's last stage (not one of a compared design)
+        return [s for s in result.stages if s.design is None][-1]
     for s in result.stages:
         if s.name == stage:
             return s

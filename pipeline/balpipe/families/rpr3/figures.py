@@ -11,9 +11,9 @@ from .template import pose_of, prismatic_equivalent
 
 
 def _own(study) -> list:
-    """The main design's stages (those of ``compare`` designs are named design:stage and shown in
-    the generic "Designs side by side" table, not in the paper's figures)."""
-    return [s for s in study.stages if ":" not in s.stage.name]
+    """The main design's stages (those of ``compare`` designs are shown in the generic "Designs
+    side by side" table, not in the paper's figures)."""
+    return [s for s in study.stages if s.stage.design is None]
 
 
 def _stage(study, name: str):

@@ -44,8 +44,8 @@ def _is_paper(study, paper: str) -> bool:
 
 
 def _main(study) -> dict:
-    """The main design's stage results by name (a ``compare`` design's are named design:stage)."""
-    return {s.stage.name: s for s in study.stages if ":" not in s.stage.name}
+    """The main design's stage results by name (not those of a ``compare`` design)."""
+    return {s.stage.name: s for s in study.stages if s.stage.design is None}
 
 
 def _params(study) -> dict:
