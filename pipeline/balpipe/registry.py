@@ -15,6 +15,7 @@ from .balancing.partial.spec import PartialBalance
 from .balancing.specs import ForceBalance, MomentBalance, Stages
 from .model import Law, Model
 from .laws.drives import drive_laws
+from .laws.load_spec import model_loads
 from .motion import law_for
 from .plugins import Method, Ref, Template, discover
 from .mechanics.sampling import time_grid
@@ -108,7 +109,11 @@ def unbalanced_model(spec: Any) -> Model:
         laws = mech.laws(spec.motion)
     else:
         laws = scalar_laws(spec.motion, mech.drives())
-    return template.build(mech, laws, time_grid(spec))
+    t = time_grid(spec)
+    model = template.build(mech, laws, t)
+    if getattr(spec, "loads", None):
+        model = replace(model, loads=model_loads(spec.loads, model, float(t[0])))
+    return model
 
 
 def motion_model(spec: Any, motion: Any, samples: int | None, path: tuple) -> tuple[Model, np.ndarray]:

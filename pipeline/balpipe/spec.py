@@ -13,6 +13,7 @@ from typing import Annotated, Literal, Union
 from pydantic import Field
 
 from . import registry
+from .laws.load_spec import LoadSpec
 from .laws.motion_spec import Motion
 from .spec_parts import Strict
 from .sweep_spec import SweepSpec
@@ -96,6 +97,9 @@ class Spec(Strict):
     balancing: Balancing = Field(NoBalancing(method="none"))
     analysis: AnalysisSettings = Field(AnalysisSettings())
     validation: ValidationSpec = Field(ValidationSpec())
+    loads: list[LoadSpec] = Field(
+        [], description="springs, dampers, force laws, gas pressures, torsional springs, applied forces and torques, "
+        "joint friction: counted in the efforts, reactions and frame loads, never in the shaking loads")
     references: list[Reference] = Field([], description="published values to compare with")
     compare: list[Design] = Field(
         [], description="other balancing designs of the same mechanism, analysed and tabulated beside the main one"

@@ -8,7 +8,7 @@ Every numeric spec field is one of the types below (:func:`quantity`, :func:`num
 :func:`count`, :data:`Sign`, :data:`Rate`): they refuse booleans, NaN and infinities, and
 magnitudes beyond :data:`MAX_ABS` (stated limits: a 1e300 m link would overflow the engine), with
 a message that names the field's kind and the limit.
-Hand-written on purpose: six dimensions and a dozen units do not justify a units library's
+Hand-written on purpose: a few dimensions and a dozen units do not justify a units library's
 import time in a tool that loads hundreds of specs.
 """
 
@@ -37,17 +37,29 @@ UNITS: dict[str, dict[str, float]] = {
     "velocity": {"m/s": 1.0, "mm/s": 1e-3, "cm/s": 1e-2},
     "angular velocity": {"rad/s": 1.0, "deg/s": math.pi / 180, "rpm": math.pi / 30, "rev/s": 2 * math.pi},
     "angular acceleration": {"rad/s^2": 1.0, "deg/s^2": math.pi / 180},
+    "force": {"N": 1.0, "kN": 1e3, "MN": 1e6, "lbf": 4.4482216152605},
+    "torque": {"N m": 1.0, "kN m": 1e3, "N mm": 1e-3},
+    "pressure": {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "bar": 1e5, "psi": 6894.757293168},
+    "area": {"m^2": 1.0, "cm^2": 1e-4, "mm^2": 1e-6},
+    "stiffness": {"N/m": 1.0, "N/mm": 1e3, "kN/m": 1e3, "kN/mm": 1e6},
+    "damping": {"N s/m": 1.0, "N s/mm": 1e3, "kN s/m": 1e3},
+    "torsional stiffness": {"N m/rad": 1.0, "N m/deg": 180 / math.pi, "kN m/rad": 1e3},
+    "torsional damping": {"N m s/rad": 1.0, "N m s/deg": 180 / math.pi},
     "dimensionless": {"": 1.0},
 }
 SI = {"length": "m", "angle": "rad", "time": "s", "mass": "kg", "inertia": "kg m^2",
       "acceleration": "m/s^2", "velocity": "m/s", "angular velocity": "rad/s",
-      "angular acceleration": "rad/s^2", "dimensionless": ""}
+      "angular acceleration": "rad/s^2", "force": "N", "torque": "N m", "pressure": "Pa", "area": "m^2",
+      "stiffness": "N/m", "damping": "N s/m", "torsional stiffness": "N m/rad",
+      "torsional damping": "N m s/rad", "dimensionless": ""}
 
 #: Largest magnitude accepted per dimension, in SI units: beyond these a planar mechanism is not
 #: what the spec means, and products such as m L^2 w^2 approach float overflow.
 MAX_ABS = {"length": 1e4, "angle": 1e5, "time": 1e5, "mass": 1e6, "inertia": 1e12,
            "acceleration": 1e7, "velocity": 1e6, "angular velocity": 1e6,
-           "angular acceleration": 1e9, "dimensionless": 1e12}
+           "angular acceleration": 1e9, "force": 1e9, "torque": 1e9, "pressure": 1e10, "area": 1e4,
+           "stiffness": 1e12, "damping": 1e12, "torsional stiffness": 1e12, "torsional damping": 1e12,
+           "dimensionless": 1e12}
 
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 #: a quantity as written, "<number> <unit>": group 1 the number, group 2 the unit (may be empty)
@@ -119,7 +131,9 @@ def _example(dimension: str) -> str:
     return {"length": "0.2 m", "angle": "30 deg", "time": "0.25 s", "mass": "12 g",
             "inertia": "0.01 kg m^2", "acceleration": "9.81 m/s^2", "velocity": "0.5 m/s",
             "angular velocity": "2 rad/s", "angular acceleration": "10 rad/s^2",
-            "dimensionless": "0.5"}[dimension]
+            "force": "250 N", "torque": "12 N m", "pressure": "6 bar", "area": "50 cm^2",
+            "stiffness": "2 kN/m", "damping": "40 N s/m", "torsional stiffness": "5 N m/rad",
+            "torsional damping": "0.2 N m s/rad", "dimensionless": "0.5"}[dimension]
 
 
 def quantity(dimension: str, **field_kwargs: Any) -> Any:

@@ -289,7 +289,8 @@ def solve(lt: LoadTerms, rhs: np.ndarray, solver: Solver) -> tuple[np.ndarray, n
     """Multipliers (N, m) and frame load (N, 3: Fx, Fy, M about O) of Phi_q^T lambda = rhs + Q
     with every load, Coulomb friction included (module docstring); ``solver(rhs)`` gives the
     multipliers and -Phi_q0^T lambda of a right-hand side, linearly. Adds each Coulomb joint's
-    friction (signed, on body b or the slider) and its power loss to ``lt.series``."""
+    friction (signed, on body b or the slider), its magnitude ``coulomb`` and its power loss to
+    ``lt.series``."""
     lam, frame = solver(rhs + lt.Q)
     frame = frame + lt.frame
     if not lt.coulomb:
@@ -304,6 +305,7 @@ def solve(lt: LoadTerms, rhs: np.ndarray, solver: Solver) -> tuple[np.ndarray, n
         s = lt.series[cf.name]
         s[cf.on_b] = s[cf.on_b] + cf.direction * phi[:, j]
         s["loss"] = s["loss"] + phi[:, j] * np.abs(cf.rate)
+        s["coulomb"] = phi[:, j]
         s["normal" if cf.on_b == "force" else "reaction"] = np.linalg.norm(_reaction(cf, lam), axis=1)
     return lam, frame
 

@@ -25,6 +25,7 @@ from ..units import Angle, Duration, Length, PositiveLength, Rate, RateRate, num
 from . import cycle as cycle_laws
 from . import paths as geometry
 from .periodic import Cam, ConstantSpeed, Fourier, cam_jumps
+from .load_spec import table_files as table_files_of_loads
 from .table import Tabulated, TableError, parse_table
 
 #: relative size of a state jump at a join that counts as a jump (of the segment's own scale)
@@ -531,31 +532,35 @@ def motion_sections(spec: Any):
             yield root + ("motions", k, "motion"), other.motion
 
 
+def spec_tables(spec: Any) -> list[tuple[tuple, Any]]:
+    """(path, entry with ``file`` and ``_text``) of every table ``spec`` reads: its motions'
+    table drives, then its loads' tables (:func:`.load_spec.table_files`)."""
+    out = [(sub, d) for root, motion in motion_sections(spec) for name, drive in motion.drive.items()
+           for sub, d in _tables(drive, root + ("drive", name))]
+    return out + table_files_of_loads(getattr(spec, "loads", None) or [])
+
+
 def read_tables(spec: Any, folder: FilePath) -> None:
-    """Read the CSV file of every table drive of ``spec``'s motions (relative to ``folder``, the
-    spec's), keeping its text on the drive. The file is read by
+    """Read the CSV file of every table of ``spec`` (:func:`spec_tables`, relative to ``folder``,
+    the spec's), keeping its text on the entry. The file is read by
     :func:`balpipe.runtime.inputs.read_input_text`: only a regular file inside the spec's folder,
     at most :data:`MAX_TABLE_BYTES`; anything else is a located error that quotes none of it."""
-    for root, motion in motion_sections(spec):
-        for name, drive in motion.drive.items():
-            for sub, d in _tables(drive, root + ("drive", name)):
-                try:
-                    d._text = read_input_text(folder, d.file, MAX_TABLE_BYTES, "table")
-                except InputFileError as exc:
-                    raise SpecFieldError(sub + ("file",), str(exc)) from None
+    for sub, d in spec_tables(spec):
+        try:
+            d._text = read_input_text(folder, d.file, MAX_TABLE_BYTES, "table")
+        except InputFileError as exc:
+            raise SpecFieldError(sub + ("file",), str(exc)) from None
 
 
 def table_texts(spec: Any) -> str:
     """The text of every table the spec reads, for the build's input hash ("" without tables, so
     the hash of a spec without tables is unchanged): a changed CSV rebuilds the page."""
-    return "".join(f"\0table {d.file}\0{d._text}" for _, motion in motion_sections(spec)
-                   for drive in motion.drive.values() for _, d in _tables(drive, ()))
+    return "".join(f"\0table {d.file}\0{d._text}" for _, d in spec_tables(spec))
 
 
 def table_files(spec: Any) -> list[str]:
     """The files of the tables the spec reads, as written in it, in :func:`table_texts`'s order."""
-    return [d.file for _, motion in motion_sections(spec) for drive in motion.drive.values()
-            for _, d in _tables(drive, ())]
+    return [d.file for _, d in spec_tables(spec)]
 
 
 def _tables(drive: Any, path: tuple):

@@ -71,9 +71,12 @@ def _name(cell: str) -> str:
 
 
 def parse_table(text: str, dimension: str, time_column: str | None = None,
-                value_column: str | None = None) -> Table:
+                value_column: str | None = None, argument: str = "time", spline: bool = True) -> Table:
     """Parse the CSV ``text``: the time column and the value column of ``dimension`` (angle or
-    length) converted to SI; raises :class:`TableError` with the row of the first problem."""
+    length) converted to SI; raises :class:`TableError` with the row of the first problem.
+    ``argument``: the dimension of the first column when it is not a time (a load's table
+    against an angle or a stroke); ``spline`` False: a table interpolated linearly (a load's),
+    which needs two rows, not a spline's eight and even spacing."""
     reader = list(csv.reader(io.StringIO(text)))
     lines = [(k + 1, r) for k, r in enumerate(reader) if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
     if not lines:
@@ -82,7 +85,7 @@ def parse_table(text: str, dimension: str, time_column: str | None = None,
     it, tu = _column(header, time_column, 0, "time")
     iv, vu = _column(header, value_column, 1, "value")
     factors = []
-    for unit, dim, col in ((tu, "time", header[it]), (vu, dimension, header[iv])):
+    for unit, dim, col in ((tu, argument, header[it]), (vu, dimension, header[iv])):
         if not unit:
             factors.append(1.0)
             continue
@@ -100,11 +103,17 @@ def parse_table(text: str, dimension: str, time_column: str | None = None,
                              f"(the row has {len(cells)} cell(s))", row) from None
         if not (np.isfinite(tv) and np.isfinite(qv)):
             raise TableError("not a finite number", row)
+        if ts and not tv * factors[0] > ts[-1] and argument != "time":
+            raise TableError(f"the {argument} column must increase: {tv:g} after {ts[-1] / factors[0]:g} on row {rows[-1]}", row)
         if ts and not tv * factors[0] > ts[-1]:
             raise TableError(f"times must increase: t = {tv:g} after {ts[-1] / factors[0]:g} on row {rows[-1]}", row)
         ts.append(tv * factors[0])
         qs.append(qv * factors[1])
         rows.append(row)
+    if not spline:
+        if len(ts) < 2:
+            raise TableError("too coarse: a load table needs at least two rows of data")
+        return Table(np.array(ts), np.array(qs), tuple(rows))
     if len(ts) < MIN_ROWS:
         raise TableError(f"too coarse: {len(ts)} rows of data; a spline with consistent accelerations needs at least {MIN_ROWS}")
     dt = np.diff(ts)

@@ -100,6 +100,7 @@ def simulate(
     abort: tuple[float, float] | None = None,
     settle: int = 0,
     feedforward: bool = False,
+    applied=None,
     **build_options,
 ) -> SimulationRun:
     """Simulate ``model`` along ``analysis``' motion and measure the loads on the frame.
@@ -130,6 +131,8 @@ def simulate(
     ``feedforward`` (a position-driven run only): before each step every moving body gets the
     inertial force and torque of the analysed motion (:mod:`balpipe.validate.feedforward`); the
     drivers impose the motion either way, the solver converges with fewer iterations.
+    ``applied``: a :class:`balpipe.validate.applied.AppliedLoads`, whose loads act on the
+    bodies before every step (a torque-driven run of a model with loads).
     """
     t = np.asarray(analysis.t, dtype=float)
     t0 = float(t[0])
@@ -145,6 +148,8 @@ def simulate(
     )
     space = sim.space
     bodies = sim.moving
+    if applied is not None:
+        applied = None if sim.floating else applied.bind(sim.bodies)
     everything = bodies + ([sim.base] if sim.floating else [])
     # the loads are measured with the model's masses and moments (a massless body simulated
     # with a floor mass, and the light auxiliary gears of meshes, count for nothing)
@@ -208,6 +213,8 @@ def simulate(
             push(step)
         for act, e in acts:
             act.apply(float(e[max(k, 0)]), dt)
+        if applied is not None:
+            applied.apply(float(every[step]), dt)
         space.step(dt)
         if k >= -1:
             read()

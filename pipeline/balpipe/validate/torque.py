@@ -57,6 +57,7 @@ from .run import SimulationRun, model_scale, simulate
 from .extend import continued, is_moving_start
 from .settings import (HEALTH_LIMIT, ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings,
                        halve_while_shrinking, jump_times)
+from .applied import COULOMB_NOTE, AppliedLoads
 from .space import build_space
 from .verdict import Verdict
 
@@ -193,6 +194,7 @@ class _Plan:
     n: int
     times: np.ndarray
     iterations: int
+    applied: AppliedLoads | None = None
 
 
 def _plan(model: Model, analysis: Analysis, settings: ValidationSettings, analytic_model: Model | None,
@@ -228,8 +230,11 @@ def _plan(model: Model, analysis: Analysis, settings: ValidationSettings, analyt
         )
     _average_jumps(efforts, effort_model, analysis, times, dt)
     travel = _travel(analytic_model, t)
+    applied = AppliedLoads(sim_model, fine, times) if sim_model.loads else None
+    if applied is not None and applied.has_coulomb:
+        notes.append(COULOMB_NOTE)
     return _Plan(model, analytic_model, sim_model, floored, efforts, share, notes, travel, dt, nsteps, idx, n, times,
-                 int(it_default or ITERATIONS))
+                 int(it_default or ITERATIONS), applied)
 
 
 def _average_jumps(efforts: dict[str, np.ndarray], model: Model, analysis: Analysis, times: np.ndarray,
@@ -297,7 +302,7 @@ def _torque_driven_once(
                     sim_model, analysis, dt, iterations, startup_steps=settings.startup_steps,
                     startup_iterations=max(settings.startup_iterations, iterations),
                     efforts={k: factor * v for k, v in efforts.items()}, measure_with=model,
-                    mass_floor=settings.mass_floor, abort=abort,
+                    mass_floor=settings.mass_floor, abort=abort, applied=plan.applied,
                 )
             except (ZeroDivisionError, ValueError, OverflowError, FloatingPointError):
                 return None
