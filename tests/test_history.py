@@ -270,6 +270,6 @@ def test_a_spec_that_build_rejects_is_rejected_by_history(tmp_path):
     p.write_text(text, encoding="utf-8")
     outcome = build([str(p)], Options(out=tmp_path / "out", simulate=False))[0]
     assert outcome.status == "error" and "motion.duration" in outcome.message and "overflows" in outcome.message
-    point = history.compute(text, str(p), False, "h")
+    point = history.compute(text, outcome.source, False, "h")  # the name build publishes: fast.yaml
     assert point["status"] == "invalid" and point["stages"] == []
     assert point["problems"] == outcome.message.splitlines()

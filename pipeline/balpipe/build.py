@@ -32,17 +32,17 @@ from .report import history_file
 from .runtime.inputs import MAX_TABLE_BYTES, InputFileError, read_input_text
 from .runtime.fsutil import remove_path, remove_temporaries, tmp_name, write_atomic_dir, write_file_atomic, write_new
 from .site_files.site_earlier import earlier_pages
-from .site_files.spec_files import MAX_SLUG, clash_notes, clashes, find_specs, slug_for  # noqa: F401  (build.find_specs, build.slug_for as before)
+from .site_files.spec_files import MAX_SLUG, clash_notes, clashes, find_specs, published_names, slug_for  # noqa: F401  (build.find_specs, build.slug_for as before)
 
 # The phases' modules (numpy, pydantic, matplotlib, jinja2) are imported when a spec is computed,
 # not when an unchanged site is checked (a rebuild with nothing changed takes 0.3 s). The
 # names below stay this module's, so that a caller (the build benchmark) can wrap them.
 
 
-def load(path):
+def load(path, name=None):
     """:func:`balpipe.loader.load`."""
     from .loader import load as f
-    return f(path)
+    return f(path, name)
 
 
 def schema() -> dict:
@@ -96,6 +96,12 @@ class Options:
     simulate: bool = True
     force: bool = False
     sim_workers: int = 1  # processes for one spec's simulations (cores left over by fewer specs than cores)
+    #: the published name of each spec path (:func:`published_names`); a path not in it is shown as given
+    names: tuple[tuple[Path, str], ...] = ()
+
+    def name(self, path: Path) -> str:
+        """How published files and messages name the spec ``path``: never a path of the machine."""
+        return dict(self.names).get(path, str(path))
 
 
 class SchedulerError(Exception):
@@ -174,6 +180,7 @@ class Job:
     figure_cache: Path | None = None
     redraw: bool = False  # --force: every figure drawn, simulation run and search computed, its cache entry rewritten
     figure_keys: frozenset[str] = frozenset()  # the cache entries the planning used (history figures): kept
+    source: str = ""  # the spec's published name (Options.name), "" for str(path)
 
 
 @dataclass
@@ -201,7 +208,7 @@ def _mixed_hash(inputs: str, target: Path, simulate: bool) -> str:
     return history_file.mix_hash(input_hash(inputs, Options(out=target.parent, simulate=simulate)), target)
 
 
-def _unchanged(path: Path, slug: str, target: Path, previous: dict, seconds: float) -> Outcome:
+def _unchanged(path: Path | str, slug: str, target: Path, previous: dict, seconds: float) -> Outcome:
     stale_failed = target / "failed"
     if stale_failed.exists() or stale_failed.is_symlink():  # the spec is back to its good page
         remove_path(stale_failed)
@@ -242,22 +249,22 @@ def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outc
     start = time.perf_counter()
     slug = slug_for(path)
     try:
-        loaded = load(path)
+        loaded = load(path, opts.name(path))
     except SpecErrors as exc:
-        return Outcome(str(path), slug, "error", str(exc), spec_error=True, seconds=time.perf_counter() - start)
+        return Outcome(opts.name(path), slug, "error", str(exc), spec_error=True, seconds=time.perf_counter() - start)
     target = opts.out / slug
     h = page_hash(loaded, target, opts.simulate)
     if not opts.force:
         previous = _read_results(target)
         if previous is not None and previous.get("input_hash") == h:
-            return _unchanged(path, slug, target, previous, time.perf_counter() - start)
+            return _unchanged(opts.name(path), slug, target, previous, time.perf_counter() - start)
     from .cache import figures as cache
     from .report import history_page
 
     store = cache.Store(opts.out, slug, code_hash(), reuse=not opts.force) if figure_cache else None
     with cache.using(store):
         history, files = history_page.section(target), history_page.build_files(target)
-    return Job(path, loaded.text, h, opts.simulate, history, files, opts.sim_workers,
+    return Job(path, loaded.text, h, opts.simulate, history, files, opts.sim_workers, source=opts.name(path),
                figure_cache=opts.out if figure_cache else None, redraw=opts.force,
                figure_keys=frozenset(store.used) if store is not None else frozenset())
 
@@ -295,11 +302,11 @@ def _compute(job: Job) -> Computed:
     from .spec_parts import SpecFieldError
 
     start = time.perf_counter()
-    source = str(job.path)
+    source = job.source or str(job.path)
     loaded = None
     try:
-        spec, node = load_text(job.text, source)
-        loaded = LoadedSpec(job.path, job.text, spec, node)
+        spec, node = load_text(job.text, source, job.path.parent)
+        loaded = LoadedSpec(job.path, job.text, spec, node, source)
         with pool.spare_workers(job.sim_workers):  # the cores left over also serve the spec's independent work
             st = runner.analyse(loaded, simulate=job.simulate)
         extra: dict[str, str] = {}
@@ -327,14 +334,27 @@ def _compute(job: Job) -> Computed:
         message = str(loaded.error(exc)) if loaded is not None else f"{source}: {exc}"
         return Computed("error", message, seconds=time.perf_counter() - start)
     except Exception as exc:  # a bug in balpipe: keep going, report it with its traceback
-        tb = traceback.format_exc(limit=6)
+        tb = _TB_FILE.sub(lambda m: f'File "{_code_file(m.group(1))}"', traceback.format_exc(limit=6))
         return Computed("crash", f"{source}: internal error: {exc!r}\n{tb}", seconds=time.perf_counter() - start)
+
+
+_TB_FILE = re.compile(r'File "([^"\n]+)"')
+
+
+def _code_file(path: str) -> str:
+    """A traceback's file as the index may show it: from the package folder on
+    (``balpipe/engine/x.py``, ``numpy/linalg/y.py``), never the machine's path to it."""
+    parts = Path(path).parts
+    for k in range(len(parts) - 2, -1, -1):
+        if parts[k] in ("site-packages", "dist-packages", "pipeline", "lib-dynload") or parts[k].startswith("python3"):
+            return "/".join(parts[k + 1:])
+    return parts[-1] if parts else path
 
 
 def finish(job: Job, done: Computed, opts: Options) -> Outcome:
     """Write what :func:`compute` made into the site: the page folder, replaced whole; a build
     that fails its checks after a good one goes beside it, in ``failed/``."""
-    source, slug = str(job.path), slug_for(job.path)
+    source, slug = job.source or str(job.path), slug_for(job.path)
     if done.status in ("error", "crash"):
         return Outcome(source, slug, done.status, done.message, spec_error=done.status == "error", seconds=done.seconds)
     target = opts.out / slug
@@ -443,20 +463,21 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
     site stays whole."""
     problems: list[str] = []
     specs = find_specs(paths, problems)
+    opts = replace(opts, names=tuple(published_names(paths, specs).items()))
     outcomes: list[Outcome] = [Outcome(msg.split(":", 1)[0], "", "error", msg, spec_error=True) for msg in problems]
-    clash = clashes(specs)
+    clash = clashes(specs, opts.name)
     todo: list[Path] = []
     for p in specs:
         if p in clash:
-            outcomes.append(Outcome(str(p), slug_for(p), "error", clash[p], spec_error=True))
+            outcomes.append(Outcome(opts.name(p), slug_for(p), "error", clash[p], spec_error=True))
         else:
             todo.append(p)
     prepare_output(opts.out)
     if progress:
         for o in outcomes:  # refused before any work: k = 0
             progress(0, len(todo), o)
-        for p, note in clash_notes(specs).items():  # said before any work too; built as usual
-            progress(0, len(todo), Outcome(str(p), slug_for(p), "ok", note))
+        for p, note in clash_notes(specs, opts.name).items():  # said before any work too; built as usual
+            progress(0, len(todo), Outcome(opts.name(p), slug_for(p), "ok", note))
     cores = jobs if jobs is not None else pool.usable_cores()
     changed = len(todo) if scheduler else sum(up_to_date(p, opts) is None for p in todo)
     if jobs is None:
@@ -544,7 +565,8 @@ def _run(todo: list[Path], opts: Options, jobs: int, progress, outcomes: list[Ou
     built = pool.in_order(build_one, rest, jobs, opts, cost=lambda p: spec_cost(p, opts.simulate))
     for k, p in enumerate(todo):
         previous, seconds = known[p]
-        o = next(built) if previous is None else _unchanged(p, slug_for(p), opts.out / slug_for(p), previous, seconds)
+        o = next(built) if previous is None else _unchanged(opts.name(p), slug_for(p), opts.out / slug_for(p), previous,
+                                                            seconds)
         outcomes.append(o)
         if progress:
             progress(k + 1, total, o)

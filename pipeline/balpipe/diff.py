@@ -42,30 +42,58 @@ class Side:
     study: Study
 
 
-def read_side(ref: str) -> LoadedSpec:
-    """A spec file, or REV:PATH read with ``git show REV:./PATH`` (PATH relative to the current
-    folder, or absolute)."""
+def shown_ref(ref: str) -> str:
+    """How the outputs name a side: a file or the PATH of REV:PATH as
+    :func:`balpipe.site_files.spec_files.published_names` does (never a path of the machine)."""
+    from .site_files.spec_files import published_names
+
     p = Path(ref)
     if p.exists() or ":" not in ref:
-        return load(p)
+        return published_names([ref], [p])[p]
+    rev, path = ref.split(":", 1)
+    return f"{rev}:{published_names([path], [Path(path)])[Path(path)]}"
+
+
+def read_side(ref: str) -> LoadedSpec:
+    """A spec file, or REV:PATH read with ``git show REV:./PATH`` (PATH relative to the current
+    folder, or absolute). REV is verified as a commit first (``git rev-parse --verify
+    --end-of-options``) and only its hash reaches ``git show``: a REV that starts with ``-`` is
+    refused, never read as an option."""
+    p = Path(ref)
+    name_shown = shown_ref(ref)
+    if p.exists() or ":" not in ref:
+        return load(p, name_shown)
     rev, path = ref.split(":", 1)
     target = Path(path)
     cwd = target.parent if target.is_absolute() else Path(".")
     name = target.name if target.is_absolute() else target.as_posix()
+
+    def refused(why: str) -> SpecErrors:
+        return SpecErrors([SpecError(name_shown, None, None, "", why)])
+
+    if not rev or rev.startswith("-"):
+        raise refused(f"not a git revision: {rev!r} (a revision cannot start with '-')")
     try:
-        text = subprocess.run(["git", "show", f"{rev}:./{name}"], cwd=cwd, capture_output=True,
+        commit = subprocess.run(["git", "rev-parse", "--verify", "--quiet", "--end-of-options", f"{rev}^{{commit}}"],
+                                cwd=cwd, capture_output=True, text=True, check=True).stdout.strip()
+    except (subprocess.CalledProcessError, OSError):
+        raise refused(f"cannot read it from git: {rev!r} is not a commit of the repository here") from None
+    if not re.fullmatch(r"[0-9a-f]{40,64}", commit):
+        raise refused(f"cannot read it from git: {rev!r} is not a commit of the repository here")
+    try:
+        text = subprocess.run(["git", "show", f"{commit}:./{name}"], cwd=cwd, capture_output=True,
                               text=True, check=True).stdout
     except (subprocess.CalledProcessError, OSError) as exc:
         detail = (getattr(exc, "stderr", "") or str(exc)).strip().splitlines()
-        raise SpecErrors([SpecError(ref, None, None, "", "cannot read it from git: " + (detail[0] if detail else "?"))]) from None
-    spec, node = load_text(text, ref)
-    return LoadedSpec(Path(ref), text, spec, node)
+        raise refused("cannot read it from git: " + (detail[0] if detail else "?")) from None
+    spec, node = load_text(text, name_shown, Path(ref).parent)
+    return LoadedSpec(Path(ref), text, spec, node, name_shown)
 
 
 def run_side(ref: str, simulate: bool) -> Side:
     loaded = read_side(ref)
     st = runner.run(loaded, simulate)  # the checks and limits of check and build, errors located
-    return Side(ref, loaded, st)
+    return Side(shown_ref(ref), loaded, st)
 
 
 def _flatten(obj: Any, prefix: str = "") -> dict[str, Any]:

@@ -219,6 +219,7 @@ def dumps(history: dict) -> str:
 class _Work:
     path: Path
     slug: str
+    name: str = ""  # the published name of ``path`` (never a path of the machine)
     root: Path | None = None
     commits: list[Commit] = field(default_factory=list)
     hashes: list[str] = field(default_factory=list)
@@ -230,17 +231,20 @@ def run(paths: list[str], out: Path, cache_dir: Path, simulate: bool = True, job
         max_commits: int | None = None, progress=None) -> list[SpecHistory]:
     """Walk, compute (only what no cache holds) and write the history of every spec."""
     from .build import Options, find_specs, input_hash, slug_for
+    from .site_files.spec_files import published_names
 
     opts = Options(out=out, simulate=simulate)
     cache = Cache(cache_dir)
     works: list[_Work] = []
     seen_slugs: dict[str, Path] = {}
-    for p in find_specs(paths):
-        w = _Work(p, slug_for(p))
-        w.outcome = SpecHistory(str(p), w.slug)
+    specs = find_specs(paths)
+    names = published_names(paths, specs)
+    for p in specs:
+        w = _Work(p, slug_for(p), name=names[p])
+        w.outcome = SpecHistory(names[p], w.slug)
         works.append(w)
         if w.slug in seen_slugs:
-            w.outcome.status, w.outcome.message = "error", f"{p}: same page name as {seen_slugs[w.slug]}; rename one"
+            w.outcome.status, w.outcome.message = "error", f"{w.name}: same page name as {names[seen_slugs[w.slug]]}; rename one"
             continue
         seen_slugs[w.slug] = p
         try:
@@ -251,7 +255,7 @@ def run(paths: list[str], out: Path, cache_dir: Path, simulate: bool = True, job
             continue
         w.hashes = [input_hash(t, opts) for t in w.texts]
         if not w.commits:
-            w.outcome.status, w.outcome.message = "untracked", f"{p}: no commit of this file yet"
+            w.outcome.status, w.outcome.message = "untracked", f"{w.name}: no commit of this file yet"
 
     # what to compute: hashes in no cache and no results.json of the build
     known: dict[str, dict] = {}
@@ -329,7 +333,7 @@ def history_dict(w: _Work, known: dict[str, dict], failures: dict[str, str], sim
 
     return json_safe({
         "schema_version": SCHEMA_VERSION,
-        "source": w.path.as_posix(),
+        "source": w.name or w.path.as_posix(),
         "slug": w.slug,
         "shallow": is_shallow(w.root),
         "simulated": simulate,

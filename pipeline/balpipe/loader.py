@@ -18,6 +18,7 @@ import yaml
 from pydantic import ValidationError
 
 from .laws.drives import read_tables
+from .runtime.inputs import InputFileError, read_regular
 from .limits import check_limits
 from .spec import Spec
 from .spec_parts import SpecFieldError
@@ -59,10 +60,11 @@ class LoadedSpec:
     text: str
     spec: Spec
     node: yaml.Node
+    name: str | None = None  # how messages name the file (a published name), else str(path)
 
     def error(self, exc: SpecFieldError) -> SpecErrors:
         """Locate a semantic error raised while building or balancing this spec."""
-        return SpecErrors([located(str(self.path), self.node, exc.path, exc.message)])
+        return SpecErrors([located(self.name or str(self.path), self.node, exc.path, exc.message)])
 
 
 def format_path(path: tuple) -> str:
@@ -349,7 +351,9 @@ def _check_strings(node: yaml.Node, file: str, path: tuple = ()) -> list[SpecErr
     return sorted(errors, key=lambda e: (e.line or 0, e.column or 0))[:5]
 
 
-def load_text(text: str, file: str) -> tuple[Spec, yaml.Node]:
+def load_text(text: str, file: str, folder: str | Path | None = None) -> tuple[Spec, yaml.Node]:
+    """Validate the spec ``text``; messages name it ``file``. The files it names (tables) are
+    read in ``folder`` (default: ``file``'s folder). Raises :class:`SpecErrors`."""
     if text.startswith("\ufeff"):
         text = text[1:]
     _check_text(text, file)
@@ -390,7 +394,7 @@ def load_text(text: str, file: str) -> tuple[Spec, yaml.Node]:
         raise SpecErrors(sorted(unique, key=lambda e: (e.line or 0, e.column or 0))) from None
     try:
         check_limits(spec)
-        read_tables(spec, Path(file).parent)
+        read_tables(spec, Path(file).parent if folder is None else Path(folder))
     except SpecFieldError as exc:
         raise SpecErrors([located(file, node, exc.path, exc.message)]) from None
     return spec, node
@@ -414,21 +418,20 @@ def decode(raw: bytes, file: str) -> str:
                                     f"not UTF-8{hint}: byte 0x{raw[exc.start]:02x} cannot be decoded; save the file as UTF-8")]) from None
 
 
-def load(path: str | Path) -> LoadedSpec:
-    """Read and validate one spec file; raises :class:`SpecErrors`."""
+def load(path: str | Path, name: str | None = None) -> LoadedSpec:
+    """Read and validate one spec file; raises :class:`SpecErrors`. Messages name the file
+    ``name`` (a published name, :func:`balpipe.site_files.spec_files.published_names`), else
+    ``path``."""
     p = Path(path)
-    try:
-        size = p.stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise SpecErrors([SpecError(str(p), None, None, "",
-                                        f"file too large: {size} bytes (limit {MAX_FILE_BYTES} bytes)")])
-        raw = p.read_bytes()
-    except OSError as exc:
-        reason = exc.strerror or str(exc)
-        raise SpecErrors([SpecError(str(p), None, None, "", f"cannot read the file: {reason}")]) from None
-    text = decode(raw, str(p))
-    spec, node = load_text(text, str(p))
-    return LoadedSpec(p, text, spec, node)
+    shown = name or str(p)
+    try:  # a regular file only (a FIFO or /dev/zero named on the command line is refused), the limit enforced while reading
+        raw = read_regular(p, MAX_FILE_BYTES, "the file")
+    except InputFileError as exc:
+        message = str(exc).replace("the file is larger than", "file too large: larger than")
+        raise SpecErrors([SpecError(shown, None, None, "", message)]) from None
+    text = decode(raw, shown)
+    spec, node = load_text(text, shown, p.parent)
+    return LoadedSpec(p, text, spec, node, name)
 
 
 def prepare() -> None:

@@ -51,9 +51,9 @@ def read_input(folder: str | os.PathLike, name: str, limit: int, what: str = "fi
     label = f"the {what} {name!r}"
     if not name or "\0" in name:
         raise InputFileError(f"{label}: not a file name")
-    if os.path.isabs(name) or name.startswith("~"):
-        raise InputFileError(f"{label}: an absolute path; give a path relative to the spec's folder "
-                             "and keep the file there")
+    if os.path.isabs(name) or name.startswith("~"):  # not quoted: it is a path of the machine
+        raise InputFileError(f"the {what} is given by an absolute path; give a path relative to the spec's "
+                             "folder and keep the file there")
     try:
         base = os.path.realpath(folder)
         real = os.path.realpath(os.path.join(base, name))
@@ -62,14 +62,24 @@ def read_input(folder: str | os.PathLike, name: str, limit: int, what: str = "fi
     if os.path.commonpath([base, real]) != base:
         raise InputFileError(f"{label} is outside the spec's folder (after resolving links); "
                              "only files in the spec's folder or below it are read: copy it there")
+    return read_regular(real, limit, label, follow=False)
+
+
+def read_regular(path: str | os.PathLike, limit: int, label: str, follow: bool = True) -> bytes:
+    """The bytes of ``path`` if it is a regular file of at most ``limit`` bytes (checked before
+    opening, on the open descriptor, and while reading: at most ``limit + 1`` bytes are read);
+    else :class:`InputFileError` whose message calls the file ``label`` (e.g. "the table 'x.csv'").
+    ``follow=False``: a symlink at ``path`` itself is refused (``path`` was resolved already)."""
+    real = os.fspath(path)
     try:
         kind = _kind(os.stat(real).st_mode)
     except OSError as exc:
         raise InputFileError(f"cannot read {label}: {_reason(exc)}") from None
     if kind:
         raise InputFileError(f"{label} is {kind}, not a regular file; give a file")
-    flags = os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_CLOEXEC", 0) \
-        | getattr(os, "O_NOFOLLOW", 0)
+    flags = os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0) | getattr(os, "O_CLOEXEC", 0)
+    if not follow:
+        flags |= getattr(os, "O_NOFOLLOW", 0)
     try:
         fd = os.open(real, flags)
     except OSError as exc:

@@ -18,7 +18,9 @@ def find_specs(paths: list[str], problems: list[str] | None = None) -> list[Path
         if p.is_dir():
             def unreadable(exc: OSError) -> None:
                 if problems is not None:
-                    problems.append(f"{exc.filename}: cannot read the folder: {exc.strerror or exc}")
+                    where = Path(exc.filename)
+                    shown = published_names([str(p)], [where]).get(where, where.name)
+                    problems.append(f"{shown}: cannot read the folder: {exc.strerror or exc}")
             files = []
             for root, dirs, names in os.walk(p, onerror=unreadable):
                 dirs.sort()
@@ -33,6 +35,30 @@ def find_specs(paths: list[str], problems: list[str] | None = None) -> list[Path
             seen.add(key)
             unique.append(f)
     return unique
+
+
+def published_names(paths: list[str], specs: list[Path]) -> dict[Path, str]:
+    """The name under which each of ``specs`` (found from the command line's ``paths``) appears
+    in published files (index, pages, results.json, messages): never a path of the machine.
+
+    A path given relative and without ``..`` is kept as given (``specs/x.yaml``). Any other is
+    made relative to the first of: the working folder (unless it is ``/``), the git repository holding it, the folder
+    holding the command line's folder or file that found it (``/abs/specs`` gives
+    ``specs/x.yaml``). So a build from absolute paths publishes what the same build from
+    relative paths does."""
+    cwd = Path(os.getcwd())
+    named = [Path(os.path.normpath(os.path.abspath(p))) for p in paths]
+    out = {}
+    for spec in specs:
+        if not spec.is_absolute() and ".." not in spec.parts:
+            out[spec] = spec.as_posix()
+            continue
+        a = Path(os.path.normpath(os.path.abspath(spec)))
+        root = next((n for n in named if a == n or n in a.parents), a)
+        bases = [*([cwd] if cwd.parent != cwd else []), *(q for q in a.parents if (q / ".git").exists())][:2]
+        bases.append(root.parent)
+        out[spec] = next(a.relative_to(b).as_posix() for b in bases if b == a.parent or b in a.parents)
+    return out
 
 
 MAX_SLUG = 80  # characters of a page folder's name (file systems allow 255 bytes)
@@ -58,23 +84,24 @@ def clash_groups(specs: list[Path]) -> list[list[Path]]:
     return [sorted(g, key=str) for g in groups.values() if len(g) > 1]
 
 
-def clashes(specs: list[Path]) -> dict[Path, str]:
+def clashes(specs: list[Path], name=str) -> dict[Path, str]:
     """The specs refused for a page-name clash: every one after the first of its group in sorted
-    order (the first is built), each with a message naming the others."""
+    order (the first is built), each with a message naming the others (``name``: a path's
+    name in messages)."""
     out = {}
     for first, *rest in clash_groups(specs):
         for p in rest:
-            others = ", ".join(str(q) for q in [first, *rest] if q is not p)
-            out[p] = (f"{p}: its page {slug_for(p)}/ would be the same as that of {others}; "
-                      f"{first} (the first in sorted order) is built, not this file; rename one of these files")
+            others = ", ".join(name(q) for q in [first, *rest] if q is not p)
+            out[p] = (f"{name(p)}: its page {slug_for(p)}/ would be the same as that of {others}; "
+                      f"{name(first)} (the first in sorted order) is built, not this file; rename one of these files")
     return out
 
 
-def clash_notes(specs: list[Path]) -> dict[Path, str]:
+def clash_notes(specs: list[Path], name=str) -> dict[Path, str]:
     """For the spec built from each clashing group: a note naming the files refused beside it."""
     out = {}
     for first, *rest in clash_groups(specs):
-        others = ", ".join(map(str, rest))
-        out[first] = (f"{first}: its page {slug_for(first)}/ would be the same as that of {others}; "
+        others = ", ".join(map(name, rest))
+        out[first] = (f"{name(first)}: its page {slug_for(first)}/ would be the same as that of {others}; "
                       f"built from this file, the first in sorted order ({others} refused); rename one of these files")
     return out
