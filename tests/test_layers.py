@@ -31,8 +31,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("balpipe.families",),
     # L3' the schema
     ("balpipe.spec", "balpipe.sweep_spec", "balpipe.loader", "balpipe.limits"),
-    # L4 pipeline
-    ("balpipe.study", "balpipe.validation_stage", "balpipe.runner"),
+    # L4 pipeline, and the families' conformance checks that run it (balpipe.testing)
+    ("balpipe.study", "balpipe.validation_stage", "balpipe.runner", "balpipe.testing"),
     # L5 presentation
     ("balpipe.report",),
     # L6 commands

@@ -36,3 +36,15 @@ def test_runtime_imports_are_declared_dependencies():
     names = {"yaml": "pyyaml"}
     for mod in sorted(imported & third_party):
         assert names.get(mod, mod) in declared, f"{mod} is imported at module level but not a dependency"
+
+
+def test_every_family_examples_folder_is_package_data():
+    """The example specs a family ships (balpipe.plugins.Family.examples, run by balpipe.testing)
+    are installed with it."""
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    data = config["tool"]["setuptools"]["package-data"]
+    folders = sorted((ROOT / "pipeline" / "balpipe" / "families").glob("*/examples"))
+    assert folders
+    for folder in folders:
+        package = f"balpipe.families.{folder.parent.name}"
+        assert "examples/*.yaml" in data.get(package, []), f"{package}: examples/*.yaml not installed"

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from importlib import import_module
 from importlib.metadata import entry_points
+from pathlib import Path
 from typing import Any, Callable
 
 from . import FAMILY_GROUP
@@ -127,7 +128,10 @@ class Method:
 class Family:
     """One mechanism family: its templates and paper methods, in the order they appear in the
     spec's unions. ``package`` is the family's import package (the build's code hash takes the
-    code of the package that the family's entry point names, read without importing it)."""
+    code of the package that the family's entry point names, read without importing it).
+    ``examples``: specs that use the family, shipped with its package (paths, e.g.
+    :func:`packaged_examples`, or YAML texts); :func:`balpipe.testing.check_family` builds them,
+    so that a family is checked without balpipe's own ``specs/``."""
 
     name: str
     order: int
@@ -135,6 +139,13 @@ class Family:
     methods: tuple[Method, ...] = ()
     paper: str | None = None
     package: str = field(default="")
+    examples: tuple[str | Path, ...] = ()
+
+
+def packaged_examples(package_file: str) -> tuple[Path, ...]:
+    """The ``*.yaml`` specs in the ``examples`` folder beside ``package_file`` (a family
+    package's ``__init__.py``: ``packaged_examples(__file__)``), sorted by name."""
+    return tuple(sorted((Path(package_file).resolve().parent / "examples").glob("*.yaml")))
 
 
 def _check(obj: Any, where: str) -> Family:

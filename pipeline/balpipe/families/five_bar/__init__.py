@@ -1,12 +1,13 @@
 """The five-bar family: the fixed-sequence 5R with gear-coupled inputs and its gear balancing."""
 
-from ...plugins import Family, Method, Ref, Template
+from ...plugins import Family, Method, Ref, Template, packaged_examples
 from . import specs, template
 
 FAMILY = Family(
     name="five_bar",
     order=2,
     package=__name__,
+    examples=packaged_examples(__file__),
     templates=(
         Template("five_bar", template.FiveBarMechanism, template.build,
                  "five-bar (5R), fixed-sequence with gear-coupled inputs", Ref(f"{__name__}.figures:figures"),

@@ -1,12 +1,13 @@
 """The 3-RPR family: the parallel manipulator, its idler-loop and Scott-Russell balancings."""
 
-from ...plugins import Family, Method, Ref, Template
+from ...plugins import Family, Method, Ref, Template, packaged_examples
 from . import specs, template
 
 FAMILY = Family(
     name="rpr3",
     order=4,
     package=__name__,
+    examples=packaged_examples(__file__),
     templates=(
         Template("rpr3", template.Rpr3Mechanism, template.build, "3-RPR parallel manipulator",
                  Ref(f"{__name__}.figures:figures"), notation=template.NOTATION),

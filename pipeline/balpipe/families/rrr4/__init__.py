@@ -1,12 +1,13 @@
 """The n-RRR family (paper 001): the planar parallel manipulator and its counter-masses."""
 
-from ...plugins import Family, Method, Ref, Template
+from ...plugins import Family, Method, Ref, Template, packaged_examples
 from . import specs, template
 
 FAMILY = Family(
     name="rrr4",
     order=3,
     package=__name__,
+    examples=packaged_examples(__file__),
     templates=(
         Template("rrr4", template.RRR4Mechanism, template.build,
                  "planar n-RRR parallel manipulator (4-RRR of paper 001, legs removable)",

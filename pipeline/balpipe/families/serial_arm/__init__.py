@@ -1,13 +1,14 @@
 """The serial-arm family: the nR arm, gear decoupling (paper 002) and centre-of-mass motion
 planning (paper 003)."""
 
-from ...plugins import Family, Method, Ref, Template
+from ...plugins import Family, Method, Ref, Template, packaged_examples
 from . import specs, template
 
 FAMILY = Family(
     name="serial_arm",
     order=5,
     package=__name__,
+    examples=packaged_examples(__file__),
     templates=(
         Template("serial_arm", template.SerialArmMechanism, template.build, "serial nR arm", notation=template.notation),
     ),

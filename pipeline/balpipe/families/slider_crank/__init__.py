@@ -1,13 +1,14 @@
 """The slider-crank family: the template and the counterweight recipe (with eq. 20's inertia for
 a Scott-Russell mechanism)."""
 
-from ...plugins import Family, Method, Ref, Template
+from ...plugins import Family, Method, Ref, Template, packaged_examples
 from . import specs, template
 
 FAMILY = Family(
     name="slider_crank",
     order=0,
     package=__name__,
+    examples=packaged_examples(__file__),
     templates=(
         Template("slider_crank", template.SliderCrankMechanism, template.build, "slider-crank",
                  notation=template.NOTATION),
