@@ -20,6 +20,39 @@ class Parameter:
 
 
 @dataclass(frozen=True)
+class Goal:
+    """One load a stage was optimised for (``role`` 'objective') or held to (``role`` 'cap', at
+    most ``at_most`` x ``reference``): its measure's ``value`` at the stage and at the
+    ``reference`` (the unbalanced mechanism), in ``unit``."""
+
+    label: str
+    role: str
+    value: float
+    reference: float
+    unit: str = ""
+    at_most: float | None = None
+    load: str = ""  # shaking_force, shaking_moment, effort, joint: which of the stage's loads it is
+
+    def to_json(self) -> dict[str, Any]:
+        return {"label": self.label, "role": self.role, "load": self.load, "value": self.value, "reference": self.reference,
+                "ratio": self.value / self.reference if self.reference else None, "unit": self.unit,
+                "at_most": self.at_most}
+
+
+@dataclass(frozen=True)
+class Aim:
+    """What an optimised stage aimed at: its objective's terms and its caps
+    (:mod:`balpipe.report.verdict` judges the stage on them, the shaking loads it did not optimise
+    being side effects), and, for a design that adds nothing, why (``nothing_added``)."""
+
+    goals: tuple[Goal, ...]
+    nothing_added: str = ""
+
+    def to_json(self) -> dict[str, Any]:
+        return {"goals": [g.to_json() for g in self.goals], "nothing_added": self.nothing_added}
+
+
+@dataclass(frozen=True)
 class Stage:
     """One balancing stage: a complete model of the mechanism in that state.
 
@@ -47,6 +80,8 @@ class Stage:
     # the design of ``spec.compare`` the stage belongs to (its name; its stage is then named
     # "design:stage" on the page and in results.json), None for the main design's
     design: str | None = None
+    # what an optimised stage minimised and was held to (partial_balance): the verdict's measure
+    aim: Aim | None = None
 
 
 @dataclass(frozen=True)

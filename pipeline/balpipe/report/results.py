@@ -39,6 +39,9 @@ def json_safe(x: Any) -> Any:
 def results_dict(study: Study, source: str, input_hash: str, simulated: bool) -> dict:
     spec = study.spec
     stages = [s.metrics.to_json() for s in study.stages]
+    for row, s in zip(stages, study.stages):  # an optimised stage's objective and caps: its verdict's measure
+        if s.stage.aim is not None:
+            row["aim"] = s.stage.aim.to_json()
     validation = {}
     for s in study.stages:
         if s.validation is not None:

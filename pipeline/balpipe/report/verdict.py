@@ -79,13 +79,59 @@ def claims_of(stage: dict) -> list[str]:
     return [p for p in ("force", "moment") if p in b]
 
 
+#: a cap is kept when its ratio is at most its bound by this relative margin (the solver's tolerance)
+CAP_MARGIN = 1e-6
+SHAKING = {"force": "shaking_force", "moment": "shaking_moment"}
+
+
+def aim_verdict(aim: dict, loads: dict, realisable: bool) -> tuple[str, str, dict]:
+    """(level, words, details) of an optimised stage, judged on what it aimed at (its row's
+    ``aim``: :class:`balpipe.balancing.base.Aim`): each objective term reduced / unchanged / worse
+    in the words of :func:`outcome`, each cap kept or broken, and the shaking force and moment it
+    did not optimise as side effects. A stage that adds nothing says why."""
+    goals = aim.get("goals") or []
+    objective = [{**g, **outcome(g.get("ratio"), False, False)} for g in goals if g["role"] == "objective"]
+    caps = [{**g, "kept": g.get("ratio") is not None and g["at_most"] is not None
+             and g["ratio"] <= g["at_most"] * (1 + CAP_MARGIN)} for g in goals if g["role"] == "cap"]
+    aimed_at = {g.get("load") for g in goals if g["role"] == "objective"}
+    side = [p for p in ("force", "moment") if SHAKING[p] not in aimed_at]
+    kinds = {o["outcome"] for o in objective}
+    if any(not c["kept"] for c in caps):
+        level = "bad"
+    elif "worse" in kinds or not realisable:
+        level = "warn"
+    elif not kinds or kinds <= {"unchanged", "zero"}:
+        level = "neutral"
+    else:
+        level = "good"
+    parts = [f"{o['label']} {o['text']} (objective)" for o in objective]
+    parts += [f"{c['label']} {c['ratio']:.3g} x the unbalanced, cap {c['at_most']:g} x "
+              f"{'kept' if c['kept'] else 'broken'}" for c in caps]
+    if side:
+        parts.append(", ".join(f"{p} {loads[p]['text']}" for p in side) + (" (side effects)" if len(side) > 1 else " (side effect)"))
+    words = "; ".join(parts)
+    if aim.get("nothing_added"):
+        words = f"adds nothing: {aim['nothing_added']}; {words}"
+    return level, words, {"objective": objective, "caps": caps, "side_effects": side,
+                          "nothing_added": aim.get("nothing_added") or ""}
+
+
 def stage_verdict(stage: dict, weight: float | None = None, reference: dict | None = None) -> dict:
-    """The verdict of one stage against its own claim (see the module's docstring); ``reference``:
-    the row of the stage it is measured against (a load at round-off there reads ``zero``)."""
+    """The verdict of one stage against its own claim (see the module's docstring), or, for an
+    optimised stage (its row has an ``aim``), against its objective and caps (:func:`aim_verdict`);
+    ``reference``: the row of the stage it is measured against (a load at round-off there reads
+    ``zero``)."""
     claims = claims_of(stage)
     loads = {p: outcome(stage.get(f"{p}_ratio"), bool(stage.get(f"{p}_balanced")), p in claims,
                         bool(reference and reference.get(f"{p}_balanced")))
              for p in ("force", "moment")}
+    if stage.get("aim") and not claims:
+        realisable = stage.get("realisable", True) is not False
+        level, words, aim = aim_verdict(stage["aim"], loads, realisable)
+        if not realisable:
+            words += f"; {stage.get('not_realisable') or 'not realisable'} (on paper only)"
+        return {"level": level, "text": words, "claims": [], "holds": None, "realisable": realisable,
+                "force": loads["force"], "moment": loads["moment"], "weight": weight, "aim": aim}
     fails = [p for p in claims if loads[p]["outcome"] not in ("cancelled", "zero")]
     worse = [p for p in ("force", "moment") if loads[p]["outcome"] == "worse"]
     realisable = stage.get("realisable", True) is not False
@@ -223,11 +269,23 @@ def verdict(results: dict, weights: dict[str, float] | None = None, main: set[st
     if results.get("status") not in (None, "ok"):
         level = "bad"
     claimed = any(per_stage[g["final"]]["claims"] for g in groups)
-    good = "balanced as claimed" if claimed else "loads reduced"
-    words = {"good": good, "neutral": "no change", "warn": "mixed", "bad": "balancing fails"}[level]
+    aimed = bool(groups) and all("aim" in per_stage[g["final"]] for g in groups)
+    good = "balanced as claimed" if claimed else "objective reduced" if aimed else "loads reduced"
+    bad = "a cap broken" if aimed else "balancing fails"
+    words = {"good": good, "neutral": "no change", "warn": "mixed", "bad": bad}[level]
     if level == "warn" and balance_level in ("good", "neutral"):
         words = f"{good if balance_level == 'good' else 'no change'}; published numbers not all reproduced"
-    text = f"{words}: force {force['text']}, moment {moment['text']}"
+    if aimed and any(o["outcome"] == "worse" for g in groups for o in per_stage[g["final"]]["aim"]["objective"]):
+        words = "objective worse"
+    if results.get("status") not in (None, "ok"):
+        words = "balancing fails"
+    if aimed and level == "neutral" and all(per_stage[g["final"]]["aim"]["nothing_added"] for g in groups):
+        words = "adds nothing"  # the stage's words say why
+        text = " | ".join(per_stage[g["final"]]["text"] for g in groups)
+    elif aimed:  # judged by what it optimised: its objective, its caps, the shaking loads as side effects
+        text = f"{words}: " + " | ".join(per_stage[g["final"]]["text"] for g in groups)
+    else:
+        text = f"{words}: force {force['text']}, moment {moment['text']}"
     if refs["total"]:
         text += f"; {refs['text']}"
     return {"level": level, "words": words, "text": text, "force": force, "moment": moment,

@@ -252,6 +252,8 @@ class ActiveProgram:
         nz = self.maps.nz
         A = np.concatenate([L.A.reshape(-1, nz) for L in term.maps])
         _, S, Vt = np.linalg.svd(A, full_matrices=False)
+        if not S.size or S[0] <= 0:  # no part changes the load: every design is optimal
+            return self.least_mass(caps=list(caps), polish=[term])
         E = Vt[S > 1e-12 * S[0]]  # the row space of the load's map: the same equations, independent
         return self.least_mass(E, E @ z, caps=list(caps), polish=[term])
 

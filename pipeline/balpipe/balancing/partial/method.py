@@ -35,7 +35,7 @@ from ...notation import COMMON, ours, setting
 from ...spec_parts import SpecFieldError
 from . import fronts as PF
 from . import motions as PMo
-from ..base import BalanceResult, Parameter, Stage
+from ..base import Aim, BalanceResult, Goal, Parameter, Stage
 from ..force_balance import body_point, counterweight_notation, regions_from_spec
 from ..moment_balance import add_discs, counter_rotation_notation
 from .maps import NO_PART, DiscVars, Maps, PartVars, build
@@ -262,10 +262,42 @@ def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None
     ] + PMo.notes(details["motions"])
     label = method.label or "partial balance"
     stages = [Stage("unbalanced", "unbalanced", model, "the mechanism as given"),
-              Stage("partial", label, design, "parts chosen by the cone programme (global optimum at this motion)"
+              Stage("partial", label, design, aim=aim_of(maps, method, objective, caps, z, out), description="parts chosen by the cone programme (global optimum at this motion)"
                     if len(motions) == 1 else f"parts chosen by the cone programme (global optimum over {len(motions)} "
                     "motions; analysed and validated on the spec's motion)")]
     return BalanceResult(params, stages, notes, details={"partial_balance": details})
+
+
+def goal_label(t) -> str:
+    """'peak effort of crank', 'RMS shaking force', 'peak load of joint O2': a spec term in words."""
+    what = {"shaking_force": "shaking force", "shaking_moment": "shaking moment", "effort": "effort",
+            "joint": "load"}[t.load]
+    of = f" of {t.actuator}" if t.actuator else f" of joint {t.joint}" if t.joint else ""
+    return f"{'RMS' if t.measure == 'rms' else 'peak'} {what}{of}"
+
+
+def aim_of(maps: Maps, method: PartialBalance, objective: list[Term], caps: list, z: np.ndarray, out) -> Aim:
+    """What the partial stage aimed at: each objective term and cap at the design and unbalanced
+    (over every motion), and, where the design adds nothing, why: a zero budget, or no part in
+    the regions that lowers the objective within the caps (the optimum is the mechanism as given)."""
+    unit = lambda t: t.maps[0].unit  # noqa: E731
+    goals = [Goal(goal_label(s), "objective", t.value(z), t.scale, unit(t), None, s.load)
+             for s, t in zip(method.objective, objective)]
+    goals += [Goal(goal_label(s), "cap", t.value(z), t.scale, unit(t), b, s.load) for s, (t, b) in zip(method.caps, caps)]
+    why = ""
+    # a part below the solver's round-off (1e-9 of the budget or of 1 kg) is none
+    added = (maps.added_mass(z) - maps.fixed_mass > 1e-9 * max(method.budget.mass, 1.0)
+             or any(z[d.col] > 1e-12 for d in maps.discs))
+    if not added:
+        if method.budget.mass <= maps.fixed_mass:
+            why = f"the mass budget ({method.budget.mass:g} kg) is zero" if method.budget.mass <= 0 else (
+                f"the mass budget ({method.budget.mass:g} kg) is spent on the discs' own mass")
+        elif method.budget.inertia is not None and method.budget.inertia <= 0:
+            why = "the inertia budget is zero"
+        else:
+            why = ("no part in these regions lowers the objective" + (" within the caps" if caps else "")
+                   + ": the mechanism as given is the optimum, and more budget would not lower it")
+    return Aim(tuple(goals), why)
 
 
 def precision_text(error: float | None) -> str:
