@@ -27,6 +27,7 @@ from ..units import Length, NonNegativeLength, number, quantity
 from .table import TableError, parse_table
 
 Source = Literal["internal", "external"]
+_NAME = r"^[A-Za-z0-9_\-]+$"  # a column of the time series
 _SOURCE = "internal: between two parts of the machine (the frame included), so the frame feels its reaction; " \
           "external: from outside the machine (a well, a workpiece), felt by the frame only through the joints"
 
@@ -71,7 +72,7 @@ class LoadTableSpec(TableFile):
 
 
 class _Element(Strict):
-    name: str = Field(min_length=1, description="the load's name (time series, pages)")
+    name: str = Field(min_length=1, pattern=_NAME, description="the load's name (time series, pages)")
     a: PointRef = Field(description="first end")
     b: PointRef = Field(description="second end")
     source: Source = Field("internal", description=_SOURCE)
@@ -106,7 +107,7 @@ class PressureSpec(Strict):
     """A pressure times an area pushing a piston off its cylinder head (a gas force, internal)."""
 
     type: Literal["pressure"]
-    name: str = Field(min_length=1, description="the load's name")
+    name: str = Field(min_length=1, pattern=_NAME, description="the load's name (time series, pages)")
     piston: PointRef = Field(description="the piston's point the pressure pushes")
     head: PointRef = Field(description="the cylinder head's point (the frame for a fixed cylinder)")
     area: quantity("area", gt=0) = Field(description="the piston's area")
@@ -118,7 +119,7 @@ class TorsionSpec(Strict):
     """A torsional spring and damper at a revolute joint: torque on b -(k (phi - phi0) + c dphi/dt)."""
 
     type: Literal["torsion"]
-    name: str = Field(min_length=1, description="the load's name")
+    name: str = Field(min_length=1, pattern=_NAME, description="the load's name (time series, pages)")
     joint: str = Field(description="a revolute joint")
     stiffness: quantity("torsional stiffness", ge=0) = Field(0.0, description="torsional stiffness k")
     free_angle: quantity("angle") | None = Field(None, description="the joint angle at which it is free (default: the angle at the motion's start)")
@@ -131,7 +132,7 @@ class ForceSpec(Strict):
     """A force and/or torque applied at a point of a body: constant, or a table times a direction."""
 
     type: Literal["force"]
-    name: str = Field(min_length=1, description="the load's name")
+    name: str = Field(min_length=1, pattern=_NAME, description="the load's name (time series, pages)")
     at: PointRef = Field(description="where it acts")
     force: tuple[quantity("force"), quantity("force")] | None = Field(None, description="constant force [Fx, Fy]")
     torque: quantity("torque") | None = Field(None, description="constant torque (counter-clockwise)")
@@ -145,7 +146,7 @@ class FrictionSpec(Strict):
     """Friction in a revolute or prismatic joint, from the joint's own reaction."""
 
     type: Literal["friction"]
-    name: str = Field(min_length=1, description="the load's name")
+    name: str = Field(min_length=1, pattern=_NAME, description="the load's name (time series, pages)")
     joint: str = Field(description="a revolute or prismatic joint")
     viscous: number(ge=0) = Field(0.0, description="viscous coefficient, N m s/rad (revolute) or N s/m (prismatic)")
     coefficient: number(ge=0, le=10) = Field(0.0, description="Coulomb coefficient mu")

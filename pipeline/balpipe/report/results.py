@@ -12,6 +12,7 @@ from .. import __version__
 from ..mechanics.motion_outputs import motion_columns
 from ..study import Study
 from . import present
+from .load_table import load_columns, load_summary
 from .notation_table import names_for
 from .verdict import verdict
 
@@ -81,6 +82,9 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     names = names_for(spec).names
     for row in out["actuators"]:  # the paper's symbol of the driver, for the index (θ₁ for theta1)
         row["symbol"] = names.text("driver", row["driver"])
+    summary = load_summary([(s.stage.name, s.stage.label, s.stage.model, s.analysis) for s in study.stages])
+    if summary is not None:  # the spec's loads: peaks, friction energy, frame load beside the shaking load
+        out["loads"] = summary
     out["moving_mass"] = sum(b.mass_properties()[0] for b in study.unbalanced.stage.model.bodies)
     if study.balance.details:
         out["balancing_details"] = study.balance.details
@@ -168,7 +172,8 @@ def joint_load_table(study: Study) -> list[dict]:
 
 def timeseries_csv(study: Study) -> str:
     """One row per sample: t, then per stage Fx, Fy, |F|, M (about the moment point), every
-    actuator effort, every joint reaction (see :func:`balpipe.engine.dynamics.joint_reactions`), the
+    actuator effort, every joint reaction (see :func:`balpipe.engine.dynamics.joint_reactions`), with
+    loads the frame load and every load's series (:func:`.load_table.load_columns`), the
     total centre of mass, every body's pose and every named point's path with their velocities
     (:func:`balpipe.mechanics.motion_outputs.motion_columns`); SI units, 12 significant digits."""
     cols: list[tuple[str, np.ndarray]] = [("t_s", study.unbalanced.analysis.t)]
@@ -185,6 +190,7 @@ def timeseries_csv(study: Study) -> str:
         for j in sorted(an.reactions):
             for comp, values in an.reactions[j].items():
                 cols.append((f"{n}.reaction.{j}.{comp}", values))
+        cols += load_columns(n, an)
         cols += [(f"{n}.{name}", values) for name, values in motion_columns(s.stage.model, an)]
     return ",".join(c for c, _ in cols) + "\n" + csv_rows([v for _, v in cols])
 
