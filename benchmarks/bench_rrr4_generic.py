@@ -51,7 +51,7 @@ def main() -> None:
         tl, sol = best(lambda: LM.solve(model, cond, regions))
         print(f"{name:28s} {'least-mass synthesis (8 discs, 128-gons, linprog)':46s} {1e3 * tl:9.1f}  "
               f"{sol.total_mass:.6g} kg")
-        tr_, res = best(lambda: recipe.balance(spec.mechanism, spec.balancing, model), 3)
+        tr_, res = best(lambda: recipe.balance(registry.context(spec, model=model)), 3)
         print(f"{name:28s} {'recipe: all stages (finder and least mass incl.)':46s} {1e3 * tr_:9.1f}  "
               f"{len(res.stages)} stages")
     with tempfile.TemporaryDirectory() as tmp:

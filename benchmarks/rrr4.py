@@ -58,7 +58,7 @@ def main() -> None:
         b = best(lambda: analyse(square, t))
         print(f"{n:>8} {n / a:>22.0f} {n / b:>26.0f}")
     print("\n2. paper recipe and conditions (best of 3)")
-    res = best(lambda: recipe.balance(spec.mechanism, spec.balancing, model))
+    res = best(lambda: recipe.balance(registry.context(spec, model=model)))
     rows = best(lambda: recipe.eq17_residuals(spec.mechanism, model))
     print(f"   rrr4 recipe (leg by leg + eq. 17 design): {1000 * res:.2f} ms")
     print(f"   eq. 17's twelve conditions with residuals: {1000 * rows:.3f} ms")

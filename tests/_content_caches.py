@@ -27,14 +27,21 @@ def _slow_square(x: float, log: str) -> float:
     return x * x
 
 
-def _in_child(cache: ModuleType, out: str, log: str, q) -> None:
-    store = cache.Store(Path(out), "spec", "salt")
+def through(cache: ModuleType, store, fn, *args):
+    """``fn(*args)`` computed through ``store`` of ``cache``: a memo over it (the balancing's
+    searches, :class:`balpipe.cache.balance.Memo`) or the store made active (the simulations')."""
+    if hasattr(cache, "Memo"):
+        return cache.Memo(store)(fn, *args)
     with cache.using(store):
-        q.put(cache.run(_slow_square, 3.0, log))
+        return cache.run(fn, *args)
+
+
+def _in_child(cache: ModuleType, out: str, log: str, q) -> None:
+    q.put(through(cache, cache.Store(Path(out), "spec", "salt"), _slow_square, 3.0, log))
 
 
 def computed_once_by_two_processes(cache: ModuleType, out: Path, log: Path) -> None:
-    """Two forked processes ask ``cache`` (a module with ``Store``, ``using`` and ``run``) for one
+    """Two forked processes ask ``cache`` (a module with ``Store`` and ``Memo``, or ``using`` and ``run``) for one
     slow result at once: both get it, it is computed once (the second waits for the first's entry)."""
     out.mkdir()  # the output folder, as a build has it
     ctx = multiprocessing.get_context("fork")

@@ -104,7 +104,7 @@ def test_another_library_version_computes_again(tmp_path, fronts, monkeypatch):
     env = balance_cache.environment()
     assert all(f"{lib} " in env for lib in ("numpy", "scipy", "clarabel")) and " -" not in env
     fronts.clear()
-    monkeypatch.setattr(balance_cache.ACTIVE, "environment", lambda: env.replace("clarabel ", "clarabel 0+"))
+    monkeypatch.setattr(balance_cache, "environment", lambda: env.replace("clarabel ", "clarabel 0+"))
     write_spec(specs, replaced(PARTIAL, DESCRIPTION, "Changed text"))
     run(specs, out)
     assert len(fronts) == 1
@@ -179,11 +179,11 @@ def test_the_4rrr_rebuild_searches_nothing(tmp_path, stored, monkeypatch):
 
 
 def test_without_a_store_or_a_key_the_search_is_computed(tmp_path):
-    assert balance_cache.run(max, 1, 2) == 2  # no build: no store
+    assert balance_cache.Memo()(max, 1, 2) == 2  # no build: no store
     store = balance_cache.Store(tmp_path, "spec", "salt")
-    with balance_cache.using(store):
-        assert balance_cache.run(lambda x: x + 1, 1) == 2  # no name to key by
-        assert balance_cache.run(len, [object()]) == 1  # an argument that is not plain data
+    memo = balance_cache.Memo(store)
+    assert memo(lambda x: x + 1, 1) == 2  # no name to key by
+    assert memo(len, [object()]) == 1  # an argument that is not plain data
     assert store.used == set() and not (tmp_path / ".cache").exists()
 
 

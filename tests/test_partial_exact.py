@@ -102,7 +102,7 @@ def test_least_rms_counterweight_at_a_point_and_its_page_precision():
     first = m.crank.mass * m.crank.com + m.coupler.mass * (1 - lam) * r + (m.slider.mass + m.coupler.mass * lam) * r / 2
     assert out.z[0] == pytest.approx(first / (0.8 * r), rel=1e-9)
     from balpipe import registry
-    res = P.balance(None, spec.balancing, registry.unbalanced_model(spec), registry.time_grid(spec), spec)
+    res = P.balance(registry.context(spec))
     d = res.details["partial_balance"]
     assert d["relative_error"] is not None and d["relative_error"] <= 1e-9
     assert "exact to" in d["precision"] and "exact to" in res.notes[0]

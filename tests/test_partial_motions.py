@@ -35,9 +35,7 @@ def two_motions(seed: int, other: dict | None = None, samples: int = 151, **kw) 
 
 
 def motions_of(spec: Spec):
-    model = registry.unbalanced_model(spec)
-    return P.motion_maps(model, registry.time_grid(spec), spec.balancing, spec,
-                         lambda motion, samples, path: registry.motion_model(spec, motion, samples, path))
+    return P.motion_maps(registry.context(spec))
 
 
 def alone(d: dict, k: int) -> Spec:
@@ -83,7 +81,7 @@ def test_two_motion_optimum_is_bracketed_by_the_single_motion_optima(objective):
     singles = []
     for k in (0, 1):
         one = alone(d, k)
-        maps = P.motion_maps(registry.unbalanced_model(one), registry.time_grid(one), one.balancing, one)
+        maps = P.motion_maps(registry.context(one))
         _, o, (t1,), *_ = P.solve(maps, one.balancing)
         best_k = t1.value(o.z)
         assert PMo.restrict(term, motions[k]).value(out.z) >= best_k * (1 - 1e-7)

@@ -14,6 +14,7 @@ import pytest
 from balpipe import registry
 from balpipe.balancing import force_balance as FB
 from balpipe.balancing import moment_balance as MB
+from balpipe.balancing.context import BalanceContext
 from balpipe.engine import analyse
 from balpipe.model import Model
 from balpipe.validate import validate
@@ -59,7 +60,7 @@ def test_random_3rpr_legs_force_balanced_by_the_generic_method(kind, seed):
     spec, model = linkage(kind, seed)
     t = registry.time_grid(spec)
     method = FB.ForceBalance.model_validate({"method": "force_balance", "counterweights": segments(model)})
-    res = FB.balance(spec.mechanism, method, model, t)
+    res = FB.balance(registry.context(spec, method, model=model))
     assert [s.name for s in res.stages] == ["unbalanced", "counterweights"]
     an0, an = analyse(model, t), analyse(res.stages[1].model, t)
     assert an0.max_force > 0
@@ -89,7 +90,7 @@ def assert_stage_balanced(model: Model, an0, t: np.ndarray, expect: tuple[str, .
 def moment_balanced(model: Model, t: np.ndarray, discs: list[dict]):
     method = MB.MomentBalance.model_validate({"method": "moment_balance", "counterweights": segments(model),
                                              "counter_rotations": discs})
-    return MB.balance(None, method, model, t)
+    return MB.balance(BalanceContext(method, model, t))
 
 
 def test_random_3rpr_idler_loop_moment_balanced_and_validated_in_pymunk():
@@ -132,8 +133,8 @@ def test_random_3rpr_legs_force_then_moment_balanced(kind, seed, discs, pymunk):
     spec, model = linkage(kind, seed)
     t = registry.time_grid(spec)
     an0 = analyse(model, t)
-    fb = FB.balance(None, FB.ForceBalance.model_validate({"method": "force_balance", "counterweights": segments(model)}),
-                    model, t)
+    fb = FB.balance(BalanceContext(FB.ForceBalance.model_validate({"method": "force_balance",
+                                                                  "counterweights": segments(model)}), model, t))
     assert_stage_balanced(fb.stages[1].model, an0, t, ("force",), pymunk=False)
     res = moment_balanced(model, t, discs)
     assert res.stages[2].balances == "force+moment", res.notes

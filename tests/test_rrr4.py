@@ -231,7 +231,7 @@ def test_designs_satisfying_eq17_have_no_shaking_force(seed):
 @pytest.mark.parametrize("seed", range(3))
 def test_leg_by_leg_solution_satisfies_eq17_and_balances(seed):
     data, spec, model = regular_random(200 + seed)
-    res = recipe.balance(spec.mechanism, spec.balancing, model)
+    res = recipe.balance(registry.context(spec, model=model))
     names = [s.name for s in res.stages]
     assert names == ["unbalanced", "leg_by_leg", "least_mass", "general"]
     rows = cond.eq17(recipe.geometry(spec.mechanism))

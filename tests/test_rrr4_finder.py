@@ -123,7 +123,7 @@ def test_six_conditions_suffice_for_a_translating_platform(kind):
 @pytest.mark.parametrize("seed", [None, 0, 1, 2])
 def test_least_mass_adds_no_more_than_leg_by_leg_and_balances(seed):
     spec, model = _case(seed, 320)
-    res = recipe.balance(spec.mechanism, spec.balancing, model)
+    res = recipe.balance(registry.context(spec, model=model))
     stages = {s.name: s for s in res.stages}
     lbl, lm = stages["leg_by_leg"].model, stages["least_mass"].model
     base = model.total_mass()

@@ -25,6 +25,7 @@ from functools import lru_cache
 from importlib import resources
 from importlib.util import find_spec
 from pathlib import Path
+from typing import Any
 
 from . import FAMILY_GROUP
 from .runtime import pool
@@ -285,8 +286,8 @@ def compute(job: Job) -> Computed:
         sim_cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw)
     searches = None if job.figure_cache is None else \
         balance_cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw)
-    with cache.using(store), sim_cache.using(sims), balance_cache.using(searches):
-        done = _compute(job)
+    with cache.using(store), sim_cache.using(sims):
+        done = _compute(job, balance_cache.Memo(searches))
     if done.status in ("ok", "failed"):
         for used in (store, sims, searches):
             if used is not None:
@@ -294,9 +295,11 @@ def compute(job: Job) -> Computed:
     return done
 
 
-def _compute(job: Job) -> Computed:
-    """:func:`compute` without the figure cache's set-up."""
+def _compute(job: Job, memo: Any = None) -> Computed:
+    """:func:`compute` without the caches' set-up; the balancing's searches through ``memo``
+    (a :class:`balpipe.cache.balance.Memo`; default: computed, no cache)."""
     from . import runner
+    from .balancing.context import compute as no_cache
     from .laws.drives import table_files
     from .loader import LoadedSpec, SpecErrors, load_text
     from .spec_parts import SpecFieldError
@@ -308,7 +311,7 @@ def _compute(job: Job) -> Computed:
         spec, node = load_text(job.text, source, job.path.parent)
         loaded = LoadedSpec(job.path, job.text, spec, node, source)
         with pool.spare_workers(job.sim_workers):  # the cores left over also serve the spec's independent work
-            st = runner.analyse(loaded, simulate=job.simulate)
+            st = runner.analyse(loaded, simulate=job.simulate, memo=memo if memo is not None else no_cache)
         extra: dict[str, str] = {}
         if job.simulate and runner.simulate(loaded, st, workers=job.sim_workers):
             from .validation_stage import timing, timing_script

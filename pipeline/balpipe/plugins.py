@@ -31,6 +31,7 @@ from typing import Any, Callable
 
 from . import FAMILY_GROUP
 from .balancing.base import BalanceResult
+from .balancing.context import BalanceContext
 from .model import Model
 from .spec_parts import Strict
 
@@ -90,14 +91,17 @@ class Template:
 @dataclass(frozen=True)
 class Method:
     """A balancing method: ``spec`` is its pydantic section (a ``method`` literal names it),
-    ``balance(mechanism_spec, method_spec, model) -> BalanceResult`` for ``templates``.
+    ``balance(ctx) -> BalanceResult`` with ``ctx`` a :class:`balpipe.balancing.context.BalanceContext`
+    (the spec, its mechanism section and this method's, the unbalanced model, the time grid,
+    gravity, moment point, ``page``, the mechanism on other motions and the memo of its searches),
+    for ``templates`` (empty: every template, as the generic methods).
     ``figures(study)`` optionally yields the method's report figures as (title, svg or html,
     caption), drawn from the study's stages and ``study.balance.details``: the page composes the
     template's figures and the method's, so no figure code branches on a method's name.
     ``page_only`` names fields of ``spec`` that only add to the page (no error depends on them):
-    ``balpipe check`` balances with them set to None. With ``page_aware``, ``balance`` also
-    receives ``page=``: False in ``balpipe check`` of a spec without references, where it may
-    leave out parameters, notes and details that no error depends on (designs only drawn).
+    ``balpipe check`` balances with them set to None. ``ctx.page`` is False in ``balpipe check``
+    of a spec without references: a method may then leave out parameters, notes and details that
+    no error depends on (designs only drawn).
     ``balance``, ``figures`` and ``notation`` may be :class:`Ref` objects: the spec section is a class,
     the computing code is imported when the method runs. ``check_cost``: the seconds (on one
     core, measured) that checking a spec with this method takes beyond a plain spec's few
@@ -108,18 +112,12 @@ class Method:
 
     name: str
     spec: type[Strict]
-    balance: Callable[..., BalanceResult]
-    templates: tuple[str, ...]
+    balance: Callable[[BalanceContext], BalanceResult]
+    templates: tuple[str, ...]  # the templates it applies to; () for every template (the generic methods)
     label: str
-    uses_spec: bool = False  # balance(..., spec): the method also reads the motion and analysis settings
-    generic: bool = False  # applies to every template; balance() also receives the time grid t
-    # balance(..., models=f) also receives f(motion, samples, path) -> (unbalanced model, time grid)
-    # of the mechanism on another motion section (errors located at path); generic methods only
-    other_motions: bool = False
     notation: Any = None  # the papers' symbols of the inputs: a table or table(method_spec) (balpipe.notation)
     figures: Callable[..., Any] | None = None
     page_only: tuple[str, ...] = ()
-    page_aware: bool = False  # balance(..., page=bool): whether the page's outputs are wanted
     check_cost: float = 0.0  # seconds that ``balpipe check`` of a spec with this method takes beyond a plain one's
     build_cost: float = 0.0  # seconds that ``balpipe build --no-sim`` of such a spec takes beyond its text's estimate
 

@@ -11,6 +11,7 @@ import numpy as np
 
 from . import units
 from .balancing.base import BalanceResult, Stage
+from .balancing.context import BalanceContext, Memo, compute
 from .balancing.partial.spec import PartialBalance
 from .balancing.specs import ForceBalance, MomentBalance, Stages
 from .model import Law, Model
@@ -18,11 +19,12 @@ from .laws.drives import drive_laws
 from .laws.load_spec import model_loads
 from .motion import law_for
 from .plugins import Method, Ref, Template, discover
-from .mechanics.sampling import time_grid
+from .mechanics.sampling import gravity_vector, time_grid
 from .spec_parts import DriveSpec, SpecFieldError
 
 __all__ = [
-    "METHODS", "TEMPLATES", "Method", "Template", "balance", "balance_designs", "method_specs", "scalar_laws",
+    "METHODS", "TEMPLATES", "BalanceContext", "Method", "Template", "balance", "balance_designs", "context",
+    "method_specs", "scalar_laws",
     "template_specs", "time_grid", "unbalanced_model", "motion_model",
 ]
 
@@ -31,15 +33,15 @@ __all__ = [
 _CODE = "balpipe.balancing"
 GENERIC: tuple[Method, ...] = (
     Method("force_balance", ForceBalance, Ref(f"{_CODE}.force_balance:balance"), (),
-           "force-balance conditions from the momentum + least-mass counterweights", generic=True,
+           "force-balance conditions from the momentum + least-mass counterweights",
            notation=Ref(f"{_CODE}.force_balance:notation")),
     Method("moment_balance", MomentBalance, Ref(f"{_CODE}.moment_balance:balance"), (),
-           "least-mass counterweights + counter-rotations from the angular momentum", generic=True,
+           "least-mass counterweights + counter-rotations from the angular momentum",
            notation=Ref(f"{_CODE}.moment_balance:notation")),
     Method("stages", Stages, Ref(f"{_CODE}.stages:balance"), (), "stages written by hand, each adding parts",
-           generic=True, notation=Ref(f"{_CODE}.stages:notation")),
+           notation=Ref(f"{_CODE}.stages:notation")),
     Method("partial_balance", PartialBalance, Ref(f"{_CODE}.partial.method:balance"), (),
-           "optimal partial balancing (cone programme)", uses_spec=True, generic=True, other_motions=True,
+           "optimal partial balancing (cone programme)",
            notation=Ref(f"{_CODE}.partial.method:notation"),
            page_only=("fronts",),  # the Pareto fronts: about 90 % of its time, drawn only on the page
            check_cost=0.5,  # the optimum's cone programme (Clarabel): 0.1-1 s beyond a plain spec
@@ -130,11 +132,27 @@ def motion_model(spec: Any, motion: Any, samples: int | None, path: tuple) -> tu
         raise SpecFieldError(path + exc.path[1:], exc.message) from None
 
 
-def balance(spec: Any, balancing: Any = None, page: bool = True) -> BalanceResult:
-    """The unbalanced model and the method's stages, with every semantic check of the spec;
-    ``balancing`` replaces ``spec.balancing`` (the designs of ``spec.compare``). Without
-    ``page``, the method's :attr:`Method.page_only` fields are left out (``balpipe check``), and a
-    :attr:`Method.page_aware` method is told so unless the spec has references."""
+def context(spec: Any, balancing: Any = None, page: bool = True, memo: Memo = compute,
+            model: Model | None = None) -> BalanceContext:
+    """The :class:`BalanceContext` of ``spec`` for its method section ``balancing`` (default:
+    ``spec.balancing``; a design of ``spec.compare`` otherwise): its unbalanced ``model`` (built
+    when not given), time grid, gravity and moment point; ``page`` True unless ``balpipe check``
+    runs a spec without references (which may name any parameter); ``memo`` as given."""
+    return BalanceContext(
+        balancing=balancing if balancing is not None else spec.balancing,
+        model=model if model is not None else unbalanced_model(spec),
+        t=time_grid(spec), spec=spec, mechanism=spec.mechanism, gravity=gravity_vector(spec),
+        moment_point=tuple(spec.analysis.moment_point), page=bool(page or spec.references),
+        models=functools.partial(motion_model, spec), memo=memo)
+
+
+def balance(spec: Any, balancing: Any = None, page: bool = True, memo: Memo = compute) -> BalanceResult:
+    """The unbalanced model and the method's stages, with every semantic check of the spec:
+    ``METHODS[name].balance(ctx)`` with ctx its :func:`context`. ``balancing`` replaces
+    ``spec.balancing`` (the designs of ``spec.compare``). Without ``page``, the method's
+    :attr:`Method.page_only` fields are left out (``balpipe check``) and the context says so
+    unless the spec has references. ``memo``: what the method's searches go through (the
+    build's cache, :class:`balpipe.cache.balance.Memo`; default: computed)."""
     balancing = balancing if balancing is not None else spec.balancing
     name = balancing.method
     model = unbalanced_model(spec)
@@ -143,29 +161,21 @@ def balance(spec: Any, balancing: Any = None, page: bool = True) -> BalanceResul
     method = METHODS[name]
     if not page and method.page_only:
         balancing = balancing.model_copy(update=dict.fromkeys(method.page_only))
-    aware = {"page": bool(page or spec.references)} if method.page_aware else {}  # references may name anything
-    if method.generic:
-        extra = {"spec": spec, **aware} if method.uses_spec else dict(aware)
-        if method.other_motions:
-            extra["models"] = functools.partial(motion_model, spec)
-        return method.balance(spec.mechanism, balancing, model, t=time_grid(spec), **extra)
-    if spec.mechanism.template not in method.templates:
+    if method.templates and spec.mechanism.template not in method.templates:
         raise SpecFieldError(
             ("balancing", "method"),
             f"method {name!r} applies to {', '.join(method.templates)}, not to {spec.mechanism.template!r}",
         )
-    if method.uses_spec:
-        return method.balance(spec.mechanism, balancing, model, spec, **aware)
-    return method.balance(spec.mechanism, balancing, model, **aware)
+    return method.balance(context(spec, balancing, page, memo, model))
 
 
-def balance_designs(spec: Any, page: bool = True) -> BalanceResult:
+def balance_designs(spec: Any, page: bool = True, memo: Memo = compute) -> BalanceResult:
     """:func:`balance`, then the stages of every design in ``spec.compare`` after the main
     design's, each with its :attr:`Stage.design` and named ``design:stage`` on the page and in
     results.json (their unbalanced stage, the same model, is dropped);
     parameters are prefixed the same way and details go to ``details["compare"][design]``;
-    ``page`` as in :func:`balance`."""
-    main = balance(spec, page=page)
+    ``page`` and ``memo`` as in :func:`balance`."""
+    main = balance(spec, page=page, memo=memo)
     designs = getattr(spec, "compare", None) or []
     if not designs:
         return main
@@ -174,7 +184,7 @@ def balance_designs(spec: Any, page: bool = True) -> BalanceResult:
     details["compare"] = {}
     for k, d in enumerate(designs):
         try:
-            res = balance(spec, d.balancing, page)
+            res = balance(spec, d.balancing, page, memo)
         except SpecFieldError as exc:
             path = exc.path
             if path[:1] == ("balancing",):

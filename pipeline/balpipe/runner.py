@@ -7,19 +7,21 @@ from __future__ import annotations
 from contextlib import contextmanager
 
 from . import study as study_mod
+from .balancing.context import Memo, compute
 from .limits import check_finite, check_simulation
 from .loader import LoadedSpec, SpecError, SpecErrors
 from .spec_parts import SpecFieldError
 
 
-def analyse(loaded: LoadedSpec, simulate: bool = True, page: bool = True):
+def analyse(loaded: LoadedSpec, simulate: bool = True, page: bool = True, memo: Memo = compute):
     """Balance and analyse one loaded spec (no simulation, nothing written): the study, or
     :class:`SpecErrors` for every problem of the spec, located. The results must be finite and,
     with ``simulate``, within the simulation's limits. Without ``page`` (``balpipe check``), what
-    only the page shows is left out: the same errors, less work."""
+    only the page shows is left out: the same errors, less work. ``memo``: what the balancing's
+    searches go through (the build's cache)."""
     try:
         with _quiet_numpy():
-            st = study_mod.run(loaded.spec, page)
+            st = study_mod.run(loaded.spec, page, memo)
             check_finite(st)
             if simulate:
                 check_simulation(st)

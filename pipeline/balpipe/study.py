@@ -13,6 +13,7 @@ from .diagnose import actuation, assembly, dead_centres, loop_closure
 from .mechanics import realisable
 from . import registry
 from .balancing.base import BalanceResult, Stage
+from .balancing.context import Memo, compute
 from .mechanics.claim_precision import claim_tolerances
 from .engine import Analysis, AnalysisError, analyse, condition_peak
 from .engine.load_reference import LoadReference, load_reference
@@ -288,17 +289,18 @@ def near_singular_note(stages: list[StageResult], balance: BalanceResult, proble
     return cond
 
 
-def run(spec: Spec, page: bool = True) -> Study:
+def run(spec: Spec, page: bool = True, memo: Memo = compute) -> Study:
     """Balance and analyse every stage; collect checks and problems (no simulation). Without
     ``page``, what only the page shows is not computed (:func:`.registry.balance`), nor the
     condition numbers, near-singular notes and dead-centre warnings (``checks`` then has
     ``max_condition_number`` None), nor the parameters of the method's ``derived`` hook unless
-    the spec has references (which may name them): none of them makes a spec invalid."""
+    the spec has references (which may name them): none of them makes a spec invalid. ``memo``:
+    what the balancing's searches go through (:class:`balpipe.cache.balance.Memo` in a build)."""
     model = registry.unbalanced_model(spec)
     if model.sources:  # a spec that gives its own poses (custom): the assembly must confirm them
         assembly.check(model, float(registry.time_grid(spec)[0]))
     try:
-        balance = registry.balance_designs(spec, page)
+        balance = registry.balance_designs(spec, page, memo)
     except AnalysisError as exc:  # a balancing method analysed a motion that cannot be followed
         raise loop_closure.located(model, registry.time_grid(spec), exc) from None
     stages = run_stage_analyses(spec, balance)

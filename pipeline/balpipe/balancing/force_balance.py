@@ -14,6 +14,7 @@ from . import conditions as C
 from . import least_mass as LM
 from . import regressor as R
 from .base import BalanceResult, Parameter, Stage
+from .context import BalanceContext
 from .parts import add_counterweight
 from .specs import CounterweightRegionSpec, FinderSettings, ForceBalance, Point
 
@@ -103,7 +104,9 @@ def force_stage(model: Model, specs: list[CounterweightRegionSpec], settings: Fi
     return out, params, details, notes
 
 
-def balance(mech, method: ForceBalance, model: Model, t: np.ndarray) -> BalanceResult:
+def balance(ctx: BalanceContext) -> BalanceResult:
+    method: ForceBalance = ctx.balancing
+    model, t = ctx.model, ctx.t
     cw_model, params, details, notes = force_stage(model, method.counterweights, method, t)
     stages = [
         Stage("unbalanced", "unbalanced", model, "the mechanism as given"),

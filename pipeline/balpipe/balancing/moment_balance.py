@@ -26,6 +26,7 @@ from ..spec_parts import SpecFieldError
 from . import regressor as R
 from . import conditions as C
 from .base import BalanceResult, Parameter, Stage
+from .context import BalanceContext
 from . import least_mass as LM
 from .force_balance import body_point, regions_from_spec
 from .parts import add_counter_rotation, add_counterweight
@@ -99,7 +100,9 @@ def moment_conditions(model: Model, discs: list[str], t: np.ndarray, tolerance: 
     return LM.MomentConditions(names, matrix, discs)
 
 
-def balance(mech, method: MomentBalance, model: Model, t: np.ndarray) -> BalanceResult:
+def balance(ctx: BalanceContext) -> BalanceResult:
+    method: MomentBalance = ctx.balancing
+    model, t = ctx.model, ctx.t
     root = ("balancing",)
     discs = [s.name for s in method.counter_rotations]
     with_discs = add_discs(model, method.counter_rotations, root + ("counter_rotations",))

@@ -6,12 +6,12 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-import numpy as np
 
 from ..mechanics.claim_precision import Rounding, half_unit
 from ..model import Attachment, Model
 from ..spec_parts import SpecFieldError
 from .base import BalanceResult, Stage
+from .context import BalanceContext
 from .force_balance import body_point
 from .moment_balance import add_discs, set_disc_inertias
 from .specs import PartSpec, Stages
@@ -51,7 +51,9 @@ def part_rounding(part: PartSpec) -> Rounding:
     return Rounding(part.body, part.name, dm, x, y, dI, text)
 
 
-def balance(mech, method: Stages, model: Model, t: np.ndarray | None = None) -> BalanceResult:
+def balance(ctx: BalanceContext) -> BalanceResult:
+    method: Stages = ctx.balancing
+    model = ctx.model
     stages = [Stage("unbalanced", "unbalanced", model, "the mechanism as given")]
     current = model
     seen = {"unbalanced"}

@@ -18,11 +18,14 @@ writes, refusal of symlinks, pruning and per-key locks of :class:`balpipe.cache.
 A served result is the object that was computed, unpickled: the same bits. ``balpipe build``
 uses the cache (with ``--no-sim`` too: the balancing is the same); ``--force`` computes every
 search again and rewrites its entry; ``--scheduler``, ``balpipe check``, ``sweep`` and ``diff``
-do not use it (no store active: :func:`run` computes).
+do not use it. The store is no ambient global: the build hands a :class:`Memo` over it to the
+study, which gives it to the balancing in its context (:class:`balpipe.balancing.context.BalanceContext`);
+a method computes its searches as ``ctx.memo(fn, *args)``.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Callable, ClassVar
 
 from . import content as content_cache
@@ -46,12 +49,14 @@ def environment() -> str:
     return content_cache.library_versions(LIBRARIES)
 
 
-#: the store of :func:`using`: a module global, as the simulations' (:mod:`balpipe.cache.simulation`)
-ACTIVE = content_cache.Active(environment)
-using = ACTIVE.using  # compute the block's searches through a store (None: compute them all, no cache)
+@dataclass(frozen=True)
+class Memo:
+    """``memo(fn, *args, **kwargs)``: ``fn(*args, **kwargs)``, a balancing search, from ``store``
+    when it holds it, else computed and stored (:func:`balpipe.cache.content.run_through`, with
+    :func:`environment` in the key). Without a store, or for inputs that cannot be keyed:
+    computed."""
 
+    store: Store | None = None
 
-def run(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
-    """``fn(*args, **kwargs)``, a balancing search, from the active store when it holds it, else
-    computed and stored. Without a store, or for inputs that cannot be keyed: computed."""
-    return ACTIVE.run(fn, args, kwargs)
+    def __call__(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Any:
+        return content_cache.run_through(self.store, environment, fn, args, kwargs)

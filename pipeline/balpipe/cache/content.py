@@ -484,18 +484,23 @@ class Active:
             self.store.used |= keys
 
     def run(self, fn: Callable[..., Any], args: tuple, kwargs: dict) -> Any:
-        """``fn(*args, **kwargs)`` from the active store when it holds it (the object computed
-        then, unpickled), else computed and stored. Without a store, or for inputs that cannot be
-        keyed (:class:`Unhashable`): computed."""
-        store = self.store
-        if store is None:
-            return fn(*args, **kwargs)
-        try:
-            k = key(fn, args, kwargs, f"{store.salt}\0{self.environment()}")
-        except Unhashable:
-            return fn(*args, **kwargs)
-        with store.lock(k):
-            return store.serve(k, lambda: fn(*args, **kwargs))
+        """``fn(*args, **kwargs)`` through the active store (:func:`run_through`)."""
+        return run_through(self.store, self.environment, fn, args, kwargs)
+
+
+def run_through(store: PickleStore | None, environment: Callable[[], str], fn: Callable[..., Any], args: tuple,
+                kwargs: dict) -> Any:
+    """``fn(*args, **kwargs)`` from ``store`` when it holds it (the object computed then,
+    unpickled), else computed and stored; ``environment()`` is part of the key. Without a store,
+    or for inputs that cannot be keyed (:class:`Unhashable`): computed."""
+    if store is None:
+        return fn(*args, **kwargs)
+    try:
+        k = key(fn, args, kwargs, f"{store.salt}\0{environment()}")
+    except Unhashable:
+        return fn(*args, **kwargs)
+    with store.lock(k):
+        return store.serve(k, lambda: fn(*args, **kwargs))
 
 
 def prune_specs(out: Path, pages: set[str], kind: str) -> None:

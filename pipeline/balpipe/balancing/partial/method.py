@@ -23,12 +23,12 @@ joint, and caps that no design within the budget meets (the error gives the leas
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
 
-from ...cache import balance as balance_cache
+from ..context import BalanceContext
 from ...mechanics.planar import cross
 from ...model import Model
 from ...notation import COMMON, ours, setting
@@ -191,13 +191,14 @@ def active_constraints(program: ActiveProgram, z: np.ndarray, method: PartialBal
     return out
 
 
-def motion_maps(model: Model, t: np.ndarray, method: PartialBalance, spec=None, models: Callable | None = None) -> list[Maps]:
+def motion_maps(ctx: BalanceContext) -> list[Maps]:
     """The load maps of the spec's motion, then of each of ``method.motions`` (their models are
-    built, and their errors found, before any analysis), every region and name checked."""
+    built by ``ctx.models``, and their errors found, before any analysis), every region and name
+    checked; with the context's gravity and moment point."""
+    method: PartialBalance = ctx.balancing
+    model, t, gravity, point = ctx.model, ctx.t, ctx.gravity, ctx.moment_point
     with_discs, parts, discs = parts_from_spec(model, method)
-    others = PMo.other_models(method, models, ROOT)
-    gravity = (0.0, -spec.analysis.g) if spec is not None and spec.analysis.gravity else (0.0, 0.0)
-    point = tuple(spec.analysis.moment_point) if spec is not None else (0.0, 0.0)
+    others = PMo.other_models(method, ctx.models, ROOT)
     motions = [build(with_discs, model, t, parts, discs, gravity, point)]
     for m, tm in others:
         motions.append(build(add_discs(m, method.counter_rotations, ROOT + ("counter_rotations",)), m, tm, parts, discs,
@@ -206,11 +207,13 @@ def motion_maps(model: Model, t: np.ndarray, method: PartialBalance, spec=None, 
     return motions
 
 
-def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None,
-            models: Callable | None = None) -> BalanceResult:
-    """The optimum's stage; ``models(motion, samples, path)`` gives the unbalanced model and time
-    grid of each of ``method.motions`` (:func:`balpipe.registry.motion_model`)."""
-    motions = motion_maps(model, t, method, spec, models)
+def balance(ctx: BalanceContext) -> BalanceResult:
+    """The optimum's stage; ``ctx.models(motion, samples, path)`` gives the unbalanced model and
+    time grid of each of ``method.motions`` (:func:`balpipe.registry.motion_model`); the fronts
+    go through ``ctx.memo``."""
+    method: PartialBalance = ctx.balancing
+    model, t = ctx.model, ctx.t
+    motions = motion_maps(ctx)
     maps = motions[0]
     program, out, objective, caps = solve(motions, method)
     z = out.z
@@ -237,7 +240,7 @@ def balance(mech, method: PartialBalance, model: Model, t: np.ndarray, spec=None
         "motions": PMo.per_motion(motions, PMo.names(method), objective, caps, std, z),
     }
     if method.fronts is not None:
-        details["fronts"] = balance_cache.run(PF.fronts, maps, method.budget.inertia, std, method.budget.mass,
+        details["fronts"] = ctx.memo(PF.fronts, maps, method.budget.inertia, std, method.budget.mass,
                                               method.fronts.points, method.fronts.max_mass)
     source = f"cone programme (Clarabel), {precision_text(out.precision)}"
     params = [Parameter(f"{r['name']}.{k}", r[k], u, source, f"{r['name']} on {r['body']}")

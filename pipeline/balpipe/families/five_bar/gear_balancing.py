@@ -40,6 +40,7 @@ from .template import FiveBarMechanism, Synthesis
 from ...model import Attachment, Body, Gear, Model, Revolute
 from ...spec_parts import SpecFieldError
 from ...balancing.base import BalanceResult, Parameter, Stage
+from ...balancing.context import BalanceContext
 from .specs import CounterRotation, FiveBarGearBalancing
 
 
@@ -127,7 +128,10 @@ def _counterweighted(
     return bodies, masses, icw
 
 
-def balance(mech: FiveBarMechanism, method: FiveBarGearBalancing, model: Model) -> BalanceResult:
+def balance(ctx: BalanceContext) -> BalanceResult:
+    mech: FiveBarMechanism = ctx.mechanism
+    method: FiveBarGearBalancing = ctx.balancing
+    model = ctx.model
     if mech.coupling is None:
         raise SpecFieldError(
             ("mechanism", "coupling"),

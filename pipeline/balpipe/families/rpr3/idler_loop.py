@@ -27,6 +27,7 @@ from . import template as rpr3
 from ...model import FRAME, Body, Model, Revolute
 from ...spec_parts import SpecFieldError
 from ...balancing.base import BalanceResult, Parameter, Stage
+from ...balancing.context import BalanceContext
 from ...balancing.parts import add_counter_rotation, add_counterweight
 from .specs import Rpr3IdlerLoop
 
@@ -136,14 +137,16 @@ def add_idler_loop(mech: rpr3.Rpr3Mechanism, method: Rpr3IdlerLoop, model: Model
     return replace(out, name="3-RPR with idler loop", frame_points={**out.frame_points, "E": (float(E[0]), float(E[1]))})
 
 
-def balance(mech: rpr3.Rpr3Mechanism, method: Rpr3IdlerLoop, model: Model, t: np.ndarray | None = None) -> BalanceResult:
+def balance(ctx: BalanceContext) -> BalanceResult:
     """Stages: unbalanced (plain 3-RPR), idler loop, counterweights (eqs. 5a-d), counter-rotations
     (eqs. 9a-d)."""
+    mech: rpr3.Rpr3Mechanism = ctx.mechanism
+    method: Rpr3IdlerLoop = ctx.balancing
+    model = ctx.model
     for key in ("link5", "link6"):
         if getattr(method, key).com_offset:
             raise SpecFieldError(PATH + (key, "com_offset"), "eqs. 5 and 9 assume centres of mass on the link axes")
-    if t is None:
-        t = rpr3.sample_times(model)
+    t = rpr3.sample_times(model)  # where the idler loop must reach P (the motion's own samples)
     d = design_of(mech, method)
     cwp = PATH + ("counterweights",)
     if d.c1 == 0 or d.c5 == 0 or d.c6 == 0 or d.c2 == d.L1:

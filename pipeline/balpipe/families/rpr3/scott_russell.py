@@ -30,6 +30,7 @@ from . import template as rpr3
 from ...model import FRAME, Body, Model, Revolute
 from ...spec_parts import SpecFieldError
 from ...balancing.base import BalanceResult, Parameter, Stage
+from ...balancing.context import BalanceContext
 from ...balancing.parts import add_counter_rotation, add_counterweight
 from ...balancing.scott_russell import eq20_lhs
 from .specs import MomentUnknown, Rpr3ScottRussell
@@ -158,9 +159,12 @@ def _set_inertia(model: Model, body: str, inertia: float) -> Model:
     return model.replace_body(replace(model.body(body), inertia=inertia))
 
 
-def balance(mech: rpr3.Rpr3Mechanism, method: Rpr3ScottRussell, model: Model) -> BalanceResult:
+def balance(ctx: BalanceContext) -> BalanceResult:
     """Stages: unbalanced (plain 3-RPR), Scott-Russell legs, counterweights (eqs. 30a-d),
     counter-rotations (eq. 30f; moment balanced when eq. 30e holds)."""
+    mech: rpr3.Rpr3Mechanism = ctx.mechanism
+    method: Rpr3ScottRussell = ctx.balancing
+    model = ctx.model
     for key in ("crank", "coupler"):
         if getattr(method, key).com_offset:
             raise SpecFieldError(PATH + (key, "com_offset"), "eqs. 30 assume centres of mass on the link axes")

@@ -39,7 +39,7 @@ from . import conditions as cond
 from . import finder as generic
 from . import topologies as topologies
 from .placement import realise
-from ...cache import balance as balance_cache
+from ...balancing.context import BalanceContext, Memo, compute
 from ...balancing.base import BalanceResult, Parameter, Stage
 from ...balancing.conditions import clarity_text
 from ...engine import analyse
@@ -169,13 +169,16 @@ def platform_rotates(model: Model, samples: int = 201) -> bool:
     return bool(np.ptp(th) > 1e-12)
 
 
-def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, page: bool = True) -> BalanceResult:
+def balance(ctx: BalanceContext) -> BalanceResult:
     """The stages (unbalanced, leg by leg, least mass, eq. 17's general design, the special
-    kinematics' design), their parameters and notes. Without ``page`` (``balpipe check`` of a
+    kinematics' design), their parameters and notes. Without ``ctx.page`` (``balpipe check`` of a
     spec without references) the drawn designs of Figs. 3 and 4b (:func:`topology_designs`:
     parameters, a note, details and their derived peak forces) and the finder's count for
     translating-platform motions (:func:`finder_stage`) are left out: no stage and no error
-    depends on them."""
+    depends on them. The searches go through ``ctx.memo``."""
+    mech: RRR4Mechanism = ctx.mechanism
+    spec: RRR4Balancing = ctx.balancing
+    model, page, memo = ctx.model, ctx.page, ctx.memo
     legs = resolve_legs(mech)
     stages = [Stage("unbalanced", "unbalanced", model, f"the {model.name} as given")]
     lbl, params = leg_by_leg(mech, spec, model)
@@ -192,7 +195,7 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, page: bool =
     details: dict = {}
     derived = None
     if spec.least_mass or len(legs) == 4:
-        found = finder_stage(mech, spec, model, lbl, stages, params, notes, details, page)
+        found = finder_stage(mech, spec, model, lbl, stages, params, notes, details, page, memo)
     if len(legs) == 4:
         g = geometry(mech)
         rows = cond.eq17(g)
@@ -212,8 +215,8 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, page: bool =
             params.append(Parameter("added_mass_general", gen.total_mass() - base_mass, "kg", "eq. 17",
                                     "counter-masses of the eq. 17 design (Fig. 4a)"))
             if page:
-                designs = topology_designs(model, g, spec, found, base_mass, params, notes, details)
-                derived = partial(design_loads, designs, details["topologies"]["designs"])
+                designs = topology_designs(model, g, spec, found, base_mass, params, notes, details, memo)
+                derived = partial(design_loads, designs, details["topologies"]["designs"], memo=memo)
             if mech.kinematics != "general":
                 fig = topologies.fig6_label(mech.kinematics, topologies.arms_cross(model))
                 eq = cond.SPECIAL_EQ[mech.kinematics]
@@ -265,12 +268,13 @@ def balance(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, page: bool =
 
 
 def topology_designs(model: Model, g: cond.Geometry, spec: RRR4Balancing, found: generic.FinderCheck,
-                     base_mass: float, params: list, notes: list, details: dict) -> list[topologies.Design]:
+                     base_mass: float, params: list, notes: list, details: dict,
+                     memo: Memo = compute) -> list[topologies.Design]:
     """Figs. 3 (our selection) and 4b from eq. 17 (:mod:`.topologies`): each design's added
     mass, eq. 17's largest residual and the finder's, in ``details["topologies"]`` (the page
     draws them from there); returns the designs for :func:`design_loads`."""
     cw = spec.counterweights
-    designs = topologies.designs(model, g, cw.proximal, cw.distal)
+    designs = topologies.designs(model, g, cw.proximal, cw.distal, memo)
     free = topologies.freedoms(g)
     out = []
     for d in designs:
@@ -300,20 +304,20 @@ def topology_designs(model: Model, g: cond.Geometry, spec: RRR4Balancing, found:
     return designs
 
 
-def design_loads(designs: list[topologies.Design], rows: list[dict], stages: list) -> list[Parameter]:
+def design_loads(designs: list[topologies.Design], rows: list[dict], stages: list, memo: Memo = compute) -> list[Parameter]:
     """The ``derived`` hook of the topology designs: each design analysed by the engine on the
     stages' time grid, with their gravity and moment point; its peak inertial shaking force and
     that peak over the reference force of the stage ratios (the unbalanced stage's inertial peak,
     :func:`balpipe.engine.load_reference.load_reference`), the stages' ``force_ratio``. Written
     into each design's row of ``details["topologies"]["designs"]`` (``rows``, in the order of
     ``designs``) and returned as parameters ``peak_force_ratio_<fig>``. ``stages``: the analysed
-    stages (``StageResult``), the unbalanced one first."""
+    stages (``StageResult``), the unbalanced one first; each analysis through ``memo``."""
     base = stages[0]
     an0 = base.analysis
     ref = load_reference(base.stage.model, an0).force
     out = []
     for d, row in zip(designs, rows, strict=True):
-        peak = balance_cache.run(peak_inertial_force, d.model, an0.t, an0.gravity, an0.moment_point)
+        peak = memo(peak_inertial_force, d.model, an0.t, an0.gravity, an0.moment_point)
         ratio = peak / ref if ref > 0 else 0.0
         row["peak_inertial_force"] = peak
         row["force_ratio"] = ratio
@@ -335,7 +339,8 @@ def finder_grid(model: Model, samples: int = 9) -> np.ndarray:
 
 
 def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Model, stages: list,
-                 params: list, notes: list, details: dict, page: bool = True) -> generic.FinderCheck:
+                 params: list, notes: list, details: dict, page: bool = True,
+                 memo: Memo = compute) -> generic.FinderCheck:
     """The generic condition finder on the model: its count, eq. 17's rows and the
     leg-by-leg design checked against its space, the translating-platform count of the special
     kinematics (with ``page`` only: its parameters, note and details are shown, no stage uses
@@ -344,8 +349,8 @@ def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Mo
     four = len(legs) == 4
     g = geometry(mech) if four else None
     special = page and four and mech.kinematics != "general" and not platform_rotates(model)
-    found = balance_cache.run(generic.check, model, finder_grid(model), cond.eq17(g) if four else [],
-                              cond.special(g, mech.kinematics) if special else None)  # the build's cache
+    found = memo(generic.check, model, finder_grid(model), cond.eq17(g) if four else [],
+                 cond.special(g, mech.kinematics) if special else None)  # the build's cache
     gen = found.general
     src = "counted from the momentum at reachable states"
     params += [

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .template import mass_parameters
-from ...cache import balance as balance_cache
+from ...balancing.context import Memo, compute
 from ...model import Model
 from . import conditions as cond
 from .placement import realise
@@ -179,14 +179,15 @@ def solve_counter_masses(model: Model, g: cond.Geometry, links: list[str], proxi
 
 
 def design(model: Model, g: cond.Geometry, kept: tuple[str, ...], proximal: float, distal: float, figure: str,
-           assumed: str) -> Design:
-    """The bodies ``kept`` as built, one counter-mass on every other link (:func:`solve_counter_masses`)."""
+           assumed: str, memo: Memo = compute) -> Design:
+    """The bodies ``kept`` as built, one counter-mass on every other link (:func:`solve_counter_masses`,
+    through ``memo``: the build's cache)."""
     links = [b for b in BODIES[:-1] if b not in kept]
-    targets = balance_cache.run(solve_counter_masses, model, g, links, proximal, distal)  # the build's cache
+    targets = memo(solve_counter_masses, model, g, links, proximal, distal)
     return Design(figure, kept, realise_all(model, targets, proximal, distal, figure), assumed)
 
 
-def fig3_designs(model: Model, g: cond.Geometry, proximal: float, distal: float) -> list[Design]:
+def fig3_designs(model: Model, g: cond.Geometry, proximal: float, distal: float, memo: Memo = compute) -> list[Design]:
     """Fig. 3 (our selection): for each pair of legs (a, b), the platform and the distal links
     l_a2, l_b2 as built, counter-masses on the six other links from eq. 17 (the pair (1, 3) is
     Fig. 4a's choice)."""
@@ -194,22 +195,22 @@ def fig3_designs(model: Model, g: cond.Geometry, proximal: float, distal: float)
     for letter, (a, b) in zip("abcdef", itertools.combinations(LEGS, 2)):
         kept = (f"{a}2", f"{b}2", "5")
         out.append(design(model, g, kept, proximal, distal, f"Fig. 3{letter}",
-                          f"l{a}2, l{b}2 and the platform as built (our choice of the six free parameters)"))
+                          f"l{a}2, l{b}2 and the platform as built (our choice of the six free parameters)", memo))
     return out
 
 
-def fig4b_design(model: Model, g: cond.Geometry, proximal: float, distal: float) -> Design:
+def fig4b_design(model: Model, g: cond.Geometry, proximal: float, distal: float, memo: Memo = compute) -> Design:
     """Fig. 4b: a counter-mass on every link, the platform as built, the sixteen link first
     moments changed by the least Euclidean norm that meets eq. 17."""
     return design(model, g, ("5",), proximal, distal, "Fig. 4b",
                   "the platform as built; the four free link first moments chosen by the least Euclidean norm of "
-                  "the sixteen first-moment changes (every link treated alike)")
+                  "the sixteen first-moment changes (every link treated alike)", memo)
 
 
-def designs(model: Model, g: cond.Geometry, proximal: float, distal: float) -> list[Design]:
+def designs(model: Model, g: cond.Geometry, proximal: float, distal: float, memo: Memo = compute) -> list[Design]:
     """Every drawn design from eq. 17: Fig. 3's six (:func:`fig3_designs`), then Fig. 4b's
     (:func:`fig4b_design`)."""
-    return fig3_designs(model, g, proximal, distal) + [fig4b_design(model, g, proximal, distal)]
+    return fig3_designs(model, g, proximal, distal, memo) + [fig4b_design(model, g, proximal, distal, memo)]
 
 
 def whose(figure: str) -> str:

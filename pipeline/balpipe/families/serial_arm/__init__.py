@@ -17,7 +17,7 @@ FAMILY = Family(
                "decoupling by gears 1'-2' and mass redistribution, counter-rotating gear 3 (paper 002)",
                notation=Ref(f"{__name__}.decoupling:NOTATION"), figures=Ref(f"{__name__}.figures:decoupling_figures")),
         Method("com_motion_planning", specs.ComMotionPlanning, Ref(f"{__name__}.com_planning:balance"),
-               ("serial_arm",), "centre-of-mass motion planning, phi optimised (paper 003)", uses_spec=True,
+               ("serial_arm",), "centre-of-mass motion planning, phi optimised (paper 003)",
                notation=Ref(f"{__name__}.com_planning:NOTATION"), figures=Ref(f"{__name__}.figures:com_planning_figures"),
                check_cost=2.0,  # paper 003's eight trajectories: phi optimised, ramps bisected
                build_cost=2.0),  # and their figures: 2.5 s

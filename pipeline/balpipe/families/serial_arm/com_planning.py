@@ -51,7 +51,7 @@ from .template import (
     tip_chain,
     with_joint_laws,
 )
-from ...cache import balance as balance_cache
+from ...balancing.context import BalanceContext
 from ...model import Law, Model
 from ...motion import PointToPoint, bang_bang, law_for, quintic
 from ...spec_parts import SpecFieldError, paper_id
@@ -393,12 +393,16 @@ def trajectories_of(method: ComMotionPlanning, model: Model) -> list[tuple[str, 
     return out
 
 
-def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, spec) -> BalanceResult:
+def balance(ctx: BalanceContext) -> BalanceResult:
+    """Paper 003's cases per trajectory, phi optimised through ``ctx.memo`` (:func:`phi_search`)."""
+    mech: SerialArmMechanism = ctx.mechanism
+    method: ComMotionPlanning = ctx.balancing
+    model, spec = ctx.model, ctx.spec
     if len(mech.links) != 3:
         raise SpecFieldError(("mechanism", "links"), f"com_motion_planning plans a 3R arm (eqs. 8-10); got {len(mech.links)} links")
     T = spec.motion.duration
-    t = time_grid(spec)
-    planner = Planner(model, mech, method, T, t, gravity_vector(spec), spec.analysis.moment_point)
+    t = ctx.t
+    planner = Planner(model, mech, method, T, t, ctx.gravity, ctx.moment_point)
     law_name = spec.motion.law if spec.motion.law != "polynomial" else "quintic"
     plans: list[Plan] = []
     stages: list[Stage] = []
@@ -414,7 +418,7 @@ def balance(mech: SerialArmMechanism, method: ComMotionPlanning, model: Model, s
         JointSolution(planner.tip, TaskMotion(tip_laws, "tip", path, name), mech.working_mode, t)
         JointSolution(planner.com, _com_motion(plan, bang_bang, T, PhiPolynomial(start[2], end[2], T), path),
                       plan.com_mode, t)
-        plan.phi_coefficients, plan.phi_peak_start, plan.phi_peak_best, plan.evaluations = balance_cache.run(
+        plan.phi_coefficients, plan.phi_peak_start, plan.phi_peak_best, plan.evaluations = ctx.memo(
             phi_search, model, mech, method, T, t, planner.gravity, planner.point, replace(plan), path)
         planner.ramp(plan, PhiPolynomial(start[2], end[2], T, plan.phi_coefficients), path)
         plan.models = planner.stages(plan, law_name, path)

@@ -39,6 +39,7 @@ from .template import SerialArmMechanism
 from ...model import FRAME, Attachment, Model
 from ...spec_parts import SpecFieldError
 from ...balancing.base import BalanceResult, Parameter, Stage
+from ...balancing.context import BalanceContext
 from ...balancing.parts import add_counter_rotation, add_counterweight
 from .specs import GearDecoupling
 
@@ -89,7 +90,10 @@ def mass_matrix_2r(model: Model, l1: float, gear: tuple[float, float, float, flo
     )
 
 
-def balance(mech: SerialArmMechanism, method: GearDecoupling, model: Model) -> BalanceResult:
+def balance(ctx: BalanceContext) -> BalanceResult:
+    mech: SerialArmMechanism = ctx.mechanism
+    method: GearDecoupling = ctx.balancing
+    model = ctx.model
     if len(mech.links) != 2:
         raise SpecFieldError(("mechanism", "links"), f"gear_decoupling balances a 2R arm (got {len(mech.links)} links)")
     # a payload on link 2 is part of link 2's assembly: conditions (1)-(3) include it

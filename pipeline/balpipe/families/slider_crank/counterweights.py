@@ -6,9 +6,10 @@ from __future__ import annotations
 from dataclasses import replace
 
 from .template import SliderCrankMechanism
-from ...model import Attachment, Model
+from ...model import Attachment
 from ...spec_parts import SpecFieldError
 from ...balancing.base import BalanceResult, Parameter, Stage
+from ...balancing.context import BalanceContext
 from ...balancing.scott_russell import eq20_lhs
 from .specs import SliderCrankCounterweights
 
@@ -35,7 +36,10 @@ def is_scott_russell(mech: SliderCrankMechanism) -> bool:
     return abs(mech.offset) <= 1e-12 * L1 and abs(L1 - L2) <= 1e-12 * L1
 
 
-def balance(mech: SliderCrankMechanism, method: SliderCrankCounterweights, model: Model) -> BalanceResult:
+def balance(ctx: BalanceContext) -> BalanceResult:
+    mech: SliderCrankMechanism = ctx.mechanism
+    method: SliderCrankCounterweights = ctx.balancing
+    model = ctx.model
     path = ("balancing",)
     c1, c2 = method.crank_counterweight, method.coupler_counterweight
     for key, c in (("crank_counterweight", c1), ("coupler_counterweight", c2)):
