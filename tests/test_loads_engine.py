@@ -281,3 +281,107 @@ def test_masses_times_k_without_loads_still_scale():
     two = analyse(heavy, GRID, gravity=GRAVITY).efforts["crank"]
     assert _peak(two - one - bare) <= 1e-9 * _peak(two)
     assert not math.isclose(_peak(one), _peak(bare))
+
+
+def test_prismatic_coulomb_friction_and_pressure_equal_newton_euler():
+    """A slider-crank (gravity on, offset guide) against a constant gas pressure, Coulomb friction
+    on the slideway (mu |N|) and in the crank pin (mu r |R|): Newton-Euler per body with the pin
+    forces, the slideway's normal force and lock moment and the motor torque as unknowns, the
+    friction by plain fixed-point iteration."""
+    from balpipe.loader import load_text
+    spec = load_text("""
+name: x
+mechanism:
+  template: slider_crank
+  offset: 20 mm
+  crank:   {length: 50 mm, mass: 1.0 kg, com: 20 mm, inertia: 0.0003 kg m^2}
+  coupler: {length: 200 mm, mass: 0.6 kg, com: 80 mm, inertia: 0.0025 kg m^2}
+  slider:  {mass: 1.2 kg}
+motion:
+  law: quintic
+  duration: 0.15 s
+  drive:
+    crank: {from: 10 deg, to: 370 deg}
+analysis: {samples: 151, gravity: true}
+loads:
+  - {type: pressure, name: gas, piston: {body: slider, point: C}, head: {body: frame, point: [0.3, 0.02]}, area: 20 cm^2, pressure: 3 bar}
+  - {type: friction, name: rings, joint: guide, coefficient: 0.12}
+  - {type: friction, name: pin, joint: B, coefficient: 0.2, pin_radius: 8 mm}
+""", "x.yaml")[0]
+    from balpipe import registry
+    from balpipe.mechanics.sampling import gravity_vector
+    model, t = registry.unbalanced_model(spec), registry.time_grid(spec)
+    g = np.asarray(gravity_vector(spec))
+    an = analyse(model, t, tuple(g))
+    names = an.names
+    N = len(t)
+    com = {b.name: np.array(b.mass_properties()[1]) for b in model.bodies}
+    mass = {b.name: b.mass_properties()[0] for b in model.bodies}
+    inert = {b.name: b.mass_properties()[2] for b in model.bodies}
+
+    def pt(body, p, k):
+        i = names.index(body)
+        return an.q[k, i, :2] + rot(an.q[k, i, 2], np.array(p, float) - com[body])
+
+    jA, jB, jC, guide = (model.joint(n) for n in ("A", "B", "C", "guide"))
+    head = np.array([0.3, 0.02])
+    area, p = 20e-4, 3e5
+    eff = np.zeros(N)
+    Ng = np.zeros(N)
+    RB = np.zeros((N, 2))
+    bi = {"crank": 0, "coupler": 1, "slider": 2}
+    for k in range(N):
+        w = {n: an.v[k, names.index(n), 2] for n in bi}
+        Pc = pt("slider", guide.point_slider, k)
+        u = np.array(guide.axis, float) / np.linalg.norm(guide.axis)
+        n_ = np.array([-u[1], u[0]])
+        sdot = an.v[k, names.index("slider"), :2] @ u  # the slider does not turn
+        wB = w["coupler"] - w["crank"]
+        d = Pc - head
+        gas = p * area * d / np.linalg.norm(d)  # pushes the piston away from the head
+
+        def solve(f_rings, t_pin):
+            A = np.zeros((9, 9))
+            rhs = np.zeros(9)
+            for n, i in bi.items():
+                a = an.a[k, names.index(n)]
+                rhs[3 * i: 3 * i + 2] = mass[n] * (a[:2] - g)
+                rhs[3 * i + 2] = inert[n] * a[2]
+            r = {n: an.q[k, names.index(n), :2] for n in bi}
+            # unknowns: F_A (0,1) on crank; F_B (2,3) on coupler from crank; F_C (4,5) on slider from coupler; N (6); M (7); tau (8)
+            for col, jt in ((0, jA), (2, jB), (4, jC)):
+                P = pt(jt.b, jt.point_b, k)
+                for body, s in ((jt.b, 1.0), (jt.a, -1.0)):
+                    if body == "frame":
+                        continue
+                    i = bi[body]
+                    A[3 * i: 3 * i + 2, col: col + 2] += s * np.eye(2)
+                    arm = P - r[body]
+                    A[3 * i + 2, col] += -s * arm[1]
+                    A[3 * i + 2, col + 1] += s * arm[0]
+            i = bi["slider"]
+            A[3 * i: 3 * i + 2, 6] = n_
+            A[3 * i + 2, 6] = cross(Pc - r["slider"], n_)
+            A[3 * i + 2, 7] = 1.0
+            A[3 * bi["crank"] + 2, 8] = 1.0
+            F = gas + f_rings * u
+            rhs[3 * i: 3 * i + 2] -= F
+            rhs[3 * i + 2] -= cross(Pc - r["slider"], F)
+            rhs[3 * bi["coupler"] + 2] -= t_pin
+            rhs[3 * bi["crank"] + 2] += t_pin
+            return np.linalg.solve(A, rhs)
+
+        fr, tp = 0.0, 0.0
+        for _ in range(500):
+            x = solve(fr, tp)
+            fr2 = -np.sign(sdot) * 0.12 * abs(x[6])
+            tp2 = -np.sign(wB) * 0.2 * 0.008 * np.linalg.norm(x[2:4])
+            if abs(fr2 - fr) <= 1e-15 * max(1.0, abs(fr2)) and abs(tp2 - tp) <= 1e-16 * max(1.0, abs(tp2)):
+                break
+            fr, tp = fr2, tp2
+        x = solve(fr2, tp2)
+        eff[k], Ng[k], RB[k] = x[8], x[6], x[2:4]
+    assert _peak(an.efforts["crank"] - eff) <= 1e-9 * _peak(eff)
+    assert _peak(an.reactions["guide"]["N"] - Ng) <= 1e-9 * _peak(Ng)
+    got = np.stack([an.reactions["B"]["Fx"], an.reactions["B"]["Fy"]], axis=1)
+    assert _peak(got - RB) <= 1e-9 * _peak(RB)
