@@ -117,3 +117,55 @@ FIVE_BAR_DISCS = [
     {"name": "d3", "carrier": "link1", "at": "A1", "geared_to": "link3", "ratio": -1},
     {"name": "d4", "carrier": "link2", "at": "A2", "geared_to": "link4", "ratio": -1},
 ]
+
+
+def watt_six_bar(ratios) -> dict:
+    """A Watt-II six-bar of ours (a crank-rocker whose ternary rocker drives a second four-bar loop)
+    at 60 rpm, moment_balance with counterweights on every link and five counter-rotating discs
+    (on the frame geared to the crank, the first and the output rocker; on the crank geared to the
+    first coupler; on the ternary rocker geared to the second coupler) of the given ``ratios``."""
+    a, b, c, d = 0.08, 0.30, 0.25, 0.30
+    O4, O6 = np.array([d, 0.0]), np.array([0.55, 0.10])
+    th = 0.3
+    A = a * np.array([math.cos(th), math.sin(th)])
+    B = _circles(A, b, O4, c)
+    psi = math.atan2(B[1] - O4[1], B[0] - O4[0])
+    Cl = np.array([0.10, -0.12])  # C on rocker4 (its frame: x toward B)
+    R = np.array([[math.cos(psi), -math.sin(psi)], [math.sin(psi), math.cos(psi)]])
+    C = O4 + R @ Cl
+    e, f = 0.30, 0.22
+    D = _circles(C, e, O6, f)
+    ang = lambda p, q: math.atan2(q[1] - p[1], q[0] - p[0])  # noqa: E731
+
+    def bar(name, m, L, pose, pts, I=None):
+        return {"name": name, "mass": m, "com": [L / 2, 0.0], "inertia": I or m * L * L / 12, "pose": list(map(float, pose)), "points": pts}
+    phi1, phi2, phi6 = ang(A, B), ang(C, D), ang(O6, D)
+    bodies = [
+        bar("crank", 0.5, a, (0, 0, th), {"O2": [0, 0], "A": [a, 0]}),
+        bar("coupler1", 1.0, b, (A[0], A[1], phi1), {"A": [0, 0], "B": [b, 0]}),
+        {"name": "rocker4", "mass": 1.2, "com": [0.1, -0.03], "inertia": 0.008, "pose": [float(O4[0]), float(O4[1]), psi],
+         "points": {"O4": [0, 0], "B": [c, 0], "C": Cl.tolist()}},
+        bar("coupler2", 0.9, e, (C[0], C[1], phi2), {"C": [0, 0], "D": [e, 0]}),
+        bar("rocker6", 0.7, f, (O6[0], O6[1], phi6), {"O6": [0, 0], "D": [f, 0]}),
+    ]
+    J = lambda n, x, y, p: {  # noqa: E731
+        "type": "revolute", "name": n, "a": x, "b": y, "point_a": p, "point_b": p}
+    cws = [{"body": "crank", "name": "cw_crank", "segment": [[0, 0], [-0.08, 0]]},
+           {"body": "coupler1", "name": "cw_c1", "disc": {"centre": [0.15, 0], "radius": 0.3}},
+           {"body": "rocker4", "name": "cw_r4", "disc": {"centre": [0.0, 0.0], "radius": 0.2}},
+           {"body": "coupler2", "name": "cw_c2", "disc": {"centre": [0.15, 0], "radius": 0.3}},
+           {"body": "rocker6", "name": "cw_r6", "segment": [[0, 0], [-0.15, 0]]}]
+    discs = [("d_crank", "frame", "O2", "crank"), ("d_c1", "crank", "O2", "coupler1"), ("d_r4", "frame", "O4", "rocker4"),
+             ("d_c2", "rocker4", "O4", "coupler2"), ("d_r6", "frame", "O6", "rocker6")]
+    return {
+        "name": "Watt-II six-bar", "mechanism": {"template": "custom",
+            "frame_points": {"O2": [0, 0], "O4": O4.tolist(), "O6": O6.tolist()}, "bodies": bodies,
+            "joints": [J("O2", "frame", "crank", "O2"), J("A", "crank", "coupler1", "A"), J("B", "coupler1", "rocker4", "B"),
+                       J("O4", "frame", "rocker4", "O4"), J("C", "rocker4", "coupler2", "C"), J("D", "coupler2", "rocker6", "D"),
+                       J("O6", "frame", "rocker6", "O6")],
+            "drivers": [{"name": "crank", "joint": "O2"}]},
+        "motion": {"cycles": 1, "drive": {"crank": {"law": "constant_speed", "from": th, "speed": "60 rpm"}}},
+        "balancing": {"method": "moment_balance", "counterweights": cws,
+                      "counter_rotations": [{"name": n, "carrier": cr, "at": at, "geared_to": g, "ratio": r}
+                                            for (n, cr, at, g), r in zip(discs, ratios)]},
+        "analysis": {"samples": 181}, "validation": {"enabled": False}}

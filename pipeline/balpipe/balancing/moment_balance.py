@@ -28,6 +28,7 @@ from . import conditions as C
 from .base import BalanceResult, Parameter, Stage
 from .context import BalanceContext
 from . import least_mass as LM
+from . import gear_signs as GS
 from .force_balance import body_point, regions_from_spec
 from .parts import add_counter_rotation, add_counterweight
 from .specs import CounterRotationSpec, MomentBalance
@@ -101,6 +102,49 @@ def moment_conditions(model: Model, discs: list[str], t: np.ndarray, tolerance: 
 
 
 def balance(ctx: BalanceContext) -> BalanceResult:
+    """The stages; where the spec's gear ratios cannot cancel the moment (a disc would need a
+    negative inertia, or the residual stays above :data:`MOMENT_TOLERANCE`), the sign combination
+    that does is searched (:mod:`.gear_signs`) and named, every disc at once: in the error, or in
+    the notes of a stage that then claims the force only."""
+    method: MomentBalance = ctx.balancing
+    try:
+        result = _balance(ctx)
+    except SpecFieldError as exc:
+        if exc.path[-1:] != ("ratio",) or "negative inertia" not in exc.message:
+            raise
+        found = _working(ctx)
+        if found is None:
+            raise SpecFieldError(exc.path, exc.message.split(": reverse")[0] + "; no other signs of the ratios "
+                                 "cancel the moment either (other carriers, gear targets or ratios may)") from None
+        raise SpecFieldError(("balancing", "counter_rotations"), f"{exc.message.split(': reverse')[0]} with these "
+                             f"ratios; the ratios {_named(method, found)} cancel the moment: set them") from None
+    if result.stages[-1].balances != "force+moment":
+        found = _working(ctx)
+        if found is not None:
+            result.notes.insert(0, f"The gear ratios {_named(method, found)} cancel the moment (these do not): set them.")
+    return result
+
+
+def _named(method: MomentBalance, ratios) -> str:
+    return GS.named([s.name for s in method.counter_rotations], ratios)
+
+
+def _working(ctx: BalanceContext):
+    """The sign combination of the spec's ratios with which the moment is cancelled, or None."""
+    method: MomentBalance = ctx.balancing
+
+    def cancels(ratios) -> bool:
+        discs = [s.model_copy(update={"ratio": r}) for s, r in zip(method.counter_rotations, ratios)]
+        try:
+            out = _balance(replace(ctx, balancing=method.model_copy(update={"counter_rotations": discs})))
+        except SpecFieldError:
+            return False
+        return out.stages[-1].balances == "force+moment"
+
+    return GS.working_ratios([float(s.ratio) for s in method.counter_rotations], cancels)
+
+
+def _balance(ctx: BalanceContext) -> BalanceResult:
     method: MomentBalance = ctx.balancing
     model, t = ctx.model, ctx.t
     root = ("balancing",)
