@@ -31,13 +31,17 @@ import numpy as np
 
 from ..engine import Compiled, compile_model, jacobian, solve_positions
 from ..engine.constraints import with_frame
+from ..engine.fastpath import solve_positions_by_blocks
 from ..engine.positions import newton_raphson
 from ..mechanics.planar import cross
 from ..model import Law, Model
+from .state_blocks import BlockRound
 
 MIN_CONDITION = 1e-7  # smallest / largest singular value of a kept configuration's Jacobian
 ANGLE_SPREAD = 0.6  # rad: random displacement of angle drivers around the path
 LENGTH_SPREAD = 0.15  # fraction of the model's size: displacement of length drivers
+BLOCK_COORDINATES = 60  # from this many coordinates (20 bodies) on, trial states are solved by blocks
+CHUNK = 256  # trial states solved together by blocks
 
 
 @dataclass(frozen=True)
@@ -55,7 +59,8 @@ class _Table(Law):
 @dataclass
 class States:
     """Sampled feasible states: body-frame poses ``pose`` (S, nb, 3) = (x, y, theta) of each
-    body's frame origin and their rates ``rate`` (S, nb, 3); ``dof`` the mobility found."""
+    body's frame origin and their rates ``rate`` (S, nb, 3); ``dof`` the mobility found;
+    ``discarded`` the trial states solved and rejected."""
 
     names: list[str]
     pose: np.ndarray
@@ -136,10 +141,15 @@ def _restrict(c: Compiled, joint_prims: list, driver_prims: list) -> Compiled:
                    joint_rows={})
 
 
-def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0) -> States:
+def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0, blocks: bool | None = None) -> States:
     """Feasible states of ``model`` around the motion on the time grid ``t``.
 
     ``samples`` = 0 picks 2 (number of parameters) + 12. Deterministic for a given seed.
+    ``blocks``: each round's states solved by blocks (:mod:`.state_blocks`: one degree of
+    freedom, O(bodies) per state, the same states to round-off) or densely (every Jacobian
+    whole, O(bodies^3) per state); by default by blocks from :data:`BLOCK_COORDINATES`
+    coordinates on, densely below (where the dense route costs less, and the results of small
+    machines stay bit for bit those of the dense route).
     """
     rng = np.random.default_rng(seed)
     c = compile_model(model)
@@ -150,10 +160,12 @@ def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0) 
     tc = np.unique(t[np.linspace(0, len(t) - 1, min(len(t), 9)).round().astype(int)])
     q_first, ok, _ = newton_raphson(_square_subset(c, c.q0), c.q0[None, :], t[:1], max_iter=50)
     sq = _square_subset(c, q_first[0] if ok[0] else c.q0)
-    base = solve_positions(sq, tc)
+    use_blocks = n >= BLOCK_COORDINATES if blocks is None else blocks
+    base = solve_positions_by_blocks(sq, tc) if use_blocks else solve_positions(sq, tc)
     joint_prims, driver_prims = _joint_and_driver_prims(sq)
     base_values = np.array([p.law(tc)[0] for p in driver_prims]).T if driver_prims else np.zeros((len(tc), 0))
     joints_only = _restrict(sq, joint_prims, [])
+    joint_rows = len(joints_only.row_owner)
     size = model_size(model)
     spread = np.array([
         LENGTH_SPREAD * size if _is_length(model, p) else ANGLE_SPREAD for p in driver_prims
@@ -170,15 +182,15 @@ def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0) 
         trial = replace(sq, prims=joint_prims + [
             replace(p, law=_Table(values[:, j])) for j, p in enumerate(driver_prims)
         ])
-        q, ok, _ = newton_raphson(trial, base[k], np.arange(2 * need, dtype=float))
-        Jj = jacobian(joints_only, with_frame(q))[:, :, 3:]
-        u, s, vt = np.linalg.svd(Jj)
-        rank = int(np.median(np.sum(s > 1e-9 * s[:, :1], axis=1)))
+        block = BlockRound.of(trial, joint_rows) if use_blocks else None
+        found = _block_round(block, joints_only, base[k], need) if block is not None else None
+        if found is None:
+            found = _dense_round(trial, joints_only, base[k])
+        q, ok, rank, good, null_of, solved = found
         dof = n - rank if dof is None else dof
-        good = ok & (s[:, rank - 1] > MIN_CONDITION * s[:, 0]) if rank > 0 else ok
-        discarded += int(np.count_nonzero(~good))
+        discarded += int(np.count_nonzero(~good[:solved]))
         idx = np.flatnonzero(good)[:need]
-        null = np.transpose(vt[idx, rank:, :], (0, 2, 1))  # (S, n, dof)
+        null = null_of(idx)  # (S, n, n - rank)
         v = np.einsum("snd,sd->sn", null, rng.normal(size=(len(idx), n - rank)))
         poses.append(q[idx])
         rates.append(v)
@@ -187,6 +199,67 @@ def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0) 
     if len(q) < min(target, 6):
         raise ValueError(f"only {len(q)} regular configurations found around the motion of {model.name!r}")
     return _body_frames(model, c, q, v, dof or 0, discarded)
+
+
+def _dense_round(trial: Compiled, joints_only: Compiled, guess: np.ndarray):
+    """One round's trial states solved densely: (q, converged, rank, good, null vectors of the
+    states ``idx``, number of states solved: all) with the rank the median of the states' numerical ranks (1e-9) and good
+    the converged states whose joint Jacobian has s_rank > MIN_CONDITION s_1."""
+    q, ok, _ = newton_raphson(trial, guess, np.arange(len(guess), dtype=float))
+    Jj = jacobian(joints_only, with_frame(q))[:, :, 3:]
+    u, s, vt = np.linalg.svd(Jj)
+    rank = int(np.median(np.sum(s > 1e-9 * s[:, :1], axis=1)))
+    good = ok & (s[:, rank - 1] > MIN_CONDITION * s[:, 0]) if rank > 0 else ok
+    return q, ok, rank, good, lambda idx: np.transpose(vt[idx, rank:, :], (0, 2, 1)), len(q)
+
+
+def _block_round(block: BlockRound, joints_only: Compiled, guess: np.ndarray, need: int):
+    """:func:`_dense_round` by blocks (:mod:`.state_blocks`), in chunks of :data:`CHUNK` states
+    (the memory of a chunk, whatever the number of states), with the SVD only for the states
+    the block route does not certify. The trial states are independent of each other, so the
+    chunks stop as soon as the states solved decide the round as the whole would: the first
+    ``need`` good states among them, and more than half of all the states certified (the median
+    rank is then m). Returns None when the rank is not the joints' row count (then the dense
+    round decides every state)."""
+    S, n, m = len(guess), guess.shape[1], block.m
+    q, null_b = np.zeros((S, n)), np.zeros((S, n))
+    ok, sure, good = np.zeros(S, bool), np.zeros(S, bool), np.zeros(S, bool)
+    ranks = np.full(S, m)
+    fallback: dict[int, np.ndarray] = {}  # state -> its SVD's null space (uncertified, converged states)
+    majority = S // 2 + 1
+    done = 0
+    while done < S:
+        hi = min(S, done + CHUNK)
+        part = slice(done, hi)
+        q[part], ok[part] = block.newton(guess[part], np.arange(done, hi, dtype=float))
+        sure[part], null_b[part] = block.certify(q[part], MIN_CONDITION)
+        good[part] = ok[part] & sure[part]
+        unsure = done + np.flatnonzero(~sure[part] & ok[part])
+        if unsure.size:
+            _, su, vtu = np.linalg.svd(jacobian(joints_only, with_frame(q[unsure]))[:, :, 3:])
+            ranks[unsure] = np.sum(su > 1e-9 * su[:, :1], axis=1)
+            good[unsure] = su[:, m - 1] > MIN_CONDITION * su[:, 0]
+            for i, k in enumerate(unsure.tolist()):
+                fallback[k] = vtu[i, m:, :].T
+        done = hi
+        if np.count_nonzero(sure[:done]) >= majority and np.count_nonzero(good[:done]) >= need:
+            break
+    if np.count_nonzero(sure[:done]) < majority:  # every state solved: the median as counted densely
+        rest = np.flatnonzero(~sure & ~ok)
+        if rest.size:
+            s = np.linalg.svd(jacobian(joints_only, with_frame(q[rest]))[:, :, 3:], compute_uv=False)
+            ranks[rest] = np.sum(s > 1e-9 * s[:, :1], axis=1)
+        if int(np.median(ranks)) != m:
+            return None
+
+    def null_of(idx: np.ndarray) -> np.ndarray:
+        out = null_b[idx][:, :, None].copy()
+        for i, k in enumerate(idx.tolist()):
+            if k in fallback:
+                out[i] = fallback[k]
+        return out
+
+    return q, ok, m, good, null_of, done
 
 
 def states_from_analysis(model: Model, *analyses) -> States:

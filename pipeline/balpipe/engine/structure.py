@@ -384,8 +384,32 @@ def _gauss_jordan(A: np.ndarray) -> np.ndarray:
 
 
 def invert_blocks(dec: Decomposition, vals: np.ndarray) -> dict[int, np.ndarray]:
-    """Inverses (k, k, N) of the k x k diagonal blocks, by block index."""
-    return {b: inverse(vals[diag]) for b, diag in dec.square_blocks}
+    """Inverses (k, k, N) of the k x k diagonal blocks, by block index. The blocks of one size
+    are inverted in one call (a ladder of loops has as many blocks as loops), each sample of
+    each block by the same operations as alone: the same inverses."""
+    by_size: dict[int, list[tuple[int, np.ndarray]]] = {}
+    for b, diag in dec.square_blocks:
+        by_size.setdefault(diag.shape[0], []).append((b, diag))
+    out: dict[int, np.ndarray] = {}
+    N = vals.shape[1]
+    for k, group in by_size.items():
+        if len(group) == 1:
+            b, diag = group[0]
+            out[b] = inverse(vals[diag])
+            continue
+        slots = np.stack([diag for _, diag in group], axis=2)  # (k, k, blocks)
+        stacked = vals[slots].reshape(k, k, -1)  # samples of block 0, then block 1, ...
+        if N <= _LAPACK_SAMPLES or k >= 7:
+            try:
+                inv = np.linalg.inv(stacked.transpose(2, 0, 1)).transpose(1, 2, 0)
+            except np.linalg.LinAlgError:  # an exactly singular sample: each block alone, as inverse() does
+                out.update({b: inverse(vals[diag]) for b, diag in group})
+                continue
+        else:
+            inv = _gauss_jordan(stacked)
+        for i, (b, _) in enumerate(group):
+            out[b] = inv[:, :, i * N : (i + 1) * N]
+    return out
 
 
 def block_sigma_min(dec: Decomposition, vals: np.ndarray, inverses: dict[int, np.ndarray]) -> np.ndarray:
