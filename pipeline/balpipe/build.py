@@ -565,14 +565,14 @@ def _run(todo: list[Path], opts: Options, jobs: int, progress, outcomes: list[Ou
         start = time.perf_counter()
         known[p] = (up_to_date(p, opts), time.perf_counter() - start)
     rest = [p for p in todo if known[p][0] is None]
-    built = pool.in_order(build_one, rest, jobs, opts, cost=lambda p: spec_cost(p, opts.simulate))
-    for k, p in enumerate(todo):
-        previous, seconds = known[p]
-        o = next(built) if previous is None else _unchanged(opts.name(p), slug_for(p), opts.out / slug_for(p), previous,
-                                                            seconds)
-        outcomes.append(o)
-        if progress:
-            progress(k + 1, total, o)
+    with pool.finished(pool.in_order(build_one, rest, jobs, opts, cost=lambda p: spec_cost(p, opts.simulate))) as built:
+        for k, p in enumerate(todo):
+            previous, seconds = known[p]
+            o = next(built) if previous is None else _unchanged(opts.name(p), slug_for(p), opts.out / slug_for(p),
+                                                                previous, seconds)
+            outcomes.append(o)
+            if progress:
+                progress(k + 1, total, o)
 
 
 def spec_cost(path: Path, simulate: bool = True) -> float:

@@ -12,6 +12,7 @@ import argparse
 import gc
 import importlib
 import os
+import signal
 import sys
 
 from .. import __version__
@@ -65,11 +66,26 @@ def entry() -> None:
     """The ``balpipe`` console script and ``python -m balpipe``: :func:`main`, then exit with its
     code. What is alive at the end is frozen first (:func:`gc.freeze`), so the interpreter's
     shutdown does not walk every object of the loaded modules in a last collection: about 0.15 s
-    of a 0.6 s ``balpipe check`` of one spec. (Not in :func:`main`, which tests call in-process.)"""
+    of a 0.6 s ``balpipe check`` of one spec. (Not in :func:`main`, which tests call in-process.)
+
+    Ctrl-C or SIGTERM at any moment from here on gives exit 130 or 143 and no traceback: one
+    that arrives before :func:`main` handles it (parsing the arguments) or after it returned is
+    caught here; once the command's code is known, both are blocked until the exit (the work is
+    done: the pools' clean-up at exit cannot print "Exception ignored" for one)."""
     try:
-        code = main()
-    finally:
-        gc.freeze()
+        signal.signal(signal.SIGTERM, on_sigterm)  # main() sets it too; here it covers parsing the arguments
+        try:
+            code = main()
+        finally:
+            gc.freeze()
+        if hasattr(signal, "pthread_sigmask"):
+            signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    except Terminated:
+        print("balpipe: terminated; the site is as the last complete build left it", file=sys.stderr)
+        code = EXIT_TERMINATED
+    except KeyboardInterrupt:
+        print("balpipe: interrupted; the site is as the last complete build left it", file=sys.stderr)
+        code = EXIT_INTERRUPTED
     sys.exit(code)
 
 

@@ -31,6 +31,12 @@ def run(args) -> int:
         return usage_error(problem)
     if args.scheduler and args.jobs is not None:
         return usage_error("--scheduler and -j exclude each other: the cluster's workers set the parallelism")
+    if args.scheduler:
+        from ..runtime.cluster import address_problem
+
+        bad = address_problem(args.scheduler)
+        if bad:
+            return usage_error(f"--scheduler {args.scheduler}: {bad}")
     opts = Options(out=Path(args.out), simulate=not args.no_sim, force=args.force)
 
     def progress(k: int, total: int, o) -> None:

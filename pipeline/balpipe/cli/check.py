@@ -51,7 +51,7 @@ def run(args) -> int:
 
     from .. import loader, runner  # noqa: F401  (loaded once here, before the workers fork)
     from ..site_files.check_cost import check_cost
-    from ..runtime.pool import default_jobs, in_order
+    from ..runtime.pool import default_jobs, finished, in_order
     from ..site_files.spec_files import clashes, find_specs
 
     problem = paths_jobs_problem(args.paths, args.jobs)
@@ -70,8 +70,9 @@ def run(args) -> int:
     # copying their pages (the objects made from here on are collected as usual)
     gc.freeze()
     try:
-        bad, crashed = _report(in_order(_check_item, [(f, clash.get(f)) for f in files], jobs,
-                                        cost=lambda item: check_cost(item[0])))
+        with finished(in_order(_check_item, [(f, clash.get(f)) for f in files], jobs,
+                               cost=lambda item: check_cost(item[0]))) as results:
+            bad, crashed = _report(results)
     finally:
         gc.unfreeze()  # as it was for a caller in the same process (tests)
     bad += len(problems)

@@ -7,7 +7,7 @@ import sys
 import time
 from pathlib import Path
 
-from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, paths_jobs_problem
+from .common import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, EXIT_TERMINATED, EXIT_USAGE, Terminated, paths_jobs_problem
 
 DEFAULT_CACHE = ".balpipe-cache/history"
 
@@ -56,7 +56,10 @@ def run(args) -> int:
     try:
         outcomes = history.run(args.paths, Path(args.out), Path(args.cache), simulate=not args.no_sim,
                                jobs=args.jobs, max_commits=args.max_commits, progress=progress)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:  # SIGTERM (Terminated) too: each with its own code
+        if isinstance(exc, Terminated):
+            print("balpipe: terminated", file=sys.stderr)
+            return EXIT_TERMINATED
         print("balpipe: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     if not outcomes:

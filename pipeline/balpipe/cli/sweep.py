@@ -56,6 +56,12 @@ def run(args) -> int:
             print("balpipe: error: --parquet needs pyarrow (pip install pyarrow)", file=sys.stderr)
             return EXIT_USAGE
     if args.scheduler:
+        from ..runtime.cluster import address_problem
+
+        bad = address_problem(args.scheduler)
+        if bad:
+            print(f"balpipe: error: --scheduler {args.scheduler}: {bad}", file=sys.stderr)
+            return EXIT_USAGE
         try:
             import distributed  # noqa: F401
         except ImportError:

@@ -79,6 +79,21 @@ def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any,
 
 
 @contextmanager
+def finished(results: Iterator[Any]) -> Iterator[Iterator[Any]]:
+    """Use the generator ``results`` (:func:`in_order`'s) in the block, then run it to its end
+    here, where its pool shuts down, and close it in any case. A caller that takes exactly as
+    many results as items leaves the generator suspended after its last ``yield``: its pool would
+    then shut down when the garbage collector closes it, where a Ctrl-C is printed as "Exception
+    ignored" and lost (the command exits 0). Here it propagates like any other."""
+    try:
+        yield results
+        for _ in results:
+            pass
+    finally:
+        results.close()
+
+
+@contextmanager
 def _pool(workers: int, context: Any) -> Iterator[Any]:
     """A process pool of ``workers`` started by ``context``, its workers set up by
     :func:`worker_init` (submit inside :func:`sigint_held`: they are forked then); on any
