@@ -385,3 +385,31 @@ loads:
     assert _peak(an.reactions["guide"]["N"] - Ng) <= 1e-9 * _peak(Ng)
     got = np.stack([an.reactions["B"]["Fx"], an.reactions["B"]["Fy"]], axis=1)
     assert _peak(got - RB) <= 1e-9 * _peak(RB)
+
+
+def test_mass_sweep_and_partial_maps_count_the_loads():
+    """The loads add the same multipliers to every mass design: the mass sweep's efforts and
+    reactions, and the partial-balancing maps' constant terms, equal the engine's with the loads,
+    for this model and for another mass distribution of it."""
+    from balpipe.balancing.mass_sweep import MassSweep
+    from balpipe.balancing.partial import maps
+    from balpipe.balancing.regressor import parameters
+    rng = np.random.default_rng(11)
+    model = loaded(rng, coulomb=(0.0, 0.0))
+    sweep = MassSweep.build(model, GRID, GRAVITY)
+    other = dataclasses.replace(model, bodies=tuple(dataclasses.replace(b, mass=1.7 * b.mass, com=(b.com[0] * 0.8, 0.01))
+                                                    for b in model.bodies))
+    for m in (model, other):
+        an = analyse(m, GRID, gravity=GRAVITY)
+        p = parameters(m, angular=True)
+        e = sweep.loads(p)[2][:, 0]
+        assert _peak(e - an.efforts["crank"]) <= 1e-9 * _peak(an.efforts["crank"])
+        R = sweep.reactions(p)["C"]["Fx"]
+        assert _peak(R - an.reactions["C"]["Fx"]) <= 1e-9 * _peak(an.reactions["C"]["Fx"])
+        peak = sweep.peaks(p[None, :])["max_actuator_effort"][0]
+        assert peak == pytest.approx(_peak(an.efforts["crank"]), rel=1e-9)
+    mp = maps.build(model, model, GRID, [], [], GRAVITY)
+    an = analyse(model, GRID, gravity=GRAVITY)
+    assert _peak(mp.loads["effort:crank"].b[:, 0] - an.efforts["crank"]) <= 1e-9 * _peak(an.efforts["crank"])
+    with pytest.raises(ValueError, match="Coulomb"):
+        MassSweep.build(loaded(rng), GRID, GRAVITY)

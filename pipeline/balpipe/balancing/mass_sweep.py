@@ -15,7 +15,11 @@ frame origin; :func:`balpipe.balancing.regressor.parameters` with ``angular=True
   linear too.
 
 So one engine analysis of a base design gives matrices from which every design's loads are a
-matrix product. The radial tooth forces of gear meshes with pitch radii (|F_t| tan alpha) are
+matrix product. A model's loads (springs, dampers, applied loads, viscous friction:
+:mod:`balpipe.mechanics.loads`) depend on the motion alone, not on the masses: they add the same
+multipliers ``Lam0`` (and efforts ``G0``) to every design, so the efforts and reactions are
+affine in p; the shaking loads, inertial, keep no such term. Coulomb friction is not affine (its
+magnitude follows the reactions): a model with it has no mass sweep (ValueError). The radial tooth forces of gear meshes with pitch radii (|F_t| tan alpha) are
 not linear; they change only the bearings' reactions (and a fixed sun's frame load, which the
 momentum route already contains), and :meth:`MassSweep.multipliers` adds them per design.
 """
@@ -30,6 +34,7 @@ from .regressor import dynamics_regressor, parameters, shaking_regressor, states
 from ..engine import analyse, compile_model, jacobian
 from ..engine.constraints import with_frame
 from ..engine.dynamics import joint_reactions, solve_multipliers, radial_tooth_loads, tooth_rows
+from ..engine.loads import terms as load_terms
 from ..mechanics.planar import rotate
 from ..model import Model
 
@@ -45,7 +50,7 @@ def geometry_key(model: Model, t: np.ndarray, gravity=(0.0, 0.0), moment_point=(
     drivers = tuple((d.name, d.target, tuple(np.asarray(x, dtype=float).tobytes() for x in d.law(t)))
                     for d in model.drivers)
     return (bodies, model.joints, tuple(sorted(model.initial.items())), tuple(sorted(model.frame_points.items())),
-            drivers, t.tobytes(), tuple(map(float, gravity)), tuple(map(float, moment_point)))
+            drivers, t.tobytes(), tuple(map(float, gravity)), tuple(map(float, moment_point)), model.loads)
 
 
 def check_parameters(names: list[str], P: np.ndarray) -> list[str | None]:
@@ -82,6 +87,8 @@ class MassSweep:
     drivers: list[str]
     compiled: object
     mesh_geo: list
+    Lam0: np.ndarray | float = 0.0  # (N, m): the multipliers of the loads, the same for every design
+    G0: np.ndarray | float = 0.0  # (N, ndrv): their efforts
 
     @classmethod
     def build(cls, model: Model, t: np.ndarray, gravity=(0.0, 0.0), moment_point=(0.0, 0.0)) -> "MassSweep":
@@ -91,12 +98,18 @@ class MassSweep:
         states = states_from_analysis(model, an)
         YF, YM = shaking_regressor(states, gravity, moment_point)
         YD = dynamics_regressor(states, gravity)
-        c = compile_model(model)
-        c = c.dynamics or c  # with actuators: their rows, not the drivers' (engine.compile._actuated)
+        base = compile_model(model)
+        c = base.dynamics or base  # with actuators: their rows, not the drivers' (engine.compile._actuated)
         N = len(t)
         qx = with_frame(an.q.reshape(N, -1))
         J = jacobian(c, qx)
         geo = tooth_rows(c, qx, J)
+        Lam0: np.ndarray | float = 0.0
+        if model.loads:  # in centre-of-mass coordinates, before the change below
+            lt = load_terms(model, base, t, an.q.reshape(N, -1), an.v.reshape(N, -1))
+            if lt.coulomb:
+                raise ValueError("Coulomb friction is not linear in the masses: no mass sweep of this model")
+            Lam0 = solve_multipliers(c, J[:, :, 3:].copy(), lt.Q)
         for k, b in enumerate(model.bodies):  # centre-of-mass -> frame-origin coordinates
             _, com, _ = b.mass_properties()
             s = rotate(an.q[:, k, 2], np.asarray(com, dtype=float))
@@ -107,7 +120,8 @@ class MassSweep:
         drivers = list(c.driver_rows)
         G = -Lam[:, [c.driver_rows[d] for d in drivers], :]
         key = geometry_key(model, t, gravity, moment_point)
-        return cls(model, t, key, YF, YM, Lam, G, drivers, c, geo)
+        G0 = -Lam0[:, [c.driver_rows[d] for d in drivers]] if model.loads else 0.0
+        return cls(model, t, key, YF, YM, Lam, G, drivers, c, geo, Lam0, G0)
 
     @property
     def names(self) -> list[str]:
@@ -123,11 +137,11 @@ class MassSweep:
 
     def loads(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Shaking force (N, 2), moment (N,) and efforts (N, ndrv) of one design."""
-        return self.YF @ p, self.YM @ p, self.G @ p
+        return self.YF @ p, self.YM @ p, self.G @ p + self.G0
 
     def multipliers(self, p: np.ndarray) -> np.ndarray:
         """All multipliers (N, m) of one design, radial tooth forces included."""
-        lam = self.Lam @ p
+        lam = self.Lam @ p + self.Lam0
         if self.compiled.meshes:
             lam, _ = radial_tooth_loads(self.compiled, self.mesh_geo, lam)
         return lam
@@ -154,5 +168,7 @@ class MassSweep:
             out["max_shaking_moment"][s : s + chunk] = np.maximum(m.max(axis=1), -m.min(axis=1))
             if nd:
                 e = R[:, 3 * N :]
+                if self.model.loads:
+                    e = e + np.asarray(self.G0).T.reshape(1, nd * N)
                 out["max_actuator_effort"][s : s + chunk] = np.maximum(e.max(axis=1), -e.min(axis=1))
         return out

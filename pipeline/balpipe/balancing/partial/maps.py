@@ -201,6 +201,19 @@ def _joint_maps(sweep: MassSweep) -> dict[str, np.ndarray]:
     return out
 
 
+def _load_offsets(sweep: MassSweep) -> dict[str, np.ndarray]:
+    """The efforts and joint loads (N, k) that the model's loads add to every design (none
+    without loads): the affine maps' constant terms beside Y p."""
+    if not sweep.model.loads:
+        return {}
+    out = {f"effort:{d}": np.asarray(sweep.G0)[:, k: k + 1] for k, d in enumerate(sweep.drivers)}
+    reactions = joint_reactions(sweep.model, sweep.compiled, np.asarray(sweep.Lam0), sweep.mesh_geo)
+    for jt in sweep.model.joints:
+        kind = "revolute" if isinstance(jt, Revolute) else "prismatic" if isinstance(jt, Prismatic) else "gear"
+        out[f"joint:{jt.name}"] = np.stack([reactions[jt.name][k] for k in JOINT_COMPONENTS[kind]], axis=1)
+    return out
+
+
 def build(model: Model, unbalanced: Model, t: np.ndarray, parts: list[PartVars], discs: list[DiscVars],
           gravity=(0.0, 0.0), moment_point=(0.0, 0.0)) -> Maps:
     """One engine analysis of ``model`` (the mechanism with the discs at zero inertia) and the
@@ -217,8 +230,10 @@ def build(model: Model, unbalanced: Model, t: np.ndarray, parts: list[PartVars],
         Ys[f"effort:{d}"] = (sweep.G[:, k : k + 1, :], "N or N m")
     for name, Y in _joint_maps(sweep).items():
         Ys[f"joint:{name}"] = (Y, "N or N m")
+    fixed = _load_offsets(sweep)  # the model's loads: the same in every design (MassSweep.Lam0)
     w = time_weights(t)
-    loads = {name: Load(name, unit, Y @ G, Y @ p0, Y @ p_unb, w) for name, (Y, unit) in Ys.items()}
+    loads = {name: Load(name, unit, Y @ G, Y @ p0 + fixed.get(name, 0.0), Y @ p_unb + fixed.get(name, 0.0), w)
+             for name, (Y, unit) in Ys.items()}
     moving = {}  # a body is at rest when its frame neither accelerates (m column less the weight) nor turns
     for k, b in enumerate(model.bodies):
         acc = sweep.YF[:, :, 4 * k] - np.asarray(gravity, dtype=float)
