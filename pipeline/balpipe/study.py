@@ -57,6 +57,8 @@ class Study:
     problems: list[str] = field(default_factory=list)
     reactionless: Any = None
     warnings: list[dict] = field(default_factory=list)  # dead centres and singularities (balpipe.diagnose.dead_centres)
+    # checks that could not resolve their own error: nothing shown false; exit 0 unless --strict
+    unconfirmed: list[str] = field(default_factory=list)
 
     @property
     def unbalanced(self) -> StageResult:

@@ -19,7 +19,7 @@ BASE_MASS = 10.0
 
 def settings_for(study: Study) -> ValidationSettings:
     v = study.spec.validation
-    return ValidationSettings(dt=v.dt, iterations=v.iterations, tolerance=v.tolerance)
+    return ValidationSettings(dt=v.dt, iterations=v.iterations, tolerance=v.tolerance, max_refinement=v.max_refinement)
 
 
 def reactionless_enabled(study: Study) -> bool:
@@ -140,7 +140,9 @@ def _keyed(fn, a: tuple, study: Study) -> tuple:
 
 
 def simulate_study(study: Study, workers: int = 1) -> None:
-    """Validate every stage; failures become problems of the study (the build exits 1).
+    """Validate every stage; failures (a claim shown false) become problems of the study (the build
+    exits 1), unconfirmed checks (an error not resolved within the validator's budget) its
+    ``unconfirmed`` list (exit 0, unless ``build --strict``).
     ``workers`` > 1: the stages' simulations, and the free-frame runs, run in that many forked
     processes from one pool (for a build that leaves cores free); the results, and the order of
     the problems, are the same."""
@@ -152,10 +154,14 @@ def simulate_study(study: Study, workers: int = 1) -> None:
     runs = _parallel(study, workers, tasks)
     for s, (v, tq) in zip(study.stages, runs[:n]):
         s.validation, s.torque = v, tq
-        if not v.passed:
-            study.problems.append(f"pymunk validation of stage {s.stage.name!r} fails: {'; '.join(v.reasons)}")
-        if not tq.passed:
-            study.problems.append(f"torque-driven run of stage {s.stage.name!r} fails: {'; '.join(tq.reasons)}")
+        for what, r in (("pymunk validation", v), ("torque-driven run", tq)):
+            if r.passed:
+                continue
+            if r.unconfirmed:  # nothing shown false: said, not failed (``build --strict`` fails on it)
+                study.unconfirmed.append(f"{what} of stage {s.stage.name!r} unconfirmed: {'; '.join(r.reasons)}; "
+                                         f"remedy: {r.remedy}")
+            else:
+                study.problems.append(f"{what} of stage {s.stage.name!r} fails: {'; '.join(r.reasons)}")
     if floating:
         study.reactionless = _reactionless(study, runs[n:])
 

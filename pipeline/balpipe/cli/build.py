@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from .common import EXIT_FAILED, EXIT_OK, EXIT_USAGE, paths_jobs_problem, usage_error
+from .common import EXIT_FAILED, EXIT_OK, EXIT_UNCONFIRMED, EXIT_USAGE, paths_jobs_problem, usage_error
 
 
 def add_parser(sub) -> None:
@@ -21,6 +21,9 @@ def add_parser(sub) -> None:
     b.add_argument("--no-sim", action="store_true", help="skip the pymunk validation (quick iterations)")
     b.add_argument("--force", action="store_true", help="rebuild specs even when unchanged")
     b.add_argument("-q", "--quiet", action="store_true", help="print only errors and the summary")
+    b.add_argument("--strict", action="store_true",
+                   help=f"exit {EXIT_UNCONFIRMED} when a simulation check is unconfirmed (it could not resolve its own "
+                   "error within the validator's budget; nothing shown false), where the build otherwise exits 0")
 
 
 def run(args) -> int:
@@ -51,6 +54,8 @@ def run(args) -> int:
             print("    " + o.message.replace("\n", "\n    "), file=sys.stderr)
         for w in ((o.results or {}).get("warnings") or []) if not o.skipped else []:
             print("    warning: " + w["message"], file=sys.stderr)
+        for u in ((o.results or {}).get("unconfirmed") or []) if not o.skipped else []:
+            print("    " + u, file=sys.stderr)
 
     try:
         outcomes = build(args.paths, opts, jobs=args.jobs, progress=progress, scheduler=args.scheduler)
@@ -61,7 +66,12 @@ def run(args) -> int:
     n_err = sum(o.spec_error for o in outcomes)
     n_fail = sum(o.status in ("failed", "crash") for o in outcomes)
     n_ok = len(outcomes) - n_err - n_fail
-    print(f"balpipe: {n_ok} ok, {n_fail} failed, {n_err} invalid; site: {opts.out / 'index.html'}", file=sys.stderr)
+    n_unconfirmed = sum(bool((o.results or {}).get("unconfirmed")) for o in outcomes if o.status == "ok")
+    also = f" ({n_unconfirmed} with an unconfirmed simulation check)" if n_unconfirmed else ""
+    print(f"balpipe: {n_ok} ok{also}, {n_fail} failed, {n_err} invalid; site: {opts.out / 'index.html'}",
+          file=sys.stderr)
     if n_fail:
         return EXIT_FAILED
-    return EXIT_USAGE if n_err else EXIT_OK
+    if n_err:
+        return EXIT_USAGE
+    return EXIT_UNCONFIRMED if args.strict and n_unconfirmed else EXIT_OK

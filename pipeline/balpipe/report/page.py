@@ -171,6 +171,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                 "name": s.stage.name, "label": s.stage.label, "force_residual": v.force_residual,
                 "moment_residual": v.moment_residual, "sim_force_ratio": v.force_peak,
                 "sim_moment_ratio": v.moment_peak, "tracking": v.tracking_error_max, "passed": v.passed,
+                "status": v.status, "remedy": v.remedy,
                 "dt": v.dt, "steps": v.steps, "iterations": v.iterations, "tolerance": v.tolerance,
                 "reasons": "; ".join(v.reasons), "notes": "; ".join(v.notes),
                 "excluded": v.excluded_samples, "version": v.pymunk_version,
@@ -185,7 +186,8 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                 "resolution": q.resolution, "force_residual": q.force_residual, "moment_residual": q.moment_residual,
                 "force_peak": q.force_peak, "moment_peak": q.moment_peak,
                 "dt": q.dt, "steps": q.steps, "iterations": q.iterations, "tolerance": q.tracking_tolerance,
-                "passed": q.passed, "reasons": "; ".join(q.reasons), "notes": "; ".join(q.notes),
+                "passed": q.passed, "status": q.status, "remedy": q.remedy, "reasons": "; ".join(q.reasons),
+                "notes": "; ".join(q.notes),
                 "per_driver": markupsafe.Markup(", ").join(names.driver(k) + f" {v:.2g}"
                                                            for k, v in sorted(q.tracking_error.items())),
             })

@@ -55,6 +55,7 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
         "input_hash": input_hash,
         "status": "ok" if study.ok else "failed",
         "problems": study.problems,
+        "unconfirmed": study.unconfirmed,
         "mechanism": spec.mechanism.template,
         "method": spec.balancing.method,
         "samples": spec.analysis.samples,

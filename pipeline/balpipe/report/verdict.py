@@ -14,7 +14,10 @@ Levels, worst first: ``bad`` (a claim fails, or the build failed), ``warn`` (a s
 load worse than its reference, a part cannot be built, or a published number does not
 reproduce), ``neutral`` (nothing changed), ``good``. A spec's level is the worst of its main
 design's headline stages (below), of its stages' claims and of its references: a spec whose |M|
-gets worse after a stage that claims moment balance is never ``good``.
+gets worse after a stage that claims moment balance is never ``good``. "Balancing fails" is said
+only where a claim of the analysis fails: a build that failed a check while every claim holds (the
+pymunk simulation contradicts the analysis) says so instead, and a check that could not resolve
+its own error (``unconfirmed`` in results.json: nothing shown false) is named after the loads.
 
 The headline numbers come from the spec's main design (not a design of ``compare``), one
 row per motion (the stages sharing a reference stage); a compared design never stands in. Per
@@ -266,6 +269,7 @@ def verdict(results: dict, weights: dict[str, float] | None = None, main: set[st
         moment = _span([per_stage[g["final"]]["moment"] for g in groups])
         balance_level = worst([g["level"] for g in groups] + [g["final_level"] for g in groups])
     level = worst([balance_level, refs["level"] if refs["total"] else "good"])
+    claims_fail = any(s["holds"] is False for s in per_stage.values())
     if results.get("status") not in (None, "ok"):
         level = "bad"
     claimed = any(per_stage[g["final"]]["claims"] for g in groups)
@@ -278,7 +282,11 @@ def verdict(results: dict, weights: dict[str, float] | None = None, main: set[st
     if aimed and any(o["outcome"] == "worse" for g in groups for o in per_stage[g["final"]]["aim"]["objective"]):
         words = "objective worse"
     if results.get("status") not in (None, "ok"):
-        words = "balancing fails"
+        # "balancing fails" only where a claim of the analysis fails: a build that failed a check
+        # while every claim holds (the simulation contradicts the analysis) says so instead, never
+        # "balancing fails" beside loads the analysis finds cancelled
+        words = ("balancing fails" if claims_fail or balance_level == "bad"
+                 else check_failure(results.get("problems") or []))
     if aimed and level == "neutral" and all(per_stage[g["final"]]["aim"]["nothing_added"] for g in groups):
         words = "adds nothing"  # the stage's words say why
         text = " | ".join(per_stage[g["final"]]["text"] for g in groups)
@@ -288,5 +296,18 @@ def verdict(results: dict, weights: dict[str, float] | None = None, main: set[st
         text = f"{words}: force {force['text']}, moment {moment['text']}"
     if refs["total"]:
         text += f"; {refs['text']}"
+    unconfirmed = list(results.get("unconfirmed") or [])
+    if unconfirmed:
+        text += f"; simulation check unconfirmed for {len(unconfirmed)} run{'s' if len(unconfirmed) > 1 else ''}"
     return {"level": level, "words": words, "text": text, "force": force, "moment": moment,
-            "references": refs, "motions": groups, "stages": per_stage}
+            "references": refs, "motions": groups, "stages": per_stage,
+            "validation": "unconfirmed" if unconfirmed else None}
+
+
+def check_failure(problems: list[str]) -> str:
+    """The headline of a build that failed a check while every claim of the analysis holds: the
+    simulation contradicts the analysis (a claim shown false by pymunk), or the analysis' own
+    cross-check fails."""
+    if any(p.startswith(("pymunk validation", "torque-driven run")) for p in problems):
+        return "the simulation contradicts the analysis"
+    return "a cross-check fails"

@@ -139,8 +139,8 @@ from ..engine import Analysis, analyse
 from ..model import Model
 from .extend import continued, settling_steps
 from .run import SimulationRun, model_scale, _relative_poses, _run_adaptive
-from .settings import (MAX_ITERATIONS, ValidationSettings, _jumps, _law_kinds, _step_grid, default_settings,
-                       halve_while_shrinking)
+from .settings import (MAX_ITERATIONS, Refinement, ValidationSettings, _jumps, _law_kinds, _step_grid,
+                       default_settings, refine_step, step_setting)
 from .verdict import Verdict
 
 @dataclass
@@ -198,6 +198,9 @@ class StageValidation(Verdict):
     force_reference: float = math.nan
     moment_reference: float = math.nan
     reference_basis: str = "force: unbalanced peak; moment: unbalanced peak"
+    solver_change: float = math.nan
+    unconfirmed: bool = False
+    remedy: str = ""
 
     def to_json(self) -> dict:
         """Plain, deterministic summary (no curves, no wall-clock times)."""
@@ -355,26 +358,57 @@ def validate(
     expect: tuple[str, ...] = (),
     reference=None,
 ) -> StageValidation:
-    """:func:`_validate_once`; a run that fails on its residuals is run again at half the step
-    while each halving shrinks its largest residual at least :data:`.settings.STEP_ERROR_RATIO` times (the
-    momentum differences are second order in the step), up to :data:`.settings.MAX_HALVINGS` times, and
-    the last such run is kept, saying so; a residual that does not shrink is the design's or the
-    analysis' and fails as it was, its notes giving the finer step's residual. Not where
-    ``settings.dt`` is given (a spec's ``validation.dt``): that step is the one used. The slider-driven
-    slider-crank (specs/custom_slider_driven_slider_crank_gravity.yaml) on a 3-4-5 cam with dwells
-    failed at 2.0e-2 of the reference moment at the default step (the counterweights make its
-    moment 16 times the reference), 5.0e-3 at half of it and 1.2e-3 at a quarter."""
+    """:func:`_validate_once`; a run that fails on its residuals (or came apart) is run again at
+    finer steps while each refinement shrinks its largest residual as a second-order error shrinks
+    (:func:`.settings.refine_step`; the momentum differences are second order in the step), down
+    to ``settings.max_refinement`` times finer, and the last such run is kept, saying so; then
+    :func:`_judge` says whether it fails (a residual that does not shrink is the design's or the
+    analysis') or is unconfirmed. Not where ``settings.dt`` is given (a spec's ``validation.dt``):
+    that step is the one used. The slider-driven slider-crank
+    (specs/custom_slider_driven_slider_crank_gravity.yaml) on a 3-4-5 cam with dwells failed at
+    2.0e-2 of the reference moment at the default step (the counterweights make its moment 16
+    times the reference), 5.0e-3 at half of it and 1.2e-3 at a quarter."""
     settings = settings or ValidationSettings()
     v = _validate_once(model, analysis, unbalanced_peaks, settings, expect, reference)
 
     def worst(r: StageValidation) -> float:
         return max(r.force_residual, r.moment_residual)
 
-    if v.passed or settings.dt or not math.isfinite(worst(v)) or worst(v) <= settings.tolerance:
-        return v  # a step the spec gives (validation.dt) is the step used
-    return halve_while_shrinking(
-        v, lambda dt: _validate_once(model, analysis, unbalanced_peaks, replace(settings, dt=dt), expect, reference),
-        worst, lambda x: x.passed, "largest residual")
+    refinement = Refinement(None, False, None)
+    if not v.passed and not settings.dt and (not math.isfinite(worst(v)) or worst(v) > settings.tolerance):
+        v, refinement = refine_step(
+            v, lambda dt: _validate_once(model, analysis, unbalanced_peaks, replace(settings, dt=dt), expect, reference),
+            worst, lambda x: x.passed, "largest residual", settings.max_refinement,
+            lambda x: 0.5 * settings.tolerance)
+    return _judge(v, refinement, settings)
+
+
+def _judge(v: StageValidation, refinement: Refinement, settings: ValidationSettings) -> StageValidation:
+    """Fail or unconfirmed, for a run that does not pass. It fails where the simulated loads
+    contradict the analysis (or a claimed cancellation) by more than the run's own unresolved
+    error: its residual does not shrink with the step (or the spec gives the step), and exceeds
+    the tolerance by more than the solver's last change between doublings of its iterations
+    (``solver_change``). Unconfirmed, with the remedy: a simulation that came apart at every
+    count, a residual that still shrinks with the step at the budget's finest step, a solver that
+    had not converged to within the excess."""
+    if v.passed:
+        return v
+    worst = max(v.force_residual, v.moment_residual)
+    excess = max(worst - v.tolerance, max((pk - v.balance_tolerance for what, pk in
+                                           (("force", v.force_peak), ("moment", v.moment_peak)) if what in v.expect),
+                                          default=-math.inf))
+    if not math.isfinite(worst):
+        v.unconfirmed = True
+        v.remedy = f"a finer validation.dt than {v.dt:.3g} s, or validation: {{iterations: {2 * MAX_ITERATIONS}}}"
+    elif refinement.shrinks and refinement.remedy_dt is not None:
+        v.unconfirmed = True
+        v.remedy = (f"{step_setting(refinement.remedy_dt)} (second order: the residual falls with the square of the step; the "
+                    f"validator stopped at {1e3 * v.dt:.4g} ms, {settings.max_refinement:g} times finer at most)")
+    elif not excess > (v.solver_change if math.isfinite(v.solver_change) else math.inf):
+        v.unconfirmed = True
+        v.remedy = (f"validation: {{iterations: {2 * v.iterations}}} (the solver had not converged: its loads still "
+                    f"changed by {v.solver_change:.2g} of the reference between the last doublings)")
+    return v
 
 
 def _validate_once(model: Model, analysis: Analysis, unbalanced_peaks: tuple[float, float],
@@ -448,6 +482,7 @@ def _validate_once(model: Model, analysis: Analysis, unbalanced_peaks: tuple[flo
     )
     if F0 <= 0 or M0 <= 0:
         notes.append("an unbalanced peak is zero: that residual is absolute")
+    solver_change = max(change[0] / fden, change[1] / mden)
     N = len(analysis.t)
     if run is None:
         nan = np.full(N, np.nan)
@@ -488,6 +523,6 @@ def _validate_once(model: Model, analysis: Analysis, unbalanced_peaks: tuple[flo
         tolerance=tol, balance_tolerance=settings.balance_tolerance, expect=tuple(expect),
         passed=not reasons, reasons=reasons, excluded_samples=excluded,
         extrapolated_samples=extrapolated, floored_bodies=list(run.sim.floored), notes=notes,
-        timing={"simulation_s": run.wall, "total_s": time.perf_counter() - wall0}, **refs,
+        timing={"simulation_s": run.wall, "total_s": time.perf_counter() - wall0}, solver_change=solver_change, **refs,
     )
 

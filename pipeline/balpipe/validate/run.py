@@ -85,6 +85,15 @@ def _driver_coordinate(model: Model, d, poses: dict[str, tuple], com: dict):
 
 
 
+def initial_state(model: Model, analysis: Analysis, dt: float, settle: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """The state :func:`simulate` builds its space in (centre-of-mass poses and velocities, (nb, 3)
+    each): one step before the first simulated step's landing q0 (``settle`` steps before t0),
+    q0 - dt v_h with the half-step velocity v_h = v0 - a0 dt / 2."""
+    q0, v0, a0 = start_state(model, analysis, settle, dt)
+    vh = v0 - 0.5 * dt * a0
+    return q0 - dt * vh, vh
+
+
 def simulate(
     model: Model,
     analysis: Analysis,
@@ -138,9 +147,7 @@ def simulate(
     t0 = float(t[0])
     n = int(round((float(t[-1]) - t0) / dt))
     times = t0 + dt * np.arange(n + 1)
-    q0, v0, a0 = start_state(model, analysis, settle, dt)
-    vh = v0 - 0.5 * dt * a0
-    qs = q0 - dt * vh
+    qs, vh = initial_state(model, analysis, dt, settle)
     gravity = (0.0, 0.0) if floating_base is not None else analysis.gravity
     sim = build_space(
         model, qs, vh, gravity=gravity, iterations=iterations, floating_base=floating_base,

@@ -23,6 +23,8 @@ ITERATIONS = 100
 MAX_ITERATIONS = 3200
 #: deviation from the analysed motion (rad, or relative to the model's size) that makes a run retry
 HEALTH_LIMIT = 1e-3
+#: the finest step the validator tries on its own, as a fraction of the first (three halvings)
+MAX_REFINEMENT = 8
 
 
 @dataclass(frozen=True)
@@ -56,6 +58,9 @@ class ValidationSettings:
     torque I alpha of the analysed motion before every step (:mod:`balpipe.validate.feedforward`):
     the motion is imposed by the drivers either way, and the solver is left with a small
     remainder (the idler loop's stages converge at 800-1600 iterations instead of 3200).
+    ``max_refinement``: the validator's own budget for a run that cannot resolve its error at the
+    first step: steps down to the first divided by this (:func:`refine_step`); a run still
+    unresolved there is *unconfirmed*, with the step that would resolve it (1: no refinement).
     """
 
     dt: float | None = None
@@ -69,41 +74,91 @@ class ValidationSettings:
     tracking_tolerance: float = 1e-3
     early_accept: bool = True
     feedforward: bool = True
+    max_refinement: float = MAX_REFINEMENT
 
 
-
-#: halvings of the step tried on a run that fails on its numbers alone (position-driven residuals,
-#: torque-driven tracking), while each shrinks its error as an integration error shrinks
-MAX_HALVINGS = 3
-#: how much a halving must shrink the error for it to be the step's (second order: 4x)
+#: how much a halving must shrink the error for it to be the step's (second order: 4x); a
+#: refinement by a factor r must shrink it by STEP_ERROR_RATIO / 4 of r^2
 STEP_ERROR_RATIO = 3.0
 
 
-def halve_while_shrinking(first, rerun, error, good, what: str):
-    """The run at a finer step, where ``first`` fails on its numbers alone (``error(first)``
-    finite): ``rerun(dt)`` at half the step while each halving shrinks ``error`` at least
-    :data:`STEP_ERROR_RATIO` times (an integration error of second order shrinks 4x), up to
-    :data:`MAX_HALVINGS` times or until ``good(run)``. Returns the last run that shrank so, with a
-    note of each step's ``what`` ("tracking error 0.007 at 0.625 ms, 0.0017 at 0.3125 ms (the
-    step's error, second order): kept the run at 0.3125 ms"), or ``first`` noted that a finer step
-    does not shrink it. Runs have ``dt``, ``notes`` and ``timing["total_s"]`` (summed)."""
-    trail, best, spent = [(first.dt, error(first))], first, first.timing.get("total_s", 0.0)
-    for _ in range(MAX_HALVINGS):
-        finer = rerun(best.dt / 2.0)
+@dataclass
+class Refinement:
+    """What :func:`refine_step` found. ``shrinks``: the error shrank with the step as an
+    integration error of second order shrinks (the last refinement tried; None when none was
+    tried); ``exhausted``: the budget's finest step was reached without resolving the run;
+    ``remedy_dt``: where it shrinks, the step at which the second-order error reaches the target
+    (the setting that would resolve the run), else None."""
+
+    shrinks: bool | None
+    exhausted: bool
+    remedy_dt: float | None
+
+
+def _error_at(e: float) -> float:
+    return e if math.isfinite(e) else math.inf
+
+
+def refine_step(first, rerun, error, good, what: str, budget: float = MAX_REFINEMENT, target=None):
+    """The run at a finer step, where ``first`` fails on its numbers alone: ``rerun(dt)`` at a
+    finer step while each refinement shrinks ``error`` as an integration error of second order
+    shrinks (by at least ``STEP_ERROR_RATIO / 4`` of the step ratio squared), until ``good(run)``
+    or the finest step ``first.dt / budget``. The step is chosen from the error itself: with
+    ``target(run)`` (the error that would resolve the run), the step ratio is the power of two
+    at or above sqrt(error / target) (second order: one rerun where the error is the step's),
+    else 2. A run that came apart (error infinite) is retried at half the step; one that holds
+    together there counts as shrinking. Returns the last run that shrank so, with a note of each
+    step's ``what`` ("tracking error 0.007 at 0.625 ms, 0.0017 at 0.3125 ms (the step's error,
+    second order): kept the run at 0.3125 ms"), or ``first`` noted that a finer step does not
+    shrink it; and a :class:`Refinement`. Runs have ``dt``, ``notes`` and ``timing["total_s"]``
+    (summed)."""
+    best, spent = first, first.timing.get("total_s", 0.0)
+    trail = [(first.dt, error(first))]
+    finest = first.dt / max(float(budget), 1.0)
+    shrinks: bool | None = None
+    while not good(best):
+        room = best.dt / finest
+        if room < 1.5:
+            break
+        e = _error_at(error(best))
+        want = 2.0
+        goal = target(best) if target is not None and math.isfinite(e) else None
+        if goal is not None and goal > 0 and e > goal:
+            want = 2.0 ** math.ceil(math.log2(math.sqrt(e / goal)) - 1e-9)
+        factor = min(max(want, 2.0), room)
+        finer = rerun(best.dt / factor)
         spent += finer.timing.get("total_s", 0.0)
-        trail.append((finer.dt, error(finer)))
-        if not error(finer) * STEP_ERROR_RATIO <= error(best):
+        ef = _error_at(error(finer))
+        trail.append((finer.dt, ef))
+        ratio = (best.dt / finer.dt) ** 2 * STEP_ERROR_RATIO / 4.0
+        shrinks = (math.isfinite(ef) and not math.isfinite(e)) or (math.isfinite(ef) and ef * ratio <= e)
+        if not shrinks:
             break
         best = finer
-        if good(best):
-            break
     steps = ", ".join(f"{e:.2g} at {1e3 * dt:.4g} ms" for dt, e in trail)
-    if best is first:
-        first.notes.append(f"{what} {steps}: a finer step does not shrink it as an integration error shrinks")
-    else:
-        best.notes.append(f"{what} {steps} (the step's error, second order): kept the run at {1e3 * best.dt:.4g} ms")
+    if len(trail) > 1:
+        if best is first:
+            first.notes.append(f"{what} {steps}: a finer step does not shrink it as an integration error shrinks")
+        else:
+            best.notes.append(f"{what} {steps} (the step's error, second order): kept the run at {1e3 * best.dt:.4g} ms")
     best.timing["total_s"] = spent
-    return best
+    resolved = good(best)
+    remedy = None
+    if not resolved and shrinks is not False and target is not None:
+        e = _error_at(error(best))
+        goal = target(best)
+        if math.isfinite(e) and goal is not None and goal > 0 and e > goal:
+            remedy = best.dt * math.sqrt(goal / e)
+        elif not math.isfinite(e):
+            remedy = best.dt / 2.0
+    return best, Refinement(shrinks, not resolved and best.dt / finest < 1.5, remedy)
+
+
+def step_setting(dt: float) -> str:
+    """A step as a spec would give it, rounded down to two significant digits: "validation: {dt: 1.2e-06 s}"."""
+    exponent = math.floor(math.log10(dt))
+    mantissa = math.floor(dt / 10.0**exponent * 10.0) / 10.0
+    return f"validation: {{dt: {mantissa:g}e{exponent:+03d} s}}"
 
 
 def default_settings(model: Model, analysis: Analysis) -> tuple[float, int]:
