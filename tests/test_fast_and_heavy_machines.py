@@ -128,3 +128,99 @@ def test_the_auxiliary_gears_are_in_the_machine_the_efforts_drive(scara):
                      for b in sim.space.bodies)
         assert ke_sim == pytest.approx(kinetic(effort_model, t), rel=1e-9)
         assert abs(ke_sim / kinetic(sim_model, t) - 1) > 0.01
+
+
+def test_a_run_that_cannot_resolve_its_error_within_its_budget_is_unconfirmed(v_twin):
+    """The V-twin's complete force balance with the validator's own refinement off: at the default
+    step its torque-driven run cannot resolve the calibration's model error (the crank and its
+    counterweights are a flywheel). That shows nothing false: unconfirmed, with the step that
+    would resolve it, which does."""
+    s = _stage(v_twin, "complete:counterweights")
+    tight = ValidationSettings(max_refinement=1)
+    r = _torque(v_twin, s, settings=tight)
+    assert r.status == "unconfirmed" and not r.passed and r.unconfirmed
+    assert any("does not resolve a model error" in x for x in r.reasons)
+    assert r.remedy.startswith("validation: {dt: ") and r.to_json()["status"] == "unconfirmed"
+    dt = float(r.remedy.split("{dt: ")[1].split(" s}")[0])
+    assert dt < r.dt / 2
+    resolved = _torque(v_twin, s, settings=ValidationSettings(dt=dt))
+    assert resolved.status == "pass" and resolved.resolution >= 10, resolved.reasons
+
+
+def _v_twin_text(validation: str, counterweight_factor: float = 1.0) -> str:
+    """The V-twin's mechanism and motion with the complete force balance typed as one stage that
+    claims it (counterweights times ``counterweight_factor``)."""
+    st = load(V_TWIN)
+    text = V_TWIN.read_text(encoding="utf-8")
+    head = text[: text.index("balancing:")]
+    params = {p.name: p.value for p in study_mod.run(st.spec).balance.parameters}
+    parts = "\n".join(
+        f"            - {{body: {body}, name: {cw}, mass: {counterweight_factor * params[f'complete:{cw}.mass']!r} kg, "
+        f"position: [{params[f'complete:{cw}.x']!r}, {params[f'complete:{cw}.y']!r}]}}"
+        for body, cw in (("crank", "cw_crank"), ("rod1", "cw_rod1"), ("rod2", "cw_rod2")))
+    return head + f"""balancing:
+  method: stages
+  stages:
+    - name: complete
+      balances: force
+      tolerance: 1e-9
+      parts:
+{parts}
+analysis:
+  samples: 361
+validation: {validation}
+"""
+
+
+def _build(folder: Path, *args):
+    return subprocess.run([sys.executable, "-m", "balpipe", "build", str(folder), "-o", str(folder / "site"), *args],
+                          capture_output=True, text=True)
+
+
+def test_build_exits_0_on_an_unconfirmed_check_and_3_under_strict(tmp_path):
+    specs = tmp_path / "specs"
+    specs.mkdir()
+    (specs / "v_twin.yaml").write_text(_v_twin_text("{max_refinement: 1}"), encoding="utf-8")
+    p = _build(specs)
+    assert p.returncode == 0, p.stderr
+    assert "unconfirmed" in p.stderr and "remedy: validation: {dt: " in p.stderr and "fails" not in p.stderr
+    res = json.loads((specs / "site" / "v_twin" / "results.json").read_text(encoding="utf-8"))
+    assert res["status"] == "ok" and res["unconfirmed"] and not res["problems"]
+    assert res["torque_driven"]["complete"]["status"] == "unconfirmed"
+    assert "fails" not in res["verdict"]["text"] and "unconfirmed" in res["verdict"]["text"]
+    assert res["verdict"]["validation"] == "unconfirmed"
+    page = (specs / "site" / "v_twin" / "index.html").read_text(encoding="utf-8")
+    assert ">unconfirmed<" in page and "remedy: validation: {dt: " in page
+    strict = _build(specs, "--strict")  # unchanged: the previous results are read
+    assert strict.returncode == 3, strict.stderr
+
+
+def test_build_of_a_ten_percent_counterweight_error_exits_1(tmp_path):
+    specs = tmp_path / "specs"
+    specs.mkdir()
+    (specs / "v_twin.yaml").write_text(_v_twin_text("{enabled: true}", 1.1), encoding="utf-8")
+    p = _build(specs)
+    assert p.returncode == 1, p.stderr
+    res = json.loads((specs / "site" / "v_twin" / "results.json").read_text(encoding="utf-8"))
+    assert res["status"] == "failed" and res["verdict"]["words"] == "balancing fails"
+    assert res["validation"]["complete"]["status"] == "fail" and not res["unconfirmed"]
+
+
+def test_a_verdict_never_says_balancing_fails_beside_cancelled_loads():
+    """A build that failed only on the simulation (every claim of the analysis holds) says the
+    simulation contradicts the analysis; an unconfirmed check is named, not failed."""
+    stages = [
+        {"name": "unbalanced", "label": "unbalanced", "balances": "", "force_ratio": 1.0, "moment_ratio": 1.0,
+         "max_inertial_force": 10.0, "max_inertial_moment": 2.0},
+        {"name": "full", "label": "full", "balances": "force+moment", "force_ratio": 1e-14, "moment_ratio": 1e-14,
+         "force_balanced": True, "moment_balanced": True, "max_inertial_force": 1e-13, "max_inertial_moment": 1e-14,
+         "reference": "unbalanced"},
+    ]
+    failed = verdict({"stages": stages, "status": "failed",
+                      "problems": ["torque-driven run of stage 'full' fails: tracking error 0.5 of the travel > 0.001"]})
+    assert failed["level"] == "bad" and "cancelled" in failed["text"]
+    assert "balancing fails" not in failed["text"] and failed["words"] == "the simulation contradicts the analysis"
+    unsure = verdict({"stages": stages, "status": "ok", "unconfirmed": ["torque-driven run of stage 'full' unconfirmed"]})
+    assert unsure["words"] == "balanced as claimed" and "unconfirmed" in unsure["text"]
+    claim = dict(stages[1], force_balanced=False, force_ratio=0.2)
+    assert verdict({"stages": [stages[0], claim], "status": "failed"})["words"] == "balancing fails"

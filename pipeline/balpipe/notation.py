@@ -239,6 +239,7 @@ COMMON: dict[str, Sym] = {
     "validation.iterations": setting("iterations", "pymunk solver iterations per step"),
     "validation.tolerance": setting("ε_{sim}", "pymunk residuals pass below this fraction of the reference loads"),
     "validation.reactionless": setting("free frame", "free-floating frame demonstration"),
+    "validation.max_refinement": setting("refinement", "a run that cannot resolve its error is rerun at steps down to the first divided by this, then unconfirmed"),
     # the generic finder's settings, shared by force_balance and moment_balance
     "balancing.rank_tolerance": setting("ε_{rank}", "finding the conditions numerically: a direction smaller than this fraction of the largest counts as round-off"),
     "balancing.samples": setting("N_{states}", "states the mechanism can reach at which its momentum is evaluated to find the conditions (0: automatic)"),

@@ -258,13 +258,10 @@ def _plan(model: Model, analysis: Analysis, settings: ValidationSettings, analyt
         share = _floor_share(efforts, analysis, analytic_model, times)
         loads = (f"the efforts include their inertial loads, {100 * share:.3g} % of the peak effort" if share > 1e-9
                  else "along this motion they add no load to the efforts")
-        what = []
-        if floored:
-            what.append("floor parts (" + ", ".join(floored) + ")")
-        if auxiliary:
-            what.append("the auxiliary gears of coaxial pairs on moving carriers")
-        notes.append("simulated with " + " and ".join(what) + f" ({100 * settings.mass_floor:g} % of the largest "
-                     "mass and moment); " + loads)
+        size = f"{100 * settings.mass_floor:g} % of the largest mass and moment"
+        what = (["floor parts (" + ", ".join(floored) + f": {size})"] if floored else []) + (
+            [f"the auxiliary gears of coaxial gear pairs on moving carriers ({size})"] if auxiliary else [])
+        notes.append("simulated with " + " and ".join(what) + "; " + loads)
     _average_jumps(efforts, effort_model, analysis, times, dt)
     travel = _travel(analytic_model, t)
     applied = AppliedLoads(sim_model, fine, times) if sim_model.loads else None
