@@ -30,3 +30,21 @@ def test_the_index_cites_each_paper_once_in_id_order():
     papers = site_papers(entries)
     assert [p["id"] for p in papers] == ["000", "002"]
     assert papers[1]["text"] == citations.cite("002: b")
+
+
+def test_a_familys_paper_is_cited_and_drawn_through_its_hooks(monkeypatch):
+    """The report holds no paper's data: a paper that a family declares (``Family.papers``) is
+    cited from its :class:`Citation` and its own panels come from its hook."""
+    from types import SimpleNamespace
+
+    from balpipe import registry
+    from balpipe.plugins import Citation, Paper
+    from balpipe.report import paper_figures
+
+    panel = ("Fig. 1 of paper 999", "<svg/>", "drawn by the family")
+    monkeypatch.setitem(registry.PAPERS, "999", Paper("999", Citation("A title", authors="A. Author", venue="Venue",
+                                                                      year="2001"), ("1",), lambda study: [panel]))
+    assert citations.cite("999: words of the spec") == "Paper 999: A. Author, “A title”, Venue, 2001."
+    assert paper_figures.own_figures(SimpleNamespace(spec=SimpleNamespace(paper="999: x"))) == [panel]
+    assert paper_figures.own_figures(SimpleNamespace(spec=SimpleNamespace(paper="998: x"))) == []
+    assert registry.PAPERS["002"].citation.doi == "10.11159/icmie25.110"  # paper 002's, declared by serial_arm

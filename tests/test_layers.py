@@ -335,8 +335,8 @@ def _family_words() -> set[str]:
 
 
 def names_of_families(src: Path, words: set[str]) -> list[str]:
-    """String constants (docstrings aside) and identifiers equal to a family's, a template's or a
-    method's name, in modules outside ``balpipe.families``."""
+    """String constants (docstrings aside) and identifiers equal to one of ``words`` (a family's,
+    a template's or a method's name; a paper's id), in modules outside ``balpipe.families``."""
     found = []
     for m, p in modules(src).items():
         if m.startswith("balpipe.families"):
@@ -361,6 +361,28 @@ def test_a_planted_family_name_in_the_core_fails(tree_copy: Path):
     study = tree_copy / "balpipe" / "study.py"
     study.write_text(study.read_text(encoding="utf-8") + '\n\ndef _planted(spec):\n    return spec.mechanism.template == "rrr4"\n')
     assert any(b.startswith("balpipe.study:") for b in names_of_families(tree_copy, _family_words()))
+
+
+def _paper_ids() -> set[str]:
+    """The ids of the papers the families declare (``Family.papers``): "000" to "004" in this tree."""
+    from balpipe import plugins
+
+    ids = {p.id for f in plugins.discover() for p in f.papers}
+    assert ids >= {"000", "001", "002", "003", "004"}  # the test below has something to find
+    return ids
+
+
+def test_no_core_module_names_a_paper():
+    """A paper's data (citation, figures, its own panels) live on the family that reproduces it:
+    no module outside ``balpipe.families`` names a paper id as a string constant."""
+    assert names_of_families(SRC, _paper_ids()) == []
+
+
+def test_a_planted_paper_id_in_the_core_fails(tree_copy: Path):
+    page = tree_copy / "balpipe" / "report" / "page.py"
+    page.write_text(page.read_text(encoding="utf-8") + '\n\ndef _planted(spec):\n    return spec.paper == "004"\n')
+    assert any(b.startswith("balpipe.report.page:") and b.endswith("names '004'")
+               for b in names_of_families(tree_copy, _paper_ids()))
 
 
 def _docs_layers() -> dict[int, str]:

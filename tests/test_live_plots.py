@@ -176,12 +176,14 @@ def test_the_papers_time_series_are_interactive_in_their_stage_styles():
     from balpipe.report import paper_figures as PF
 
     st = run(load(SPECS / "paper004_five_bar.yaml").spec)
-    force_only = next(s for s in st.stages if s.stage.balances == "force" and ":" not in s.stage.name)
+    from balpipe.families.five_bar import figures as P4
+
+    force_only = next(s for s in st.stages if s.stage.balances == "force" and s.stage.design is None)
     _, html, _ = next(f for f in PF.own_figures(st) if f[0].startswith("Fig. 12"))
     script = html[html.index('data-live="live-p004fig12">') + len('data-live="live-p004fig12">'):html.rindex("</script>")]
     data = json.loads(script)
     [series] = data["series"]
-    k = PF._k(st, force_only)
+    k = P4.style_of(st, force_only)
     assert k > 0 and {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(k)
     assert data["panels"] == [{"key": "y", "title": "", "axis": "M (N m)",
                                "floor": pytest.approx(1e-9 * np.max(np.abs(force_only.analysis.moment)), rel=1e-2)}]

@@ -72,13 +72,15 @@ def test_the_papers_panels_keep_the_pages_stage_styles(studies, pages):
     """Fig. 12 of paper 004 draws the force-balanced stage in that stage's style of the page (one
     legend per page), not in the first style."""
     study = studies("paper004_five_bar.yaml")
-    force_only = next(s for s in study.stages if s.stage.balances == "force" and ":" not in s.stage.name)
-    k = PF._k(study, force_only)
+    from balpipe.families.five_bar import figures as P4
+
+    force_only = next(s for s in study.stages if s.stage.balances == "force" and s.stage.design is None)
+    k = P4.style_of(study, force_only)
     assert k > 0 and study.stages[k] is force_only
     title, svg, _ = next(f for f in PF.own_figures(study) if f[0].startswith("Fig. 12"))
     a2 = force_only.analysis
-    mine = PF._series(a2.t, [(force_only.stage.label, a2.moment, k)], "M (N m)", "p004fig12")
-    first = PF._series(a2.t, [(force_only.stage.label, a2.moment, 0)], "M (N m)", "p004fig12")
+    mine = P4.series(a2.t, [(force_only.stage.label, a2.moment, k)], "M (N m)", "p004fig12")
+    first = P4.series(a2.t, [(force_only.stage.label, a2.moment, 0)], "M (N m)", "p004fig12")
     assert svg == mine and svg != first
     html = pages("paper004_five_bar.yaml")
     assert html.count('id="style-legend"') == 1

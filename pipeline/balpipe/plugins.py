@@ -123,11 +123,60 @@ class Method:
 
 
 @dataclass(frozen=True)
+class Citation:
+    """A paper cited as far as the sources say: what its stored text prints, or a public record
+    whose abstract is the stored text's word for word (``source`` names it); a field that no such
+    source gives stays empty and :meth:`text` says so, instead of a guess."""
+
+    title: str
+    authors: str = ""
+    venue: str = ""
+    year: str = ""
+    doi: str = ""
+    source: str = ""  # where a field not printed in the stored paper comes from
+
+    def text(self) -> str:
+        """'V. Arakelian, "Title", Venue, 2025. DOI 10.x/y', missing fields named as missing."""
+        parts = [self.authors] if self.authors else []
+        parts.append(f"“{self.title}”")
+        if self.venue:
+            parts.append(self.venue)
+        if self.year:
+            parts.append(self.year)
+        out = ", ".join(parts) + "."
+        if self.doi:
+            out += f" DOI {self.doi}."
+        if self.source:
+            out += f" (Title from {self.source}; its authors, venue and year are not in the part of that record we could read.)"
+        elif not (self.authors and self.venue and self.year):
+            out += (" (Title as the spec describes the paper: its stored text has no title block, authors,"
+                    " venue or year.)")
+        return out
+
+
+@dataclass(frozen=True)
+class Paper:
+    """A paper whose worked examples a family reproduces: ``id`` is the number a spec names it by
+    (``paper: "NNN: title"``); ``citation`` (None: the spec's own title is cited, and said to
+    be); ``figures``: the figure numbers its pages reproduce (a number covers its panels: "6"
+    by "6a"), which a test holds the pages to; ``own_figures(study)`` optionally yields the
+    paper's panels that no method's or template's hook draws as the paper numbers them
+    (title, svg or html, caption), shown on the page of every spec that names the paper, after
+    the balancing's figures. ``own_figures`` may be a :class:`Ref`."""
+
+    id: str
+    citation: Citation | None = None
+    figures: tuple[str, ...] = ()
+    own_figures: Callable[..., Any] | None = None
+
+
+@dataclass(frozen=True)
 class Family:
     """One mechanism family: its templates and paper methods, in the order they appear in the
-    spec's unions. ``package`` is the family's import package (the build's code hash takes the
-    code of the package that the family's entry point names, read without importing it).
-    ``examples``: specs that use the family, shipped with its package (paths, e.g.
+    spec's unions, and the papers it reproduces (:class:`Paper`: citation, figures; each paper
+    declared by one family). ``package`` is the family's import package (the build's code hash
+    takes the code of the package that the family's entry point names, read without importing
+    it). ``examples``: specs that use the family, shipped with its package (paths, e.g.
     :func:`packaged_examples`, or YAML texts); :func:`balpipe.testing.check_family` builds them,
     so that a family is checked without balpipe's own ``specs/``."""
 
@@ -135,7 +184,7 @@ class Family:
     order: int
     templates: tuple[Template, ...] = ()
     methods: tuple[Method, ...] = ()
-    paper: str | None = None
+    papers: tuple[Paper, ...] = ()
     package: str = field(default="")
     examples: tuple[str | Path, ...] = ()
 

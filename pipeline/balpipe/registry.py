@@ -18,14 +18,13 @@ from .model import Law, Model
 from .laws.drives import drive_laws
 from .laws.load_spec import model_loads
 from .motion import law_for
-from .plugins import Method, Ref, Template, discover
+from .plugins import Method, Paper, Ref, Template, discover
 from .mechanics.sampling import gravity_vector, time_grid
 from .spec_parts import DriveSpec, SpecFieldError
 
 __all__ = [
-    "METHODS", "TEMPLATES", "BalanceContext", "Method", "Template", "balance", "balance_designs", "context",
-    "method_specs", "scalar_laws",
-    "template_specs", "time_grid", "unbalanced_model", "motion_model",
+    "METHODS", "PAPERS", "TEMPLATES", "BalanceContext", "Method", "Paper", "Template", "balance",
+    "balance_designs", "context", "method_specs", "scalar_laws", "template_specs", "time_grid", "unbalanced_model", "motion_model",
 ]
 
 # methods for every template (they read only the model); "none" is the spec's own default. Their
@@ -49,24 +48,31 @@ GENERIC: tuple[Method, ...] = (
 )
 
 
-def _tables() -> tuple[dict[str, Template], dict[str, Method]]:
-    """Templates and methods of the discovered families in their order, then the generic methods."""
+def _tables() -> tuple[dict[str, Template], dict[str, Method], dict[str, Paper]]:
+    """Templates, methods and papers of the discovered families in their order, then the generic
+    methods; the papers by id."""
     templates: dict[str, Template] = {}
     methods: dict[str, Method] = {}
+    papers: dict[str, Paper] = {}
     for family in discover():
         for kind, table, items in (("template", templates, family.templates), ("method", methods, family.methods)):
             for item in items:
                 if item.name in table or (kind == "method" and item.name == "none"):
                     raise ValueError(f"family {family.name!r}: {kind} {item.name!r} is already defined")
                 table[item.name] = item
+        for paper in family.papers:
+            if paper.id in papers:
+                raise ValueError(f"family {family.name!r}: paper {paper.id!r} is already declared")
+            papers[paper.id] = paper
     for item in GENERIC:
         if item.name in methods:
             raise ValueError(f"method {item.name!r} is already defined")
         methods[item.name] = item
-    return templates, methods
+    return templates, methods, papers
 
 
-TEMPLATES, METHODS = _tables()
+#: the templates and methods by name, the papers the families reproduce by id (:class:`balpipe.plugins.Paper`)
+TEMPLATES, METHODS, PAPERS = _tables()
 
 
 def template_specs() -> tuple[type, ...]:

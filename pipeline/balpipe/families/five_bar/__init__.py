@@ -1,6 +1,6 @@
 """The five-bar family: the fixed-sequence 5R with gear-coupled inputs and its gear balancing."""
 
-from ...plugins import Family, Method, Ref, Template, packaged_examples
+from ...plugins import Family, Method, Paper, Ref, Template, packaged_examples
 from . import specs, template
 
 FAMILY = Family(
@@ -8,6 +8,8 @@ FAMILY = Family(
     order=2,
     package=__name__,
     examples=packaged_examples(__file__),
+    # stored from its abstract on: the spec's title is cited; Figs. 10a-12 drawn as the paper numbers them
+    papers=(Paper("004", figures=("10a", "10b", "11", "12"), own_figures=Ref(f"{__name__}.figures:paper_figures")),),
     templates=(
         Template("five_bar", template.FiveBarMechanism, template.build,
                  "five-bar (5R), fixed-sequence with gear-coupled inputs", Ref(f"{__name__}.figures:figures"),

@@ -1,10 +1,15 @@
 """The five-bar's report figures (paper 004): the gripper path (Fig. 7) and the input angles
-(Figs. 8-9), drawn from the study's analyses."""
+(Figs. 8-9), drawn from the study's analyses; and paper 004's own panels on the page of every
+spec that names the paper (:func:`paper_figures`, its :attr:`balpipe.plugins.Paper.own_figures`):
+Figs. 10a, 10b, 11, 12, the shaking force along x and along y and the shaking moment (N m) of the
+unbalanced manipulator, and the shaking moment after shaking force balancing."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from ...balancing.base import style_index
+from ...draw import live
 from .template import gripper_path, input_angles, segment_distance
 
 
@@ -67,3 +72,46 @@ def angles_html(t: np.ndarray, th1: np.ndarray, th2: np.ndarray) -> str:
                          [{"key": k, "title": f"{k} (rad)", "axis": f"{k} (rad)"} for k in ("theta1", "theta2")], [],
                          styles=[{"color": "black", "linestyle": "-", "linewidth": 1.4}], grid=True)
     return live.html("fivebar-angles", curves)
+
+
+def series(t, curves: list[tuple[str, np.ndarray, int]], ylabel: str, prefix: str) -> str:
+    """A time series in the page's stage styles: each curve (label, values, k) drawn in
+    ``figures.style(k)``, k the stage's place in the page's stage table, so that one line style
+    means one stage on the whole page; interactive, on screen and in print
+    (:func:`balpipe.draw.live.html`, element ``#live-<prefix>``)."""
+    curves_of = live.Curves(t, [(label, {"y": y}) for label, y, _ in curves],
+                            [{"key": "y", "title": "", "axis": ylabel}], [], styles=[k for _, _, k in curves])
+    return live.html(prefix, curves_of)
+
+
+def style_of(study, stage) -> int:
+    """The stage's style index on the page (:func:`balpipe.balancing.base.style_index`)."""
+    return style_index(study.stages, stage)
+
+
+def paper_figures(study) -> list[tuple[str, str, str]]:
+    """Paper 004's Figs. 10a, 10b, 11 (the unbalanced manipulator) and 12 (the main design's
+    force-balanced stage, when there is one), (title, html, caption), from the study's analyses."""
+    un = study.unbalanced
+    an = un.analysis
+    force_only = next((s for s in study.stages if s.stage.balances == "force" and s.stage.design is None), None)
+    k0 = style_of(study, un)
+    out = [
+        ("Fig. 10a of paper 004: shaking force along x (N)",
+         series(an.t, [(un.stage.label, an.force[:, 0], k0)], "F_x (N)", "p004fig10a"),
+         "The unbalanced manipulator, from the analysis of this spec."),
+        ("Fig. 10b of paper 004: shaking force along y (N)",
+         series(an.t, [(un.stage.label, an.force[:, 1], k0)], "F_y (N)", "p004fig10b"),
+         "The unbalanced manipulator, from the analysis of this spec."),
+        ("Fig. 11 of paper 004: shaking moment (N m)",
+         series(an.t, [(un.stage.label, an.moment, k0)], "M (N m)", "p004fig11"),
+         "The unbalanced manipulator, about the moment point of the spec."),
+    ]
+    if force_only is not None:
+        a2 = force_only.analysis
+        out.append(("Fig. 12 of paper 004: shaking moment after shaking force balancing (N m)",
+                    series(a2.t, [(force_only.stage.label, a2.moment, style_of(study, force_only))], "M (N m)",
+                           "p004fig12"),
+                    f"Stage '{force_only.stage.label}' (force balanced by counterweights), in its line style of this "
+                    "page: the moment grows, as the paper says."))
+    return out

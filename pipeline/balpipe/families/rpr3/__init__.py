@@ -1,6 +1,6 @@
 """The 3-RPR family: the parallel manipulator, its idler-loop and Scott-Russell balancings."""
 
-from ...plugins import Family, Method, Ref, Template, packaged_examples
+from ...plugins import Family, Method, Paper, Ref, Template, packaged_examples
 from . import specs, template
 
 FAMILY = Family(
@@ -8,6 +8,8 @@ FAMILY = Family(
     order=4,
     package=__name__,
     examples=packaged_examples(__file__),
+    # paper 000's stored text starts at its abstract, without a title block: the spec's title is cited
+    papers=(Paper("000", figures=("4", "8")),),
     templates=(
         Template("rpr3", template.Rpr3Mechanism, template.build, "3-RPR parallel manipulator",
                  Ref(f"{__name__}.figures:figures"), notation=template.NOTATION),

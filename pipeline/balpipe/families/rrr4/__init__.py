@@ -1,6 +1,6 @@
 """The n-RRR family (paper 001): the planar parallel manipulator and its counter-masses."""
 
-from ...plugins import Family, Method, Ref, Template, packaged_examples
+from ...plugins import Citation, Family, Method, Paper, Ref, Template, packaged_examples
 from . import specs, template
 
 FAMILY = Family(
@@ -8,6 +8,13 @@ FAMILY = Family(
     order=3,
     package=__name__,
     examples=packaged_examples(__file__),
+    # the title is the CORE record's (https://core.ac.uk/works/19417988, the same abstract as the stored
+    # text); its authors, venue and year are not in that record's text that we could check: left empty
+    papers=(Paper("001", Citation(
+        "Generic method for deriving the general shaking force balance conditions of parallel manipulators with "
+        "application to a redundant planar 4-RRR parallel manipulator",
+        source="the CORE record core.ac.uk/works/19417988, whose abstract is the paper's"),
+        figures=("2", "3", "4", "6a", "6b", "6c")),),  # Fig. 6's three panels are three designs, one spec each
     templates=(
         Template("rrr4", template.RRR4Mechanism, template.build,
                  "planar n-RRR parallel manipulator (4-RRR of paper 001, legs removable)",

@@ -1,7 +1,7 @@
 """The serial-arm family: the nR arm, gear decoupling (paper 002) and centre-of-mass motion
 planning (paper 003)."""
 
-from ...plugins import Family, Method, Ref, Template, packaged_examples
+from ...plugins import Citation, Family, Method, Paper, Ref, Template, packaged_examples
 from . import specs, template
 
 FAMILY = Family(
@@ -9,6 +9,16 @@ FAMILY = Family(
     order=5,
     package=__name__,
     examples=packaged_examples(__file__),
+    papers=(
+        # paper 002 prints its authors, venue, year and DOI on its first page
+        Paper("002", Citation("Shaking Force and Shaking Moment Balancing in Planar Serial Manipulators",
+                              authors="V. Arakelian",
+                              venue="Proceedings of the 11th World Congress on Mechanical, Chemical, and Material "
+                                    "Engineering (MCM'25), Paris, France, Paper No. ICMIE 110",
+                              year="2025", doi="10.11159/icmie25.110"),
+              figures=("2",)),
+        Paper("003", figures=("2", "3", "4")),  # stored from its abstract on: the spec's title is cited
+    ),
     templates=(
         Template("serial_arm", template.SerialArmMechanism, template.build, "serial nR arm", notation=template.notation),
     ),
