@@ -147,22 +147,33 @@ def shared(tmp_path_factory) -> Shared:
 
 
 @pytest.fixture(scope="session")
-def studies(shared):
-    """``studies(name)``: the study of ``specs/<name>``, run once per run (the first xdist worker
-    that needs it runs it, the others load it: :class:`Shared`); the tests only read it."""
-    from balpipe import loader
-    from balpipe import study as study_mod
+def api_studies(shared):
+    """``api_studies(name)``: ``balpipe.run(balpipe.load("specs/<name>"))`` (no simulation; the
+    path relative to the repository, as ``balpipe build specs/`` names it), run once per run (the
+    first xdist worker that needs it runs it, the others load it: :class:`Shared`); the tests
+    only read it."""
+    import contextlib
 
     cache: dict = {}
+
+    def compute(name: str):
+        with contextlib.chdir(SPECS.parent):
+            return balpipe.run(balpipe.load(Path("specs") / name), simulate=False)
 
     def get(name: str):
         if name not in cache:
             text = (SPECS / name).read_text(encoding="utf-8")
-            cache[name] = shared.get(f"study\n{name}\n{text}",
-                                     lambda: study_mod.run(loader.load(SPECS / name).spec))
+            cache[name] = shared.get(f"api study\n{name}\n{text}", lambda: compute(name))
         return cache[name]
 
     return get
+
+
+@pytest.fixture(scope="session")
+def studies(api_studies):
+    """``studies(name)``: the pipeline's study of ``specs/<name>``
+    (:attr:`balpipe.Study.engine_study` of :func:`api_studies`'s); the tests only read it."""
+    return lambda name: api_studies(name).engine_study
 
 
 class Pages:

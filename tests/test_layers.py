@@ -35,8 +35,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("balpipe.study", "balpipe.validation_stage", "balpipe.runner", "balpipe.testing"),
     # L5 presentation
     ("balpipe.report",),
-    # L6 commands
-    ("balpipe.build", "balpipe.diff", "balpipe.history", "balpipe.sweep", "balpipe.site_files"),
+    # L6 commands, and the Python API (the build's functions, for a caller in Python)
+    ("balpipe.build", "balpipe.diff", "balpipe.history", "balpipe.sweep", "balpipe.site_files", "balpipe.api"),
     # L7 command line
     ("balpipe.cli", "balpipe.__main__"),
 )
@@ -78,9 +78,16 @@ def source_of(node: ast.ImportFrom, pkg: str) -> str:
     return f"{base}.{node.module}" if node.module else base
 
 
+#: The one upward import allowed: the package's ``__init__`` (L0) re-exports the public API
+#: (``balpipe.load``, ``balpipe.run``, ...) from ``balpipe.api`` lazily, in its module
+#: ``__getattr__`` (an import there runs on first use of a name, after every layer has loaded).
+#: The same import anywhere else in ``__init__``, or of any other module there, is refused.
+FACADE = ("balpipe", "__getattr__", "balpipe.api")
+
+
 def imports(src: Path) -> dict[str, set[tuple[str, bool, int]]]:
     """module -> {(imported balpipe module, deferred?, line)}, every import statement of the file
-    (inside functions too)."""
+    (inside functions too), less the lazy re-export of :data:`FACADE`."""
     mods = modules(src)
     edges: dict[str, set[tuple[str, bool, int]]] = defaultdict(set)
     for m, p in mods.items():
@@ -91,9 +98,10 @@ def imports(src: Path) -> dict[str, set[tuple[str, bool, int]]]:
                 name = name.rsplit(".", 1)[0]
             return name if name in mods and name.startswith("balpipe") else None
 
-        def visit(node: ast.AST, deferred: bool) -> None:
+        def visit(node: ast.AST, deferred: bool, function: str) -> None:
             for ch in ast.iter_child_nodes(node):
                 d = deferred or isinstance(ch, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
+                fn = ch.name if isinstance(ch, (ast.FunctionDef, ast.AsyncFunctionDef)) and node is tree else function
                 found: list[str | None] = []
                 if isinstance(ch, ast.Import):
                     found = [target(a.name) for a in ch.names]
@@ -101,11 +109,12 @@ def imports(src: Path) -> dict[str, set[tuple[str, bool, int]]]:
                     mod = source_of(ch, pkg)
                     found = [target(f"{mod}.{a.name}") for a in ch.names]
                 for t in found:
-                    if t and t != m:
+                    if t and t != m and (m, function, t) != FACADE:
                         edges[m].add((t, d, ch.lineno))
-                visit(ch, d)
+                visit(ch, d, fn)
 
-        visit(_tree(p.read_text(encoding="utf-8")), False)
+        tree = _tree(p.read_text(encoding="utf-8"))
+        visit(tree, False, "")
     return edges
 
 
@@ -229,6 +238,21 @@ def test_families_import_nothing_above_the_drawing_layer():
         if layer_of(t) >= fam and not t.startswith("balpipe.families." + m.split(".")[2])
     ]
     assert bad == []
+
+
+def test_the_api_is_re_exported_lazily_only(tree_copy: Path):
+    """The package's ``__getattr__`` may import balpipe.api (:data:`FACADE`); the same import at
+    the top of ``__init__``, or ``__getattr__`` importing the build, is an upward import."""
+    assert not any(b.startswith("balpipe:") for b in upward(SRC))
+    init = tree_copy / "balpipe" / "__init__.py"
+    text = init.read_text(encoding="utf-8")
+    assert "        from . import api\n" in text
+    init.write_text(text.replace("        from . import api\n", "        from . import api, build  # noqa\n")
+                    + "\nfrom . import api as _eager  # noqa\n")
+    found = upward(tree_copy)
+    top = layer_of("balpipe.api")
+    assert any(b.startswith("balpipe:") and b.endswith(f"imports balpipe.build (deferred): layer 0 < {top}") for b in found)
+    assert any(b.startswith("balpipe:") and b.endswith(f"imports balpipe.api: layer 0 < {top}") for b in found)
 
 
 @pytest.fixture()

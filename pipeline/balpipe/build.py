@@ -298,9 +298,6 @@ def compute(job: Job) -> Computed:
 def _compute(job: Job, memo: Any = None) -> Computed:
     """:func:`compute` without the caches' set-up; the balancing's searches through ``memo``
     (a :class:`balpipe.cache.balance.Memo`; default: computed, no cache)."""
-    from . import runner
-    from .balancing.context import compute as no_cache
-    from .laws.drives import table_files
     from .loader import LoadedSpec, SpecErrors, load_text
     from .spec_parts import SpecFieldError
 
@@ -310,25 +307,9 @@ def _compute(job: Job, memo: Any = None) -> Computed:
     try:
         spec, node = load_text(job.text, source, job.path.parent)
         loaded = LoadedSpec(job.path, job.text, spec, node, source)
-        with pool.spare_workers(job.sim_workers):  # the cores left over also serve the spec's independent work
-            st = runner.analyse(loaded, simulate=job.simulate, memo=memo if memo is not None else no_cache)
-        extra: dict[str, str] = {}
-        if job.simulate and runner.simulate(loaded, st, workers=job.sim_workers):
-            from .validation_stage import timing, timing_script
-
-            times = timing(st)
-            extra = {"timing.json": json.dumps(times, indent=2, sort_keys=True) + "\n",
-                     "timing.js": timing_script(times)}
-        results = results_dict(st, source, job.input_hash, simulated=st.stages[0].validation is not None)
-        if table_files(spec):  # what up_to_date reads to recompute the input hash
-            results["input_tables"] = table_files(spec)
-        files = {
-            "index.html": render_page(st, results, job.text, history=job.history),
-            "results.json": dumps(results),
-            "timeseries.csv": timeseries_csv(st),
-            **extra,
-            **job.history_files,
-        }
+        st = study_of(loaded, job.simulate, job.sim_workers, memo)
+        results = page_results(loaded, st, job.input_hash)
+        files = page_files(loaded, st, results, job.history, job.history_files)
         return Computed("ok" if st.ok else "failed", "; ".join(st.problems), results, files,
                         time.perf_counter() - start)
     except SpecErrors as exc:
@@ -352,6 +333,58 @@ def _code_file(path: str) -> str:
         if parts[k] in ("site-packages", "dist-packages", "pipeline", "lib-dynload") or parts[k].startswith("python3"):
             return "/".join(parts[k + 1:])
     return parts[-1] if parts else path
+
+
+def study_of(loaded, simulate: bool, workers: int = 1, memo: Any = None):
+    """The study of a loaded spec (:class:`balpipe.loader.LoadedSpec`) as a page shows it:
+    :func:`balpipe.runner.analyse` (the balancing's searches through ``memo``, a
+    :class:`balpipe.cache.balance.Memo`; default: computed, no cache), then with ``simulate`` the
+    pymunk validation of every stage (:func:`balpipe.runner.simulate`, its stages in ``workers``
+    processes). ``balpipe build`` and :func:`balpipe.run` both compute their studies here;
+    raises the loader's ``SpecErrors``."""
+    from . import runner
+    from .balancing.context import compute as no_cache
+
+    with pool.spare_workers(workers):  # the cores left over also serve the spec's independent work
+        st = runner.analyse(loaded, simulate=simulate, memo=memo if memo is not None else no_cache)
+    if simulate:
+        runner.simulate(loaded, st, workers=workers)
+    return st
+
+
+def page_results(loaded, st, input_hash: str) -> dict:
+    """The study's ``results.json`` as a dict (:func:`balpipe.report.results.results_dict`), with
+    the tables the spec read (``input_tables``, what :func:`up_to_date` reads to recompute the
+    input hash)."""
+    from .laws.drives import table_files
+
+    results = results_dict(st, loaded.name or str(loaded.path), input_hash,
+                           simulated=st.stages[0].validation is not None)
+    if table_files(loaded.spec):
+        results["input_tables"] = table_files(loaded.spec)
+    return results
+
+
+def page_files(loaded, st, results: dict, history: dict | None = None,
+               history_files: dict[str, str] | None = None) -> dict[str, str]:
+    """The files of a study's page folder, by name: ``index.html`` (the page, with the spec's
+    text and its ``history``), ``results.json`` (``results``), ``timeseries.csv``, with the
+    simulation the wall times of its runs (``timing.json``, ``timing.js``), and the history's
+    files. ``balpipe build`` and :meth:`balpipe.Study.write` both write these."""
+    extra: dict[str, str] = {}
+    if st.stages[0].validation is not None:
+        from .validation_stage import timing, timing_script
+
+        times = timing(st)
+        extra = {"timing.json": json.dumps(times, indent=2, sort_keys=True) + "\n",
+                 "timing.js": timing_script(times)}
+    return {
+        "index.html": render_page(st, results, loaded.text, history=history),
+        "results.json": dumps(results),
+        "timeseries.csv": timeseries_csv(st),
+        **extra,
+        **(history_files or {}),
+    }
 
 
 def finish(job: Job, done: Computed, opts: Options) -> Outcome:

@@ -1,6 +1,8 @@
 """The one path from a loaded spec to its results: study (balancing and analysis), checks,
-simulation. ``check``, ``build``, ``diff`` and ``history`` all go through it, so a spec that one
-of them rejects is rejected by the others with the same located errors."""
+simulation. ``check``, ``build``, ``diff``, ``history`` and the Python API (:mod:`balpipe.api`) all
+go through it, so a spec that one of them rejects is rejected by the others with the same located
+errors. Each call runs on one BLAS thread whatever the import order
+(:func:`balpipe.runtime.threads.blas_threads`)."""
 
 from __future__ import annotations
 
@@ -10,6 +12,7 @@ from . import study as study_mod
 from .balancing.context import Memo, compute
 from .limits import check_finite, check_simulation
 from .loader import LoadedSpec, SpecError, SpecErrors
+from .runtime.threads import blas_threads
 from .spec_parts import SpecFieldError
 
 
@@ -20,7 +23,7 @@ def analyse(loaded: LoadedSpec, simulate: bool = True, page: bool = True, memo: 
     only the page shows is left out: the same errors, less work. ``memo``: what the balancing's
     searches go through (the build's cache)."""
     try:
-        with _quiet_numpy():
+        with _quiet_numpy(), blas_threads():
             st = study_mod.run(loaded.spec, page, memo)
             check_finite(st)
             if simulate:
@@ -42,7 +45,8 @@ def simulate(loaded: LoadedSpec, st, workers: int = 1) -> bool:
     from .validation_stage import simulate_study  # pymunk only when a simulation runs
 
     try:
-        simulate_study(st, workers=workers)
+        with blas_threads():
+            simulate_study(st, workers=workers)
     except SpecFieldError as exc:
         raise loaded.error(exc) from None
     return True

@@ -48,7 +48,10 @@ def drawing_times(study: Study) -> dict:
     return {"solid": f"{solid:.4g}", "ghosts": " and ".join(texts), "count": len(texts), "sleeves": sleeved}
 
 
-def study_figures(study: Study, names: PageNames | None = None) -> dict:
+def time_curves(study: Study, names: PageNames | None = None) -> dict[str, live.Curves]:
+    """The curves of the page's time-series figures, by name: ``loads`` (the shaking force and
+    moment of the shown stages, with their pymunk runs when simulated), ``efforts`` (the
+    actuators') and ``joints`` (the joint loads; no panel when the mechanism has no joint load)."""
     names = names if names is not None else names_for(study.spec)
     sims = []
     for s in shown_stages(study):
@@ -59,12 +62,20 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
              for s in shown_stages(study) for d in (*s.stage.model.drivers, *s.stage.model.actuators)}
     marks = [(w["time"], w["kind"].replace("_", " ")) for w in study.warnings]
     shown_names = {d: names.text("driver", d) for d in units}  # the paper's symbols in the panels' titles
-    # each time-series figure interactive, on screen and in print (draw/live.py; curves: report/live_plots.py)
-    loads = live.html("loads", live_plots.loads(shown, sims)) + "".join(
-        f'<p class="muted coincide">{markupsafe.escape(note)}</p>' for note in live_plots.coincide_notes(shown))
-    efforts = live.html("efforts", live_plots.efforts(shown, units, marks, shown_names))
     joint_names = {j: names.text("joint", j) for _, an in shown for j in an.reactions}  # the paper's symbols
-    joint_curves = live_plots.joints(shown, joint_names)
+    return {"loads": live_plots.loads(shown, sims), "efforts": live_plots.efforts(shown, units, marks, shown_names),
+            "joints": live_plots.joints(shown, joint_names)}
+
+
+def study_figures(study: Study, names: PageNames | None = None) -> dict:
+    names = names if names is not None else names_for(study.spec)
+    shown = [(s.stage.label, s.analysis) for s in shown_stages(study)]
+    curves = time_curves(study, names)
+    # each time-series figure interactive, on screen and in print (draw/live.py; curves: report/live_plots.py)
+    loads = live.html("loads", curves["loads"]) + "".join(
+        f'<p class="muted coincide">{markupsafe.escape(note)}</p>' for note in live_plots.coincide_notes(shown))
+    efforts = live.html("efforts", curves["efforts"])
+    joint_curves = curves["joints"]
     joints = live.html("joints", joint_curves) if joint_curves.panels else ""
     limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
     numbers = labels.gear_numbers([s.stage.model for s in shown_stages(study)])

@@ -172,11 +172,19 @@ def joint_load_table(study: Study) -> list[dict]:
 
 
 def timeseries_csv(study: Study) -> str:
-    """One row per sample: t, then per stage Fx, Fy, |F|, M (about the moment point), every
-    actuator effort, every joint reaction (see :func:`balpipe.engine.dynamics.joint_reactions`), with
-    loads the frame load and every load's series (:func:`.load_table.load_columns`), the
-    total centre of mass, every body's pose and every named point's path with their velocities
-    (:func:`balpipe.mechanics.motion_outputs.motion_columns`); SI units, 12 significant digits."""
+    """One row per sample, the columns of :func:`timeseries_columns`; SI units, 12 significant
+    digits."""
+    cols = timeseries_columns(study)
+    return ",".join(c for c, _ in cols) + "\n" + csv_rows([v for _, v in cols])
+
+
+def timeseries_columns(study: Study) -> list[tuple[str, np.ndarray]]:
+    """The columns of ``timeseries.csv`` as (name, values), in its order: t, then per stage Fx,
+    Fy, |F|, M (about the moment point), every actuator effort, every joint reaction (see
+    :func:`balpipe.engine.dynamics.joint_reactions`), with loads the frame load and every load's
+    series (:func:`.load_table.load_columns`), the total centre of mass, every body's pose and
+    every named point's path with their velocities
+    (:func:`balpipe.mechanics.motion_outputs.motion_columns`); SI units, full precision."""
     cols: list[tuple[str, np.ndarray]] = [("t_s", study.unbalanced.analysis.t)]
     for s in study.stages:
         an, n = s.analysis, s.stage.name
@@ -193,7 +201,7 @@ def timeseries_csv(study: Study) -> str:
                 cols.append((f"{n}.reaction.{j}.{comp}", values))
         cols += load_columns(n, an)
         cols += [(f"{n}.{name}", values) for name, values in motion_columns(s.stage.model, an)]
-    return ",".join(c for c, _ in cols) + "\n" + csv_rows([v for _, v in cols])
+    return cols
 
 
 def csv_rows(columns: list[np.ndarray]) -> str:
