@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Annotated, Any
+from typing import Annotated, Any, Callable
 
 from pydantic import BeforeValidator, Field, WithJsonSchema
 
@@ -143,6 +143,7 @@ def quantity(dimension: str, **field_kwargs: Any) -> Any:
     by :data:`MAX_ABS`; ``field_kwargs`` add pydantic bounds (``gt``, ``ge``, ``le``, ...).
     Use it bare (``x: Length``) or as ``x: quantity("time", gt=0) = Field(...)``; never nested
     inside another ``Annotated[float, ...]`` (pydantic would then skip the unit parser)."""
+    schema: dict[str, Any]
     if dimension == "dimensionless":
         schema = {"type": "number", "description": "a finite number"}
     else:
@@ -206,16 +207,16 @@ class RateValue(float):
 
     kind: str | None = None
 
-    def __new__(cls, value: float, kind: str | None):
+    def __new__(cls, value: float, kind: str | None) -> "RateValue":
         obj = super().__new__(cls, value)
         obj.kind = kind
         return obj
 
-    def __reduce__(self):  # pickled into build workers
+    def __reduce__(self) -> tuple[type["RateValue"], tuple[float, str | None]]:  # pickled into build workers
         return (RateValue, (float(self), self.kind))
 
 
-def _rate_parser(order: int):
+def _rate_parser(order: int) -> Callable[[Any], RateValue]:
     dims = ("velocity", "angular velocity") if order == 1 else ("acceleration", "angular acceleration")
 
     def parse_rate(value: Any) -> RateValue:

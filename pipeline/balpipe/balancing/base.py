@@ -116,7 +116,7 @@ def in_style_order(results: list) -> list:
     return main + [r for r in results if r.stage.design is not None]
 
 
-def style_index(results: list, r) -> int:
+def style_index(results: list[Any], r: Any) -> int:
     """The line style of stage result ``r`` on the page (``draw.figures.style(k)``): its place in
     :func:`in_style_order` of the stages of its group (its motion)."""
     group = [x for x in results if x.stage.group == r.stage.group]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -60,7 +61,7 @@ class Analysis:
         bearing and slideway reactions, the motors' reactions and the frame-side reactions of
         internal loads. It equals the shaking load plus the external loads (the same as the
         shaking load without external loads, :mod:`.loads`)."""
-        if self.frame_force is None:
+        if self.frame_force is None or self.frame_moment is None:
             return self.force, self.moment
         return self.frame_force, self.frame_moment
 
@@ -130,25 +131,25 @@ class _Extra(dict):
             self._found = motion_peak(*self._motion)
         return self._found
 
-    def __missing__(self, key):
+    def __missing__(self, key: str) -> Any:
         if key == "condition" and self._motion is not None:
             self["condition"] = value = condition_numbers(*self._motion)
             return value
         raise KeyError(key)
 
-    def __contains__(self, key) -> bool:
+    def __contains__(self, key: object) -> bool:
         return super().__contains__(key) or (key == "condition" and self._motion is not None)
 
-    def get(self, key, default=None):
+    def get(self, key: str, default: Any = None) -> Any:
         return self[key] if key in self else default
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[type[dict[str, Any]], tuple[dict[str, Any]]]:
         if self._motion is not None:
             self["condition"]
         return (dict, (dict(self),))
 
 
-def _argmax(values) -> tuple[int, float]:
+def _argmax(values: Any) -> tuple[int, float]:
     v = np.asarray(values, dtype=float)
     k = int(np.argmax(v))
     return k, float(v[k])
@@ -250,7 +251,9 @@ def analyse(
             J0, base = by_frame[1], rhs
 
             def solver(rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-                lam = by_frame[0] if rhs is base else shared.multipliers(c, placed, rhs)[0]
+                again = by_frame if rhs is base else shared.multipliers(c, placed, rhs)
+                assert again is not None  # the same placed geometry as the base's, which has its map
+                lam = again[0]
                 return lam, -np.einsum("nmk,nm->nk", J0, lam)  # load on the frame: Fx, Fy, M_O
         else:
             qx = with_frame(q)

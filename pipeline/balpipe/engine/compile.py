@@ -4,11 +4,17 @@ docstring): body indices, joint points relative to each centre of mass, constrai
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any, Callable
 
 import numpy as np
 
 from ..mechanics.meshes import mesh_geometry
-from ..model import FRAME, Driver, Gear, Model, Prismatic, Revolute, pose_of_com
+from ..model import FRAME, Gear, Joint, Law, Model, Prismatic, Revolute, pose_of_com
+
+#: a body's index by name (``where`` names the joint or driver for the error)
+Index = Callable[[str, str], int]
+#: a point of a body in coordinates relative to its centre of mass
+Local = Callable[[str, Any], np.ndarray]
 
 
 def _perp(v: np.ndarray) -> np.ndarray:
@@ -34,7 +40,7 @@ class _Angle:
     owner: str
     coeffs: list[tuple[int, float]]
     const: float = 0.0
-    law: object = None
+    law: Law | None = None
     rows: int = 1
 
 
@@ -47,7 +53,7 @@ class _Projection:
     j: int
     sj: np.ndarray
     const: float = 0.0
-    law: object = None
+    law: Law | None = None
     rows: int = 1
 
 
@@ -66,12 +72,12 @@ class Compiled:
     q0: np.ndarray  # (3 nb,) initial guess
     condition: np.ndarray | None = None  # condition numbers of Phi_q along the last motion solved (None: shown regular)
     meshes: list = field(default_factory=list)  # _Mesh: gear pairs that pass tooth forces
-    fast: object = None  # the block-triangular path's data (:func:`.fastpath.prepare`), made once
-    com_local: np.ndarray | None = None  # (nb, 2) centres of mass in the bodies' own frames
+    fast: Any = None  # the block-triangular path's data (:func:`.fastpath.prepare`), made once
+    com_local: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (nb, 2) centres of mass in the bodies' own frames (set by compile_model)
     frame: "Compiled | None" = None  # the frame model's (:func:`.fastpath.frame_motion`), made once
     keys: tuple | None = None  # (shape, numbers, law ids) of the model (:func:`.warmstart.model_keys`), made once
     dynamics: "Compiled | None" = None  # with actuators: the joints' rows and the actuators' (:func:`_actuated`)
-    revolutes: object = None  # the revolute joints' rows at once (:func:`.constraints.revolute_rows`), made once
+    revolutes: Any = None  # the revolute joints' rows at once (:func:`.constraints.revolute_rows`), made once
 
     @property
     def nb(self) -> int:
@@ -103,7 +109,7 @@ def compile_model(model: Model) -> Compiled:
         except KeyError:
             raise ValueError(f"{where} refers to unknown body {name!r}") from None
 
-    def local(name: str, p) -> np.ndarray:
+    def local(name: str, p: Any) -> np.ndarray:
         return np.asarray(p, dtype=float) - com[name]
 
     init = {FRAME: (0.0, 0.0, 0.0)}
@@ -113,7 +119,7 @@ def compile_model(model: Model) -> Compiled:
         init[b.name] = pose_of_com(b, model.initial[b.name])
 
     prims: list = []
-    joints_by_name = {}
+    joints_by_name: dict[str, Joint] = {}
     for jt in model.joints:
         if jt.name in joints_by_name:
             raise ValueError(f"joint name {jt.name!r} is used twice")
@@ -131,9 +137,9 @@ def compile_model(model: Model) -> Compiled:
                 _Projection(jt.name, g, _perp(ax), local(jt.guide, jt.point_guide), s, local(jt.slider, jt.point_slider))
             )
         elif isinstance(jt, Gear):
-            a, b, c = idx(jt.a, jt.name), idx(jt.b, jt.name), idx(jt.carrier, jt.name)
+            ia, ib, ic = idx(jt.a, jt.name), idx(jt.b, jt.name), idx(jt.carrier, jt.name)
             coeffs: dict[int, float] = {}
-            for k, v in ((b, 1.0), (c, -1.0), (a, -jt.ratio), (c, jt.ratio)):
+            for k, v in ((ib, 1.0), (ic, -1.0), (ia, -jt.ratio), (ic, jt.ratio)):
                 coeffs[k] = coeffs.get(k, 0.0) + v
             if jt.phase is None:
                 th = {n: init[n][2] for n in (jt.a, jt.b, jt.carrier)}
@@ -147,7 +153,7 @@ def compile_model(model: Model) -> Compiled:
     driver_rows: dict[str, int] = {}
     for d in model.drivers:
         start = len(prims)
-        prims.append(_driver_primitive(d, joints_by_name, idx, local, model))
+        prims.append(_driver_primitive(d.name, d.target, d.law, joints_by_name, idx, local, model))
         driver_rows[d.name] = start
 
     row_owner: list[str] = []
@@ -169,7 +175,7 @@ def compile_model(model: Model) -> Compiled:
     return compiled
 
 
-def _actuated(c: Compiled, joints: dict, idx, local) -> Compiled | None:
+def _actuated(c: Compiled, joints: dict[str, Joint], idx: Index, local: Local) -> Compiled | None:
     """The system of the inverse dynamics when the model names actuators: the joints' own rows
     (same indices as in ``c``) followed by one row per actuator, the gradient of its joint
     coordinate (the primitive a driver of that joint would have). The drivers' rows are left
@@ -182,7 +188,8 @@ def _actuated(c: Compiled, joints: dict, idx, local) -> Compiled | None:
     nd = len(model.drivers)
     joint_prims = c.prims[: len(c.prims) - nd]
     rows = sum(p.rows for p in joint_prims)
-    prims, actuator_rows = list(joint_prims), {}
+    prims = list(joint_prims)
+    actuator_rows: dict[str, int] = {}
     for a in model.actuators:
         jt = joints.get(a.joint)
         if jt is None or isinstance(jt, Gear):
@@ -190,7 +197,7 @@ def _actuated(c: Compiled, joints: dict, idx, local) -> Compiled | None:
             raise ValueError(f"actuator {a.name!r}: {a.joint!r} is {what}")
         if a.name in actuator_rows:
             raise ValueError(f"actuator name {a.name!r} is used twice")
-        prims.append(_driver_primitive(Driver(a.name, ("joint", a.joint), None), joints, idx, local, model))
+        prims.append(_driver_primitive(a.name, ("joint", a.joint), None, joints, idx, local, model))
         actuator_rows[a.name] = rows + len(actuator_rows)
     owner = c.row_owner[:rows] + list(actuator_rows)
     joint_rows = {n: [r for r in rs if r < rows] for n, rs in c.joint_rows.items() if n in joints}
@@ -220,7 +227,7 @@ class _Mesh:
     sign_b: float
 
 
-def _compile_meshes(model: Model, idx, local, joint_rows: dict[str, list[int]]) -> list[_Mesh]:
+def _compile_meshes(model: Model, idx: Index, local: Local, joint_rows: dict[str, list[int]]) -> list[_Mesh]:
     out = []
     for jt in model.joints:
         if not isinstance(jt, Gear):
@@ -239,28 +246,30 @@ def _compile_meshes(model: Model, idx, local, joint_rows: dict[str, list[int]]) 
     return out
 
 
-def _driver_primitive(d: Driver, joints: dict, idx, local, model: Model):
-    kind = d.target[0]
+def _driver_primitive(name: str, target: tuple[str, ...], law: Law | None, joints: dict[str, Joint], idx: Index,
+                      local: Local, model: Model) -> _Angle | _Projection:
+    """The primitive of a coordinate ``target`` (a driver's, with its law; an actuator's, without)."""
+    kind = target[0]
     if kind == "joint":
-        jt = joints.get(d.target[1])
+        jt = joints.get(target[1])
         if jt is None:
-            raise ValueError(f"driver {d.name!r} refers to unknown joint {d.target[1]!r}")
+            raise ValueError(f"driver {name!r} refers to unknown joint {target[1]!r}")
         if isinstance(jt, Revolute):
-            return _Angle(d.name, [(idx(jt.b, d.name), 1.0), (idx(jt.a, d.name), -1.0)], 0.0, d.law)
+            return _Angle(name, [(idx(jt.b, name), 1.0), (idx(jt.a, name), -1.0)], 0.0, law)
         if isinstance(jt, Prismatic):
             ax = np.asarray(jt.axis, dtype=float)
             ax = ax / np.linalg.norm(ax)
             return _Projection(
-                d.name, idx(jt.guide, d.name), ax, local(jt.guide, jt.point_guide),
-                idx(jt.slider, d.name), local(jt.slider, jt.point_slider), 0.0, d.law,
+                name, idx(jt.guide, name), ax, local(jt.guide, jt.point_guide),
+                idx(jt.slider, name), local(jt.slider, jt.point_slider), 0.0, law,
             )
-        raise ValueError(f"driver {d.name!r}: a gear pair cannot be driven, drive one of its bodies")
-    body = d.target[1]
-    b = idx(body, d.name)
+        raise ValueError(f"driver {name!r}: a gear pair cannot be driven, drive one of its bodies")
+    body = target[1]
+    b = idx(body, name)
     if kind == "angle":  # absolute angle: theta_b - theta_frame, so the reaction lands on the frame
-        return _Angle(d.name, [(b, 1.0), (0, -1.0)], 0.0, d.law)
+        return _Angle(name, [(b, 1.0), (0, -1.0)], 0.0, law)
     if kind in ("x", "y"):
-        point = model.body(body).point(d.target[2]) if len(d.target) > 2 else (0.0, 0.0)
+        point = model.body(body).point(target[2]) if len(target) > 2 else (0.0, 0.0)
         axis = np.array([1.0, 0.0]) if kind == "x" else np.array([0.0, 1.0])
-        return _Projection(d.name, 0, axis, np.zeros(2), b, local(body, point), 0.0, d.law)
-    raise ValueError(f"driver {d.name!r}: unknown target {d.target!r}")
+        return _Projection(name, 0, axis, np.zeros(2), b, local(body, point), 0.0, law)
+    raise ValueError(f"driver {name!r}: unknown target {target!r}")

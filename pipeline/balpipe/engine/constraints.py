@@ -9,7 +9,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..mechanics.planar import rotate
-from .compile import Compiled, _Angle, _Coincident, _perp
+from .compile import Compiled, _Angle, _Coincident, _Projection, _perp
 
 
 def _split(q: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -17,7 +17,7 @@ def _split(q: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
     return q[:, 3 * k : 3 * k + 2], q[:, 3 * k + 2]
 
 
-def _law_values(prim, t: np.ndarray):
+def _law_values(prim: _Angle | _Projection, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     if prim.law is None:
         z = np.zeros_like(t)
         return z, z, z
@@ -46,15 +46,17 @@ class GridLaws:
     def __init__(self, grid: np.ndarray, evaluate: Callable[[np.ndarray], Any], row: Callable[[Any, int], Any]):
         self.grid, self._evaluate, self._row = grid, evaluate, row
         self._where = {x: k for k, x in enumerate(grid.tolist())}
-        self._table = None
+        self._table: Any = None
 
-    def at(self, t: np.ndarray):
+    def at(self, t: np.ndarray) -> Any:
         k = self._where.get(float(t[0])) if len(t) == 1 else None
         if t is not self.grid and k is None:
             return None
         if self._table is None:
             self._table = self._evaluate(self.grid)
-        return self._table if t is self.grid else self._row(self._table, k)
+        if t is self.grid or k is None:  # k is None only for the grid itself (returned above otherwise)
+            return self._table
+        return self._row(self._table, k)
 
 
 def residual(c: Compiled, qx: np.ndarray, t: np.ndarray, laws: list | None = None) -> np.ndarray:
@@ -157,7 +159,8 @@ def revolute_rows(c: Compiled) -> RevoluteRows | None:
     has none or a joint joins a body to itself (then the joints are evaluated one at a time)."""
     if c.revolutes is None:
         c.revolutes = _revolute_rows(c.prims) or False
-    return c.revolutes or None
+    rows: RevoluteRows | None = c.revolutes or None
+    return rows
 
 
 def _revolute_rows(prims: list) -> RevoluteRows | None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 
 class AnalysisError(Exception):
     """The mechanism cannot follow the motion: non-convergence or a singular configuration."""
@@ -10,4 +12,4 @@ class AnalysisError(Exception):
         super().__init__(message)
         self.time = time
         self.joint = joint
-        self.q = None  # positions (3 nb,) where the position analysis stopped, when it did
+        self.q: np.ndarray | None = None  # positions (3 nb,) where the position analysis stopped, when it did

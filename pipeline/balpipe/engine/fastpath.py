@@ -78,6 +78,14 @@ class Kinematics:
     inverses: dict[int, np.ndarray]  # of the k x k diagonal blocks
 
 
+def _decomposed(p: Prepared) -> Decomposition:
+    """``p``'s decomposition; :class:`Fallback` when the block path does not apply (no
+    decomposition: :func:`kinematics` refuses such a model first)."""
+    if p.dec is None:
+        raise Fallback
+    return p.dec
+
+
 def kinematics(c: Compiled, p: Prepared, t: np.ndarray) -> Kinematics:
     """Positions, velocities and accelerations, coordinate-major, with the Jacobian's values."""
     dec, vz = p.dec, p.vz
@@ -220,7 +228,7 @@ def _arms(frame: np.ndarray, com: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _screen(c: Compiled, p: Prepared, vals: np.ndarray, inverses: dict, X: np.ndarray, t: np.ndarray) -> None:
     """Singular configurations: the block bound, then the exact check where it is close."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        bound = np.abs(vals[p.free_slots]).max(axis=0) / block_sigma_min(p.dec, vals, inverses)
+        bound = np.abs(vals[p.free_slots]).max(axis=0) / block_sigma_min(_decomposed(p), vals, inverses)
     close = ~(bound <= _COND_LIMIT * _SCREEN)
     if close.any():
         q = X[3:-1, close].T
@@ -250,7 +258,7 @@ def solve_positions_by_blocks(c: Compiled, t: np.ndarray) -> np.ndarray:
 
 def multipliers(p: Prepared, k: Kinematics, rhs: np.ndarray) -> np.ndarray:
     """lambda (m, N) from Phi_q^T lambda = rhs (n, N), square Phi_q."""
-    return solve(p.dec.backward, k.vals, rhs, k.inverses)[:-1]
+    return solve(_decomposed(p).backward, k.vals, rhs, k.inverses)[:-1]
 
 
 def frame_load(p: Prepared, vals: np.ndarray, lam: np.ndarray) -> np.ndarray:

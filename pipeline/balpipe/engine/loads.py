@@ -63,7 +63,7 @@ class LoadTerms:
     external: np.ndarray  # (N, 3) external loads on the links (Fx, Fy, M about O)
     series: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
     coulomb: list[_Coulomb] = field(default_factory=list)
-    t: np.ndarray | None = None
+    t: np.ndarray = field(default_factory=lambda: np.zeros(0))  # the motion's times
 
 
 class _Acc:
@@ -97,6 +97,8 @@ class _Acc:
 
     def outside(self, P: np.ndarray | None, F: np.ndarray | None, T: np.ndarray | None = None) -> None:
         if F is not None:
+            if P is None:
+                raise ValueError("an external force needs its point of application")
             self.external[:, :2] += F
             self.external[:, 2] += cross(P, F)
         if T is not None:
@@ -154,10 +156,10 @@ class _Motion:
                     return np.broadcast_to(np.asarray(x, dtype=float), self.t.shape), np.broadcast_to(np.asarray(xd, dtype=float), self.t.shape)
             raise ValueError(f"a load table refers to unknown driver {law.argument[1]!r}")
         if kind == "stroke":
-            _, body, p, d, origin = law.argument
+            _, body, p, direction, origin = law.argument
             _, P, V = self.point(Anchor(body, p))
-            d = np.asarray(d, dtype=float)
-            return P @ d - origin, V @ d
+            axis = np.asarray(direction, dtype=float)
+            return P @ axis - origin, V @ axis
         if kind == "deflection" and own is not None:
             return own
         raise ValueError(f"unknown load table argument {law.argument!r}")
@@ -212,6 +214,8 @@ def _element(mo: _Motion, acc: _Acc, e: ForceElement) -> dict[str, np.ndarray]:
 
 def _torsion(mo: _Motion, acc: _Acc, e: TorsionElement) -> dict[str, np.ndarray]:
     jt = mo.model.joint(e.joint)
+    if isinstance(jt, Prismatic):
+        raise ValueError(f"torsion element on {e.joint!r}: a prismatic joint has no relative angle")
     ka, kb = mo.body(jt.a), mo.body(jt.b)
     (tha, wa), (thb, wb) = mo.angle(ka), mo.angle(kb)
     phi, w = thb - tha, wb - wa

@@ -49,7 +49,7 @@ class BlockOps:
         free = np.flatnonzero(vz.cols >= 3)
         self._free, self._frow, self._fcol = free, vz.rows[free], vz.cols[free] - 3
         self.n = vz.ncol - 3
-        self._last_state = None  # (q, State) where the last single-sample Newton stopped
+        self._last_state: tuple[np.ndarray, State] | None = None  # (q, State) where the last single-sample Newton stopped
 
     def _X(self, q: np.ndarray) -> np.ndarray:
         X = np.zeros((self.vz.ncol + 1, q.shape[0]))
@@ -71,7 +71,7 @@ class BlockOps:
         found = None if self._grid is None else self._grid.at(t)
         return law_table(self.vz, t) if found is None else found
 
-    def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = 25):
+    def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = 25) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Batched Newton-Raphson from q (N, n) at times t (N,). Returns (q, converged mask,
         residual norms), as :func:`.positions.newton_raphson`."""
         vz = self.vz

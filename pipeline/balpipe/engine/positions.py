@@ -4,6 +4,7 @@ Phi(q, t) = 0, with the regularity (singularity) check."""
 from __future__ import annotations
 
 import functools
+from typing import Protocol
 
 import numpy as np
 
@@ -12,6 +13,18 @@ from .compile import Compiled
 from .constraints import GridLaws, with_frame, jacobian, law_positions, law_triples, residual
 from .errors import AnalysisError
 from .kinematics import _solve_rect, _vel_acc
+
+
+class Ops(Protocol):
+    """The continuation's solves (:class:`DenseOps`, :class:`.newton_blocks.BlockOps`)."""
+
+    def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = ...) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Batched Newton-Raphson from q (N, n) at t (N,): (q, converged mask, residual norms)."""
+        ...
+
+    def vel_acc(self, q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Velocities and accelerations (N, n) at positions q and times t."""
+        ...
 
 _TOL = 1e-12
 _MAX_ITER = 25
@@ -60,7 +73,7 @@ def _check_redundancy(c: Compiled, q: np.ndarray, t: float) -> None:
 
 
 def newton_raphson(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER,
-                   laws: list | None = None):
+                   laws: list | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Batched Newton-Raphson. Returns (q, converged mask, residual norms). ``laws``: the
     drivers' f(t), :func:`.constraints.law_positions` (evaluated here when not given)."""
     q = q.copy()
@@ -193,7 +206,7 @@ class DenseOps:
         single time on it), else None (the callee evaluates them)."""
         return None if self._grid is None else self._grid.at(t)
 
-    def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER):
+    def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         laws = self._laws(t)
         return newton_raphson(self.c, q, t, max_iter, None if laws is None else [None if f is None else f[0] for f in laws])
 
@@ -206,7 +219,7 @@ def _triples_row(table: list, k: int) -> list:
     return [None if f is None else (f[0][k : k + 1], f[1][k : k + 1], f[2][k : k + 1]) for f in table]
 
 
-def _ops(c: Compiled, t: np.ndarray):
+def _ops(c: Compiled, t: np.ndarray) -> Ops:
     """The solves for the continuation of ``c``: by the constraints evaluated by type
     (:class:`.newton_blocks.BlockOps`) when the block path has decomposed its Jacobian
     (``c.fast``, :func:`.fastpath.prepare`), else the general path's."""
@@ -234,7 +247,7 @@ def solve_positions(c: Compiled, t: np.ndarray) -> np.ndarray:
     return qall
 
 
-def follow_motion(c: Compiled, t: np.ndarray, ops=None) -> np.ndarray:
+def follow_motion(c: Compiled, t: np.ndarray, ops: Ops | None = None) -> np.ndarray:
     """:func:`solve_positions` without the regularity check (the caller makes it). ``ops``: the
     Newton-Raphson and velocity solves (:class:`DenseOps`, or
     :class:`.newton_blocks.BlockOps`); by default the block ones where ``c`` has been decomposed
@@ -303,7 +316,7 @@ def _coarse_times(t: np.ndarray) -> np.ndarray:
     return np.concatenate(parts)
 
 
-def _continue(c: Compiled, q0: np.ndarray, tc: np.ndarray, ops) -> tuple[np.ndarray, np.ndarray]:
+def _continue(c: Compiled, q0: np.ndarray, tc: np.ndarray, ops: Ops) -> tuple[np.ndarray, np.ndarray]:
     """Positions and velocities at the times ``tc`` followed from ``q0`` (the pose at tc[0]) by
     a second-order predictor and Newton-Raphson, substepped where a step does not converge."""
     qc = np.zeros((len(tc), q0.shape[0]))
@@ -324,12 +337,12 @@ def _continue(c: Compiled, q0: np.ndarray, tc: np.ndarray, ops) -> tuple[np.ndar
     return qc, vc
 
 
-def _lead(c: Compiled, q0: np.ndarray, times: np.ndarray, ops) -> np.ndarray:
+def _lead(c: Compiled, q0: np.ndarray, times: np.ndarray, ops: Ops) -> np.ndarray:
     """The pose at ``times[-1]`` followed from ``q0`` (the pose at ``times[0]``) along ``times``."""
     return _continue(c, q0, times, ops)[0][-1]
 
 
-def _substep(c: Compiled, q: np.ndarray, ta: float, tb: float, depth: int = 0, ops=None) -> np.ndarray:
+def _substep(c: Compiled, q: np.ndarray, ta: float, tb: float, depth: int = 0, ops: Ops | None = None) -> np.ndarray:
     ops = ops if ops is not None else DenseOps(c)
     for n in (4, 16, 64):
         cur = q.copy()

@@ -74,9 +74,18 @@ def kinematics(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.n
     q, entry = _positions(c, t)
     if entry is None:
         return (q, *_vel_acc(c, q, t), None)
+    frame = _motion(entry)
     if entry.rates is None:
-        entry.rates = _vel_acc(entry.fc, entry.frame, t)  # once per geometry and grid
-    return (q, *_place_rates(entry.frame, *entry.rates, c.com_local), entry)
+        entry.rates = _vel_acc(entry.fc, frame, t)  # once per geometry and grid
+    return (q, *_place_rates(frame, *entry.rates, c.com_local), entry)
+
+
+def _motion(entry: _Shared) -> np.ndarray:
+    """The frame motion of an entry that positions were placed from (:func:`_positions` returns
+    only those whose motion was followed)."""
+    if entry.frame is None:
+        raise RuntimeError("a shared entry without its frame motion placed a model's positions")
+    return entry.frame
 
 
 def multipliers(c: Compiled, entry: _Shared | None, rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
@@ -93,10 +102,10 @@ def multipliers(c: Compiled, entry: _Shared | None, rhs: np.ndarray) -> tuple[np
     if fc.meshes or fc.dynamics is not None or fc.row_owner != c.row_owner or fc.driver_rows != c.driver_rows:
         return None
     if entry.dynamics is None:
-        J = jacobian(fc, with_frame(entry.frame))
+        J = jacobian(fc, with_frame(_motion(entry)))
         entry.dynamics = (multiplier_map(fc, J[:, :, 3:]), J[:, :, :3])  # once per geometry and grid
     K, J0 = entry.dynamics
-    rx, ry = _arms(entry.frame, c.com_local)
+    rx, ry = _arms(_motion(entry), c.com_local)
     moved = rhs.copy()
     moved[:, 2::3] += rx * rhs[:, 1::3] - ry * rhs[:, 0::3]
     return np.einsum("nmk,nk->nm", K, moved), J0

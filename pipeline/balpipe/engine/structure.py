@@ -170,10 +170,12 @@ def _decompose(vz: Vectorised) -> Decomposition | None:
                 r = members[b][0]
                 c = match[r]
                 if not transposed:
-                    eqs.append(r), unks.append(c)
+                    eqs.append(r)
+                    unks.append(c)
                     offs.append([(s, cc) for cc, s in row_entries[r] if cc != c])
                 else:
-                    eqs.append(c), unks.append(r)
+                    eqs.append(c)
+                    unks.append(r)
                     offs.append([(s, rr) for rr, s in col_entries[c] if rr != r])
                 piv.append(slot_of[r, c])
             if eqs:
@@ -217,7 +219,8 @@ def _decompose(vz: Vectorised) -> Decomposition | None:
                          angle_steps, position_steps)
 
 
-def _step(eqs, unks, diag, offs, pad: int, n: int, square: bool, block: int = -1) -> Step:
+def _step(eqs: list[int], unks: list[int], diag: np.ndarray, offs: list[list[tuple[int, int]]], pad: int, n: int,
+          square: bool, block: int = -1) -> Step:
     w = max((len(o) for o in offs), default=0)
     off_slots = [[s for s, _ in o] + [pad] * (w - len(o)) for o in offs]
     off_unk = [[u for _, u in o] + [n] * (w - len(o)) for o in offs]
@@ -245,7 +248,8 @@ def maximum_matching(adj: list[list[int]], n: int) -> list[int]:
         if row_col[r] >= 0:
             continue
         seen = [False] * n
-        path, pos, via = [r], [0], []  # rows on the path, next column to try, columns taken
+        path, pos = [r], [0]  # rows on the path, next column to try
+        via: list[int] = []  # columns taken
         while path:
             u = path[-1]
             a = adj[u]
@@ -266,7 +270,8 @@ def maximum_matching(adj: list[list[int]], n: int) -> list[int]:
                 for u2, c2 in zip(path, via):
                     row_col[u2], col_row[c2] = c2, u2
                 break
-            path.append(w), pos.append(0)
+            path.append(w)
+            pos.append(0)
         # no augmenting path from r: r stays unmatched (Kuhn: it never gets one later)
     return row_col
 
@@ -417,7 +422,7 @@ def block_sigma_min(dec: Decomposition, vals: np.ndarray, inverses: dict[int, np
     |pivot| for a 1 x 1 block, 1 / |B^-1|_F for a k x k one. Phi_q is singular exactly when a
     block is, and cond(Phi_q) >= max|entry| / sigma_min(block) (a diagonal block's inverse is a
     block of the inverse of a block-triangular matrix)."""
-    out = None
+    out: np.ndarray | None = None
     for st in dec.forward.steps:
         if not st.square:
             s = np.abs(vals[st.diag]).min(axis=0)
@@ -425,4 +430,6 @@ def block_sigma_min(dec: Decomposition, vals: np.ndarray, inverses: dict[int, np
             with np.errstate(invalid="ignore"):
                 s = 1.0 / np.sqrt(np.einsum("abn,abn->n", inverses[st.block], inverses[st.block]))
         out = s if out is None else np.minimum(out, s)
+    if out is None:
+        raise ValueError("a decomposition without diagonal blocks has no smallest singular value")
     return out

@@ -11,7 +11,9 @@ are written once. The driver laws are evaluated once per call (:func:`law_table`
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -78,8 +80,12 @@ def vectorise(c: Compiled) -> Vectorised:
             law_rows.append(row)
             laws.append(p.law)
         row += p.rows
-    ia = lambda xs: np.array(xs, dtype=np.intp)  # noqa: E731
-    fa = lambda xs, shape=(0,): np.array(xs, dtype=float).reshape((-1,) + shape[1:]) if xs else np.zeros(shape)  # noqa: E731
+    def ia(xs: Sequence[Any]) -> np.ndarray:
+        return np.array(xs, dtype=np.intp)
+
+    def fa(xs: Sequence[Any], shape: tuple[int, ...] = (0,)) -> np.ndarray:
+        return np.array(xs, dtype=float).reshape((-1,) + shape[1:]) if xs else np.zeros(shape)
+
     ci, cj = ia([p.i for p, _ in coinc]), ia([p.j for p, _ in coinc])
     csi, csj = fa([p.si for p, _ in coinc], (0, 2)), fa([p.sj for p, _ in coinc], (0, 2))
     crow = ia([r for _, r in coinc])
@@ -91,9 +97,12 @@ def vectorise(c: Compiled) -> Vectorised:
     pa = fa([p.a for p, _ in proj], (0, 2))
     psi, psj = fa([p.si for p, _ in proj], (0, 2)), fa([p.sj for p, _ in proj], (0, 2))
 
-    rows, cols, const, struct = [], [], [], []
+    rows: list[int] = []
+    cols: list[int] = []
+    const: list[float] = []
+    struct: list[bool] = []
 
-    def add(r, col, value, nonzero=True):
+    def add(r: int, col: int, value: float, nonzero: Any = True) -> None:
         rows.append(r)
         cols.append(col)
         const.append(value)

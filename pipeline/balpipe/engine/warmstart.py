@@ -27,6 +27,7 @@ import contextlib
 import dataclasses
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -141,7 +142,7 @@ def model_keys(c: Compiled) -> tuple[tuple, np.ndarray, tuple]:
     return c.keys
 
 
-def _shape(v, numbers: list[float]):
+def _shape(v: Any, numbers: list[float]) -> Any:
     """Nested tuples, lists and arrays with every number replaced by "#" (appended to ``numbers``)."""
     if isinstance(v, (str, type(None))):
         return v
