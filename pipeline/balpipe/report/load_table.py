@@ -14,10 +14,10 @@ import numpy as np
 from ..mechanics.loads import AppliedLoad, ForceElement, JointFriction, TorsionElement
 
 #: per load type: (the series shown, what it is, its unit)
-_SHOWN = {
+# the series shown for each element (applied loads and joint friction choose theirs by the series)
+_SHOWN: dict[type, tuple[str, str, str]] = {
     ForceElement: ("tension", "tension (pulls its ends together)", "N"),
     TorsionElement: ("torque", "torque on the joint's second body (negated)", "N m"),
-    JointFriction: (None, "friction", None),
 }
 
 

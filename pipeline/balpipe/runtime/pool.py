@@ -8,7 +8,7 @@ from __future__ import annotations
 import os
 import signal
 from contextlib import contextmanager
-from typing import Any, Callable, Iterable, Iterator
+from typing import Any, Callable, Generator, Iterator
 
 
 def worker_init() -> None:
@@ -59,7 +59,7 @@ def default_jobs(items: int) -> int:
 
 
 def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any,
-             cost: Callable[[Any], float] | None = None) -> Iterable[Any]:
+             cost: Callable[[Any], float] | None = None) -> Generator[Any, None, None]:
     """``fn(item, *args)`` for each item, yielded in the items' order: in ``jobs`` processes
     when ``jobs`` > 1 and there is more than one item (``fn`` and its arguments must pickle),
     else here, one after another. ``cost``: an estimate of each item's work; the pool starts the
@@ -79,7 +79,7 @@ def in_order(fn: Callable[..., Any], items: list, jobs: int, *args: Any,
 
 
 @contextmanager
-def finished(results: Iterator[Any]) -> Iterator[Iterator[Any]]:
+def finished(results: Generator[Any, None, None]) -> Iterator[Generator[Any, None, None]]:
     """Use the generator ``results`` (:func:`in_order`'s) in the block, then run it to its end
     here, where its pool shuts down, and close it in any case. A caller that takes exactly as
     many results as items leaves the generator suspended after its last ``yield``: its pool would
