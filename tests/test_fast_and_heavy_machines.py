@@ -224,3 +224,26 @@ def test_a_verdict_never_says_balancing_fails_beside_cancelled_loads():
     assert unsure["words"] == "balanced as claimed" and "unconfirmed" in unsure["text"]
     claim = dict(stages[1], force_balanced=False, force_ratio=0.2)
     assert verdict({"stages": [stages[0], claim], "status": "failed"})["words"] == "balancing fails"
+
+
+def test_a_position_driven_run_unresolved_at_its_first_step_is_unconfirmed_with_a_step_that_resolves_it():
+    """The offset slider-crank's counterweights stage held to a tolerance of 5e-4 of the
+    reference: its moment residual at the default step is 1.0e-3, the step's error (second
+    order). With the validator's refinement off it is unconfirmed, not failed, and the step it
+    names passes; with the default budget the validator finds such a step itself."""
+    st = study_mod.run(load(ROOT / "specs" / "offset_slider_crank.yaml").spec)
+    s = _stage(st, "counterweights")
+    ref = ratio_reference(st.reference_stage(s))
+    args = (simulated_model(s.stage.model), s.analysis, (ref.force_peak, ref.moment_peak))
+
+    def run(**kw):
+        return validate(*args, ValidationSettings(tolerance=5e-4, **kw), ("force",), reference=ref)
+
+    tight = run(max_refinement=1)
+    assert tight.status == "unconfirmed" and tight.moment_residual > 5e-4, tight.reasons
+    assert tight.remedy.startswith("validation: {dt: ") and tight.to_json()["status"] == "unconfirmed"
+    dt = float(tight.remedy.split("{dt: ")[1].split(" s}")[0])
+    assert dt < tight.dt
+    assert run(dt=dt).status == "pass"
+    found = run()
+    assert found.status == "pass" and found.dt < tight.dt, found.notes

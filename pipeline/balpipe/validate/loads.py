@@ -389,7 +389,8 @@ def _judge(v: StageValidation, refinement: Refinement, settings: ValidationSetti
     error: its residual does not shrink with the step (or the spec gives the step), and exceeds
     the tolerance by more than the solver's last change between doublings of its iterations
     (``solver_change``). Unconfirmed, with the remedy: a simulation that came apart at every
-    count, a residual that still shrinks with the step at the budget's finest step, a solver that
+    count, a residual that still shrinks with the step at the budget's finest step (or was not
+    refined: ``max_refinement`` 1), a solver that
     had not converged to within the excess."""
     if v.passed:
         return v
@@ -400,7 +401,7 @@ def _judge(v: StageValidation, refinement: Refinement, settings: ValidationSetti
     if not math.isfinite(worst):
         v.unconfirmed = True
         v.remedy = f"a finer validation.dt than {v.dt:.3g} s, or validation: {{iterations: {2 * MAX_ITERATIONS}}}"
-    elif refinement.shrinks and refinement.remedy_dt is not None:
+    elif refinement.shrinks is not False and refinement.remedy_dt is not None:
         v.unconfirmed = True
         v.remedy = (f"{step_setting(refinement.remedy_dt)} (second order: the residual falls with the square of the step; the "
                     f"validator stopped at {1e3 * v.dt:.4g} ms, {settings.max_refinement:g} times finer at most)")
