@@ -31,7 +31,7 @@ from . import FAMILY_GROUP
 from .runtime import pool
 from .report import history_file
 from .runtime.inputs import MAX_TABLE_BYTES, InputFileError, read_input_text
-from .runtime.fsutil import remove_path, remove_temporaries, tmp_name, write_atomic_dir, write_file_atomic, write_new
+from .runtime.fsutil import LeftBehind, describe, remove_path, remove_temporaries, tmp_name, write_atomic_dir, write_file_atomic, write_new
 from .site_files.site_earlier import earlier_pages
 from .site_files.spec_files import MAX_SLUG, clash_notes, clashes, find_specs, published_names, slug_for  # noqa: F401  (build.find_specs, build.slug_for as before)
 
@@ -110,7 +110,9 @@ class SchedulerError(Exception):
 
 
 class OutputError(Exception):
-    """The output folder cannot be used (a file, not writable): nothing was written."""
+    """The output folder cannot be used (a file, not writable): nothing was written; or, found at
+    the end (a full disk), the index could not be written: the pages built are in place, the index
+    is the previous build's."""
 
 
 @lru_cache(maxsize=1)
@@ -395,13 +397,21 @@ def finish(job: Job, done: Computed, opts: Options) -> Outcome:
         return Outcome(source, slug, done.status, done.message, spec_error=done.status == "error", seconds=done.seconds)
     target = opts.out / slug
     previous = _read_results(target) if not target.is_symlink() else None
-    if done.status == "failed" and previous is not None and previous.get("status") == "ok":
-        # the README's promise: a failing spec never replaces a good page; its own page goes
-        # beside it, in failed/
-        write_atomic_dir(target / "failed", done.files)
-        return Outcome(source, slug, done.status, done.message, done.results, seconds=done.seconds, kept_previous=True)
-    write_atomic_dir(target, done.files)
-    return Outcome(source, slug, done.status, done.message, done.results, seconds=done.seconds)
+    keep = done.status == "failed" and previous is not None and previous.get("status") == "ok"
+    # the README's promise: a failing spec never replaces a good page; its own page goes beside
+    # it, in failed/
+    folder = f"{slug}/failed/" if keep else f"{slug}/"
+    try:
+        write_atomic_dir(target / "failed" if keep else target, done.files)
+    except LeftBehind as exc:
+        return Outcome(source, slug, "failed", f"{source}: its page {folder} was written, but the earlier copy "
+                       f"{Path(exc.filename).name} beside it could not be removed ({describe(exc, '')}); "
+                       "remove it by hand",
+                       done.results, seconds=done.seconds, kept_previous=keep)
+    except OSError as exc:
+        return Outcome(source, slug, "failed", f"{source}: its page {folder} was not written ({describe(exc, '')}); "
+                       "its earlier page, if any, is as it was", seconds=done.seconds)
+    return Outcome(source, slug, done.status, done.message, done.results, seconds=done.seconds, kept_previous=keep)
 
 
 def build_one(path: Path, opts: Options) -> Outcome:
@@ -544,8 +554,13 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
         if not (key and _site_is_current(opts.out, key)):
             from .report.site import write_site
 
-            write_site(opts.out, built, earlier, site_key=key)
-            write_file_atomic(opts.out / "balpipe.schema.json", json.dumps(schema(), indent=2, sort_keys=True) + "\n")
+            try:
+                write_site(opts.out, built, earlier, site_key=key)
+                write_file_atomic(opts.out / "balpipe.schema.json", json.dumps(schema(), indent=2, sort_keys=True) + "\n")
+            except OSError as exc:
+                remove_temporaries(opts.out)
+                raise OutputError(f"the site's index was not written ({describe(exc, opts.out)}); the pages built are "
+                                  "in place, the index is the previous build's") from None
     return outcomes
 
 

@@ -190,8 +190,8 @@ def write_site(out: Path, outcomes: list, earlier: list = (), site_key: str = ""
         comparisons=comparisons(entries),
         site_key=site_key,
     )
-    write_file_atomic(out / "index.html", html)
     write_file_atomic(out / "site_nav.js", site_nav_script(entries))
+    write_file_atomic(out / "index.html", html)  # last: a failure before it leaves the previous index
 
 
 def comparisons(entries: list[dict]) -> list[dict]:

@@ -4,10 +4,36 @@ interrupted build removed."""
 
 from __future__ import annotations
 
+import errno
 import os
 import secrets
 import shutil
 from pathlib import Path
+
+#: what to do about an OS error, by its errno
+_REMEDIES = {
+    errno.ENOSPC: "the disk is full: free space there (or write to another folder) and run again",
+    errno.EDQUOT: "the disk quota is used up: free space there (or write to another folder) and run again",
+    errno.EROFS: "the file system is read-only: write to another folder",
+    errno.EACCES: "permission denied: make it writable for this user (or write to another folder)",
+    errno.EPERM: "not permitted: make it writable for this user (or write to another folder)",
+    errno.ENOTDIR: "a file stands where a folder is expected: move it away",
+    errno.EISDIR: "a folder stands where a file is expected: move it away",
+    errno.EEXIST: "something of that name is in the way: move it away",
+    errno.ENAMETOOLONG: "the path is too long: use a shorter output folder",
+    errno.EMFILE: "too many open files: raise the limit (ulimit -n) or use fewer -j",
+    errno.EIO: "an input/output error of the disk: check it",
+}
+
+
+def describe(exc: OSError, path: str | os.PathLike | None = None) -> str:
+    """An OS error as a user reads it: the path (``path``, else the error's own; "" for none), the
+    reason and what to do, e.g. ``out/x: No space left on device; the disk is full: ...``."""
+    where = os.fspath(path) if path is not None else exc.filename
+    reason = exc.strerror or type(exc).__name__
+    remedy = _REMEDIES.get(exc.errno or 0)
+    return (f"{where}: " if where else "") + reason + (f"; {remedy}" if remedy else "")
+
 
 TMP_MARK = ".balpipe-tmp-"  # temporary files and folders in the output folder carry this
 
@@ -51,7 +77,9 @@ def write_file_atomic(path: Path, content: str | bytes) -> None:
 
 def write_atomic_dir(target: Path, files: dict[str, str]) -> None:
     """Write a page folder next to ``target`` and move it into place when complete. Modes follow
-    the umask (os.mkdir(0o777)), not tempfile's 0700."""
+    the umask (os.mkdir(0o777)), not tempfile's 0700. An :class:`OSError` before the move leaves
+    ``target`` as it was; :class:`LeftBehind` after it: the new folder is in place, the earlier
+    copy beside it could not be removed (:func:`remove_tree`)."""
     target.parent.mkdir(parents=True, exist_ok=True)
     tmp = target.with_name(tmp_name(target.name))
     os.mkdir(tmp, 0o777)
@@ -65,11 +93,35 @@ def write_atomic_dir(target: Path, files: dict[str, str]) -> None:
             old = target.with_name(tmp_name(target.name + ".old"))
             target.rename(old)
         tmp.rename(target)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+    if old is not None:
+        remove_tree(old)
+
+
+def remove_tree(folder: Path) -> None:
+    """Remove the folder tree ``folder``; a folder in it without write permission is made
+    writable first (balpipe wrote it). Raises :class:`OSError` naming ``folder`` when it stays
+    (a read-only file system, a folder of another user): never left behind silently."""
+    shutil.rmtree(folder, ignore_errors=True)
+    if not os.path.lexists(folder):
+        return
+    for root, dirs, _ in os.walk(folder):
+        for d in [root, *(os.path.join(root, x) for x in dirs)]:
+            try:
+                if not os.path.islink(d):
+                    os.chmod(d, 0o700)
+            except OSError:
+                pass
+    try:
+        shutil.rmtree(folder)
+    except OSError as exc:
+        raise LeftBehind(exc.errno, exc.strerror, str(folder)) from None
+
+
+class LeftBehind(OSError):
+    """A page folder was replaced, but its earlier copy (``filename``) could not be removed."""
 
 
 def remove_temporaries(out: Path) -> None:
