@@ -25,7 +25,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ...engine import analyse
 from ...engine.dynamics import joint_reactions
+from ...mechanics.loads import JointFriction
 from ..mass_sweep import MassSweep
 from ...model import Model, Prismatic, Revolute
 from ..parts import add_counterweight
@@ -214,10 +216,32 @@ def _load_offsets(sweep: MassSweep) -> dict[str, np.ndarray]:
     return out
 
 
+def coulomb_friction(model: Model) -> list[str]:
+    """The model's joint frictions with a Coulomb part (their names): their moment depends on the
+    joint's reaction, so the loads are not affine in the parts' masses."""
+    return [f.name for f in getattr(model, "loads", ()) if isinstance(f, JointFriction) and f.coefficient]
+
+
+def _frame_offsets(model: Model, t: np.ndarray, gravity, moment_point) -> dict[str, np.ndarray]:
+    """What the frame feels beyond the shaking load, (N, k): the loads from outside the machine
+    (the frame force and moment less the shaking ones, the same in every design: they depend on
+    the motion alone); nothing without loads."""
+    if not getattr(model, "loads", ()):
+        return {}
+    an = analyse(model, t, gravity, moment_point)
+    if an.frame_force is None:
+        return {}
+    return {"frame_force": an.frame_force - an.force, "frame_moment": (an.frame_moment - an.moment)[:, None]}
+
+
 def build(model: Model, unbalanced: Model, t: np.ndarray, parts: list[PartVars], discs: list[DiscVars],
           gravity=(0.0, 0.0), moment_point=(0.0, 0.0)) -> Maps:
     """One engine analysis of ``model`` (the mechanism with the discs at zero inertia) and the
-    affine maps of every load in the design variables."""
+    affine maps of every load in the design variables, the applied loads included (efforts,
+    joint loads and frame loads; raises ValueError for Coulomb friction, not affine)."""
+    if coulomb_friction(model):
+        raise ValueError(f"Coulomb friction ({', '.join(coulomb_friction(model))}) makes the efforts and reactions "
+                         "depend on the reactions, not affinely on the parts' masses")
     nz = 4 * len(parts) + len(discs)
     sweep = MassSweep.build(model, t, gravity, moment_point)
     p0 = parameters(model, angular=True)
@@ -225,12 +249,14 @@ def build(model: Model, unbalanced: Model, t: np.ndarray, parts: list[PartVars],
     p_unb = p0.copy()
     p_unb[disc_rows] = 0.0  # a massless, inertia-free disc transmits nothing: the unbalanced mechanism
     G = _basis(model, parts, discs, nz)
-    Ys = {"shaking_force": (sweep.YF, "N"), "shaking_moment": (sweep.YM[:, None, :], "N m")}
+    Ys = {"shaking_force": (sweep.YF, "N"), "shaking_moment": (sweep.YM[:, None, :], "N m"),
+          "frame_force": (sweep.YF, "N"), "frame_moment": (sweep.YM[:, None, :], "N m")}
     for k, d in enumerate(sweep.drivers):
         Ys[f"effort:{d}"] = (sweep.G[:, k : k + 1, :], "N or N m")
     for name, Y in _joint_maps(sweep).items():
         Ys[f"joint:{name}"] = (Y, "N or N m")
     fixed = _load_offsets(sweep)  # the model's loads: the same in every design (MassSweep.Lam0)
+    fixed.update(_frame_offsets(model, t, gravity, moment_point))  # the outside loads on the frame
     w = time_weights(t)
     loads = {name: Load(name, unit, Y @ G, Y @ p0 + fixed.get(name, 0.0), Y @ p_unb + fixed.get(name, 0.0), w)
              for name, (Y, unit) in Ys.items()}

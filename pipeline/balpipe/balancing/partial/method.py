@@ -38,7 +38,7 @@ from . import motions as PMo
 from ..base import Aim, BalanceResult, Goal, Parameter, Stage
 from ..force_balance import body_point, counterweight_notation, regions_from_spec
 from ..moment_balance import add_discs, counter_rotation_notation
-from .maps import NO_PART, DiscVars, Maps, PartVars, build
+from .maps import NO_PART, DiscVars, Maps, PartVars, build, coulomb_friction
 from .active import ActiveProgram
 from .program import Term
 from .spec import PartialBalance, PartialCounterweightSpec
@@ -197,6 +197,10 @@ def motion_maps(ctx: BalanceContext) -> list[Maps]:
     checked; with the context's gravity and moment point."""
     method: PartialBalance = ctx.balancing
     model, t, gravity, point = ctx.model, ctx.t, ctx.gravity, ctx.moment_point
+    if coulomb_friction(model):
+        raise SpecFieldError(ROOT + ("method",), f"partial_balance needs loads affine in the parts' masses; the Coulomb "
+                             f"friction of {', '.join(coulomb_friction(model))} depends on the joints' reactions: give it "
+                             "as viscous friction, or balance by another method")
     with_discs, parts, discs = parts_from_spec(model, method)
     others = PMo.other_models(method, ctx.models, ROOT)
     motions = [build(with_discs, model, t, parts, discs, gravity, point)]
@@ -273,8 +277,8 @@ def balance(ctx: BalanceContext) -> BalanceResult:
 
 def goal_label(t) -> str:
     """'peak effort of crank', 'RMS shaking force', 'peak load of joint O2': a spec term in words."""
-    what = {"shaking_force": "shaking force", "shaking_moment": "shaking moment", "effort": "effort",
-            "joint": "load"}[t.load]
+    what = {"shaking_force": "shaking force", "shaking_moment": "shaking moment", "frame_force": "frame force",
+            "frame_moment": "frame moment", "effort": "effort", "joint": "load"}[t.load]
     of = f" of {t.actuator}" if t.actuator else f" of joint {t.joint}" if t.joint else ""
     return f"{'RMS' if t.measure == 'rms' else 'peak'} {what}{of}"
 

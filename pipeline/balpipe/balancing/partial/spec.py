@@ -43,9 +43,11 @@ class PartialCounterRotationSpec(CounterRotationSpec):
 class LoadTerm(Strict):
     """One load over the motion's time samples, measured by its peak or its RMS."""
 
-    load: Literal["shaking_force", "shaking_moment", "effort", "joint"] = Field(
-        description="shaking_force |F|, shaking_moment |M| (about the analysis' moment point), effort |tau| of "
-        "an actuator, joint: the load a joint carries (|F| of a revolute, |N| of a prismatic pair, |T| of a gear)"
+    load: Literal["shaking_force", "shaking_moment", "frame_force", "frame_moment", "effort", "joint"] = Field(
+        description="shaking_force |F|, shaking_moment |M| (about the analysis' moment point; inertial, loads do not "
+        "change them), frame_force, frame_moment: everything the frame feels (the shaking load plus the external "
+        "loads), effort |tau| of an actuator, joint: the load a joint carries (|F| of a revolute, |N| of a "
+        "prismatic pair, |T| of a gear); efforts, joint and frame loads count the spec's loads"
     )
     measure: Literal["peak", "rms"] = Field("peak", description="peak over the samples, or root mean square")
     actuator: str | None = Field(None, description="effort: the driver's name (default: every actuator, the largest)")
