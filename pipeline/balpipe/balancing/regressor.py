@@ -170,7 +170,9 @@ def sample_states(model: Model, t: np.ndarray, samples: int = 0, seed: int = 0, 
     spread = np.array([
         LENGTH_SPREAD * size if _is_length(model, p) else ANGLE_SPREAD for p in driver_prims
     ])
-    poses, rates, discarded, dof = [], [], 0, None
+    poses: list[np.ndarray] = []
+    rates: list[np.ndarray] = []
+    discarded, dof = 0, None
     for round_ in range(6):  # rounds, until enough good samples; smaller displacements each round
         need = target - sum(len(p) for p in poses)
         if need <= 0:

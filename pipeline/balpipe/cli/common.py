@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import NoReturn
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 EXIT_UNCONFIRMED = 3  # ``build --strict``: a simulation check could not resolve its own error (nothing shown false)
@@ -21,7 +22,7 @@ def on_sigterm(signum, frame) -> None:
 
 
 class Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # usage errors: exit 2, no traceback
+    def error(self, message: str) -> NoReturn:  # usage errors: exit 2, no traceback
         self.print_usage(sys.stderr)
         print(f"balpipe: error: {message}", file=sys.stderr)
         sys.exit(EXIT_USAGE)

@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Set as AbstractSet
+from typing import Any
 
 import numpy as np
 
@@ -130,12 +132,15 @@ def same_scale(views: dict, rel: float = 0.02) -> bool:
     return max(s) <= (1 + rel) * min(s)
 
 
-def _labels(model: Model, numbers: dict[str, str], unnamed: set[str] = frozenset()) -> dict:
+def _labels(model: Model, numbers: dict[str, str], unnamed: AbstractSet[str] = frozenset()) -> dict:
     """What the player names, in body frames: joints (body points, discs' axes left out, and
     the names in ``unnamed``: :func:`labels.repeated_names`, as the drawings), links (middle of
     the first outline segment; a platform at its centroid), counterweights, and every gear's
     number (:func:`labels.gear_numbers`)."""
-    joints, links, cws, gears = [], [], [], []
+    joints: list[list[Any]] = []
+    links: list[Any] = []
+    cws: list[Any] = []
+    gears: list[Any] = []
     for j, b in enumerate(model.bodies):
         if b.radius:
             gears.append([j, 0.0, 0.0, round(b.radius, 5), numbers.get(b.name, b.name)])

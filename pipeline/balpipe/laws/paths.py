@@ -194,4 +194,5 @@ class PathComponent(Law):
     def __call__(self, t) -> Triple:
         t = np.asarray(t, dtype=float)
         out = self.motion.values(t)[self.index]
-        return tuple(np.asarray(v).reshape(t.shape) for v in out)
+        q, qd, qdd = (np.asarray(v).reshape(t.shape) for v in out)
+        return q, qd, qdd

@@ -41,7 +41,8 @@ def body_point(pose: tuple[Triple, Triple, Triple], c) -> Triple:
     """(N, 2) position, velocity and acceleration of the point with local coordinates ``c`` of a
     body whose frame has the pose (x, y, phi), each given with its two derivatives (the values
     of the pose laws): C = P + R c, C' = P' + phi' J R c, C'' = P'' + phi'' J R c - phi'^2 R c."""
-    return tuple(np.stack(xy, axis=-1) for xy in body_point_xy(pose, c))
+    pos, vel, acc = (np.stack(xy, axis=-1) for xy in body_point_xy(pose, c))
+    return pos, vel, acc
 
 
 def body_point_xy(pose: tuple[Triple, Triple, Triple], c) -> tuple[tuple[np.ndarray, np.ndarray], ...]:

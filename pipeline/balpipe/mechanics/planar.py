@@ -50,7 +50,7 @@ def wrap_angle(a: float | np.ndarray) -> float | np.ndarray:
     return np.pi - np.mod(np.pi - a, 2 * np.pi)
 
 
-def world_point(pose: Sequence[float] | np.ndarray, p: Sequence[float]) -> np.ndarray:
+def world_point(pose: Sequence[float] | np.ndarray, p: Sequence[float] | np.ndarray) -> np.ndarray:
     """The world position of the body-frame point p on a body at pose (x, y, theta): shape (2,)
     for one pose (computed with :mod:`math`), (N, 2) for poses (N, 3)."""
     if np.ndim(pose) == 1:

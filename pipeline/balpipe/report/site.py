@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any, Sequence
 
 from ..runtime.fsutil import write_file_atomic  # replaced in one step, never through a planted symlink
 from . import citations, site_filter, verdict
@@ -165,7 +166,7 @@ def _costs(results: dict, first: dict, last: dict) -> dict:
     return {"claims": claims, "added_mass": added, "efforts": efforts, "joint_increase": joint}
 
 
-def write_site(out: Path, outcomes: list, earlier: list = (), site_key: str = "") -> None:
+def write_site(out: Path, outcomes: list, earlier: Sequence[Any] = (), site_key: str = "") -> None:
     """The site's index (and its navigation script): this build's ``outcomes`` and the pages of
     ``earlier`` builds still in ``out`` (:func:`balpipe.site_files.site_earlier.earlier_pages`). ``site_key``
     (:func:`balpipe.build.site_key`) is written into the index's head, so that a build with
@@ -211,7 +212,7 @@ def comparisons(entries: list[dict]) -> list[dict]:
         for e in group:
             r, v = e["results"], e["verdict"]
             g = v["motions"][0]
-            comp = next((c for c in (r.get("comparison") or {}).get("rows") or [] if c["stage"] == g["final"]), {})
+            comp: dict[str, Any] = next((c for c in (r.get("comparison") or {}).get("rows") or [] if c["stage"] == g["final"]), {})
             c = g["costs"]
             rows.append({
                 "title": e["title"], "link": e["link"], "method": r.get("method"), "level": v["level"],

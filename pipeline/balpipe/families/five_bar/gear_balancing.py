@@ -293,7 +293,9 @@ def _full_stage(model: Model, links: dict[str, Body], I: dict[str, float], mech:
         full = full.replace_body(b)
     gear5 = full.body("gear5")
     full = full.replace_body(replace(gear5, inertia=I["I5"] - sum(a.inertia for a in gear5.attachments)))
-    new_bodies, new_joints, init = [], [], {}
+    new_bodies: list[Body] = []
+    new_joints: list[Revolute | Gear] = []
+    init: dict[str, tuple[float, float, float]] = {}
     for j, prox, dist in ((1, "link1", "link3"), (2, "link2", "link4")):
         lp = (p1, p2)[j - 1]
         r_planet = lp.length / (1 + U)
@@ -324,7 +326,7 @@ def _notation() -> dict:
                 **{f"r{k}": Sym(f"r_{k}", f"pitch radius of gear {k}") for k in (5, 6, 7)},
                 **{f"I{k}": Sym(f"I_{k}", f"axial moment of inertia of gear {k} (eqs. 19-21)") for k in (5, 6, 7)},
                 **{f"U{ab}": Sym(f"U_{{{ab}}}", "transmission ratio") for ab in ("21", "51", "63", "74")}})
-    return names | {
+    return dict(names) | {
         "balancing.counterweights.proximal": Sym(
             "−r_{CW1} = −r_{CW2}", "counterweights 1, 2 along A_jB_j from A_j (negative: beyond A_j, at r_{CW} from it)"),
         "balancing.counterweights.distal": Sym(

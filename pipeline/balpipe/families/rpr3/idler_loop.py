@@ -238,7 +238,7 @@ def _notation() -> dict:
         **{f"rcp{j}": Sym(f"r_{{cp{j}}}", f"position coefficient of counterweight {j}") for j in (1, 2, 5, 6)},
         **{f"Icr{k}": Sym(f"I_{{cr{k}}}", f"inertia of counter-rotation {k} (eqs. 9a-d)") for k in (1, 2, 3, 4)},
     })
-    return names | {
+    return dict(names) | {
         "balancing.E": Sym("E", "base pivot of the idler loop E-F-P (the paper: E = O)"),
         "balancing.link5.length": Sym("L_5", "length EF of link 5"),
         "balancing.link5.mass": Sym("m_5", "mass of link 5"),

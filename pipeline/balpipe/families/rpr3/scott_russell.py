@@ -272,7 +272,7 @@ def _notation() -> dict:
         **{f"rcp{j}": Sym(f"r_{{cp{j}}}", f"position coefficient of counterweight {j}") for j in links.values()},
         "Icr": Sym("I_{cr}", "inertia of each leg's counter-rotation (eq. 30f)"),
     })
-    return names | {
+    return dict(names) | {
         # Sec. 3 renumbers the leg: the piston is link 3, the cylinder link 4 (Fig. 6)
         "mechanism.cylinder.mass": Sym("m_4", "mass of each cylinder, link 4 of the leg (Sec. 3.2)"),
         "mechanism.cylinder.com": Sym("r_4 L_3", "centre of mass S_4 of the cylinder from A_i towards C_i"),

@@ -17,6 +17,7 @@ balancing in a closure. Every stage is drawn in its line style of the page
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -296,7 +297,8 @@ def _other_trajectories(study, plans, by: dict) -> tuple[str, str, str]:
 
     n = len(plans)
     cases = [key for key, _ in sorted(CASES, key=lambda kl: STYLES[kl[0]])]
-    panels, curves = [], {key: {} for key in cases}
+    panels: list[Any] = []
+    curves: dict[str, dict[str, Any]] = {key: {} for key in cases}
     for p in plans:
         pre = _prefix(p.name)
         panels += [{"key": f"F {p.name}", "title": f"{p.name}: shaking force |F| (N)", "axis": "|F| (N)"},

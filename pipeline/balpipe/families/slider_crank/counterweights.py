@@ -148,7 +148,7 @@ def _notation() -> dict:
         parts={f"counterweight {j}": Sym(f"m_{{cp{j}}}", f"counterweight M_{j} on link {j} (eq. 15)") for j in (1, 2)},
         params={**{f"mcp{j}": Sym(f"m_{{cp{j}}}", f"mass of counterweight M_{j} (eq. 15)") for j in (1, 2)},
                 **{f"rcp{j}": Sym(f"r_{{cp{j}}}", f"position coefficient of counterweight M_{j}") for j in (1, 2)}})
-    return names | {
+    return dict(names) | {
         "balancing.crank_counterweight": Sym(
             "r_{cp1} L_1", "position of counterweight M_1 along the crank from A (negative: beyond A)"),
         "balancing.coupler_counterweight": Sym(
