@@ -275,8 +275,11 @@ def analyse(
                                 "give the friction as viscous, or the gears without pitch radii", float(t[0]))
         lam, gen0 = solve_loads(lt, rhs, solver)
     if mesh_geo:
+        # the radial tooth forces move load between bearings (in place in lam): the frame's
+        # bearings among them change the frame's load by -Phi_q0^T dlambda
+        before = lam.copy()
         lam, radial_on_frame = radial_tooth_loads(cd, mesh_geo, lam)
-        gen0 = gen0 + radial_on_frame
+        gen0 = gen0 - np.einsum("nmk,nm->nk", J0, lam - before) + radial_on_frame
     frame_gen = gen0
     if lt is not None:
         gen0 = gen0 - lt.external  # the shaking load: the frame load less the external loads
