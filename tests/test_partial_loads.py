@@ -34,7 +34,7 @@ def _pumpjack(objective=None, budget=None):
 def _unbalanced(spec):
     model = registry.unbalanced_model(spec)
     t = registry.time_grid(spec)
-    return model, t, analyse(model, t, (0.0, -spec.analysis.g))
+    return model, t, analyse(model, t, (0.0, -spec.analysis.g) if spec.analysis.gravity else (0.0, 0.0))
 
 
 def _counterweight_torque(spec, t):
@@ -125,3 +125,45 @@ def test_coulomb_friction_is_a_located_error():
     with pytest.raises(SpecFieldError) as err:
         registry.balance(spec)
     assert err.value.path == ("balancing", "method") and "Coulomb friction of main_bearing, piston_rings" in err.value.message
+
+
+COMPRESSOR = SPECS / "custom_compressor_gas_pressure_partial.yaml"
+
+
+def _bearing_terms(spec):
+    """The main bearing's force (joint A) of the unbalanced compressor under its gas force, and
+    what a crank counterweight adds per unit first moment (crank axes) at constant speed: its
+    centripetal force, -w^2 R(th) s, through the bearing (no torque, no other joint's force)."""
+    model, t, an = _unbalanced(spec)
+    k = [b.name for b in model.bodies].index("crank")
+    th, w = an.q[:, k, 2], an.v[:, k, 2]
+    R0 = np.stack([an.reactions["A"]["Fx"], an.reactions["A"]["Fy"]], axis=1)
+    c, s = np.cos(th), np.sin(th)
+    T = np.stack([np.stack([c, -s], axis=1), np.stack([s, c], axis=1)], axis=1) * (w * w)[:, None, None]
+    return R0, T
+
+
+def test_least_peak_main_bearing_load_under_the_gas_force_equals_a_cvxpy_reference():
+    """min over s (|s| <= 60 mm x 3 kg) of max_t |R0 + sigma T s| (sigma the sign the textbook
+    design shows) written with cvxpy here, against balpipe's optimum: value and design."""
+    import cvxpy as cp
+
+    spec = load(COMPRESSOR).spec
+    program, out, objective, _ = P.solve(P.motion_maps(registry.context(spec)), spec.balancing)
+    R0, T = _bearing_terms(spec)
+    res = study.run(spec.model_copy(update={"balancing": spec.compare[0].balancing, "compare": []}), page=False)
+    R = np.stack([res.stages[1].analysis.reactions["A"][k] for k in ("Fx", "Fy")], axis=1)
+    s_text = np.array([-1.58 * 0.05, 0.0])
+    sigma = 1.0 if np.max(np.abs(R - R0 - T @ s_text)) < np.max(np.abs(R - R0 + T @ s_text)) else -1.0
+    assert np.max(np.abs(R - R0 - sigma * (T @ s_text))) <= 1e-9 * np.max(np.abs(R0))
+    s = cp.Variable(2)
+    u = cp.Variable()
+    scale = float(np.max(np.linalg.norm(R0, axis=1)))
+    A = sigma * T / scale
+    cons = [cp.norm(s) <= 0.06 * 3.0] + [cp.norm(R0[n] / scale + A[n] @ s) <= u for n in range(len(R0))]
+    cp.Problem(cp.Minimize(u), cons).solve(solver=cp.CLARABEL)
+    ours = float(np.max(np.linalg.norm(R0 + sigma * (T @ out.z[1:3]), axis=1)))
+    assert ours == pytest.approx(objective[0].value(out.z), rel=1e-9)  # the maps count the gas force
+    assert ours == pytest.approx(float(u.value) * scale, rel=1e-7)
+    assert np.max(np.abs(out.z[1:3] - s.value)) <= 1e-5 * 0.18
+    assert ours < 0.8 * scale  # the gas force's bearing load a quarter lower
