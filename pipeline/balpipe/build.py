@@ -97,12 +97,15 @@ class Options:
     simulate: bool = True
     force: bool = False
     sim_workers: int = 1  # processes for one spec's simulations (cores left over by fewer specs than cores)
-    #: the published name of each spec path (:func:`published_names`); a path not in it is shown as given
+    #: the published name of each spec path (:func:`published_names`); others as if their folder had been given
     names: tuple[tuple[Path, str], ...] = ()
 
     def name(self, path: Path) -> str:
-        """How published files and messages name the spec ``path``: never a path of the machine."""
-        return dict(self.names).get(path, str(path))
+        """How published files and messages name the spec ``path``: never a path of the machine.
+        A path the command line did not name (a caller in Python) is named as if its folder had
+        been given (:func:`published_names`)."""
+        known = dict(self.names).get(path)
+        return known if known is not None else published_names([str(path.parent)], [path])[path]
 
 
 class SchedulerError(Exception):
