@@ -247,3 +247,16 @@ def test_a_position_driven_run_unresolved_at_its_first_step_is_unconfirmed_with_
     assert run(dt=dt).status == "pass"
     found = run()
     assert found.status == "pass" and found.dt < tight.dt, found.notes
+
+
+def test_the_history_records_an_unconfirmed_check_as_such():
+    from balpipe.history import figures_from_results
+
+    base = {"status": "ok", "spec": "s", "mechanism": "custom", "method": "none", "parameters": [],
+            "stages": [{"name": "a", "label": "a"}, {"name": "b", "label": "b"}]}
+    unsure = {"a": {"passed": True, "status": "pass"}, "b": {"passed": False, "status": "unconfirmed"}}
+    fig = figures_from_results({**base, "validation": unsure})
+    assert fig["validation"] == "unconfirmed" and [s["validation"] for s in fig["stages"]] == ["pass", "unconfirmed"]
+    failed = {**unsure, "a": {"passed": False, "status": "fail"}}
+    assert figures_from_results({**base, "validation": failed})["validation"] == "fail"
+    assert figures_from_results({**base, "validation": {"a": {"passed": False}}})["validation"] == "fail"

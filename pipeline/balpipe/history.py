@@ -130,6 +130,12 @@ def has_uncommitted_changes(root: Path, path: Path) -> bool:
 
 # ------------------------------------------------------------------------------ the figures
 
+def _status(v: dict) -> str:
+    """A stage's validation status: "pass", "fail" or "unconfirmed" (results written before
+    that status have ``passed`` only)."""
+    return v.get("status") or ("pass" if v.get("passed") else "fail")
+
+
 def figures_from_results(results: dict) -> dict:
     """The headline figures of one revision, from its ``results.json`` dictionary (already
     rounded to 12 significant digits: a history point equals a build's numbers)."""
@@ -138,12 +144,13 @@ def figures_from_results(results: dict) -> dict:
     for s in results["stages"]:
         row = {"name": s["name"], "label": s["label"], **{k: s.get(k) for k in STAGE_KEYS}}
         v = (val or {}).get(s["name"])
-        row["validation"] = None if v is None else ("pass" if v.get("passed") else "fail")
+        row["validation"] = None if v is None else _status(v)
         stages.append(row)
     if val is None:
         overall = "skipped"
-    else:
-        overall = "pass" if val and all(v.get("passed") for v in val.values()) else "fail"
+    else:  # the worst of the stages' (an unconfirmed check is not a failure)
+        kinds = {_status(v) for v in val.values()}
+        overall = "fail" if not val or "fail" in kinds else "unconfirmed" if "unconfirmed" in kinds else "pass"
     return {
         "status": results["status"],
         "problems": list(results.get("problems") or []),
