@@ -115,8 +115,9 @@ def evaluate_chunk(data: dict, paths: list[tuple], chunk: list[tuple[int, tuple]
     ``anchors`` (:func:`run`; :mod:`balpipe.engine.warmstart`: no sequential continuation, and
     the same numbers in any chunk or worker)."""
     from ..engine import warm_start
+    from ..runtime.threads import blas_threads
 
-    with warm_start(anchors):
+    with warm_start(anchors), blas_threads():  # one BLAS thread in any worker, whatever it imported first
         return _evaluate(data, paths, chunk, stage, keys)
 
 
