@@ -150,22 +150,19 @@ def test_with_values_changes_fields_and_refuses_as_the_file_would():
         spec.with_values({"mechanism.crank.colour": "red"})
 
 
+def _example():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("parameter_study", ROOT / "docs" / "examples" / "parameter_study.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def _four_bar() -> balpipe.Spec:
     """specs/custom_four_bar_balancing.yaml built in Python, part by part."""
     twin = balpipe.load(SPECS / FOUR_BAR).parsed
-    mech = b.mechanism(
-        frame_points={"O2": (0, 0), "O4": ("300 mm", 0)},
-        bodies=[
-            b.body("crank", "0.4 kg", com=(0.04, 0), inertia="0.000213 kg m^2", pose=(0, 0, 0),
-                   points={"O2": (0, 0), "A": (0.08, 0)}),
-            b.body("coupler", "1.2 kg", com=(0.14, 0), inertia="0.00784 kg m^2", pose=(0.08, 0, 1.2),
-                   points={"A": (0, 0), "B": (0.28, 0)}),
-            b.body("rocker", "900 g", com=(0.11, 0), inertia="0.00363 kg m^2", pose=(0.30, 0, 1.8),
-                   points={"O4": (0, 0), "B": (0.22, 0)}),
-        ],
-        joints=[b.revolute("O2", "frame", "crank", "O2", "O2"), b.revolute("A", "crank", "coupler", "A", "A"),
-                b.revolute("B", "coupler", "rocker", "B", "B"), b.revolute("O4", "frame", "rocker", "O4", "O4")],
-        drivers=[b.driver("crank", joint="O2")])
+    mech = _example().my_mechanism()  # the example's machine (docs/examples/parameter_study.py)
     cws = [b.counterweight("crank", "cw_crank", segment=((0, 0), (-0.08, 0))),
            b.counterweight("coupler", "cw_coupler", disc=((0.14, 0), 0.25)),
            b.counterweight("rocker", "cw_rocker", segment=((0, 0), (-0.12, 0)))]

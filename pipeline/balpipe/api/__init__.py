@@ -6,10 +6,10 @@
     print(study.verdict["text"], study.results()["stages"][-1]["max_shaking_force"])
     study.write("out/slider_crank")
 
-The names of :data:`__all__` are balpipe's stable API (docs/api.md states the policy); they are
+The names of ``__all__`` are balpipe's stable API (docs/api.md states the policy); they are
 also reachable as ``balpipe.<name>``, loaded on first use so that ``import balpipe`` stays cheap.
-This layer sits beside the build (``balpipe build`` and :func:`run` compute their studies with the
-same functions, :func:`balpipe.build.study_of` and :func:`balpipe.build.page_files`)."""
+This layer sits beside the build (``balpipe build`` and ``run`` compute their studies with the
+same functions, ``balpipe.build.study_of`` and ``balpipe.build.page_files``)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The API's one exception for a bad spec: :class:`SpecError`, every problem located."""
+"""The API's one exception for a bad spec: ``SpecError``, every problem located."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ class SpecError(SpecErrors):
         file, line, column, field, message: those of the first problem.
 
     ``str(error)`` is the command line's message, one problem per line. It is also a
-    :class:`ValueError`-like ``Exception`` subclass of the loader's ``SpecErrors``, so code that
+    ``ValueError``-like ``Exception`` subclass of the loader's ``SpecErrors``, so code that
     caught that keeps working."""
 
     def __init__(self, problems: list[Problem]):

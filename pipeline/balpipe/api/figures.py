@@ -1,6 +1,6 @@
-"""A page's time-series figure (:class:`balpipe.draw.live.Curves`, what the page plots
+"""A page's time-series figure (``balpipe.draw.live.Curves``, what the page plots
 interactively) drawn as a matplotlib figure: a panel per quantity, a curve per stage in the
-page's line styles (:func:`balpipe.draw.figures.style`)."""
+page's line styles (``balpipe.draw.figures.style``)."""
 
 from __future__ import annotations
 

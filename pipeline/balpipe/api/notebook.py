@@ -1,5 +1,5 @@
-"""A study shown in a notebook (Jupyter, VS Code): :func:`study_html`, the HTML of
-:meth:`balpipe.Study._repr_html_`. The verdict, the design card and the shaking loads as the
+"""A study shown in a notebook (Jupyter, VS Code): ``study_html``, the HTML of
+``balpipe.Study._repr_html_``. The verdict, the design card and the shaking loads as the
 page's interactive plot (uPlot and the page's own ``live_plots.js``, inlined: no server, no
 network), the plot isolated in an ``<iframe srcdoc>`` so that several studies in one notebook
 keep their own plots."""
@@ -18,7 +18,8 @@ from ..report.page import time_curves
 
 #: the panels of the loads figure that the notebook shows: the force's magnitude and the moment
 SHOWN = ("F", "M")
-PANEL_HEIGHT = 270  # px a panel takes in the frame (live_plots.js draws it 240 px high, with its legend)
+PANEL_HEIGHT = 300  # px a panel takes in the frame (live_plots.js draws it 240 px high), its legend aside
+LEGEND_LINE = 28  # px a line of the legend takes (about two stages a line in a notebook's width)
 
 
 @lru_cache(maxsize=None)
@@ -34,11 +35,11 @@ def loads_frame(st) -> str:
     c = c._replace(panels=[p for p in c.panels if p["key"] in SHOWN])
     doc = ("<!doctype html><html><head><meta charset='utf-8'><style>"
            + _asset("uplot.min.css")
-           + "body{margin:0;font:13px system-ui,sans-serif}.live-plot{margin:0 0 8px}</style></head><body>"
+           + "body{margin:0;overflow-x:hidden;font:13px system-ui,sans-serif}.live-plot{margin:0 0 8px}</style></head><body>"
            + live.html("loads", c)
            + "<script id='uplot-js'>" + _asset("uplot.iife.min.js") + "</script><script>"
            + _asset("live_plots.js") + "</script></body></html>")
-    height = PANEL_HEIGHT * len(c.panels) + 40
+    height = (PANEL_HEIGHT + LEGEND_LINE * ((len(c.stages) + 1) // 2)) * len(c.panels) + 20
     return (f'<iframe srcdoc="{html.escape(doc, quote=True)}" title="shaking loads" '
             f'style="width:100%;height:{height}px;border:0" sandbox="allow-scripts"></iframe>')
 
@@ -65,7 +66,7 @@ def _card(st, results: dict) -> str:
 
 
 def study_html(study) -> str:
-    """The notebook's view of a :class:`balpipe.Study`: its name, the verdict, the stages' peak
+    """The notebook's view of a ``balpipe.Study``: its name, the verdict, the stages' peak
     loads, the design card and the live plot of the shaking loads."""
     r = study._results_view()
     v = r["verdict"]

@@ -1,9 +1,9 @@
-"""A spec in Python: :func:`load` (a file or YAML text), :meth:`Spec.with_values` (fields changed
-by their dotted paths, for parameter studies) and :meth:`Spec.from_parts` (a spec assembled
+"""A spec in Python: ``load`` (a file or YAML text), ``Spec.with_values`` (fields changed
+by their dotted paths, for parameter studies) and ``Spec.from_parts`` (a spec assembled
 from sections built in Python). Every one of them validates through the loader that ``balpipe
-check`` and ``balpipe build`` use (:func:`balpipe.loader.load_text`: the schema, the units, the
+check`` and ``balpipe build`` use (``balpipe.loader.load_text``: the schema, the units, the
 limits, the motion's tables), so a spec accepted here is accepted there and a refused one is
-refused with the same located problems (:class:`~balpipe.api.errors.SpecError`)."""
+refused with the same located problems (``balpipe.api.errors.SpecError``)."""
 
 from __future__ import annotations
 
@@ -24,8 +24,8 @@ TEXT = "<text>"
 class Spec:
     """One validated spec: its text and where it came from.
 
-    Make one with :func:`balpipe.load`, :meth:`with_values` or :meth:`from_parts`; run it with
-    :func:`balpipe.run`. A Spec is immutable: every change makes a new one."""
+    Make one with ``balpipe.load``, ``with_values`` or ``from_parts``; run it with
+    ``balpipe.run``. A Spec is immutable: every change makes a new one."""
 
     __slots__ = ("_loaded",)
 
@@ -57,8 +57,8 @@ class Spec:
 
     @property
     def parsed(self):
-        """The validated spec, a :class:`balpipe.spec.Spec` (pydantic): every field with its
-        default, in SI units. Read it; change a spec with :meth:`with_values`."""
+        """The validated spec, a ``balpipe.spec.Spec`` (pydantic): every field with its
+        default, in SI units. Read it; change a spec with ``with_values``."""
         return self._loaded.spec
 
     def data(self) -> dict:
@@ -75,12 +75,12 @@ class Spec:
                 is named by its index. The last key of a path may be a field the spec omits.
 
         Returns:
-            The new :class:`Spec`; its text is the changed YAML (comments dropped), its path
-            this spec's (its tables are read from the same folder).
+            The new ``Spec``; its text is the changed YAML (comments dropped), its path
+                this spec's (its tables are read from the same folder).
 
         Raises:
             SpecError: a path that is not in the spec, or a value the schema refuses, located at
-                the field in this spec's file where it exists (named :attr:`source`)."""
+                the field in this spec's file where it exists (named ``source``)."""
         paths = [tuple(int(p) if p.isdigit() else p for p in str(key).split(".")) for key in changes]
         data = yaml.safe_load(self.text)
         try:
@@ -107,7 +107,7 @@ class Spec:
         Args:
             name: the study's title (the spec's ``name``).
             mechanism: the ``mechanism`` section: a pydantic section (the builders of
-                :mod:`balpipe.families.custom.builders` make a custom mechanism body by body) or
+                ``balpipe.families.custom.builders`` make a custom mechanism body by body) or
                 the same as plain data.
             motion: the ``motion`` section (data or its pydantic section).
             balancing: the ``balancing`` section (default: none).
@@ -117,7 +117,7 @@ class Spec:
                 ``compare``, ``references``), as data or pydantic sections.
 
         Returns:
-            The :class:`Spec`; its text is the YAML the sections make.
+            The ``Spec``; its text is the YAML the sections make.
 
         Raises:
             SpecError: what the loader refuses, located in that YAML text."""
@@ -167,8 +167,8 @@ def _path_of(text: str) -> tuple:
 
 
 def loads(text: str, path: str | Path = TEXT) -> Spec:
-    """A :class:`Spec` from YAML ``text``; ``path`` names it in errors and is the folder its
-    tables are read from. Raises :class:`SpecError`."""
+    """A ``Spec`` from YAML ``text``; ``path`` names it in errors and is the folder its
+    tables are read from. Raises ``SpecError``."""
     try:
         spec, node = loader.load_text(text, str(path))
     except loader.SpecErrors as exc:
@@ -180,11 +180,11 @@ def load(path_or_text: str | Path) -> Spec:
     """Read and validate one spec.
 
     Args:
-        path_or_text: a spec file (a :class:`~pathlib.Path`, or a string without a line break),
+        path_or_text: a spec file (a ``pathlib.Path``, or a string without a line break),
             or the spec's YAML text (a string with at least one line break).
 
     Returns:
-        The validated :class:`Spec`.
+        The validated ``Spec``.
 
     Raises:
         SpecError: every problem of the spec, located (``file:line:column: field: message``), as

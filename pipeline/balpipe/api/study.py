@@ -1,6 +1,6 @@
-"""A study in Python: :func:`run` balances and analyses a :class:`~balpipe.api.spec.Spec` through
-the engine that ``balpipe build`` runs (:func:`balpipe.build.study_of`: :mod:`balpipe.runner`),
-and the :class:`Study` it returns gives what the page holds: ``results.json`` as a dict, the
+"""A study in Python: ``run`` balances and analyses a ``balpipe.api.spec.Spec`` through
+the engine that ``balpipe build`` runs (``balpipe.build.study_of``: ``balpipe.runner``),
+and the ``Study`` it returns gives what the page holds: ``results.json`` as a dict, the
 time series, the page's figures and the page itself."""
 
 from __future__ import annotations
@@ -25,8 +25,8 @@ class Stage:
         label: the label of the page's figures and tables.
         metrics: the stage's entry of ``results.json``'s ``stages`` (peaks, ratios, whether it is
             force and moment balanced, added mass and inertia, ...; docs/site.md lists them).
-        model: the stage's mechanism, a :class:`balpipe.model.Model` (bodies, joints, drivers).
-        analysis: the engine's analysis of the stage's motion (:class:`balpipe.engine.Analysis`:
+        model: the stage's mechanism, a ``balpipe.model.Model`` (bodies, joints, drivers).
+        analysis: the engine's analysis of the stage's motion (``balpipe.engine.Analysis``:
             ``t``, ``force``, ``moment``, ``efforts``, ``reactions``)."""
 
     name: str
@@ -37,7 +37,7 @@ class Stage:
 
 
 class Study:
-    """A balanced and analysed spec, as its page shows it. Made by :func:`balpipe.run`."""
+    """A balanced and analysed spec, as its page shows it. Made by ``balpipe.run``."""
 
     def __init__(self, spec: Spec, study: Any, input_hash: str):
         self.spec = spec
@@ -47,7 +47,7 @@ class Study:
 
     @property
     def engine_study(self):
-        """The pipeline's own study (:class:`balpipe.study.Study`), for what the API does not
+        """The pipeline's own study (``balpipe.study.Study``), for what the API does not
         give; its fields may change between versions."""
         return self._study
 
@@ -71,7 +71,7 @@ class Study:
 
     @property
     def problems(self) -> list[str]:
-        """The failed checks, as the page lists them (empty when :attr:`ok`)."""
+        """The failed checks, as the page lists them (empty when ``ok``)."""
         return list(self._study.problems)
 
     @property
@@ -88,20 +88,20 @@ class Study:
 
     def results(self) -> dict:
         """``results.json`` as a dict: exactly what ``balpipe build`` writes for this spec (its
-        ``source`` is :attr:`Spec.source`, its ``input_hash`` that of a page folder without history).
+        ``source`` is ``Spec.source``, its ``input_hash`` that of a page folder without history).
 
         Returns:
             A fresh copy (changing it changes nothing here)."""
         return copy.deepcopy(self._results_view())
 
-    def timeseries(self):
+    def timeseries(self) -> Any:
         """The columns of ``timeseries.csv`` (t, then per stage the shaking force and moment,
         the efforts, the joint reactions, the centre of mass and the poses; SI units; full
         precision, where the CSV keeps 12 significant digits).
 
         Returns:
-            A :class:`pandas.DataFrame` when pandas is installed, else a dict of column name ->
-            1-D :class:`numpy.ndarray`, in the CSV's order."""
+            A ``pandas.DataFrame`` when pandas is installed, else a dict of column name ->
+                1-D ``numpy.ndarray``, in the CSV's order."""
         from ..report.results import timeseries_columns
 
         columns = {name: values.copy() for name, values in timeseries_columns(self._study)}
@@ -113,21 +113,21 @@ class Study:
 
     @property
     def figure_names(self) -> tuple[str, ...]:
-        """The names :meth:`figure` draws: ``loads`` (shaking force and moment), ``efforts``
+        """The names ``figure`` draws: ``loads`` (shaking force and moment), ``efforts``
         (actuators), and ``joints`` (joint loads) when the mechanism has joint loads."""
         from ..report.page import time_curves
 
         return tuple(k for k, c in time_curves(self._study).items() if c.panels)
 
-    def figure(self, name: str):
+    def figure(self, name: str) -> Any:
         """One of the page's time-series figures, drawn with matplotlib from the very curves the
         page plots (every stage shown on the page, a panel per quantity).
 
         Args:
-            name: one of :attr:`figure_names`.
+            name: one of ``figure_names``.
 
         Returns:
-            A :class:`matplotlib.figure.Figure` (not shown; ``fig.savefig(...)`` or display it).
+            A ``matplotlib.figure.Figure`` (not shown; ``fig.savefig(...)`` or display it).
 
         Raises:
             KeyError: an unknown name."""
@@ -171,17 +171,17 @@ class Study:
 def run(spec: Spec, simulate: bool = False, workers: int = 1) -> Study:
     """Balance and analyse a spec: every stage of its method (and of its ``compare`` designs), the
     checks, and with ``simulate`` the pymunk validation of every stage, as ``balpipe build``
-    computes them (the same code: :func:`balpipe.build.study_of`). Runs on one BLAS thread
-    whatever was imported first (:mod:`balpipe.runtime.threads`).
+    computes them (the same code: ``balpipe.build.study_of``). Runs on one BLAS thread
+    whatever was imported first (``balpipe.runtime.threads``).
 
     Args:
-        spec: a :class:`Spec` (:func:`balpipe.load`).
+        spec: a ``Spec`` (``balpipe.load``).
         simulate: also run the pymunk validation (slower: seconds to a minute a spec); off by
             default, as ``balpipe build --no-sim``.
         workers: processes for the stages' simulations (the same results for any number).
 
     Returns:
-        The :class:`Study`.
+        The ``Study``.
 
     Raises:
         SpecError: a problem found while balancing or analysing (a motion the mechanism cannot

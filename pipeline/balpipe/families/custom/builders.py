@@ -1,6 +1,6 @@
 """A ``custom`` mechanism built in Python, part by part: each builder returns the pydantic
 section that the same YAML would give (validated as it: pydantic's ``ValidationError`` for a
-value the schema refuses), and :meth:`balpipe.Spec.from_parts` turns the assembled sections into a
+value the schema refuses), and ``balpipe.Spec.from_parts`` turns the assembled sections into a
 spec through the loader that reads spec files, so a mechanism built here is checked and computed
 exactly as its YAML twin (the same located errors for what only the whole spec can tell: a joint
 naming a missing body, a pose the joints do not confirm).
