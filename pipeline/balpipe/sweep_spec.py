@@ -58,7 +58,7 @@ def _range_text(value: Any) -> str:
 
 def _range_syntax(text: str) -> str:
     try:
-        parse_vary("x=" + text, origin="")
+        parse_vary("x=" + text, origin="", syntax_only=True)
     except SweepError as exc:
         raise ValueError(str(exc).removeprefix(": ").removeprefix("x=" + text + ": ")) from None
     return text

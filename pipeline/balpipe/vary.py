@@ -12,6 +12,9 @@ from typing import Any
 
 from .units import kinds_of
 
+#: most values along one field (as many as a random sample's designs may have)
+MAX_VALUES = 10_000_000
+
 _NUM = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
 
 
@@ -64,9 +67,23 @@ def _conversion(frm: str, to: str, arg: str) -> float:
     raise SweepError(f"{arg}: LO and HI have units of different kinds ({to!r}, {frm!r})")
 
 
-def parse_vary(arg: str, origin: str = "--vary") -> Vary:
+def vary_count(arg: str) -> int | None:
+    """How many values ``PATH=RANGE`` gives a grid, read without parsing a value (so a sweep's
+    size is checked before any work): N of LO:HI:N, the number of a,b,c; None for LO:HI or a
+    range that :func:`parse_vary` will refuse."""
+    rng = arg.split("=", 1)[1] if "=" in arg else ""
+    if "," in rng:
+        return rng.count(",") + 1
+    parts = rng.split(":")
+    if len(parts) == 3 and parts[2].strip().isdigit() and len(parts[2].strip()) <= 30:
+        return int(parts[2])
+    return None
+
+
+def parse_vary(arg: str, origin: str = "--vary", syntax_only: bool = False) -> Vary:
     """``PATH=RANGE`` -> :class:`Vary` (syntax only; :func:`plan` validates against the spec).
-    Messages start with ``origin arg`` (``--vary PATH=RANGE``)."""
+    Messages start with ``origin arg`` (``--vary PATH=RANGE``). N above :data:`MAX_VALUES` is
+    refused before a value is made; ``syntax_only``: LO:HI:N is checked, its values not made."""
     tag = f"{origin} {arg}" if origin else arg
     if "=" not in arg:
         raise SweepError(f"{tag}: expected PATH=RANGE, e.g. mechanism.crank.mass=0.5kg:2kg:7")
@@ -97,6 +114,10 @@ def parse_vary(arg: str, origin: str = "--vary") -> Vary:
             raise SweepError(f"{tag}: N must be an integer (got {parts[2]!r})") from None
         if n < 1:
             raise SweepError(f"{tag}: N must be at least 1")
+        if n > MAX_VALUES:
+            raise SweepError(f"{tag}: N = {n} is above the limit of {MAX_VALUES} values along one field")
+        if syntax_only:
+            return Vary(arg, path, (), lo, hi, unit, origin)
         xs = np.linspace(lo, hi, n) if n > 1 else np.array([lo])
         return Vary(arg, path, tuple(f"{float(x)!r} {unit}" if unit else float(x) for x in xs), unit=unit, origin=origin)
     return Vary(arg, path, (), lo, hi, unit, origin)

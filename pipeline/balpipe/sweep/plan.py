@@ -14,7 +14,7 @@ import yaml
 from pydantic import ValidationError
 
 from ..sweep_spec import MAX_DESIGNS
-from ..vary import SweepError, Vary, get_attr_path, parse_vary, set_path
+from ..vary import SweepError, Vary, get_attr_path, parse_vary, set_path, vary_count
 from .evaluate import _validate
 
 
@@ -105,9 +105,9 @@ def plan(spec_file: str, vary_args: list[str] | None = None, sample: str | None 
     data.pop("sweep", None)  # the designs are specs without the block (validated once, above)
     block = loaded.spec.sweep
     if vary_args:
-        varies = [parse_vary(a) for a in vary_args]
+        args, origin = list(vary_args), "--vary"
     elif block is not None:
-        varies = [parse_vary(f"{k}={v}", origin="sweep.vary") for k, v in block.vary.items()]
+        args, origin = [f"{k}={v}" for k, v in block.vary.items()], "sweep.vary"
     else:
         raise SweepError("nothing to vary: give at least one --vary PATH=RANGE, or a sweep: block in the spec")
     limit_from_block = max_designs is None and block is not None
@@ -120,6 +120,11 @@ def plan(spec_file: str, vary_args: list[str] | None = None, sample: str | None 
     sample = sample or "grid"
     n, seed = n or 0, seed or 0
     max_designs = MAX_DESIGNS if max_designs is None else max_designs
+    # the size first, from the counts alone: a grid of 10^9 values is refused before one is made
+    early = math.prod(vary_count(a) or 1 for a in args) if sample == "grid" else n
+    if early > max_designs:
+        _too_many(loaded, block, early, max_designs, limit_from_block)
+    varies = [parse_vary(a, origin=origin) for a in args]
     problems: list[str] = []
     seen = set()
     for v in varies:
@@ -157,14 +162,20 @@ def plan(spec_file: str, vary_args: list[str] | None = None, sample: str | None 
         raise SweepError("\n".join(dict.fromkeys(problems)))
     size = math.prod(len(v.values) for v in varies) if sample == "grid" else n
     if size > max_designs:
-        msg = f"the sweep has {size} designs, above the limit of {max_designs}"
-        if limit_from_block:
-            from ..loader import located as locate
-
-            at = ("sweep", "max_designs") if "max_designs" in block.model_fields_set else ("sweep",)
-            raise SweepError(str(locate(str(loaded.path), loaded.node, at, msg + " (sweep.max_designs)")))
-        raise SweepError(msg + " (--max-designs)")
+        _too_many(loaded, block, size, max_designs, limit_from_block)
     return Plan(str(loaded.path), loaded.text, data, varies, designs_of(varies, sample, n, seed), stage, sample, seed)
+
+
+def _too_many(loaded, block, size: int, max_designs: int, limit_from_block: bool) -> None:
+    """Raise the sweep-size error: located at the spec's ``sweep.max_designs`` when that is the
+    limit, else naming ``--max-designs``."""
+    msg = f"the sweep has {size} designs, above the limit of {max_designs}"
+    if limit_from_block:
+        from ..loader import located as locate
+
+        at = ("sweep", "max_designs") if "max_designs" in block.model_fields_set else ("sweep",)
+        raise SweepError(str(locate(str(loaded.path), loaded.node, at, msg + " (sweep.max_designs)")))
+    raise SweepError(msg + " (--max-designs)")
 
 
 def _has(data: Any, path: tuple) -> bool:
