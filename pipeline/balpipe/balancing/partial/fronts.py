@@ -176,4 +176,4 @@ def fronts(maps: Maps, inertia_budget: float | None, terms: dict[str, Term], bud
     """:func:`compute` on a new :class:`ActiveProgram` of ``maps`` (the spec's motion's; ``terms``
     may span several motions) with ``inertia_budget``: a function of plain data (the maps, the
     terms' load maps, the numbers), which :func:`balpipe.cache.balance.run` can key."""
-    return compute(ActiveProgram(maps, inertia_budget), terms, budget, n, max_mass)
+    return compute(ActiveProgram(maps, inertia_budget, exact=False), terms, budget, n, max_mass)

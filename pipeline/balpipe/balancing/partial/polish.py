@@ -107,6 +107,7 @@ def polish(q: np.ndarray, A: np.ndarray, b: np.ndarray, cones: list[tuple[str, i
     if any(r <= 0 for _, _, r in parts):
         return None
     mu = np.linalg.lstsq(J.T, q, rcond=None)[0]  # q = J' mu at the optimum
+    last = np.inf
     for _ in range(ITERATIONS):
         H = np.zeros((n, n))
         for k, (A1, u, r) in enumerate(parts):
@@ -121,8 +122,12 @@ def polish(q: np.ndarray, A: np.ndarray, b: np.ndarray, cones: list[tuple[str, i
         c, J, parts = equations(x)
         if any(r <= 0 for _, _, r in parts):
             return None
-        if np.linalg.norm(step[:n]) <= 1e-15 * max(1.0, float(np.linalg.norm(x))):
+        size = float(np.linalg.norm(step))
+        # converged: a step at round-off, one that no longer shrinks (round-off reached), or the
+        # one step that solves equations that are all linear
+        if size <= 1e-14 * max(1.0, float(np.linalg.norm(x))) or size >= 0.5 * last or not curved:
             break
+        last = size
     scale = max(1.0, float(np.max(np.abs(q))))
     if np.max(np.abs(q - J.T @ mu), initial=0.0) > 1e-10 * scale or np.max(np.abs(c), initial=0.0) > FEASIBLE:
         return None
