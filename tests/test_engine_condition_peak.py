@@ -98,3 +98,25 @@ def test_an_analysis_peak_is_its_condition_numbers_argmax():
     assert condition_peak(an.extra) == found
     assert condition_peak({"actuation_condition": np.array([1.0, 3.0, 3.0])}, "actuation_condition") == (1, 3.0)
     assert condition_peak({}, "actuation_condition") is None
+
+
+def test_chunked_jacobians_give_the_same_peak_and_numbers(monkeypatch):
+    """motion_peak and condition_numbers form the Jacobians a chunk of samples at a time (the
+    memory of a chunk, whatever the motion's length): the same sample and the same floats as the
+    whole motion's Jacobians at once, for chunks that cut the motion anywhere."""
+    from balpipe.engine.constraints import jacobian, with_frame
+    from balpipe.engine.positions import condition_numbers
+
+    spec = loader.load(Path(__file__).resolve().parents[1] / "specs" / "paper004_five_bar.yaml").spec
+    model = registry.unbalanced_model(spec)
+    engine.clear_cache()
+    an = analyse(model, registry.time_grid(spec))
+    c = engine.compiled(model)
+    q = an.q.reshape(len(an.t), -1)
+    whole = jacobian(c, with_frame(q))[:, :, 3:]
+    expected = conditioning.peak(whole)
+    numbers = _condition(whole)
+    for chunk in (1, 7, 64, len(q) - 1, 10 * len(q)):
+        monkeypatch.setattr(conditioning, "CHUNK", chunk)
+        assert conditioning.motion_peak(c, q) == expected
+        assert np.array_equal(condition_numbers(c, q, chunk=chunk), numbers)

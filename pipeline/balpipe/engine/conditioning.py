@@ -37,29 +37,53 @@ STRIDE = 8
 ROUNDING = 1e-9
 #: below this many samples every SVD is computed
 SMALL = 4 * STRIDE
+#: samples whose Jacobians are held at once
+CHUNK = 2048
 
 
 def peak(J: np.ndarray) -> tuple[int, float]:
     """The first sample k of the largest 2-norm condition number of J (N, m, n), m >= n, and that
     number: ``k = argmax(cond)``, ``cond[k]`` with ``cond = positions._condition(J)``, the same
     floats."""
-    N = J.shape[0]
-    if N < SMALL or not np.all(np.isfinite(J)):
-        cond = _condition(J)
+    norm, steps = _norms_and_steps(J)
+    return _peak(len(J), lambda idx: J[idx], norm, steps)
+
+
+def _norms_and_steps(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """||J_k||_F (N,) and ||J_k+1 - J_k||_F (N - 1,)."""
+    D = np.diff(J, axis=0)
+    return np.sqrt(np.einsum("nij,nij->n", J, J)), np.sqrt(np.einsum("nij,nij->n", D, D))
+
+
+def _condition_of(get, idx: np.ndarray) -> np.ndarray:
+    """Condition numbers of the samples ``idx``, :data:`CHUNK` at a time (``get(idx)``: their J)."""
+    return np.concatenate([_condition(get(idx[a : a + CHUNK])) for a in range(0, len(idx), CHUNK)] or [np.zeros(0)])
+
+
+def _singular(get, idx: np.ndarray) -> np.ndarray:
+    """Singular values of the samples ``idx``, :data:`CHUNK` at a time."""
+    return np.concatenate([np.linalg.svd(get(idx[a : a + CHUNK]), compute_uv=False) for a in range(0, len(idx), CHUNK)])
+
+
+def _peak(N: int, get, norm: np.ndarray, steps: np.ndarray) -> tuple[int, float]:
+    """:func:`peak` from ``get(idx)`` (the Jacobians of the samples idx), their Frobenius norms
+    and the norms of the steps between consecutive samples. A Jacobian is finite exactly when
+    its norm is."""
+    every = np.arange(N)
+    if N < SMALL or not np.all(np.isfinite(norm)):
+        cond = _condition_of(get, every)
         k = int(np.argmax(cond))
         return k, float(cond[k])
     known = np.unique(np.r_[np.arange(0, N, STRIDE), N - 1])
-    s = np.linalg.svd(J[known], compute_uv=False)
+    s = _singular(get, known)
     smax, smin = np.full(N, np.nan), np.full(N, np.nan)
     smax[known], smin[known] = s[:, 0], s[:, -1]
     cond = np.full(N, -np.inf)
     cond[known] = condition_of(s)
     best = float(np.max(cond[known]))
-    norm = np.sqrt(np.einsum("nij,nij->n", J, J))
-    D = np.diff(J, axis=0)
-    path = np.concatenate([[0.0], np.cumsum(np.sqrt(np.einsum("nij,nij->n", D, D)))])  # arc length in ||.||_F
+    path = np.concatenate([[0.0], np.cumsum(steps)])  # arc length in ||.||_F
     slack = N * np.finfo(float).eps * path[-1]  # the rounding of the sums
-    after = np.searchsorted(known, np.arange(N))  # known[after] >= i
+    after = np.searchsorted(known, every)  # known[after] >= i
     upper = np.full(N, np.inf)
     for side in (known[np.maximum(after - 1, 0)], known[np.minimum(after, len(known) - 1)]):
         # ||J_i - J_j|| <= the path's length between them (the triangle inequality, step by step)
@@ -71,12 +95,24 @@ def peak(J: np.ndarray) -> tuple[int, float]:
     upper[known] = -np.inf
     rest = np.flatnonzero(~(upper * (1 + 1e-9) < best))
     if rest.size:
-        cond[rest] = _condition(J[rest])
+        cond[rest] = _condition_of(get, rest)
     k = int(np.argmax(cond))
     return k, float(cond[k])
 
 
 def motion_peak(c: Compiled, q: np.ndarray) -> tuple[int, float]:
     """:func:`peak` of Phi_q at positions q (N, 3 nb): the peak of
-    :func:`.positions.condition_numbers` ``(c, q)``."""
-    return peak(jacobian(c, with_frame(q))[:, :, 3:])
+    :func:`.positions.condition_numbers` ``(c, q)``. The Jacobians are formed :data:`CHUNK`
+    samples at a time (each sample's entries, norms and SVD do not depend on the others: the
+    same floats), so that the memory does not grow with the number of samples."""
+    def get(idx) -> np.ndarray:
+        return jacobian(c, with_frame(q[idx]))[:, :, 3:]
+
+    N = len(q)
+    norms, steps = [], []
+    for a in range(0, N, CHUNK):
+        lo = max(a - 1, 0)  # one sample of overlap: the step into this chunk
+        n_, s_ = _norms_and_steps(get(slice(lo, min(a + CHUNK, N))))
+        norms.append(n_[a - lo :])
+        steps.append(s_)
+    return _peak(N, get, np.concatenate(norms), np.concatenate(steps))

@@ -123,9 +123,12 @@ def _fail_position(c: Compiled, q: np.ndarray, t: float) -> AnalysisError:
     return err
 
 
-def condition_numbers(c: Compiled, q: np.ndarray) -> np.ndarray:
-    """2-norm condition numbers of Phi_q (N,) at positions q (N, 3 nb)."""
-    return _condition(jacobian(c, with_frame(q))[:, :, 3:])
+def condition_numbers(c: Compiled, q: np.ndarray, chunk: int = 2048) -> np.ndarray:
+    """2-norm condition numbers of Phi_q (N,) at positions q (N, 3 nb), ``chunk`` samples'
+    Jacobians at a time (each sample's number does not depend on the others)."""
+    if len(q) <= chunk:
+        return _condition(jacobian(c, with_frame(q))[:, :, 3:])
+    return np.concatenate([_condition(jacobian(c, with_frame(q[a : a + chunk]))[:, :, 3:]) for a in range(0, len(q), chunk)])
 
 
 def _condition(J: np.ndarray) -> np.ndarray:
