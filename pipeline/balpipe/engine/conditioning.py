@@ -38,7 +38,7 @@ ROUNDING = 1e-9
 #: below this many samples every SVD is computed
 SMALL = 4 * STRIDE
 #: samples whose Jacobians are held at once
-CHUNK = 2048
+CHUNK = 512
 
 
 def peak(J: np.ndarray) -> tuple[int, float]:

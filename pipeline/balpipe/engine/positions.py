@@ -123,7 +123,7 @@ def _fail_position(c: Compiled, q: np.ndarray, t: float) -> AnalysisError:
     return err
 
 
-def condition_numbers(c: Compiled, q: np.ndarray, chunk: int = 2048) -> np.ndarray:
+def condition_numbers(c: Compiled, q: np.ndarray, chunk: int = 512) -> np.ndarray:
     """2-norm condition numbers of Phi_q (N,) at positions q (N, 3 nb), ``chunk`` samples'
     Jacobians at a time (each sample's number does not depend on the others)."""
     if len(q) <= chunk:

@@ -397,24 +397,35 @@ def invert_blocks(dec: Decomposition, vals: np.ndarray) -> dict[int, np.ndarray]
         by_size.setdefault(diag.shape[0], []).append((b, diag))
     out: dict[int, np.ndarray] = {}
     N = vals.shape[1]
-    for k, group in by_size.items():
-        if len(group) == 1:
-            b, diag = group[0]
-            out[b] = inverse(vals[diag])
-            continue
-        slots = np.stack([diag for _, diag in group], axis=2)  # (k, k, blocks)
-        stacked = vals[slots].reshape(k, k, -1)  # samples of block 0, then block 1, ...
-        if N <= _LAPACK_SAMPLES or k >= 7:
-            try:
-                inv = np.linalg.inv(stacked.transpose(2, 0, 1)).transpose(1, 2, 0)
-            except np.linalg.LinAlgError:  # an exactly singular sample: each block alone, as inverse() does
-                out.update({b: inverse(vals[diag]) for b, diag in group})
-                continue
-        else:
-            inv = _gauss_jordan(stacked)
-        for i, (b, _) in enumerate(group):
-            out[b] = inv[:, :, i * N : (i + 1) * N]
+    per_call = max(1, _STACKED // max(N, 1))  # blocks per call: a bounded stack whatever N
+    for k, same in by_size.items():
+        for start in range(0, len(same), per_call):
+            _invert_group(vals, same[start : start + per_call], k, N, out)
     return out
+
+
+_STACKED = 65536  # block samples inverted in one call at most
+
+
+def _invert_group(vals: np.ndarray, group: list[tuple[int, np.ndarray]], k: int, N: int,
+                  out: dict[int, np.ndarray]) -> None:
+    """The inverses of ``group``'s k x k blocks (index, slots), in one call, into ``out``."""
+    if len(group) == 1:
+        b, diag = group[0]
+        out[b] = inverse(vals[diag])
+        return
+    slots = np.stack([diag for _, diag in group], axis=2)  # (k, k, blocks)
+    stacked = vals[slots].reshape(k, k, -1)  # samples of block 0, then block 1, ...
+    if N <= _LAPACK_SAMPLES or k >= 7:
+        try:
+            inv = np.linalg.inv(stacked.transpose(2, 0, 1)).transpose(1, 2, 0)
+        except np.linalg.LinAlgError:  # an exactly singular sample: each block alone, as inverse() does
+            out.update({b: inverse(vals[diag]) for b, diag in group})
+            return
+    else:
+        inv = _gauss_jordan(stacked)
+    for i, (b, _) in enumerate(group):
+        out[b] = inv[:, :, i * N : (i + 1) * N]
 
 
 def block_sigma_min(dec: Decomposition, vals: np.ndarray, inverses: dict[int, np.ndarray]) -> np.ndarray:
