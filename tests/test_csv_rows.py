@@ -30,3 +30,22 @@ def test_one_row_one_column_and_no_rows():
     assert csv_rows([np.array([2.5])]) == "2.5\n"
     assert csv_rows([np.array([]), np.array([])]) == ""
     assert csv_rows([]) == ""
+
+
+def test_the_file_written_by_pieces_is_the_whole_text(rng, tmp_path, monkeypatch):
+    """The time-series file is written ROWS rows at a time (never whole in memory): the same
+    bytes as the whole text, for pieces that cut the rows anywhere, through the build's writer."""
+    from balpipe.report.results import CsvFile
+    from balpipe.runtime.fsutil import write_new
+
+    n = 53
+    a, b = rng.normal(size=n), rng.normal(size=n) * 1e-9
+    columns = [np.arange(n) * 0.01, a, b, a.copy(), -b]
+    whole = "t,a,b,a2,mb\n" + csv_rows(columns)
+    for rows in (1, 7, 52, 53, 1000):
+        monkeypatch.setattr(CsvFile, "ROWS", rows)
+        f = CsvFile("t,a,b,a2,mb", columns)
+        assert f.text() == whole
+        path = tmp_path / f"ts{rows}.csv"
+        write_new(path, f)
+        assert path.read_bytes() == whole.encode("utf-8")

@@ -64,9 +64,9 @@ def results_dict(*args, **kwargs) -> dict:
     return f(*args, **kwargs)
 
 
-def timeseries_csv(*args, **kwargs) -> str:
-    """:func:`balpipe.report.results.timeseries_csv`."""
-    from .report.results import timeseries_csv as f
+def timeseries_file(*args, **kwargs) -> Any:
+    """:func:`balpipe.report.results.timeseries_file` (written by pieces)."""
+    from .report.results import timeseries_file as f
     return f(*args, **kwargs)
 
 
@@ -197,7 +197,7 @@ class Computed:
     status: str  # "ok", "failed", "error", "crash"
     message: str = ""
     results: dict | None = None
-    files: dict[str, str] | None = None
+    files: dict[str, Any] | None = None  # text, bytes, or content written by pieces (fsutil.Streamed)
     seconds: float = 0.0
 
 
@@ -371,9 +371,10 @@ def page_results(loaded, st, input_hash: str) -> dict:
 
 
 def page_files(loaded, st, results: dict, history: dict | None = None,
-               history_files: dict[str, str] | None = None) -> dict[str, str]:
+               history_files: dict[str, str] | None = None) -> dict[str, Any]:
     """The files of a study's page folder, by name: ``index.html`` (the page, with the spec's
-    text and its ``history``), ``results.json`` (``results``), ``timeseries.csv``, with the
+    text and its ``history``), ``results.json`` (``results``), ``timeseries.csv`` (written by
+    pieces: :class:`balpipe.report.results.CsvFile`), with the
     simulation the wall times of its runs (``timing.json``, ``timing.js``), and the history's
     files. ``balpipe build`` and :meth:`balpipe.Study.write` both write these."""
     extra: dict[str, str] = {}
@@ -386,7 +387,7 @@ def page_files(loaded, st, results: dict, history: dict | None = None,
     return {
         "index.html": render_page(st, results, loaded.text, history=history),
         "results.json": dumps(results),
-        "timeseries.csv": timeseries_csv(st),
+        "timeseries.csv": timeseries_file(st),
         **extra,
         **(history_files or {}),
     }

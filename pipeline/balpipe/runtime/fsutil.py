@@ -9,6 +9,7 @@ import os
 import secrets
 import shutil
 from pathlib import Path
+from typing import BinaryIO, Protocol
 
 #: what to do about an OS error, by its errno
 _REMEDIES = {
@@ -42,16 +43,27 @@ def tmp_name(name: str) -> str:
     return f".{name[:100]}{TMP_MARK}{os.getpid()}-{secrets.token_hex(4)}"
 
 
-def write_new(path: Path, content: str | bytes) -> None:
+def write_new(path: Path, content: "str | bytes | Streamed") -> None:
     """Create ``path`` (it must not exist: never writes through a planted symlink) with
-    ``content`` (text as UTF-8, or bytes); mode from the umask."""
+    ``content`` (text as UTF-8, bytes, or a :class:`Streamed` that writes itself piece by piece,
+    never whole in memory); mode from the umask."""
     fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0), 0o666)
+    if hasattr(content, "write_to"):
+        with os.fdopen(fd, "wb") as fb:
+            content.write_to(fb)
+        return
     if isinstance(content, bytes):
         with os.fdopen(fd, "wb") as fb:
             fb.write(content)
         return
     with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
         f.write(content)
+
+
+class Streamed(Protocol):
+    """File content written by pieces: ``write_to(f)`` writes it to the binary file ``f``."""
+
+    def write_to(self, f: BinaryIO) -> None: ...
 
 
 def remove_path(path: Path) -> None:
@@ -75,7 +87,7 @@ def write_file_atomic(path: Path, content: str | bytes) -> None:
         raise
 
 
-def write_atomic_dir(target: Path, files: dict[str, str]) -> None:
+def write_atomic_dir(target: Path, files: "dict[str, str | bytes | Streamed]") -> None:
     """Write a page folder next to ``target`` and move it into place when complete. Modes follow
     the umask (os.mkdir(0o777)), not tempfile's 0700. An :class:`OSError` before the move leaves
     ``target`` as it was; :class:`LeftBehind` after it: the new folder is in place, the earlier
