@@ -58,3 +58,15 @@ def test_sign_combinations_fewest_reversals_first():
     assert combos == [(1.0, 2.0), (-1.0, -2.0), (1.0, -2.0)]
     assert GS.working_ratios([1.0] * (GS.MAX_DISCS + 1), lambda r: True) is None
     assert GS.named(["a", "b"], [-1, 2.5]) == "a: -1, b: +2.5"
+
+
+def test_gear_signs_find_balances_with_the_signs_it_found():
+    """gear_signs: find: the Watt-II with every disc at +1 builds, force and moment cancelled, and
+    the notes and parameters name the signs used."""
+    d = watt_six_bar([1, 1, 1, 1, 1])
+    d["balancing"]["gear_signs"] = "find"
+    res = registry.balance(Spec.model_validate(d))
+    assert res.stages[-1].balances == "force+moment"
+    assert res.notes[0].startswith("Gear signs found (gear_signs: find): d_crank: -1, d_c1: -1, d_r4: +1, d_c2: +1, d_r6: -1")
+    discs = res.details["moment_balance"]["discs"]
+    assert [x["ratio"] for x in discs] == [-1, -1, 1, 1, -1] and all(x["inertia"] >= 0 for x in discs)

@@ -116,12 +116,33 @@ def balance(ctx: BalanceContext) -> BalanceResult:
         if found is None:
             raise SpecFieldError(exc.path, exc.message.split(": reverse")[0] + "; no other signs of the ratios "
                                  "cancel the moment either (other carriers, gear targets or ratios may)") from None
+        if method.gear_signs == "find":
+            return _found(ctx, found)
         raise SpecFieldError(("balancing", "counter_rotations"), f"{exc.message.split(': reverse')[0]} with these "
-                             f"ratios; the ratios {_named(method, found)} cancel the moment: set them") from None
+                             f"ratios; the ratios {_named(method, found)} cancel the moment: set them "
+                             "(or gear_signs: find)") from None
     if result.stages[-1].balances != "force+moment":
         found = _working(ctx)
+        if found is not None and method.gear_signs == "find":
+            return _found(ctx, found)
         if found is not None:
             result.notes.insert(0, f"The gear ratios {_named(method, found)} cancel the moment (these do not): set them.")
+    return result
+
+
+def _with_ratios(ctx: BalanceContext, ratios) -> BalanceContext:
+    method: MomentBalance = ctx.balancing
+    discs = [s.model_copy(update={"ratio": r}) for s, r in zip(method.counter_rotations, ratios)]
+    return replace(ctx, balancing=method.model_copy(update={"counter_rotations": discs}))
+
+
+def _found(ctx: BalanceContext, ratios) -> BalanceResult:
+    """The balance with the gear signs found (``gear_signs: find``), saying which they are."""
+    method: MomentBalance = ctx.balancing
+    result = _balance(_with_ratios(ctx, ratios))
+    given = ", ".join(f"{s.ratio:+g}" for s in method.counter_rotations)
+    result.notes.insert(0, f"Gear signs found (gear_signs: find): {_named(method, ratios)}; the spec's ({given}) "
+                        "could not cancel the moment.")
     return result
 
 
@@ -134,9 +155,8 @@ def _working(ctx: BalanceContext):
     method: MomentBalance = ctx.balancing
 
     def cancels(ratios) -> bool:
-        discs = [s.model_copy(update={"ratio": r}) for s, r in zip(method.counter_rotations, ratios)]
         try:
-            out = _balance(replace(ctx, balancing=method.model_copy(update={"counter_rotations": discs})))
+            out = _balance(_with_ratios(ctx, ratios))
         except SpecFieldError:
             return False
         return out.stages[-1].balances == "force+moment"

@@ -86,6 +86,10 @@ class MomentBalance(FinderSettings):
         [], description="where counterweights may go; empty: the mechanism must be force balanced already"
     )
     counter_rotations: list[CounterRotationSpec] = Field(min_length=1, description="the counter-rotating discs")
+    gear_signs: Literal["given", "find"] = Field(
+        "given", description="given: the ratios as written (where they cannot cancel the moment the error names "
+        "signs that do); find: where they cannot, the method uses the first sign combination that does (fewest "
+        "reversals first) and says so")
 
 
 class PartSpec(Strict):
