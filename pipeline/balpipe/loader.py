@@ -128,11 +128,14 @@ def clean_loc(loc: tuple, data: Any) -> tuple:
     discriminated unions (a template's or method's name) and validator names ('function-after[...]')."""
     out: list = []
     cur = data
-    for part in loc:
+    for k, part in enumerate(loc):
         in_document = isinstance(cur, dict) and part in cur
         if isinstance(part, str) and ("[" in part or part.startswith("function-")) and not in_document:
             continue
-        if isinstance(cur, dict) and part not in cur and any(cur.get(d) == part for d in _DISCRIMINATORS):
+        tag = isinstance(cur, dict) and any(cur.get(d) == part for d in _DISCRIMINATORS)
+        # a tag that is also a key of the mapping (method: stages, with its stages: list) is the
+        # tag when the next part of the location is a key of the same mapping
+        if tag and (part not in cur or (k + 1 < len(loc) and loc[k + 1] in cur)):
             continue
         out.append(part)
         if isinstance(cur, dict):

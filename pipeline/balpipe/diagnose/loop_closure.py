@@ -75,6 +75,12 @@ def _dyad_message(model: Model, d: dyads.Dyad, dist: float, t: float) -> tuple[t
         have = {long_: ll, short: ls}
     else:
         return None
+    zero = [b for b in have if have[b] <= 0.0]
+    if zero:  # a link of zero length (its two joints at one point): that is the one to fix
+        blame = zero[0]
+        end = d.end_i.name if blame == d.body_i else d.end_j.name
+        return _length_field(model, blame, d), (f"{text}; {blame} has zero length: its joints {end} and "
+                                                f"{d.middle.name} are at one point, give them distinct points")
     blame = min(need, key=lambda b: abs(math.log(need[b] / have[b])) if need[b] > 0 else math.inf)
     return _length_field(model, blame, d), text
 

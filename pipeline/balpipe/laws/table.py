@@ -103,6 +103,10 @@ def parse_table(text: str, dimension: str, time_column: str | None = None,
                              f"(the row has {len(cells)} cell(s))", row) from None
         if not (np.isfinite(tv) and np.isfinite(qv)):
             raise TableError("not a finite number", row)
+        for x, f, dim, col in ((tv, factors[0], "time", it), (qv, factors[1], dimension, iv)):
+            if abs(x * f) > units.MAX_ABS[dim]:  # the spec's own limits (docs/limits.md), here not blamed on a joint
+                raise TableError(f"column {_name(header[col])!r}: out of range: |{x * f:.4g}| {units.SI[dim]} exceeds "
+                                 f"the limit {units.MAX_ABS[dim]:g} {units.SI[dim]}", row)
         if ts and not tv * factors[0] > ts[-1] and argument != "time":
             raise TableError(f"the {argument} column must increase: {tv:g} after {ts[-1] / factors[0]:g} on row {rows[-1]}", row)
         if ts and not tv * factors[0] > ts[-1]:

@@ -161,6 +161,8 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
     joints = []
     for k, j in enumerate(mech.joints):
         jp = root + ("joints", k)
+        if any(o.name == j.name for o in mech.joints[:k]):
+            raise SpecFieldError(jp + ("name",), f"joint name {j.name!r} is used twice (each joint needs its own name)")
         if isinstance(j, RevoluteSpec):
             check_body(j.a, jp + ("a",))
             check_body(j.b, jp + ("b",))
@@ -179,6 +181,8 @@ def build(mech: CustomMechanism, laws: dict, t: np.ndarray) -> Model:
     drivers = []
     for k, d in enumerate(mech.drivers):
         dp = root + ("drivers", k)
+        if any(o.name == d.name for o in mech.drivers[:k]):
+            raise SpecFieldError(dp + ("name",), f"driver name {d.name!r} is used twice (each driver needs its own name)")
         if d.joint is not None:
             if d.joint not in jnames:
                 raise SpecFieldError(dp + ("joint",), f"unknown joint {d.joint!r}")

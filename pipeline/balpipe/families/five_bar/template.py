@@ -41,6 +41,7 @@ from ...mechanics.meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
 from ...mechanics.planar import bar_body, cross, wrap_angle, world_point
 from ...model import FRAME, Attachment, Body, Driver, Gear, Law, Model, Revolute
 from ...motion import law_for
+from ...laws.paths import PathComponent
 from ...spec_parts import LinkSpec, SpecFieldError, Strict
 from ...units import Inertia, Length, Mass, PositiveLength, Sign
 
@@ -371,7 +372,7 @@ def build(mech: FiveBarMechanism, laws: dict, t: np.ndarray) -> Model:
     else:
         lx, ly = laws["gripper_x"], laws["gripper_y"]
         C = np.stack([lx(t)[0], ly(t)[0]], axis=1)
-        _check_straight_path(mech, C, t)
+        _check_gripper_path(mech, C, t, isinstance(lx, PathComponent))
         C0 = (float(C[0, 0]), float(C[0, 1]))
         th1, th2 = inverse_kinematics(mech, C0, GRIPPER_PATH + ("from",))
         extra_links = ((), ())
@@ -424,9 +425,11 @@ def build(mech: FiveBarMechanism, laws: dict, t: np.ndarray) -> Model:
     return actuation.with_actuators(model, motors, ("mechanism", "actuators"))
 
 
-def _check_straight_path(mech: FiveBarMechanism, C: np.ndarray, t: np.ndarray) -> None:
-    """Plain 5R: every point of the segment reachable in the same working modes, and the distal
-    links never aligned."""
+def _check_gripper_path(mech: FiveBarMechanism, C: np.ndarray, t: np.ndarray, on_path: bool = False) -> None:
+    """Plain 5R: every point of the gripper's path reachable in the same working modes, and the
+    distal links never aligned. ``on_path``: the drive is ``law: path`` (a problem is located at
+    its ``path`` field), else a point-to-point drive (a straight path, located at its ``to``)."""
+    where, what = (GRIPPER_PATH + ("path",), "the path") if on_path else (GRIPPER_PATH + ("to",), "the straight path")
     A = (mech.pivots.A1, mech.pivots.A2)
     th = []
     for j, ((lp, ld), Aj, sigma) in enumerate(zip(mech.legs(), A, mech.working_modes), start=1):
@@ -435,8 +438,8 @@ def _check_straight_path(mech: FiveBarMechanism, C: np.ndarray, t: np.ndarray) -
         if np.any(margin <= 1e-9 * (lp.length + ld.length)):
             k = int(np.argmin(margin))
             raise SpecFieldError(
-                GRIPPER_PATH + ("to",),
-                f"the straight path leaves the workspace at t = {t[k]:.4g} s, ({C[k, 0]:.4g}, "
+                where,
+                f"{what} leaves the workspace at t = {t[k]:.4g} s, ({C[k, 0]:.4g}, "
                 f"{C[k, 1]:.4g}): {reach_message(j, Aj, lp.length, ld.length, C[k], sigma) or f'leg {j} is stretched or folded (singular)'}",
             )
         th.append(inverse_leg(Aj, lp.length, ld.length, C, sigma))
@@ -446,8 +449,8 @@ def _check_straight_path(mech: FiveBarMechanism, C: np.ndarray, t: np.ndarray) -
     if np.any(np.sign(side) != np.sign(side[0])) or np.any(side == 0):
         k = int(np.argmax(np.sign(side) != np.sign(side[0])))
         raise SpecFieldError(
-            GRIPPER_PATH + ("to",),
-            f"the straight path crosses a parallel singularity (B1, C, B2 aligned) near t = {t[k]:.4g} s",
+            where,
+            f"{what} crosses a parallel singularity (B1, C, B2 aligned) near t = {t[k]:.4g} s",
         )
 
 
