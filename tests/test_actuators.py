@@ -221,7 +221,7 @@ def test_3rrr_redundant_actuation_is_minimum_norm(seed):
     s, model = model_of(spec)
     t = registry.time_grid(s)
     an = analyse(model, t)
-    assert an.extra["redundant_actuators"] == 1
+    assert an.redundant_actuators == 1
     ref = rrr3_reference(spec, t, acts)  # np.linalg.lstsq of G^T tau = f: the minimum-norm tau
     assert _agree(an.efforts, ref) < 1e-9
     # and it is not the non-redundant solution: B1 takes a share

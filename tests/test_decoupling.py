@@ -80,7 +80,7 @@ def test_closed_form_mass_matrix_equals_the_engines(paper):
     spec, st, p = paper
     unb = st.stages[0]
     names, M = mass_matrix(unb.stage.model, unb.analysis.t)
-    q2 = unb.analysis.extra["frame_pose"][:, 1, 2] - unb.analysis.extra["frame_pose"][:, 0, 2]
+    q2 = unb.analysis.frame_pose[:, 1, 2] - unb.analysis.frame_pose[:, 0, 2]
     closed = mass_matrix_2r(unb.stage.model, spec.mechanism.links[0].length, None).values(q2)
     assert names == ["q1", "q2"]
     assert np.max(np.abs(M - closed)) <= 1e-12 * np.max(np.abs(M))
@@ -166,7 +166,7 @@ def test_the_methods_figures_come_from_the_study_not_a_closure(paper):
     fig2 = figs["Fig. 2 of paper 002: shaking force and shaking moment of the unbalanced manipulator"]
     an = st.unbalanced.analysis
     if spec.analysis.gravity:
-        w = an.extra["total_mass"] * float(np.hypot(*an.gravity))
+        w = an.total_mass * float(np.hypot(*an.gravity))
         assert f"weight m g = {w:.4g} N" in fig2[1] and f"peaks at {an.max_inertial_force:.4g} N" in fig2[1]
         assert an.max_force > an.max_inertial_force
     else:

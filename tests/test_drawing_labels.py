@@ -75,7 +75,7 @@ def test_gear_numbers_from_names_else_in_model_order():
 def test_names_on_the_papers_drawings_never_overlap(studies, name):
     st = studies(name)
     shown = page.shown_stages(st)
-    limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown])
+    limits = figures.common_limits([(s.stage.model, s.analysis.frame_pose) for s in shown])
     numbers = labels.gear_numbers([s.stage.model for s in shown])
     for s in shown:
         canvas, placed = figures.mechanism_drawing(s.stage.model, s.analysis, page.drawn_instants(st), s.stage.label,
@@ -146,7 +146,7 @@ def _stages(st, moving_base: bool):
     out = []
     for s in st.stages:
         t = s.analysis.t
-        poses = np.array(s.analysis.extra["frame_pose"], dtype=float)
+        poses = np.array(s.analysis.frame_pose, dtype=float)
         base = np.zeros((len(t), 3))
         if moving_base:  # the frame drifts and turns: the bodies move with it
             u = np.linspace(0, 1, len(t))

@@ -91,7 +91,7 @@ def test_every_3rpr_leg_is_one_piece_from_base_pivot_to_platform_at_every_sample
     st = studies(name)
     for s in page.shown_stages(st):
         m = s.stage.model
-        poses = s.analysis.extra["frame_pose"]
+        poses = s.analysis.frame_pose
         idx = {b.name: i for i, b in enumerate(m.bodies)}
         assert len(sleeves.pairs(m)) == 3
         assert sleeves.guided_sliders(m) == {"piston1", "piston2", "piston3"}
@@ -168,7 +168,7 @@ def test_the_player_draws_the_same_connected_legs(studies):
 
     st = studies("paper000_rpr3_idler_loop.yaml")
     s = st.stages[0]
-    poses = np.asarray(s.analysis.extra["frame_pose"], dtype=float)
+    poses = np.asarray(s.analysis.frame_pose, dtype=float)
     d = player.player_data([{"label": "x", "model": s.stage.model, "t": s.analysis.t,
                              "base": np.zeros((len(poses), 3)), "poses": poses}])["stages"][0]
     assert len(d["sleeves"]) == len(d["poses"]) and all(len(f) == 3 for f in d["sleeves"])
@@ -207,7 +207,7 @@ def test_every_named_point_is_named_once_and_repeated_names_are_left_off(studies
         assert {"A1", "A2", "A3", "C1", "C2", "C3"} <= set(texts)
         assert "tip" not in texts and "B" not in texts
         assert all(n == 1 for n in texts.values()), texts
-        poses = np.asarray(s.analysis.extra["frame_pose"], dtype=float)
+        poses = np.asarray(s.analysis.frame_pose, dtype=float)
         d = player.player_data([{"label": "x", "model": s.stage.model, "t": s.analysis.t,
                                  "base": np.zeros((len(poses), 3)), "poses": poses}])["stages"][0]
         names = {j[3] for j in d["names"]["joints"]}

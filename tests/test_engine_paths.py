@@ -65,7 +65,7 @@ def _arrays(an) -> dict[str, np.ndarray]:
                                         "com", "momentum", "angular_momentum")}
     out.update({f"effort {k}": v for k, v in an.efforts.items()})
     out.update({f"reaction {j}.{k}": v for j, d in an.reactions.items() for k, v in d.items()})
-    out["frame_pose"] = an.extra["frame_pose"]
+    out["frame_pose"] = an.frame_pose
     return out
 
 
@@ -98,9 +98,9 @@ def test_block_path_equals_dense_path(case, balanced):
         for k in b:
             err = float(np.abs(a[k] - b[k]).max())
             assert err <= 1e-10 * scale[k], f"{case}/{stage.name}: {k} differs by {err:.3g} (scale {scale[k]:.3g})"
-        cond_a, cond_b = fast.extra["condition"], dense.extra["condition"]
+        cond_a, cond_b = fast.condition, dense.condition
         assert np.allclose(cond_a, cond_b, rtol=1e-6), f"{case}/{stage.name}: condition numbers differ"
-        assert fast.extra["redundant_actuators"] == dense.extra["redundant_actuators"]
+        assert fast.redundant_actuators == dense.redundant_actuators
 
 
 @pytest.mark.parametrize("case", [k for k, (_, kind) in CASES.items() if kind != "dense"])
@@ -178,10 +178,10 @@ def test_the_condition_numbers_are_computed_when_read_and_pickled():
     spec, stages = _stages(CASES["slider-crank"][0])
     t = registry.time_grid(spec)
     an = analyse(stages[0].model, t)
-    assert "condition" in an.extra and an.extra.get("condition") is not None
+    assert an.condition is not None
     again = pickle.loads(pickle.dumps(an))
-    assert type(again.extra) is dict
-    assert np.array_equal(again.extra["condition"], an.extra["condition"])
+    assert again._motion is None and again._condition is not None  # pickled with them, without the compiled model
+    assert np.array_equal(again.condition, an.condition)
 
 
 def test_unknown_method_is_refused():

@@ -73,11 +73,11 @@ def test_dense_path_condition_numbers_are_computed_when_read_and_unchanged():
     an = analyse(model, t, method="dense")
     c = compile_model(model)
     assert c.condition is None  # shown regular: no SVD yet
-    assert "condition" in an.extra and dict.get(an.extra, "condition") is None
+    assert an._condition is None  # computed when read
     exact = _condition(jacobian(c, with_frame(an.q.reshape(len(t), -1)))[:, :, 3:])
-    assert an.extra["condition"].tobytes() == exact.tobytes()
+    assert an.condition.tobytes() == exact.tobytes()
     fast = analyse(model, t)  # the block path's, also computed when read
-    assert np.allclose(fast.extra["condition"], exact, rtol=1e-6)
+    assert np.allclose(fast.condition, exact, rtol=1e-6)
 
 
 def test_a_singular_sample_is_reported_as_without_the_screen(monkeypatch):

@@ -55,7 +55,7 @@ def test_stages_share_one_frame_motion_and_agree_with_their_own_continuation(rrr
         assert np.abs(a.moment - b.moment).max() <= 1e-9 * np.abs(b.moment).max(), s.name
         for name in b.efforts:
             assert np.abs(a.efforts[name] - b.efforts[name]).max() <= 1e-9 * np.abs(b.efforts[name]).max()
-        assert a.extra["condition"] == pytest.approx(b.extra["condition"], rel=1e-6)
+        assert a.condition == pytest.approx(b.condition, rel=1e-6)
 
 
 def test_a_stage_gets_the_same_bits_whatever_ran_before(rrr4):

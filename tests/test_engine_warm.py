@@ -215,12 +215,12 @@ def test_a_design_on_the_other_branch_falls_back_to_the_continuation():
     ref = _cold(other, t, g, mp)
     anchors = _anchors(stages[:1], t, g, mp)
     [(_, anchor)] = next(iter(anchors.designs.values()))
-    assert np.abs(ref.extra["frame_pose"][:, 2, 2] - anchor[:, 8]).min() > 0.5  # really another branch
+    assert np.abs(ref.frame_pose[:, 2, 2] - anchor[:, 8]).min() > 0.5  # really another branch
     # what an unguarded warm start would give: the anchor's branch
     fc = fastpath._frame_compiled(engine.compiled(other))
     f = fastpath.law_table(fc.fast.vz, t)[0]
     unguarded = warmstart.newton(fc, fc.fast.vz, fc.fast.dec, anchor, t, f)
-    assert unguarded is not None and np.abs(unguarded[:, 8] - ref.extra["frame_pose"][:, 2, 2]).max() > 0.5
+    assert unguarded is not None and np.abs(unguarded[:, 8] - ref.frame_pose[:, 2, 2]).max() > 0.5
     _assert_rejected(other, anchors, t, g, mp, ref, "flipped four-bar")
 
 

@@ -188,9 +188,9 @@ def test_transmission_angle_is_the_law_of_cosines():
     an, model = st.stages[0].analysis, st.stages[0].stage.model
     c = compile_model(model)
     (d,) = [b.dyad for b in dyads.blocks(c, an.q.reshape(len(an.t), -1)[0]) if b.dyad is not None]
-    poses = {n: an.extra["frame_pose"][:, k] for k, n in enumerate(an.names)}
+    poses = {n: an.frame_pose[:, k] for k, n in enumerate(an.names)}
     Ei, Ej = dyads.end_points(model, d, poses)
-    x = an.extra["frame_pose"][:, an.names.index("slider"), 0]
+    x = an.frame_pose[:, an.names.index("slider"), 0]
     cos_mu = (0.1**2 + 0.3**2 - x**2) / (2 * 0.1 * 0.3)
     mu = np.arccos(cos_mu)
     assert np.allclose(dyads.transmission_angle(d, Ei, Ej), np.minimum(mu, np.pi - mu), atol=1e-9)

@@ -73,7 +73,7 @@ def test_tooth_forces_leave_the_five_bar_shaking_loads_efforts_and_torques_uncha
 
 def _centre(an, body: str) -> np.ndarray:
     """Global position (N, 2) of a body frame's origin (every gear's centre in the five-bar)."""
-    return an.extra["frame_pose"][:, an.names.index(body), :2]
+    return an.frame_pose[:, an.names.index(body), :2]
 
 
 def _tooth_force_on_b(an, mesh: str, a: str, b: str, r_b: float) -> np.ndarray:
@@ -253,7 +253,7 @@ def test_random_geared_models_keep_their_dynamics_and_every_gear_obeys_newton(se
 
 
 def _point(an, model: Model, body: str, p) -> np.ndarray:
-    pose = an.extra["frame_pose"][:, an.names.index(body)]
+    pose = an.frame_pose[:, an.names.index(body)]
     c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
     return np.stack([pose[:, 0] + c * p[0] - s * p[1], pose[:, 1] + s * p[0] + c * p[1]], axis=1)
 

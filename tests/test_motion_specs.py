@@ -68,7 +68,7 @@ def test_constant_speed_over_cycles_sets_the_duration(tmp_path):
     assert qd[0] == pytest.approx(4 * math.pi) and qdd[0] == 0  # moving at t = 0: steady state
     assert q[1] - q[0] == pytest.approx(6 * math.pi)
     study = run(spec)  # the engine turns the crank three times
-    th = study.unbalanced.analysis.extra["frame_pose"][:, study.unbalanced.analysis.names.index("crank"), 2]
+    th = study.unbalanced.analysis.frame_pose[:, study.unbalanced.analysis.names.index("crank"), 2]
     assert th[-1] - th[0] == pytest.approx(6 * math.pi)
 
 
@@ -208,7 +208,7 @@ def test_path_components_of_a_custom_point(tmp_path):
     study = run(spec)
     an = study.unbalanced.analysis
     k = an.names.index("l2")
-    pose = an.extra["frame_pose"][:, k]
+    pose = an.frame_pose[:, k]
     tip = pose[:, :2] + 0.25 * np.stack([np.cos(pose[:, 2]), np.sin(pose[:, 2])], axis=1)
     assert tip[0] == pytest.approx([0.2, 0.3], abs=1e-9) and tip[-1] == pytest.approx([0.35, 0.15], abs=1e-9)
     # the corner is cut by the fillet: the tip never reaches (0.35, 0.3)
@@ -245,7 +245,7 @@ def test_a_path_on_the_3rpr_platform_pose(tmp_path):
     p.write_text(yaml.safe_dump(data))
     study = run(load(p).spec)
     an = study.unbalanced.analysis
-    pose = an.extra["frame_pose"][:, an.names.index("platform")]
+    pose = an.frame_pose[:, an.names.index("platform")]
     assert pose[0, :2] == pytest.approx([-0.1, -0.05], abs=1e-9) and pose[-1, :2] == pytest.approx([-0.05, 0.0], abs=1e-9)
     # heading: tangent of a counter-clockwise arc at angle a is a + 90 deg, plus the -80 deg offset
     assert pose[0, 2] == pytest.approx(math.radians(-90 + 90 - 80)) and pose[-1, 2] == pytest.approx(math.radians(0 + 90 - 80))
@@ -296,7 +296,7 @@ def test_a_serial_arms_tip_on_a_circle(tmp_path):
     spec = load(p).spec
     assert spec.motion.duration == pytest.approx(2 * math.pi * 0.08 / 0.5)
     an = run(spec).unbalanced.analysis
-    pose = an.extra["frame_pose"][:, an.names.index("link2")]
+    pose = an.frame_pose[:, an.names.index("link2")]
     tip = pose[:, :2] + 0.30 * np.stack([np.cos(pose[:, 2]), np.sin(pose[:, 2])], axis=1)
     assert np.allclose(np.hypot(tip[:, 0] - 0.3, tip[:, 1] - 0.25), 0.08, atol=1e-9)
     assert tip[0] == pytest.approx([0.38, 0.25], abs=1e-9) and tip[-1] == pytest.approx([0.38, 0.25], abs=1e-9)

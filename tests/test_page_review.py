@@ -274,7 +274,7 @@ def test_player_writes_no_negative_zero():
         pytest.skip("node is not installed")
     st = study_mod.run(loader.load(SPECS / "scott_russell.yaml").spec)
     stages = [{"label": s.stage.label, "model": s.stage.model, "t": s.analysis.t, "base": np.zeros((len(s.analysis.t), 3)),
-               "poses": np.asarray(s.analysis.extra["frame_pose"])} for s in st.stages]
+               "poses": np.asarray(s.analysis.frame_pose)} for s in st.stages]
     html = player.player_html(stages)
     fn = re.search(r"^function fixed\(v, d\) \{.*?\}  // no \"-0.000\"$", html, re.M)
     assert fn, "fixed() not in the player"

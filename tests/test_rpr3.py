@@ -188,12 +188,12 @@ def _leg_jacobian_by_hand(spec: Spec, an) -> np.ndarray:
     """Rows [u_i, (C_i - P) x u_i] (prismatic) or [n_i, (C_i - P) x n_i] / rho_i (revolute),
     from the analysed poses of the cylinders and the platform."""
     k = an.names.index("platform")
-    P, phi = an.extra["frame_pose"][:, k, :2], an.extra["frame_pose"][:, k, 2]
+    P, phi = an.frame_pose[:, k, :2], an.frame_pose[:, k, 2]
     c = rpr3.platform_points(spec.mechanism.platform_radius)
     A = rpr3.base_points(spec.mechanism.base_radius)
     rows = []
     for i in range(3):
-        th = an.extra["frame_pose"][:, an.names.index(f"cyl{i + 1}"), 2]
+        th = an.frame_pose[:, an.names.index(f"cyl{i + 1}"), 2]
         u = np.stack([np.cos(th), np.sin(th)], axis=1)
         rc = np.stack([np.cos(phi) * c[i, 0] - np.sin(phi) * c[i, 1], np.sin(phi) * c[i, 0] + np.cos(phi) * c[i, 1]], 1)
         rho = np.linalg.norm(P + rc - A[i], axis=1)

@@ -100,7 +100,7 @@ def regular_random(seed: int, **kw) -> tuple[dict, Spec, Model]:
             an = analyse(model, registry.time_grid(spec))
         except (SpecFieldError, SpecErrors, AnalysisError):
             continue
-        if an.extra["condition"].max() < 300:
+        if an.condition.max() < 300:
             return data, spec, model
     raise AssertionError("no regular random design found")
 
@@ -149,7 +149,7 @@ def test_redundant_efforts_are_the_pseudo_inverse_solution(seed):
     t = registry.time_grid(spec)
     red = analyse(model, t, gravity=(0.0, -9.81), moment_point=(0.02, -0.01))
     sq = analyse(platform_driven(model), t, gravity=(0.0, -9.81), moment_point=(0.02, -0.01))
-    assert red.extra["redundant_actuators"] == 1 and sq.extra["redundant_actuators"] == 0
+    assert red.redundant_actuators == 1 and sq.redundant_actuators == 0
     f = np.stack([sq.efforts["x"], sq.efforts["y"], sq.efforts["angle"]], axis=1)
     G = actuated_jacobian(spec, model, t)
     tau = np.stack([red.efforts[f"A{i}"] for i in (1, 2, 3, 4)], axis=1)
@@ -303,7 +303,7 @@ def test_fewer_legs_analyse_and_balance_leg_by_leg(keep, actuators, com):
     assert st.ok, st.problems
     assert [s.stage.name for s in st.stages] == ["unbalanced", "leg_by_leg", "least_mass"]
     assert st.stages[1].analysis.max_inertial_force <= 1e-9 * st.stages[0].analysis.max_inertial_force
-    assert st.stages[0].analysis.extra["redundant_actuators"] == 0
+    assert st.stages[0].analysis.redundant_actuators == 0
     assert st.stages[0].stage.model.name == f"{len(keep)}-RRR"
 
 

@@ -91,7 +91,7 @@ def test_task_space_laws_are_exact(rng):
         an = analyse(model, t)
         k = an.names.index(f"link{n}")
         L = model.body(f"link{n}").point("tip")[0]
-        pose = an.extra["frame_pose"][:, k]
+        pose = an.frame_pose[:, k]
         tip = pose[:, :2] + L * np.stack([np.cos(pose[:, 2]), np.sin(pose[:, 2])], axis=1)
         law = quintic(t / t[-1])[0]
         start, end = np.array(spec.motion.drive["tip"].start[:2]), np.array(spec.motion.drive["tip"].end[:2])

@@ -279,7 +279,7 @@ def near_singular_note(stages: list[StageResult], balance: BalanceResult, proble
     path has not computed them all); above
     :data:`NEAR_SINGULAR`, a note of the accuracy lost there, also appended to the balance
     ``problems`` (in place). Only the page shows them: ``balpipe check`` skips this."""
-    peaks = [condition_peak(s.analysis.extra) for s in stages]
+    peaks = [condition_peak(s.analysis) for s in stages]
     i = max(range(len(stages)), key=lambda i: peaks[i][1])  # the first stage of the largest
     k, cond = peaks[i]
     if cond > NEAR_SINGULAR:
@@ -334,7 +334,7 @@ def run(spec: Spec, page: bool = True, memo: Memo = compute) -> Study:
                 + f", set by the {m.tolerance_source}" + ("" if m.tolerance_source == "spec" else
                 " (each rounded at its last digit, the worst case carried through the loads)") + ".")
     max_condition = near_singular_note(stages, balance, problems) if page else None
-    redundant = max(int(s.analysis.extra.get("redundant_actuators", 0)) for s in stages)
+    redundant = max(s.analysis.redundant_actuators for s in stages)
     if redundant:
         n = len(stages[0].stage.model.drivers)
         balance.notes.append(

@@ -61,7 +61,7 @@ def find(model: Model, an: Analysis, stage: str = "") -> list[dict]:
     where = f"stage {stage!r}: " if stage else ""
     c = compile_model(model)
     q = an.q.reshape(len(an.t), -1)
-    poses = {name: an.extra["frame_pose"][:, k] for k, name in enumerate(an.names)}
+    poses = {name: an.frame_pose[:, k] for k, name in enumerate(an.names)}
     for b in dyads.blocks(c, q[0]):
         d = b.dyad
         if d is None:
@@ -81,7 +81,7 @@ def find(model: Model, an: Analysis, stage: str = "") -> list[dict]:
             })
     for key, what in (("condition", "the constraint Jacobian of the prescribed motion is ill-conditioned"),
                       ("actuation_condition", "the actuators lose control of the mechanism (the actuated system is ill-conditioned)")):
-        found = condition_peak(an.extra, key)
+        found = condition_peak(an, key)
         if found is None:
             continue
         k, cond = found

@@ -31,7 +31,7 @@ NEGLIGIBLE = 0.05  # of the largest excursion
 
 def point_tracks(model: Model, poses: np.ndarray) -> np.ndarray:
     """(N, P, 2) global positions over the N samples of every body's named points (its frame's
-    origin for a body without one); ``poses`` (N, bodies, 3) as ``analysis.extra['frame_pose']``."""
+    origin for a body without one); ``poses`` (N, bodies, 3) as ``analysis.frame_pose``."""
     tracks = []
     for i, b in enumerate(model.bodies):
         x, y, th = poses[:, i, 0], poses[:, i, 1], poses[:, i, 2]

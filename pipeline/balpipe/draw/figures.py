@@ -196,7 +196,7 @@ def mechanism_figure(model: Model, analysis, ghosts: list[int] | None = None, pr
     :func:`labels.gear_numbers`), placed so that no two overlap (:func:`labels.place`);
     ``limits`` (x0, y0, x1, y1) gives every panel of a figure the same scale; ``texts``: name ->
     the text drawn for it (the paper's symbol, :class:`balpipe.notation.Names`)."""
-    return cache.svg(mechanism_svg, drawn_model(model), analysis.extra["frame_pose"], ghosts, prefix, title, limits,
+    return cache.svg(mechanism_svg, drawn_model(model), analysis.frame_pose, ghosts, prefix, title, limits,
                      numbers, texts)
 
 
@@ -274,7 +274,7 @@ def mechanism_drawing(model: Model, analysis, ghosts: list[int] | None = None, t
                       numbers: dict[str, str] | None = None, texts: dict[str, str] | None = None) -> tuple:
     """The drawing of :func:`mechanism_figure` (a :class:`.canvas.Canvas`) and its placed labels
     (:class:`labels.Placed`, boxes in the canvas's layout points)."""
-    return pose_drawing(model, analysis.extra["frame_pose"], ghosts, title, limits, numbers, texts)
+    return pose_drawing(model, analysis.frame_pose, ghosts, title, limits, numbers, texts)
 
 
 def pose_drawing(model: Model, poses: np.ndarray, ghosts: list[int] | None = None, title: str = "",

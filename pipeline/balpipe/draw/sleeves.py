@@ -54,7 +54,7 @@ def guided_sliders(model: Model) -> set[str]:
 def sleeves(model: Model, pose_row: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
     """The sleeve of every prismatic pair between two moving bodies at one pose (module
     docstring), as its two ends in global coordinates, in the order the model lists its joints;
-    ``pose_row`` (bodies, 3) one row of ``analysis.extra['frame_pose']``."""
+    ``pose_row`` (bodies, 3) one row of ``analysis.frame_pose``."""
     out = []
     for g, s, j in pairs(model):
         u = np.array(j.axis, dtype=float) / math.hypot(*j.axis)

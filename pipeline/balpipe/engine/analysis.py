@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from ..cache.content import MEMO
 from ..mechanics.planar import cross
 from ..model import Model
 from . import fastpath, shared, structure
@@ -32,6 +33,16 @@ class Analysis:
     the actuator to the driven body. ``reactions``: constraint loads per joint (the generalized
     forces of the joint's multipliers, see :func:`joint_reactions`), for revolutes the force
     exerted on body b by body a.
+
+    What every reader of an analysis uses besides: ``frame_pose`` (N, nb, 3), each body's own
+    frame (origin and angle, not its centre of mass), for drawing; ``total_mass`` of the moving
+    bodies (kg); ``redundant_actuators``, the actuators beyond the degrees of freedom (0 when the
+    drive is exact); ``actuated``: whether the model has actuators apart from its drivers, and
+    then ``actuation_condition`` (N,), the condition number of the actuation matrix, and
+    ``actuator_rates``, each actuator's rate along the motion; :attr:`condition`, the condition
+    numbers of the constraint Jacobian Phi_q along the motion, computed when first read (an SVD
+    per sample) unless the engine's path had them, and :meth:`condition_peak`, their first
+    largest value with fewer SVDs.
     """
 
     t: np.ndarray
@@ -50,10 +61,43 @@ class Analysis:
     angular_momentum: np.ndarray
     moment_point: tuple[float, float]
     gravity: tuple[float, float]
-    extra: dict = field(default_factory=dict)
+    frame_pose: np.ndarray
+    total_mass: float
+    redundant_actuators: int = 0
+    actuated: bool = False
+    actuation_condition: np.ndarray | None = None
+    actuator_rates: dict[str, np.ndarray] | None = None
     frame_force: np.ndarray | None = None
     frame_moment: np.ndarray | None = None
     loads: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    # the condition numbers as given by the engine's path (None: computed from _motion when read);
+    # memos of the caches' keys (a function of the model and q, which the keys hold)
+    _condition: np.ndarray | None = field(default=None, repr=False, compare=False, metadata={MEMO: True})
+    _motion: tuple[Compiled, np.ndarray] | None = field(default=None, repr=False, compare=False, metadata={MEMO: True})
+    _peak: tuple[int, float] | None = field(default=None, repr=False, compare=False, metadata={MEMO: True})
+
+    @property
+    def condition(self) -> np.ndarray:
+        """The condition numbers of Phi_q along the motion (N,), computed when first read."""
+        if self._condition is None:
+            self._condition = condition_numbers(*self._motion)
+        return self._condition
+
+    def condition_peak(self) -> tuple[int, float]:
+        """(k, cond[k]) of the first largest condition number: from the array when it has been
+        read, else by :func:`.conditioning.motion_peak` (kept): the same sample and value."""
+        if self._condition is not None or self._motion is None:
+            return _argmax(self.condition)
+        if self._peak is None:
+            self._peak = motion_peak(*self._motion)
+        return self._peak
+
+    def __getstate__(self) -> dict:
+        """Pickled with its condition numbers computed and without the compiled model."""
+        state = dict(self.__dict__)
+        state["_condition"] = self.condition
+        state["_motion"] = None
+        return state
 
     @property
     def frame_load(self) -> tuple[np.ndarray, np.ndarray]:
@@ -76,7 +120,7 @@ class Analysis:
     def static_load(self) -> tuple[np.ndarray, np.ndarray]:
         """The part of the shaking loads due to the moving links' weight: the force m g (2,)
         and its moment (N,) about the moment point, (r_com - P) x m g. Zero without gravity."""
-        W = self.extra["total_mass"] * np.asarray(self.gravity)
+        W = self.total_mass * np.asarray(self.gravity)
         r = self.com - np.asarray(self.moment_point)
         return W, r[:, 0] * W[1] - r[:, 1] * W[0]
 
@@ -108,45 +152,7 @@ class Analysis:
     def pose(self, k: int, body: str) -> tuple[float, float, float]:
         """Pose of a body's own frame (not its centre of mass) at sample k."""
         i = self.names.index(body)
-        return self.extra["frame_pose"][k, i].tolist()
-
-
-class _Extra(dict):
-    """``Analysis.extra``, whose ``condition`` entry (the condition numbers of Phi_q along the
-    motion, an SVD per sample) is computed when first read from ``motion`` (the compiled model
-    and its positions; None when the entry is given), and whose peak alone
-    (:func:`condition_peak`) needs fewer SVDs. Pickles as a plain dict."""
-
-    def __init__(self, data: dict, motion: tuple[Compiled, np.ndarray] | None):
-        super().__init__(data)
-        self._motion = motion
-        self._found: tuple[int, float] | None = None
-
-    def condition_peak(self) -> tuple[int, float]:
-        """(k, cond[k]) of the first largest condition number: from the array when it has been
-        read, else by :func:`.conditioning.motion_peak` (kept)."""
-        if dict.__contains__(self, "condition") or self._motion is None:
-            return _argmax(self["condition"])
-        if self._found is None:
-            self._found = motion_peak(*self._motion)
-        return self._found
-
-    def __missing__(self, key: str) -> Any:
-        if key == "condition" and self._motion is not None:
-            self["condition"] = value = condition_numbers(*self._motion)
-            return value
-        raise KeyError(key)
-
-    def __contains__(self, key: object) -> bool:
-        return super().__contains__(key) or (key == "condition" and self._motion is not None)
-
-    def get(self, key: str, default: Any = None) -> Any:
-        return self[key] if key in self else default
-
-    def __reduce__(self) -> tuple[type[dict[str, Any]], tuple[dict[str, Any]]]:
-        if self._motion is not None:
-            self["condition"]
-        return (dict, (dict(self),))
+        return self.frame_pose[k, i].tolist()
 
 
 def _argmax(values: Any) -> tuple[int, float]:
@@ -155,14 +161,14 @@ def _argmax(values: Any) -> tuple[int, float]:
     return k, float(v[k])
 
 
-def condition_peak(extra: dict, key: str = "condition") -> tuple[int, float] | None:
-    """The first sample k of the largest value of ``extra[key]`` (``"condition"``, the condition
-    numbers of Phi_q, or ``"actuation_condition"``) and that value, None without that entry. The
-    condition numbers' peak of an analysis (whose ``extra`` is not a pickled copy) takes SVDs only
-    where it can be (:func:`.conditioning.peak`): the same sample and value as the whole array's."""
-    if key == "condition" and isinstance(extra, _Extra) and "condition" in extra:
-        return extra.condition_peak()
-    return _argmax(extra[key]) if key in extra else None
+def condition_peak(an: Analysis, key: str = "condition") -> tuple[int, float] | None:
+    """The first sample k of the largest value of ``an``'s ``condition`` (the condition numbers
+    of Phi_q: :meth:`Analysis.condition_peak`, SVDs only where they can be) or
+    ``actuation_condition`` and that value; None for an analysis without actuation condition."""
+    if key == "condition":
+        return an.condition_peak()
+    values = getattr(an, key)
+    return _argmax(values) if values is not None else None
 
 
 _COMPILED: dict[int, tuple[weakref.ref, Compiled]] = {}
@@ -317,9 +323,7 @@ def analyse(
         frame_force=None if lt is None else frame_gen[:, :2],
         frame_moment=None if lt is None else about_P(frame_gen[:, 2], frame_gen[:, :2]),
         loads={} if lt is None else lt.series,
-        extra=_Extra({"frame_pose": frame_pose, "total_mass": float(m.sum()),
-                      "redundant_actuators": redundancy(cd),
-                      "actuated": c.dynamics is not None,
-                      **({"actuation_condition": actuation, "actuator_rates": rates} if actuation is not None else {}), **({"condition": cond} if cond is not None else {})},
-                     None if cond is not None else (c, q)),
+        frame_pose=frame_pose, total_mass=float(m.sum()), redundant_actuators=redundancy(cd),
+        actuated=c.dynamics is not None, actuation_condition=actuation, actuator_rates=rates,
+        _condition=cond, _motion=None if cond is not None else (c, q),
     )

@@ -19,7 +19,7 @@ substitution on the decomposed Jacobian (:mod:`.structure`), the constraints eva
 * Regularity: cond(Phi_q) >= max|entry| / sigma_min(block) for every diagonal block; samples
   where this bound passes 1e-4 of the limit get the exact (SVD) condition number, and a sample
   beyond the limit is reported by :func:`.positions._check_regular`, with the same message as
-  the general path. The full condition numbers (``Analysis.extra["condition"]``) are computed
+  the general path. The full condition numbers (``Analysis.condition``) are computed
   when first read.
 
 Anything this path does not cover (redundant actuation, structurally singular patterns, a

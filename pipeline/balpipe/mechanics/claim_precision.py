@@ -70,7 +70,7 @@ def rounding_bounds(model, an, roundings: tuple[Rounding, ...]) -> tuple[float, 
     N = len(an.t)
     dF, dM = np.zeros(N), np.zeros(N)
     O = np.asarray(an.moment_point, dtype=float)
-    fp = an.extra["frame_pose"]
+    fp = an.frame_pose
     for r in roundings:
         if r.exact:
             continue

@@ -22,7 +22,7 @@ def body_columns(model, an) -> list[Column]:
     """``pose.<body>.{x_m, y_m, angle_rad, vx_m_s, vy_m_s, omega_rad_s}`` of every moving body's
     frame origin, then ``point.<body>.<point>.{x_m, y_m, vx_m_s, vy_m_s}`` of its named points."""
     out: list[Column] = []
-    fp = an.extra["frame_pose"]
+    fp = an.frame_pose
     for k, name in enumerate(an.names):
         xo, yo, th = fp[:, k, 0], fp[:, k, 1], fp[:, k, 2]
         w = an.v[:, k, 2]
@@ -41,7 +41,7 @@ def body_columns(model, an) -> list[Column]:
 def com_columns(an) -> list[Column]:
     """``com.{x_m, y_m, vx_m_s, vy_m_s}``: the total centre of mass of the moving bodies and its
     velocity (the linear momentum over the total mass; zero for a massless mechanism)."""
-    M = an.extra["total_mass"]
+    M = an.total_mass
     v = an.momentum / M if M > 0 else np.zeros_like(an.momentum)
     return [("com.x_m", an.com[:, 0]), ("com.y_m", an.com[:, 1]), ("com.vx_m_s", v[:, 0]), ("com.vy_m_s", v[:, 1])]
 

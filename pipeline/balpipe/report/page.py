@@ -29,7 +29,7 @@ def drawn_instants(study: Study) -> list[int]:
     (:func:`extremes.extreme_instants`), from the first stage drawn: one set of instants for
     every panel, as the stages share their motion."""
     s = shown_stages(study)[0]
-    return extremes.extreme_instants(s.stage.model, s.analysis.extra["frame_pose"])
+    return extremes.extreme_instants(s.stage.model, s.analysis.frame_pose)
 
 
 def drawn_times(study: Study) -> tuple[float, list[float]]:
@@ -77,7 +77,7 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
     efforts = live.html("efforts", curves["efforts"])
     joint_curves = curves["joints"]
     joints = live.html("joints", joint_curves) if joint_curves.panels else ""
-    limits = figures.common_limits([(s.stage.model, s.analysis.extra["frame_pose"]) for s in shown_stages(study)])
+    limits = figures.common_limits([(s.stage.model, s.analysis.frame_pose) for s in shown_stages(study)])
     numbers = labels.gear_numbers([s.stage.model for s in shown_stages(study)])
     ghosts = drawn_instants(study)
     texts = names.link_texts([s.stage.model for s in shown_stages(study)])  # one name per link on the page

@@ -16,8 +16,8 @@ from ..model import Model
 def driver_rate(analysis, model: Model, name: str) -> np.ndarray | None:
     """The rate of the driven coordinate (rad/s or m/s) from the driver's law q(t), q'(t), q''(t);
     an actuator's joint rate from the analysis."""
-    if name in analysis.extra.get("actuator_rates", {}):
-        return analysis.extra["actuator_rates"][name]
+    if name in (analysis.actuator_rates or {}):
+        return analysis.actuator_rates[name]
     for d in model.drivers:
         if d.name == name:
             t = np.asarray(analysis.t, dtype=float)

@@ -98,7 +98,7 @@ def verdict_of(study: Study, out: dict) -> dict:
     """The ``verdict`` object (:mod:`balpipe.report.verdict`); with gravity on, each stage's
     weight (total moving mass x g, N) is given apart from its inertial loads."""
     g = math.hypot(*study.unbalanced.analysis.gravity)
-    weights = {s.stage.name: s.analysis.extra["total_mass"] * g for s in study.stages} if g else None
+    weights = {s.stage.name: s.analysis.total_mass * g for s in study.stages} if g else None
     return verdict(out, weights, main={s.stage.name for s in study.stages if s.stage.design is None})
 
 

@@ -461,14 +461,14 @@ def _check_gripper_path(mech: FiveBarMechanism, C: np.ndarray, t: np.ndarray, on
 def gripper_path(analysis, model: Model) -> np.ndarray:
     """The gripper C(t) (N, 2) from an analysis of any stage (distal end of link 3)."""
     k = analysis.names.index("link3")
-    pose = analysis.extra["frame_pose"][:, k]
+    pose = analysis.frame_pose[:, k]
     cx, cy = model.body("link3").point("C")
     return world_point(pose, (cx, cy))
 
 
 def input_angles(analysis) -> tuple[np.ndarray, np.ndarray]:
     """theta1(t), theta2(t) (Figs. 8-9) from an analysis."""
-    q = analysis.extra["frame_pose"]
+    q = analysis.frame_pose
     return q[:, analysis.names.index("link1"), 2], q[:, analysis.names.index("link2"), 2]
 
 

@@ -216,7 +216,7 @@ def topology_figure(study):
     shown = [s for s in study.stages if s.stage.name in FIGURE_OF_STAGE]
     if not shown:
         return None
-    return panels_svg([(s.stage.model, s.analysis.extra["frame_pose"][0], f"{s.stage.label}\nadded {s.added_mass:.3g} kg")
+    return panels_svg([(s.stage.model, s.analysis.frame_pose[0], f"{s.stage.label}\nadded {s.added_mass:.3g} kg")
                        for s in shown], "rrr4-topology")
 
 
@@ -240,7 +240,7 @@ def designs_figure(study, drawn: list[tuple], figures: tuple[str, ...]):
     shown = [c for c in drawn if c[0].figure in figures]
     if not shown:
         return None
-    poses = study.stages[0].analysis.extra["frame_pose"][0]
+    poses = study.stages[0].analysis.frame_pose[0]
     titles = [f"{topo.whose(d.figure)}: {', '.join(row['kept'])} as built\nadded {row['added_mass']:.3g} kg, "
               f"peak |F| / reference {row['force_ratio']:.1e}" for d, row in shown]
     return panels_svg([(d.model, poses, title) for (d, _), title in zip(shown, titles)], "rrr4-" + topo.tag(figures[0]))

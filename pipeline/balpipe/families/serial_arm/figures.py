@@ -145,7 +145,7 @@ def _paper002_fig2(study, un):
     from ...draw import live
 
     an = un.analysis
-    weight = an.extra["total_mass"] * float(np.hypot(*an.gravity))
+    weight = an.total_mass * float(np.hypot(*an.gravity))
     if weight:
         apart = (f" With gravity on, Fˢʰ includes the links' constant weight m g = {weight:.4g} N: its inertial part "
                  f"alone peaks at {an.max_inertial_force:.4g} N, the whole at {an.max_force:.4g} N.")
