@@ -80,6 +80,8 @@ class Analysis:
     def condition(self) -> np.ndarray:
         """The condition numbers of Phi_q along the motion (N,), computed when first read."""
         if self._condition is None:
+            if self._motion is None:
+                raise ValueError("an analysis without its condition numbers or the motion to compute them from")
             self._condition = condition_numbers(*self._motion)
         return self._condition
 
