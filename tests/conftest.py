@@ -13,6 +13,11 @@ import sys
 from pathlib import Path
 
 import balpipe  # noqa: F401  (first: it sets one BLAS thread before numpy loads)
+
+# tests/ mirrors the package's folders (tests/engine/ for balpipe.engine, ...); a test module may
+# read another's helpers by its name (``from test_validate import ...``), wherever it lives
+_TESTS = Path(__file__).resolve().parent
+sys.path[1:1] = [str(d) for d in sorted(_TESTS.iterdir()) if d.is_dir() and any(d.glob("test_*.py"))]
 import numpy as np
 import pytest
 
@@ -28,7 +33,7 @@ def pytest_addoption(parser):
                           "by default a short seeded sample of them runs")
     parser.addoption(
         "--built-site", metavar="DIR", default=None,
-        help="run the browser's page checks (tests/test_site_browser.py, the tests named built_site) "
+        help="run the browser's page checks (tests/report/test_site_browser.py, the tests named built_site) "
              "on every HTML page of a site already built into DIR (balpipe build specs/ -o DIR)")
 
 
@@ -273,7 +278,7 @@ def chromium() -> str | None:
 @pytest.fixture(scope="session")
 def browser():
     """Headless Chromium through playwright, launched once per xdist worker: the browser tests
-    (tests/test_site_browser.py, tests/test_live_browser.py) share one xdist_group, so one worker
+    (tests/report/test_site_browser.py, tests/report/test_live_browser.py) share one xdist_group, so one worker
     launches it. Skipped with the reason when playwright or Chromium is missing."""
     # CI installs Chromium and sets BALPIPE_REQUIRE_BROWSER: there a missing browser fails
     missing = pytest.fail if os.environ.get("BALPIPE_REQUIRE_BROWSER") else pytest.skip

@@ -438,3 +438,14 @@ def test_the_docs_list_every_entry_in_its_layer():
             if not re.search(pattern, docs[k]):
                 missing.append(f"L{k}: {e}")
     assert missing == []
+
+
+def test_the_tests_mirror_the_package_folders():
+    """Each folder of tests/ (fixtures aside) is named after a folder of the package, so a test
+    of ``balpipe.engine`` is found in ``tests/engine/``; the tests of the whole (specs, docs,
+    the command line's contracts, the layers) stay at the top."""
+    tests = SRC.parent / "tests"
+    pkg_folders = {p.name for p in (SRC / "balpipe").iterdir() if (p / "__init__.py").exists()}
+    folders = {p.name for p in tests.iterdir() if p.is_dir() and p.name not in ("fixtures", "__pycache__")}
+    assert folders - pkg_folders == set()
+    assert all(any(f.glob("test_*.py")) for f in (tests / n for n in folders))

@@ -20,7 +20,7 @@ Method
     which the warm-started solver finds in a few iterations. The loads are measured, as before,
     from the simulated momenta with the model's masses (:mod:`balpipe.validate.run`), never from
     these forces; a design error (a wrong mass or inertia measured with the model's own values)
-    changes the momenta, not the motion, so the check keeps its power (tests/test_validation_power.py).
+    changes the momenta, not the motion, so the check keeps its power (tests/validate/test_validation_power.py).
 
 Measured (idler loop, counterweights / counter-rotations stages, dt = 2.5e-4, moment residual):
 800 iterations 0.15 -> 0.0057, 1600 0.056 -> 0.0057 / 0.015 -> 0.0046, unchanged from 800 (counterweights)

@@ -69,7 +69,7 @@ Defaults and why (measured with pymunk 7.3.1 on a 2-core machine)
       counterweights stage 800 + 1600 iterations, moment residual 0.0025 (was 800 + 1600 + 3200,
       0.0019, not converged); paper 004's counterweights stage 100 iterations (was 400); loads
       at 800 iterations the same with and without to 1e-4 of the unbalanced peaks
-      (tests/test_feedforward.py). The table below was measured without it.
+      (tests/validate/test_feedforward.py). The table below was measured without it.
     * mass floor 0.1: bodies lighter (of smaller moment) than 0.1 of the heaviest are simulated
       at that floor. A massless idler between two gears otherwise stalls the solver (floor 1e-6:
       comes apart at 3200 iterations; 1e-3: 800 iterations; 1e-2 and 0.1: 200, residuals
@@ -94,7 +94,7 @@ Moving starts
 Measured residuals (max |sim - analytic| / unbalanced peak) at the defaults, 0.5 s motions,
 251 samples, with the wall-clock time of ``validate`` (all runs included)
     ===========================================  =======  =======  ==========  =====
-    model (tests/test_validate.py)               force    moment   iterations  s
+    model (tests/validate/test_validate.py)               force    moment   iterations  s
     ===========================================  =======  =======  ==========  =====
     2R arm, joint drivers                        5.7e-5   5.5e-5   200         0.13
     five-bar, gravity on                         7.6e-6   2.9e-5   200         0.23

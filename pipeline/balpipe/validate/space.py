@@ -74,7 +74,7 @@ Drivers (the dead-beat recipe)
       (moment) of the reference at 200 iterations, the pivot 9.3e-7 and 2.0e-6 at 100; on a
       five-bar with longer distal links (0.34 m on 0.22 m proximal links, pivots 0.16 m apart) the
       grooves let the mechanism come apart within 0.07 s at any iteration count or step, the pivot
-      follows it to 2.8e-4 of its size (``tests/test_point_drivers.py``). On a free base the
+      follows it to 2.8e-4 of its size (``tests/validate/test_point_drivers.py``). On a free base the
       two grooves stay: a moving anchor would put the two ends of the impulse ~ v dt apart, a
       spurious couple on the base;
     * x or y of a body point alone: a ``GrooveJoint`` on the frame, the vertical (horizontal)

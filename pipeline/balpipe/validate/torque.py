@@ -39,7 +39,7 @@ Pass criterion and why it is meaningful
     error produces, about 0.1 of the travel for a mechanism dominated by inertia (the motion
     scales with the effort). The verdict needs calibration_error / tracking_error >= 10
     as well (``resolution``: the check would see a 1 % error of the whole model's inertia).
-    Measured at the defaults (tests/test_torque.py, specs/): see README "Validation".
+    Measured at the defaults (tests/validate/test_torque.py, specs/): see README "Validation".
 """
 
 from __future__ import annotations

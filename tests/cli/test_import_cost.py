@@ -1,0 +1,101 @@
+"""``balpipe --help`` and ``balpipe check`` of a spec load only what they need (issue 23 item 4):
+no scipy, matplotlib, pymunk, jinja2, cvxpy, Clarabel or dask. Each runs in a fresh interpreter, so what
+another test imported cannot hide an import."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+HEAVY = ("scipy", "matplotlib", "pymunk", "jinja2", "cvxpy", "clarabel", "distributed", "dask")
+
+PROBE = """
+import json, sys
+from balpipe.cli import main
+try:
+    main(json.loads(sys.argv[1]))
+except SystemExit:
+    pass
+print(json.dumps(sorted(m for m in {heavy!r} if m in sys.modules)), file=sys.stderr)
+"""
+
+
+def loaded_by(args: list[str]) -> list[str]:
+    r = subprocess.run([sys.executable, "-c", PROBE.format(heavy=HEAVY), json.dumps(args)], cwd=ROOT,
+                       capture_output=True, text=True, timeout=120)
+    return json.loads(r.stderr.strip().splitlines()[-1])
+
+
+@pytest.mark.parametrize("args", [["--help"], ["build", "--help"], ["check", "specs/scott_russell.yaml"],
+                                  ["check", "specs/offset_slider_crank.yaml", "specs/paper002_decoupling.yaml"]])
+def test_a_command_loads_no_heavy_library_it_does_not_use(args):
+    assert loaded_by(args) == []
+
+
+@pytest.mark.parametrize("args", [["--help"], ["check", "--help"], ["sweep", "--help"], ["--version"]])
+def test_help_loads_neither_numpy_nor_pydantic(args):
+    """The help states the sweep's limit (balpipe.MAX_DESIGNS) without the spec schema."""
+    probe = PROBE.format(heavy=HEAVY + ("numpy", "pydantic"))
+    r = subprocess.run([sys.executable, "-c", probe, json.dumps(args)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=120)
+    assert json.loads(r.stderr.strip().splitlines()[-1]) == []
+
+
+@pytest.mark.parametrize("args", [["check", "specs/scott_russell.yaml"],
+                                  ["check", "specs/offset_slider_crank.yaml", "specs/paper002_decoupling.yaml"]])
+def test_check_loads_neither_numpy_ma_nor_numpy_random(args):
+    """``np.unique`` imports numpy.ma (~90 ms) and the dead-centre search numpy.random: the
+    engine spreads its continuation's samples without it (:func:`balpipe.mechanics.sampling.spread_indices`)
+    and check leaves the page's diagnostics out. The sweep's planner only for a spec with a
+    ``sweep:`` block."""
+    probe = PROBE.format(heavy=HEAVY + ("numpy.ma", "numpy.random", "balpipe.sweep"))
+    r = subprocess.run([sys.executable, "-c", probe, json.dumps(args)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=120)
+    assert json.loads(r.stderr.strip().splitlines()[-1]) == []
+
+
+CODE_PROBE = """
+import json, sys
+{action}
+from balpipe import registry
+from balpipe.plugins import Ref
+code = {{f.target.split(":")[0] for item in (*registry.TEMPLATES.values(), *registry.METHODS.values())
+         for f in (getattr(item, k, None) for k in ("build", "balance", "figures", "notation")) if isinstance(f, Ref)}}
+heavy = {heavy!r}
+print(json.dumps({{"code": sorted(m for m in code if m in sys.modules),
+                   "heavy": sorted(m for m in sys.modules if m.split(".")[0] in heavy or m.startswith(
+                       ("balpipe.engine", "balpipe.draw", "balpipe.report", "balpipe.study")))}}), file=sys.stderr)
+"""
+
+
+def code_loaded(action: str) -> dict:
+    """The methods' and templates' code modules (named by their :class:`balpipe.plugins.Ref`) and
+    the heavy libraries and computing layers loaded after ``action``, in a fresh interpreter."""
+    r = subprocess.run([sys.executable, "-c", CODE_PROBE.format(action=action, heavy=HEAVY)], cwd=ROOT,
+                       capture_output=True, text=True, timeout=120)
+    return json.loads(r.stderr.strip().splitlines()[-1])
+
+
+@pytest.mark.parametrize("module", ["balpipe.spec", "balpipe.loader"])
+def test_the_schema_loads_no_methods_code(module):
+    """The spec's unions need the methods' sections, not their code (issue 23 item 4): importing
+    the schema loads no method's or figure's module, no engine, and no heavy library."""
+    assert code_loaded(f"import {module}") == {"code": [], "heavy": []}
+
+
+@pytest.mark.parametrize("spec, code", [
+    ("specs/scott_russell.yaml", ["balpipe.families.slider_crank.counterweights"]),
+    ("specs/paper002_decoupling.yaml", ["balpipe.families.serial_arm.decoupling"]),
+    ("specs/paper004_five_bar.yaml", ["balpipe.families.five_bar.gear_balancing"]),
+])
+def test_check_loads_the_code_of_its_specs_method_only(spec, code):
+    """``balpipe check`` of a spec imports its own method's code and no other's (registry entries
+    are :class:`balpipe.plugins.Ref` objects, resolved on first use), nor any figure module."""
+    found = code_loaded(f"from balpipe.cli import main\ntry:\n    main(['check', {spec!r}])\nexcept SystemExit:\n    pass")
+    assert found["code"] == code
+    assert [m for m in found["heavy"] if not m.startswith(("balpipe.engine", "balpipe.study"))] == []

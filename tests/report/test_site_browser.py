@@ -1,0 +1,769 @@
+"""The report site as a team meets it: served from a subfolder of a web server
+(``python -m http.server``), every page and asset loads in a real browser with no console error
+and no 404, the links stay relative, and the index's search and filter work.
+
+The browser is the system's Chromium driven by playwright for Python (``pip install '.[test]'``;
+no browser download: ``executable_path`` points at the installed one, ``BALPIPE_CHROMIUM``
+overrides it). Without either, the browser tests are skipped with the reason; the static check
+of the links runs everywhere.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import socket
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.request
+from html.parser import HTMLParser
+from pathlib import Path
+from urllib.parse import urljoin, urlsplit
+
+import pytest
+
+from _gitrepo import Repo, edit
+
+from balpipe import history
+from balpipe.build import Options, build
+
+# one xdist worker runs the whole module and tests/report/test_live_browser.py (addopts --dist loadgroup):
+# their sites and the browser (the session's ``browser`` fixture, tests/conftest.py) are made once
+# per run, not once per worker
+pytestmark = pytest.mark.xdist_group("site_browser")
+
+SUBFOLDER = "team/balpipe"
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory) -> Path:
+    """A git repository of three specs (one with two commits, one invalid), its history and a
+    simulated build, written to <root>/team/balpipe; returns <root>."""
+    tmp = tmp_path_factory.mktemp("site")
+    repo = Repo(tmp / "repo")
+    repo.copy_spec("scott_russell.yaml", "specs/scott_russell.yaml")
+    repo.copy_spec("offset_slider_crank.yaml", "specs/osc.yaml")
+    repo.commit("two designs", {"specs/scott_russell.yaml": repo.read("specs/scott_russell.yaml"),
+                                "specs/osc.yaml": repo.read("specs/osc.yaml")})
+    repo.commit("heavier slider", {"specs/osc.yaml": edit(repo.read("specs/osc.yaml"), "{mass: 600 g}", "{mass: 700 g}")})
+    repo.commit("a broken spec", {"specs/broken.yaml": "name: broken\nmechanism: {template: slider_crank\n"})
+    root = tmp / "www"
+    out = root / SUBFOLDER
+    cwd = os.getcwd()
+    os.chdir(repo.path)
+    try:
+        history.run(["specs"], out, tmp / "cache", simulate=False)
+        outcomes = build(["specs"], Options(out=out, simulate=True))
+    finally:
+        os.chdir(cwd)
+    assert sorted(o.status for o in outcomes) == ["error", "ok", "ok"], [o.message for o in outcomes]
+    (root / "index.html").write_text("<!doctype html><title>another site</title>\n")  # the server's own root
+    return root
+
+
+@pytest.fixture(scope="module")
+def server(site):
+    """``python -m http.server`` on 127.0.0.1 and a free port, serving the folder above the site."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    proc = subprocess.Popen([sys.executable, "-m", "http.server", str(port), "--bind", "127.0.0.1",
+                             "--directory", str(site)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    base = f"http://127.0.0.1:{port}/"
+    try:
+        deadline = time.monotonic() + 20
+        while True:
+            try:
+                urllib.request.urlopen(base, timeout=1).close()
+                break
+            except (urllib.error.URLError, OSError):
+                if proc.poll() is not None or time.monotonic() > deadline:
+                    raise RuntimeError("http.server did not start")
+                time.sleep(0.1)
+        yield base + SUBFOLDER + "/"
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+class Watched:
+    """A browser page that records console errors, page errors, failed requests, HTTP errors and
+    every URL it requested."""
+
+    def __init__(self, browser):
+        self.page = browser.new_page()
+        self.problems: list[str] = []
+        self.requested: list[str] = []
+        p = self.page
+        p.on("console", lambda m: self.problems.append(f"console {m.type}: {m.text} ({p.url})")
+             if m.type in ("error", "assert") else None)
+        p.on("pageerror", lambda e: self.problems.append(f"JavaScript error: {e} ({p.url})"))
+        p.on("requestfailed", lambda r: self.problems.append(f"request failed: {r.url} ({r.failure})"))
+        p.on("response", lambda r: self.problems.append(f"HTTP {r.status}: {r.url}") if r.status >= 400 else None)
+        p.on("request", lambda r: self.requested.append(r.url))
+
+
+def test_every_page_and_asset_loads_from_a_subfolder(site, server, browser):
+    w = Watched(browser)
+    pages, assets, queue = set(), set(), [server + "index.html"]
+    while queue:
+        url = queue.pop(0)
+        if url in pages:
+            continue
+        pages.add(url)
+        resp = w.page.goto(url, wait_until="load")
+        assert resp is not None and resp.status == 200, url
+        w.page.wait_for_timeout(150)  # let the page's scripts run (player, timing, filter)
+        check_figures_and_anchors(w.page, url)
+        for href in w.page.eval_on_selector_all("a[href]", "els => els.map(e => e.href)"):
+            target = href.split("#")[0]
+            assert target.startswith(server), f"{url} links outside the site's folder: {href}"
+            if target.endswith(".html"):
+                queue.append(target)
+            else:
+                assets.add(target)
+    for a in sorted(assets):
+        r = w.page.request.get(a)
+        assert r.status == 200, f"{a}: HTTP {r.status}"
+    on_disk = {server + p.relative_to(site / SUBFOLDER).as_posix() for p in (site / SUBFOLDER).rglob("*.html")}
+    assert on_disk == pages, f"pages not reachable from the index: {sorted(on_disk - pages)}"
+    outside = [u for u in w.requested if not (u.startswith(server) or u.startswith("data:"))]
+    assert not outside, f"requests outside the site's folder: {outside}"
+    assert not w.problems, "\n".join(w.problems)
+    # what was loaded: three study pages, two history pages, their data files and scripts
+    names = {u[len(server):] for u in pages | assets | set(w.requested)}
+    for expected in ("scott_russell/index.html", "osc/history.html", "osc/history.json", "osc/results.json",
+                     "osc/timeseries.csv", "scott_russell/timing.js", "balpipe.schema.json"):
+        assert expected in names, expected
+
+
+def check_figures_and_anchors(page, url: str) -> None:
+    """Every figure is visible with a real size, and every in-page link (the table of contents)
+    names an element of the page."""
+    page.evaluate("document.querySelectorAll('details').forEach(d => d.open = true)")  # collapsed sections
+    page.wait_for_timeout(50)
+    figs = page.locator("figure")
+    for k in range(figs.count()):
+        f = figs.nth(k)
+        f.scroll_into_view_if_needed()
+        box = f.bounding_box()
+        assert f.is_visible() and box and box["width"] > 100 and box["height"] > 50, f"{url}: figure {k} not visible"
+        inner = f.locator("svg, canvas, img")
+        if inner.count():
+            b = inner.first.bounding_box()
+            assert b and b["width"] > 100 and b["height"] > 50, f"{url}: figure {k}'s drawing has no size"
+    sw, cw = page.evaluate("[document.documentElement.scrollWidth, document.documentElement.clientWidth]")
+    assert sw <= cw + 1, f"{url}: the page is wider than the window ({sw} > {cw} px)"
+    missing = page.evaluate("""() => [...document.querySelectorAll('a[href^="#"]')]
+        .map(a => a.getAttribute('href').slice(1)).filter(id => id && !document.getElementById(id))""")
+    assert not missing, f"{url}: in-page links to nothing: {missing}"
+
+
+def test_study_pages_have_contents_and_links_between_studies(server, browser):
+    w = Watched(browser)
+    p = w.page
+    p.goto(server + "osc/index.html", wait_until="load")
+    toc = p.eval_on_selector_all("nav.toc a", "els => els.map(e => e.textContent)")
+    assert "Balancing stages" in toc and "Inputs" in toc and "What balancing costs the actuators" in toc
+    # site_nav.js: the index's order is broken (invalid, no page), osc, scott_russell
+    nxt = p.eval_on_selector_all("a[rel=next]", "els => els.map(e => e.href)")
+    prev = p.eval_on_selector_all("a[rel=prev]", "els => els.map(e => e.href)")
+    assert nxt and all(h == server + "scott_russell/index.html" for h in nxt) and not prev
+    p.click("#sitenav a[rel=next]")
+    p.wait_for_load_state("load")
+    assert p.url == server + "scott_russell/index.html"
+    assert p.eval_on_selector_all("a[rel=prev]", "els => els.map(e => e.href)")[0] == server + "osc/index.html"
+    assert p.locator("table.inputs").count() == 1 and "kg" in p.text_content("table.inputs")
+    # the print stylesheet hides the navigation and the player's controls
+    p.emulate_media(media="print")
+    assert not p.is_visible("nav.toc") and not p.is_visible("header.top") and not p.is_visible(".player-controls")
+    p.emulate_media(media="screen")
+    assert p.is_visible("nav.toc")
+    assert not w.problems, "\n".join(w.problems)
+
+
+def open_sections(page) -> None:
+    """Open the page's collapsed sections, as a reader does to reach the player."""
+    page.evaluate("document.querySelectorAll('details').forEach(d => d.open = true)")
+    page.wait_for_timeout(50)
+
+
+PRINT_RATIO = 3  # templates/live_plots.js: device pixels per CSS pixel of a plot drawn for print
+# How long a print copy may take to appear or go: waiting returns as soon as it holds, the limit
+# only matters on a loaded machine (5 s failed once at a load average of 21 on 2 cores).
+PRINT_WAIT_MS = 30_000
+
+_PRINTED = """host => {
+  const style = getComputedStyle(host);
+  const columns = style.display === "grid" ? style.gridTemplateColumns.split(" ").length : 1;
+  return { width: host.clientWidth, columns: columns, plots: [...host.querySelectorAll(".live-plot")].map(el => {
+    const c = el.querySelector(".live-print canvas"), screen = el.querySelector(":scope > .uplot");
+    if (!c) return null;
+    const box = c.getBoundingClientRect(), wrap = c.parentNode;
+    return { width: box.width, height: box.height, pixels: c.width, drawn: parseFloat(wrap.style.width),
+             screen: screen.getBoundingClientRect().height };
+  }) };
+}"""
+
+
+def assert_printed(page, figure: str) -> None:
+    """In print media every panel of the live figure ``#figure`` is drawn for print: a canvas of
+    PRINT_RATIO device pixels per CSS pixel, stretched across its share of the printed width (a
+    figure of small multiples: two a row), the screen's plot hidden, and every panel shown (a
+    joint selector's too); back on screen the print copies are gone. The media query is what
+    Playwright's emulation and the print layout change (page.pdf and the print dialog also send
+    beforeprint: :func:`test_a_pdf_prints_every_panel_drawn_for_print`)."""
+    page.emulate_media(media="print")
+    try:
+        page.wait_for_function(f"document.querySelectorAll('#{figure} .live-print canvas').length === "
+                               f"document.querySelectorAll('#{figure} .live-plot').length", timeout=PRINT_WAIT_MS)
+        got = page.eval_on_selector(f"#{figure}", _PRINTED)
+        assert got["plots"] and all(got["plots"]), got
+        column = got["width"] / got["columns"]
+        for plot in got["plots"]:
+            assert plot["width"] >= 0.9 * column and plot["height"] > 0.2 * plot["width"], (figure, plot, column)
+            assert plot["pixels"] >= PRINT_RATIO * plot["drawn"] - 1, (figure, plot)  # sharp on paper
+            assert plot["screen"] == 0, (figure, plot)  # the screen's plot is not printed
+        assert not page.is_visible(f"#{figure} .live-choose")
+    finally:
+        page.emulate_media(media="screen")
+    page.wait_for_function(f"!document.querySelector('#{figure} .live-print')", timeout=PRINT_WAIT_MS)
+    assert page.is_visible(f"#{figure} .live-plot:not([hidden]) > .uplot canvas")
+
+
+def test_player_pauses_scrubs_and_answers_the_keyboard(server, browser):
+    w = Watched(browser)
+    p = w.page
+    p.goto(server + "scott_russell/index.html", wait_until="load")
+    open_sections(p)
+    p.locator("#player").scroll_into_view_if_needed()
+    p.wait_for_timeout(300)
+    assert p.get_attribute("#player", "data-playing") == "1"  # plays by default, in real time
+    assert p.eval_on_selector("#player-speed", "s => s.value") == "1"
+    assert "1× real time" in p.text_content("#player-clock")
+    t0 = p.text_content("#player-clock")
+    p.wait_for_timeout(120)
+    assert p.text_content("#player-clock") != t0  # it moves
+    p.click("#player-play")  # pause
+    assert p.get_attribute("#player", "data-playing") == "0" and p.text_content("#player-play") == "Play"
+    paused = p.text_content("#player-clock")
+    pixels = p.eval_on_selector("#player", "c => c.toDataURL()")
+    p.wait_for_timeout(250)
+    assert p.text_content("#player-clock") == paused and p.eval_on_selector("#player", "c => c.toDataURL()") == pixels
+    # scrub: the slider sets the time and the drawing
+    p.eval_on_selector("#player-time", "s => { s.value = '500'; s.dispatchEvent(new Event('input')); }")
+    clock = p.text_content("#player-clock")
+    m = re.match(r"t = (\d+\.\d+) s of (\d+\.\d+) s", clock)
+    assert m and abs(float(m.group(1)) - 0.5 * float(m.group(2))) < 1e-3, clock
+    assert p.eval_on_selector("#player", "c => c.toDataURL()") != pixels
+    p.eval_on_selector("#player-time", "s => { s.value = '1000'; s.dispatchEvent(new Event('input')); }")
+    assert re.match(r"t = (\S+) s of \1 s", p.text_content("#player-clock"))
+    # keyboard: arrows step back, space plays again
+    p.focus("#player")
+    p.keyboard.press("ArrowLeft")
+    assert not re.match(r"t = (\S+) s of \1 s", p.text_content("#player-clock"))
+    p.keyboard.press(" ")
+    assert p.get_attribute("#player", "data-playing") == "1"
+    p.focus("#player-play")
+    p.keyboard.press("Enter")  # the button is a real button
+    assert p.get_attribute("#player", "data-playing") == "0"
+    assert not w.problems, "\n".join(w.problems)
+
+
+def test_player_names_its_parts_and_shows_a_scale_bar_per_panel(server, browser):
+    """The player's names (pivots, joints, links, counterweights) are drawn, none over another
+    (the placer leaves out what does not fit), and can be switched off; the caption says how
+    the panels' scales compare."""
+    w = Watched(browser)
+    p = w.page
+    p.goto(server + "scott_russell/index.html", wait_until="load")
+    open_sections(p)
+    p.click("#player-play")  # pause
+    p.eval_on_selector("#player-time", "s => { s.value = '300'; s.dispatchEvent(new Event('input')); }")
+    named = p.eval_on_selector("#player", "c => Object.keys(c.dataset).filter(k => k.startsWith('names')).map(k => +c.dataset[k])")
+    assert len(named) == 3 and all(n >= 5 for n in named), named  # A, B, C, crank, coupler at least
+    pixels = p.eval_on_selector("#player", "c => c.toDataURL()")
+    p.uncheck("#player-names")
+    assert p.eval_on_selector("#player", "c => c.dataset.names0") == "0"
+    assert p.eval_on_selector("#player", "c => c.toDataURL()") != pixels
+    p.focus("#player-names")
+    p.keyboard.press(" ")  # a real checkbox: the keyboard turns the names back on
+    assert p.is_checked("#player-names") and p.eval_on_selector("#player", "c => +c.dataset.names0") >= 5
+    caption = p.text_content("figure:has(#player) figcaption")
+    assert "scale bar" in caption and ("scales differ" in caption or "same scale" in caption)
+    assert not w.problems, "\n".join(w.problems)
+
+
+def test_scripts_ran_in_the_pages(server, browser):
+    w = Watched(browser)
+    w.page.goto(server + "scott_russell/index.html", wait_until="load")
+    cells = w.page.eval_on_selector_all("[data-timing]", "els => els.map(e => e.textContent)")
+    assert cells and all(re.fullmatch(r"\d+\.\d{3} s", c) for c in cells), cells  # timing.js filled them
+    assert w.page.eval_on_selector("canvas", "c => c.width") > 0  # the reactionless player
+    assert w.page.locator("#history").count() == 1
+    assert not w.problems, "\n".join(w.problems)
+
+
+def visible_specs(page) -> list[str]:
+    return page.eval_on_selector_all(
+        "#studies tbody.entry", "els => els.filter(e => !e.hidden).map(e => e.dataset.text)")
+
+
+def test_index_search_and_filters(server, browser):
+    w = Watched(browser)
+    p = w.page
+    p.goto(server + "index.html", wait_until="load")
+    assert len(visible_specs(p)) == 3 and p.text_content("#f-count") == "3 of 3 shown"
+    options = p.eval_on_selector_all("#f-method option", "els => els.map(e => e.value)")
+    assert options == ["", "slider_crank_counterweights"]
+    p.select_option("#f-method", "slider_crank_counterweights")
+    assert len(visible_specs(p)) == 2  # the invalid spec has no method
+    p.fill("#f-q", "scott russell")
+    shown = visible_specs(p)
+    assert len(shown) == 1 and "scott-russell" in shown[0]
+    assert p.text_content("#f-count") == "1 of 3 shown"
+    p.press("#f-q", "Enter")  # no form submission, no reload
+    assert "?" not in p.url and len(visible_specs(p)) == 1
+    assert "q=scott%20russell" in p.evaluate("location.hash") and "method=" in p.evaluate("location.hash")
+    p.fill("#f-q", "no such study")
+    assert visible_specs(p) == [] and p.is_visible("#f-none")
+    # a shared link restores the filter
+    p.goto(server + "index.html#status=invalid", wait_until="load")
+    p.reload(wait_until="load")
+    shown = visible_specs(p)
+    assert len(shown) == 1 and "broken" in shown[0]
+    assert p.eval_on_selector("#f-status", "s => s.value") == "invalid"
+    assert p.eval_on_selector_all("#f-status option", "els => els.map(e => e.value)") == ["", "invalid", "ok"]
+    papers = p.eval_on_selector_all("#f-paper option", "els => els.map(e => e.value)")
+    assert any(v.startswith("000:") for v in papers)
+    p.select_option("#f-status", "")
+    p.select_option("#f-paper", next(v for v in papers if v.startswith("000:")))
+    assert len(visible_specs(p)) == 2
+    assert not w.problems, "\n".join(w.problems)
+
+
+class _Links(HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.urls: list[str] = []
+
+    def handle_starttag(self, tag, attrs):
+        for k, v in attrs:
+            if k in ("href", "src", "xlink:href", "action") and v is not None:
+                self.urls.append(v)
+
+
+def test_links_are_relative_and_resolve(site):
+    """Without a browser too: every href and src in every page is relative and names a file of
+    the site, so the site works from any folder of any server (and from file://)."""
+    top = site / SUBFOLDER
+    for page in sorted(top.rglob("*.html")):
+        parser = _Links()
+        parser.feed(page.read_text(encoding="utf-8"))
+        for url in parser.urls:
+            if url.startswith("#") or url.startswith("data:"):
+                continue
+            parts = urlsplit(url)
+            assert not parts.scheme and not parts.netloc and not url.startswith("/"), f"{page}: {url}"
+            target = Path(urljoin(page.as_posix(), parts.path))
+            assert target.exists() and top in target.resolve().parents, f"{page}: {url} -> {target}"
+
+
+def test_the_watcher_sees_a_missing_asset_and_a_script_error(site, server, browser):
+    """Negative control: a page outside the site with a missing script and a failing one."""
+    probe = site / "probe"
+    probe.mkdir(exist_ok=True)
+    (probe / "page.html").write_text('<!doctype html><link rel="icon" href="data:,"><title>probe</title>'
+                                     '<script src="missing.js"></script><script>undefinedFunction()</script>\n')
+    w = Watched(browser)
+    w.page.goto(server.replace(SUBFOLDER + "/", "probe/page.html"), wait_until="load")
+    assert any(p.startswith("HTTP 404") and p.endswith("/probe/missing.js") for p in w.problems), w.problems
+    assert any("undefinedFunction" in p for p in w.problems), w.problems
+
+
+# ------------------------------------------------------------------------------------------
+# Layout (issue 22): every built page at 400 px and 1400 px
+
+
+PAPER_SPECS = ("custom_four_bar_balancing.yaml", "paper000_rpr3_scott_russell.yaml", "paper002_decoupling.yaml")
+SCREENS = 12  # a page is at most this many screens long at 1400 px with its sections collapsed
+MAX_BYTES = 2_000_000  # and weighs less than this (the page with everything it loads)
+
+
+@pytest.fixture(scope="module")
+def paper_site(tmp_path_factory) -> Path:
+    """Three paper and custom specs built without simulation (their pages are the longest)."""
+    out = tmp_path_factory.mktemp("papers") / "site"
+    specs = Path(__file__).resolve().parents[2] / "specs"
+    outcomes = build([str(specs / s) for s in PAPER_SPECS], Options(out=out, simulate=False))
+    assert all(o.status == "ok" for o in outcomes), [o.message for o in outcomes]
+    # and a diff page beside them (balpipe diff -f html), a page of the site as well
+    new = out.parent / "heavier.yaml"
+    new.write_text((specs / "offset_slider_crank.yaml").read_text().replace("{mass: 600 g}", "{mass: 700 g}"))
+    r = subprocess.run([sys.executable, "-m", "balpipe", "diff", str(specs / "offset_slider_crank.yaml"), str(new),
+                        "--no-sim", "-f", "html", "-o", str(out / "diff.html")], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    return out
+
+
+# Elements whose content spills out of their box: clipped (overflow hidden/auto) or drawn over
+# their neighbours (overflow visible). Measured from the laid-out boxes.
+_SPILLS = """() => {
+  const out = [];
+  const vw = document.documentElement.clientWidth;
+  for (const el of document.querySelectorAll(
+      'main td, main th, main p, main li, main dd, main dt, main h1, main h2, main h3, main summary, main figcaption, header.top, main span.badge, main code, main pre')) {
+    const r = el.getBoundingClientRect();
+    if (!r.width || !r.height || el.offsetParent === null) continue;
+    const text = (el.textContent || '').trim().slice(0, 60);
+    if (r.right > vw + 1 || r.left < -1) out.push(`outside the window (${Math.round(r.left)}..${Math.round(r.right)} of ${vw} px): ${el.tagName} "${text}"`);
+    const cs = getComputedStyle(el);
+    if (cs.display === 'inline') continue;
+    if (el.scrollWidth > el.clientWidth + 1) out.push(`spills ${el.scrollWidth - el.clientWidth} px (overflow ${cs.overflowX}): ${el.tagName} "${text}"`);
+  }
+  // cells of one row never overlap
+  for (const tr of document.querySelectorAll('main tr')) {
+    const cells = [...tr.cells].map(c => c.getBoundingClientRect()).filter(r => r.width && r.height);
+    for (let i = 1; i < cells.length; i++) {
+      const a = cells[i - 1], b = cells[i];
+      const overlapX = Math.min(a.right, b.right) - Math.max(a.left, b.left);
+      const overlapY = Math.min(a.bottom, b.bottom) - Math.max(a.top, b.top);
+      if (overlapX > 1 && overlapY > 1) out.push(`cells overlap in a row: "${(tr.textContent || '').trim().slice(0, 60)}"`);
+    }
+  }
+  return out;
+}"""
+
+
+# Text of a drawing (SVG) shown smaller than MIN_TEXT_PX: a wide figure squeezed into a narrow
+# window. Size on screen = the text's font size times the scale of its transform to the screen.
+MIN_TEXT_PX = 6
+_SMALL_TEXT = """min => {
+  const out = [];
+  for (const svg of document.querySelectorAll('main svg')) {
+    if (!svg.getBoundingClientRect().width) continue;  // not shown (the print copy of a live plot)
+    let small = Infinity, text = '';
+    for (const t of svg.querySelectorAll('text')) {
+      const m = t.getScreenCTM();
+      const size = m ? parseFloat(getComputedStyle(t).fontSize) * Math.hypot(m.a, m.b) : Infinity;
+      if (size < small) { small = size; text = t.textContent; }
+    }
+    if (small < min) {
+      const cap = svg.closest('figure')?.querySelector('figcaption')?.textContent.trim().slice(0, 60) || '';
+      out.push(`drawing text ${small.toFixed(1)} px on screen (< ${min} px), "${text}" in the figure "${cap}"`);
+    }
+  }
+  return out;
+}"""
+
+
+def _pages(root: Path) -> list[Path]:
+    return sorted(p for p in root.rglob("*.html") if "probe" not in p.parts)
+
+
+def _weight(page: Path) -> int:
+    """Bytes of a page and the local files it loads (scripts, styles, images)."""
+    parser = _Links()
+    parser.feed(page.read_text(encoding="utf-8"))
+    total = page.stat().st_size
+    for url in parser.urls:
+        if url.endswith((".js", ".css", ".png", ".svg")) and not url.startswith(("data:", "#")):
+            f = Path(urljoin(page.as_posix(), urlsplit(url).path))
+            total += f.stat().st_size if f.exists() else 0
+    return total
+
+
+def page_problems(ctx, page_file: Path, width: int) -> list[str]:
+    """What a reader meets on one built page opened from file:// (as a downloaded site) in a
+    window ``width`` px wide: a page longer than SCREENS windows at 1400 px as it opens (its long
+    sections collapsed), then, with every section open, a page that scrolls sideways, text clipped
+    or drawn over its neighbours (_SPILLS), drawings whose text is too small to read (_SMALL_TEXT),
+    and console errors, script errors or failed loads."""
+    w = Watched(ctx)
+    p = w.page
+    url = page_file.as_uri()
+    problems = []
+    try:
+        p.goto(url, wait_until="load")
+        p.wait_for_timeout(100)
+        if width == 1400:
+            height = p.evaluate("document.documentElement.scrollHeight")
+            if height > SCREENS * 900:
+                problems.append(f"{url}: {height} px long with its sections collapsed (> {SCREENS} screens)")
+        open_sections(p)
+        p.wait_for_timeout(100)  # the opened sections' tables and plots take their width
+        sw, cw = p.evaluate("[document.documentElement.scrollWidth, document.documentElement.clientWidth]")
+        if sw > cw + 1:
+            problems.append(f"{url}: scrolls sideways ({sw} > {cw} px)")
+        problems += [f"{url}: {s}" for s in p.evaluate(_SPILLS) + p.evaluate(_SMALL_TEXT, MIN_TEXT_PX)]
+        return problems + w.problems
+    finally:
+        p.close()
+
+
+def layout_context(browser, width: int):
+    return browser.new_context(viewport={"width": width, "height": 900})
+
+
+@pytest.mark.parametrize("width", [400, 1400])
+def test_every_page_fits_the_window_with_nothing_clipped(site, paper_site, browser, width):
+    problems = []
+    ctx = layout_context(browser, width)
+    try:
+        for top in (site / SUBFOLDER, paper_site):
+            for page_file in _pages(top):
+                problems += page_problems(ctx, page_file, width)
+    finally:
+        ctx.close()
+    assert not problems, f"{len(problems)} problems at {width} px:\n" + "\n".join(problems[:40])
+
+
+def test_every_page_weighs_less_than_2_mb(site, paper_site):
+    heavy = [(p, _weight(p)) for top in (site / SUBFOLDER, paper_site) for p in _pages(top)]
+    assert heavy and all(n < MAX_BYTES for _, n in heavy), [(str(p), n) for p, n in heavy if n >= MAX_BYTES]
+
+
+def test_index_verdicts_agree_with_results_json(paper_site, browser):
+    import json
+
+    w = Watched(browser)
+    w.page.goto((paper_site / "index.html").as_uri(), wait_until="load")
+    shown = w.page.eval_on_selector_all(
+        "#studies tbody.entry", "els => els.map(e => [e.dataset.spec, e.dataset.verdict, e.querySelector('.verdict .badge').textContent])")
+    assert len(shown) == len(PAPER_SPECS)
+    for slug, level, words in shown:
+        v = json.loads((paper_site / slug / "results.json").read_text(encoding="utf-8"))["verdict"]
+        assert (level, words) == (v["level"], v["words"]), slug
+    assert not w.problems, "\n".join(w.problems)
+
+
+_LEGEND_VALUES = "el => [...el.querySelectorAll('.u-legend .u-series .u-value')].map(v => v.textContent)"
+_CURSOR_TIME = "el => el.querySelector('.u-legend .u-series .u-value').textContent"
+
+
+def hover(page, plot, min_width: int = 200) -> list[str]:
+    """Move the mouse over a live plot (a .live-plot), 40 % along its time axis, and read its
+    legend: the time and every curve's value there. The plot must be drawn, its plotting area
+    wider than ``min_width`` px."""
+    over = plot.locator(".u-over")  # the plotting area itself: a legend of many curves (paper 003's
+    over.scroll_into_view_if_needed()  # 96 at 400 px) makes the plot taller than the window
+    box = over.bounding_box()
+    assert box and box["width"] > min_width, f"no interactive plot drawn ({box})"
+    page.mouse.move(box["x"] + box["width"] * 0.4, box["y"] + box["height"] * 0.5)
+    return plot.evaluate(_LEGEND_VALUES)
+
+
+def test_hovering_a_plot_shows_its_values_and_a_click_hides_a_curve(paper_site, browser):
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto((paper_site / "paper002_decoupling" / "index.html").as_uri(), wait_until="load")
+    plot = p.locator("#live-loads .live-plot").first
+    shown = hover(p, plot)
+    assert shown and all(re.search(r"\d", v) for v in shown), shown  # time and every curve's value
+    # a click on a legend entry hides its curve
+    entry = plot.locator(".u-legend .u-series").nth(1)
+    entry.click()
+    assert "u-off" in (entry.get_attribute("class") or "")
+    # no static figure: printing prints the live plot, drawn again for print, the hidden curve hidden
+    assert not p.locator(".static-plot").count() and not p.locator("#live-loads svg").count()
+    label = entry.locator(".u-label").text_content()
+    p.emulate_media(media="print")
+    p.wait_for_selector("#live-loads .live-print .u-legend", state="attached")
+    off = plot.evaluate("""(el, label) => [...el.querySelectorAll(".live-print .u-legend .u-series")]
+        .map(r => [r.querySelector(".u-label").textContent, r.classList.contains("u-off")])""", label)
+    assert [hidden for name, hidden in off if name == label] == [True] and [h for _, h in off].count(True) == 1, off
+    p.emulate_media(media="screen")
+    assert_printed(p, "live-loads")
+    assert not w.problems, "\n".join(w.problems)
+
+
+def test_a_pdf_prints_every_panel_drawn_for_print(paper_site, browser):
+    """Playwright's page.pdf, as the print dialog, sends beforeprint with the screen's layout:
+    by then every panel of every live figure (the joints' hidden ones too, and those of the
+    collapsed sections, which printing opens: fit_tables.js) is drawn for print; after it the
+    print copies are gone and the screen's plots are drawn as before."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto((paper_site / "paper002_decoupling" / "index.html").as_uri(), wait_until="load")
+    p.evaluate("""addEventListener("beforeprint", () => { window.printedPanels = [...document.querySelectorAll(".live-plot")]
+        .map(el => { const c = el.querySelector(".live-print canvas"); return c ? c.width / parseFloat(c.parentNode.style.width) : 0; }); })""")
+    pdf = p.pdf()
+    assert pdf.startswith(b"%PDF") and len(pdf) > 10_000
+    ratios = p.evaluate("window.printedPanels")
+    assert ratios and len(ratios) == p.locator(".live-plot").count() and min(ratios) >= PRINT_RATIO - 0.01, ratios
+    assert not p.locator(".live-print").count()
+    assert p.is_visible("#live-loads .live-plot > .uplot canvas")
+    assert not w.problems, "\n".join(w.problems)
+
+
+
+
+@pytest.mark.parametrize("figure, unit", [("live-efforts", r"^(torque \(N m\)|force \(N\))$"),
+                                          ("live-joints", r"^\|?\w+\|? \((N|N m)\)$"),
+                                          ("live-p002fig2", r"^(Fˢʰ \(N\)|Mˢʰ \(N m\))$")])
+def test_the_efforts_joint_loads_and_paper_plots_are_interactive(paper_site, browser, figure, unit):
+    """As the shaking loads' plot: hover shows the time and every curve's value, the axis names
+    its unit, a click on a legend entry hides that curve, and printing prints the plot drawn for print;
+    for the actuator efforts, the joint loads and a paper's own time series (paper 002's Fig. 2)."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto((paper_site / "paper002_decoupling" / "index.html").as_uri(), wait_until="load")
+    open_sections(p)
+    plot = p.locator(f"#{figure} .live-plot:not([hidden])").first  # a figure of many joints shows one
+    p.wait_for_timeout(100)  # opened sections: the plots take their width
+    axes = p.eval_on_selector(f"script[data-live='{figure}']", "s => JSON.parse(s.textContent).panels.map(q => q.axis)")
+    assert axes and all(re.match(unit, a) for a in axes), axes  # the value axis names its unit (drawn on the canvas)
+    shown = hover(p, plot)
+    # the time and every stage with a curve in this panel (the joint first shown, the largest load,
+    # may be one that only a balanced stage has)
+    key = plot.get_attribute("data-quantity")
+    has = p.eval_on_selector(f"script[data-live='{figure}']", f"s => JSON.parse(s.textContent).series.map(q => {json.dumps(key)} in q.y)")
+    assert len(shown) == len(has) + 1 >= 2 and re.search(r"\d", shown[0]), shown
+    assert [bool(re.search(r"\d", v)) for v in shown[1:]] == has, (shown, has)
+    pixels = plot.locator("canvas").evaluate("c => c.toDataURL()")
+    entry = plot.locator(".u-legend .u-series").nth(1 + has.index(True))
+    entry.click()
+    assert "u-off" in (entry.get_attribute("class") or "")
+    assert plot.locator("canvas").evaluate("c => c.toDataURL()") != pixels  # the curve is gone
+    assert_printed(p, figure)
+    assert not w.problems, "\n".join(w.problems)
+
+
+def test_the_player_and_the_plots_share_their_time(server, browser):
+    """Scrubbing the player moves every plot's cursor to its time; a click in a plot (not a drag,
+    which zooms) moves the paused player to the time clicked."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto(server + "scott_russell/index.html", wait_until="load")
+    open_sections(p)
+    p.click("#player-play")  # pause
+    p.eval_on_selector("#player-time", "s => { s.value = '500'; s.dispatchEvent(new Event('input')); }")
+    clock = re.match(r"t = (\d+\.\d+) s of (\d+\.\d+) s", p.text_content("#player-clock"))
+    t, end = float(clock.group(1)), float(clock.group(2))
+    step = end / 100  # the plots keep at least 100 samples: a cursor snaps to the nearest
+    plots = p.locator("#live-loads .live-plot, #live-efforts .live-plot, #live-joints .live-plot").all()
+    assert len(plots) >= 4
+    for plot in plots:
+        assert abs(float(plot.evaluate(_CURSOR_TIME)) - t) <= step, plot.get_attribute("data-quantity")
+    plot = p.locator("#live-efforts .live-plot").first
+    plot.scroll_into_view_if_needed()
+    box = plot.locator(".u-over").bounding_box()
+    p.mouse.click(box["x"] + box["width"] * 0.2, box["y"] + box["height"] * 0.5)
+    clicked = float(plot.evaluate(_CURSOR_TIME))
+    assert abs(clicked - 0.2 * end) <= 2 * step
+    shown = float(re.match(r"t = (\d+\.\d+)", p.text_content("#player-clock")).group(1))
+    assert abs(shown - clicked) <= step and p.get_attribute("#player", "data-playing") == "0"
+    assert abs(float(p.locator("#live-loads .live-plot").first.evaluate(_CURSOR_TIME)) - shown) <= step
+    # a drag zooms the plot and leaves the player where it is
+    p.mouse.move(box["x"] + box["width"] * 0.5, box["y"] + box["height"] * 0.5)
+    p.mouse.down()
+    p.mouse.move(box["x"] + box["width"] * 0.8, box["y"] + box["height"] * 0.5, steps=5)
+    p.mouse.up()
+    assert float(re.match(r"t = (\d+\.\d+)", p.text_content("#player-clock")).group(1)) == shown
+    assert not w.problems, "\n".join(w.problems)
+
+
+# ------------------------------------------------------------------------------------------
+# The same checks on a site already built (the whole of specs/, say), page by page:
+#   balpipe build specs/ -o reports --no-sim
+#   python -m pytest tests/report/test_site_browser.py -k built_site --built-site reports
+
+
+NO_BUILT_SITE = ("no --built-site DIR given: to check every page of a built site, run "
+                 "python -m pytest tests/report/test_site_browser.py -k built_site --built-site DIR")
+
+
+def built_site_dir(config) -> Path | None:
+    given = config.getoption("--built-site")
+    if given is None:
+        return None
+    top = Path(given).resolve()
+    if not _pages(top):
+        raise pytest.UsageError(f"--built-site {given}: no HTML page under {top}")
+    return top
+
+
+def pytest_generate_tests(metafunc):
+    """``built_page``: every page of the --built-site; ``built_plot_page``: those with
+    interactive plots. Without the option, one skipped case that says how to run them."""
+    names = [n for n in ("built_page", "built_plot_page") if n in metafunc.fixturenames]
+    if not names:
+        return
+    top = built_site_dir(metafunc.config)
+    if top is None:
+        metafunc.parametrize(names[0], [pytest.param(None, marks=pytest.mark.skip(reason=NO_BUILT_SITE))])
+        return
+    pages = _pages(top)
+    if names[0] == "built_plot_page":
+        pages = [p for p in pages if "data-live=" in p.read_text(encoding="utf-8")]
+    metafunc.parametrize(names[0], pages, ids=[p.relative_to(top).as_posix() for p in pages])
+
+
+def test_built_site_page_weighs_less_than_2_mb(built_page):
+    assert _weight(built_page) < MAX_BYTES
+
+
+def test_built_site_page_has_no_static_copy_of_a_live_figure(built_page):
+    """A live figure is its plot alone (issue 22): no static SVG of the same curves beside it
+    (printing prints the plot), a <noscript> line in its place for a reader without JavaScript."""
+    html = built_page.read_text(encoding="utf-8")
+    assert "static-plot" not in html
+    for m in re.finditer(r'<div class="live" id="(live-[^"]+)">(.*?)</div>', html, re.S):
+        assert m.group(2).startswith("<noscript>") and "<svg" not in m.group(2), m.group(1)
+
+
+@pytest.mark.parametrize("width", [400, 1400])
+def test_built_site_page_fits_the_window_with_nothing_clipped(built_page, browser, width):
+    ctx = layout_context(browser, width)
+    try:
+        problems = page_problems(ctx, built_page, width)
+    finally:
+        ctx.close()
+    assert not problems, f"{len(problems)} problems at {width} px:\n" + "\n".join(problems[:40])
+
+
+# for a live plot: [has its quantity] per curve, from the data it was drawn from (a stage without
+# the joint of a joint-load panel has no curve there, its legend entry shows a dash)
+_CURVES_PRESENT = """el => {
+  const d = JSON.parse(document.querySelector(`script[data-live='${el.parentElement.id}']`).textContent);
+  return d.series.map(s => el.dataset.quantity in s.y);
+}"""
+
+
+@pytest.mark.parametrize("width", [400, 1400])
+def test_built_site_plots_show_values_on_hover(built_plot_page, browser, width):
+    """The first plot of every interactive figure of the page, its sections open, shows the time
+    and the value of every curve it draws under the mouse."""
+    ctx = layout_context(browser, width)
+    w = Watched(ctx)
+    p = w.page
+    try:
+        p.goto(built_plot_page.as_uri(), wait_until="load")
+        open_sections(p)
+        p.wait_for_timeout(100)
+        # plots over time; a Pareto front over its budget has a value only at its designs (its hover
+        # is checked at a design in tests/report/test_live_browser.py)
+        timed = [h for h in p.locator(".live.live-ready").all()
+                 if not p.eval_on_selector(f"script[data-live='{h.get_attribute('id')}']", "s => 'x' in JSON.parse(s.textContent)")]
+        plots = [h.locator(".live-plot:not([hidden])").first for h in timed]
+        assert plots, "no interactive plot drawn"
+        for plot in plots:
+            shown = hover(p, plot, min_width=width // 4)
+            present = plot.evaluate(_CURVES_PRESENT)
+            assert len(shown) == 1 + len(present) and any(present), plot.get_attribute("data-quantity")
+            valued = [bool(re.search(r"\d", v)) for v in shown]
+            assert valued == [True] + present, (plot.get_attribute("data-quantity"), shown)
+    finally:
+        ctx.close()
+    assert not w.problems, "\n".join(w.problems)
