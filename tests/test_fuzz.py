@@ -2,8 +2,9 @@
 
 Random YAML documents and mutations of every spec in ``specs/`` (dropped, renamed and duplicated
 keys, swapped types, NaN, inf, 1e308, -0, negatives, zeros, empty and enormous lists, deep
-nesting, unicode and control characters, aliases). Every case must end with a located message
-(exit 2) or a valid result, never a traceback or a hang.
+nesting, unicode and control characters, aliases), and mutated CSV table files read by a motion
+and by a path's timing. Every case must end with a located message (exit 2) or a valid result,
+never a traceback or a hang.
 
 The default run takes a small fixed-seed sample (hypothesis ``derandomize``); ``--long`` (or
 ``BALPIPE_LONG_TESTS=1``) a larger one, still fixed. A long random run by hand:
@@ -29,12 +30,13 @@ from hypothesis import strategies as st
 from balpipe.cli import main
 from balpipe.loader import SpecError, SpecErrors, load_text
 from _long import sample
+from test_motion_specs import FOUR_BAR, TWO_R_TIP
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC_FILES = sorted((ROOT / "specs").glob("*.yaml"))
 LONG = os.environ.get("BALPIPE_FUZZ") == "long"
 N = int(os.environ.get("BALPIPE_FUZZ_EXAMPLES", "0"))
-COUNT = {"loader": 0, "mutations": 0, "cli": 0}
+COUNT = {"loader": 0, "mutations": 0, "cli": 0, "tables": 0}
 
 
 def fuzz_settings(ci: int, long: int, short: int | None = None):
@@ -225,6 +227,83 @@ def test_cli_check_and_build_on_mutated_specs(tmp_path_factory, text):
     if rc == 0:
         rb = main(["build", str(d / "s.yaml"), "-o", str(d / "out"), "--no-sim", "-q"])
         assert rb in (0, 1), "check passed but build refused the spec"
+
+
+# --- table files ------------------------------------------------------------------------------
+
+TABLE_SPEC = (FOUR_BAR.replace("analysis: {samples: 201}", "analysis: {samples: 21}")
+              + "motion:\n  duration: 1 s\n  drive:\n    crank: {law: table, file: crank.csv, ends: periodic}\n")
+TIMING_SPEC = TWO_R_TIP.replace("analysis: {samples: 201}", "analysis: {samples: 21}").replace(
+    "timing: {law: quintic}", "timing: {law: table, file: crank.csv, ends: clamped}")
+GOOD_ROWS = [(k / 20, 30 * (1 - math.cos(2 * math.pi * k / 20))) for k in range(21)]
+#: the timing's arc length s (m) along TWO_R_TIP's polyline (0.15 m + 0.15 m, a fillet cut), at rest at both ends
+TIMING_ROWS = [(k / 20, 0.28 * (k / 20 - math.sin(2 * math.pi * k / 20) / (2 * math.pi))) for k in range(21)]
+cells = st.sampled_from(["nan", "inf", "-inf", "1e308", "-1e308", "1e400", "0", "-0", "", " ", "x", "1,5", '"1"',
+                         "1e5", "1e7", "\x00", "\ufeff0", "0x10", "1_000", "٣"]) | st.floats(allow_nan=True) | text_st
+headers = st.sampled_from(["t [s], crank [deg]", "t [ms], crank [rad]", "t, crank", "t [s]", "t [s], crank [mm]",
+                           "\ufefft [s], crank [deg]", "t (s); crank (deg)", "", "# comment", "t [s], crank [deg], x",
+                           "t [xyz], crank [deg]", "t [s], crank [kg]"]) | text_st
+
+
+@st.composite
+def table_file(draw, good: list, good_header: str) -> bytes:
+    """A CSV table: the good one, then a few of its rows and cells replaced, rows dropped,
+    duplicated or shuffled, the header changed, line endings and encodings changed, bytes added."""
+    rows = [[repr(t), repr(q)] for t, q in good]
+    for _ in range(draw(st.integers(0, 4))):
+        kind = draw(st.sampled_from(["cell", "drop", "dup", "swap", "extra", "short", "many"]))
+        if not rows:
+            break
+        i = draw(st.integers(0, len(rows) - 1))
+        if kind == "cell":
+            rows[i][draw(st.integers(0, len(rows[i]) - 1))] = str(draw(cells))
+        elif kind == "drop":
+            rows.pop(i)
+        elif kind == "dup":
+            rows.insert(i, list(rows[i]))
+        elif kind == "swap":
+            j = draw(st.integers(0, len(rows) - 1))
+            rows[i], rows[j] = rows[j], rows[i]
+        elif kind == "extra":
+            rows[i].append(str(draw(cells)))
+        elif kind == "short":
+            rows[i] = rows[i][:1]
+        else:
+            rows = rows * draw(st.integers(2, 50))
+    header = draw(st.just(good_header) | headers)
+    sep = draw(st.sampled_from(["\n", "\r\n", "\r"]))
+    text = sep.join([header] + [", ".join(r) for r in rows]) + sep
+    enc = draw(st.sampled_from(["utf-8", "utf-8-sig", "utf-16", "latin-1"]))
+    data = text.encode(enc, errors="replace")
+    if draw(st.booleans()):
+        data += draw(st.binary(max_size=40))
+    return data
+
+
+@fuzz_settings(ci=40, long=5000, short=12)  # each case a check of a small spec
+@given(st.booleans().flatmap(lambda timing: st.tuples(st.just(timing), table_file(
+    TIMING_ROWS if timing else GOOD_ROWS, "t [s], s [m]" if timing else "t [s], crank [deg]"))))
+def test_table_files_check_or_fail_located(tmp_path_factory, case):
+    """A table file of any content, read by a motion or a path's timing: ``check`` passes or
+    refuses it with located lines (exit 2) that quote no row of it; never an exception."""
+    import contextlib
+    import io
+
+    timing, data = case
+    COUNT["tables"] += 1
+    COUNT["tables_valid"] = COUNT.get("tables_valid", 0)
+    d = tmp_path_factory.mktemp("table")
+    (d / "crank.csv").write_bytes(data)
+    spec = d / "s.yaml"
+    spec.write_text(TIMING_SPEC if timing else TABLE_SPEC)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        rc = main(["check", str(spec)])
+    assert rc in (0, 2), err.getvalue()
+    COUNT["tables_valid"] += rc == 0
+    for line in err.getvalue().splitlines()[:-1]:  # the last is the summary
+        assert re.match(rf"{re.escape(str(spec))}:\d+:\d+: \S", line) and "Traceback" not in line, line
+        assert "internal error" not in line and "computation failed" not in line, line
 
 
 def test_fuzz_report():

@@ -35,17 +35,16 @@ def changed(text: str, old: str, new: str, count: int = 1) -> str:
     return text.replace(old, new, count)
 
 
-def test_a_joint_name_used_twice_is_located(tmp_path, capsys):
-    text = changed(STEADY, "{type: revolute, name: A,", "{type: revolute, name: O2,")
+@pytest.mark.parametrize("old, new, at, field, words", [
+    ("{type: revolute, name: A,", "{type: revolute, name: O2,", ("name: O2", 2), "mechanism.joints[1].name",
+     "joint name 'O2' is used twice"),
+    ("    - {name: crank, joint: O2}\n", "    - {name: crank, joint: O2}\n    - {name: crank, joint: O4}\n",
+     ("joint: O4}", 1), "mechanism.drivers[1].name", "driver name 'crank' is used twice"),
+], ids=["joint", "driver"])
+def test_a_name_used_twice_in_a_custom_mechanism_is_located(tmp_path, capsys, old, new, at, field, words):
+    text = changed(STEADY, old, new)
     p, line = located(tmp_path, capsys, text)
-    assert line.startswith(f"{p}:{line_of(text, 'name: O2', 2)}:") and "mechanism.joints[1].name" in line
-    assert "joint name 'O2' is used twice" in line
-
-
-def test_a_driver_name_used_twice_is_located(tmp_path, capsys):
-    text = changed(STEADY, "    - {name: crank, joint: O2}\n", "    - {name: crank, joint: O2}\n    - {name: crank, joint: O4}\n")
-    p, line = located(tmp_path, capsys, text)
-    assert line.startswith(f"{p}:{line_of(text, 'joint: O4}')}:") and "mechanism.drivers[1].name" in line
+    assert line.startswith(f"{p}:{line_of(text, *at)}:") and f"{field}: {words}" in line, line
 
 
 def test_a_zero_length_link_is_located_at_its_point(tmp_path, capsys):

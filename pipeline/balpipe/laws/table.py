@@ -77,7 +77,11 @@ def parse_table(text: str, dimension: str, time_column: str | None = None,
     ``argument``: the dimension of the first column when it is not a time (a load's table
     against an angle or a stroke); ``spline`` False: a table interpolated linearly (a load's),
     which needs two rows, not a spline's eight and even spacing."""
-    reader = list(csv.reader(io.StringIO(text)))
+    reader = csv.reader(io.StringIO(text, newline=None))  # universal newlines: \r, \r\n and \n end a row
+    try:
+        reader = list(reader)
+    except csv.Error as exc:  # a NUL byte, a field too large: the message names no cell
+        raise TableError(f"not a CSV table: {str(exc).split(' - ')[0]}", reader.line_num or None) from None
     lines = [(k + 1, r) for k, r in enumerate(reader) if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
     if not lines:
         raise TableError("the file is empty (expected a header such as 't [s], angle [deg]' and rows of numbers)")
