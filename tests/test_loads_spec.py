@@ -150,7 +150,7 @@ def test_angle_tables_repeat_every_turn(tmp_path):
     assert np.allclose(an.loads["f"]["Fy"], expected, atol=1e-9)
 
 
-LOADED = ("pumpjack_rod_load.yaml", "compressor_gas_pressure.yaml", "custom_four_bar_loaded.yaml")
+LOADED = ("custom_pumpjack_rod_load.yaml", "custom_compressor_gas_pressure.yaml", "custom_four_bar_loaded.yaml")
 
 
 def test_loaded_examples_build_and_validate_at_default_settings(tmp_path):
@@ -171,7 +171,7 @@ def test_loaded_examples_build_and_validate_at_default_settings(tmp_path):
 
 
 def test_pumpjack_frame_load_is_the_shaking_load_plus_the_rod_load(studies):
-    st = studies("pumpjack_rod_load.yaml")
+    st = studies("custom_pumpjack_rod_load.yaml")
     for sr in st.stages:
         an = sr.analysis
         rod = an.loads["rod_load"]

@@ -50,7 +50,7 @@ def geometry_key(model: Model, t: np.ndarray, gravity=(0.0, 0.0), moment_point=(
     drivers = tuple((d.name, d.target, tuple(np.asarray(x, dtype=float).tobytes() for x in d.law(t)))
                     for d in model.drivers)
     return (bodies, model.joints, tuple(sorted(model.initial.items())), tuple(sorted(model.frame_points.items())),
-            drivers, t.tobytes(), tuple(map(float, gravity)), tuple(map(float, moment_point)), model.loads)
+            drivers, model.loads, t.tobytes(), tuple(map(float, gravity)), tuple(map(float, moment_point)))
 
 
 def check_parameters(names: list[str], P: np.ndarray) -> list[str | None]:

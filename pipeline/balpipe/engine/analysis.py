@@ -282,12 +282,13 @@ def analyse(
             raise AnalysisError("Coulomb friction in a model whose gear meshes carry tooth forces is not supported: "
                                 "give the friction as viscous, or the gears without pitch radii", float(t[0]))
         lam, gen0 = solve_loads(lt, rhs, solver)
-    if mesh_geo:
-        # the radial tooth forces move load between bearings (in place in lam): the frame's
-        # bearings among them change the frame's load by -Phi_q0^T dlambda
+    if mesh_geo:  # the radial tooth forces move the bearings' multipliers: the frame's share too
         before = lam.copy()
         lam, radial_on_frame = radial_tooth_loads(cd, mesh_geo, lam)
-        gen0 = gen0 - np.einsum("nmk,nm->nk", J0, lam - before) + radial_on_frame
+        if lt is None:
+            gen0 = -np.einsum("nmk,nm->nk", J0, lam) + radial_on_frame  # load on the frame: Fx, Fy, M_O
+        else:
+            gen0 = gen0 - np.einsum("nmk,nm->nk", J0, lam - before) + radial_on_frame
     frame_gen = gen0
     if lt is not None:
         gen0 = gen0 - lt.external  # the shaking load: the frame load less the external loads
