@@ -117,7 +117,7 @@ def test_frame_load_maps_add_the_outside_load():
 
 
 def test_coulomb_friction_is_a_located_error():
-    spec = load(SPECS / "compressor_gas_pressure.yaml").spec
+    spec = load(SPECS / "custom_compressor_gas_pressure.yaml").spec
     d = spec.model_dump(mode="json", exclude_none=True)
     bal = {"method": "partial_balance", "counterweights": [{"body": "crank", "name": "cw", "disc": {"centre": [0, 0], "radius": 0.05}}],
            "objective": [{"load": "joint", "joint": "A"}], "budget": {"mass": 3}, "fronts": None}
