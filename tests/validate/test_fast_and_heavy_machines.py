@@ -145,6 +145,8 @@ def test_a_run_that_cannot_resolve_its_error_within_its_budget_is_unconfirmed(v_
     assert dt < r.dt / 2
     resolved = _torque(v_twin, s, settings=ValidationSettings(dt=dt))
     assert resolved.status == "pass" and resolved.resolution >= 10, resolved.reasons
+    given = _torque(v_twin, s, settings=ValidationSettings(dt=r.dt))  # the spec's step: not refined, still not failed
+    assert given.status == "unconfirmed" and "validation: {dt: " in given.remedy, given.remedy
 
 
 def _v_twin_text(validation: str, counterweight_factor: float = 1.0) -> str:

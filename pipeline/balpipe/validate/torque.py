@@ -496,7 +496,10 @@ def _judge(r: TorqueDriven, refinement: Refinement, settings: ValidationSettings
         r.remedy = (f"{step_setting(refinement.remedy_dt)} (second order: the tracking error falls with the square of the step; "
                     f"the validator stopped at {1e3 * r.dt:.4g} ms, {settings.max_refinement:g} times finer at most)")
     elif settings.dt:
+        goal = 0.5 * min(tol, r.calibration_error / MIN_RESOLUTION if math.isfinite(r.calibration_error) else tol)
         r.remedy = f"a finer validation.dt than the spec's {settings.dt:g} s"
+        if not apart and goal > 0 and r.tracking_error_max > goal:  # second order, if the error is the step's
+            r.remedy += f", {step_setting(r.dt * math.sqrt(goal / r.tracking_error_max))} if the error is the step's"
     elif apart:
         r.remedy = f"validation: {{iterations: {2 * r.iterations}}} or a finer validation.dt"
     else:
