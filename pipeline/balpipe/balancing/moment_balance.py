@@ -304,5 +304,8 @@ def notation(method: MomentBalance) -> dict:
     """Symbols of this method's inputs, named after the spec's counterweights and discs."""
     from .force_balance import counterweight_notation
 
+    from ..notation import setting
+
     return {**counterweight_notation(method.counterweights),
-            **counter_rotation_notation(method.counter_rotations, "balancing.counter_rotations")}
+            **counter_rotation_notation(method.counter_rotations, "balancing.counter_rotations"),
+            "balancing.gear_signs": setting("gear signs", "the discs' gear signs as given, or found by the method")}
