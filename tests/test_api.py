@@ -92,7 +92,7 @@ def test_figures_are_the_pages_curves(api_studies):
     from matplotlib.figure import Figure
 
     st = api_studies("offset_slider_crank.yaml")
-    assert st.figure_names == ("loads", "efforts", "joints")
+    assert st.figure_names == ("loads", "efforts", "joints", "mechanism")
     fig = st.figure("loads")
     assert isinstance(fig, Figure)
     axes = fig.axes
@@ -101,8 +101,12 @@ def test_figures_are_the_pages_curves(api_studies):
     moment = {line.get_label(): line.get_ydata() for line in axes[3].get_lines()}
     for s in st.stages:
         np.testing.assert_array_equal(moment[s.label], s.analysis.moment)
-    with pytest.raises(KeyError, match="no figure 'nope'; figures: loads, efforts, joints"):
+    with pytest.raises(KeyError, match="no figure 'nope'; figures: loads, efforts, joints, mechanism"):
         st.figure("nope")
+    drawn = st.figure("mechanism")  # the page's drawings: a panel per stage, named as the paper does
+    assert [ax.get_title() for ax in drawn.axes] == [s.label for s in st.stages]
+    assert [[t.get_text() for t in ax.texts] for ax in drawn.axes] == [
+        ["A", "B", "C", "link 1", "link 2"], ["A", "B", "C", "counterweight 1", "counterweight 2", "link 1", "link 2"]]
 
 
 def test_the_notebook_view_shows_verdict_card_and_a_live_plot(api_studies):

@@ -114,14 +114,16 @@ class Study:
     @property
     def figure_names(self) -> tuple[str, ...]:
         """The names ``figure`` draws: ``loads`` (shaking force and moment), ``efforts``
-        (actuators), and ``joints`` (joint loads) when the mechanism has joint loads."""
+        (actuators), ``joints`` (joint loads) when the mechanism has joint loads, and
+        ``mechanism`` (its drawings, a panel per stage)."""
         from ..report.page import time_curves
 
-        return tuple(k for k, c in time_curves(self._study).items() if c.panels)
+        return tuple(k for k, c in time_curves(self._study).items() if c.panels) + ("mechanism",)
 
     def figure(self, name: str) -> Any:
-        """One of the page's time-series figures, drawn with matplotlib from the very curves the
-        page plots (every stage shown on the page, a panel per quantity).
+        """One of the page's figures, drawn with matplotlib: a time series from the very curves
+        the page plots (every stage shown on the page, a panel per quantity), or the page's
+        drawings of the mechanism (``mechanism``).
 
         Args:
             name: one of ``figure_names``.
@@ -131,9 +133,12 @@ class Study:
 
         Raises:
             KeyError: an unknown name."""
+        from ..report.notation_table import names_for
         from ..report.page import time_curves
-        from .figures import matplotlib_figure
+        from .figures import matplotlib_figure, mechanism_figure
 
+        if name == "mechanism":
+            return mechanism_figure(self._study, names_for(self._study.spec))
         curves = time_curves(self._study)
         if name not in curves or not curves[name].panels:
             raise KeyError(f"no figure {name!r}; figures: {', '.join(self.figure_names)}")

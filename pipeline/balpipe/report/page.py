@@ -67,6 +67,17 @@ def time_curves(study: Study, names: PageNames | None = None) -> dict[str, live.
             "joints": live_plots.joints(shown, joint_names)}
 
 
+def drawing_settings(study: Study, names: PageNames) -> dict:
+    """What every mechanism drawing of the page shares (the keyword arguments of
+    :func:`balpipe.draw.figures.mechanism_figure`): the ghosts' instants, one scale for every
+    panel, the gears' numbers, and one name per link (the paper's symbols)."""
+    shown = shown_stages(study)
+    return {"ghosts": drawn_instants(study),
+            "limits": figures.common_limits([(s.stage.model, s.analysis.frame_pose) for s in shown]),
+            "numbers": labels.gear_numbers([s.stage.model for s in shown]),
+            "texts": names.link_texts([s.stage.model for s in shown])}
+
+
 def study_figures(study: Study, names: PageNames | None = None) -> dict:
     names = names if names is not None else names_for(study.spec)
     shown = [(s.stage.label, s.analysis) for s in shown_stages(study)]
@@ -77,13 +88,10 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
     efforts = live.html("efforts", curves["efforts"])
     joint_curves = curves["joints"]
     joints = live.html("joints", joint_curves) if joint_curves.panels else ""
-    limits = figures.common_limits([(s.stage.model, s.analysis.frame_pose) for s in shown_stages(study)])
-    numbers = labels.gear_numbers([s.stage.model for s in shown_stages(study)])
-    ghosts = drawn_instants(study)
-    texts = names.link_texts([s.stage.model for s in shown_stages(study)])  # one name per link on the page
+    drawing = drawing_settings(study, names)
     mech = [
-        (s.stage.label, figures.mechanism_figure(s.stage.model, s.analysis, ghosts, prefix=f"mech{k}",
-                                                 title=s.stage.label, limits=limits, numbers=numbers, texts=texts))
+        (s.stage.label, figures.mechanism_figure(s.stage.model, s.analysis, prefix=f"mech{k}", title=s.stage.label,
+                                                 **drawing))
         for k, s in enumerate(shown_stages(study))
     ]
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
@@ -124,7 +132,7 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
                             "paper's numbers draw each stage as every other figure does" if study.spec.paper else
                             "These are the line styles of the paper whose method balances this spec, so the figures "
                             "drawn as that paper's draw each stage as every other figure does"),
-            "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(numbers), "extra": extra,
+            "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(drawing["numbers"]), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
