@@ -19,7 +19,10 @@ each further round if too few samples close) and the constraints re-solved (Newt
 engine's; with redundant actuation, a subset of drivers that makes the system square),
 and velocities are random combinations of the null space of the joint constraints' Jacobian (every
 feasible velocity, independent of the drivers). Configurations whose joint Jacobian is nearly
-singular (smallest to largest singular value below :data:`MIN_CONDITION`) are discarded.
+singular (smallest to largest singular value below :data:`MIN_CONDITION`) are discarded. A
+machine of one degree of freedom with at least :data:`BLOCK_COORDINATES` coordinates has its
+trial states solved by blocks (:mod:`.state_blocks`: the same states to round-off, O(bodies) per
+state instead of the SVD's O(bodies^3)).
 """
 
 from __future__ import annotations
