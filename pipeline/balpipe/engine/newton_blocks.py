@@ -99,9 +99,12 @@ class BlockOps:
                 return np.linalg.solve(J, -phi[:, todo].T[..., None])[..., 0].T
             except np.linalg.LinAlgError:
                 return self._general(X[3:-1, todo], phi[:, todo])
+        every = bool(todo.all())  # no copies of the values when every sample takes the step
+        v = vals if every else vals[:, todo]
         with np.errstate(all="ignore"):
-            dq = solve(self.dec.forward, vals[:, todo], -phi[:, todo], invert_blocks(self.dec, vals[:, todo]),
+            dq = solve(self.dec.forward, v, -(phi if every else phi[:, todo]), invert_blocks(self.dec, v),
                        offset=3)[3:-1]
+        del v
         bad = ~np.isfinite(dq).all(axis=0)
         if bad.any():
             dq[:, bad] = self._general(X[3:-1, todo][:, bad], phi[:, todo][:, bad])

@@ -404,7 +404,7 @@ def invert_blocks(dec: Decomposition, vals: np.ndarray) -> dict[int, np.ndarray]
     return out
 
 
-_STACKED = 65536  # block samples inverted in one call at most
+_STACKED = 16384  # block samples inverted in one call at most
 
 
 def _invert_group(vals: np.ndarray, group: list[tuple[int, np.ndarray]], k: int, N: int,
