@@ -180,3 +180,29 @@ def test_pumpjack_frame_load_is_the_shaking_load_plus_the_rod_load(studies):
         # the counterbalance lowers the peak net gearbox torque
     peaks = [float(np.max(np.abs(s.analysis.efforts["crank"]))) for s in st.stages]
     assert peaks[1] < 0.5 * peaks[0]
+
+
+def test_force_deflection_law_and_torque_table(tmp_path):
+    """A tabulated force-deflection law gives the table's tension at the element's own deflection;
+    a torque table (no direction) acts as a torque; both enter the power balance of the motor."""
+    (tmp_path / "k.csv").write_text("d [mm], T [N]\n-100, -300\n0, 0\n20, 40\n100, 500\n")
+    (tmp_path / "m.csv").write_text("t [s], M [N m]\n0, 0\n0.05, 2\n0.1, 0\n")
+    st = _run("  - {type: force_law, name: k, a: {body: frame, point: [0.5, 0.05]}, b: {body: slider, point: C},"
+              " free_length: 0.26, table: {file: k.csv, against: deflection}}\n"
+              "  - {type: force, name: m, at: {body: coupler, point: B}, table: {file: m.csv}}", tmp_path)
+    an = st.unbalanced.analysis
+    k = an.loads["k"]
+    expected = np.interp(k["length"] - 0.26, [-0.1, 0.0, 0.02, 0.1], [-300.0, 0.0, 40.0, 500.0])
+    assert np.allclose(k["tension"], expected, rtol=1e-13, atol=1e-10)
+    m = an.loads["m"]
+    assert np.allclose(m["torque"], np.interp(an.t, [0, 0.05, 0.1], [0, 2, 0]), rtol=1e-13, atol=1e-12)
+    assert np.all(m["Fx"] == 0) and np.all(m["Fy"] == 0)
+    # power balance: motor power = d(kinetic energy)/dt + the loads' absorbed power
+    model = st.unbalanced.stage.model
+    mass = np.array([b.mass_properties()[0] for b in model.bodies])
+    inertia = np.array([b.mass_properties()[2] for b in model.bodies])
+    dKE = np.einsum("k,nkd,nkd->n", mass, an.v[:, :, :2], an.a[:, :, :2]) + np.einsum("k,nk,nk->n", inertia, an.v[:, :, 2], an.a[:, :, 2])
+    w_coupler = an.v[:, an.names.index("coupler"), 2]
+    motor = an.efforts["crank"] * an.v[:, an.names.index("crank"), 2]
+    expected_power = dKE - k["power"] - m["torque"] * w_coupler
+    assert np.max(np.abs(motor - expected_power)) <= 1e-9 * np.max(np.abs(motor))
