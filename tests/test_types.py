@@ -16,7 +16,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
 #: the most modules the backlog may hold: lower it when a module leaves, never raise it
-BACKLOG_LIMIT = 63
+BACKLOG_LIMIT = 60
 STRICT = {"balpipe.engine.*", "balpipe.model", "balpipe.units", "balpipe.plugins", "balpipe.balancing.base",
           "balpipe.mechanics.planar", "balpipe.testing", "balpipe.testing.*"}
 

@@ -6,7 +6,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from .units import Inertia, Length, Mass, PositiveLength, Rate, RateRate, number
+from .units import AccelFraction, Inertia, Length, Mass, PositiveLength, Rate, RateRate
 
 
 def paper_id(paper: str | None) -> str:
@@ -70,6 +70,6 @@ class DriveSpec(Strict):
         None, description="this drive's own law (quintic, cycloidal, bang_bang, trapezoidal, polynomial); "
         "default: motion.law"
     )
-    accel_fraction: number(gt=0, le=0.5) | None = Field(
+    accel_fraction: AccelFraction | None = Field(
         None, description="trapezoidal law: this drive's acceleration fraction (default: motion.accel_fraction)"
     )

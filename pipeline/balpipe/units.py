@@ -271,3 +271,6 @@ PositiveMass = quantity("mass", gt=0)
 Inertia = quantity("inertia", ge=0)
 Acceleration = quantity("acceleration")
 Number = number()
+PositiveNumber = number(gt=0)
+AccelFraction = number(gt=0, le=0.5)  # a trapezoidal law's acceleration time, of the segment's
+Cycles = number(gt=0, le=10_000)  # a motion's number of periods

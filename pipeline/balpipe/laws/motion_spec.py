@@ -9,7 +9,7 @@ from typing import Literal
 from pydantic import Field, PrivateAttr, model_validator
 
 from ..spec_parts import Strict
-from ..units import Duration, number
+from ..units import AccelFraction, Cycles, Duration
 from .drives import Drive, common_period, period
 
 
@@ -25,10 +25,10 @@ class Motion(Strict):
         "polynomial meeting the drives' boundary velocities and accelerations",
     )
     duration: Duration | None = Field(None, description="duration of the motion (or give cycles)")
-    cycles: number(gt=0, le=10_000) | None = Field(
+    cycles: Cycles | None = Field(
         None, description="instead of duration: this many periods of the periodic drives (constant speed "
         "in rpm or rad/s: one turn; cam, fourier: their period; cycle: the sum of its segments)")
-    accel_fraction: number(gt=0, le=0.5) = Field(
+    accel_fraction: AccelFraction = Field(
         1 / 3, description="trapezoidal law: fraction of the duration spent accelerating"
     )
     drive: dict[str, Drive] = Field(

@@ -11,7 +11,7 @@ from pydantic import Field
 from .template import GearPart
 from ...mechanics.meshes import DEFAULT_PRESSURE_ANGLE, PressureAngle
 from ...spec_parts import Strict
-from ...units import Inertia, Length, Mass, number
+from ...units import Inertia, Length, Mass, PositiveNumber
 
 
 class CounterweightPositions(Strict):
@@ -31,7 +31,7 @@ class CounterRotation(Strict):
     """Gears 3', 4' fixed on the distal links at B_j, meshing with gears 6, 7 on axes A_j carried
     by the input links (r3' + r6 = l1, r4' + r7 = l2)."""
 
-    ratio: number(gt=0) = Field(1.0, description="U63 = U74 = r3'/r6 = r4'/r7 (the paper: 1)")
+    ratio: PositiveNumber = Field(1.0, description="U63 = U74 = r3'/r6 = r4'/r7 (the paper: 1)")
     gear_3p: GearPart = Field(
         GearPart(), description="gears 3' and 4' (each), fixed on the distal links at B_j in the full stage"
     )
