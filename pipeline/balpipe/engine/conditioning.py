@@ -24,6 +24,8 @@ varies, as many do, needs most of its samples.)
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from .compile import Compiled
@@ -41,6 +43,9 @@ SMALL = 4 * STRIDE
 CHUNK = 512
 
 
+#: the Jacobians (k, m, n) of the samples idx (k,)
+Jacobians = Callable[[np.ndarray], np.ndarray]
+
 def peak(J: np.ndarray) -> tuple[int, float]:
     """The first sample k of the largest 2-norm condition number of J (N, m, n), m >= n, and that
     number: ``k = argmax(cond)``, ``cond[k]`` with ``cond = positions._condition(J)``, the same
@@ -55,17 +60,17 @@ def _norms_and_steps(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.sqrt(np.einsum("nij,nij->n", J, J)), np.sqrt(np.einsum("nij,nij->n", D, D))
 
 
-def _condition_of(get, idx: np.ndarray) -> np.ndarray:
+def _condition_of(get: Jacobians, idx: np.ndarray) -> np.ndarray:
     """Condition numbers of the samples ``idx``, :data:`CHUNK` at a time (``get(idx)``: their J)."""
     return np.concatenate([_condition(get(idx[a : a + CHUNK])) for a in range(0, len(idx), CHUNK)] or [np.zeros(0)])
 
 
-def _singular(get, idx: np.ndarray) -> np.ndarray:
+def _singular(get: Jacobians, idx: np.ndarray) -> np.ndarray:
     """Singular values of the samples ``idx``, :data:`CHUNK` at a time."""
     return np.concatenate([np.linalg.svd(get(idx[a : a + CHUNK]), compute_uv=False) for a in range(0, len(idx), CHUNK)])
 
 
-def _peak(N: int, get, norm: np.ndarray, steps: np.ndarray) -> tuple[int, float]:
+def _peak(N: int, get: Jacobians, norm: np.ndarray, steps: np.ndarray) -> tuple[int, float]:
     """:func:`peak` from ``get(idx)`` (the Jacobians of the samples idx), their Frobenius norms
     and the norms of the steps between consecutive samples. A Jacobian is finite exactly when
     its norm is."""
@@ -105,7 +110,7 @@ def motion_peak(c: Compiled, q: np.ndarray) -> tuple[int, float]:
     :func:`.positions.condition_numbers` ``(c, q)``. The Jacobians are formed :data:`CHUNK`
     samples at a time (each sample's entries, norms and SVD do not depend on the others: the
     same floats), so that the memory does not grow with the number of samples."""
-    def get(idx) -> np.ndarray:
+    def get(idx: np.ndarray | slice) -> np.ndarray:
         return jacobian(c, with_frame(q[idx]))[:, :, 3:]
 
     N = len(q)
