@@ -110,6 +110,30 @@ class GivenCounterRotation(CounterRotationSpec):
     inertia: Inertia = Field(description="centroidal inertia of the disc")
 
 
+class LoadTerm(Strict):
+    """One load over the motion's time samples, measured by its peak or its RMS."""
+
+    load: Literal["shaking_force", "shaking_moment", "frame_force", "frame_moment", "effort", "joint"] = Field(
+        description="shaking_force |F|, shaking_moment |M| (about the analysis' moment point; inertial, loads do not "
+        "change them), frame_force, frame_moment: everything the frame feels (the shaking load plus the external "
+        "loads), effort |tau| of an actuator, joint: the load a joint carries (|F| of a revolute, |N| of a "
+        "prismatic pair, |T| of a gear); efforts, joint and frame loads count the spec's loads"
+    )
+    measure: Literal["peak", "rms"] = Field("peak", description="peak over the samples, or root mean square")
+    actuator: str | None = Field(None, description="effort: the driver's name (default: every actuator, the largest)")
+    joint: str | None = Field(None, description="joint: the joint's name")
+
+    @model_validator(mode="after")
+    def _names(self):
+        if self.load == "joint" and not self.joint:
+            raise ValueError("a joint load names its joint (joint: NAME)")
+        if self.load != "joint" and self.joint:
+            raise ValueError("joint: only with load: joint")
+        if self.load != "effort" and self.actuator:
+            raise ValueError("actuator: only with load: effort")
+        return self
+
+
 class StageStep(Strict):
     """One stage: parts added or changed relative to the stage before."""
 
@@ -122,10 +146,21 @@ class StageStep(Strict):
     parts: list[PartSpec] = Field([], description="parts added (or changed, by body and name)")
     remove: list[str] = Field([], description="parts removed, as body.name")
     counter_rotations: list[GivenCounterRotation] = Field([], description="counter-rotating discs added")
+    aim: list[LoadTerm] = Field(
+        [], description="the loads the stage is designed to lower (a crank counterbalance: the peak gearbox torque): "
+        "the stage is judged on them, each against the unbalanced mechanism, and the shaking force and moment it does "
+        "not name are side effects; a stage claims a balance (balances) or aims, not both"
+    )
     tolerance: number(gt=0, lt=1) | None = Field(
         None, description="tolerance of the stage's claims, a fraction of the reference load; default: "
         "analysis.balance_tolerance plus what the rounding of the entered numbers allows (numbers of "
         "four or more significant digits are taken as rounded at their last digit)")
+
+    @model_validator(mode="after")
+    def _claim_or_aim(self):
+        if self.aim and self.balances:
+            raise ValueError("a stage claims a balance (balances) or aims at loads (aim), not both")
+        return self
 
 
 class Stages(Strict):

@@ -10,9 +10,11 @@ from dataclasses import replace
 from ..mechanics.claim_precision import Rounding, half_unit
 from ..model import Attachment, Model
 from ..spec_parts import SpecFieldError
-from .base import BalanceResult, Stage
+from ..engine import analyse
+from .base import Aim, BalanceResult, Goal, Stage
 from .context import BalanceContext
 from .force_balance import body_point
+from .load_measures import goal_label, measure
 from .moment_balance import add_discs, set_disc_inertias
 from .specs import PartSpec, Stages
 
@@ -76,8 +78,23 @@ def balance(ctx: BalanceContext) -> BalanceResult:
                 entered[(c.name, None)] = Rounding(c.name, None, inertia=half_unit(c.inertia),
                                                    text=f"{c.name}.inertia = {c.inertia:.12g} kg m^2")
         stages.append(Stage(step.name, step.label or step.name, current, step.description, step.balances,
-                            tolerance=step.tolerance, rounding=tuple(entered.values())))
+                            tolerance=step.tolerance, rounding=tuple(entered.values()),
+                            aim=aim(ctx, model, current, step.aim, path + ("aim",)) if step.aim else None))
     return BalanceResult([], stages, [])
+
+
+def aim(ctx: BalanceContext, unbalanced: Model, model: Model, terms: list, path: tuple) -> Aim:
+    """What a hand-written stage aims at: each load term of its ``aim`` measured on the stage and
+    on the unbalanced mechanism over the motion (:func:`~balpipe.balancing.load_measures.measure`),
+    as partial balancing's objective terms are, so that the verdict judges the stage on them."""
+    before = analyse(unbalanced, ctx.t, ctx.gravity, ctx.moment_point)
+    after = analyse(model, ctx.t, ctx.gravity, ctx.moment_point)
+    goals = []
+    for i, term in enumerate(terms):
+        value, unit = measure(after, model, term, path + (i,))
+        reference, _ = measure(before, unbalanced, term, path + (i,))
+        goals.append(Goal(goal_label(term), "objective", value, reference, unit, None, term.load))
+    return Aim(tuple(goals))
 
 
 def notation(method: Stages) -> dict:

@@ -35,6 +35,7 @@ from ...notation import COMMON, ours, setting
 from ...spec_parts import SpecFieldError
 from . import fronts as PF
 from . import motions as PMo
+from ..load_measures import goal_label
 from ..base import Aim, BalanceResult, Goal, Parameter, Stage
 from ..force_balance import body_point, counterweight_notation, regions_from_spec
 from ..moment_balance import add_discs, counter_rotation_notation
@@ -273,14 +274,6 @@ def balance(ctx: BalanceContext) -> BalanceResult:
                     if len(motions) == 1 else f"parts chosen by the cone programme (global optimum over {len(motions)} "
                     "motions; analysed and validated on the spec's motion)")]
     return BalanceResult(params, stages, notes, details={"partial_balance": details})
-
-
-def goal_label(t) -> str:
-    """'peak effort of crank', 'RMS shaking force', 'peak load of joint O2': a spec term in words."""
-    what = {"shaking_force": "shaking force", "shaking_moment": "shaking moment", "frame_force": "frame force",
-            "frame_moment": "frame moment", "effort": "effort", "joint": "load"}[t.load]
-    of = f" of {t.actuator}" if t.actuator else f" of joint {t.joint}" if t.joint else ""
-    return f"{'RMS' if t.measure == 'rms' else 'peak'} {what}{of}"
 
 
 def aim_of(maps: Maps, method: PartialBalance, objective: list[Term], caps: list, z: np.ndarray, out) -> Aim:

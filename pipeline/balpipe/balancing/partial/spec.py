@@ -12,7 +12,7 @@ from pydantic import Field, model_validator
 from ...laws.motion_spec import Motion
 from ...spec_parts import Strict
 from ...units import Inertia, Mass, count, number
-from ..specs import CounterRotationSpec, CounterweightRegionSpec, Point
+from ..specs import CounterRotationSpec, CounterweightRegionSpec, LoadTerm, Point
 
 LOADS = ("shaking_force", "shaking_moment", "effort", "joint")
 MAIN_MOTION = "motion"  # the name of the spec's own motion in the report
@@ -38,30 +38,6 @@ class PartialCounterRotationSpec(CounterRotationSpec):
     """A counter-rotating disc whose inertia (>= 0) the optimiser chooses."""
 
     max_inertia: Inertia | None = Field(None, description="upper bound on the disc's inertia")
-
-
-class LoadTerm(Strict):
-    """One load over the motion's time samples, measured by its peak or its RMS."""
-
-    load: Literal["shaking_force", "shaking_moment", "frame_force", "frame_moment", "effort", "joint"] = Field(
-        description="shaking_force |F|, shaking_moment |M| (about the analysis' moment point; inertial, loads do not "
-        "change them), frame_force, frame_moment: everything the frame feels (the shaking load plus the external "
-        "loads), effort |tau| of an actuator, joint: the load a joint carries (|F| of a revolute, |N| of a "
-        "prismatic pair, |T| of a gear); efforts, joint and frame loads count the spec's loads"
-    )
-    measure: Literal["peak", "rms"] = Field("peak", description="peak over the samples, or root mean square")
-    actuator: str | None = Field(None, description="effort: the driver's name (default: every actuator, the largest)")
-    joint: str | None = Field(None, description="joint: the joint's name")
-
-    @model_validator(mode="after")
-    def _names(self):
-        if self.load == "joint" and not self.joint:
-            raise ValueError("a joint load names its joint (joint: NAME)")
-        if self.load != "joint" and self.joint:
-            raise ValueError("joint: only with load: joint")
-        if self.load != "effort" and self.actuator:
-            raise ValueError("actuator: only with load: effort")
-        return self
 
 
 class WeightedTerm(LoadTerm):
