@@ -281,6 +281,8 @@ def table_file(draw, good: list, good_header: str) -> bytes:
 
 
 @fuzz_settings(ci=40, long=5000, short=12)  # each case a check of a small spec
+@example((False, b'"\n0.0, 0.0\n' + b"".join(f"{t!r}, {q!r}\n".encode() for t, q in GOOD_ROWS[1:])))  # found by the long run
+@example((False, b"t [s], crank [deg]\r" + b"".join(f"{t!r}, {q!r}\r".encode() for t, q in GOOD_ROWS)))  # CR line ends
 @given(st.booleans().flatmap(lambda timing: st.tuples(st.just(timing), table_file(
     TIMING_ROWS if timing else GOOD_ROWS, "t [s], s [m]" if timing else "t [s], crank [deg]"))))
 def test_table_files_check_or_fail_located(tmp_path_factory, case):

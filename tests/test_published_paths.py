@@ -105,3 +105,19 @@ def test_a_folder_with_a_secret_link_and_a_device_table_builds_the_good_spec_onl
         for bad in machine_paths(tmp_path):
             assert bad not in data, (name, bad)
     assert os.path.getsize(out / "good" / "timeseries.csv") > 0
+
+
+def test_a_sweep_of_an_absolute_path_publishes_no_path_of_the_machine(tmp_path):
+    folder = tmp_path / "specs"
+    folder.mkdir()
+    (folder / "sr.yaml").write_text((ROOT / "specs" / "scott_russell.yaml").read_text())
+    out = tmp_path / "sweep"
+    r = run("sweep", folder / "sr.yaml", "--vary", "mechanism.slider.mass=0.2,0.7", "-o", out, "-j", "1", "-q",
+            cwd=ROOT)
+    assert r.returncode == 0, r.stderr
+    published = site_bytes(out)
+    assert "index.html" in published and any(k.startswith("designs/") for k in published)
+    for name, data in published.items():
+        for bad in machine_paths(tmp_path):
+            assert bad not in data, (name, bad)
+    assert b"sr.yaml" in published["index.html"]

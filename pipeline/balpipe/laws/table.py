@@ -32,7 +32,7 @@ MIN_ROWS = 8
 #: largest gap between two rows, as a multiple of the median spacing
 MAX_GAP = 10.0
 
-_HEADER = re.compile(r"^\s*(.*?)\s*(?:[\[(]\s*(.*?)\s*[\])])?\s*$")
+_HEADER = re.compile(r"^\s*(.*?)\s*(?:[\[(]\s*(.*?)\s*[\])])?\s*$", re.S)  # a quoted cell may hold line breaks
 
 
 class TableError(ValueError):
@@ -66,7 +66,7 @@ def _column(header: list[str], want: str | None, default: int, what: str) -> tup
 
 def _name(cell: str) -> str:
     """A column name as a message quotes it: stripped, at most 40 characters."""
-    cell = cell.strip()
+    cell = " ".join("".join(c if c.isprintable() else " " for c in cell).split())  # one line, printable
     return cell if len(cell) <= 40 else cell[:39] + "…"
 
 

@@ -98,8 +98,12 @@ def plan(spec_file: str, vary_args: list[str] | None = None, sample: str | None 
     loader's ``SpecErrors`` for an invalid base spec. What is not given (None, or no
     ``vary_args``) comes from the spec's ``sweep:`` block (:class:`balpipe.sweep_spec.SweepSpec`),
     else the defaults (grid, seed 0, :data:`MAX_DESIGNS`, the method's last stage)."""
-    from ..loader import load
+    from pathlib import Path
 
+    from ..loader import load
+    from ..site_files.spec_files import published_names
+
+    name = published_names([spec_file], [Path(spec_file)])[Path(spec_file)]  # what the outputs show of it
     loaded = load(spec_file)
     data = yaml.safe_load(loaded.text)
     data.pop("sweep", None)  # the designs are specs without the block (validated once, above)
@@ -163,7 +167,7 @@ def plan(spec_file: str, vary_args: list[str] | None = None, sample: str | None 
     size = math.prod(len(v.values) for v in varies) if sample == "grid" else n
     if size > max_designs:
         _too_many(loaded, block, size, max_designs, limit_from_block)
-    return Plan(str(loaded.path), loaded.text, data, varies, designs_of(varies, sample, n, seed), stage, sample, seed)
+    return Plan(name, loaded.text, data, varies, designs_of(varies, sample, n, seed), stage, sample, seed)
 
 
 def _too_many(loaded, block, size: int, max_designs: int, limit_from_block: bool) -> None:
