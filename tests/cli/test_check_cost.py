@@ -77,7 +77,7 @@ def test_check_starts_the_costliest_first_and_reports_in_the_specs_order(tmp_pat
     def recording(fn, items, jobs, *args, cost=None):
         assert jobs == 2 and cost is not None
         started.extend(Path(items[i][0]).name for i in sorted(range(len(items)), key=lambda i: -cost(items[i])))
-        return [("ok", f"{f}: ok") for f, _ in items]
+        return (("ok", f"{f}: ok") for f, _ in items)  # a generator, as in_order's (pool.finished closes it)
 
     monkeypatch.setattr(pool, "in_order", recording)
     assert main(["check", "-j", "2", str(folder)]) == 0

@@ -20,6 +20,7 @@ import numpy as np
 from ..engine import Analysis
 from ..mechanics.drivers import driver_unit
 from ..model import Model
+from ..notation import ours
 from ..spec_parts import SpecFieldError
 
 
@@ -70,3 +71,21 @@ def measure(an: Analysis, model: Model, term: Any, path: tuple = ()) -> tuple[fl
     none. Raises :class:`SpecFieldError` at ``path`` for an unknown actuator or joint."""
     values = [(float(np.max(x)) if term.measure == "peak" else time_rms(x, an.t), u) for x, u in _series(an, model, term, path)]
     return max(values, key=lambda vu: vu[0])
+
+
+def term_notation(root: str, terms: list, what: str) -> dict:
+    """The inputs table's symbols of the load terms at ``root`` (``balancing.objective``): each
+    term's load, measure, actuator, joint, weight and cap, named ``what`` and its number."""
+    table = {}
+    for k, t in enumerate(terms):
+        p, name = f"{root}[{k}]", f"{t.measure} {t.load}" + (f" {t.actuator}" if t.actuator else "") + (f" {t.joint}" if t.joint else "")
+        table.update({
+            f"{p}.load": ours(f"{what} {k + 1}", f"the load of {what} {k + 1} ({name})"),
+            f"{p}.measure": ours(f"{what} {k + 1}", f"peak or RMS over the samples ({name})"),
+            f"{p}.actuator": ours(f"{what} {k + 1}", f"the actuator whose effort is meant ({name})"),
+            f"{p}.joint": ours(f"{what} {k + 1}", f"the joint whose load is meant ({name})"),
+            f"{p}.weight": ours(f"w_{{{k + 1}}}", f"weight of objective term {k + 1} ({name}, divided by its unbalanced value)"),
+            f"{p}.at_most": ours(f"c_{{{k + 1}}}", f"cap {k + 1}: {name} at most this"),
+            f"{p}.relative": ours(f"c_{{{k + 1}}}", f"cap {k + 1} is a multiple of the unbalanced value"),
+        })
+    return table

@@ -14,7 +14,7 @@ from ..engine import analyse
 from .base import Aim, BalanceResult, Goal, Stage
 from .context import BalanceContext
 from .force_balance import body_point
-from .load_measures import goal_label, measure
+from .load_measures import goal_label, measure, term_notation
 from .moment_balance import add_discs, set_disc_inertias
 from .specs import PartSpec, Stages
 
@@ -119,4 +119,5 @@ def notation(method: Stages) -> dict:
                 f"{q}.radius": ours(f"r_{{{n},disc}}", f"radius of `{n}` drawn as a disc"),
             })
         table.update(counter_rotation_notation(s.counter_rotations, f"{p}.counter_rotations"))
+        table.update(term_notation(f"{p}.aim", s.aim, f"aim of `{s.name}`,"))
     return table

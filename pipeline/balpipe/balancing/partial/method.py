@@ -35,7 +35,7 @@ from ...notation import COMMON, ours, setting
 from ...spec_parts import SpecFieldError
 from . import fronts as PF
 from . import motions as PMo
-from ..load_measures import goal_label
+from ..load_measures import goal_label, term_notation
 from ..base import Aim, BalanceResult, Goal, Parameter, Stage
 from ..force_balance import body_point, counterweight_notation, regions_from_spec
 from ..moment_balance import add_discs, counter_rotation_notation
@@ -328,28 +328,12 @@ def design_table(maps: Maps, z: np.ndarray) -> list[dict]:
     return rows
 
 
-def _term_notation(root: str, terms: list, what: str) -> dict:
-    table = {}
-    for k, t in enumerate(terms):
-        p, name = f"{root}[{k}]", f"{t.measure} {t.load}" + (f" {t.actuator}" if t.actuator else "") + (f" {t.joint}" if t.joint else "")
-        table.update({
-            f"{p}.load": ours(f"{what} {k + 1}", f"the load of {what} {k + 1} ({name})"),
-            f"{p}.measure": ours(f"{what} {k + 1}", f"peak or RMS over the samples ({name})"),
-            f"{p}.actuator": ours(f"{what} {k + 1}", f"the actuator whose effort is meant ({name})"),
-            f"{p}.joint": ours(f"{what} {k + 1}", f"the joint whose load is meant ({name})"),
-            f"{p}.weight": ours(f"w_{{{k + 1}}}", f"weight of objective term {k + 1} ({name}, divided by its unbalanced value)"),
-            f"{p}.at_most": ours(f"c_{{{k + 1}}}", f"cap {k + 1}: {name} at most this"),
-            f"{p}.relative": ours(f"c_{{{k + 1}}}", f"cap {k + 1} is a multiple of the unbalanced value"),
-        })
-    return table
-
-
 def notation(method: PartialBalance) -> dict:
     """Symbols of this method's inputs, named after its parts and terms."""
     table = {**counterweight_notation(method.counterweights),
              **counter_rotation_notation(method.counter_rotations, "balancing.counter_rotations"),
-             **_term_notation("balancing.objective", method.objective, "objective term"),
-             **_term_notation("balancing.caps", method.caps, "cap")}
+             **term_notation("balancing.objective", method.objective, "objective term"),
+             **term_notation("balancing.caps", method.caps, "cap")}
     for k, c in enumerate(method.counterweights):
         n = c.name or f"cw_{c.body}"
         table[f"balancing.counterweights[{k}].max_mass"] = ours(f"m_{{{n},max}}", f"upper bound on the mass of `{n}`")
