@@ -157,3 +157,42 @@ def test_half_reciprocating_counterweight_halves_the_primary_and_moves_half_acro
     assert cw[0].forward.amplitude < 1e-9 * half  # what remains turns backward only
     assert cw[0].backward.amplitude == pytest.approx(half, rel=1e-9)
     assert cw[1].fx.amplitude == pytest.approx(un[1].fx.amplitude, rel=1e-9)
+
+
+def test_docs_example_runs_and_prints_the_closed_form_primary(capsys):
+    from pathlib import Path
+    text = (Path(__file__).parents[2] / "docs" / "orders.md").read_text()
+    code = text.split("```python\n", 1)[1].split("```", 1)[0]
+    namespace: dict = {}
+    exec(compile(code, "docs/orders.md", "exec"), namespace)
+    w = 3000 * 2 * math.pi / 60
+    assert namespace["primary"].fx.amplitude == pytest.approx(0.9 * 0.04 * w**2, rel=1e-9)
+    assert f"primary: {0.9 * 0.04 * w**2:.1f} N" in capsys.readouterr().out
+
+
+def test_results_json_carries_orders_only_for_periodic_motions():
+    from balpipe.report.results import results_dict
+    spec, _ = load_text(slider_crank(M_ROT, R, cycles=1, samples=201), "s.yaml")
+    out = results_dict(run(spec), "s.yaml", "h", simulated=False)
+    o = out["stages"][0]["orders"]
+    assert o["cycles"] == 1 and o["frequency"] == pytest.approx(RPM / 60, rel=1e-12)
+    assert [h["name"] for h in o["orders"][:3]] == ["primary", "secondary", "order 3"]
+    assert o["orders"][0]["fx"]["amplitude"] == pytest.approx((M_ROT + M_REC) * R * W**2, rel=1e-9)
+    aperiodic = slider_crank(M_ROT, R, samples=201).replace(
+        "  cycles: 2\n", "  duration: 0.1 s\n")
+    spec, _ = load_text(aperiodic, "s.yaml")
+    assert results_dict(run(spec), "s.yaml", "h", simulated=False)["stages"][0]["orders"] is None
+
+
+def test_page_shows_the_orders_table_or_says_there_are_none():
+    from balpipe.report.page import render_page
+    from balpipe.report.results import results_dict
+    for text, periodic in ((slider_crank(M_ROT, R, cycles=1, samples=201), True),
+                           (slider_crank(M_ROT, R, samples=201).replace("  cycles: 2\n", "  duration: 0.1 s\n"), False)):
+        spec, _ = load_text(text, "s.yaml")
+        study = run(spec)
+        html = render_page(study, results_dict(study, "s.yaml", "h", simulated=False), text)
+        assert ">Orders</h2>" in html
+        assert ("primary" in html and "secondary" in html) == periodic
+        assert ("have no orders" in html) != periodic
+        assert ("of the largest)" in html) == periodic  # the odd orders above 1: round-off, shown as 0

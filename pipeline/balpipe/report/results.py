@@ -13,6 +13,7 @@ from ..mechanics.motion_outputs import motion_columns
 from ..study import Study
 from . import present
 from .load_table import load_columns, load_summary
+from .orders_table import orders_json
 from .notation_table import names_for
 from .verdict import verdict
 
@@ -43,6 +44,7 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     for row, s in zip(stages, study.stages):  # an optimised stage's objective and caps: its verdict's measure
         if s.stage.aim is not None:
             row["aim"] = s.stage.aim.to_json()
+        row["orders"] = orders_json(spec.motion, s.analysis)  # None unless the motion is periodic
     validation = {}
     for s in study.stages:
         if s.validation is not None:
