@@ -174,14 +174,14 @@ def test_results_json_carries_orders_only_for_periodic_motions():
     from balpipe.report.results import results_dict
     spec, _ = load_text(slider_crank(M_ROT, R, cycles=1, samples=201), "s.yaml")
     out = results_dict(run(spec), "s.yaml", "h", simulated=False)
-    o = out["stages"][0]["orders"]
+    o = out["orders"][out["stages"][0]["name"]]
     assert o["cycles"] == 1 and o["frequency"] == pytest.approx(RPM / 60, rel=1e-12)
     assert [h["name"] for h in o["orders"][:3]] == ["primary", "secondary", "order 3"]
     assert o["orders"][0]["fx"]["amplitude"] == pytest.approx((M_ROT + M_REC) * R * W**2, rel=1e-9)
     aperiodic = slider_crank(M_ROT, R, samples=201).replace(
         "  cycles: 2\n", "  duration: 0.1 s\n")
     spec, _ = load_text(aperiodic, "s.yaml")
-    assert results_dict(run(spec), "s.yaml", "h", simulated=False)["stages"][0]["orders"] is None
+    assert results_dict(run(spec), "s.yaml", "h", simulated=False)["orders"] == {"unbalanced": None}
 
 
 def test_page_shows_the_orders_table_or_says_there_are_none():

@@ -44,7 +44,6 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     for row, s in zip(stages, study.stages):  # an optimised stage's objective and caps: its verdict's measure
         if s.stage.aim is not None:
             row["aim"] = s.stage.aim.to_json()
-        row["orders"] = orders_json(spec.motion, s.analysis)  # None unless the motion is periodic
     validation = {}
     for s in study.stages:
         if s.validation is not None:
@@ -79,6 +78,8 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
         if simulated else None,
     }
     out["comparison"] = comparison(study)
+    # per stage, the harmonics of the shaking force and moment; None unless the motion is periodic
+    out["orders"] = {s.stage.name: orders_json(spec.motion, s.analysis) for s in study.stages}
     # what balancing costs a motor: peak, RMS effort and peak power per stage and driver
     out["actuators"] = present.effort_rows(
         [(s.stage.name, s.stage.label, s.stage.model, s.analysis) for s in study.stages])
