@@ -195,6 +195,7 @@ def test_page_shows_the_orders_table_or_says_there_are_none():
         assert ">Orders</h2>" in html
         assert ("primary" in html and "secondary" in html) == periodic
         assert ("have no orders" in html) != periodic
+        assert ("peak force of the order" in html) == periodic  # the figure's axis
         assert ("of the largest)" in html) == periodic  # the odd orders above 1: round-off, shown as 0
 
 

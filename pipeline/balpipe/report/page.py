@@ -13,6 +13,7 @@ from . import citations, live_plots, paper_figures, partial_figures, present, se
 from .design_card import design_card
 from .notation_table import PageNames, names_for, notation_groups
 from .render import environment
+from .orders_figure import orders_svg
 from .results import joint_load_table
 
 
@@ -226,6 +227,8 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                       "player": rl.player(), "player_note": rl.player_note()} if rl is not None else None,
         drawn=drawing_times(study),
         joint_loads=joint_load_table(study),
+        orders_figure=orders_svg([(s.stage.name, results["orders"][s.stage.name]) for s in shown_stages(study)
+                                  if (results.get("orders") or {}).get(s.stage.name)]),
         stage_names=[(s.stage.name, s.stage.label) for s in shown_stages(study)],
         group=study.stages[0].stage.group if len(shown_stages(study)) < len(study.stages) else "",
         reference={"force": study.reference.describe("force"), "moment": study.reference.describe("moment"),
