@@ -85,3 +85,14 @@ def test_an_unknown_name_is_a_located_error(aim, field):
 def test_a_stage_claims_or_aims_not_both():
     with pytest.raises(ValidationError, match="not both"):
         slider_crank([{"load": "effort"}], balances="force")
+
+
+@pytest.mark.parametrize("name", ["custom_pumpjack_rod_load.yaml", "custom_four_bar_partial.yaml"])
+def test_the_verdict_box_says_what_the_stage_aimed_at(pages, name):
+    """A stage judged by its aim (hand-written or optimised): the page's "Did balancing work?"
+    sentence is its objective and side effects, not the shaking loads alone beside an
+    "objective reduced" badge."""
+    html = pages(name)
+    sentence = html.split("Did balancing work?</strong>", 1)[1].split("</p>", 1)[0]
+    assert "(objective)" in sentence and "side effect" in sentence
+    assert not sentence.lstrip().startswith("Force ")
