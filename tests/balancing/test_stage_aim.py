@@ -96,3 +96,23 @@ def test_the_verdict_box_says_what_the_stage_aimed_at(pages, name):
     sentence = html.split("Did balancing work?</strong>", 1)[1].split("</p>", 1)[0]
     assert "(objective)" in sentence and "side effect" in sentence
     assert not sentence.lstrip().startswith("Force ")
+
+
+def test_the_index_lists_an_aimed_stage_by_its_objective(shared_build):
+    """The site index's verdict column of a spec judged by its aim: the objective first, the
+    shaking loads it did not aim at as side effects, a shaking load it aimed at not repeated."""
+    import re
+
+    from conftest import SPECS
+
+    # the build of every spec that tests/test_api.py reads too (the same key: built once a run)
+    folder, done = shared_build(tuple(sorted(p.name for p in SPECS.iterdir() if p.is_file())), "specs", "-o", "site", "--no-sim")
+    assert done.returncode in (0, 1), done.stderr
+    html = (folder / "site" / "index.html").read_text(encoding="utf-8")
+    cells = {m.group(1): re.sub(r"<[^>]+>", "|", m.group(2)) for m in re.finditer(
+        r'data-spec="([^"]+)".*?<td data-label="Verdict" class="verdict">(.*?)</td>', html, re.S)}
+    pump, four = cells["custom_pumpjack_rod_load"], cells["custom_four_bar_partial"]
+    assert "peak effort of crank reduced by 68.5 % (objective)" in pump
+    assert "side effects: force worse" in pump and ", moment unchanged" in pump
+    assert "peak shaking force reduced by" in four and "side effects: moment worse" in four
+    assert "side effects: force" not in four  # the force is the objective, no side effect
