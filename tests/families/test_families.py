@@ -7,6 +7,8 @@ they enumerate balpipe's own families (the package ``balpipe.families``), not ev
 
 from __future__ import annotations
 
+import importlib
+
 import json
 import os
 import subprocess
@@ -71,7 +73,9 @@ def test_every_family_ships_examples_that_are_worked_examples():
         assert f.examples, f.name
         for ex in f.examples:
             path = Path(ex)
-            assert path.parent.parent == ROOT / "pipeline" / "balpipe" / "families" / f.name
+            # in the family's package as installed (the source tree, or site-packages after pip install .)
+            package = Path(importlib.import_module(f"balpipe.families.{f.name}").__file__).parent
+            assert path.parent.parent == package and path.parent.name == "examples"
             assert path.read_bytes() == (ROOT / "specs" / path.name).read_bytes(), path
 
 
