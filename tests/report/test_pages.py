@@ -3,6 +3,8 @@ driver, a table of contents, no "-0" in the CSV."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from balpipe.report import present, toc
@@ -101,3 +103,18 @@ def test_an_effort_and_its_unit_stay_on_one_line(pages):
 
     css = (pathlib.Path(__file__).resolve().parents[2] / "templates" / "style.css").read_text()
     assert re.search(r"span\.qty\s*\{\s*white-space:\s*nowrap", css)
+
+
+def test_the_papers_figures_and_the_published_numbers_are_open_at_load():
+    from balpipe.report import sections
+
+    body = "".join(f"<h2>{t}</h2><p>{k}</p>" for k, t in enumerate((
+        "Balancing stages", "What balancing costs the actuators", "Published vs computed",
+        "Fig. 8 of paper 000", "Figs. 10a, 11 of paper 004", "Joint loads", "Checks", "Figures of the method")))
+    page = sections.collapse(f"<main>{sections.START}{body}{sections.END}</main>")
+    opened = re.findall(r'<details class="section"( open)?><summary><h2>([^<]*)</h2>', page)
+    assert {t: bool(o) for o, t in opened} == {
+        "Balancing stages": True, "What balancing costs the actuators": True, "Published vs computed": True,
+        "Fig. 8 of paper 000": True, "Figs. 10a, 11 of paper 004": True,
+        "Joint loads": False, "Checks": False, "Figures of the method": False}
+    assert sections.collapse(f"<main>{sections.START}{body}{sections.END}</main>") == page  # deterministic

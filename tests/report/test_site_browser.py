@@ -767,3 +767,52 @@ def test_built_site_plots_show_values_on_hover(built_plot_page, browser, width):
     finally:
         ctx.close()
     assert not w.problems, "\n".join(w.problems)
+
+
+_SECTIONS = """() => [...document.querySelectorAll('details.section')].map(d =>
+    [d.querySelector('summary').textContent.trim(), d.open])"""
+_SHOWN = """id => { const el = document.getElementById(id); const d = el && el.closest('details.section');
+    const r = el && el.getBoundingClientRect();
+    return !!d && d.open && r.top >= -1 && r.top < innerHeight; }"""
+
+
+def test_the_papers_figures_and_the_costs_are_open_and_links_open_their_section(server, browser):
+    """Open at load: the paper's figures, "Published vs computed" and the actuators' costs, beside
+    the stage table and the shaking loads; the other sections folded. A deep link loaded directly,
+    a Contents entry clicked and a change of the fragment open the section of their target and
+    scroll to it; "open all" and "close all" act on every section."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    url = server + "scott_russell/index.html"
+    p.goto(url, wait_until="load")
+    state = dict(p.evaluate(_SECTIONS))
+    # the paper's figures ("Fig. N of paper ...") open by their titles: tests/report/test_pages.py
+    must_open = [t for t in state if re.match(r"Figs?\.\s*\d", t)] + ["Balancing stages", "What balancing costs the actuators", "Shaking force and shaking moment"]
+    must_open += [t for t in state if t == "Published vs computed"]
+    assert all(state[t] for t in must_open), {t: state[t] for t in must_open}
+    folded = [t for t, is_open in state.items() if not is_open]
+    assert "Checks" in folded and "Inputs" in folded, state
+
+    # a deep link loaded directly: its folded section opens and its heading is in the window
+    p.goto(server + "osc/index.html", wait_until="load")  # another page first: a real navigation
+    p.goto(url + "#checks", wait_until="load")
+    p.wait_for_function(_SHOWN, arg="checks")
+    # a Contents entry clicked, from the top of a fresh load
+    p.goto(url, wait_until="load")
+    assert not p.evaluate("() => document.getElementById('inputs').closest('details').open")
+    p.click('nav.toc a[href="#inputs"]')
+    p.wait_for_function(_SHOWN, arg="inputs")
+    # the fragment changed by hand (hashchange) opens a folded section too
+    assert not p.evaluate("() => document.getElementById('joint-loads').closest('details').open")
+    p.evaluate("location.hash = '#joint-loads'")
+    p.wait_for_function(_SHOWN, arg="joint-loads")
+
+    # open all, close all
+    p.click("nav.toc button[data-sections=open]")
+    p.wait_for_function("[...document.querySelectorAll('details.section')].every(d => d.open)")
+    p.click("nav.toc button[data-sections=close]")
+    p.wait_for_function("[...document.querySelectorAll('details.section')].every(d => !d.open)")
+    assert p.text_content("nav.toc button[data-sections=open]") == "open all"
+    assert p.text_content("nav.toc button[data-sections=close]") == "close all"
+    assert not w.problems, "\n".join(w.problems)
