@@ -821,3 +821,70 @@ def test_the_papers_figures_and_the_costs_are_open_and_links_open_their_section(
     assert p.text_content("nav.toc button[data-sections=open]") == "open all"
     assert p.text_content("nav.toc button[data-sections=close]") == "close all"
     assert not w.problems, "\n".join(w.problems)
+
+
+@pytest.fixture(scope="module")
+def compare_site(tmp_path_factory) -> Path:
+    """Two designs of one mechanism (the offset slider-crank's counterweights and its partial
+    optimum) and a paper spec, built without simulation."""
+    out = tmp_path_factory.mktemp("compare") / "site"
+    specs = Path(__file__).resolve().parents[2] / "specs"
+    names = ("offset_slider_crank.yaml", "partial_offset_slider_crank.yaml", "paper000_rpr3_scott_russell.yaml")
+    outcomes = build([str(specs / s) for s in names], Options(out=out, simulate=False))
+    assert all(o.status == "ok" for o in outcomes), [o.message for o in outcomes]
+    return out
+
+
+def _order(page) -> list[str]:
+    return page.eval_on_selector_all("#studies tbody.entry", "els => els.map(e => e.dataset.spec)")
+
+
+def test_index_sorts_filters_by_verdict_and_compares_designs_of_one_mechanism(compare_site, browser):
+    """Every column of the index sorts (again: the other way) and the order is kept in the
+    address; the verdict filter; a row's paper links to its one citation; the designs of one
+    mechanism are side by side, sortable, with the added mass relative to the moving mass."""
+    w = Watched(browser)
+    p = w.page
+    p.goto((compare_site / "index.html").as_uri(), wait_until="load")
+    built = _order(p)
+    force = {s: float(json.loads((compare_site / s / "results.json").read_text())["verdict"]["motions"][0]["force"][1])
+             for s in built}
+    p.click('#studies button[data-sort="force"]')
+    assert _order(p) == sorted(built, key=force.get)
+    assert "sort=force" in p.evaluate("location.hash")
+    assert p.get_attribute('#studies th:has(button[data-sort="force"])', "aria-sort") == "ascending"
+    p.click('#studies button[data-sort="force"]')
+    assert _order(p) == sorted(built, key=force.get, reverse=True)
+    # a shared address restores the order and the filter
+    levels = {s: json.loads((compare_site / s / "results.json").read_text())["verdict"]["level"] for s in built}
+    level = levels["paper000_rpr3_scott_russell"]
+    p.goto((compare_site / "index.html").as_uri() + f"#verdict={level}&sort=-title", wait_until="load")
+    p.reload(wait_until="load")
+    shown = visible_specs(p)
+    assert len(shown) == sum(v == level for v in levels.values()) and p.eval_on_selector("#f-verdict", "s => s.value") == level
+    titles = p.eval_on_selector_all("#studies tbody.entry", "els => els.map(e => e.dataset.sortTitle)")
+    assert titles == sorted(titles, reverse=True)
+    # the paper's citation once, above; the row links to it and opens it
+    p.select_option("#f-verdict", "")
+    with_paper = [s for s in built if json.loads((compare_site / s / "results.json").read_text())["paper"]]
+    links = p.eval_on_selector_all("a.cite", "els => els.map(a => a.getAttribute('href'))")
+    assert links == ["#paper-000"] * len(with_paper) and with_paper
+    assert p.locator("li#paper-000").count() == 1 and not p.is_visible("#paper-000")
+    p.locator("a.cite").first.click()
+    assert p.is_visible("#paper-000")
+    # the designs of the slider-crank side by side; no table for the Scott-Russell's one spec
+    tables = p.locator("#compared table.compare")
+    assert tables.count() == 1
+    rows = lambda: tables.first.evaluate("t => [...t.tBodies[0].rows].map(r => r.cells[0].textContent)")
+    assert len(rows()) == 2
+    rel = tables.first.evaluate("t => [...t.tBodies[0].rows].map(r => Number(r.cells[4].dataset.sort))")
+    moving = json.loads((compare_site / "offset_slider_crank" / "results.json").read_text())["moving_mass"]
+    added = {s: json.loads((compare_site / s / "results.json").read_text())["verdict"]["motions"][0]["costs"]["added_mass"]
+             for s in ("offset_slider_crank", "partial_offset_slider_crank")}
+    assert sorted(rel) == pytest.approx(sorted(a / moving for a in added.values()), rel=1e-12)
+    before = rows()
+    tables.first.locator('button[data-col="4"]').click()
+    first = rows()
+    tables.first.locator('button[data-col="4"]').click()
+    assert rows() == first[::-1] and sorted(first) == sorted(before)
+    assert not w.problems, "\n".join(w.problems)

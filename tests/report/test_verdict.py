@@ -140,7 +140,7 @@ def test_index_agrees_with_results_json_and_leads_with_it(tmp_path):
           Options(out=out, simulate=False))
     html = (out / "index.html").read_text(encoding="utf-8")
     head = html[html.index('<table id="studies"'):]
-    assert re.search(r"<th>Spec</th><th>Verdict</th>", head)
+    assert re.search(r'>Spec</button></th><th aria-sort="none"><button [^>]*>Verdict</button>', head)
     for slug in ("custom_four_bar_balancing", "paper000_rpr3_scott_russell"):
         level = json.loads((out / slug / "results.json").read_text())["verdict"]["level"]
         m = re.search(rf'data-spec="{slug}" data-verdict="(\w+)"', html)
@@ -155,24 +155,46 @@ def test_index_agrees_with_results_json_and_leads_with_it(tmp_path):
     assert "26.67" not in row and "67.33 → 0 (&lt; 1e-9 of unbalanced)" in row
 
 
-def test_methods_on_one_mechanism_side_by_side():
+def test_designs_of_one_mechanism_side_by_side():
+    """The index compares the specs whose unbalanced linkage is the same (results.json's
+    mechanism_key), whatever their template's name; a mechanism with one spec has no table."""
     from balpipe.report.site import comparisons
 
-    def entry(title, method, *st):
+    def entry(title, method, key, *st):
         r = results(*st)
-        r.update({"mechanism": "rpr3", "method": method, "comparison": {"rows": [
-            {"stage": s["name"], "design": "main", "counter_rotations": 3} for s in r["stages"]]}})
+        r.update({"mechanism": "rpr3", "method": method, "mechanism_key": key, "moving_bodies": ["a", "b", "c"],
+                  "comparison": {"rows": [{"stage": s["name"], "design": "main", "counter_rotations": 3} for s in r["stages"]]}})
         return {"title": title, "link": f"{title}/index.html", "results": r, "verdict": V.verdict(r)}
 
-    a = entry("idler", "idler_loop", stage("cr", "force+moment", f=1e-13, m=1e-13))
-    b = entry("legs", "scott_russell", stage("cr", "force+moment", f=1e-13, m=6.7))
-    c = entry("other", "idler_loop", stage("cw", "force", f=1e-13, m=2.0))
-    c["results"]["mechanism"] = "four_bar"  # one method only on its mechanism: no comparison
+    a = entry("idler", "idler_loop", "k1", stage("cr", "force+moment", f=1e-13, m=1e-13, added_mass=1.0))
+    b = entry("legs", "scott_russell", "k1", stage("cr", "force+moment", f=1e-13, m=6.7, added_mass=3.0))
+    c = entry("other", "idler_loop", "k2", stage("cw", "force", f=1e-13, m=2.0))
+    c["results"]["mechanism"] = "rpr3"  # the same template, another linkage: not compared with a and b
     got = comparisons([a, b, c])
-    assert [g["template"] for g in got] == ["rpr3"]
+    assert [(g["key"], g["bodies"], g["methods"]) for g in got] == [("k1", "a, b and c", 2)]
     rows = {r["title"]: r for r in got[0]["rows"]}
     assert rows["idler"]["moment"] == "cancelled" and rows["legs"]["level"] == "bad"
     assert rows["legs"]["moment"].startswith("worse") and rows["idler"]["counter_rotations"] == 3
+    # the added mass relative to the moving mass (2 kg), and the rows best verdict first
+    assert rows["legs"]["added_relative_value"] == pytest.approx(1.5) and rows["legs"]["added_relative"] == "× 1.5"
+    assert [r["title"] for r in got[0]["rows"]] == ["idler", "legs"]
+
+
+def test_the_mechanism_key_names_the_linkage_not_its_motion_or_round_off():
+    from dataclasses import replace
+
+    from balpipe.report.mechanism_key import mechanism_key
+    from balpipe.model import FRAME, Body, Model, Revolute
+
+    crank = Body("crank", 1.0, (0.05, 0.0), 1e-3, points={"O": (0.0, 0.0), "A": (0.1, 0.0)})
+    model = Model("m", (crank,), (Revolute("O", FRAME, "crank", (0.0, 0.0), (0.0, 0.0)),),
+                  (), {"crank": (0.0, 0.0, 0.0)})
+    k = mechanism_key(model)
+    assert len(k) == 12 and k == mechanism_key(replace(model, name="other", initial={"crank": (0.0, 0.0, 1.0)}))
+    # 6.1e-17 (cos 90 deg) is round-off of 0, not another linkage; a real change of mass is
+    same = replace(model, bodies=(replace(crank, com=(0.05, 6.123233995736766e-17)),))
+    assert mechanism_key(same) == k
+    assert mechanism_key(replace(model, bodies=(replace(crank, mass=1.0 + 1e-9),))) != k
 
 
 def test_a_spec_without_balancing_stages_has_a_neutral_verdict_and_an_index_row():

@@ -12,6 +12,7 @@ from .. import __version__
 from ..mechanics.motion_outputs import motion_columns
 from ..study import Study
 from . import present
+from .mechanism_key import mechanism_key
 from .load_table import load_columns, load_summary
 from .orders_table import orders_json
 from .notation_table import names_for
@@ -90,6 +91,9 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     if summary is not None:  # the spec's loads: peaks, friction energy, frame load beside the shaking load
         out["loads"] = summary
     out["moving_mass"] = sum(b.mass_properties()[0] for b in study.unbalanced.stage.model.bodies)
+    # the linkage without its drivers, motion, loads and method: specs sharing it are compared on the index
+    out["mechanism_key"] = mechanism_key(study.unbalanced.stage.model)
+    out["moving_bodies"] = [b.name for b in study.unbalanced.stage.model.bodies]
     if study.balance.details:
         out["balancing_details"] = study.balance.details
     out["paper"] = spec.paper  # the site index filters by it

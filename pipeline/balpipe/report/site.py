@@ -8,7 +8,9 @@ from typing import Any, Sequence
 
 from ..runtime.fsutil import write_file_atomic  # replaced in one step, never through a planted symlink
 from . import citations, site_filter, verdict
+from .verdict import LEVELS
 from .costs import factor_text
+from .mechanism_key import describe
 from .render import environment, num, printable, ratio
 from .render import tol as tol_fmt
 
@@ -44,7 +46,8 @@ def _entry(out: Path, o) -> dict:
         "not_realisable": [],
         "slug": o.slug,
         "verdict": None,
-        "citation": citations.cite((results or {}).get("paper")),
+        "citation": citations.cite((results or {}).get("paper")),  # once, in "The papers"; a row links to it
+        "paper_id": citations.paper_id((results or {}).get("paper") or "") if (results or {}).get("paper") else "",
         "built": "",
         "stale_text": "page from an earlier build",
     }
@@ -71,6 +74,7 @@ def _entry(out: Path, o) -> dict:
             passed = all(v.get("passed") for v in val.values())
             e["validation"] = '<span class="badge ok">pass</span>' if passed else '<span class="badge bad">fail</span>'
     e.update(site_filter.facets(e, results, out, o.slug))  # search, filter and history link
+    e["sort"] = sort_keys(e)
     return e
 
 
@@ -196,17 +200,19 @@ def write_site(out: Path, outcomes: list, earlier: Sequence[Any] = (), site_key:
 
 
 def comparisons(entries: list[dict]) -> list[dict]:
-    """The methods applied to one mechanism side by side: per template with specs of two or more
-    methods, one row per spec (its main design's final stage): verdict, added mass and inertia,
-    counter-rotations, residual |F| and |M| as ratios, and the cost factors."""
+    """The designs of one mechanism side by side: the specs whose unbalanced linkage is the same
+    (``mechanism_key`` of results.json, :mod:`balpipe.report.mechanism_key`), two or more of them,
+    one row per spec (its main design's headline stage): verdict, added mass (kg and relative to
+    the moving mass), added inertia, counter-rotations, residual |F| and |M| as the verdict words
+    them, and the cost factors; each cell carries its value for sorting."""
     by: dict[str, list[dict]] = {}
     for e in entries:
         r = e.get("results")
-        if r and e.get("verdict") and e["verdict"].get("motions"):
-            by.setdefault(r.get("mechanism") or "", []).append(e)
+        if r and r.get("mechanism_key") and e.get("verdict") and e["verdict"].get("motions"):
+            by.setdefault(r["mechanism_key"], []).append(e)
     out = []
-    for template, group in sorted(by.items()):
-        if len({e["results"].get("method") for e in group}) < 2:
+    for key, group in by.items():
+        if len(group) < 2:
             continue
         rows = []
         for e in group:
@@ -214,16 +220,47 @@ def comparisons(entries: list[dict]) -> list[dict]:
             g = v["motions"][0]
             comp: dict[str, Any] = next((c for c in (r.get("comparison") or {}).get("rows") or [] if c["stage"] == g["final"]), {})
             c = g["costs"]
+            mm = r.get("moving_mass") or 0.0
+            rel = c["added_mass"] / mm if mm and c["added_mass"] is not None else None
             rows.append({
                 "title": e["title"], "link": e["link"], "method": r.get("method"), "level": v["level"],
-                "words": v["words"], "added_mass": num(c["added_mass"]),
+                "rank": LEVELS.index(v["level"]),
+                "words": v["words"], "added_mass": num(c["added_mass"]), "added_mass_value": c["added_mass"] or 0.0,
+                "added_relative": factor_text(rel), "added_relative_value": rel if rel is not None else 0.0,
                 "added_inertia": num(c["added_inertia"]) if c["added_inertia"] is not None else "cannot be built",
+                "added_inertia_value": c["added_inertia"] if c["added_inertia"] is not None else "",
                 "counter_rotations": comp.get("counter_rotations", "—"),
-                "force": v["stages"][g["final"]]["force"]["text"], "moment": v["stages"][g["final"]]["moment"]["text"],
-                "effort": factor_text(c["effort"]), "joint_load": factor_text(c["joint_load"]),
+                "force": v["stages"][g["final"]]["force"]["text"], "force_value": g["force"][1],
+                "moment": v["stages"][g["final"]]["moment"]["text"], "moment_value": g["moment"][1],
+                "effort": factor_text(c["effort"]), "effort_value": c["effort"] if c["effort"] is not None else "",
+                "joint_load": factor_text(c["joint_load"]),
+                "joint_load_value": c["joint_load"] if c["joint_load"] is not None else "",
             })
-        out.append({"template": template, "rows": rows})
-    return out
+        first = group[0]["results"]
+        bodies = first.get("moving_bodies") or []
+        out.append({"key": key, "template": first.get("mechanism") or "",
+                    "bodies": describe(bodies), "moving_mass": num(first.get("moving_mass")),
+                    "methods": len({row["method"] for row in rows}),
+                    "rows": sorted(rows, key=lambda row: (row["rank"], row["added_relative_value"], row["title"]))})
+    return sorted(out, key=lambda c: (-len(c["rows"]), c["template"], c["bodies"], c["key"]))
+
+
+def sort_keys(e: dict) -> dict:
+    """What each column of the index sorts by: the title, the verdict (best first), the
+    headline stage's |F| and |M| peaks (the largest over the motions), the added mass relative
+    to the moving mass, and the build's status."""
+    v = e.get("verdict") or {}
+    ms = v.get("motions") or []
+    mm = (e.get("results") or {}).get("moving_mass") or 0.0
+    added = ms[0]["costs"]["added_mass"] if ms else None
+    return {
+        "title": e["title"].lower(),
+        "verdict": LEVELS.index(v["level"]) if v.get("level") in LEVELS else len(LEVELS),
+        "force": max((g["force"][1] for g in ms), default=""),
+        "moment": max((g["moment"][1] for g in ms), default=""),
+        "cost": added / mm if mm and added is not None else "",
+        "built": e["status"],
+    }
 
 
 def site_papers(entries: list[dict]) -> list[dict]:

@@ -1,4 +1,4 @@
-"""Facets of the site index (paper, template, method, status) for its search and filter bar.
+"""Facets of the site index (verdict, paper, template, method, status) for its search and filter bar.
 
 Each index entry gets the values it is filtered by and a lower-case text that the search box
 matches word by word; :func:`options` lists the values present, sorted, for the drop-downs.
@@ -11,17 +11,22 @@ from pathlib import Path
 
 from .history_page import index_link
 
-FACETS = ("paper", "template", "method", "status")
+FACETS = ("verdict", "paper", "template", "method", "status")
 NO_PAPER = "(no paper)"
 # the index's status labels -> short filter values (also the labels of the status drop-down)
 STATUS = {"invalid spec": "invalid", "internal error": "internal-error"}
+# the verdict's levels (balpipe.report.verdict.LEVELS, best first) as the drop-down names them
+VERDICTS = {"good": "works as claimed or designed", "neutral": "no change",
+            "warn": "works, with a caveat", "bad": "a claim fails"}
 
 
 def facets(entry: dict, results: dict | None, out: Path, slug: str) -> dict:
     """Filter values of one index entry; ``results`` may be a stale page's results.json."""
     r = results or {}
     paper = r.get("paper") or NO_PAPER
+    v = r.get("verdict") if results is not None and not entry.get("stale") else None
     f = {
+        "verdict": (v or {}).get("level", ""),
         "paper": paper,
         "template": r.get("mechanism") or "",
         "method": r.get("method") or "",
@@ -41,5 +46,8 @@ def options(entries: list[dict]) -> dict[str, list[tuple[str, str]]]:
     out: dict[str, list[tuple[str, str]]] = {}
     for k in FACETS:
         values = sorted({e["facets"][k] for e in entries if e["facets"][k]})
+        if k == "verdict":  # best first, in words
+            out[k] = [(v, VERDICTS.get(v, v)) for v in sorted(values, key=lambda v: list(VERDICTS).index(v) if v in VERDICTS else len(VERDICTS))]
+            continue
         out[k] = [(v, _label(v)) for v in values]
     return out
