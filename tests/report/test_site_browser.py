@@ -888,3 +888,33 @@ def test_index_sorts_filters_by_verdict_and_compares_designs_of_one_mechanism(co
     tables.first.locator('button[data-col="4"]').click()
     assert rows() == first[::-1] and sorted(first) == sorted(before)
     assert not w.problems, "\n".join(w.problems)
+
+
+def test_wide_screens_keep_the_contents_beside_the_page(paper_site, browser):
+    """At 1700 px the Contents stay in the left margin while the page scrolls, never over the
+    page; a side entry opens its folded section and is marked as the section in view; at
+    1400 px there is no room and no side Contents."""
+    page = paper_site / "paper000_rpr3_scott_russell" / "index.html"
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1700, "height": 900})
+    p.goto(page.as_uri(), wait_until="load")
+    side = p.locator("nav.toc-side")
+    assert side.is_visible()
+    entries = side.locator("a").evaluate_all("els => els.map(a => a.textContent)")
+    assert entries == p.locator("nav.toc a").evaluate_all("els => els.map(a => a.textContent)") and entries
+    box, main = side.bounding_box(), p.locator("main").bounding_box()
+    assert box["x"] + box["width"] <= main["x"] + 1
+    folded = p.eval_on_selector_all(
+        "nav.toc-side a", "els => els.filter(a => { const t = document.getElementById(a.getAttribute('href').slice(1));"
+        " const d = t && t.closest('details'); return d && !d.open; }).map(a => a.getAttribute('href'))")
+    assert folded, "no folded section to open"
+    link = side.locator(f'a[href="{folded[-1]}"]')
+    link.click()
+    target = p.locator(folded[-1])
+    assert target.evaluate("t => t.closest('details').open") and target.is_visible()
+    p.wait_for_function(f"document.querySelector('nav.toc-side a[href=\"{folded[-1]}\"]').classList.contains('current')")
+    assert side.bounding_box()["y"] == box["y"]  # it stayed where it was while the page scrolled
+    p.set_viewport_size({"width": 1400, "height": 900})
+    assert not side.is_visible()
+    assert not w.problems, "\n".join(w.problems)
