@@ -13,6 +13,7 @@ from typing import Annotated, Literal, Union
 from pydantic import Field
 
 from . import registry
+from .laws.frame_spec import FrameSpec
 from .laws.load_spec import LoadSpec
 from .laws.motion_spec import Motion
 from .spec_parts import Strict
@@ -101,6 +102,8 @@ class Spec(Strict):
     loads: list[LoadSpec] = Field(
         [], description="springs, dampers, force laws, gas pressures, torsional springs, applied forces and torques, "
         "joint friction: counted in the efforts, reactions and frame loads, never in the shaking loads")
+    frame: FrameSpec | None = Field(
+        None, description="the frame as a rigid body on elastic mounts: its vibration and the forces on the floor per stage")
     references: list[Reference] = Field([], description="published values to compare with")
     compare: list[Design] = Field(
         [], description="other balancing designs of the same mechanism, analysed and tabulated beside the main one"

@@ -274,3 +274,9 @@ Number = number()
 PositiveNumber = number(gt=0)
 AccelFraction = number(gt=0, le=0.5)  # a trapezoidal law's acceleration time, of the segment's
 Cycles = number(gt=0, le=10_000)  # a motion's number of periods
+Stiffness = quantity("stiffness", ge=0)  # a mount's, along one axis
+Damping = quantity("damping", ge=0)
+PositiveInertia = quantity("inertia", gt=0)
+PositiveVelocity = quantity("velocity", gt=0)
+PositiveForce = quantity("force", gt=0)
+OpenFraction = number(gt=0, lt=1)  # strictly between 0 and 1

@@ -14,6 +14,7 @@ from .design_card import design_card
 from .notation_table import PageNames, names_for, notation_groups
 from .render import environment
 from .orders_figure import orders_svg
+from .mounts_figure import mounts_svg
 from .results import joint_load_table
 
 
@@ -229,6 +230,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         joint_loads=joint_load_table(study),
         orders_figure=orders_svg([(s.stage.name, results["orders"][s.stage.name]) for s in shown_stages(study)
                                   if (results.get("orders") or {}).get(s.stage.name)]),
+        mounts_figure=mounts_svg(results.get("mounts"), [(s.stage.name, s.stage.label) for s in shown_stages(study)]),
         stage_names=[(s.stage.name, s.stage.label) for s in shown_stages(study)],
         group=study.stages[0].stage.group if len(shown_stages(study)) < len(study.stages) else "",
         reference={"force": study.reference.describe("force"), "moment": study.reference.describe("moment"),

@@ -12,6 +12,7 @@ from .. import __version__
 from ..mechanics.motion_outputs import motion_columns
 from ..study import Study
 from . import present
+from .frame_mounts import mounts_json
 from .mechanism_key import mechanism_key
 from .load_table import load_columns, load_summary
 from .orders_table import orders_json
@@ -90,6 +91,9 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     summary = load_summary([(s.stage.name, s.stage.label, s.stage.model, s.analysis) for s in study.stages])
     if summary is not None:  # the spec's loads: peaks, friction energy, frame load beside the shaking load
         out["loads"] = summary
+    mounts = mounts_json(study)
+    if mounts is not None:  # the spec's frame on its mounts: floor forces, vibration velocity, modes
+        out["mounts"] = mounts
     out["moving_mass"] = sum(b.mass_properties()[0] for b in study.unbalanced.stage.model.bodies)
     # the linkage without its drivers, motion, loads and method: specs sharing it are compared on the index
     out["mechanism_key"] = mechanism_key(study.unbalanced.stage.model)
