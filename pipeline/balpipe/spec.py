@@ -83,8 +83,11 @@ class Reference(Strict):
     unit: str = Field("", description="unit of the value, for display")
     tolerance: number(ge=0) = Field(0.005, description="relative tolerance for 'agrees'")
     note: str = Field("", description="what the paper says, misprints, how to read it")
-    expect: Literal["agree", "differ"] = Field(
-        "agree", description="'differ' when the published value is known not to reproduce (the note says why)"
+    expect: Literal["agree", "differ", "misprint", "assumption"] = Field(
+        "agree", description="'differ' when the published value is known not to reproduce (the note says why); "
+        "'misprint' when the printed value is a misprint the note explains (counted apart, never lowering the "
+        "verdict); 'assumption' when it reproduces within the stated tolerance only under assumptions the paper "
+        "does not state (the note states them)"
     )
 
 

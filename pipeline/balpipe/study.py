@@ -147,6 +147,7 @@ class StageMetrics:
     label: str
     description: str
     balances: str
+    paper_claims: str
     headline: bool
     max_shaking_force: float
     max_shaking_moment: float
@@ -200,6 +201,7 @@ def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float, override
         label=sr.stage.label,
         description=sr.stage.description,
         balances=sr.stage.balances,
+        paper_claims=sr.stage.paper_claims,
         headline=sr.stage.headline,
         max_shaking_force=sr.analysis.max_force,
         max_shaking_moment=sr.analysis.max_moment,
@@ -260,9 +262,26 @@ def compare_references(spec: Spec, balance: BalanceResult, metrics: list[StageMe
             "relative_difference": rel,
             "status": "agrees" if agrees else "differs",
             "expected": ref.expect,
+            "kind": reference_kind("agrees" if agrees else "differs", ref.expect),
             "note": ref.note,
         })
     return out
+
+
+#: how a published number compares (``references[].kind`` in results.json), from its status and
+#: what the spec expects of it (``references[].expect``): reproduced; reproduced within the
+#: tolerance the spec states under assumptions the paper does not state (``assumption``); a
+#: misprint the note explains (``misprint``); known not to reproduce (``differ``: the note says
+#: why); unexpectedly not reproduced
+REFERENCE_KINDS = ("reproduced", "assumption", "misprint", "not_reproduced", "unexpected")
+
+
+def reference_kind(status: str, expect: str) -> str:
+    """The :data:`REFERENCE_KINDS` entry of a published number: its ``status`` ('agrees' or
+    'differs') and the spec's ``expect``."""
+    if status == "agrees":
+        return "assumption" if expect == "assumption" else "reproduced"
+    return {"misprint": "misprint", "differ": "not_reproduced"}.get(expect, "unexpected")
 
 
 def _decimals(x: float) -> int:

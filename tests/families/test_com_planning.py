@@ -48,7 +48,12 @@ def test_eight_trajectories_with_their_reductions(paper):
     assert 0.41 < p["moment_reduction_min"] < 0.44 and 0.63 < p["moment_reduction_max"] < 0.66
     refs = {r["name"]: r for r in st.references}
     assert refs["force_reduction_min"]["published"] == 0.48 and refs["moment_reduction_max"]["published"] == 0.61
-    assert all(r["status"] == "differs" and r["expected"] == "differ" for r in refs.values())
+    # within the tolerance each states under the assumptions its note states (duration, numbering,
+    # the optimiser's objective: the paper gives none), and only just: 5 % for the force, 15 % for
+    # the moment, each at least a fifth used
+    assert all(r["status"] == "agrees" and r["expected"] == "assumption" for r in refs.values())
+    assert max(refs[k]["relative_difference"] for k in ("force_reduction_min", "force_reduction_max")) > 0.01
+    assert refs["moment_reduction_min"]["relative_difference"] > 0.1
     assert st.ok, st.problems
 
 

@@ -76,6 +76,8 @@ def test_paper_references_point_at_parameters(paper):
         assert ref.name in p, ref.name
         agrees = abs(p[ref.name] - ref.published) <= ref.tolerance * abs(ref.published)
         assert agrees == (ref.expect == "agree"), (ref.name, p[ref.name], ref.published)
+        if ref.expect == "misprint":  # r5: printed 0.790, a decimal shifted (0.0789 m fits between the pivots)
+            assert p[ref.name] == pytest.approx(ref.published / 10, rel=0.005)
 
 
 def test_paper_stages_are_balanced(paper):

@@ -59,15 +59,20 @@ def test_outcomes_in_words():
     assert w["outcome"] == "worse" and w["text"] == "worse: 674 % of the reference"
 
 
-def test_unclaimed_worse_final_stage_is_a_warning_and_references_count():
+def test_a_force_balance_holds_as_designed_its_moment_a_cost_and_references_count_apart():
     r = results(stage("cw", "force", f=1e-13, m=6.74),
                 refs=[{"status": "agrees"}, {"status": "differs", "expected": "differ"}])
     v = V.verdict(r)
-    assert v["level"] == "warn" and v["words"] == "mixed"
+    assert v["words"] == "force balanced as designed" and v["verdict"] == "holds"
+    assert v["costs"] == ["moment × 6.74"] and "cost: moment × 6.74" in v["text"]
+    assert v["level"] == "warn"  # a published number known not to reproduce, never the moment's growth
+    assert V.verdict(results(stage("cw", "force", f=1e-13, m=6.74)))["level"] == "good"
     assert v["references"]["reproduced"] == 1 and v["references"]["total"] == 2
-    assert "moment worse" in v["text"]
+    assert v["references"]["known_not"] == 1 and "mixed" not in v["text"]
     r = results(stage("all", "force+moment", f=1e-13, m=1e-13))
-    assert V.verdict(r)["level"] == "good" and V.verdict(r)["words"] == "balanced as claimed"
+    assert V.verdict(r)["level"] == "good" and V.verdict(r)["words"] == "balanced as designed"
+    r["paper"] = "004: a paper"
+    assert V.verdict(r)["words"] == "balanced as claimed"
     r = results(stage("all", "force+moment", f=1e-13, m=1e-13), refs=[{"status": "differs", "expected": "agree"}])
     assert V.verdict(r)["level"] == "bad"  # a published number that should reproduce and does not
     r = results(stage("all", "force+moment", f=1e-13, m=1e-13, realisable=False))
@@ -92,7 +97,7 @@ def test_several_motions_each_judged():
     v = V.verdict(r)
     assert [g["final"] for g in v["motions"]] == ["a_plan", "b_plan"]
     assert v["force"]["text"] == "reduced by 50 % to 60 % (over 2 motions)"
-    assert v["level"] == "good" and v["words"] == "loads reduced"
+    assert v["level"] == "good" and v["words"] == "loads reduced" and v["verdict"] == "unclaimed"
 
 
 def test_the_headline_judges_the_declared_stage_else_the_last():

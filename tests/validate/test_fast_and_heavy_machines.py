@@ -204,7 +204,7 @@ def test_build_of_a_ten_percent_counterweight_error_exits_1(tmp_path):
     p = _build(specs)
     assert p.returncode == 1, p.stderr
     res = json.loads((specs / "site" / "v_twin" / "results.json").read_text(encoding="utf-8"))
-    assert res["status"] == "failed" and res["verdict"]["words"] == "balancing fails"
+    assert res["status"] == "failed" and res["verdict"]["words"].startswith("the design's claim fails: force")
     assert res["validation"]["complete"]["status"] == "fail" and not res["unconfirmed"]
 
 
@@ -223,9 +223,11 @@ def test_a_verdict_never_says_balancing_fails_beside_cancelled_loads():
     assert failed["level"] == "bad" and "cancelled" in failed["text"]
     assert "balancing fails" not in failed["text"] and failed["words"] == "the simulation contradicts the analysis"
     unsure = verdict({"stages": stages, "status": "ok", "unconfirmed": ["torque-driven run of stage 'full' unconfirmed"]})
-    assert unsure["words"] == "balanced as claimed" and "unconfirmed" in unsure["text"]
+    assert unsure["words"] == "balanced as designed" and "unconfirmed" in unsure["text"]
+    assert unsure["verdict"] == "unconfirmed" and failed["verdict"] == "fails"
     claim = dict(stages[1], force_balanced=False, force_ratio=0.2)
-    assert verdict({"stages": [stages[0], claim], "status": "failed"})["words"] == "balancing fails"
+    assert verdict({"stages": [stages[0], claim], "status": "failed"})["words"] == (
+        "the design's claim fails: force not cancelled (20 % of the reference left)")
 
 
 def test_a_position_driven_run_unresolved_at_its_first_step_is_unconfirmed_with_a_step_that_resolves_it():

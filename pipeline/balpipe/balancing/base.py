@@ -82,6 +82,11 @@ class Stage:
     design: str | None = None
     # what an optimised stage minimised and was held to (partial_balance): the verdict's measure
     aim: Aim | None = None
+    # what the stage's paper claims it balances where that is more than the design as given
+    # guarantees ("force+moment" for the Scott-Russell legs' counter-rotations of paper 000, whose
+    # printed inertias break eq. 30e): the verdict judges it ("the paper's claim fails"), while the
+    # build and the simulation check only ``balances``
+    paper_claims: str = ""
 
 
 @dataclass(frozen=True)

@@ -63,10 +63,7 @@ def _entry(out: Path, o) -> dict:
         last = next((s for s in st if v["motions"] and s["name"] == v["motions"][0]["final"]), st[-1])
         e["added_mass"] = f"{num(last['added_mass'])} kg"
         e.update(_costs(results, first, last))
-        refs = results.get("references") or []
-        agree = sum(r["status"] == "agrees" for r in refs)
-        known = sum(r["status"] != "agrees" and r.get("expected") == "differ" for r in refs)
-        e["refs"] = (f"{agree}/{len(refs)} reproduced" + (f", {known} known not to" if known else "")) if refs else "—"
+        e["refs"] = v["references"].get("badge") or "—"  # reproduced / explained / not reproduced, apart
         val = results.get("validation")
         if val is None:
             e["validation"] = '<span class="muted">skipped</span>'
@@ -137,7 +134,7 @@ def _costs(results: dict, first: dict, last: dict) -> dict:
         parts = [p for p in ("force", "moment") if p in (s.get("balances") or "")]
         holds = all(s.get(f"{p}_balanced") for p in parts)
         claims.append({
-            "label": s["label"], "claims": " and ".join(parts) or "—", "holds": holds if parts else None,
+            "name": s["name"], "label": s["label"], "claims": " and ".join(parts) or "—", "holds": holds if parts else None,
             "realisable": s.get("realisable", True) is not False,
             "worse": (s.get("moment_ratio") or 0.0) > 1.0 + 1e-9,
             "moment": ratio(s.get("moment_ratio"), tol), "force": ratio(s.get("force_ratio"), tol),

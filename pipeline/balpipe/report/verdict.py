@@ -33,7 +33,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from .costs import cost_factors
+from ..study import REFERENCE_KINDS, reference_kind
+from .costs import cost_factors, factor_text
 
 #: a ratio within this of 1 reads "unchanged"
 UNCHANGED = 0.01
@@ -119,46 +120,131 @@ def aim_verdict(aim: dict, loads: dict, realisable: bool) -> tuple[str, str, dic
                           "nothing_added": aim.get("nothing_added") or ""}
 
 
-def stage_verdict(stage: dict, weight: float | None = None, reference: dict | None = None) -> dict:
-    """The verdict of one stage against its own claim (see the module's docstring), or, for an
-    optimised stage (its row has an ``aim``), against its objective and caps (:func:`aim_verdict`);
-    ``reference``: the row of the stage it is measured against (a load at round-off there reads
-    ``zero``)."""
-    claims = claims_of(stage)
-    loads = {p: outcome(stage.get(f"{p}_ratio"), bool(stage.get(f"{p}_balanced")), p in claims,
-                        bool(reference and reference.get(f"{p}_balanced")))
+#: the machine-readable verdict of a stage or spec (``verdict`` in results.json): every claim
+#: holds; a claim fails; an optimised stage judged by its objective; no claim, no aim (the loads'
+#: changes only); the claims hold in the analysis but a simulation check could not confirm them
+KINDS = ("holds", "fails", "objective", "unclaimed", "unconfirmed")
+
+
+def _row(stage: Any) -> dict:
+    """A stage's results.json row: a :class:`balpipe.study.StageMetrics` or its row already."""
+    return stage.to_json() if hasattr(stage, "to_json") else stage
+
+
+def paper_claims_of(stage: dict) -> list[str]:
+    """The loads the stage's paper claims it balances beyond what its design as given
+    guarantees (``paper_claims``: the Scott-Russell legs' counter-rotations as printed)."""
+    own = claims_of(stage)
+    return [p for p in claims_of({"balances": stage.get("paper_claims")}) if p not in own]
+
+
+def _shortfall(load: str, o: dict) -> str:
+    """A claimed load that is not cancelled: 'moment × 6.74' (grown), or what is left of it."""
+    r = o["ratio"]
+    if r is None:
+        return f"{load} unknown"
+    return f"{load} {factor_text(r)}" if r >= 1.0 else f"{load} not cancelled ({percent(r)} of the reference left)"
+
+
+def _cost(load: str, o: dict) -> str:
+    """A load the stage does not claim that grows: 'moment × 12.6'."""
+    return f"{load} {factor_text(o['ratio'])}"
+
+
+def stage_words(stage: Any, paper: bool = False, reference: dict | None = None) -> dict:
+    """The verdict of one stage in engineering words: the one function the index, the page,
+    ``balpipe diff`` and results.json read. ``stage``: a :class:`balpipe.study.StageMetrics` or
+    its results.json row; ``paper``: the spec reproduces a paper (a claim of complete balance is
+    then the paper's: "balanced as claimed"); ``reference``: the row of the stage it is measured
+    against (a load at round-off there reads ``zero``).
+
+    Returns ``verdict`` (one of :data:`KINDS`), ``words``, ``costs`` (the loads the stage does
+    not claim that grow, 'moment × 12.6'), ``level``, the per-load outcomes and the claims:
+
+    * every claim holds: "force balanced as designed" (a force balance: the moment's growth is
+      a cost, not a failure), "balanced as designed" (force and moment), "balanced as claimed"
+      (force and moment, claimed by the spec's paper); "... on paper only" when a part cannot be
+      built;
+    * a claim fails: "the paper's claim fails: moment × 6.74" (the spec's paper, or a claim the
+      paper makes beyond the design as given), else "the design's claim fails: ...";
+    * an optimised stage: judged by its objective and caps (:func:`aim_verdict`);
+    * no claim and no aim: "loads reduced", "no change" or "loads worse"."""
+    row = _row(stage)
+    ref = _row(reference) if reference is not None else None
+    design = claims_of(row)
+    beyond = paper_claims_of(row)
+    claims = [p for p in ("force", "moment") if p in design or p in beyond]
+    loads = {p: outcome(row.get(f"{p}_ratio"), bool(row.get(f"{p}_balanced")), p in claims,
+                        bool(ref and ref.get(f"{p}_balanced")))
              for p in ("force", "moment")}
-    if stage.get("aim") and not claims:
-        realisable = stage.get("realisable", True) is not False
-        level, words, aim = aim_verdict(stage["aim"], loads, realisable)
+    realisable = row.get("realisable", True) is not False
+    costs = [_cost(p, loads[p]) for p in ("force", "moment") if p not in claims and loads[p]["outcome"] == "worse"]
+    out: dict[str, Any] = {"claims": claims, "paper_claims": beyond, "realisable": realisable,
+                           "force": loads["force"], "moment": loads["moment"], "costs": costs}
+    if row.get("aim") and not claims:
+        level, text, aim = aim_verdict(row["aim"], loads, realisable)
         if not realisable:
-            words += f"; {stage.get('not_realisable') or 'not realisable'} (on paper only)"
-        return {"level": level, "text": words, "claims": [], "holds": None, "realisable": realisable,
-                "force": loads["force"], "moment": loads["moment"], "weight": weight, "aim": aim}
+            text += f"; {row.get('not_realisable') or 'not realisable'} (on paper only)"
+        kinds = {o["outcome"] for o in aim["objective"]}
+        if any(not c["kept"] for c in aim["caps"]):
+            words = "a cap broken"
+        elif aim["nothing_added"] and level == "neutral":
+            words = "adds nothing"
+        elif "worse" in kinds:
+            words = "objective worse"
+        elif level == "neutral":
+            words = "objective unchanged"
+        else:
+            words = "objective reduced"
+        out["costs"] = [_cost(p, loads[p]) for p in aim["side_effects"] if loads[p]["outcome"] == "worse"]
+        return {**out, "verdict": "objective", "words": words, "level": level, "text": text, "holds": None,
+                "aim": aim}
     fails = [p for p in claims if loads[p]["outcome"] not in ("cancelled", "zero")]
-    worse = [p for p in ("force", "moment") if loads[p]["outcome"] == "worse"]
-    realisable = stage.get("realisable", True) is not False
+    gains = [f"{p} {loads[p]['text']}" for p in ("force", "moment")
+             if p not in claims and loads[p]["outcome"] in ("reduced", "cancelled")]
     if fails:
-        level = "bad"
-    elif worse or not realisable:
-        level = "warn"
-    elif all(loads[p]["outcome"] in ("unchanged", "zero") for p in loads):
-        level = "neutral"
-    else:
+        whose = "the paper's claim" if paper or any(p in beyond for p in fails) else "the design's claim"
+        kind, level = "fails", "bad"
+        words = f"{whose} fails: " + ", ".join(_shortfall(p, loads[p]) for p in fails)
+        kept = [p for p in claims if p not in fails]
+        details = [f"{p} {loads[p]['text']} as claimed" for p in kept] + gains
+    elif claims:
+        kind = "holds"
+        complete = claims == ["force", "moment"]
+        words = ("balanced" if complete else f"{claims[0]} balanced") + (" as claimed" if paper and complete else " as designed")
         level = "good"
-    words = f"force {loads['force']['text']}, moment {loads['moment']['text']}"
-    if claims:
-        words += f"; claims {' and '.join(claims)} balance: " + (
-            f"fails ({' and '.join(fails)} not cancelled)" if fails else "holds")
+        details = gains
+        if not realisable:
+            words += " on paper only"
+            level = "warn"
     else:
-        words += "; no balance claimed"
+        kind = "unclaimed"
+        kinds = {loads[p]["outcome"] for p in loads}
+        if "worse" in kinds:  # nothing claimed: a load made worse is no chosen cost
+            words, level = "loads worse" if kinds <= {"worse", "unchanged", "zero"} else "a load worse", "warn"
+        elif kinds & {"reduced", "cancelled"}:
+            words, level = "loads reduced", "good"
+        else:
+            words, level = "no change", "neutral"
+        details = [f"{p} {loads[p]['text']}" for p in ("force", "moment")]
+        costs = out["costs"] = []  # the loads' own words say it
+        if not realisable:
+            level = worst([level, "warn"])
+    text = words
+    if details:
+        text += ": " + ", ".join(details) if kind == "unclaimed" else "; " + ", ".join(details)
+    if costs:
+        text += f"; cost{'s' if len(costs) > 1 else ''}: " + ", ".join(costs)
     if not realisable:
-        words += f"; {stage.get('not_realisable') or 'not realisable'} (balanced on paper only)"
-    return {
-        "level": level, "text": words, "claims": claims, "holds": (not fails) if claims else None,
-        "realisable": realisable, "force": loads["force"], "moment": loads["moment"],
-        "weight": weight,
-    }
+        text += f"; {row.get('not_realisable') or 'not realisable'} (balanced on paper only)"
+    return {**out, "verdict": kind, "words": words, "level": level, "text": text,
+            "holds": (not fails) if claims else None}
+
+
+def stage_verdict(stage: dict, weight: float | None = None, reference: dict | None = None,
+                  paper: bool = False) -> dict:
+    """The verdict of one stage (:func:`stage_words`) with its weight (N, gravity on) apart."""
+    return {**stage_words(stage, paper, reference), "weight": weight}
 
 
 def main_design(results: dict) -> set[str]:
@@ -191,24 +277,46 @@ def headline_stage(members: list[dict]) -> tuple[dict, bool]:
     return (declared[-1], True) if declared else (members[-1], False)
 
 
+def _reference_kind(ref: dict) -> str:
+    """One ``references`` row's kind (:func:`balpipe.study.reference_kind`; a results.json of an
+    older build has none)."""
+    return ref.get("kind") or reference_kind(ref.get("status") or "", ref.get("expected") or "agree")
+
+
 def references_verdict(refs: list[dict]) -> dict:
-    """Published numbers reproduced k of n; those the spec expects not to (a paper's typo,
-    documented in its note) counted apart."""
+    """The published numbers counted apart: reproduced; explained (a misprint the page explains,
+    or reproduced within the stated tolerance under stated assumptions), which never lowers the
+    verdict; known not to reproduce (the note says why: ``warn``); unexpectedly not (``bad``)."""
     n = len(refs)
-    k = sum(r.get("status") == "agrees" for r in refs)
-    known = sum(r.get("status") != "agrees" and r.get("expected") == "differ" for r in refs)
-    unexpected = n - k - known
+    kinds = [_reference_kind(r) for r in refs]
+    count = {k: kinds.count(k) for k in REFERENCE_KINDS}
+    explained = count["assumption"] + count["misprint"]
+    out = {"reproduced": count["reproduced"], "total": n, "explained": explained,
+           "misprint": count["misprint"], "assumption": count["assumption"],
+           "known_not": count["not_reproduced"], "unexpected": count["unexpected"], "kinds": kinds}
     if not n:
-        return {"reproduced": 0, "total": 0, "known_not": 0, "unexpected": 0, "level": "neutral",
-                "text": "no published numbers"}
-    text = f"published numbers reproduced {k} of {n}"
-    if known:
-        text += f" ({known} known not to: the paper's own numbers do not reproduce)"
-    if unexpected:
-        text += f", {unexpected} unexpectedly not"
-    level = "bad" if unexpected else ("warn" if known else "good")
-    return {"reproduced": k, "total": n, "known_not": known, "unexpected": unexpected, "level": level,
-            "text": text}
+        return {**out, "level": "neutral", "text": "no published numbers", "badge": ""}
+    parts = []
+    if count["reproduced"]:
+        parts.append(f"{count['reproduced']} reproduced")
+    if count["assumption"]:
+        parts.append(f"{count['assumption']} reproduced within the stated tolerance under the stated assumptions")
+    if count["misprint"]:
+        parts.append(f"{count['misprint']} misprint{'s' if count['misprint'] > 1 else ''} the page explains")
+    if count["not_reproduced"]:
+        parts.append(f"{count['not_reproduced']} not reproduced (the notes say why)")
+    if count["unexpected"]:
+        parts.append(f"{count['unexpected']} unexpectedly not reproduced")
+    level = "bad" if count["unexpected"] else ("warn" if count["not_reproduced"] else "good")
+    # the index's short badge: reproduced / explained / not reproduced, apart
+    badge = f"{count['reproduced'] + count['assumption']} of {n} reproduced"
+    if count["assumption"]:
+        badge += f" ({count['assumption']} within the stated tolerance)"
+    if count["misprint"]:
+        badge += f", {count['misprint']} misprint{'s' if count['misprint'] > 1 else ''} explained"
+    if count["not_reproduced"] + count["unexpected"]:
+        badge += f", {count['not_reproduced'] + count['unexpected']} not reproduced"
+    return {**out, "level": level, "text": f"published numbers ({n}): " + ", ".join(parts), "badge": badge}
 
 
 def _span(outs: list[dict]) -> dict:
@@ -234,20 +342,27 @@ def _span(outs: list[dict]) -> dict:
 
 def verdict(results: dict, weights: dict[str, float] | None = None, main: set[str] | None = None) -> dict[str, Any]:
     """The ``verdict`` object of ``results.json`` from its other fields (``stages``,
-    ``references``, ``status``); ``weights``: per stage name, the moving links' weight (N), with
-    gravity on; ``main``: the names of the main design's stages (default: :func:`main_design`)."""
+    ``references``, ``status``, ``paper``); ``weights``: per stage name, the moving links' weight
+    (N), with gravity on; ``main``: the names of the main design's stages (default:
+    :func:`main_design`). ``verdict``, ``words`` and ``costs`` are those of the headline stage
+    (:func:`stage_words`), or of the first main-design stage whose claim fails (a later stage
+    does not redeem it)."""
     weights = weights or {}
     stages = results.get("stages") or []
+    paper = bool(results.get("paper"))
     per_stage = {}
     by_name = {s["name"]: s for s in stages}
     for s in stages:
         if s.get("reference", stages[0]["name"]) == s["name"]:
             continue  # a reference: nothing to judge
-        per_stage[s["name"]] = stage_verdict(s, weights.get(s["name"]), by_name.get(s.get("reference", stages[0]["name"])))
+        per_stage[s["name"]] = stage_verdict(s, weights.get(s["name"]), by_name.get(s.get("reference", stages[0]["name"])),
+                                             paper)
     groups = []
+    failing: list[str] = []
     for ref, members in motions(stages, main if main is not None else main_design(results)):
         final, declared = headline_stage(members)
         v = per_stage[final["name"]]
+        failing += [m["name"] for m in members if per_stage[m["name"]]["verdict"] == "fails"]
         groups.append({
             "reference": ref["name"], "reference_label": ref["label"], "final": final["name"],
             "final_label": final["label"], "declared": declared,
@@ -264,43 +379,51 @@ def verdict(results: dict, weights: dict[str, float] | None = None, main: set[st
     if not groups:
         force = moment = outcome(None, False, False)
         balance_level = "neutral"
+        kind, words, costs = "unclaimed", "no change", []
     else:
         force = _span([per_stage[g["final"]]["force"] for g in groups])
         moment = _span([per_stage[g["final"]]["moment"] for g in groups])
         balance_level = worst([g["level"] for g in groups] + [g["final_level"] for g in groups])
+        judged = [per_stage[failing[0]]] if failing else [per_stage[g["final"]] for g in groups]
+        lead = max(judged, key=lambda x: LEVELS.index(x["level"]))  # the worst motion speaks
+        kind, words = lead["verdict"], lead["words"]
+        costs = list(dict.fromkeys(c for j in judged for c in j["costs"]))
+        if failing and failing[0] not in {g["final"] for g in groups}:
+            words += f" ({by_name[failing[0]]['label']})"
+        if len(judged) > 1 and len({j["words"] for j in judged}) > 1:
+            words += f" (the worst of {len(judged)} motions)"
     level = worst([balance_level, refs["level"] if refs["total"] else "good"])
-    claims_fail = any(s["holds"] is False for s in per_stage.values())
+    claims_fail = bool(failing) or any(s["holds"] is False for s in per_stage.values())
     if results.get("status") not in (None, "ok"):
         level = "bad"
-    claimed = any(per_stage[g["final"]]["claims"] for g in groups)
-    aimed = bool(groups) and all("aim" in per_stage[g["final"]] for g in groups)
-    good = "balanced as claimed" if claimed else "objective reduced" if aimed else "loads reduced"
-    bad = "a cap broken" if aimed else "balancing fails"
-    words = {"good": good, "neutral": "no change", "warn": "mixed", "bad": bad}[level]
-    if level == "warn" and balance_level in ("good", "neutral"):
-        words = f"{good if balance_level == 'good' else 'no change'}; published numbers not all reproduced"
-    if aimed and any(o["outcome"] == "worse" for g in groups for o in per_stage[g["final"]]["aim"]["objective"]):
-        words = "objective worse"
-    if results.get("status") not in (None, "ok"):
         # "balancing fails" only where a claim of the analysis fails: a build that failed a check
         # while every claim holds (the simulation contradicts the analysis) says so instead, never
         # "balancing fails" beside loads the analysis finds cancelled
-        words = ("balancing fails" if claims_fail or balance_level == "bad"
-                 else check_failure(results.get("problems") or []))
-    if aimed and level == "neutral" and all(per_stage[g["final"]]["aim"]["nothing_added"] for g in groups):
-        words = "adds nothing"  # the stage's words say why
-        text = " | ".join(per_stage[g["final"]]["text"] for g in groups)
-    elif aimed:  # judged by what it optimised: its objective, its caps, the shaking loads as side effects
-        text = f"{words}: " + " | ".join(per_stage[g["final"]]["text"] for g in groups)
-    else:
+        if not claims_fail and balance_level != "bad":
+            kind, words = "fails", check_failure(results.get("problems") or [])
+        elif kind != "fails":
+            kind, words = "fails", "balancing fails"
+    unconfirmed = list(results.get("unconfirmed") or [])
+    if unconfirmed and kind == "holds":
+        kind = "unconfirmed"
+    aimed = bool(groups) and all("aim" in per_stage[g["final"]] for g in groups)
+    if aimed:  # judged by what it optimised: its objective, its caps, the shaking loads as side effects
+        body = " | ".join(per_stage[g["final"]]["text"] for g in groups)
+        text = body if words == "adds nothing" else f"{words}: {body}"
+    elif len(groups) == 1 and kind != "fails" or failing:  # the judged stage's own words
+        text = words + lead["text"][len(lead["words"]):]
+    elif groups:
         text = f"{words}: force {force['text']}, moment {moment['text']}"
+        if costs:
+            text += f"; cost{'s' if len(costs) > 1 else ''}: " + ", ".join(costs)
+    else:
+        text = words
     if refs["total"]:
         text += f"; {refs['text']}"
-    unconfirmed = list(results.get("unconfirmed") or [])
     if unconfirmed:
         text += f"; simulation check unconfirmed for {len(unconfirmed)} run{'s' if len(unconfirmed) > 1 else ''}"
-    return {"level": level, "words": words, "text": text, "force": force, "moment": moment,
-            "references": refs, "motions": groups, "stages": per_stage,
+    return {"verdict": kind, "level": level, "words": words, "costs": costs, "text": text, "force": force,
+            "moment": moment, "references": refs, "motions": groups, "stages": per_stage,
             "validation": "unconfirmed" if unconfirmed else None}
 
 

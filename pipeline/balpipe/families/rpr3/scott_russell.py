@@ -251,7 +251,7 @@ def balance(ctx: BalanceContext) -> BalanceResult:
         Stage("counter_rotations", "counter-rotations", full,
               "one counter-rotation per leg on the base, geared to the cylinder (eq. 30f, Fig. 7)"
               + ("" if ok30e else "; eq. 30e does not hold, so the moment remains"),
-              balances="force+moment" if ok30e else "force"),
+              balances="force+moment" if ok30e else "force", paper_claims="force+moment"),
     )]  # the paper's line styles
     return BalanceResult(params, stages, notes)
 
