@@ -334,3 +334,23 @@ def test_page_shows_the_frame_on_its_mounts_only_with_a_frame():
             assert "What balancing did to the floor" in html and "Natural modes" in html
             assert "exceeds: " in html and " mm/s vs 1 mm/s" in html and "within limit" in html
             assert "1.61e-12" not in html  # the balanced stage's velocity is round-off, shown as 0
+
+
+def test_external_loads_reach_the_mounts_through_the_frame_load():
+    """The pumpjack's well load is external: the frame feels the shaking loads plus it (the
+    frame load), and so do its mounts; the shaking loads alone would give other floor forces."""
+    from balpipe.loader import load
+    from balpipe.report.frame_mounts import stage_json
+    spec = load(ROOT / "specs" / "custom_pumpjack_rod_load.yaml").spec
+    framed, _ = load_text((ROOT / "specs" / "custom_pumpjack_rod_load.yaml").read_text(encoding="utf-8") + FRAME,
+                          str(ROOT / "specs" / "custom_pumpjack_rod_load.yaml"))
+    study = run(spec, page=False)
+    an = study.unbalanced.analysis
+    frame = framed.frame.model()
+    got = stage_json(framed, an)
+    assert got["method"] == "time"
+    for source, same in ((an.frame_load, True), ((an.force, an.moment), False)):
+        r = transient_response(frame, an.t, frame.load_about_com(*source, tuple(an.moment_point)))
+        peaks = [float(np.max(np.linalg.norm(f, axis=1))) for f in r.mount_forces(frame)]
+        assert (peaks == [m["peak"] for m in got["mounts"]]) == same
+    assert np.max(np.abs(an.frame_load[0] - an.force)) > 0.1 * np.max(np.abs(an.force))
