@@ -177,6 +177,7 @@ def test_player_panels_contain_every_instant_and_fill_their_box(studies, name, m
     d = player.player_data(stages)
     W, H = d["layout"]["width"], d["layout"]["height"]
     inner_w, inner_h = W - 2 * player.SIDE, H - player.TOP - player.BOTTOM
+    spans = []
     for stage, src in zip(d["stages"], stages):
         m = src["model"]
         pts = []
@@ -199,13 +200,28 @@ def test_player_panels_contain_every_instant_and_fill_their_box(studies, name, m
         xy = np.vstack(pts)
         ok, ext = _inside_panel(d, stage, xy)
         assert ok, (name, stage["label"], ext)
-        # it fills its panel: the swept extent spans most of the width or of the height
+        # at one scale for every panel (the stages' own scales within a factor 3 here), the
+        # largest stage filling its panel: its swept extent spans most of the width or the height
         ox, oy, s = stage["view"]
-        w_px, h_px = s * np.ptp(xy[:, 0]), s * np.ptp(xy[:, 1])
-        assert w_px >= 0.8 * inner_w or h_px >= 0.8 * inner_h, (stage["label"], w_px, h_px, inner_w, inner_h)
+        spans.append((s * np.ptp(xy[:, 0]), s * np.ptp(xy[:, 1])))
         # the scale bar is a round length within the panel
         bar = stage["bar"][0]
         assert 0 < bar * s <= inner_w and f"{bar:g}" != "" and stage["bar"][1].endswith("m")
+    assert d["same_scale"]
+    assert any(w_px >= 0.8 * inner_w or h_px >= 0.8 * inner_h for w_px, h_px in spans), (spans, inner_w, inner_h)
+
+
+def test_panels_share_one_scale_unless_a_stage_is_three_times_larger():
+    """Boxes of 1 m and 2 m: one scale (the smaller, so both fit); 1 m and 4 m: each its own."""
+    def ext(size):
+        return np.array([[0.0, 0.0], [size, size]])
+
+    shared = player.panel_views([ext(1.0), ext(2.0)])
+    assert player.same_scale(shared)
+    apart = player.panel_views([ext(1.0), ext(4.0)])
+    s = [p["view"][2] for p in apart["panels"]]
+    assert not player.same_scale(apart) and s[0] == pytest.approx(4 * s[1])
+    assert shared["panels"][0]["view"][2] == pytest.approx(apart["panels"][1]["view"][2] * 2)
 
 
 def test_player_says_when_the_panels_scales_differ(studies):

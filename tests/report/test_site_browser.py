@@ -23,6 +23,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 from urllib.parse import urljoin, urlsplit
 
+import numpy as np
 import pytest
 
 from _gitrepo import Repo, edit
@@ -917,4 +918,43 @@ def test_wide_screens_keep_the_contents_beside_the_page(paper_site, browser):
     assert side.bounding_box()["y"] == box["y"]  # it stayed where it was while the page scrolled
     p.set_viewport_size({"width": 1400, "height": 900})
     assert not side.is_visible()
+    assert not w.problems, "\n".join(w.problems)
+
+
+@pytest.mark.parametrize("width", [1400, 400])
+def test_the_mechanism_moves_with_its_shaking_loads_in_table_order(paper_site, studies, browser, width):
+    """Every page's mechanism drawings move: one panel per stage in the stage table's order, at
+    one scale, paused at load; the shaking force and moment at each panel's time are the engine's
+    (to the 4 digits shown); a click in a plot (balpipe:seek) moves it; at 400 px one readable
+    column (panels at their own size, not shrunk)."""
+    study = studies("custom_four_bar_balancing.yaml")
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": width, "height": 900})
+    p.goto((paper_site / "custom_four_bar_balancing" / "index.html").as_uri(), wait_until="load")
+    p.click("#the-mechanism")
+    cv = p.locator("#mechanism-player")
+    cv.scroll_into_view_if_needed()
+    assert cv.get_attribute("data-playing") == "0"
+    table = p.eval_on_selector_all("details:has(#balancing-stages) table tr td:first-child strong",
+                                   "els => els.map(e => e.textContent.trim())")
+    labels = json.loads(cv.get_attribute("data-stages"))
+    assert labels == [s.stage.label for s in study.stages if s.stage.group == study.stages[0].stage.group]
+    assert [t for t in table if t in labels][:len(labels)] == labels
+    cols = int(cv.get_attribute("data-columns"))
+    box = cv.bounding_box()
+    assert (cols == 1 and box["width"] >= 299) if width == 400 else cols == min(4, len(labels))
+    p.eval_on_selector("#mechanism-player-time", "s => { s.value = '1000'; s.dispatchEvent(new Event('input')); }")
+    shown = cv.get_attribute("data-loads").split(" | ")
+    fmax = max(float(np.max(np.hypot(*s.analysis.force.T))) for s in study.stages if s.stage.label in labels)
+    for text, s in zip(shown, [next(x for x in study.stages if x.stage.label == lab) for lab in labels]):
+        m = re.fullmatch(r"\|F\| (\S+) N, M (\S+) N m", text)
+        assert m, text
+        f = float(np.hypot(*s.analysis.force[-1]))
+        assert float(m.group(1)) == (pytest.approx(f, rel=1e-3) if f > 1e-9 * fmax else 0.0), (s.stage.label, text)
+    pixels = cv.evaluate("c => c.toDataURL()")
+    t_end = p.text_content("#mechanism-player-clock")
+    p.evaluate("document.dispatchEvent(new CustomEvent('balpipe:seek', {detail: {time: 0.2}}))")
+    assert p.text_content("#mechanism-player-clock").startswith("t = 0.200 s") and cv.evaluate("c => c.toDataURL()") != pixels
+    assert t_end != p.text_content("#mechanism-player-clock")
     assert not w.problems, "\n".join(w.problems)

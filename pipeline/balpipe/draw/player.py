@@ -16,6 +16,7 @@ No library, no external file.
 
 from __future__ import annotations
 
+import html
 import json
 import math
 from collections.abc import Set as AbstractSet
@@ -78,6 +79,9 @@ def _extent_points(model: Model, poses: np.ndarray, base: np.ndarray | None = No
 
 
 PANEL_W = 300  # px per panel
+#: the panels share one scale (the smallest of their own) while their own scales differ by at
+#: most this factor; beyond it (a stage that moves far more than another) each fills its panel
+COMMON_SCALE = 3.0
 TOP, BOTTOM, SIDE = 22, 40, 10  # px: the stage's name above, the frame's pose and scale bar below
 MAX_COLUMNS = 4
 
@@ -99,9 +103,11 @@ def _length_text(x: float) -> str:
 
 def panel_views(extents: list[np.ndarray], width: int = PANEL_W) -> dict:
     """Per-panel view boxes: every panel the same pixel size (its height from the widest
-    aspect of the stages' extents), each mechanism scaled to fill its own panel: ``box`` (x0, y0,
-    x1, y1, m, with a 6 % margin), ``view`` (ox, oy, s: pixel = (ox + s x, oy - s y) on the
-    canvas), the scale bar (length m, text) and the layout (columns, rows, panel size)."""
+    aspect of the stages' extents), each mechanism centred in its panel at one scale for every
+    panel (the smallest of the panels' own, so that every stage fits) where their own scales
+    differ by at most :data:`COMMON_SCALE`, else each scaled to fill its own panel: ``box``
+    (x0, y0, x1, y1, m, with a 6 % margin), ``view`` (ox, oy, s: pixel = (ox + s x, oy - s y) on
+    the canvas), the scale bar (length m, text) and the layout (columns, rows, panel size)."""
     boxes = []
     for xy in extents:
         lo, hi = xy.min(axis=0), xy.max(axis=0)
@@ -113,14 +119,16 @@ def panel_views(extents: list[np.ndarray], width: int = PANEL_W) -> dict:
     height = inner_h + TOP + BOTTOM
     cols = min(len(boxes), MAX_COLUMNS) or 1
     rows = -(-len(boxes) // cols)
+    own = [min(inner_w / (b[2] - b[0]), inner_h / (b[3] - b[1])) for b in boxes]
+    common = min(own) if max(own) <= COMMON_SCALE * min(own) else None
     panels = []
     for k, b in enumerate(boxes):
-        s = min(inner_w / (b[2] - b[0]), inner_h / (b[3] - b[1]))
+        s = common if common is not None else own[k]
         col, row = k % cols, k // cols
         cx, cy = 0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3])
         ox = col * width + SIDE + 0.5 * inner_w - s * cx
         oy = row * height + TOP + 0.5 * inner_h + s * cy
-        bar = nice_length(0.3 * (b[2] - b[0]))
+        bar = nice_length(0.3 * inner_w / s)
         panels.append({"box": [round(v, 6) for v in b], "view": [round(ox, 4), round(oy, 4), round(s, 6)],
                        "origin": [col * width, row * height], "bar": [round(bar, 9), _length_text(bar)]})
     return {"panels": panels, "columns": cols, "rows": rows, "width": width, "height": height}
@@ -193,10 +201,28 @@ def _pose(row, position: int, angle: int) -> list[float]:
     return [round(float(row[0]), position) + 0.0, round(float(row[1]), position) + 0.0, round(float(row[2]), angle) + 0.0]
 
 
+def _loads(stages: list[dict], ks_of: list[np.ndarray]) -> tuple[list[dict], dict]:
+    """The shaking force and moment of each stage at its frames (4 significant digits: what an
+    arrow and a 4-digit number show), where the stages carry them (``force`` (n, 2) N,
+    ``moment`` (n,) N m about ``point``), and their largest magnitudes over every stage and
+    every sample: one arrow scale for all panels, and the floor below which a value is shown as
+    0 (1e-9 of that largest: round-off of the model's own scale)."""
+    if not all("force" in s for s in stages):
+        return [{} for _ in stages], {}
+    fmax = max(float(np.max(np.hypot(s["force"][:, 0], s["force"][:, 1]), initial=0.0)) for s in stages)
+    mmax = max(float(np.max(np.abs(s["moment"]), initial=0.0)) for s in stages)
+    sig = lambda v: float(f"{float(v):.4g}") + 0.0  # noqa: E731
+    out = [{"force": [[sig(f[0]), sig(f[1])] for f in s["force"][ks]], "moment": [sig(m) for m in s["moment"][ks]],
+            "point": [round(float(s["point"][0]), 6), round(float(s["point"][1]), 6)]}
+           for s, ks in zip(stages, ks_of)]
+    return out, {"fmax": sig(fmax), "mmax": sig(mmax), "floor": 1e-9}
+
+
 def player_data(stages: list[dict]) -> dict:
     """The player's data: per stage its label, times, frame and body poses (about
-    :data:`FRAMES` frames, rounded to what its panel shows: :func:`digits`), shapes, names, and
-    its own view box (:func:`panel_views`)."""
+    :data:`FRAMES` frames, rounded to what its panel shows: :func:`digits`), shapes, names, its
+    own view box (:func:`panel_views`) and, where the stages carry them, the shaking force and
+    moment at those frames (:func:`_loads`)."""
     from .labels import gear_numbers
 
     numbers = gear_numbers([s["model"] for s in stages])
@@ -204,9 +230,9 @@ def player_data(stages: list[dict]) -> dict:
     views = panel_views(extents)
     size = math.hypot(views["width"], views["height"])
     data = []
-    for s, view in zip(stages, views["panels"]):
-        n = len(s["t"])
-        ks = spread_indices(n, FRAMES)
+    ks_of = [np.asarray(spread_indices(len(s["t"]), FRAMES)) for s in stages]
+    loads, scale = _loads(stages, ks_of)
+    for s, view, ks, load in zip(stages, views["panels"], ks_of, loads):
         poses = s["poses"][ks]
         base = s["base"][ks]
         position, angle = digits(view["view"][2], size)
@@ -223,11 +249,12 @@ def player_data(stages: list[dict]) -> dict:
             "guides": [[[round(a[0], 5), round(a[1], 5)], [round(b[0], 5), round(b[1], 5)]] for a, b in s["model"].guides],
             "sleeves": [[[[round(float(v), position) + 0.0 for v in end] for end in ends]
                          for ends in sleeves(s["model"], frame)] for frame in poses],
+            **load,
         })
     for d, p in zip(data, views["panels"]):
         d.update(p)
     return {"stages": data, "layout": {k: views[k] for k in ("columns", "rows", "width", "height")},
-            "same_scale": same_scale(views), "numbers": numbers}
+            "same_scale": same_scale(views), "numbers": numbers, "loads": scale}
 
 
 def scale_note(stages: list[dict]) -> str:
@@ -243,20 +270,28 @@ def scale_note(stages: list[dict]) -> str:
     return note
 
 
-def player_html(stages: list[dict], element_id: str = "player") -> str:
+def player_html(stages: list[dict], element_id: str = "player", floating: bool = True, autoplay: bool = True) -> str:
     """``stages``: dicts with label, model, t (n,), base (n, 3) frame-origin poses and poses
-    (n, nb, 3) body-frame poses, all in the global frame of the start. One panel per stage, each
-    with its own view box and scale bar (:func:`panel_views`)."""
+    (n, nb, 3) body-frame poses, all in the global frame of the start; optionally ``force``
+    (n, 2), ``moment`` (n,) and ``point``: the shaking loads on the frame, drawn as an arrow at
+    the moment point (one force scale for every panel) and an arc for the moment, with their
+    values. One panel per stage at one scale where the stages allow it (:func:`panel_views`),
+    each with its scale bar; as many columns as the page's width holds (one on a phone).
+    ``floating``: the frame moves (the free-floating runs), its pose is printed per panel;
+    ``autoplay``: it plays at load (unless the reader asked for reduced motion)."""
     d = player_data(stages)
     lay = d["layout"]
-    payload = json.dumps({"stages": d["stages"], "layout": lay}, separators=(",", ":"), sort_keys=True)
+    payload = json.dumps({"stages": d["stages"], "layout": lay, "loads": d["loads"]}, separators=(",", ":"), sort_keys=True)
     # names are data: no '</script>' or '<!--' can end the script early
     payload = payload.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
     width = lay["width"] * lay["columns"]
     height = lay["height"] * lay["rows"]
     eid = element_id
+    labels = html.escape(json.dumps([st["label"] for st in d["stages"]], ensure_ascii=False))
+    what = ("the mechanism on its free-floating frame" if floating else
+            "the mechanism on its fixed frame with the shaking force and moment it passes to the frame")
     return f"""<div class="player" id="{eid}-box">
-<canvas id="{eid}" width="{width}" height="{height}" style="max-width:100%;border:1px solid #d9dee4" role="img" aria-label="Animation of the mechanism on its free-floating frame, one panel per stage, each with its own scale bar"></canvas>
+<canvas id="{eid}" width="{width}" height="{height}" data-stages="{labels}" style="max-width:100%;border:1px solid #d9dee4" role="img" aria-label="Animation of {what}, one panel per stage, each with a scale bar"></canvas>
 <div class="player-controls">
 <button type="button" id="{eid}-play" aria-controls="{eid}" aria-label="Pause">Pause</button>
 <label for="{eid}-time">time</label>
@@ -274,7 +309,50 @@ const cv = document.getElementById("{eid}"), g = cv.getContext("2d");
 const btn = document.getElementById("{eid}-play"), slider = document.getElementById("{eid}-time");
 const speedSel = document.getElementById("{eid}-speed"), clock = document.getElementById("{eid}-clock");
 const names = document.getElementById("{eid}-names");
-const L = D.layout, PW = L.width, PH = L.height;
+const L = D.layout, PW = L.width, PH = L.height, FLOATING = {str(floating).lower()};
+// as many columns as the page's width holds (the canvas is never shrunk below its panels' size):
+// each panel's view moves with its panel
+let COLS = L.columns;
+function layout() {{
+  const avail = (cv.parentElement && cv.parentElement.clientWidth) || PW * L.columns;
+  COLS = Math.max(1, Math.min(L.columns, Math.floor((avail - 2) / PW)));
+  const rows = Math.ceil(D.stages.length / COLS);
+  cv.width = COLS * PW; cv.height = rows * PH;
+  D.stages.forEach((st, k) => {{
+    st.view0 = st.view0 || st.view; st.origin0 = st.origin0 || st.origin;
+    const o = [(k % COLS) * PW, Math.floor(k / COLS) * PH];
+    st.origin = o;
+    st.view = [st.view0[0] - st.origin0[0] + o[0], st.view0[1] - st.origin0[1] + o[1], st.view0[2]];
+  }});
+  cv.dataset.columns = String(COLS);
+}}
+// a stage's name cut to its panel's width ("…" at the end); the page's table gives it whole
+function fit(text, w) {{ if (g.measureText(text).width <= w) return text;
+  let n = text.length; while (n > 1 && g.measureText(text.slice(0, n) + "…").width > w) n--; return text.slice(0, n).trimEnd() + "…"; }}
+const LD = D.loads || {{}};
+function loadText(v, max, unit) {{ return (Math.abs(v) <= LD.floor * max ? "0" : Number(v.toPrecision(4)).toString()) + " " + unit; }}
+function arrowHead(q, dx, dy, size) {{ const n = Math.hypot(dx, dy) || 1, ux = dx / n, uy = dy / n;
+  g.beginPath(); g.moveTo(q[0], q[1]); g.lineTo(q[0] - size * ux + 0.5 * size * uy, q[1] - size * uy - 0.5 * size * ux);
+  g.lineTo(q[0] - size * ux - 0.5 * size * uy, q[1] - size * uy + 0.5 * size * ux); g.closePath(); g.fill(); }}
+// the shaking force as an arrow at the moment point (one scale, N per px, for every panel) and the
+// shaking moment as an arc around it (its sweep proportional to the moment, counter-clockwise positive)
+function drawLoads(st, i, base, P) {{
+  if (!st.force || !LD.fmax) return;
+  const q = P(...T(base, st.point)), f = st.force[i], m = st.moment[i];
+  const k = 0.28 * Math.min(PW, PH - 62) / LD.fmax;
+  g.strokeStyle = g.fillStyle = "#d55e00"; g.lineWidth = 2.5;
+  if (Math.hypot(f[0], f[1]) > LD.floor * LD.fmax) {{
+    const e = [q[0] + k * f[0], q[1] - k * f[1]];
+    g.beginPath(); g.moveTo(...q); g.lineTo(...e); g.stroke(); arrowHead(e, e[0] - q[0], e[1] - q[1], 9);
+  }}
+  if (LD.mmax && Math.abs(m) > LD.floor * LD.mmax) {{
+    const r = 15, sweep = 1.5 * Math.PI * m / LD.mmax;  // canvas angles run clockwise: negate
+    g.lineWidth = 1.8; g.beginPath(); g.arc(q[0], q[1], r, 0, -sweep, sweep > 0); g.stroke();
+    const a = -sweep, tip = [q[0] + r * Math.cos(a), q[1] + r * Math.sin(a)];
+    arrowHead(tip, (sweep > 0 ? 1 : -1) * Math.sin(a), (sweep > 0 ? -1 : 1) * Math.cos(a), 7);
+  }}
+  g.lineWidth = 1;
+}}
 const T0 = D.stages[0].t[0], T1 = D.stages[0].t[D.stages[0].t.length - 1], span = Math.max(T1 - T0, 1e-9);
 function T(pose, p) {{ const c = Math.cos(pose[2]), si = Math.sin(pose[2]);
   return [pose[0] + c * p[0] - si * p[1], pose[1] + si * p[0] + c * p[1]]; }}
@@ -325,6 +403,7 @@ function placeNames(items, segs, marks, area) {{
 let time = T0, playing = true, last = null;
 function draw() {{
   g.clearRect(0, 0, cv.width, cv.height);
+  const shown = [];
   D.stages.forEach((st, k) => {{
     const v = st.view, s = v[2], O = st.origin;
     const P = (x, y) => [v[0] + x * s, v[1] - y * s];
@@ -373,11 +452,18 @@ function draw() {{
         items.push({{text: n[3], at: q, clear: 2, mark: -1, font: "italic 10px sans-serif", color: "#1f6fb4"}}); }});
     }} else items.length = 0;
     cv.dataset["names" + k] = String(placeNames(items, segs, marks, [O[0] + 2, O[1] + 18, O[0] + PW - 2, O[1] + PH - 36]));
+    drawLoads(st, i, base, P);
     g.restore();
     g.fillStyle = "#1d232b"; g.font = "12px sans-serif";
-    g.fillText(st.label, O[0] + 8, O[1] + 15);
-    const dx = base[0] * 1000, dy = base[1] * 1000, rot = base[2] * 180 / Math.PI;
-    g.fillText(`frame: (${{fixed(dx, 2)}}, ${{fixed(dy, 2)}}) mm, ${{fixed(rot, 3)}} deg`, O[0] + 8, O[1] + PH - 8);
+    g.fillText(fit(st.label, PW - 16), O[0] + 8, O[1] + 15);
+    if (FLOATING) {{
+      const dx = base[0] * 1000, dy = base[1] * 1000, rot = base[2] * 180 / Math.PI;
+      g.fillText(`frame: (${{fixed(dx, 2)}}, ${{fixed(dy, 2)}}) mm, ${{fixed(rot, 3)}} deg`, O[0] + 8, O[1] + PH - 8);
+    }}
+    if (st.force && LD.fmax) {{
+      const f = st.force[i], text = `|F| ${{loadText(Math.hypot(f[0], f[1]), LD.fmax, "N")}}, M ${{loadText(st.moment[i], LD.mmax, "N m")}}`;
+      g.fillStyle = "#a0440a"; g.fillText(text, O[0] + 8, O[1] + PH - (FLOATING ? 22 : 8)); shown.push(text);
+    }}
     // scale bar, bottom right of the panel: this panel's own scale
     const bl = st.bar[0] * s, bx = O[0] + PW - 12 - bl, by = O[1] + PH - 26;
     g.strokeStyle = "#1d232b"; g.lineWidth = 2; g.beginPath(); g.moveTo(bx, by - 4); g.lineTo(bx, by); g.lineTo(bx + bl, by);
@@ -386,6 +472,7 @@ function draw() {{
     if (k % L.columns) {{ g.strokeStyle = "#d9dee4"; g.beginPath(); g.moveTo(O[0] + 0.5, O[1]); g.lineTo(O[0] + 0.5, O[1] + PH); g.stroke(); }}
     if (O[1] > 0) {{ g.strokeStyle = "#d9dee4"; g.beginPath(); g.moveTo(O[0], O[1] + 0.5); g.lineTo(O[0] + PW, O[1] + 0.5); g.stroke(); }}
   }});
+  cv.dataset.loads = shown.join(" | ");
   slider.value = String(Math.round(1000 * (time - T0) / span));
   clock.textContent = `t = ${{time.toFixed(3)}} s of ${{T1.toFixed(3)}} s · ${{speedSel.value}}× real time`;
   document.dispatchEvent(new CustomEvent("balpipe:time", {{detail: {{time: time}}}}));  // the plots' cursors follow
@@ -410,6 +497,8 @@ cv.addEventListener("keydown", ev => {{
   else if (ev.key === "ArrowRight" || ev.key === "ArrowLeft") {{ ev.preventDefault(); setPlaying(false);
     time = Math.min(T1, Math.max(T0, time + (ev.key === "ArrowRight" ? 1 : -1) * span / 100)); draw(); }}
 }});
-draw(); setPlaying(!matchMedia("(prefers-reduced-motion: reduce)").matches);
+layout();
+addEventListener("resize", () => {{ const c = COLS; layout(); if (c !== COLS || !playing) draw(); }});
+draw(); setPlaying({str(autoplay).lower()} && !matchMedia("(prefers-reduced-motion: reduce)").matches);
 }})();
 </script>"""

@@ -8,7 +8,7 @@ import numpy as np
 from ..balancing.base import in_style_order, styled
 from ..laws.drives import law_names
 from ..study import Study
-from ..draw import extremes, figures, labels, live, sleeves
+from ..draw import extremes, figures, labels, live, player, sleeves
 from . import citations, live_plots, paper_figures, partial_figures, present, sections, toc
 from .design_card import design_card
 from .notation_table import PageNames, names_for, notation_groups
@@ -24,6 +24,25 @@ def shown_stages(study: Study) -> list:
     line styles (:attr:`Stage.style` where a method gives it, else their place in the group), so
     that stage k of this list is drawn in ``figures.style(k)`` in every figure of the page."""
     return in_style_order([s for s in study.stages if s.stage.group == study.stages[0].stage.group])
+
+
+def table_order(study: Study) -> list:
+    """The shown stages (:func:`shown_stages`) in the order of the page's stage table: the
+    drawings and the player list them as the table does (each keeps its line style elsewhere)."""
+    shown = {id(s) for s in shown_stages(study)}
+    return [s for s in study.stages if id(s) in shown]
+
+
+def mechanism_player_stages(study: Study) -> list[dict]:
+    """The player's stages of "The mechanism" (:func:`balpipe.draw.player.player_html`): each
+    shown stage on the fixed frame along its motion, in table order, with the shaking force and
+    moment (about the spec's moment point) that it passes to the frame."""
+    out = []
+    for s in table_order(study):
+        a = s.analysis
+        out.append({"label": s.stage.label, "model": s.stage.model, "t": a.t, "base": np.zeros((len(a.t), 3)),
+                    "poses": a.frame_pose, "force": a.force, "moment": a.moment, "point": a.moment_point})
+    return out
 
 
 def drawn_instants(study: Study) -> list[int]:
@@ -94,8 +113,9 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
     mech = [
         (s.stage.label, figures.mechanism_figure(s.stage.model, s.analysis, prefix=f"mech{k}", title=s.stage.label,
                                                  **drawing))
-        for k, s in enumerate(shown_stages(study))
+        for k, s in enumerate(table_order(study))
     ]
+    moving = mechanism_player_stages(study)
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
     extra += partial_figures.figures(study)  # the fronts of an optimal partial balancing, if any
     extra += paper_figures.own_figures(study)  # the paper's panels as it numbers them
@@ -134,7 +154,9 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
                             "paper's numbers draw each stage as every other figure does" if study.spec.paper else
                             "These are the line styles of the paper whose method balances this spec, so the figures "
                             "drawn as that paper's draw each stage as every other figure does"),
-            "efforts": efforts, "mechanism": mech, "gear_key": labels.gear_key(drawing["numbers"]), "extra": extra,
+            "efforts": efforts, "mechanism": mech,
+            "player": player.player_html(moving, "mechanism-player", floating=False, autoplay=False),
+            "player_note": player.scale_note(moving), "gear_key": labels.gear_key(drawing["numbers"]), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
