@@ -120,7 +120,8 @@ class Mode:
 
 def modes(frame: Frame) -> list[Mode]:
     """The undamped natural modes, lowest first: K phi = w^2 M phi (scipy's generalized symmetric
-    eigensolver), phi^T M phi = 1, each shape's largest (x, y, rho theta) component positive."""
+    eigensolver), phi^T M phi = 1, each shape's largest (x, y, rho theta) component positive and
+    components below 1e-12 of it (round-off of a motion the mode does not involve) set to 0."""
     from scipy.linalg import eigh
 
     M, K, C = frame.mass_matrix(), frame.stiffness_matrix(), frame.damping_matrix()
@@ -130,6 +131,7 @@ def modes(frame: Frame) -> list[Mode]:
     for i in range(3):
         v = phi[:, i]
         scaled = v * np.array([1.0, 1.0, rho])
+        v = np.where(np.abs(scaled) <= 1e-12 * np.max(np.abs(scaled)), 0.0, v)  # round-off of a decoupled motion
         if scaled[int(np.argmax(np.abs(scaled)))] < 0:
             v = -v
         w = float(np.sqrt(max(w2[i], 0.0)))
