@@ -147,8 +147,8 @@ def test_paper002_page_names_drivers_parts_and_joints_as_the_paper_does(page002)
     assert re.search(r'<span class="sym"[^>]*>gear 1&#x27;</span> <span class="spec-name"[^>]*>gear1p</span>', card)
     assert re.search(r'on <span class="sym"[^>]*>link 1</span>', card)
     # the actuator table and the joint table
-    acts = _section(page002, "<th>Driver</th>", "</table>")
-    assert "<td>q1</td>" not in acts and "<var>θ</var><sub>1</sub>" in acts
+    acts = _section(page002, 'class="efforts-wide"', "</table>")
+    assert 'class="group">q1</th>' not in acts and "<var>θ</var><sub>1</sub>" in acts
     joints = _section(page002, "<th>Joint</th>", "</table>")
     assert "<td>J1</td>" not in joints and re.search(r'<td><span class="sym"[^>]*><var>A</var></span>', joints)
     # the joint-load plots' panels, static and interactive: the paper's A, the model's J1 beside it

@@ -11,6 +11,7 @@ from ..study import Study
 from ..draw import extremes, figures, labels, live, player, sleeves
 from . import citations, live_plots, paper_figures, partial_figures, present, sections, toc
 from .design_card import design_card
+from .effort_table import effort_table
 from .notation_table import PageNames, names_for, notation_groups
 from .render import environment
 from .orders_figure import orders_svg
@@ -260,6 +261,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         spec_text=markupsafe.escape(spec_text),  # verbatim: markup, so render.typeset leaves its units as written
         history=history,
         actuators=results.get("actuators") or [],
+        effort_table=effort_table(results.get("actuators") or []),
         nav=nav or {},
         inputs=notation_groups(spec),
         verdict=results.get("verdict"),
