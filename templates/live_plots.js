@@ -268,6 +268,7 @@
   const printMedia = matchMedia("print");
   printMedia.addEventListener("change", e => (e.matches ? toPrint : fromPrint)());
   if (printMedia.matches) toPrint();
+  window.balpipeLive = { fmt: fmt };  // the values' format, shared with whatif.js
   document.addEventListener("balpipe:time", e => {
     playerTime = e.detail.time;
     figures.forEach(follow);

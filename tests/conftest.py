@@ -326,7 +326,8 @@ SLOW_FIRST = (
 #: table, not the marks: pytest-xdist 3.8 sends a mark's group to the controller in the test's
 #: node id, which pytest 9.2 no longer lets it change (pytest-xdist issue 1386), and the groups
 #: were silently spread over the workers (each built the browser tests' sites and a browser).
-GROUPS = {"test_site_browser.py": "site_browser", "test_live_browser.py": "site_browser"}
+GROUPS = {"test_site_browser.py": "site_browser", "test_live_browser.py": "site_browser",
+          "test_whatif_browser.py": "site_browser"}
 
 
 def pytest_collection_modifyitems(session, config, items):

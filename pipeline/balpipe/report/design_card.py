@@ -57,19 +57,27 @@ def added_parts(base: Model, final: Model, names: PageNames | None = None) -> li
     return rows
 
 
+def main_stages(study: Study, results: dict) -> tuple | None:
+    """The main design's final stage of the first motion and the stage it is judged against
+    (``results['verdict']``), as :class:`balpipe.study.StageResult`; None without a balancing
+    stage."""
+    motions = (results.get("verdict") or {}).get("motions") or []
+    if not motions:
+        return None
+    by = {s.stage.name: s for s in study.stages}
+    final, ref = by.get(motions[0]["final"]), by.get(motions[0]["reference"])
+    return None if final is None or ref is None else (final, ref)
+
+
 def design_card(study: Study, results: dict) -> dict | None:
     """The card's content: the main design's final stage (first motion), its parts and cost
     factors from ``results['verdict']``; None without a balancing stage."""
-    v = results.get("verdict") or {}
-    motions = v.get("motions") or []
-    if not motions:
+    pair = main_stages(study, results)
+    if pair is None:
         return None
-    g = motions[0]
-    by = {s.stage.name: s for s in study.stages}
-    final, ref = by.get(g["final"]), by.get(g["reference"])
-    if final is None or ref is None:
-        return None
-    c = g["costs"]
+    final, ref = pair
+    motions = results["verdict"]["motions"]
+    c = motions[0]["costs"]
     names = names_for(study.spec)
     factors = [
         ("moving mass", factor_text(c["moving_mass"]), f"+{_fmt(c['added_mass'] or 0.0)} kg"),

@@ -9,7 +9,7 @@ from ..balancing.base import in_style_order, styled
 from ..laws.drives import law_names
 from ..study import Study
 from ..draw import extremes, figures, labels, live, player, sleeves
-from . import citations, live_plots, paper_figures, partial_figures, present, sections, toc
+from . import citations, live_plots, paper_figures, partial_figures, present, sections, toc, whatif
 from .design_card import design_card
 from .effort_table import effort_table
 from .notation_table import PageNames, names_for, notation_groups
@@ -266,6 +266,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         inputs=notation_groups(spec),
         verdict=results.get("verdict"),
         card=design_card(study, results),
+        whatif=whatif.section(study, results, {s.stage.name: k for k, s in enumerate(shown_stages(study))}),
         citation=citations.cite(spec.paper),
         names=names,
     )))

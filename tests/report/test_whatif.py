@@ -1,0 +1,141 @@
+"""The live what-if's maps (balpipe.report.whatif) against the engine: at random slider values the
+maps' loads equal the engine's analysis of the model with those parts, to 1e-9 of each series'
+scale (counterweights, discs on links of their own, gears, gravity); Coulomb friction keeps the
+shaking loads and leaves the efforts out, saying why; a map that is not affine is refused; the
+page's data decode to the maps exactly, and are deterministic."""
+
+from __future__ import annotations
+
+import base64
+import json
+import re
+
+import numpy as np
+import pytest
+
+from balpipe.report import whatif
+from balpipe.report.results import results_dict
+
+
+def _whatif(studies, name: str):
+    st = studies(name)
+    return st, whatif.build(st, results_dict(st, name, "h", simulated=False))
+
+
+def _random(w, rng) -> np.ndarray:
+    lo = np.array([p.lo for p in w.parts]).reshape(-1, 4)
+    hi = np.array([p.hi for p in w.parts]).reshape(-1, 4)
+    return rng.uniform(lo, hi)
+
+
+def _scale(key: str, exact: dict) -> float:
+    return float(np.max(np.abs(exact["F" if key in ("Fx", "Fy") else key])))
+
+
+@pytest.mark.parametrize("name", ["offset_slider_crank.yaml", "custom_four_bar_balancing.yaml",
+                                  "paper002_decoupling.yaml", "custom_slider_driven_slider_crank_gravity.yaml"])
+def test_the_maps_give_the_engines_loads_at_random_parts(studies, name):
+    """Each part's mass, position and inertia drawn at random within its sliders' ranges (three
+    designs): Fx, Fy, |F|, M and every effort from the maps equal the engine's analysis of the
+    model with those parts to 1e-9 of the series' scale; at the computed design they are the
+    engine's series of the stage itself, exactly."""
+    st, w = _whatif(studies, name)
+    assert isinstance(w, whatif.WhatIf), w
+    assert any(k.startswith("effort:") for k in w.keys)
+    rng = np.random.default_rng(11)
+    for _ in range(3):
+        values = _random(w, rng)
+        got, exact = whatif.series(w, values), whatif.engine_series(w, values)
+        assert set(got) == set(w.keys) | {"F"}
+        for k in got:
+            assert np.max(np.abs(got[k] - exact[k])) <= 1e-9 * _scale(k, exact), (name, k)
+        assert any(np.max(np.abs(got[k] - w.design[k])) > 1e-3 * _scale(k, exact) for k in w.keys)  # the parts moved them
+    at_design = whatif.series(w, w.values())
+    for k in w.keys:
+        assert np.array_equal(at_design[k], w.design[k])
+    final = next(s for s in st.stages if s.stage.name == w.stage)
+    assert np.array_equal(w.design["Fx"], final.analysis.force[w.index, 0])
+
+
+def test_discs_and_counterweights_are_parts_with_their_own_bodies(studies):
+    """The four-bar's counter-rotations stage: the counterweights move on their links, each disc is
+    a body of its own (its mass, centre and inertia), and the sliders' ranges hold the design."""
+    _, w = _whatif(studies, "custom_four_bar_balancing.yaml")
+    kinds = {p.kind for p in w.parts}
+    assert "counter-rotation" in kinds and "counterweight" in kinds
+    for p in w.parts:
+        assert p.own == (p.kind == "counter-rotation")
+        assert all(lo <= v <= hi for lo, v, hi in zip(p.lo, p.design, p.hi)), p
+        assert p.lo[0] >= 0 or p.design[0] < 0  # no negative mass unless the design has one
+
+
+def test_coulomb_friction_keeps_the_shaking_loads_and_says_why_not_the_efforts(studies):
+    """Coulomb friction: the efforts follow the reactions (not affine in the parts), so only the
+    shaking force and moment have maps, which still equal the engine's."""
+    _, w = _whatif(studies, "custom_four_bar_loaded.yaml")
+    assert isinstance(w, whatif.WhatIf)
+    assert w.keys == ["Fx", "Fy", "M"] and [p["key"] for p in w.panels] == ["Fx", "Fy", "F", "M"]
+    assert any("Coulomb friction" in n and "O2_bearing" in n for n in w.notes)
+    values = _random(w, np.random.default_rng(3))
+    got, exact = whatif.series(w, values), whatif.engine_series(w, values)
+    for k in ("Fx", "Fy", "F", "M"):
+        assert np.max(np.abs(got[k] - exact[k])) <= 1e-9 * _scale(k, exact)
+
+
+def test_loads_that_are_not_affine_get_no_sliders_and_the_page_says_why(studies, monkeypatch):
+    """An engine whose shaking force grew with the square of a part's mass: the check design finds
+    it and the stage gets a sentence instead of sliders; efforts alone off: left out with a note."""
+    st = studies("offset_slider_crank.yaml")
+    res = results_dict(st, "offset_slider_crank.yaml", "h", simulated=False)
+    real = whatif.engine_series
+
+    def squared(w, values):
+        out = real(w, values)
+        out["Fx"] = out["Fx"] + 1e-3 * float(np.asarray(values)[0, 0]) ** 2
+        return out
+
+    monkeypatch.setattr(whatif, "engine_series", squared)
+    reason = whatif.build(st, res)
+    assert isinstance(reason, str) and "not affine" in reason
+    assert whatif.section(st, res) == {"reason": reason}
+
+    def efforts_off(w, values):
+        out = real(w, values)
+        out["effort:crank"] = out["effort:crank"] * 1.001
+        return out
+
+    monkeypatch.setattr(whatif, "engine_series", efforts_off)
+    w = whatif.build(st, res)
+    assert isinstance(w, whatif.WhatIf) and w.keys == ["Fx", "Fy", "M"] and "not affine" in w.notes[-1]
+
+
+def test_a_design_without_parts_has_no_what_if(studies):
+    """Paper 003's designs change the motion, not the masses: no section."""
+    st = studies("paper003_com_planning.yaml")
+    assert whatif.section(st, results_dict(st, "paper003_com_planning.yaml", "h", simulated=False)) is None
+
+
+def _f64(text: str) -> np.ndarray:
+    return np.frombuffer(base64.b64decode(text), dtype="<f8")
+
+
+def test_the_pages_data_are_the_maps_exactly_and_deterministic(studies):
+    """The JSON the page ships decodes (base64, little-endian float64) to the maps bit for bit,
+    zero columns left out; building it twice gives the same text; the samples are those of the
+    live figure, no more than the page's charts draw."""
+    st, w = _whatif(studies, "custom_four_bar_balancing.yaml")
+    d = whatif.data(w)
+    assert np.array_equal(_f64(d["t"]), w.t) and d["n"] == len(w.t) <= 400
+    for k in w.keys:
+        assert np.array_equal(_f64(d["design"][k]), w.design[k])
+        for b in w.bodies:
+            for c, shipped in zip(w.columns[k][b], d["columns"][k][b]):
+                assert (c is None) == (shipped is None)
+                if c is not None:
+                    assert np.array_equal(_f64(shipped), c) and np.any(c != 0)
+    assert [p["design"] for p in d["parts"]] == [list(p.design) for p in w.parts]
+    res = results_dict(st, "custom_four_bar_balancing.yaml", "h", simulated=False)
+    a, b = whatif.section(st, res), whatif.section(st, res)
+    assert a == b and a is not None and a["reason"] is None
+    figure = json.loads(re.search(r'data-live="live-whatif">(.*)</script>', a["figure"], re.S).group(1))
+    assert len(figure["t"]) == d["n"] and [s["label"] for s in figure["series"]][-1] == "design tried"
