@@ -374,7 +374,8 @@ def page_files(loaded, st, results: dict, history: dict | None = None,
                history_files: dict[str, str] | None = None) -> dict[str, Any]:
     """The files of a study's page folder, by name: ``index.html`` (the page, with the spec's
     text and its ``history``), ``results.json`` (``results``), ``timeseries.csv`` (written by
-    pieces: :class:`balpipe.report.results.CsvFile`), with the
+    pieces: :class:`balpipe.report.results.CsvFile`), with parts the bill of materials
+    (``parts.csv``) and each part's drawings (``part-*.dxf``, ``part-*.svg``), with the
     simulation the wall times of its runs (``timing.json``, ``timing.js``), and the history's
     files. ``balpipe build`` and :meth:`balpipe.Study.write` both write these."""
     extra: dict[str, str] = {}
@@ -384,6 +385,11 @@ def page_files(loaded, st, results: dict, history: dict | None = None,
         times = timing(st)
         extra = {"timing.json": json.dumps(times, indent=2, sort_keys=True) + "\n",
                  "timing.js": timing_script(times)}
+    if results.get("parts"):  # the bill of materials and a drawing per part (docs/parts.md)
+        from .report.part_drawings import drawing_files
+        from .report.parts_table import bom_csv
+
+        extra.update({"parts.csv": bom_csv(results["parts"]), **drawing_files(st)})
     return {
         "index.html": render_page(st, results, loaded.text, history=history),
         "results.json": dumps(results),

@@ -197,7 +197,9 @@ def balance_designs(spec: Any, page: bool = True, memo: Memo = compute) -> Balan
                 path = ("compare", k) + path
             raise SpecFieldError(path, f"design {d.name!r}: {exc.message}") from None
         for s in res.stages[1:]:
-            stages.append(replace(s, name=f"{d.name}:{s.name}", label=f"{d.label or d.name}: {s.label}", design=d.name))
+            parts = tuple(replace(p, where=f"compare[{k}].{p.where}") for p in s.parts)  # located in the spec
+            stages.append(replace(s, name=f"{d.name}:{s.name}", label=f"{d.label or d.name}: {s.label}", design=d.name,
+                                  parts=parts))
         params += [replace(p, name=f"{d.name}:{p.name}") for p in res.parameters]
         notes += [f"{d.label or d.name}: {n}" for n in res.notes]
         details["compare"][d.name] = res.details

@@ -195,7 +195,10 @@ def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float, override
     F0, M0 = ref.force, ref.moment
     F, M = sr.analysis.max_inertial_force, sr.analysis.max_inertial_moment
     df, dm = sr.analysis.route_difference()
+    unmade = realisable.unmade(sr.stage.parts)
     not_realisable = realisable.verdict(sr.stage.model)
+    if unmade:  # a counterweight's part that does not fit (or has no shape): the design cannot be made
+        not_realisable = f"{not_realisable}; a part cannot be made" if not_realisable else "not realisable: a part cannot be made"
     return StageMetrics(
         name=sr.stage.name,
         label=sr.stage.label,
@@ -221,7 +224,7 @@ def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float, override
         reactions_vs_momentum_moment=dm / M0 if M0 > 0 else dm,
         realisable=not not_realisable,
         not_realisable=not_realisable,
-        not_realisable_parts=realisable.details(sr.stage.model),
+        not_realisable_parts="; ".join(filter(None, [realisable.details(sr.stage.model), *unmade])),
         reference=unbalanced.stage.name,
         reference_loads=ref,
     )
@@ -336,7 +339,7 @@ def run(spec: Spec, page: bool = True, memo: Memo = compute) -> Study:
     metrics = [s.metrics for s in stages]
     if balance.derived is not None and (page or spec.references):  # the page's, and what a reference may name
         balance.parameters.extend(balance.derived(stages))
-    problems = []
+    problems = list(dict.fromkeys(p for s in stages for p in realisable.unmade(s.stage.parts)))  # parts not made
     rvm = max(max(m.reactions_vs_momentum_force, m.reactions_vs_momentum_moment) for m in metrics)
     if not rvm <= 1e-9 or not math.isfinite(rvm):
         problems.append(f"reactions and momentum disagree by {rvm:.3g} of the reference load (limit 1e-9)")

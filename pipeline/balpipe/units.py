@@ -45,13 +45,14 @@ UNITS: dict[str, dict[str, float]] = {
     "damping": {"N s/m": 1.0, "N s/mm": 1e3, "kN s/m": 1e3},
     "torsional stiffness": {"N m/rad": 1.0, "N m/deg": 180 / math.pi, "kN m/rad": 1e3},
     "torsional damping": {"N m s/rad": 1.0, "N m s/deg": 180 / math.pi},
+    "density": {"kg/m^3": 1.0, "g/cm^3": 1e3, "kg/dm^3": 1e3},
     "dimensionless": {"": 1.0},
 }
 SI = {"length": "m", "angle": "rad", "time": "s", "mass": "kg", "inertia": "kg m^2",
       "acceleration": "m/s^2", "velocity": "m/s", "angular velocity": "rad/s",
       "angular acceleration": "rad/s^2", "force": "N", "torque": "N m", "pressure": "Pa", "area": "m^2",
       "stiffness": "N/m", "damping": "N s/m", "torsional stiffness": "N m/rad",
-      "torsional damping": "N m s/rad", "dimensionless": ""}
+      "torsional damping": "N m s/rad", "density": "kg/m^3", "dimensionless": ""}
 
 #: Largest magnitude accepted per dimension, in SI units: beyond these a planar mechanism is not
 #: what the spec means, and products such as m L^2 w^2 approach float overflow.
@@ -59,7 +60,7 @@ MAX_ABS = {"length": 1e4, "angle": 1e5, "time": 1e5, "mass": 1e6, "inertia": 1e1
            "acceleration": 1e7, "velocity": 1e6, "angular velocity": 1e6,
            "angular acceleration": 1e9, "force": 1e9, "torque": 1e9, "pressure": 1e10, "area": 1e4,
            "stiffness": 1e12, "damping": 1e12, "torsional stiffness": 1e12, "torsional damping": 1e12,
-           "dimensionless": 1e12}
+           "density": 1e5, "dimensionless": 1e12}
 
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 #: a quantity as written, "<number> <unit>": group 1 the number, group 2 the unit (may be empty)
@@ -133,7 +134,7 @@ def _example(dimension: str) -> str:
             "angular velocity": "2 rad/s", "angular acceleration": "10 rad/s^2",
             "force": "250 N", "torque": "12 N m", "pressure": "6 bar", "area": "50 cm^2",
             "stiffness": "2 kN/m", "damping": "40 N s/m", "torsional stiffness": "5 N m/rad",
-            "torsional damping": "0.2 N m s/rad", "dimensionless": "0.5"}[dimension]
+            "torsional damping": "0.2 N m s/rad", "density": "7850 kg/m^3", "dimensionless": "0.5"}[dimension]
 
 
 def quantity(dimension: str, **field_kwargs: Any) -> Any:
@@ -280,3 +281,5 @@ PositiveInertia = quantity("inertia", gt=0)
 PositiveVelocity = quantity("velocity", gt=0)
 PositiveForce = quantity("force", gt=0)
 OpenFraction = number(gt=0, lt=1)  # strictly between 0 and 1
+Density = quantity("density", gt=0)  # a part's material
+PlateCount = count(ge=1, le=1000)  # the plates of a bolted stack

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+from ..mechanics.part_shapes import MadePart
 from ..model import Model
 
 
@@ -87,6 +88,8 @@ class Stage:
     # printed inertias break eq. 30e): the verdict judges it ("the paper's claim fails"), while the
     # build and the simulation check only ``balances``
     paper_claims: str = ""
+    # the stage's counterweights made as parts (a spec's ``part:`` sections), sized and checked
+    parts: tuple[MadePart, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,7 @@ from . import least_mass as LM
 from . import regressor as R
 from .base import BalanceResult, Parameter, Stage
 from .context import BalanceContext
+from .made_parts import inertia_of, part_for
 from .parts import add_counterweight
 from .specs import CounterweightRegionSpec, FinderSettings, ForceBalance, Point
 
@@ -56,11 +57,24 @@ def regions_from_spec(model: Model, specs: list[CounterweightRegionSpec], root: 
     return out
 
 
+def made(model: Model, specs: list[CounterweightRegionSpec], placed: list, root: tuple) -> dict:
+    """The parts of the counterweights ``placed`` (:class:`.least_mass.Placed`, in the order of
+    ``specs``) whose spec entries have a ``part:``, by counterweight name."""
+    out = {}
+    for k, (s, cw) in enumerate(zip(specs, placed)):
+        if s.part is not None:
+            axis = body_point(model, cw.region.body, s.part.axis, root + (k, "part", "axis"))
+            out[cw.region.name] = part_for(model, cw.region.body, cw.region.name, s.part, cw.mass, cw.position, axis,
+                                           root + (k, "part"))
+    return out
+
+
 def force_stage(model: Model, specs: list[CounterweightRegionSpec], settings: FinderSettings,
                 t: np.ndarray, root: tuple = ("balancing", "counterweights"), prefix: str = ""):
-    """Conditions of ``model``, least-mass counterweights and the counterweighted model.
+    """Conditions of ``model``, least-mass counterweights and the counterweighted model; a
+    counterweight made as a part has the part's centroidal inertia (a point mass otherwise).
 
-    Returns (model with counterweights, parameters, details for results.json, notes)."""
+    Returns (model with counterweights, parameters, details for results.json, notes, parts)."""
     cond = C.find(model, t, settings.rank_tolerance, settings.samples, settings.seed)
     p0 = R.parameters(model)
     regions = regions_from_spec(model, specs, root)
@@ -71,9 +85,11 @@ def force_stage(model: Model, specs: list[CounterweightRegionSpec], settings: Fi
     out = model
     params = [Parameter(f"{prefix}force_conditions", cond.count, "", "counted from the momentum at reachable states",
                         "independent force-balance conditions")]
+    parts = made(model, specs, sol.counterweights, root)
     for cw in sol.counterweights:
         if cw.mass > 0:
-            out = add_counterweight(out, cw.region.body, cw.region.name, cw.mass, cw.position)
+            inertia = inertia_of(parts[cw.region.name], 0.0) if cw.region.name in parts else 0.0
+            out = add_counterweight(out, cw.region.body, cw.region.name, cw.mass, cw.position, inertia)
         d = f"{cw.region.name} on {cw.region.body}, {cw.region.describe()}"
         params += [
             Parameter(f"{prefix}{cw.region.name}.mass", cw.mass, "kg", "least added mass (linprog)", d),
@@ -101,17 +117,18 @@ def force_stage(model: Model, specs: list[CounterweightRegionSpec], settings: Fi
            f"{sol.disc_accuracy:.1e} of their radius)" if any(r.kind == "disc" for r in regions) else "")
         + "."
     ] + LM.tie_note(sol)
-    return out, params, details, notes
+    return out, params, details, notes, tuple(parts.values())
 
 
 def balance(ctx: BalanceContext) -> BalanceResult:
     method: ForceBalance = ctx.balancing
     model, t = ctx.model, ctx.t
-    cw_model, params, details, notes = force_stage(model, method.counterweights, method, t)
+    cw_model, params, details, notes, parts = force_stage(model, method.counterweights, method, t)
     stages = [
         Stage("unbalanced", "unbalanced", model, "the mechanism as given"),
         Stage("counterweights", "least-mass counterweights", cw_model,
-              "counterweights of least added mass meeting every force-balance condition", balances="force"),
+              "counterweights of least added mass meeting every force-balance condition", balances="force",
+              parts=parts),
     ]
     return BalanceResult(params, stages, notes, details={"force_balance": details})
 

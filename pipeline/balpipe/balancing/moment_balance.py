@@ -29,7 +29,8 @@ from .base import BalanceResult, Parameter, Stage
 from .context import BalanceContext
 from . import least_mass as LM
 from . import gear_signs as GS
-from .force_balance import body_point, regions_from_spec
+from .force_balance import body_point, made, regions_from_spec
+from .made_parts import inertia_of
 from .parts import add_counter_rotation, add_counterweight
 from .specs import CounterRotationSpec, MomentBalance
 
@@ -193,9 +194,13 @@ def _balance(ctx: BalanceContext) -> BalanceResult:
         except LM.Infeasible as exc_force:
             raise SpecFieldError(root + ("counterweights",), str(exc_force)) from None
     balanced = with_discs
+    # a counterweight made as a part has the part's own inertia, not the programme's spread one:
+    # the discs' inertias below are solved with it
+    parts = made(with_discs, method.counterweights, sol.counterweights, root + ("counterweights",))
     for cw in sol.counterweights:
         if cw.mass > 0:
-            balanced = add_counterweight(balanced, cw.region.body, cw.region.name, cw.mass, cw.position, cw.inertia)
+            inertia = inertia_of(parts[cw.region.name], cw.inertia) if cw.region.name in parts else cw.inertia
+            balanced = add_counterweight(balanced, cw.region.body, cw.region.name, cw.mass, cw.position, inertia)
     # the discs' inertias by least squares on the counterweighted model, over states sampled anew
     # (another seed): the residual says how exactly the angular momentum is cancelled beyond the
     # states the conditions came from
@@ -226,6 +231,9 @@ def _balance(ctx: BalanceContext) -> BalanceResult:
             Parameter(f"{cw.region.name}.mass", cw.mass, "kg", "least added mass (linprog)", d),
             Parameter(f"{cw.region.name}.x", cw.position[0], "m", "least added mass (linprog)", f"{cw.region.name}: x in {cw.region.body}'s frame"),
             Parameter(f"{cw.region.name}.y", cw.position[1], "m", "least added mass (linprog)", f"{cw.region.name}: y in {cw.region.body}'s frame"),
+            Parameter(f"{cw.region.name}.inertia", inertia_of(parts[cw.region.name], cw.inertia), "kg m^2",
+                      f"the {parts[cw.region.name].shape}'s own", f"{cw.region.name}: centroidal inertia of its part")
+            if cw.region.name in parts and parts[cw.region.name].outline else
             Parameter(f"{cw.region.name}.inertia", cw.inertia, "kg m^2", "least added mass (linprog)",
                       f"{cw.region.name}: centroidal inertia (a mass spread over its region)"),
         ]
@@ -260,7 +268,8 @@ def _balance(ctx: BalanceContext) -> BalanceResult:
         "moment_balance": {
             "conditions": mc.equations(),
             "counterweights": [{"name": c.region.name, "body": c.region.body, "region": c.region.describe(),
-                                "mass": c.mass, "position": list(c.position), "inertia": c.inertia}
+                                "mass": c.mass, "position": list(c.position),
+                                "inertia": inertia_of(parts[c.region.name], c.inertia) if c.region.name in parts else c.inertia}
                                for c in sol.counterweights],
             "discs": [{"name": n, "carrier": s.carrier, "geared_to": s.geared_to, "ratio": s.ratio, "mass": s.mass,
                        "inertia": float(J)} for n, J, s in zip(discs, inertias, method.counter_rotations)],
@@ -272,10 +281,11 @@ def _balance(ctx: BalanceContext) -> BalanceResult:
     }
     stages = [
         Stage("unbalanced", "unbalanced", model, "the mechanism as given"),
-        Stage("counterweights", "counterweights", cw_model, "force balanced by counterweights", balances="force"),
+        Stage("counterweights", "counterweights", cw_model, "force balanced by counterweights", balances="force",
+              parts=tuple(parts.values())),
         Stage("counter_rotations", "counterweights + counter-rotations", full,
               "counter-rotating discs with the inertias solved from the angular momentum",
-              balances="force+moment" if cancelled else "force"),
+              balances="force+moment" if cancelled else "force", parts=tuple(parts.values())),
     ]
     return BalanceResult(params, stages, notes, details=details)
 

@@ -13,6 +13,7 @@ from pydantic import Field, model_validator
 from ..model import FRAME
 from ..spec_parts import Strict
 from ..units import Inertia, Length, Mass, Number, PositiveLength, count, number
+from .part_spec import PartShapeSpec
 
 RANK_TOLERANCE = 1e-9  # singular values below this fraction of the largest are dropped (conditions.find)
 POLYGON_SIDES = 128  # sides of the polygon inscribed in a disc region (least_mass.solve)
@@ -36,6 +37,8 @@ class CounterweightRegionSpec(Strict):
     at: Point | None = Field(None, description="a fixed position ([x, y] or a named point)")
     segment: tuple[Point, Point] | None = Field(None, description="anywhere on this segment")
     disc: DiscRegionSpec | None = Field(None, description="anywhere in this disc")
+    part: PartShapeSpec | None = Field(None, description="made as a part: material, shape and limits (balpipe sizes "
+                                       "it, checks its fit and analyses its own inertia; docs/parts.md)")
 
     @model_validator(mode="after")
     def _one_region(self):
@@ -102,6 +105,14 @@ class PartSpec(Strict):
     inertia: Inertia = Field(0.0, description="centroidal moment of inertia")
     kind: Literal["counterweight", "gear", "payload", "part"] = Field("counterweight", description="for drawing and accounting")
     radius: PositiveLength | None = Field(None, description="drawn as a disc of this radius")
+    part: PartShapeSpec | None = Field(None, description="made as a part: material, shape and limits; its inertia is "
+                                       "then the shape's (give no inertia; docs/parts.md)")
+
+    @model_validator(mode="after")
+    def _inertia_or_part(self):
+        if self.part is not None and self.inertia:
+            raise ValueError("inertia: a part's inertia is its shape's; give no inertia with part")
+        return self
 
 
 class GivenCounterRotation(CounterRotationSpec):

@@ -15,18 +15,31 @@ from .base import Aim, BalanceResult, Goal, Stage
 from .context import BalanceContext
 from .force_balance import body_point
 from .load_measures import goal_label, measure, term_notation
+from .made_parts import inertia_of, part_for
+from ..mechanics.part_shapes import MadePart
 from .moment_balance import add_discs, set_disc_inertias
 from .specs import PartSpec, Stages
 
 
-def attach(model: Model, part: PartSpec, path: tuple) -> Model:
-    """``model`` with ``part`` on its body; a part of the same name there is replaced."""
+def made_part(model: Model, part: PartSpec, path: tuple) -> MadePart | None:
+    """The part that ``part``'s ``part:`` section makes of it (None without one)."""
+    if part.part is None:
+        return None
+    pos = body_point(model, part.body, part.position, path + ("position",))
+    axis = body_point(model, part.body, part.part.axis, path + ("part", "axis"))
+    return part_for(model, part.body, part.name, part.part, part.mass, pos, axis, path + ("part",))
+
+
+def attach(model: Model, part: PartSpec, path: tuple, made: MadePart | None = None) -> Model:
+    """``model`` with ``part`` on its body (of the inertia of ``made``, its part, when given); a
+    part of the same name there is replaced."""
     try:
         body = model.body(part.body)
     except KeyError:
         raise SpecFieldError(path + ("body",), f"unknown body {part.body!r} (bodies: {', '.join(b.name for b in model.bodies)})") from None
     pos = body_point(model, part.body, part.position, path + ("position",))
-    new = Attachment(part.name, part.mass, pos, part.inertia, part.kind, part.radius)
+    inertia = inertia_of(made, part.inertia) if made is not None else part.inertia
+    new = Attachment(part.name, part.mass, pos, inertia, part.kind, part.radius)
     kept = tuple(a for a in body.attachments if a.name != part.name)
     return model.replace_body(replace(body, attachments=kept + (new,)))
 
@@ -60,6 +73,7 @@ def balance(ctx: BalanceContext) -> BalanceResult:
     current = model
     seen = {"unbalanced"}
     entered: dict[tuple[str, str | None], Rounding] = {}  # the precision of the parts on the model
+    made: dict[tuple[str, str], MadePart] = {}  # the parts made so far, by body and name
     for k, step in enumerate(method.stages):
         path = ("balancing", "stages", k)
         if step.name in seen:
@@ -68,9 +82,16 @@ def balance(ctx: BalanceContext) -> BalanceResult:
         for i, ref in enumerate(step.remove):
             current = detach(current, ref, path + ("remove", i))
             entered.pop(tuple(ref.split(".", 1)), None)  # type: ignore[arg-type]
+            made.pop(tuple(ref.split(".", 1)), None)  # type: ignore[arg-type]
         for i, part in enumerate(step.parts):
-            current = attach(current, part, path + ("parts", i))
+            if part.body not in {b.name for b in current.bodies}:
+                current = attach(current, part, path + ("parts", i))  # the located error of an unknown body
+            made_now = made_part(current, part, path + ("parts", i))
+            current = attach(current, part, path + ("parts", i), made_now)
             entered[(part.body, part.name)] = part_rounding(part)
+            made.pop((part.body, part.name), None)
+            if made_now is not None:
+                made[(part.body, part.name)] = made_now
         if step.counter_rotations:
             current = add_discs(current, step.counter_rotations, path + ("counter_rotations",))
             current = set_disc_inertias(current, {c.name: c.inertia for c in step.counter_rotations})
@@ -78,7 +99,7 @@ def balance(ctx: BalanceContext) -> BalanceResult:
                 entered[(c.name, None)] = Rounding(c.name, None, inertia=half_unit(c.inertia),
                                                    text=f"{c.name}.inertia = {c.inertia:.12g} kg m^2")
         stages.append(Stage(step.name, step.label or step.name, current, step.description, step.balances,
-                            tolerance=step.tolerance, rounding=tuple(entered.values()),
+                            tolerance=step.tolerance, rounding=tuple(entered.values()), parts=tuple(made.values()),
                             aim=aim(ctx, model, current, step.aim, path + ("aim",)) if step.aim else None))
     return BalanceResult([], stages, [])
 

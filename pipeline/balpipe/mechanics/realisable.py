@@ -56,3 +56,10 @@ def details(model: Model) -> str:
     """The parts that cannot be built, e.g. "'counterweight 1' on 'link1': centroidal inertia
     -0.126 kg m^2; ...", or ""."""
     return "; ".join(str(i) for i in issues(model))
+
+
+def unmade(parts: tuple) -> list[str]:
+    """Why each of ``parts`` (:class:`balpipe.mechanics.part_shapes.MadePart`) that cannot be made
+    cannot, located: "part 'cw' on 'crank' (balancing.counterweights[0].part): thickness 31 mm
+    exceeds max_thickness 25 mm"."""
+    return [f"part {p.name!r} on {p.body!r} ({p.where}): {'; '.join(p.problems)}" for p in parts if p.problems]

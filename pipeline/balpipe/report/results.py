@@ -16,6 +16,7 @@ from .frame_mounts import mounts_json
 from .mechanism_key import mechanism_key
 from .load_table import load_columns, load_summary
 from .orders_table import orders_json
+from .parts_table import parts_json
 from .notation_table import names_for
 from .verdict import verdict
 
@@ -100,6 +101,9 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     out["moving_bodies"] = [b.name for b in study.unbalanced.stage.model.bodies]
     if study.balance.details:
         out["balancing_details"] = study.balance.details
+    parts = parts_json(study)
+    if parts:  # the counterweights made as parts (docs/parts.md)
+        out["parts"] = parts
     out["paper"] = spec.paper  # the site index filters by it
     out["verdict"] = verdict_of(study, out)
     return json_safe(out)

@@ -28,6 +28,9 @@ class PartialCounterweightSpec(CounterweightRegionSpec):
 
     @model_validator(mode="after")
     def _one_region(self):
+        if self.part is not None:
+            raise ValueError("part: partial_balance chooses each counterweight's spread inertia and does not size "
+                             "parts; make them in a force_balance, moment_balance or stages design (compare)")
         given = [k for k in ("at", "segment", "disc", "polygon") if getattr(self, k) is not None]
         if len(given) != 1:
             raise ValueError(f"give exactly one of at, segment, disc, polygon (got {', '.join(given) or 'none'})")

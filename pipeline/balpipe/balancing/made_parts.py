@@ -1,0 +1,51 @@
+"""A balancing design's counterweights made as parts: the spec's ``part:`` sections read against
+the model (the body's pivots, the axis point) and sized by
+:func:`balpipe.mechanics.part_shapes.make`.
+
+Every method that places a counterweight with a ``part:`` gives the analysed model the part's
+own centroidal inertia (not a point mass's, nor the spread inertia of a least-mass programme):
+the stage's shaking moment, efforts and joint loads are those of the part that would be made.
+"""
+
+from __future__ import annotations
+
+from ..mechanics.materials import density_of
+from ..mechanics.part_shapes import Limits, MadePart, make
+from ..model import Model, Revolute, Vec2
+from .part_spec import PartShapeSpec
+
+
+def spec_path(path: tuple) -> str:
+    """A spec path as the docs write it: ("balancing", "counterweights", 0, "part") ->
+    "balancing.counterweights[0].part"."""
+    out = ""
+    for k in path:
+        out += f"[{k}]" if isinstance(k, int) else (f".{k}" if out else str(k))
+    return out
+
+
+def pivots(model: Model, body: str) -> tuple[tuple[str, Vec2], ...]:
+    """The revolute joints of ``body``, by name, at their points in its frame."""
+    out = []
+    for j in model.joints:
+        if isinstance(j, Revolute) and body in (j.a, j.b):
+            p = j.point_a if j.a == body else j.point_b
+            out.append((j.name, (float(p[0]), float(p[1]))))
+    return tuple(out)
+
+
+def part_for(model: Model, body: str, name: str, spec: PartShapeSpec, mass: float, centroid: Vec2, axis: Vec2,
+             path: tuple) -> MadePart:
+    """The part ``spec`` describes, realising a counterweight ``name`` of ``mass`` at ``centroid``
+    on ``body`` (``axis`` resolved in the body's frame), located at ``path`` in the spec."""
+    density = density_of(spec.material, spec.density)
+    material = spec.material or f"{density:g} kg/m^3"
+    limits = Limits(spec.max_thickness, spec.max_radius, spec.clearance)
+    return make(name, body, spec.shape, material, density, spec.given(), float(mass), centroid, axis, limits,
+                pivots(model, body), spec_path(path), spec.orientation)
+
+
+def inertia_of(part: MadePart, fallback: float) -> float:
+    """The centroidal inertia the analysis gives the counterweight: the part's when it could be
+    sized, else ``fallback`` (the design's own; the part's problems then say why)."""
+    return part.inertia if part.outline else fallback

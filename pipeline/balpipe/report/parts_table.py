@@ -1,0 +1,98 @@
+"""The counterweights made as parts, for ``results.json`` (``parts``), the page's table and the
+bill of materials (``parts.csv``).
+
+A part is listed once per design however many of its stages carry it (a moment balance's
+counterweights are on its force stage and on its counter-rotation stage); ``stages`` names them.
+Everything is SI: m, kg, kg/m^3, kg m^2, rad.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import re
+from typing import Any
+
+#: the dimensions' columns of the bill of materials, in its order, with their SI unit
+DIMENSIONS = (("thickness", "m"), ("radius", "m"), ("inner_radius", "m"), ("outer_radius", "m"), ("angle", "rad"),
+              ("length", "m"), ("width", "m"), ("plates", ""), ("plate_thickness", "m"), ("orientation", "rad"))
+
+
+def drawing_name(design: str, name: str) -> str:
+    """The file name (without extension) of a part's drawings: ``part-<design>-<name>``, the
+    name's characters outside [A-Za-z0-9_-] replaced by '_'."""
+    return "part-" + re.sub(r"[^A-Za-z0-9_\-]", "_", f"{design}-{name}")
+
+
+def parts_of(study: Any) -> list[tuple[str, list[str], Any]]:
+    """(design, stage names, :class:`balpipe.mechanics.part_shapes.MadePart`) of every part of
+    the study's stages, each once per design, in the stages' order."""
+    seen: dict[tuple[str, str], tuple[str, list[str], Any]] = {}
+    for s in study.stages:
+        design = s.stage.design or "main"
+        for p in s.stage.parts:
+            key = (design, json.dumps(p.to_json(), sort_keys=True))
+            seen.setdefault(key, (design, [], p))[1].append(s.stage.name)
+    return list(seen.values())
+
+
+def parts_json(study: Any) -> list[dict]:
+    """``results.json``'s ``parts``: per part its design, stages, shape, material, density,
+    dimensions, mass, centroid (in its body's frame), centroidal inertia, whether it fits and why
+    not (located by its spec path), and its drawings' file names."""
+    out = []
+    for design, stages, p in parts_of(study):
+        name = drawing_name(design, p.name)
+        out.append({"design": design, "stages": stages, **p.to_json(),
+                    "drawings": {"dxf": f"{name}.dxf", "svg": f"{name}.svg"} if p.outline else None})
+    return out
+
+
+def bom_csv(parts: list[dict]) -> str:
+    """The bill of materials: one row per part of ``parts`` (:func:`parts_json`), SI units in
+    the column names, 12 significant digits, empty cells where a dimension does not apply."""
+    header = (["part", "design", "body", "shape", "material", "density_kg_per_m3", "mass_kg"]
+              + [f"{k}_{u.replace('/', '_per_')}" if u else k for k, u in DIMENSIONS]
+              + ["centroid_x_m", "centroid_y_m", "inertia_kg_m2", "fits", "problems", "drawing_dxf"])
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(header)
+
+    def num(x: Any) -> str:
+        return "" if x is None else f"{float(x):.12g}"
+
+    for p in parts:
+        dims = p["dimensions"]
+        w.writerow([p["name"], p["design"], p["body"], p["shape"], p["material"], num(p["density"]), num(p["mass"])]
+                   + [num(dims.get(k)) for k, _ in DIMENSIONS]
+                   + [num(p["centroid"][0]), num(p["centroid"][1]), num(p["inertia"]), "yes" if p["fits"] else "no",
+                      "; ".join(p["problems"]), (p["drawings"] or {}).get("dxf", "")])
+    return buf.getvalue()
+
+
+def _mm(x: float) -> str:
+    return f"{x * 1e3:.4g} mm"
+
+
+#: how the page names each dimension, and how it prints it
+_SHOWN = {"thickness": ("t", _mm), "radius": ("r", _mm), "inner_radius": ("r_i", _mm), "outer_radius": ("r_o", _mm),
+          "angle": ("angle", lambda a: f"{a * 180 / 3.141592653589793:.4g}°"), "length": ("length", _mm),
+          "width": ("width", _mm), "plates": ("plates", lambda n: f"{int(n)}"),
+          "plate_thickness": ("each", _mm)}
+
+
+def page_rows(parts: list[dict]) -> list[dict]:
+    """The page's table of parts (templates/parts.html): ``results.json``'s ``parts`` with their
+    numbers as text (lengths in mm, angles in degrees, masses in kg, inertias in kg m^2)."""
+    rows = []
+    for p in parts:
+        dims = ", ".join(f"{label} {fmt(p['dimensions'][k])}" for k, (label, fmt) in _SHOWN.items() if k in p["dimensions"])
+        rows.append({
+            "name": p["name"], "body": p["body"], "design": p["design"], "shape": p["shape"].replace("_", " "),
+            "material": p["material"], "density": f"{p['density']:.6g} kg/m³", "dimensions": dims,
+            "mass": f"{p['mass']:.6g} kg", "centroid": f"({p['centroid'][0] * 1e3:.4g}, {p['centroid'][1] * 1e3:.4g}) mm",
+            "inertia": f"{p['inertia']:.4g} kg m²", "fits": p["fits"], "problems": "; ".join(p["problems"]),
+            "where": p["where"], "svg": (p["drawings"] or {}).get("svg"), "dxf": (p["drawings"] or {}).get("dxf"),
+        })
+    return rows
