@@ -30,7 +30,7 @@
     var words = q.value.toLowerCase().split(/\s+/).filter(Boolean);
     var shown = 0;
     rows.forEach(function (r) {
-      var ok = keys.every(function (k) { return !sel[k].value || r.getAttribute("data-" + k) === sel[k].value; }) &&
+      var ok = keys.every(function (k) { return !sel[k].value || r.getAttribute("data-f-" + k) === sel[k].value; }) &&
         words.every(function (w) { return r.getAttribute("data-text").indexOf(w) >= 0; });
       r.hidden = !ok;
       if (ok) { shown += 1; }

@@ -857,7 +857,7 @@ def test_index_sorts_filters_by_verdict_and_compares_designs_of_one_mechanism(co
     p.click('#studies button[data-sort="force"]')
     assert _order(p) == sorted(built, key=force.get, reverse=True)
     # a shared address restores the order and the filter
-    levels = {s: json.loads((compare_site / s / "results.json").read_text())["verdict"]["level"] for s in built}
+    levels = {s: json.loads((compare_site / s / "results.json").read_text())["verdict"]["verdict"] for s in built}
     level = levels["paper000_rpr3_scott_russell"]
     p.goto((compare_site / "index.html").as_uri() + f"#verdict={level}&sort=-title", wait_until="load")
     p.reload(wait_until="load")

@@ -15,9 +15,10 @@ FACETS = ("verdict", "paper", "template", "method", "status")
 NO_PAPER = "(no paper)"
 # the index's status labels -> short filter values (also the labels of the status drop-down)
 STATUS = {"invalid spec": "invalid", "internal error": "internal-error"}
-# the verdict's levels (balpipe.report.verdict.LEVELS, best first) as the drop-down names them
-VERDICTS = {"good": "works as claimed or designed", "neutral": "no change",
-            "warn": "works, with a caveat", "bad": "a claim fails"}
+# the verdict's kinds (balpipe.report.verdict.KINDS) as the drop-down names them, in that order
+VERDICTS = {"holds": "claim holds (as claimed, as designed)", "fails": "a claim fails",
+            "objective": "optimised (judged by its objective)", "unclaimed": "no claim (loads reduced or not)",
+            "unconfirmed": "unconfirmed by the simulation"}
 
 
 def facets(entry: dict, results: dict | None, out: Path, slug: str) -> dict:
@@ -26,7 +27,7 @@ def facets(entry: dict, results: dict | None, out: Path, slug: str) -> dict:
     paper = r.get("paper") or NO_PAPER
     v = r.get("verdict") if results is not None and not entry.get("stale") else None
     f = {
-        "verdict": (v or {}).get("level", ""),
+        "verdict": (v or {}).get("verdict", ""),
         "paper": paper,
         "template": r.get("mechanism") or "",
         "method": r.get("method") or "",
