@@ -4,8 +4,13 @@ Each side is a spec file, or ``REV:PATH`` for the spec as it was at a git revisi
 ``HEAD~1:specs/scott_russell.yaml``). Both are run through the same study as ``build`` (and,
 unless ``--no-sim``, the same pymunk validation); the comparison covers the inputs (every
 field of the validated spec, in SI units), the computed parameters, every stage's peaks,
-ratios, added mass and actuator effort, the references and the validation residuals. Output as
-text, Markdown, JSON or a self-contained HTML page with both designs' curves overlaid.
+ratios, added mass and actuator effort, the references and the validation residuals. Every
+output says first whether each side is still balanced, in the words of the pages' verdict
+(:func:`balpipe.report.verdict.verdict`: "force balanced as designed", "the paper's claim fails:
+moment × 6.74", the costs), then which inputs changed, then what they did. Stages are named by
+their label, as on the pages. Output as text, Markdown, JSON or a self-contained HTML page linking
+to both designs' pages on the report site, with both designs' curves overlaid in interactive
+plots (the pages' uPlot plots: :mod:`balpipe.draw.live`).
 """
 
 from __future__ import annotations
@@ -96,14 +101,44 @@ def run_side(ref: str, simulate: bool) -> Side:
     return Side(shown_ref(ref), loaded, st)
 
 
-def _flatten(obj: Any, prefix: str = "") -> dict[str, Any]:
+def side_verdict(side: Side) -> dict:
+    """The side's verdict as its page gives it (:func:`balpipe.report.verdict.verdict` of its
+    stages' rows, references, status and paper; the main design's stages): ``verdict``, ``words``,
+    ``level``, ``costs``, ``text``."""
+    from .report.verdict import verdict
+
+    st = side.study
+    rows = {"stages": [s.metrics.to_json() for s in st.stages], "references": st.references,
+            "status": "ok" if st.ok else "failed", "problems": list(st.problems),
+            "paper": side.loaded.spec.paper}
+    v = verdict(rows, main={s.stage.name for s in st.stages if s.stage.design is None})
+    return {k: v[k] for k in ("verdict", "words", "level", "costs", "text")}
+
+
+def still(old: dict, new: dict) -> str:
+    """One sentence: is the new design still what the old one was? ('still force balanced as
+    designed', 'no longer balanced: the paper's claim fails: moment × 6.74 (was: balanced as
+    claimed)', 'now balanced as designed (was: ...)')."""
+    if old["words"] == new["words"]:
+        lead = "still" if new["verdict"] in ("holds", "unconfirmed") else "both"
+        costs = ("; costs " + ", ".join(old["costs"]) + " → " + ", ".join(new["costs"])
+                 if old["costs"] != new["costs"] else "")
+        return f"{lead} {new['words']}{costs}"
+    if old["verdict"] in ("holds", "unconfirmed") and new["verdict"] not in ("holds", "unconfirmed"):
+        return f"no longer balanced: {new['words']} (was: {old['words']})"
+    if new["verdict"] in ("holds", "unconfirmed") and old["verdict"] not in ("holds", "unconfirmed"):
+        return f"now {new['words']} (was: {old['words']})"
+    return f"{old['words']} → {new['words']}"
+
+
+def flatten(obj: Any, prefix: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
     if isinstance(obj, dict):
         for k, v in obj.items():
-            out.update(_flatten(v, f"{prefix}.{k}" if prefix else str(k)))
+            out.update(flatten(v, f"{prefix}.{k}" if prefix else str(k)))
     elif isinstance(obj, list) and obj and all(isinstance(v, dict) for v in obj):
         for i, v in enumerate(obj):
-            out.update(_flatten(v, f"{prefix}[{i}]"))
+            out.update(flatten(v, f"{prefix}[{i}]"))
     else:
         out[prefix] = obj
     return out
@@ -173,8 +208,8 @@ def _input_symbol(side: Side, path: str) -> str:
 
 def compare(a: Side, b: Side) -> dict:
     """The differences between two studies, as plain data (the JSON output)."""
-    ia = _flatten(a.loaded.spec.model_dump(mode="json", by_alias=True))
-    ib = _flatten(b.loaded.spec.model_dump(mode="json", by_alias=True))
+    ia = flatten(a.loaded.spec.model_dump(mode="json", by_alias=True))
+    ib = flatten(b.loaded.spec.model_dump(mode="json", by_alias=True))
     units = _input_units(a) | _input_units(b)
     inputs = [
         {"field": k, "symbol": _input_symbol(b, k) or _input_symbol(a, k), "old": ia.get(k), "new": ib.get(k),
@@ -193,7 +228,7 @@ def compare(a: Side, b: Side) -> dict:
     mb = {s.stage.name: s.metrics for s in b.study.stages}
     stages = []
     for name in list(ma) + [n for n in mb if n not in ma]:
-        row: dict[str, Any] = {"name": name}
+        row: dict[str, Any] = {"name": name, "label": (mb.get(name) or ma[name]).label}
         for key in STAGE_KEYS:
             row[key] = _change(*(getattr(m[name], key) if name in m else None for m in (ma, mb)))
         va = next((s.validation for s in a.study.stages if s.stage.name == name), None)
@@ -215,8 +250,10 @@ def compare(a: Side, b: Side) -> dict:
         if not same(ra.get(n, {}).get("computed"), rb.get(n, {}).get("computed"))
         or ra.get(n, {}).get("status") != rb.get(n, {}).get("status")
     ]
+    va, vb = side_verdict(a), side_verdict(b)
     return json_safe({
         "old": a.ref, "new": b.ref,
+        "verdict": {"old": va, "new": vb, "still": still(va, vb)},
         "old_spec": a.loaded.spec.name, "new_spec": b.loaded.spec.name,
         "status": {"old": "ok" if a.study.ok else "failed", "new": "ok" if b.study.ok else "failed"},
         "inputs": inputs,
@@ -269,9 +306,18 @@ def _rel(d: dict) -> str:
 
 
 def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
-    """Sections as (title, rows, header) for the text and Markdown renderers: the results (stages,
-    references, computed parameters) first, the inputs last."""
+    """Sections as (title, rows, header) for the text and Markdown renderers: the verdict of each
+    side first (is it still balanced?), the inputs that changed next, then what they did (stages,
+    references, computed parameters). A stage is named by its label, as on the pages."""
     sections = []
+    v = data.get("verdict")
+    if v:
+        sections.append(("Verdict", [["old", v["old"]["words"], "; ".join(v["old"]["costs"]) or "—"],
+                                     ["new", v["new"]["words"], "; ".join(v["new"]["costs"]) or "—"]],
+                         ["design", "verdict", "costs"]))
+    sections.append(("Inputs", [[d.get("symbol") or "—", d["field"], _short(d["old"]), _short(d["new"]), d.get("unit", "")]
+                                for d in data["inputs"]],
+                     ["symbol (paper)", "field", "old", "new", "unit (SI)"]))
     rows: list[list[str]] = []
     sim: list[list[str]] = []
     for s in data["stages"]:
@@ -286,29 +332,25 @@ def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
             load = next((w for w in quiet if w in key), None)
             old_text, new_text = (_side_fmt(d[side], load is not None and cancelled[load, side]) for side in ("old", "new"))
             change = "cancelled" if new_text == ROUND_OFF_TEXT and old_text not in (ROUND_OFF_TEXT, "—") else _rel(d)
-            rows.append([s["name"], STAGE_NAMES.get(key, key), old_text, new_text, change])
+            rows.append([s.get("label") or s["name"], STAGE_NAMES.get(key, key), old_text, new_text, change])
         v = s.get("validation")
         if v:
             # the simulation's residuals are numerical noise, not a design change: their own section
             for key in ("force_residual", "moment_residual"):
                 d = v[key]
                 if not same(d["old"], d["new"]):
-                    sim.append([s["name"], f"pymunk {key.replace('_', ' ')} (vs reference load)", _fmt(d["old"]),
+                    sim.append([s.get("label") or s["name"], f"pymunk {key.replace('_', ' ')} (vs reference load)", _fmt(d["old"]),
                                 _fmt(d["new"]), _rel(d)])
             if v["passed"]["old"] != v["passed"]["new"]:
-                rows.append([s["name"], "pymunk validation passed", _fmt(v["passed"]["old"]), _fmt(v["passed"]["new"]), ""])
+                rows.append([s.get("label") or s["name"], "pymunk validation passed", _fmt(v["passed"]["old"]), _fmt(v["passed"]["new"]), ""])
     sections.append(("Stages", rows, ["stage", "result", "old", "new", "change"]))
     if sim:
         sections.append(("Simulation residuals (numerical, not a design change)", sim,
                          ["stage", "residual", "old", "new", "change"]))
     sections.append(("References", [[r["name"], _fmt(r["published"]), _fmt(r["old"]), _fmt(r["new"]), f"{_fmt(r['old_status'])} -> {_fmt(r['new_status'])}"] for r in data["references"]],
                      ["reference", "published", "old", "new", "status"]))
-    # the results first (what changed), then what was changed to get there
     sections.append(("Computed parameters", [[p["name"], _fmt(p["old"]), _fmt(p["new"]), _rel(p), p["unit"]] for p in data["parameters"]],
                      ["parameter", "old", "new", "change", "unit"]))
-    sections.append(("Inputs", [[d.get("symbol") or "—", d["field"], _short(d["old"]), _short(d["new"]), d.get("unit", "")]
-                                for d in data["inputs"]],
-                     ["symbol (paper)", "field", "old", "new", "unit (SI)"]))
     return sections
 
 
@@ -322,6 +364,8 @@ def headline(sections: list) -> list[list[str]]:
 
 def to_text(data: dict) -> str:
     out = [f"balpipe diff: {data['old']} ({data['status']['old']}) -> {data['new']} ({data['status']['new']})"]
+    if data.get("verdict"):
+        out.append(f"Verdict: {data['verdict']['still']}")
     for title, rows, header in _rows(data):
         out.append("")
         out.append(f"{title}:" if rows else f"{title}: no change")
@@ -336,6 +380,8 @@ def to_text(data: dict) -> str:
 def to_markdown(data: dict) -> str:
     out = [f"## balpipe diff: `{data['old']}` → `{data['new']}`", "",
            f"Status: {data['status']['old']} → {data['status']['new']}"]
+    if data.get("verdict"):
+        out += ["", f"**Verdict:** {data['verdict']['still']}"]
     for title, rows, header in _rows(data):
         out += ["", f"### {title}", ""]
         if not rows:
@@ -351,28 +397,36 @@ def to_json(data: dict) -> str:
     return json.dumps(data, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
 
 
-def to_html(data: dict, a: Side, b: Side, site: str = "") -> str:
-    """The HTML page; a stage whose loads are round-off in both designs is drawn on the
-    unbalanced stage's scale (flat at zero) and said so, not plotted as a signal."""
-    from .draw.figures import overlay_figure
+def _file_of(ref: str) -> str:
+    """The spec file of a side: the file, or the PATH of REV:PATH."""
+    return ref if Path(ref).exists() or ":" not in ref else ref.split(":", 1)[1]
+
+
+def to_html(data: dict, a: Side, b: Side, site: str = "", out: str | None = None) -> str:
+    """The HTML page: each side's verdict and its page on the site first, the inputs next, then
+    the results; per stage both designs' shaking loads in one interactive plot
+    (:func:`balpipe.report.diff_overlay.overlay`), a load round-off in both designs drawn as zero
+    and said so, not plotted as a signal."""
+    from .draw import live
+    from .report.diff_overlay import DIFF_NUMBERS, overlay, page_links
     from .report.render import environment
 
     figs = []
     names_b = {s.stage.name: s for s in b.study.stages}
     quiet = {s["name"]: tuple(c[w, "old"] and c[w, "new"] for w in ("force", "moment"))
              for s in data["stages"] for c in [_cancelled(s)]}
-    ua, ub = a.study.unbalanced.analysis, b.study.unbalanced.analysis
-    scale = (max(ua.max_force, ub.max_force), max(ua.max_moment, ub.max_moment))
     for k, sa in enumerate(a.study.stages):
         sb = names_b.get(sa.stage.name)
         if sb is not None:
             qf, qm = quiet.get(sa.stage.name, (False, False))
             note = " and ".join(w for w, q in (("force", qf), ("moment", qm)) if q)
-            figs.append((sa.stage.label, overlay_figure(sa.analysis, sb.analysis, prefix=f"diff{k}",
-                                                        round_off=(qf, qm), scale=scale), note))
+            figs.append((sb.stage.label, live.html(f"diff{k}", overlay(sa.analysis, sb.analysis, (qf, qm)), DIFF_NUMBERS),
+                         note))
     sections = _rows(data)
+    pages = page_links(site, out, (_file_of(str(a.loaded.path)), _file_of(str(b.loaded.path))))
     return environment().get_template("diff.html").render(d=data, sections=sections, figures=figs, site=site,
-                                                          round_off=ROUND_OFF, headline=headline(sections))
+                                                          round_off=ROUND_OFF, headline=headline(sections),
+                                                          pages=pages)
 
 
 RENDERERS = {"text": to_text, "markdown": to_markdown, "json": to_json}

@@ -30,6 +30,7 @@ import traceback
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 SCHEMA_VERSION = 1
 STAGE_KEYS = ("max_shaking_force", "max_shaking_moment", "max_inertial_force", "max_inertial_moment",
@@ -163,6 +164,9 @@ def figures_from_results(results: dict) -> dict:
         "validation": overall,
         "references": [{"name": r["name"], "status": r["status"], "expected": r.get("expected")}
                        for r in results.get("references") or []],
+        # the page's verdict of that revision (balpipe.report.verdict): still balanced, at what cost?
+        "verdict": {k: v.get(k) for k in ("verdict", "words", "level", "costs")}
+        if (v := results.get("verdict")) else None,
     }
 
 
@@ -327,15 +331,73 @@ def _read_json(p: Path) -> dict | None:
         return None
 
 
+#: at most this many changed fields and files are listed per commit (then "and k more")
+MAX_CHANGES = 12
+
+
+def spec_fields(text: str, source: str) -> dict[str, Any]:
+    """Every input field of a spec text, flattened to dotted paths (``mechanism.crank.mass``):
+    the validated spec's, in SI units with its defaults (as ``balpipe diff`` compares them), or
+    for a text that does not validate the YAML as written (``{}`` when it does not parse)."""
+    import yaml
+
+    from .diff import flatten
+    from .loader import SpecErrors, load_text
+
+    try:
+        spec, _ = load_text(text, source)
+        return flatten(spec.model_dump(mode="json", by_alias=True))
+    except SpecErrors:
+        try:
+            raw = yaml.safe_load(text)
+        except yaml.YAMLError:
+            return {}
+        return flatten(raw) if isinstance(raw, dict) else {}
+
+
+def changed_fields(before: dict[str, Any], after: dict[str, Any]) -> list[dict]:
+    """The fields whose value differs (round-off is no change: :func:`balpipe.diff.same`),
+    sorted: ``{field, old, new}`` (None where a side lacks the field)."""
+    from .diff import same
+
+    return [{"field": k, "old": before.get(k), "new": after.get(k)}
+            for k in sorted(set(before) | set(after)) if not same(before.get(k), after.get(k))]
+
+
+def commit_files(root: Path, commit: Commit) -> list[str]:
+    """The files a commit changed besides the spec (``git show --name-only``), sorted."""
+    out = _git(root, "show", "--no-renames", "--name-only", "--format=", commit.hash)
+    return sorted(n for n in {line.strip() for line in out.splitlines()} if n and n != commit.path)
+
+
+def inputs_changed(w: _Work) -> list[dict]:
+    """Per commit, which inputs it changed: ``fields`` (the spec's fields against the previous
+    commit's spec; None at the spec's first commit, where every field is new), ``more`` (fields
+    beyond :data:`MAX_CHANGES`), ``files`` (the other files the commit changed: tables the spec
+    reads, code) and ``more_files``."""
+    out = []
+    previous: dict[str, Any] | None = None
+    for c, text in zip(w.commits, w.texts):
+        now = spec_fields(text, f"{c.hash[:10]}:{c.path}")
+        fields = None if previous is None else changed_fields(previous, now)
+        files = commit_files(w.root, c) if w.root is not None else []
+        out.append({"fields": None if fields is None else fields[:MAX_CHANGES],
+                    "more": 0 if fields is None else max(0, len(fields) - MAX_CHANGES),
+                    "files": files[:MAX_CHANGES], "more_files": max(0, len(files) - MAX_CHANGES)})
+        previous = now
+    return out
+
+
 def history_dict(w: _Work, known: dict[str, dict], failures: dict[str, str], simulate: bool) -> dict:
     commits = []
-    for c, h in zip(w.commits, w.hashes):
+    changes = inputs_changed(w)
+    for c, h, changed in zip(w.commits, w.hashes, changes):
         fig = known.get(h)
         if fig is None:
             fig = {"status": "crash", "problems": failures.get(h, "not computed").splitlines()[:1],
                    "parameters": [], "stages": [], "validation": "skipped", "references": []}
         commits.append({"hash": c.hash, "short": c.hash[:7], "date": c.date, "subject": c.subject,
-                        "path": c.path, "input_hash": h, **fig})
+                        "path": c.path, "input_hash": h, "inputs_changed": changed, **fig})
     from .report.results import json_safe
 
     return json_safe({

@@ -318,7 +318,9 @@ def test_the_history_figures_are_cached_too(tmp_path, monkeypatch, drawn):
     history.run(["specs"], Path("out"), Path("cache"), simulate=False)
     drawn.clear()
     run(Path("specs"), Path("out"))
-    assert any(p.startswith("hist-") for p in drawn)  # the page's history section
+    # the page's history section: interactive plots of history.json's numbers, nothing drawn
+    assert 'data-live="live-hist-loads"' in Path("out/scott_russell/index.html").read_text()
+    assert not any(p.startswith("hist-") for p in drawn)
     n = len(entries(Path("out")))
     drawn.clear()
     spec = Path("specs/scott_russell.yaml")

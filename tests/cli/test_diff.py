@@ -39,10 +39,11 @@ def test_diff_of_two_spec_files_in_every_format(tmp_path):
     out = tmp_path / "d.html"
     assert balpipe("diff", old, new, "--no-sim", "-f", "html", "-o", out).returncode == 0
     html = out.read_text()
-    assert html.count("<svg") == 3 and "Design comparison" in html
-    # readable names with units; round-off stages drawn as zero on the unbalanced scale, said so
+    # a live (interactive) overlay per stage, no static figure
+    assert html.count('data-live="live-diff') == 3 and "<svg" not in html and "Design comparison" in html
+    # readable names with units; round-off stages drawn as zero, said so
     assert "added mass (kg)" in html and "unit (SI)" in html and "max_shaking_force" not in html
-    assert "is round-off in both designs" in html and "round-off in both designs (shown as 0" in html
+    assert "is round-off in both designs" in html
     assert "report site" not in html  # no site beside the file: no dead link
     (tmp_path / "index.html").write_text("<title>balpipe report site</title>")
     assert balpipe("diff", old, new, "--no-sim", "-f", "html", "-o", out).returncode == 0
@@ -103,7 +104,37 @@ def test_diff_leads_with_the_results(tmp_path):
     assert "Inputs: no change" in text and "Stages: no change" in text  # round-off of an input: no change
     new.write_text(replaced(old.read_text(), "{mass: 600 g}", "{mass: 700 g}"))
     text = balpipe("diff", old, new, "--no-sim").stdout
-    assert text.index("Stages:") < text.index("Computed parameters") < text.index("Inputs:")
+    # whether each side is still balanced first, then the inputs that changed, then what they did
+    assert text.splitlines()[1].startswith("Verdict: still force balanced as designed; costs moment × 10.6 → moment × 11.4")
+    assert text.index("Verdict:") < text.index("Inputs:") < text.index("Stages:") < text.index("Computed parameters")
+
+
+def test_the_diff_says_whether_each_side_is_still_balanced_in_the_pages_words(tmp_path):
+    """The printed Scott-Russell legs against the corrected ones: each side's verdict is the
+    one its page shows (the same function), the still-balanced sentence says it is lost, and the
+    HTML page links to the page of each side that the site beside it holds."""
+    from balpipe.build import Options, build
+
+    old, new = ROOT / "specs" / "paper000_rpr3_scott_russell_corrected.yaml", ROOT / "specs" / "paper000_rpr3_scott_russell.yaml"
+    site = tmp_path / "site"
+    build([str(new)], Options(out=site, simulate=False))
+    page = json.loads((site / "paper000_rpr3_scott_russell" / "results.json").read_text())["verdict"]
+    r = balpipe("diff", old, new, "--no-sim", "-f", "json")
+    assert r.returncode == 0, r.stderr
+    v = json.loads(r.stdout)["verdict"]
+    assert v["new"]["words"] == page["words"] and v["new"]["costs"] == page["costs"] and v["new"]["verdict"] == "fails"
+    assert v["old"]["words"] == "balanced as claimed"
+    assert v["still"] == f"no longer balanced: {page['words']} (was: balanced as claimed)"
+    assert all(s["label"] for s in json.loads(r.stdout)["stages"])  # each stage by its page's label too
+    out = site / "diff.html"
+    assert balpipe("diff", old, new, "--no-sim", "-f", "html", "-o", out).returncode == 0
+    html = out.read_text()
+    assert html.index('id="verdict"') < html.index('id="headline"') < html.index("<h2>Inputs</h2>") < html.index("<h2>Stages</h2>")
+    assert 'href="paper000_rpr3_scott_russell/index.html" class="page-link"' in html
+    assert html.count('class="page-link"') == 1  # the corrected design has no page on this site: no dead link
+    text = balpipe("diff", old, new, "--no-sim").stdout
+    stages = text[text.index("Stages:"):text.index("References")]
+    assert "counter-rotations" in stages and "counter_rotations" not in stages  # one name: the page's label
 
 
 def test_diff_page_opens_with_the_headline_changes(tmp_path):

@@ -205,7 +205,16 @@ def test_build_puts_the_history_in_the_study_page_and_the_index(tmp_path, monkey
     assert build_("out").status == "ok"
     folder = repo.path / "out" / "osc"
     page = (folder / "index.html").read_text()
-    assert 'id="history"' in page and page.count("<svg") > 3
+    # the history's plots are the pages' interactive ones, no static figure
+    assert 'id="history"' in page and all(f'data-live="live-hist-{k}"' in page for k in ("loads", "added", "params"))
+    # per commit, which inputs it changed, in SI units, and the verdict in the pages' words
+    data = json.loads((folder / "history.json").read_text())
+    changed = [c["inputs_changed"]["fields"] for c in data["commits"]]
+    assert changed == [None, [{"field": "mechanism.slider.mass", "old": 0.6, "new": 0.8}],
+                       [{"field": "balancing.crank_counterweight", "old": -0.1, "new": -0.12}]]
+    assert all(c["inputs_changed"]["files"] == [] for c in data["commits"])
+    assert "mechanism.slider.mass: 0.6 → 0.8" in page and "first commit of the spec" in page
+    assert [c["verdict"]["words"] for c in data["commits"]] == ["force balanced as designed"] * 3
     for h in hashes:
         assert h[:7] in page
     assert "history.json" in page and "crank counterweight further out" in page

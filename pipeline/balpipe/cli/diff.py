@@ -33,6 +33,6 @@ def run(args) -> int:
         print(str(exc), file=sys.stderr)
         return EXIT_USAGE
     data = diff.compare(a, b)
-    text = (diff.to_html(data, a, b, site=diff.site_link(args.site, args.out)) if args.format == "html"
+    text = (diff.to_html(data, a, b, site=diff.site_link(args.site, args.out), out=args.out) if args.format == "html"
             else diff.RENDERERS[args.format](data))
     return emit(text, args.out)

@@ -1,26 +1,20 @@
-"""Figures of a spec's history: its headline figures plotted against the commits that changed it.
+"""Figures of a spec's history: its headline figures plotted against the commits that changed it,
+as the pages' interactive plots (:mod:`balpipe.draw.live`: hover reads every stage's value at a
+commit, drag zooms, a legend entry hides its curve).
 
-The x axis is the sequence of commits, oldest left, labelled with their short hashes; the
-history table of the page gives each commit's date and subject. A commit whose spec is invalid
-or crashed has no point (a gap), and its label is red, as is the label of a commit whose spec
-fails a check or the pymunk validation. The figures are drawn through the figure cache
-(:mod:`balpipe.cache.figures`): a build re-renders a page's history section without redrawing them.
+The x axis is the commits' number, oldest first, as the history table numbers them (its rows
+give each commit's hash, date, subject and the inputs it changed). A commit whose spec is invalid
+or crashed has no value there (its marker is missing). Each stage keeps the line style it has on
+the study page's figures (its place in the stage table).
 """
 
 from __future__ import annotations
 
-import math
+import numpy as np
 
-import matplotlib
+from ..draw.live import Curves
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from ..cache import figures as cache  # noqa: E402
-from ..draw.figures import style, to_svg  # noqa: E402
-
-MAX_LABELS = 16
+X_AXIS = "commit # (oldest first, as the table)"
 
 
 def _stage_names(commits: list[dict]) -> list[tuple[str, str]]:
@@ -46,61 +40,31 @@ def flagged(commit: dict) -> bool:
     return commit.get("status") != "ok" or commit.get("validation") == "fail"
 
 
-def _commit_axis(ax, commits: list[dict]) -> None:
-    n = len(commits)
-    step = max(1, math.ceil(n / MAX_LABELS))
-    ticks = list(range(0, n, step))
-    if ticks[-1] != n - 1:
-        ticks.append(n - 1)
-    ax.set_xticks(ticks)
-    ax.set_xticklabels([commits[i]["short"] for i in ticks], rotation=45, ha="right", fontsize=7,
-                       fontfamily="DejaVu Sans Mono")
-    for lab, i in zip(ax.get_xticklabels(), ticks):
-        if flagged(commits[i]):
-            lab.set_color("tab:red")
-    ax.set_xlim(-0.5, n - 0.5)
-    ax.set_xlabel("commit (oldest left)")
-    for i, c in enumerate(commits):
-        if c.get("status") in ("invalid", "crash"):
-            ax.axvline(i, color="tab:red", linestyle=":", linewidth=0.8)
+def _commits_x(commits: list[dict]) -> np.ndarray:
+    return np.arange(1, len(commits) + 1, dtype=float)
 
 
-def _plot(ax, x, y, k: int, label: str) -> None:
-    st = dict(style(k))
-    st["linewidth"] = min(st["linewidth"], 1.6)
-    ax.plot(x, y, marker="o", markersize=3.5, label=label, **st)
+def _panels(commits: list[dict], stages: list[tuple[str, str]], panels: tuple[tuple[str, str, str], ...],
+            first_style: int) -> Curves:
+    """A panel per (results key, title, axis) of ``panels``: every stage's value per commit."""
+    curves = [(label, {key: _series(commits, name, key) for key, _, _ in panels}) for name, label in stages]
+    return Curves(_commits_x(commits), curves, [{"key": k, "title": t, "axis": ax} for k, t, ax in panels], [],
+                  styles=[k + first_style for k in range(len(stages))], x_axis=X_AXIS, grid=True)
 
 
-def _panels_figure(commits: list[dict], stages: list[tuple[str, str]], panels: tuple[tuple[str, str], ...],
-                   height: float, first_style: int, prefix: str) -> str:
-    """Two panels, one per (results key, title) in ``panels``: every stage's value per commit,
-    one legend under both."""
-    x = np.arange(len(commits))
-    fig, axes = plt.subplots(1, 2, figsize=(9.0, height))
-    for ax, (key, title) in zip(axes, panels):
-        for k, (name, label) in enumerate(stages):
-            _plot(ax, x, _series(commits, name, key), k + first_style, label)
-        ax.set_title(title, fontsize=9)
-        _commit_axis(ax, commits)
-    handles, labels = axes[0].get_legend_handles_labels()
-    if labels:
-        fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 4), fontsize=8, frameon=False)
-    fig.tight_layout(rect=(0, 0.08, 1, 1))
-    return to_svg(fig, prefix)
-
-
-def loads_history_figure(commits: list[dict], prefix: str = "hist-loads") -> str:
+def loads_history_figure(commits: list[dict]) -> Curves:
     """Peak shaking force |F| and moment |M| of every stage, per commit."""
-    return cache.svg(_panels_figure, commits, _stage_names(commits),
-                     (("max_shaking_force", "Peak shaking force |F| (N)"),
-                      ("max_shaking_moment", "Peak shaking moment |M| (N m)")), 3.4, 0, prefix)
+    return _panels(commits, _stage_names(commits),
+                   (("max_shaking_force", "peak shaking force |F| (N)", "|F| (N)"),
+                    ("max_shaking_moment", "peak shaking moment |M| (N m)", "|M| (N m)")), 0)
 
 
-def added_history_figure(commits: list[dict], prefix: str = "hist-added") -> str:
+def added_history_figure(commits: list[dict]) -> Curves:
     """Mass and rotating inertia that each balancing stage adds to the unbalanced mechanism."""
-    return cache.svg(_panels_figure, commits, _stage_names(commits)[1:] or _stage_names(commits),
-                     (("added_mass", "Added mass (kg)"), ("added_inertia", "Added inertia (kg m²)")),
-                     3.2, 1, prefix)
+    names = _stage_names(commits)
+    return _panels(commits, names[1:] or names,
+                   (("added_mass", "added mass (kg)", "mass (kg)"), ("added_inertia", "added inertia (kg m²)",
+                                                                      "inertia (kg m²)")), 1 if names[1:] else 0)
 
 
 def _parameters(commits: list[dict]) -> list[tuple[str, str]]:
@@ -125,32 +89,21 @@ def changing_parameters(commits: list[dict]) -> tuple[list[tuple[str, str]], lis
     return changing, constant
 
 
-def parameters_history_figure(commits: list[dict], prefix: str = "hist-params") -> str | None:
-    """One small panel per computed balancing parameter that changes along the history (its
-    unit in the title); None when none changes."""
+def parameters_history_figure(commits: list[dict]) -> Curves | None:
+    """One panel per computed balancing parameter that changes along the history (its unit in
+    the title); None when none changes."""
     params = changing_parameters(commits)[0]
     if not params:
         return None
-    return cache.svg(_parameters_figure, commits, params, prefix)
-
-
-def _parameters_figure(commits: list[dict], params: list[tuple[str, str]], prefix: str) -> str:
-    """:func:`parameters_history_figure` of the changing ``params`` (name, unit), drawn."""
-    ncol = min(3, len(params))
-    nrow = math.ceil(len(params) / ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(3.0 * ncol + 0.4, 2.5 * nrow), squeeze=False)
-    x = np.arange(len(commits))
-    for ax, (name, unit) in zip(axes.flat, params):
+    values = {}
+    for name, _ in params:
         y = np.full(len(commits), np.nan)
         for i, c in enumerate(commits):
             for p in c.get("parameters") or []:
                 if p["name"] == name and isinstance(p.get("value"), (int, float)):
                     y[i] = p["value"]
-        ax.plot(x, y, marker="o", markersize=3.5, color="black", linewidth=1.2)
-        ax.set_title(f"{name} ({unit.replace('^2', '²')})" if unit else name, fontsize=9)
-        _commit_axis(ax, commits)
-        ax.set_xlabel("")
-    for ax in list(axes.flat)[len(params):]:
-        ax.set_visible(False)
-    fig.tight_layout()
-    return to_svg(fig, prefix)
+        values[name] = y
+    panels = [{"key": name, "title": f"{name} ({unit.replace('^2', '²')})" if unit else name,
+               "axis": f"{name} ({unit.replace('^2', '²')})" if unit else name} for name, unit in params]
+    return Curves(_commits_x(commits), [("computed value", values)], panels, [], styles=[0], x_axis=X_AXIS,
+                  grid=True)

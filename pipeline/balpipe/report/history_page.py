@@ -32,10 +32,39 @@ def _peaks(c: dict, key: str) -> str:
     return num(a) if len(st) == 1 else f"{num(a)} → {peak_text(b, a, 1e-9, of='unbalanced')}"
 
 
+def _value(x) -> str:
+    """An input's value in a row of changes: a number as the pages write it, a long text by its
+    start."""
+    if isinstance(x, bool) or x is None:
+        return "—" if x is None else str(x).lower()
+    if isinstance(x, (int, float)):
+        return num(x)
+    t = str(x)
+    return t if len(t) <= 40 else t[:30].rstrip() + "…"
+
+
+def changes(c: dict) -> dict:
+    """Which inputs a commit changed (``inputs_changed`` of history.json), in words: the spec's
+    fields ('mechanism.slider.mass 0.6 → 0.7'), or that it is the spec's first commit; and the
+    other files the commit changed."""
+    ch = c.get("inputs_changed")
+    if ch is None:  # a history.json written before the field
+        return {"fields": [], "first": False, "none": False, "files": [], "known": False}
+    fields = ch.get("fields")
+    rows = [f"{f['field']}: {_value(f['old'])} → {_value(f['new'])}" for f in fields or []]
+    if ch.get("more"):
+        rows.append(f"and {ch['more']} more")
+    files = list(ch.get("files") or []) + ([f"and {ch['more_files']} more"] if ch.get("more_files") else [])
+    return {"fields": rows, "first": fields is None, "none": fields == [], "files": files, "known": True}
+
+
 def view(history: dict, prefix: str = "hist") -> dict:
-    """What the templates need: figures (title, svg, caption) and one row per commit."""
+    """What the templates need: figures (title, interactive plot, caption) and one row per commit."""
+    from ..draw import live
     from .history_figures import (added_history_figure, changing_parameters, flagged, loads_history_figure,
-                                  parameters_history_figure)  # matplotlib: only when there is a history
+                                  parameters_history_figure)
+
+    numbers = 'its numbers are in the table below and in <a href="history.json">history.json</a>'
 
     commits = history.get("commits") or []
     changing, constant = changing_parameters(commits)
@@ -61,18 +90,21 @@ def view(history: dict, prefix: str = "hist") -> dict:
             "problems": c.get("problems") or [],
             "parameters": ", ".join(f"{p['name']} = {num(p['value'])}" for p in c.get("parameters") or []
                                     if p["name"] in shown),
+            "changes": changes(c),
+            "verdict": c.get("verdict"),
         })
     figures = []
     if commits:
-        figures.append(("Peak shaking loads per commit", loads_history_figure(commits, f"{prefix}-loads"),
+        figures.append(("Peak shaking loads per commit", live.html(f"{prefix}-loads", loads_history_figure(commits), numbers),
                         "Peak over the motion of the shaking force |F| (N) and moment |M| (N m) on the frame, "
                         "each balancing stage as on the stage table, for the spec as it was at each commit."))
-        figures.append(("Added mass and inertia per commit", added_history_figure(commits, f"{prefix}-added"),
+        figures.append(("Added mass and inertia per commit",
+                        live.html(f"{prefix}-added", added_history_figure(commits), numbers),
                         "Mass (kg) and declared rotating inertia (kg m²) each balancing stage adds to the "
                         "unbalanced mechanism."))
-        params = parameters_history_figure(commits, f"{prefix}-params")
+        params = parameters_history_figure(commits)
         if params is not None:
-            figures.append(("Computed balancing parameters per commit", params,
+            figures.append(("Computed balancing parameters per commit", live.html(f"{prefix}-params", params, numbers),
                             "Each computed parameter that changes along the history, in its own unit, as in the "
                             "parameter table of the study page."))
     last = commits[-1] if commits else {}
