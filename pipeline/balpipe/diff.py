@@ -397,6 +397,24 @@ def to_json(data: dict) -> str:
     return json.dumps(data, indent=2, sort_keys=True, ensure_ascii=False) + "\n"
 
 
+def page_links(site: str, out: str | None, paths: tuple[str, str]) -> tuple[str, str]:
+    """Each side's page on the report site (``site``: the site's index, as :func:`site_link`
+    finds or is given it), '' where there is none: the page of the spec's file name
+    (:func:`balpipe.site_files.spec_files.slug_for`); of a local site, only a page that exists.
+    ``paths``: each side's file (the PATH of REV:PATH)."""
+    from .site_files.spec_files import slug_for
+
+    if not site:
+        return "", ""
+    base = site[: -len("index.html")] if site.endswith("index.html") else site.rstrip("/") + "/"
+    local = Path(out).resolve().parent if out and "://" not in site else None
+    links = []
+    for path in paths:
+        href = f"{base}{slug_for(Path(path))}/index.html"
+        links.append(href if local is None or (local / href).exists() else "")
+    return links[0], links[1]
+
+
 def _file_of(ref: str) -> str:
     """The spec file of a side: the file, or the PATH of REV:PATH."""
     return ref if Path(ref).exists() or ":" not in ref else ref.split(":", 1)[1]
@@ -408,7 +426,7 @@ def to_html(data: dict, a: Side, b: Side, site: str = "", out: str | None = None
     (:func:`balpipe.report.diff_overlay.overlay`), a load round-off in both designs drawn as zero
     and said so, not plotted as a signal."""
     from .draw import live
-    from .report.diff_overlay import DIFF_NUMBERS, overlay, page_links
+    from .report.diff_overlay import DIFF_NUMBERS, overlay
     from .report.render import environment
 
     figs = []

@@ -5,17 +5,14 @@ Fy, |F| and moment M of the old design (grey, dashed) and the new one (black, so
 Two designs of different durations or samplings are drawn over the union of their sample times,
 each curve ending where its motion ends (null beyond: a gap, never extrapolated). A load that is
 round-off in both designs is drawn as zero (its numbers are the round-off of the computation, not
-a signal); the page's caption says so. Also the links of each side to its page on the report site.
+a signal); the page's caption says so.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from ..draw.live import Curves
-from ..site_files.spec_files import slug_for
 from .live_plots import LOADS
 
 OLD_STYLE = {"color": "#8c8c8c", "linestyle": "--", "linewidth": 1.6}
@@ -49,19 +46,3 @@ def overlay(old, new, round_off: tuple[bool, bool] = (False, False)) -> Curves:
 
 #: where a reader without JavaScript finds the diff's numbers
 DIFF_NUMBERS = "the stages' peaks are in the tables above, the samples in each design's timeseries.csv"
-
-
-def page_links(site: str, out: str | None, paths: tuple[str, str]) -> tuple[str, str]:
-    """Each side's page on the report site (``site``: the site's index, as :func:`balpipe.diff.site_link`
-    finds or is given it), '' where there is none: the page of the spec's file name
-    (:func:`balpipe.site_files.spec_files.slug_for`); of a local site, only a page that exists.
-    ``paths``: each side's file (the PATH of REV:PATH)."""
-    if not site:
-        return "", ""
-    base = site[: -len("index.html")] if site.endswith("index.html") else site.rstrip("/") + "/"
-    local = Path(out).resolve().parent if out and "://" not in site else None
-    links = []
-    for path in paths:
-        href = f"{base}{slug_for(Path(path))}/index.html"
-        links.append(href if local is None or (local / href).exists() else "")
-    return links[0], links[1]
