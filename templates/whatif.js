@@ -59,7 +59,10 @@
   window.balpipeWhatif = api;
 
   // the controls: per part a group of four rows (range, number box, the computed value marked)
-  const shown = v => String(+v.toPrecision(6));  // a number box's text: 6 digits (the value itself is kept whole)
+  // what a number box and a label show: 6 digits, and 0 for a value within 1e-9 of its slider's
+  // range of 0 (a computation's round-off, 2e-17 m); the value itself is kept whole
+  const clean = (p, j, v) => (Math.abs(v) <= 1e-9 * (p.hi[j] - p.lo[j]) ? 0 : v);
+  const shown = (p, j, v) => String(+clean(p, j, v).toPrecision(6));
   const PARAMS = [["mass", "kg"], ["x", "m"], ["y", "m"], ["inertia", "kg m²"]];
   const inputs = [];
   const added = document.createElement("p");
@@ -102,17 +105,17 @@
       range.setAttribute("aria-label", name + " of " + p.label + " (" + unit + ")");
       const mark = document.createElement("i");
       mark.className = "whatif-mark";
-      mark.title = "computed design: " + fmt(p.design[j]) + " " + unit;
+      mark.title = "computed design: " + fmt(clean(p, j, p.design[j])) + " " + unit;
       const frac = p.hi[j] > p.lo[j] ? (p.design[j] - p.lo[j]) / (p.hi[j] - p.lo[j]) : 0.5;
       mark.style.setProperty("--at", String(frac));
       track.append(range, mark);
       const num = document.createElement("input");
       Object.assign(num, { type: "number", min: p.lo[j], max: p.hi[j], step: "any" });
-      num.value = shown(p.design[j]);
+      num.value = shown(p, j, p.design[j]);
       num.setAttribute("aria-label", name + " of " + p.label + " (" + unit + "), typed");
       const was = document.createElement("span");
       was.className = "whatif-was muted";
-      was.textContent = "computed " + fmt(p.design[j]);
+      was.textContent = "computed " + fmt(clean(p, j, p.design[j]));
       row.append(label, track, num, was);
       set.appendChild(row);
       const take = (v, from) => {
@@ -120,7 +123,7 @@
         v = Math.min(p.hi[j], Math.max(p.lo[j], v));
         values[i][j] = v;
         if (from !== range) range.value = String(v);
-        if (from !== num) num.value = shown(v);
+        if (from !== num) num.value = shown(p, j, v);
         row.classList.toggle("moved", v !== p.design[j]);
         update();
       };
@@ -134,7 +137,7 @@
     parts.forEach((p, i) => p.design.forEach((v, j) => {
       values[i][j] = v;
       const c = inputs[i][j];
-      c.range.value = String(v); c.num.value = shown(v); c.row.classList.remove("moved");
+      c.range.value = String(v); c.num.value = shown(p, j, v); c.row.classList.remove("moved");
     }));
     update();
   });

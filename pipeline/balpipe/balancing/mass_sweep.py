@@ -91,10 +91,13 @@ class MassSweep:
     G0: np.ndarray | float = 0.0  # (N, ndrv): their efforts
 
     @classmethod
-    def build(cls, model: Model, t: np.ndarray, gravity=(0.0, 0.0), moment_point=(0.0, 0.0)) -> "MassSweep":
-        """One engine analysis of ``model``; raises :class:`balpipe.engine.AnalysisError` like it."""
+    def build(cls, model: Model, t: np.ndarray, gravity=(0.0, 0.0), moment_point=(0.0, 0.0),
+              analysis=None) -> "MassSweep":
+        """One engine analysis of ``model`` (``analysis``, when given, is taken as that analysis:
+        the engine's of ``model`` on ``t`` with this gravity and moment point, already at hand);
+        raises :class:`balpipe.engine.AnalysisError` like it."""
         t = np.asarray(t, dtype=float)
-        an = analyse(model, t, gravity, moment_point)
+        an = analysis if analysis is not None else analyse(model, t, gravity, moment_point)
         states = states_from_analysis(model, an)
         YF, YM = shaking_regressor(states, gravity, moment_point)
         YD = dynamics_regressor(states, gravity)

@@ -210,7 +210,7 @@ def _maps(model: Model, an) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, 
     if friction:
         YF, YM = shaking_regressor(states_from_analysis(model, an), an.gravity, an.moment_point)
         return YF, YM, None, [], friction
-    sweep = MassSweep.build(model, an.t, an.gravity, an.moment_point)
+    sweep = MassSweep.build(model, an.t, an.gravity, an.moment_point, analysis=an)
     return sweep.YF, sweep.YM, sweep.G, [d for d in sweep.drivers if d in an.efforts], []
 
 
@@ -308,11 +308,11 @@ def _b64(a: np.ndarray) -> str:
 
 
 def curves(w: WhatIf) -> live.Curves:
-    """The live figure: per panel the reference stage, the computed design and the design tried
-    (the computed one until a slider moves), in that order."""
-    design = dict(w.design)
+    """The live figure: per panel the reference stage, the computed design and the design tried,
+    in that order; the design tried has no samples here (``whatif.js`` draws it, the computed
+    design's until a slider moves)."""
     return live.Curves(w.t, [(w.reference_label, {k: w.reference[k] for k in ["F", *w.keys] if k in w.reference}),
-                             (w.label, design), ("design tried", design)],
+                             (w.label, dict(w.design)), ("design tried", {})],
                        w.panels, [], styles=[w.styles[1], w.styles[0], STYLE], grid=True)
 
 
