@@ -18,9 +18,10 @@ SRC = Path(__file__).resolve().parents[1] / "pipeline"
 # modules and sub-folders with it): the layer of a module is the one entry naming it or its
 # nearest folder. The bare package is its ``__init__`` only; a module that is in no entry fails.
 LAYERS: tuple[tuple[str, ...], ...] = (
-    # L0 core data and maths: the vocabulary, the planar mechanics below the engine, where work runs, the caches
+    # L0 core data and maths: the vocabulary, the planar mechanics below the engine, where work runs, the caches,
+    # how numbers read (display)
     ("balpipe", "balpipe.units", "balpipe.model", "balpipe.motion", "balpipe.notation",
-     "balpipe.mechanics", "balpipe.runtime", "balpipe.cache"),
+     "balpipe.mechanics", "balpipe.runtime", "balpipe.cache", "balpipe.display"),
     # L1 computation: the engine and the pymunk validation
     ("balpipe.engine", "balpipe.validate"),
     # L2 contracts and drawing: spec parts, the motion laws and their spec sections, the balancing methods, drawing,

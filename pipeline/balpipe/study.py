@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from .diagnose import actuation, assembly, dead_centres, loop_closure
+from .display import numbers
 from .mechanics import realisable
 from . import registry
 from .balancing.base import BalanceResult, Stage
@@ -117,11 +118,19 @@ def run_stage_analyses(spec: Spec, result: BalanceResult) -> list[StageResult]:
         out.append(
             StageResult(
                 stage, an,
-                added_mass=stage.model.total_mass() - base.total_mass(),
-                added_inertia=total_inertia(stage.model) - total_inertia(base),
+                added_mass=difference(stage.model.total_mass(), base.total_mass()),
+                added_inertia=difference(total_inertia(stage.model), total_inertia(base)),
             )
         )
     return out
+
+
+def difference(after: float, before: float) -> float:
+    """``after - before``, exactly 0 where it is below 1e-12 of the larger total: a stage that
+    adds nothing (its parts re-summed in another order, a link's inertia written back) leaves
+    the cancellation error of two float sums (2.8e-11 kg m² on the V-twin), not an addition."""
+    d = after - before
+    return 0.0 if abs(d) <= 1e-12 * max(abs(after), abs(before)) else d
 
 
 def total_inertia(model) -> float:
@@ -352,7 +361,7 @@ def run(spec: Spec, page: bool = True, memo: Memo = compute) -> Study:
         claimed = [w for w in ("force", "moment") if w in m.balances]
         if claimed and m.tolerance_source != "analysis.balance_tolerance":
             balance.notes.append(f"Stage {m.label!r}: its claim is judged at the tolerance " + ", ".join(
-                f"{row[f'{w}_tolerance']:.3g} of the reference {w} (achieved {row[f'{w}_ratio']:.3g})" for w in claimed)
+                f"{numbers.tol(row[f'{w}_tolerance'])} of the reference {w} (achieved {numbers.ratio(row[f'{w}_ratio'], None)})" for w in claimed)
                 + f", set by the {m.tolerance_source}" + ("" if m.tolerance_source == "spec" else
                 " (each rounded at its last digit, the worst case carried through the loads)") + ".")
     max_condition = near_singular_note(stages, balance, problems) if page else None

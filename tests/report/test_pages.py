@@ -14,13 +14,13 @@ from balpipe.report.render import load, num, ratio, tol
 def test_round_off_shows_as_zero_of_its_reference():
     assert load(2.344e-13, 263.2, 1e-9) == "0 (< 1e-9 of reference)"
     assert load(263.2, 263.2, 1e-9) == "263.2"
-    assert load(3e-7, 263.2, 1e-9) == "3.000e-07"  # above the tolerance: a real number, shown
+    assert load(3e-7, 263.2, 1e-9) == "3×10⁻⁷"  # above the tolerance: a real number, shown (never in e-notation)
     assert load(0.5, 263.2, 1e-9, "N") == "0.5 N"
 
 
-def test_one_ratio_format_per_column():
-    assert ratio(1.0) == "100 %" and ratio(0.1234567) == "12.35 %"
-    assert ratio(10.5919353366) == "1059 %"  # never switching to "×" inside a column
+def test_one_ratio_convention_across_the_site():
+    assert ratio(1.0) == "100 %" and ratio(0.1234567) == "12.35 %" and ratio(9.99) == "999 %"
+    assert ratio(10.5919353366) == "× 10.6" and ratio(41.73) == "× 41.7"  # "×" from ten times on, as costs
     assert ratio(1.1e-15, 1e-9) == "0 (< 1e-9)"  # round-off of a balanced stage
     assert ratio(2e-9, 1e-9).endswith(" %")  # above the tolerance: still percent
     assert ratio(0) == "0" and ratio(None) == "—"

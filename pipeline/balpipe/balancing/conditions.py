@@ -20,6 +20,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from ..display import numbers
 from ..model import Model
 from . import regressor as R
 from .specs import RANK_TOLERANCE
@@ -60,7 +61,15 @@ class ForceConditions:
         return float(np.max(np.abs(self.residuals(p)))) / scale if self.count else 0.0
 
     def to_json(self, p: np.ndarray) -> dict:
+        """The conditions for results.json: each with its residual for design ``p`` and its
+        ``scale`` (same unit): the size of its terms (sum of |coefficient x parameter|) or the
+        design's largest parameter of its unit (mass or first moment), whichever is larger; a
+        residual at most 1e-9 of it is round-off."""
         res = self.residuals(p)
+        mass = np.array([n.startswith("m[") for n in self.names])
+        largest = {u: float(np.max(np.abs(p[sel]), initial=0.0)) for u, sel in (("kg", mass), ("kg m", ~mass))}
+        scales = [max(float(t), largest[self.unit(k)])
+                  for k, t in enumerate(np.abs(self.matrix) @ np.abs(p))]
         return {
             "count": self.count,
             "rank_tolerance": self.tolerance,
@@ -70,10 +79,10 @@ class ForceConditions:
             "mobility": self.dof,
             "parameters": self.names,
             "conditions": [
-                {"equation": eq, "residual": float(r), "unit": self.unit(k),
+                {"equation": eq, "residual": float(r), "scale": float(sc), "unit": self.unit(k),
                  "coefficients": {self.names[j]: float(v) for j, v in enumerate(row)
                                   if abs(v) > 1e-10 * float(np.max(np.abs(row)))}}
-                for k, (eq, r, row) in enumerate(zip(self.equations(), res, self.matrix))
+                for k, (eq, r, sc, row) in enumerate(zip(self.equations(), res, scales, self.matrix))
             ],
         }
 
@@ -104,11 +113,13 @@ def _pivot_order(names: list[str]) -> list[int]:
 
 def clarity_text(gap: float) -> str:
     """How clearly numerically found conditions stand out from round-off, in words: the
-    singular-value gap (last kept / first dropped) as 'clear of round-off by a factor 3e+14'
+    singular-value gap (last kept / first dropped) as 'clear of round-off by a factor over 10¹⁴'
     (larger is clearer), or 'no direction near round-off' when nothing was dropped."""
     if not math.isfinite(gap):
         return "no direction near round-off"
-    return f"clear of round-off by a factor {gap:.3g}"
+    if gap < 10:
+        return f"clear of round-off by a factor {numbers.num(gap, 3)}"
+    return f"clear of round-off by a factor over {numbers.beyond(gap)}"
 
 
 def pivot_tolerance(gap: float) -> float:

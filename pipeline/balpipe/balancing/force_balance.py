@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..display import numbers
 from ..model import Model, Vec2
 from ..spec_parts import SpecFieldError
 from . import conditions as C
@@ -114,7 +115,7 @@ def force_stage(model: Model, specs: list[CounterweightRegionSpec], settings: Fi
         f"mechanism can reach ({cond.dof} degree{'s' if cond.dof != 1 else ''} of freedom; {C.clarity_text(cond.gap)}, "
         f"larger is clearer). The counterweights of least added mass total {sol.total_mass:.6g} kg"
         + (f"; disc regions are replaced by inscribed {sol.polygon_sides}-gons (within "
-           f"{sol.disc_accuracy:.1e} of their radius)" if any(r.kind == "disc" for r in regions) else "")
+           f"{numbers.num(sol.disc_accuracy, 2)} of their radius)" if any(r.kind == "disc" for r in regions) else "")
         + "."
     ] + LM.tie_note(sol)
     return out, params, details, notes, tuple(parts.values())

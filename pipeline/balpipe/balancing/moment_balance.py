@@ -21,6 +21,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..display import numbers
 from ..model import FRAME, Model
 from ..spec_parts import SpecFieldError
 from . import regressor as R
@@ -260,8 +261,8 @@ def _balance(ctx: BalanceContext) -> BalanceResult:
            "inertias, in one linear programme; a counterweight's inertia is that of its mass spread over its region."
            if not unmet else f"Counterweights of least added mass for the force: {sol.total_mass:.6g} kg."),
         f"Counter-rotation inertias re-solved by least squares over {samples} states the mechanism can reach: relative residual "
-        f"{residual:.2g}" + (" (the moment is cancelled for every motion)." if cancelled else
-                             f", above {MOMENT_TOLERANCE:g}: the stage claims only the force."),
+        f"{numbers.ratio(residual)}" + (" (the moment is cancelled for every motion)." if cancelled else
+                             f", above {numbers.tol(MOMENT_TOLERANCE)}: the stage claims only the force."),
     ] + LM.tie_note(sol)
     details = {
         "force_balance": cond.to_json(R.parameters(model.add(tuple(b for b in with_discs.bodies if b.name in discs)))),

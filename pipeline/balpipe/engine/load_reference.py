@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import Analysis
+from ..display import numbers
 from ..model import Model
 
 #: fraction of the gross inertial load that is the smallest denominator of a relative figure
@@ -82,10 +83,10 @@ class LoadReference:
             (self.force, self.force_basis, "N") if which == "force" else (self.moment, self.moment_basis, "N m")
         )
         if basis == "unbalanced peak":
-            return f"the unbalanced stage's peak {which} ({value:.4g} {unit})"
+            return f"the unbalanced stage's peak {which} ({numbers.num(value)} {unit})"
         return (
-            f"{self.floor_fraction:g} of the gross inertial {which} ({value:.4g} {unit}), "
-            f"larger than the unbalanced stage's peak ({self.force_peak if which == 'force' else self.moment_peak:.3g} {unit})"
+            f"{numbers.num(self.floor_fraction)} of the gross inertial {which} ({numbers.num(value)} {unit}), "
+            f"larger than the unbalanced stage's peak ({numbers.num(self.force_peak if which == 'force' else self.moment_peak, 3)} {unit})"
         )
 
     def to_json(self) -> dict:

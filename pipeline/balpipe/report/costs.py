@@ -9,6 +9,8 @@ Added inertia counts only the parts that can be built: a stage with a negative m
 
 from __future__ import annotations
 
+from ..display import numbers
+
 
 def _factor(new: float | None, old: float | None) -> float | None:
     if new is None or old is None or old == 0:
@@ -51,5 +53,5 @@ def cost_factors(results: dict, reference: str, final: str) -> dict:
 
 
 def factor_text(x: float | None) -> str:
-    """One format for every cost factor: '× 1.85' (three significant digits), '—' if unknown."""
-    return "—" if x is None else f"× {x:.3g}"
+    """One format for every cost factor: '× 1.85' (:func:`balpipe.display.numbers.factor`)."""
+    return numbers.factor(x)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from markupsafe import Markup
 
+from ..display import numbers
 from ..model import Model
 from ..study import Study
 from .costs import factor_text
@@ -15,15 +16,13 @@ from .notation_table import PageNames, names_for
 
 
 def _fmt(x: float) -> str:
-    return f"{x:.4g}"
+    return numbers.num(x)
 
 
 def _position(p) -> str:
     """A part's position on its link, (x, y) m; a coordinate below 1e-9 of the other is round-off
-    of the computation and reads 0."""
-    scale = max(abs(float(p[0])), abs(float(p[1])))
-    x, y = (0.0 if abs(float(c)) <= 1e-9 * scale else float(c) for c in p[:2])
-    return f"({_fmt(x)}, {_fmt(y)}) m"
+    of the computation and reads 0 (:func:`balpipe.display.numbers.point`)."""
+    return f"{numbers.point(p)} m"
 
 
 def added_parts(base: Model, final: Model, names: PageNames | None = None) -> list[dict]:

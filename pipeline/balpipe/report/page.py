@@ -6,6 +6,7 @@ import markupsafe
 import numpy as np
 
 from ..balancing.base import in_style_order, styled
+from ..display import numbers
 from ..laws.drives import law_names
 from ..study import Study
 from ..draw import extremes, figures, labels, live, player, sleeves
@@ -204,6 +205,15 @@ def _reference_phrase(ref, label: str, which: str) -> str:
             f"stage '{label}' (larger than its peak, {peak:.3g} {unit})")
 
 
+def base_scales(results: dict) -> dict[str, float]:
+    """The mechanism's own scale of each unit of its computed parameters (a value at most 1e-9
+    of it is round-off): its moving mass (kg), size (m), their product (kg m), its inertia
+    scale (kg m²) and the inverse mass (1/kg, a sensitivity to the mass budget)."""
+    m, size = results.get("moving_mass") or 0.0, results.get("length_scale") or 0.0
+    return {"kg": m, "m": size, "kg m": m * size, "kg m^2": results.get("inertia_scale") or 0.0,
+            "1/kg": 1.0 / m if m else 0.0}
+
+
 def render_page(study: Study, results: dict, spec_text: str, history: dict | None = None,
                 nav: dict | None = None) -> str:
     spec = study.spec
@@ -233,7 +243,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                 "dt": q.dt, "steps": q.steps, "iterations": q.iterations, "tolerance": q.tracking_tolerance,
                 "passed": q.passed, "status": q.status, "remedy": q.remedy, "reasons": "; ".join(q.reasons),
                 "notes": "; ".join(q.notes),
-                "per_driver": markupsafe.Markup(", ").join(names.driver(k) + f" {v:.2g}"
+                "per_driver": markupsafe.Markup(", ").join(names.driver(k) + f" {numbers.num(v, 2)}"
                                                            for k, v in sorted(q.tracking_error.items())),
             })
     rl = study.reactionless
@@ -271,4 +281,6 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         whatif=whatif.section(study, results, {s.stage.name: k for k, s in enumerate(shown_stages(study))}),
         citation=citations.cite(spec.paper),
         names=names,
+        param_scale=numbers.scales_by_unit(((p["value"], p["unit"]) for p in results.get("parameters") or []),
+                                           base_scales(results)),
     )))

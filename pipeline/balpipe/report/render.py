@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import re
 from functools import lru_cache
 from importlib import resources
@@ -11,47 +10,21 @@ import jinja2
 import markupsafe
 
 from .. import __version__
-
-
-def num(x, digits: int = 4) -> str:
-    """A number with ``digits`` significant digits; small and large ones in scientific form."""
-    if x is None:
-        return "—"
-    x = float(x)
-    if not math.isfinite(x):
-        return str(x)
-    if x == 0:
-        return "0"
-    if 1e-3 <= abs(x) < 1e6:
-        return f"{x:.{digits}g}"
-    return f"{x:.{max(1, digits - 1)}e}"
+from ..balancing.conditions import clarity_text
+from ..display import numbers
+from ..display.numbers import num, tol  # noqa: F401  (the pages' filters, re-exported)
 
 
 def ratio(x, tol: float | None = None) -> str:
-    """A ratio to a reference, one format for every column: percent (4 significant digits,
-    scientific inside the percent when tiny), 674 % as well as 4743 %. With ``tol`` (the
-    stage's balance tolerance) a ratio at or below it is round-off and shows as "0 (< 1e-9)"."""
-    if x is None:
-        return "—"
-    x = float(x)
-    if not math.isfinite(x):
-        return str(x)
-    if x == 0:
-        return "0"
-    if tol is not None and abs(x) <= tol:
-        return f"0 (< {_tol_text(tol)})"
-    return f"{num(100 * x)} %"
+    """A ratio to a reference, the site's one convention (:func:`balpipe.display.numbers.ratio`:
+    percent below ten times, "×" from ten on). A ratio at or below ``tol`` (the stage's balance
+    tolerance; the default floor 1e-9 without one) is round-off and shows as "0 (< 1e-9)"."""
+    return numbers.ratio(x, numbers.FLOOR if tol is None else tol)
 
 
-def tol(x) -> str:
-    """A tolerance as written in a spec: 1e-09 -> '1e-9'."""
-    if x is None:
-        return "—"
-    m, _, e = f"{float(x):.3g}".partition("e")
-    return f"{m}e{int(e)}" if e else m
-
-
-_tol_text = tol  # ratio() names its argument tol
+def clarity(gap) -> str:
+    """A singular-value gap in words: 'clear of round-off by a factor over 10¹⁴'."""
+    return clarity_text(float(gap))
 
 
 def load(x, ref, tolerance, unit_text: str = "", of: str = "reference") -> str:
@@ -107,6 +80,8 @@ def environment() -> jinja2.Environment:
     env.filters["num"] = num
     env.filters["ratio"] = ratio
     env.filters["tol"] = tol
+    env.filters["num_at"] = numbers.num_at
+    env.filters["clarity"] = clarity
     env.filters["load"] = load
     env.filters["unit"] = unit
     env.filters["printable"] = printable

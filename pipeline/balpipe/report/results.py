@@ -10,6 +10,7 @@ import numpy as np
 
 from .. import __version__
 from ..mechanics.motion_outputs import motion_columns
+from ..balancing.regressor import model_size
 from ..study import Study
 from . import present
 from .frame_mounts import mounts_json
@@ -99,6 +100,8 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     # the linkage without its drivers, motion, loads and method: specs sharing it are compared on the index
     out["mechanism_key"] = mechanism_key(study.unbalanced.stage.model)
     out["moving_bodies"] = [b.name for b in study.unbalanced.stage.model.bodies]
+    out["length_scale"] = model_size(study.unbalanced.stage.model)
+    out["inertia_scale"] = inertia_scale(study.unbalanced.stage.model, out["moving_mass"])
     if study.balance.details:
         out["balancing_details"] = study.balance.details
     parts = parts_json(study)
@@ -107,6 +110,13 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     out["paper"] = spec.paper  # the site index filters by it
     out["verdict"] = verdict_of(study, out)
     return json_safe(out)
+
+
+def inertia_scale(model, moving_mass: float) -> float:
+    """The scale of the mechanism's inertias (kg m²): its links' declared inertias plus its moving
+    mass at its size (:func:`balpipe.balancing.regressor.model_size`) squared. An added inertia
+    at most 1e-9 of it is round-off (an optimiser's zero, a re-summed total) and shows as 0."""
+    return float(sum(abs(b.inertia) for b in model.bodies) + moving_mass * model_size(model) ** 2)
 
 
 def verdict_of(study: Study, out: dict) -> dict:
@@ -177,12 +187,18 @@ def joint_load_series(analysis) -> list[tuple[str, str, str, str, np.ndarray]]:
 
 def joint_load_table(study: Study) -> list[dict]:
     """Peak load of every joint in every stage (:func:`joint_load_series`), a row per joint and
-    component."""
+    component, with ``scale``: the largest peak of any joint in that unit (a peak at most 1e-9 of
+    it is round-off, shown as 0)."""
     rows: dict[tuple[str, str], dict] = {}
     for s in study.stages:
         for joint, comp, kind, unit, values in joint_load_series(s.analysis):
             row = rows.setdefault((joint, comp), {"joint": joint, "kind": kind, "unit": unit, "peaks": {}})
             row["peaks"][s.stage.name] = float(np.max(values))
+    largest: dict[str, float] = {}
+    for row in rows.values():
+        largest[row["unit"]] = max([largest.get(row["unit"], 0.0), *row["peaks"].values()])
+    for row in rows.values():
+        row["scale"] = largest[row["unit"]]
     return list(rows.values())
 
 

@@ -10,6 +10,7 @@ from ..runtime.fsutil import write_file_atomic  # replaced in one step, never th
 from . import citations, site_filter, verdict
 from .verdict import LEVELS
 from .costs import factor_text
+from ..display.numbers import num_at
 from .mechanism_key import describe
 from .render import environment, num, printable, ratio
 from .render import tol as tol_fmt
@@ -222,9 +223,10 @@ def comparisons(entries: list[dict]) -> list[dict]:
             rows.append({
                 "title": e["title"], "link": e["link"], "method": r.get("method"), "level": v["level"],
                 "rank": LEVELS.index(v["level"]),
-                "words": v["words"], "added_mass": num(c["added_mass"]), "added_mass_value": c["added_mass"] or 0.0,
+                "words": v["words"], "added_mass": num_at(c["added_mass"], r.get("moving_mass")), "added_mass_value": c["added_mass"] or 0.0,
                 "added_relative": factor_text(rel), "added_relative_value": rel if rel is not None else 0.0,
-                "added_inertia": num(c["added_inertia"]) if c["added_inertia"] is not None else "cannot be built",
+                "added_inertia": (num_at(c["added_inertia"], r.get("inertia_scale")) if c["added_inertia"] is not None
+                                  else "cannot be built"),
                 "added_inertia_value": c["added_inertia"] if c["added_inertia"] is not None else "",
                 "counter_rotations": comp.get("counter_rotations", "—"),
                 "force": v["stages"][g["final"]]["force"]["text"], "force_value": g["force"][1],

@@ -28,6 +28,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ...display import numbers
 from ..context import BalanceContext
 from ...mechanics.planar import cross
 from ...model import Model
@@ -265,7 +266,7 @@ def balance(ctx: BalanceContext) -> BalanceResult:
         "Optimal partial balancing by a second-order cone programme (Clarabel) over "
         f"{over}: objective {' + '.join(f'{x.weight:g} x {x.label}' for x in objective)} "
         f"(each divided by its unbalanced value) = {details['objective']:.6g} with {details['added_mass']:.6g} kg added; "
-        f"active: {', '.join(active) or 'none'}; d objective / d budget = {out.budget_dual:.4g} per kg; "
+        f"active: {', '.join(active) or 'none'}; d objective / d budget = {numbers.num_at(out.budget_dual, 1.0 / max(model.total_mass(), 1e-12))} per kg; "
         f"the design {precision_text(out.precision)}."
     ] + PMo.notes(details["motions"])
     label = method.label or "partial balance"
@@ -304,7 +305,8 @@ def precision_text(error: float | None) -> str:
     """How exact a design is: polished on its active set, its relative error bounded by ``error``;
     else the interior-point solver's own (its tolerance, 1e-10, on the objective)."""
     if error is not None:
-        return f"exact to {max(error, 1e-16):.0e} (relative; optimality equations solved on the active set)"
+        return (f"exact to {'round-off (relative error below 1e-9' if error <= numbers.FLOOR else numbers.num(error, 2) + ' (relative'}"
+                "; optimality equations solved on the active set)")
     return ("to the solver's tolerance (objective to 1e-10; a design where the optimum is flat to about "
             "its square root, 1e-5)")
 

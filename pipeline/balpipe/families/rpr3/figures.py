@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...balancing.base import in_style_order, style_index
+from ...display import numbers
 from .template import pose_of, prismatic_equivalent
 
 
@@ -104,11 +105,13 @@ def prismatic_forces_html(t: np.ndarray, runs: list[tuple[str, np.ndarray]]) -> 
 
 def _factor_table(study, linkage: str) -> str:
     rows = []
+    unb = study.unbalanced.analysis
     for s in _own(study):
         an = s.analysis
         rows.append(
-            f"<tr><td>{s.stage.label}</td><td>{an.max_force:.6g}</td><td>{an.max_moment:.6g}</td>"
-            f"<td>{s.max_effort:.6g}</td><td>{s.added_mass:.6g}</td><td>{s.added_inertia:.6g}</td></tr>"
+            f"<tr><td>{s.stage.label}</td><td>{numbers.num_at(an.max_force, unb.max_force, 6)}</td>"
+            f"<td>{numbers.num_at(an.max_moment, unb.max_moment, 6)}</td>"
+            f"<td>{numbers.num(s.max_effort, 6)}</td><td>{numbers.num(s.added_mass, 6)}</td><td>{numbers.num(s.added_inertia, 6)}</td></tr>"
         )
     from ...mechanics.drivers import driver_unit
 
@@ -123,8 +126,8 @@ def _factor_table(study, linkage: str) -> str:
         out += "<table><thead><tr><th>peak moment with counterweights relative to</th><th>factor</th></tr></thead><tbody>"
         for ref in (un, added):
             if ref is not None and ref.analysis.max_moment > 0:
-                out += (f"<tr><td>{ref.stage.label} ({ref.analysis.max_moment:.6g} N m)</td>"
-                        f"<td>{cw.analysis.max_moment / ref.analysis.max_moment:.4g}</td></tr>")
+                out += (f"<tr><td>{ref.stage.label} ({numbers.num(ref.analysis.max_moment, 6)} N m)</td>"
+                        f"<td>{numbers.num(cw.analysis.max_moment / ref.analysis.max_moment)}</td></tr>")
         out += "</tbody></table>"
     return out
 

@@ -33,6 +33,7 @@ from functools import partial
 import numpy as np
 
 from .template import RRR4Mechanism, corner, mass_parameters, resolve_legs
+from ...display import numbers
 from ...model import Model
 from ...spec_parts import SpecFieldError
 from . import conditions as cond
@@ -386,11 +387,11 @@ def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Mo
             f"Special kinematics ({mech.kinematics}) with a translating platform: the generic finder, run on states "
             f"of translating-platform motions only, finds {tr.count} independent conditions where the paper prints "
             f"{len(cond.SPECIAL_ROWS[mech.kinematics])} ({eq}). The printed ones are sufficient: each computed "
-            f"condition is a combination of them (distance {found.special_in_printed.max():.1e}). Two of them only "
+            f"condition is a combination of them (distance {numbers.num_at(found.special_in_printed.max(), 1.0, 2)}). Two of them only "
             "fix m5 p5 and m5 q5, i.e. how the paper splits the platform's mass m5 into point masses mu_5i at the "
             "joints C_i; with a translating platform every C_i has the platform's velocity, so the split does not "
             f"matter. Eliminating m5 p5 and m5 q5 from the printed rows leaves {found.reduced_count} combinations, "
-            f"which span the computed space (distance {found.reduced_in_translating.max():.1e})."
+            f"which span the computed space (distance {numbers.num_at(found.reduced_in_translating.max(), 1.0, 2)})."
         )
     if spec.least_mass:
         radii = {f"link{i}{j}": (spec.counterweights.proximal if j == 1 else spec.counterweights.distal)
@@ -415,8 +416,8 @@ def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Mo
         same = abs(saved) <= 1e-9 * max(added_lbl, 1e-300)
         notes.append(
             f"Generic condition finder: {gen.count} independent force-balance conditions ({clarity_text(gen.gap)})" + (f"; each of eq. 17's twelve printed conditions lies in their space (largest "
-                                 f"distance {found.eq17.max():.1e})" if four else "")
-            + f"; the leg-by-leg design meets them (residual {found.design_residual(lbl):.1e}). The least-mass "
+                                 f"distance {numbers.num_at(found.eq17.max(), 1.0, 2)})" if four else "")
+            + f"; the leg-by-leg design meets them (residual {numbers.num_at(found.design_residual(lbl), 1.0, 2)}). The least-mass "
             f"counter-masses within the same distances of the proximal joints add {sol.total_mass:.6g} kg, the "
             f"leg-by-leg ones {added_lbl:.6g} kg: "
             + ("the same mass: the leg-by-leg design is already of least mass for these positions." if same

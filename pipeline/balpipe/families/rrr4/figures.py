@@ -12,7 +12,8 @@ import re
 
 import numpy as np
 
-from ...balancing.conditions import clarity_text
+from ...balancing.conditions import clarity_text, scale_of
+from ...display import numbers
 from ...notation import Names
 from . import counter_masses as recipe
 from . import conditions as cond
@@ -32,15 +33,15 @@ def conditions_table(study) -> str | None:
     rows = cond.eq17(recipe.geometry(mech))
     if mech.kinematics != "general":
         rows = rows + cond.special(recipe.geometry(mech), mech.kinematics)
-    params = [(s.stage.label, mass_parameters(s.stage.model)) for s in study.stages]
-    head = "".join(f"<th>{html.escape(lbl)}</th>" for lbl, _ in params)
+    params = [(s.stage.label, mass_parameters(s.stage.model), scale_of(s.stage.model)) for s in study.stages]
+    head = "".join(f"<th>{html.escape(lbl)}</th>" for lbl, _, _ in params)
     body = []
     for r in rows:
         cells = []
-        for _, p in params:
-            res, scale = r.residual(p), r.scale(p)
+        for _, p, size in params:  # round-off of the terms or of the mechanism's first moments
+            res, scale = r.residual(p), max(r.scale(p), size)
             ok = abs(res) <= TOL * max(scale, 1e-300)
-            cells.append(f'<td class="num">{res:.3e}{" ✓" if ok else ""}</td>')
+            cells.append(f'<td class="num">{numbers.num_at(res, scale, floor=TOL)}{" ✓" if ok else ""}</td>')
         body.append(f"<tr><td>{html.escape(r.name)}</td><td><code>{html.escape(r.text())}</code></td>{''.join(cells)}</tr>")
     return (f"<table><tr><th>Condition</th><th>Linear equation (kg m; masses in kg)</th>{head}</tr>"
             + "".join(body) + "</table>")
@@ -58,9 +59,9 @@ def finder_table(study) -> str | None:
     rows = [("force-balance conditions, every motion", f"{int(p['finder_conditions'])}",
              "12 (eq. 17)" if four else "", clarity_text(p['finder_gap']))]
     if four:
-        rows.append(("eq. 17's printed rows: largest distance from the computed space", f"{p['eq17_in_finder_space']:.1e}",
+        rows.append(("eq. 17's printed rows: largest distance from the computed space", numbers.num_at(p['eq17_in_finder_space'], 1.0, 2),
                      "0", "relative, scaled columns; at most 1e-9: in the space"))
-    rows.append(("leg-by-leg design (eqs. 8-11): largest residual", f"{p['leg_by_leg_in_finder_space']:.1e}", "0",
+    rows.append(("leg-by-leg design (eqs. 8-11): largest residual", numbers.num_at(p['leg_by_leg_in_finder_space'], 1.0, 2), "0",
                  "/ (total mass x model size)"))
     if "translating_conditions" in p:
         eq = cond.SPECIAL_EQ[mech.kinematics]
@@ -68,9 +69,9 @@ def finder_table(study) -> str | None:
             ("conditions, translating platform (Fig. 5" + mech.kinematics[-1] + ")", f"{int(p['translating_conditions'])}",
              f"8 ({eq})", clarity_text(p['translating_gap'])),
             ("computed translating conditions: largest distance from the span of the printed eight",
-             f"{p['translating_in_printed_span']:.1e}", "", "the printed eight are sufficient"),
+             numbers.num_at(p['translating_in_printed_span'], 1.0, 2), "", "the printed eight are sufficient"),
             (f"{eq}'s rows with m5 p5, m5 q5 eliminated: independent combinations", f"{int(p['printed_reduced_conditions'])}",
-             "", f"largest distance from the computed space {p['printed_reduced_in_translating']:.1e}"),
+             "", f"largest distance from the computed space {numbers.num_at(p['printed_reduced_in_translating'], 1.0, 2)}"),
         ]
     body = "".join(f"<tr><td>{html.escape(a)}</td><td class=\"num\">{b}</td><td class=\"num\">{html.escape(c)}</td>"
                    f"<td>{html.escape(d)}</td></tr>" for a, b, c, d in rows)
@@ -82,8 +83,8 @@ def finder_table(study) -> str | None:
         cells = []
         for c in lm["counter_masses"]:
             a = lbl.get(c["body"])
-            lb = f"{a.mass:.4g} kg at ({a.position[0]:.4g}, {a.position[1]:.4g}) m" if a else "none"
-            pos = f"{c['mass']:.4g} kg at ({c['position'][0]:.4g}, {c['position'][1]:.4g}) m" if c["mass"] > 0 else "none"
+            lb = f"{numbers.num(a.mass)} kg at {numbers.point(a.position)} m" if a else "none"
+            pos = f"{numbers.num(c['mass'])} kg at {numbers.point(c['position'])} m" if c["mass"] > 0 else "none"
             cells.append(f"<tr><td>l{c['body'][4:]}</td><td>{lb}</td><td>{pos}</td></tr>")
         out += ("<table><tr><th>Link</th><th>leg-by-leg counter-mass (eqs. 8-11)</th><th>least-mass counter-mass "
                 "(linprog, same allowed positions)</th></tr>" + "".join(cells)
@@ -241,8 +242,8 @@ def designs_figure(study, drawn: list[tuple], figures: tuple[str, ...]):
     if not shown:
         return None
     poses = study.stages[0].analysis.frame_pose[0]
-    titles = [f"{topo.whose(d.figure)}: {', '.join(row['kept'])} as built\nadded {row['added_mass']:.3g} kg, "
-              f"peak |F| / reference {row['force_ratio']:.1e}" for d, row in shown]
+    titles = [f"{topo.whose(d.figure)}: {', '.join(row['kept'])} as built\nadded {numbers.num(row['added_mass'], 3)} kg, "
+              f"peak |F| / reference {numbers.ratio(row['force_ratio'])}" for d, row in shown]
     return panels_svg([(d.model, poses, title) for (d, _), title in zip(shown, titles)], "rrr4-" + topo.tag(figures[0]))
 
 

@@ -52,6 +52,7 @@ from .template import (
     with_joint_laws,
 )
 from ...balancing.context import BalanceContext
+from ...display import numbers
 from ...model import Law, Model
 from ...motion import PointToPoint, bang_bang, law_for, quintic
 from ...spec_parts import SpecFieldError, paper_id
@@ -502,8 +503,8 @@ def _description(key: str, plan: Plan, method: ComMotionPlanning) -> str:
         "ee_quintic": "tip on the straight line and φ on the 3-4-5 law (case 1)",
         "com_bang_bang": "centre of mass on the straight line, bang-bang; φ on the 3-4-5 law",
         "com_bang_bang_phi_opt": f"centre of mass bang-bang; φ a degree-{deg} polynomial minimising the peak moment (case 2)",
-        "com_trapezoidal": f"centre of mass on a trapezoidal acceleration, ramps {plan.ramp_fraction:.3g} T "
-                           f"(torque rate <= {method.torque_rate_limit:.3g} N m/s); φ as optimised (case 3)",
+        "com_trapezoidal": f"centre of mass on a trapezoidal acceleration, ramps {numbers.num(plan.ramp_fraction, 3)} T "
+                           f"(torque rate <= {numbers.num(method.torque_rate_limit, 3)} N m/s); φ as optimised (case 3)",
     }[key]
 
 
@@ -518,7 +519,7 @@ def _method_note(method: ComMotionPlanning, planner: Planner, plans: list[Plan],
         f"all for {len(plans)} trajectories (benchmarks/bench_paper003.py times them). Case 3: the shortest ramps (bisection on "
         f"f) for which every joint's torque rate, by central differences on {method.rate_samples} samples and 64 "
         f"in each ramp, stays "
-        f"within {method.torque_rate_limit:.4g} N m/s."
+        f"within {numbers.num(method.torque_rate_limit)} N m/s."
     )
 
 

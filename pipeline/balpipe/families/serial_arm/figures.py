@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from ...balancing.base import style_index
+from ...display import numbers
 from ...spec_parts import paper_id
 from .com_planning import CASES, STYLES, PhiPolynomial, replan
 from .decoupling import mass_matrix_2r
@@ -254,8 +255,8 @@ def _rate_cell(key: str, an, plan, method) -> str:
     if key.startswith("com_bang_bang"):
         return "unbounded (torques jump)"
     if key == "com_trapezoidal":
-        return f"{plan.ramp_rate:.4g} (limit {method.torque_rate_limit:.3g})"
-    return f"{max(float(np.max(np.abs(np.gradient(e, an.t)))) for e in an.efforts.values()):.4g}"
+        return f"{numbers.num(plan.ramp_rate)} (limit {numbers.num(method.torque_rate_limit, 3)})"
+    return numbers.num(max(float(np.max(np.abs(np.gradient(e, an.t)))) for e in an.efforts.values()))
 
 
 #: the paper's cases 1, 2, 3, which Figs. 3-4 draw (the stage with phi on the 3-4-5 law is not a case of the paper)
