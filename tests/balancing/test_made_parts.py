@@ -156,7 +156,7 @@ def test_limits_and_unmakeable_designs_say_why():
 FOUR_BAR = SPECS / "custom_four_bar_balancing.yaml"
 
 
-def _four_bar_force_balance(part: str) -> str:
+def _four_bar_force_balance(part: str, samples: int = 201) -> str:
     text = FOUR_BAR.read_text(encoding="utf-8")
     head = text.split("balancing:\n")[0]
     return head + textwrap.dedent(f"""\
@@ -167,7 +167,7 @@ def _four_bar_force_balance(part: str) -> str:
             - {{body: coupler, name: cw_coupler, disc: {{centre: [0.14, 0], radius: 0.25}}}}
             - {{body: rocker, name: cw_rocker, segment: [[0, 0], [-0.12, 0]]}}
         analysis:
-          samples: 201
+          samples: {samples}
         """)
 
 
@@ -235,3 +235,23 @@ def test_moment_balance_solves_its_discs_with_the_parts_inertia():
     assert cw.inertia == pytest.approx(cw.mass * (L * L + W * W) / 12, rel=1e-12)
     assert r["stages"][-1]["balances"] == "force+moment"
     assert r["stages"][-1]["force_balanced"] and r["stages"][-1]["moment_balanced"]
+
+
+def test_the_page_shows_the_part_that_does_not_fit_and_rebuilds_byte_identical(tmp_path):
+    spec = _four_bar_force_balance("{material: aluminium, shape: stack, length: 60 mm, width: 40 mm, "
+                                   "plate_thickness: 10 mm, max_thickness: 50 mm, clearance: 5 mm}", samples=41)
+    folders = [balpipe.run(balpipe.loads(spec)).write(tmp_path / f"page{k}").parent for k in range(2)]
+    names = sorted(p.name for p in folders[0].iterdir())
+    assert names == sorted(p.name for p in folders[1].iterdir())
+    assert {"parts.csv", "part-main-cw_crank.dxf", "part-main-cw_crank.svg"} <= set(names)
+    for name in names:  # the same bytes on rebuild, drawings and bill of materials included
+        assert (folders[0] / name).read_bytes() == (folders[1] / name).read_bytes(), name
+    page = (folders[0] / "index.html").read_text(encoding="utf-8")
+    assert 'id="parts"' in page and 'src="part-main-cw_crank.svg"' in page
+    assert "Problem:</strong> part &#39;cw_crank&#39; on &#39;crank&#39; (balancing.counterweights[0].part): thickness" in page
+    bom = (folders[0] / "parts.csv").read_text(encoding="utf-8").splitlines()
+    assert bom[0].startswith("part,design,body,shape,material,density_kg_per_m3,mass_kg,thickness_m")
+    (row,) = bom[1:]
+    assert ",no,thickness" in row and "max_thickness 50 mm" in row
+    doc = ezdxf.readfile(folders[0] / "part-main-cw_crank.dxf")
+    assert len(doc.modelspace().query('LWPOLYLINE[layer=="OUTLINE"]')) == 1
