@@ -16,7 +16,7 @@ from . import least_mass as LM
 from . import regressor as R
 from .base import BalanceResult, Parameter, Stage
 from .context import BalanceContext
-from .made_parts import inertia_of, part_for
+from .made_parts import inertia_of, part_for, part_notation
 from .parts import add_counterweight
 from .specs import CounterweightRegionSpec, FinderSettings, ForceBalance, Point
 
@@ -149,6 +149,7 @@ def counterweight_notation(counterweights: list[CounterweightRegionSpec], root: 
             f"{p}.segment[1]": ours(f"`{n}`", f"`{n}` anywhere on a segment of `{c.body}`: second end"),
             f"{p}.disc.centre": ours(f"`{n}`", f"`{n}` anywhere in a disc on `{c.body}`: its centre"),
             f"{p}.disc.radius": ours(f"`{n}`", f"`{n}` anywhere in a disc on `{c.body}`: its radius"),
+            **part_notation(f"{p}.part", n),
         })
     return table
 

@@ -49,3 +49,27 @@ def inertia_of(part: MadePart, fallback: float) -> float:
     """The centroidal inertia the analysis gives the counterweight: the part's when it could be
     sized, else ``fallback`` (the design's own; the part's problems then say why)."""
     return part.inertia if part.outline else fallback
+
+
+#: the inputs table's symbol and meaning of each field of a ``part:`` section ({n}: the part's name)
+_NOTATION = {
+    "material": ("`{n}`", "material of `{n}`"), "density": ("ρ_{{{n}}}", "density of `{n}`"),
+    "shape": ("`{n}`", "shape of `{n}`"), "thickness": ("t_{{{n}}}", "thickness of `{n}`"),
+    "radius": ("r_{{{n}}}", "radius of the disc `{n}`"), "inner_radius": ("r_{{i,{n}}}", "inner radius of `{n}`"),
+    "outer_radius": ("r_{{o,{n}}}", "outer radius of `{n}`"), "angle": ("α_{{{n}}}", "included angle of `{n}`"),
+    "length": ("l_{{{n}}}", "length of `{n}`"), "width": ("w_{{{n}}}", "width of `{n}`"),
+    "plates": ("n_{{{n}}}", "plates of the stack `{n}`"),
+    "plate_thickness": ("t_{{p,{n}}}", "the thickest plate of the stack `{n}`"),
+    "orientation": ("φ_{{{n}}}", "direction of the length of `{n}`"), "axis": ("`{n}`", "axis `{n}` is laid out about"),
+    "max_thickness": ("t_{{max,{n}}}", "the thickest `{n}` that fits"),
+    "max_radius": ("r_{{max,{n}}}", "how far `{n}` may reach from its axis"),
+    "clearance": ("c_{{{n}}}", "least distance from `{n}` to its body's pivots"),
+}
+
+
+def part_notation(prefix: str, name: str) -> dict:
+    """Symbols of the fields of the ``part:`` section at ``prefix`` (e.g.
+    "balancing.counterweights[0].part") of the counterweight ``name``."""
+    from ..notation import ours
+
+    return {f"{prefix}.{k}": ours(sym.format(n=name), text.format(n=name)) for k, (sym, text) in _NOTATION.items()}

@@ -15,7 +15,7 @@ from .base import Aim, BalanceResult, Goal, Stage
 from .context import BalanceContext
 from .force_balance import body_point
 from .load_measures import goal_label, measure, term_notation
-from .made_parts import inertia_of, part_for
+from .made_parts import inertia_of, part_for, part_notation
 from ..mechanics.part_shapes import MadePart
 from .moment_balance import add_discs, set_disc_inertias
 from .specs import PartSpec, Stages
@@ -138,6 +138,7 @@ def notation(method: Stages) -> dict:
                 f"{q}.inertia": ours(f"I_{{{n}}}", f"centroidal inertia of `{n}`"),
                 f"{q}.kind": ours("kind", f"what `{n}` is"),
                 f"{q}.radius": ours(f"r_{{{n},disc}}", f"radius of `{n}` drawn as a disc"),
+                **part_notation(f"{q}.part", n),
             })
         table.update(counter_rotation_notation(s.counter_rotations, f"{p}.counter_rotations"))
         table.update(term_notation(f"{p}.aim", s.aim, f"aim of `{s.name}`,"))
