@@ -42,6 +42,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..display.numbers import num, point
+
 Vec2 = tuple[float, float]
 Vertex = tuple[float, float, float]  # x, y, bulge of the segment that starts here
 
@@ -141,23 +143,23 @@ def size_sector(mass: float, rho: float, d: float, r_in: float, thickness: float
         a = angle / 2
         if math.sin(a) <= 1e-12 * a:
             if d > 0:
-                raise Unsizable(f"a full ring has its centroid on its axis, the design's is {d:.4g} m from it")
+                raise Unsizable(f"a full ring has its centroid on its axis, the design's is {num(d)} m from it")
             raise Unsizable("a full ring (angle 360 deg): give the thickness or the outer radius instead")
         K = 1.5 * d / _sinc(a)
         if K <= 1.5 * r_in:
-            raise Unsizable(f"the centroid {d:.4g} m from the axis is too near it for an inner radius of "
-                            f"{r_in:.4g} m and an angle of {math.degrees(angle):.4g} deg (at most "
-                            f"{r_in * _sinc(a):.4g} m reachable only beyond): widen the angle or reduce the inner radius")
+            raise Unsizable(f"the centroid {num(d)} m from the axis is too near it for an inner radius of "
+                            f"{num(r_in)} m and an angle of {num(math.degrees(angle))} deg (such a sector's centroid is "
+                            f"more than {num(r_in * _sinc(a))} m from it): widen the angle or reduce the inner radius")
         ro = 0.5 * ((K - r_in) + math.sqrt((K + 3 * r_in) * (K - r_in)))
         t = mass / (rho * a * (ro**2 - r_in**2))
         return {"inner_radius": r_in, "outer_radius": ro, "angle": angle, "thickness": t}
     assert r_out is not None
     if r_out <= r_in:
-        raise Unsizable(f"outer radius {r_out:.4g} m not beyond the inner radius {r_in:.4g} m")
+        raise Unsizable(f"outer radius {num(r_out)} m not beyond the inner radius {num(r_in)} m")
     s = 1.5 * d * (r_out**2 - r_in**2) / (r_out**3 - r_in**3)
     if s >= 1:
-        raise Unsizable(f"the centroid {d:.4g} m from the axis is beyond what a sector of outer radius "
-                        f"{r_out:.4g} m reaches (less than {2 / 3 * (r_out**3 - r_in**3) / (r_out**2 - r_in**2):.4g} m)")
+        raise Unsizable(f"the centroid {num(d)} m from the axis is beyond what a sector of outer radius "
+                        f"{num(r_out)} m reaches (less than {num(2 / 3 * (r_out**3 - r_in**3) / (r_out**2 - r_in**2))} m)")
     a = math.pi if s <= 0 else _root(lambda x: _sinc(x) - s, 1e-9, math.pi)
     t = mass / (rho * a * (r_out**2 - r_in**2))
     return {"inner_radius": r_in, "outer_radius": r_out, "angle": 2 * a, "thickness": t}
@@ -319,7 +321,7 @@ def make(name: str, body: str, shape: str, material: str, density: float, given:
                         where, (reason,), pivots)
 
     if not mass > 0:
-        return unmade(f"mass {mass:.4g} kg: a part needs a positive mass")
+        return unmade(f"mass {num(mass)} kg: a part needs a positive mass")
     try:
         dims = _size(shape, given, float(mass), density, d)
     except Unsizable as exc:
@@ -329,17 +331,17 @@ def make(name: str, body: str, shape: str, material: str, density: float, given:
     problems = []
     t = dims["thickness"]
     if limits.max_thickness is not None and t > limits.max_thickness:
-        problems.append(f"thickness {t * 1e3:.4g} mm exceeds max_thickness {limits.max_thickness * 1e3:.4g} mm")
+        problems.append(f"thickness {num(t * 1e3)} mm exceeds max_thickness {num(limits.max_thickness * 1e3)} mm")
     r = reach(shape, dims, c, axis, direction)
     if limits.max_radius is not None and r > limits.max_radius:
-        problems.append(f"reaches {r * 1e3:.4g} mm from the axis ({axis[0]:.4g}, {axis[1]:.4g}) m, beyond max_radius "
-                        f"{limits.max_radius * 1e3:.4g} mm")
+        problems.append(f"reaches {num(r * 1e3)} mm from the axis {point(axis)} m, beyond max_radius "
+                        f"{num(limits.max_radius * 1e3)} mm")
     if limits.clearance is not None:
         for pivot, p in pivots:
             gap = distance_to(shape, dims, c, axis, direction, p)
             if gap < limits.clearance:
-                what = "covers" if gap == 0 else f"is {gap * 1e3:.4g} mm from"
-                problems.append(f"{what} pivot {pivot!r} at ({p[0]:.4g}, {p[1]:.4g}) m (clearance "
-                                f"{limits.clearance * 1e3:.4g} mm)")
+                what = "covers" if gap == 0 else f"is {num(gap * 1e3)} mm from"
+                problems.append(f"{what} pivot {pivot!r} at {point(p)} m (clearance "
+                                f"{num(limits.clearance * 1e3)} mm)")
     return MadePart(name, body, shape, material, density, dims, float(mass), c, _inertia(shape, dims, float(mass), d),
                     outline_of(shape, dims, c, axis, direction), axis, where, tuple(problems), pivots)

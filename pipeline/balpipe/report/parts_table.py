@@ -14,6 +14,8 @@ import json
 import re
 from typing import Any
 
+from ..display.numbers import num, point
+
 #: the dimensions' columns of the bill of materials, in its order, with their SI unit
 DIMENSIONS = (("thickness", "m"), ("radius", "m"), ("inner_radius", "m"), ("outer_radius", "m"), ("angle", "rad"),
               ("length", "m"), ("width", "m"), ("plates", ""), ("plate_thickness", "m"), ("orientation", "rad"))
@@ -72,12 +74,12 @@ def bom_csv(parts: list[dict]) -> str:
 
 
 def _mm(x: float) -> str:
-    return f"{x * 1e3:.4g} mm"
+    return f"{num(x * 1e3)} mm"
 
 
 #: how the page names each dimension, and how it prints it
 _SHOWN = {"thickness": ("t", _mm), "radius": ("r", _mm), "inner_radius": ("r_i", _mm), "outer_radius": ("r_o", _mm),
-          "angle": ("angle", lambda a: f"{a * 180 / 3.141592653589793:.4g}°"), "length": ("length", _mm),
+          "angle": ("angle", lambda a: f"{num(a * 180 / 3.141592653589793)}°"), "length": ("length", _mm),
           "width": ("width", _mm), "plates": ("plates", lambda n: f"{int(n)}"),
           "plate_thickness": ("each", _mm)}
 
@@ -90,9 +92,9 @@ def page_rows(parts: list[dict]) -> list[dict]:
         dims = ", ".join(f"{label} {fmt(p['dimensions'][k])}" for k, (label, fmt) in _SHOWN.items() if k in p["dimensions"])
         rows.append({
             "name": p["name"], "body": p["body"], "design": p["design"], "shape": p["shape"].replace("_", " "),
-            "material": p["material"], "density": f"{p['density']:.6g} kg/m³", "dimensions": dims,
-            "mass": f"{p['mass']:.6g} kg", "centroid": f"({p['centroid'][0] * 1e3:.4g}, {p['centroid'][1] * 1e3:.4g}) mm",
-            "inertia": f"{p['inertia']:.4g} kg m²", "fits": p["fits"], "problems": "; ".join(p["problems"]),
+            "material": p["material"], "density": f"{num(p['density'], 6)} kg/m³", "dimensions": dims,
+            "mass": f"{num(p['mass'], 6)} kg", "centroid": f"{point([x * 1e3 for x in p['centroid']])} mm",
+            "inertia": f"{num(p['inertia'])} kg m²", "fits": p["fits"], "problems": "; ".join(p["problems"]),
             "where": p["where"], "svg": (p["drawings"] or {}).get("svg"), "dxf": (p["drawings"] or {}).get("dxf"),
         })
     return rows
