@@ -327,7 +327,7 @@ SLOW_FIRST = (
 #: node id, which pytest 9.2 no longer lets it change (pytest-xdist issue 1386), and the groups
 #: were silently spread over the workers (each built the browser tests' sites and a browser).
 GROUPS = {"test_site_browser.py": "site_browser", "test_live_browser.py": "site_browser",
-          "test_whatif_browser.py": "site_browser"}
+          "test_whatif_browser.py": "site_browser", "test_verdict_browser.py": "site_browser"}
 
 
 def pytest_collection_modifyitems(session, config, items):
