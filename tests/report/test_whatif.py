@@ -33,18 +33,21 @@ def _scale(key: str, exact: dict) -> float:
 
 
 @pytest.mark.parametrize("name", ["offset_slider_crank.yaml", "custom_four_bar_balancing.yaml",
-                                  "paper002_decoupling.yaml", "custom_slider_driven_slider_crank_gravity.yaml"])
+                                  "paper002_decoupling.yaml", "custom_slider_driven_slider_crank_gravity.yaml",
+                                  "paper001_4rrr_fig6c.yaml"])
 def test_the_maps_give_the_engines_loads_at_random_parts(studies, name):
     """Each part's mass, position and inertia drawn at random within its sliders' ranges (three
-    designs): Fx, Fy, |F|, M and every effort from the maps equal the engine's analysis of the
-    model with those parts to 1e-9 of the series' scale; at the computed design they are the
-    engine's series of the stage itself, exactly."""
+    designs), and every slider at either end of its range: Fx, Fy, |F|, M and every effort from
+    the maps equal the engine's analysis of the model with those parts to 1e-9 of the series'
+    scale (gears, discs on bodies of their own, gravity, four redundant actuators); at the
+    computed design they are the engine's series of the stage itself, exactly."""
     st, w = _whatif(studies, name)
     assert isinstance(w, whatif.WhatIf), w
     assert any(k.startswith("effort:") for k in w.keys)
     rng = np.random.default_rng(11)
-    for _ in range(3):
-        values = _random(w, rng)
+    lo = np.array([p.lo for p in w.parts]).reshape(-1, 4)
+    hi = np.array([p.hi for p in w.parts]).reshape(-1, 4)
+    for values in [_random(w, rng) for _ in range(3)] + [lo, hi]:
         got, exact = whatif.series(w, values), whatif.engine_series(w, values)
         assert set(got) == set(w.keys) | {"F"}
         for k in got:
@@ -139,3 +142,17 @@ def test_the_pages_data_are_the_maps_exactly_and_deterministic(studies):
     assert a == b and a is not None and a["reason"] is None
     figure = json.loads(re.search(r'data-live="live-whatif">(.*)</script>', a["figure"], re.S).group(1))
     assert len(figure["t"]) == d["n"] and [s["label"] for s in figure["series"]][-1] == "design tried"
+
+
+def test_parts_of_one_name_on_two_links_are_two_parts(studies):
+    """Two counterweights both named 'cw', on the crank and on the coupler: each is its own part on
+    its own link, and moving them moves each on its own link."""
+    from balpipe.balancing.parts import add_counterweight
+
+    base = studies("offset_slider_crank.yaml").stages[0].stage.model
+    final = add_counterweight(add_counterweight(base, "crank", "cw", 1.5, (-0.05, 0.01), 1e-4),
+                              "coupler", "cw", 0.7, (0.02, -0.01))
+    parts = whatif.parts_of(base, final)
+    assert [(p.name, p.body, p.design[0]) for p in parts] == [("cw", "crank", 1.5), ("cw", "coupler", 0.7)]
+    moved = whatif.with_parts(final, parts, np.array([[2.0, -0.1, 0.0, 0.0], [0.3, 0.05, 0.02, 1e-3]]))
+    assert [a.mass for b in moved.bodies for a in b.attachments] == [2.0, 0.3]

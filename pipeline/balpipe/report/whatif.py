@@ -184,14 +184,16 @@ def parts_of(base: Model, final: Model, names: PageNames | None = None) -> list[
     larger of twice the design's and the largest mass at a quarter of that reach."""
     moving = sum(b.mass_properties()[0] for b in base.bodies) or 1.0
     had = {b.name: {a.name for a in b.attachments} for b in base.bodies}
+    used: set[tuple[str, str]] = set()
     out = []
     for row in added_parts(base, final):
         if row["kind"] in BODY_KINDS or row["kind"].startswith("added "):
             b = final.body(row["part"])
             own, body, design = True, b.name, (b.mass, b.com[0], b.com[1], b.inertia)
         else:
-            b, a = next((b, a) for b in final.bodies for a in b.attachments
-                        if a.name == row["part"] and a.name not in had.get(b.name, ()))
+            b, a = next((b, a) for b in final.bodies for a in b.attachments  # in added_parts' order
+                        if a.name == row["part"] and a.name not in had.get(b.name, ()) and (b.name, a.name) not in used)
+            used.add((b.name, a.name))
             own, body, design = False, b.name, (a.mass, a.position[0], a.position[1], a.inertia)
         m, x, y, inertia = (float(v) for v in design)
         reach = _extent(final, body, (m, x, y, inertia))
@@ -255,7 +257,11 @@ def build(study, results: dict, styles: dict[str, int] | None = None) -> WhatIf 
     if not parts:
         return None
     model, an = final.stage.model, final.analysis
-    YF, YM, G, drivers, friction = _maps(model, an)
+    try:
+        YF, YM, G, drivers, friction = _maps(model, an)
+    except (AnalysisError, ValueError, np.linalg.LinAlgError) as exc:
+        return (f"The loads of {final.stage.label} could not be mapped onto its parts ({exc}), so the page offers "
+                "no sliders.")
     notes = []
     if friction:
         notes.append(f"Coulomb friction ({', '.join(friction)}) makes the actuators' efforts follow the joint "
