@@ -104,6 +104,53 @@
       c.restore();
     } } };
   }
+  // a stage's swatch: a short stretch of its line (colour, dashes, width) with its marker in the
+  // middle, as its curves are drawn; the same for the page's key (.swatch spans, filled below) and
+  // every legend, its data-* attributes saying what it shows (the browser tests compare them)
+  const SVG = "http://www.w3.org/2000/svg";
+  function swatch(stroke, dash, width, marker) {
+    const svg = document.createElementNS(SVG, "svg");
+    svg.setAttribute("width", "30"); svg.setAttribute("height", "12"); svg.setAttribute("class", "swatch-svg");
+    svg.setAttribute("aria-hidden", "true");
+    const line = document.createElementNS(SVG, "line");
+    for (const [k, v] of [["x1", 1], ["y1", 6], ["x2", 29], ["y2", 6], ["stroke", stroke], ["stroke-width", width]]) line.setAttribute(k, v);
+    if (dash.length) line.setAttribute("stroke-dasharray", dash.join(" "));
+    svg.appendChild(line);
+    if (marker) {
+      const pts = SHAPES[marker] || [], m = pts.length ? document.createElementNS(SVG, "polygon") : document.createElementNS(SVG, "circle");
+      if (pts.length) m.setAttribute("points", pts.map(([x, y]) => (15 + 3 * x) + "," + (6 + 3 * y)).join(" "));
+      else { m.setAttribute("cx", 15); m.setAttribute("cy", 6); m.setAttribute("r", 3); }
+      m.setAttribute("fill", "#fff"); m.setAttribute("stroke", stroke); m.setAttribute("stroke-width", 1);
+      svg.appendChild(m);
+    }
+    return svg;
+  }
+  function swatchData(el, stroke, dash, width, marker) {
+    el.dataset.stroke = stroke; el.dataset.dash = dash.join(","); el.dataset.width = String(width); el.dataset.marker = marker || "";
+  }
+  document.querySelectorAll(".style-legend .swatch").forEach(el => {
+    const dash = el.dataset.dash ? el.dataset.dash.split(",").map(Number) : [];
+    el.appendChild(swatch(el.dataset.stroke, dash, +el.dataset.width, el.dataset.marker));
+  });
+  // each legend row's marker replaced by the series' swatch (uPlot's shows a solid colour), its
+  // short name's long label as the row's tooltip, a simulated run's row marked .sim
+  function decorate(u, drawn) {
+    const rows = u.root.querySelectorAll(".u-legend .u-series");
+    const first = rows.length - drawn.length;
+    if (first < 0) return;
+    drawn.forEach((s, n) => {
+      const row = rows[first + n], th = row.querySelector("th"), m = th && th.querySelector(".u-marker");
+      if (!m) return;
+      const marker = s.marker ? s.marker[0] : (s.points ? "o" : "");
+      m.style.border = "none"; m.style.background = "none"; m.style.width = "auto"; m.style.height = "auto";
+      m.textContent = "";
+      m.appendChild(swatch(s.stroke, s.dash || [], s.width, marker));
+      swatchData(m, s.stroke, s.dash || [], s.width, marker);
+      m.classList.add("swatch");
+      if (s.long) th.title = s.long;
+      if (s.sim) row.classList.add("sim");
+    });
+  }
   // the legend's rows back in the stages' order (uPlot lists its series in drawing order);
   // moving a row keeps its click handler and the cells that show the hovered values
   function legendInStageOrder(u, order) {
@@ -137,27 +184,62 @@
     sel.addEventListener("change", show);
     show();
   }
+  // the figure's one toggle for its simulated runs (off at load): shows or hides them in every panel
+  function simToggle(host, f, drawn) {
+    const box = document.createElement("label");
+    box.className = "live-sim";
+    const input = document.createElement("input");
+    input.type = "checkbox";
+    input.checked = false;
+    box.appendChild(input);
+    box.appendChild(document.createTextNode(" show the pymunk simulation (dotted)"));
+    input.addEventListener("change", () => {
+      f.simShown = input.checked;
+      host.classList.toggle("sim-shown", input.checked);
+      f.plots.forEach(u => drawn.forEach((s, n) => { if (s.sim) u.setSeries(n + 1, { show: input.checked }); }));
+    });
+    host.insertBefore(box, host.firstChild);
+  }
   const figures = [], all = [];  // {host, plots, hovering, ...}: the figures over time, every figure
   let playerTime = null;
   function follow(f) {
     if (playerTime == null || f.hovering || f.timeless || f.host.offsetParent === null) return;  // hidden: skip
     f.plots.forEach(u => u.setCursor({ left: u.valToPos(playerTime, "x"), top: 20 }));
   }
+  let printing = false, PrintPlot = null;
+  // a figure's plots are built when its section opens (lazy): at load those outside a closed
+  // <details>, the others on the details' "toggle" (a Contents entry, a deep link, "open all", a
+  // click) or before printing; until then the host holds only its JSON
+  const pending = new Map();  // host -> its JSON's <script>
+  const closed = host => !!(host.parentElement && host.parentElement.closest("details:not([open])"));
+  function buildOpen() {
+    for (const [host, src] of Array.from(pending)) if (!closed(host)) { pending.delete(host); make(src, host); }
+  }
+  function buildAll() {
+    for (const [host, src] of Array.from(pending)) { pending.delete(host); make(src, host); }
+  }
   document.querySelectorAll("script[type='application/json'][data-live]").forEach(src => {
     const host = document.getElementById(src.dataset.live);
-    if (!host) return;
+    if (host) pending.set(host, src);
+  });
+  document.addEventListener("toggle", e => { if (e.target.open) buildOpen(); }, true);
+  function make(src, host) {
     const d = JSON.parse(src.textContent);
-    if (!d.panels.length) return;
+    if (!d.panels.length) { host.classList.add("live-empty"); return; }
     const f = { host: host, plots: [], hovering: false, timeless: !!d.x };
     if (d.panels.length > 2 || d.grid) host.classList.add("live-grid");  // small multiples: as many columns as fit
     const width = el => Math.max(240, el.clientWidth);
     // drawn in d.draw's order (wide lines first, under the thin ones), listed in the stages' order
     const order = d.draw || d.series.map((s, i) => i);
     const drawn = order.map(i => d.series[i]);
-    f.build = (p, make, w, extra) => {  // panel p's plot by the uPlot `make`, w wide, in its element
+    // simulated runs (pymunk) hidden until the figure's toggle shows them
+    const sims = drawn.some(s => s.sim);
+    f.simShown = false;
+    f.build = (p, Plot, w, extra) => {  // panel p's plot by the uPlot `Plot`, w wide, in its element
       // over time, or (d.x) over another quantity: a front's budget, each value a design marked
       const series = [{ label: d.x || "t (s)", value: (u, v) => fmt(v) }].concat(drawn.map(s => Object.assign({
         label: s.label, stroke: s.stroke, dash: s.dash, width: s.width, value: (u, v) => fmt(v, p.floor),
+        show: !s.sim || f.simShown,
       }, d.x ? { spanGaps: true, points: { show: true, size: s.points ? 10 : 5, width: 1.5, fill: "#fff" } } : {},
          s.points ? { paths: () => null } : {})));
       const opts = Object.assign({
@@ -171,6 +253,7 @@
       return [opts, [d.t].concat(drawn.map(s => s.y[p.key] || d.t.map(() => null)))];
     };
     f.order = order;
+    f.series = d.series;
     f.panels = d.panels;
     for (const p of d.panels) {
       const el = document.createElement("div");
@@ -179,6 +262,7 @@
       host.appendChild(el);
       const [opts, data] = f.build(p, uPlot, width(el));
       const u = new uPlot(opts, data, el);
+      decorate(u, drawn);
       legendInStageOrder(u, order);
       f.plots.push(u);
       if (d.x) continue;  // not over time: not linked to the player
@@ -196,6 +280,7 @@
       });
     }
     if (d.choose != null) chooser(host, d, f);
+    if (sims) simToggle(host, f, drawn);
     host.classList.add("live-ready");
     host.uplots = f.plots;  // the drawn plots, for the console and the browser tests
     all.push(f);
@@ -204,11 +289,11 @@
     // width once the page is laid out (a plot drawn while the layout was not final, narrower
     // than its panel, is widened when the page has loaded): resize after the observer's
     // callback, never inside it, only the plots whose panel's width differs from theirs
-    let pending = 0;
+    let frame = 0;
     const refit = () => {
       if (host.clientWidth === 0 || printing) return;
-      cancelAnimationFrame(pending);
-      pending = requestAnimationFrame(() => {
+      cancelAnimationFrame(frame);
+      frame = requestAnimationFrame(() => {
         const stale = f.plots.filter(u => !u.root.parentNode.hidden && u.width !== width(u.root.parentNode));
         stale.forEach(u => u.setSize({ width: width(u.root.parentNode), height: u.height }));
         if (stale.length) follow(f);
@@ -216,10 +301,11 @@
     };
     new ResizeObserver(refit).observe(host);
     if (document.readyState === "complete") refit(); else addEventListener("load", refit);
-  });
+    follow(f);
+  }
+  buildOpen();
   // printing: every panel drawn again for the paper (see the top), with the screen plot's curves
   // shown or hidden and its time range (a zoom), no cursor; a legend without values
-  let printing = false, PrintPlot = null;
   function printUPlot() {  // uPlot drawing at PRINT_RATIO: its own copy, read while devicePixelRatio says so
     if (PrintPlot) return PrintPlot;
     const src = document.getElementById("uplot-js");
@@ -236,6 +322,7 @@
   }
   function toPrint() {
     if (printing) return;
+    buildAll();  // the folded sections' figures too
     printing = true;
     const Make = printUPlot();
     all.forEach(f => {
@@ -248,6 +335,7 @@
         u.root.parentNode.appendChild(box);
         u.root.parentNode.classList.add("printed");
         const p = new Make(opts, data, box);
+        decorate(p, f.order.map(i => f.series[i]));
         legendInStageOrder(p, f.order);
         const x = u.scales.x;
         if (x.min != null && (x.min > data[0][0] || x.max < data[0][data[0].length - 1])) p.setScale("x", { min: x.min, max: x.max });

@@ -263,14 +263,14 @@ def test_a_partial_balancings_front_is_interactive_over_its_budget():
         data = LV.data(PFG.front_curves(pts, x, y, marks))
         assert data["x"] == PFG.AXES[x] and data["panels"][0]["axis"] == PFG.AXES[y]
         front, *marked = data["series"]
-        assert front["label"] == PFG.FRONT and "points" not in front and all(s["points"] for s in marked)
+        assert front.get("long", front["label"]) == PFG.FRONT and "points" not in front and all(s["points"] for s in marked)
         shown = sorted((xv, yv) for xv, yv in zip(data["t"], front["y"]["y"]) if yv is not None)
         floor = data["panels"][0]["floor"]  # a design's round-off, written 0
         exact = sorted((float(f"{p[x]:.6g}"), float(f"{p[y]:.6g}") if abs(p[y]) > floor else 0.0) for p in pts)
         assert shown == exact  # every design of the front, none thinned away
         for s, (label, vx, vy) in zip(marked, marks):
             at = [(xv, yv) for xv, yv in zip(data["t"], s["y"]["y"]) if yv is not None]
-            assert s["label"] == label and at == [(float(f"{vx:.6g}"), float(f"{vy:.6g}") if abs(vy) > floor else 0.0)]
+            assert s.get("long", s["label"]) == label and at == [(float(f"{vx:.6g}"), float(f"{vy:.6g}") if abs(vy) > floor else 0.0)]
         assert data["t"] == sorted(data["t"])  # uPlot's x runs forward
         json.loads(LV.as_script(data))  # valid JSON: null, not NaN
     many = [{"added_mass": m, "shaking_force": 100.0 - m} for m in np.linspace(0.0, 10.0, 1000)]
@@ -313,10 +313,10 @@ def _figure(st, title: str) -> str:
 
 def test_the_prismatic_forces_are_live_on_log_axes_with_the_unbounded_samples_left_out(studies):
     """The 3-RPR's axial forces of prismatic actuators (the family's own figure): a log panel per
-    leg, the unbalanced stage thin black and the last stage thick grey, |f_i| of
+    leg, the unbalanced stage and the last stage each in its style on the page (its key), |f_i| of
     ``prismatic_equivalent`` at the kept samples; no value (null) where a force is unbounded (NaN,
     at the parallel singularity of phi = 0) or zero."""
-    from balpipe.families.rpr3 import figures as F
+    from balpipe.balancing.base import style_index
     from balpipe.families.rpr3.template import pose_of, prismatic_equivalent
 
     st = studies("paper000_rpr3_idler_loop.yaml")
@@ -326,7 +326,8 @@ def test_the_prismatic_forces_are_live_on_log_axes_with_the_unbounded_samples_le
     last = [s for s in st.stages if ":" not in s.stage.name][-1]
     pose = pose_of(st.unbalanced.stage.model)
     nulls = 0
-    for series, s, style in zip(data["series"], (st.stages[0], last), F.PRISMATIC_STYLES):
+    for series, s in zip(data["series"], (st.stages[0], last)):
+        style = style_index(st.stages, s)
         assert series["label"] == s.stage.label
         assert {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(style)
         an = s.analysis
@@ -396,9 +397,9 @@ def test_paper_003s_other_trajectories_are_live_one_curve_per_case_in_its_style(
     data = _live(_figure(st, f"Shaking force and moment on the other {len(others)} trajectories"), "com-loads")
     assert sorted(p["key"] for p in data["panels"]) == sorted(f"{q} {g}" for g in others for q in "FM")
     labels = dict(CASES)
-    assert sorted(x["label"] for x in data["series"]) == sorted(labels.values())
+    assert sorted(x.get("long", x["label"]) for x in data["series"]) == sorted(labels.values())
     for series in data["series"]:
-        case = next(key for key, label in labels.items() if label == series["label"])
+        case = next(key for key, label in labels.items() if label == series.get("long", series["label"]))
         for g in others:
             s = next(x for x in st.stages if x.stage.name == f"{g}_{case}")
             assert {key: series[key] for key in ("stroke", "dash", "width")} == LV.line_style(style_index(st.stages, s))

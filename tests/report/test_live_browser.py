@@ -118,7 +118,7 @@ def test_the_partial_fronts_are_interactive_over_their_budget(live_site, browser
     plot = p.locator(f"#{figure} .live-plot").first
     plot.scroll_into_view_if_needed()
     labels = plot.evaluate("el => [...el.querySelectorAll('.u-legend .u-series .u-label')].map(v => v.textContent)")
-    assert labels[0] == "added mass (kg)" and labels[1] == "optimal front (cone programme)"
+    assert labels[0] == "added mass (kg)" and labels[1] == "optimal front"  # its long label in the tooltip
     box = plot.locator(".u-over").bounding_box()
     assert box and box["width"] > 400
     front = [(x, y) for x, y in zip(d["t"], d["series"][0]["y"]["y"]) if y is not None]

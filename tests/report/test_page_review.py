@@ -156,7 +156,7 @@ def test_simulation_figures_are_live_plots_with_every_stage(monkeypatch):
     assert drawn == []
     for c in figs:
         data = live.data(c)
-        assert [s["label"] for s in data["series"]][:len(names)] in (names, [n + ": crank" for n in names])
+        assert [s.get("long", s["label"]) for s in data["series"]][:len(names)] in (names, [n + ": crank" for n in names])
         assert all(len(s["y"]) == len(data["panels"]) for s in data["series"])
     assert live.data(figs[2])["series"][0]["y"]["drift"][-1] == pytest.approx(1000 * np.hypot(err[-1], err[-1]), rel=1e-5)
 

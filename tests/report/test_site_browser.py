@@ -190,9 +190,17 @@ def test_study_pages_have_contents_and_links_between_studies(server, browser):
     assert not w.problems, "\n".join(w.problems)
 
 
+#: every live figure of the page built (live_plots.js builds a figure when its section opens)
+ALL_BUILT = """() => [...document.querySelectorAll("script[data-live]")].every(s => {
+  const h = document.getElementById(s.dataset.live);
+  return !h || h.classList.contains("live-ready") || h.classList.contains("live-empty"); })"""
+
+
 def open_sections(page) -> None:
-    """Open the page's collapsed sections, as a reader does to reach the player."""
+    """Open the page's collapsed sections, as a reader does to reach the player, and wait until
+    the figures they hold are built."""
     page.evaluate("document.querySelectorAll('details').forEach(d => d.open = true)")
+    page.wait_for_function(ALL_BUILT)
     page.wait_for_timeout(50)
 
 
@@ -579,7 +587,7 @@ def test_hovering_a_plot_shows_its_values_and_a_click_hides_a_curve(paper_site, 
     entry.click()
     assert "u-off" in (entry.get_attribute("class") or "")
     # no static figure: printing prints the live plot, drawn again for print, the hidden curve hidden
-    assert not p.locator(".static-plot").count() and not p.locator("#live-loads svg").count()
+    assert not p.locator(".static-plot").count() and not p.locator("#live-loads svg:not(.swatch-svg)").count()
     label = entry.locator(".u-label").text_content()
     p.emulate_media(media="print")
     p.wait_for_selector("#live-loads .live-print .u-legend", state="attached")
@@ -957,4 +965,103 @@ def test_the_mechanism_moves_with_its_shaking_loads_in_table_order(paper_site, s
     p.evaluate("document.dispatchEvent(new CustomEvent('balpipe:seek', {detail: {time: 0.2}}))")
     assert p.text_content("#mechanism-player-clock").startswith("t = 0.200 s") and cv.evaluate("c => c.toDataURL()") != pixels
     assert t_end != p.text_content("#mechanism-player-clock")
+# --- one style per stage, the simulation's toggle, lazy figures (templates/live_plots.js) ---
+
+_KEY = """() => Object.fromEntries([...document.querySelectorAll('#style-legend .stage-key')].map(k => {
+  const s = k.querySelector('.swatch');
+  return [k.dataset.stage, [s.dataset.stroke, s.dataset.dash, s.dataset.marker, !!s.querySelector('svg line')]]; }))"""
+_LEGENDS = """() => [...document.querySelectorAll('.live.live-ready')].map(h => [h.id,
+  [...h.querySelectorAll('.live-plot:not([hidden]) .u-legend')].slice(0, 1).flatMap(l => [...l.querySelectorAll('.u-series')])
+    .filter(r => r.querySelector('.swatch'))
+    .map(r => { const s = r.querySelector('.swatch');
+      return [r.querySelector('.u-label').textContent, s.dataset.stroke, s.dataset.dash, s.dataset.marker,
+              r.classList.contains('sim'), !!s.querySelector('svg line'), r.querySelector('th').title]; })])"""
+
+
+@pytest.mark.parametrize("width", [400, 1400])
+def test_legend_swatches_show_each_stages_dash_and_marker_as_the_key(site, paper_site, browser, width):
+    """Every stage's entry in every legend of a page (its short name) shows the swatch of the
+    page's key: the same colour, dashes and marker, drawn (an SVG line); the loads' legend names
+    every stage of the key; a short name's long label is its tooltip."""
+    ctx = layout_context(browser, width)
+    w = Watched(ctx)
+    p = w.page
+    checked = 0
+    try:
+        for page_file in [paper_site / slug.removesuffix(".yaml") / "index.html" for slug in PAPER_SPECS] + \
+                         [site / SUBFOLDER / "scott_russell" / "index.html"]:
+            p.goto(page_file.as_uri(), wait_until="load")
+            open_sections(p)
+            key = p.evaluate(_KEY)
+            assert key and all(drawn for *_, drawn in key.values()), (page_file, key)
+            figures = dict(p.evaluate(_LEGENDS))
+            assert set(key) <= {row[0] for row in figures["live-loads"]}, (page_file, key, figures["live-loads"])
+            for fig, rows in figures.items():
+                for name, stroke, dash, marker, sim, drawn, title in rows:
+                    assert drawn, (fig, name)
+                    if name in key and not sim:
+                        assert [stroke, dash, marker] == key[name][:3], (page_file, fig, name, key[name])
+                        checked += 1
+            long = p.evaluate("() => [...document.querySelectorAll('#style-legend .stage-key')].map(k => [k.dataset.stage, k.title])")
+            for fig, rows in figures.items():
+                for name, *_, title in rows:
+                    for short, label in long:
+                        if name == short and label != short:
+                            assert title == label, (fig, name, title, label)
+    finally:
+        ctx.close()
+    assert checked > 20
+    assert not w.problems, "\n".join(w.problems)
+
+
+@pytest.mark.parametrize("width", [400, 1400])
+def test_the_simulated_curves_are_hidden_until_their_toggle_shows_them(server, browser, width):
+    """The shaking loads' pymunk curves are off at load (their legend rows off, the stages' on);
+    the figure's one toggle shows them in every panel, and hides them again."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": width, "height": 900})
+    p.goto(server + "scott_russell/index.html", wait_until="load")
+    rows = """() => [...document.querySelectorAll('#live-loads .live-plot')].map(el =>
+        [...el.querySelectorAll('.u-legend .u-series')].filter(r => r.querySelector('.swatch'))
+          .map(r => [r.classList.contains('sim'), r.classList.contains('u-off')]))"""
+    shown = p.evaluate(rows)
+    assert len(shown) == 4 and all(any(sim for sim, _ in panel) for panel in shown), shown
+    assert all(off == sim for panel in shown for sim, off in panel), shown
+    assert not p.locator("#live-loads .u-series.sim").first.is_visible()  # nor listed
+    toggle = p.locator("#live-loads .live-sim input")
+    assert toggle.count() == 1 and not toggle.is_checked()
+    pixels = p.locator("#live-loads .live-plot canvas").first.evaluate("c => c.toDataURL()")
+    toggle.check()
+    assert all(not off for panel in p.evaluate(rows) for _, off in panel)
+    assert p.locator("#live-loads .u-series.sim").first.is_visible()
+    assert p.locator("#live-loads .live-plot canvas").first.evaluate("c => c.toDataURL()") != pixels  # drawn
+    toggle.uncheck()
+    assert all(off == sim for panel in p.evaluate(rows) for sim, off in panel)
+    assert not w.problems, "\n".join(w.problems)
+
+
+@pytest.mark.parametrize("width", [400, 1400])
+def test_a_folded_sections_figures_are_built_when_it_opens(paper_site, browser, width):
+    """At load only the figures of open sections are drawn; a folded section's figure has no
+    plot until the section opens (a click on its summary), then it is drawn at its width."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": width, "height": 900})
+    p.goto((paper_site / "paper002_decoupling" / "index.html").as_uri(), wait_until="load")
+    state = p.evaluate("""() => [...document.querySelectorAll('script[data-live]')].map(s => {
+        const h = document.getElementById(s.dataset.live);
+        return [h.id, !!h.closest('details:not([open])'), h.querySelectorAll('.live-plot').length]; })""")
+    folded = [h for h, closed, n in state if closed]
+    assert folded and all(n == 0 for _, closed, n in state if closed), state
+    assert all(n > 0 for _, closed, n in state if not closed), state
+    target = folded[0]
+    p.locator(f"details.section:has(#{target}) > summary").first.click()
+    p.wait_for_function(f"document.querySelectorAll('#{target} .live-plot').length > 0")
+    p.wait_for_timeout(100)
+    box = p.locator(f"#{target} .live-plot:not([hidden]) .u-over").first.bounding_box()
+    assert box and box["width"] > width / 3, box
+    still = p.evaluate("""() => [...document.querySelectorAll('script[data-live]')].map(s => document.getElementById(s.dataset.live))
+        .filter(h => h.closest('details:not([open])')).map(h => h.querySelectorAll('.live-plot').length)""")
+    assert all(n == 0 for n in still), still
     assert not w.problems, "\n".join(w.problems)

@@ -26,6 +26,7 @@ import numpy as np
 
 from ..mechanics.sampling import spread_indices
 from . import figures
+from .stage_names import short_names
 
 POINTS = 400  # samples a curve keeps at most
 VALUES = 20_000  # values a figure keeps at most (curves x samples): fewer samples for a figure of many curves
@@ -97,6 +98,16 @@ def markers(k: int, n: int) -> dict:
     return {"marker": [st["marker"], int(start), int(every)]}
 
 
+def swatch(k: int) -> dict:
+    """Stage ``k``'s legend swatch as the page's key and every plot's legend draw it
+    (``live_plots.js``): ``stroke`` (hex), ``dash`` (canvas dashes, comma-separated), ``width``
+    and ``marker`` (matplotlib's letter), the same as its curves (:func:`line_style`,
+    :func:`markers`)."""
+    st = line_style(k)
+    return {"stroke": st["stroke"], "dash": ",".join(f"{d:g}" for d in st["dash"]), "width": st["width"],
+            "marker": figures.marker(k)}
+
+
 class Curves(NamedTuple):
     """The curves of one figure, before thinning: a panel per dict of ``panels`` (``key``,
     ``title`` and ``axis`` label, each with its unit), a curve per stage and panel."""
@@ -109,8 +120,9 @@ class Curves(NamedTuple):
     # a figure of many panels (a joint per panel): shown one panel at a time, a selector above
     # choosing which (or every one), this panel first; None: every panel shown
     choose: int | None = None
-    # each stage's markers (:func:`markers`) on its curve; a series of an explicit style (a dict) has none
-    markers: bool = False
+    # each stage's markers (:func:`markers`) on its curve: always on a plot over time (a stage keeps
+    # its marker in every figure, as the page's key says); a series of an explicit style (a dict) has none
+    markers: bool = True
     # a figure over another quantity than time (a Pareto front over its budget): the x axis's
     # label with its unit; such a figure is not linked to the player, keeps every sample, draws a
     # marker at every value (a curve across the samples where it has none) and the stages of
@@ -119,12 +131,19 @@ class Curves(NamedTuple):
     points: tuple = ()
     # the panels side by side where the page is wide enough (as a figure of more than two panels)
     grid: bool = False
+    # each stage's name in the legend (:func:`balpipe.draw.stage_names.short_names` of the labels
+    # when empty); the label itself is the legend entry's tooltip
+    names: tuple = ()
+    # the stages that are simulation runs (pymunk): hidden until the figure's toggle shows them
+    simulated: tuple = ()
 
 
 def data(c: Curves) -> dict:
     """The JSON of one interactive figure: a plot per panel, one series per stage in its stage's
-    line style (:func:`line_style`; null where the stage has no such curve); every curve thinned
-    to the same samples (:func:`_thin`) and rounded to 6 significant digits."""
+    line style (:func:`line_style`; null where the stage has no such curve), named by its short
+    name (``label``) with its long label (``long``) where they differ, a simulation run marked
+    ``sim`` (hidden until shown); every curve thinned to the same samples (:func:`_thin`) and
+    rounded to 6 significant digits."""
     t = np.asarray(c.t, dtype=float)
     k = (np.arange(len(t)) if c.x_axis else
          _thin(len(t), sum(p["key"] in curves for _, curves in c.stages for p in c.panels)))
@@ -137,13 +156,16 @@ def data(c: Curves) -> dict:
         out = _round(np.asarray(y, dtype=float)[k], floors[p["key"]])
         return [v if v is not None and v > cuts[p["key"]] else None for v in out] if p.get("log") else out
 
-    series = [{"label": label, "y": {p["key"]: values(p, curves[p["key"]]) for p in c.panels if p["key"] in curves},
-               **line_style(n)}
+    labels = [label for label, _ in c.stages]
+    names = list(c.names) if c.names else short_names(labels)
+    series = [{"label": names[n], "y": {p["key"]: values(p, curves[p["key"]]) for p in c.panels if p["key"] in curves},
+               **line_style(n), **({"long": label} if label != names[n] else {}),
+               **({"sim": True} if n in c.simulated else {})}
               for n, (label, curves) in enumerate(c.stages)]
     if c.styles is not None:
         for one, style in zip(series, c.styles):
             one.update(line_style(style))
-    if c.markers:
+    if c.markers and not c.x_axis:
         for n, one in enumerate(series):
             style = n if c.styles is None else c.styles[n]
             if not isinstance(style, dict):

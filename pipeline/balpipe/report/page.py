@@ -10,6 +10,7 @@ from ..display import numbers
 from ..laws.drives import law_names
 from ..study import Study
 from ..draw import extremes, figures, labels, live, player, sleeves
+from ..draw.stage_names import short_names
 from . import citations, live_plots, paper_figures, partial_figures, present, sections, toc, whatif
 from .design_card import design_card
 from .effort_table import effort_table
@@ -72,6 +73,18 @@ def drawing_times(study: Study) -> dict:
     return {"solid": f"{solid:.4g}", "ghosts": " and ".join(texts), "count": len(texts), "sleeves": sleeved}
 
 
+def stage_styles(study: Study) -> dict[str, tuple[int, str]]:
+    """Every stage's line style on the page (the index of :func:`balpipe.draw.figures.style`) and
+    its short name in legends and titles, by stage name: the shown stages in their order
+    (:func:`shown_stages`, the page's key), then the others (stages of other motions) after
+    them; so a stage looks the same in every figure drawn per stage, the simulation's included."""
+    shown = shown_stages(study)
+    rest = [s for s in study.stages if s not in shown]
+    ordered = shown + rest
+    shorts = short_names([s.stage.label for s in ordered], [s.stage.design for s in ordered])
+    return {s.stage.name: (k, short) for k, (s, short) in enumerate(zip(ordered, shorts))}
+
+
 def time_curves(study: Study, names: PageNames | None = None) -> dict[str, live.Curves]:
     """The curves of the page's time-series figures, by name: ``loads`` (the shaking force and
     moment of the shown stages, with their pymunk runs when simulated), ``efforts`` (the
@@ -87,8 +100,11 @@ def time_curves(study: Study, names: PageNames | None = None) -> dict[str, live.
     marks = [(w["time"], w["kind"].replace("_", " ")) for w in study.warnings]
     shown_names = {d: names.text("driver", d) for d in units}  # the paper's symbols in the panels' titles
     joint_names = {j: names.text("joint", j) for _, an in shown for j in an.reactions}  # the paper's symbols
-    return {"loads": live_plots.loads(shown, sims), "efforts": live_plots.efforts(shown, units, marks, shown_names),
-            "joints": live_plots.joints(shown, joint_names)}
+    styles = stage_styles(study)
+    short = [styles[s.stage.name][1] for s in shown_stages(study)]
+    return {"loads": live_plots.loads(shown, sims, short),
+            "efforts": live_plots.efforts(shown, units, marks, shown_names, short),
+            "joints": live_plots.joints(shown, joint_names, short)}
 
 
 def drawing_settings(study: Study, names: PageNames) -> dict:
@@ -113,6 +129,7 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
     joint_curves = curves["joints"]
     joints = live.html("joints", joint_curves) if joint_curves.panels else ""
     drawing = drawing_settings(study, names)
+    styled_as = stage_styles(study)
     mech = [
         (s.stage.label, figures.mechanism_figure(s.stage.model, s.analysis, prefix=f"mech{k}", title=s.stage.label,
                                                  **drawing))
@@ -126,14 +143,19 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
     vals = [s for s in shown_stages(study) if s.validation is not None]
     if vals:
         rows, caption = residual_rows(study, vals)
-        res = live_plots.residuals(rows)
+        res = live_plots.residuals(rows, [styled_as[s.stage.name][0] for s in vals],
+                                   [styled_as[s.stage.name][1] for s in vals])
         residuals.append(("Residuals of the simulation", live.html("residuals", res, live_plots.SIMULATED) + "".join(
             f'<p class="muted coincide">{markupsafe.escape(note)}</p>' for note in live_plots.residual_notes(res)),
             caption))
     if study.reactionless is not None:
         r = study.reactionless
+        # in the key's order, each stage in its style
+        runs_in_order = sorted(zip(r.labels, r.runs, r.names), key=lambda run: styled_as[run[2]][0])
         drift.append(("Frame drift and rotation",
-                      live.html("drift", live_plots.drift([(lab, x.t, x.drift, x.rotation) for lab, x in zip(r.labels, r.runs)]),
+                      live.html("drift", live_plots.drift([(lab, x.t, x.drift, x.rotation) for lab, x, _ in runs_in_order],
+                                                          [styled_as[n][0] for _, _, n in runs_in_order],
+                                                          [styled_as[n][1] for _, _, n in runs_in_order]),
                                 live_plots.SIMULATED),
                       "Displacement of the free frame's centre of mass and its rotation during the motion."))
     torque = []
@@ -141,17 +163,22 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
     if runs:
         curves = [(f"{s.stage.label}: {names.text('driver', d)}", np.abs(e) / (s.torque.travel[d] or 1.0))
                   for s in runs for d, e in sorted(s.torque.tracking.items())]
+        # each stage in its style where a stage has one driver (several: told apart by colour order)
+        tracking_styles = ([styled_as[s.stage.name][0] for s in runs]
+                           if all(len(s.torque.tracking) == 1 for s in runs) else None)
         torque.append((
             "Tracking error of the torque-driven run",
-            live.html("tracking", live_plots.tracking(runs[0].torque.t, curves), live_plots.SIMULATED),
+            live.html("tracking", live_plots.tracking(runs[0].torque.t, curves, tracking_styles), live_plots.SIMULATED),
             "Each driven coordinate of the simulation driven by the engine's efforts (no position drive), "
             "minus its planned motion, relative to its travel (largest excursion from its start): "
             + travel_text(runs[0], names) + ".",
         ))
     key = "; ".join(f"{figures.style_text(k)}: {s.stage.label}" for k, s in enumerate(shown_stages(study)))
+    swatches = [{"name": styled_as[s.stage.name][1], "label": s.stage.label, "words": figures.style_text(k),
+                 **live.swatch(k)} for k, s in enumerate(shown_stages(study))]
     # a method that gives its stages the paper's line styles (Stage.style): said in the legend
     paper_styles = styled(shown_stages(study))
-    return {"loads": loads, "joints": joints, "joints_chosen": joint_curves.choose is not None, "loads_key": key[:1].upper() + key[1:],
+    return {"loads": loads, "joints": joints, "key": swatches, "joints_chosen": joint_curves.choose is not None, "loads_key": key[:1].upper() + key[1:],
             "styles_note": ("" if not paper_styles else
                             "These are the paper's line styles for the stages it plots, so the figures titled with the "
                             "paper's numbers draw each stage as every other figure does" if study.spec.paper else

@@ -70,13 +70,14 @@ def _prismatic_forces_figure(study):
     mech = study.spec.mechanism
     pose = pose_of(study.unbalanced.stage.model)
     runs = []
-    for s in (study.stages[0], _own(study)[-1]):
+    stages = (study.stages[0], _own(study)[-1])
+    for s in stages:
         an = s.analysis
         tau = np.stack([an.efforts[f"theta{i}"] for i in (1, 2, 3)], axis=1)
         runs.append((s.stage.label, prismatic_equivalent(mech, pose, an.t, tau)))
     return (
         "Axial forces that prismatic actuators would need",
-        prismatic_forces_html(study.stages[0].analysis.t, runs),
+        prismatic_forces_html(study.stages[0].analysis.t, runs, [style_index(study.stages, s) for s in stages]),
         "The same motion driven by actuators at the prismatic pairs B_i instead of the revolutes A_i: "
         "J_p^T f = J_r^T tau (the same generalised force on the platform). Where the three leg lines meet "
         "in one point (a parallel singularity of prismatic actuation, at phi = 0 for a platform homothetic "
@@ -84,14 +85,10 @@ def _prismatic_forces_figure(study):
     )
 
 
-#: the two runs' lines: the unbalanced stage thin black, the last stage thick grey
-PRISMATIC_STYLES = ({"color": "black", "linestyle": "-", "linewidth": 1.3},
-                    {"color": "0.6", "linestyle": "-", "linewidth": 2.2})
-
-
-def prismatic_forces_html(t: np.ndarray, runs: list[tuple[str, np.ndarray]]) -> str:
+def prismatic_forces_html(t: np.ndarray, runs: list[tuple[str, np.ndarray]], styles: list[int] | None = None) -> str:
     """|axial force| of each leg over time ``t`` on logarithmic axes, a panel per leg, a line per
-    (stage label, forces (N, 3)) in :data:`PRISMATIC_STYLES`; drawn by the browser
+    (stage label, forces (N, 3)), each in its stage's style on the page (``styles``: the index of
+    :func:`balpipe.draw.figures.style`; default 0, 1, ...); drawn by the browser
     (:func:`balpipe.draw.live.html`, element ``#live-rpr3-prismatic``), no value where a force
     is unbounded (NaN) or zero."""
     from ...draw import live
@@ -99,7 +96,7 @@ def prismatic_forces_html(t: np.ndarray, runs: list[tuple[str, np.ndarray]]) -> 
     curves = live.Curves(t, [(label, {f"leg{i + 1}": np.abs(f[:, i]) for i in range(3)}) for label, f in runs],
                          [{"key": f"leg{i + 1}", "title": f"|axial force| of leg {i + 1} (N)",
                            "axis": f"|f{i + 1}| (N)", "log": True} for i in range(3)], [],
-                         styles=list(PRISMATIC_STYLES[:len(runs)]), grid=True)
+                         styles=list(styles) if styles else None, grid=True)
     return live.html("rpr3-prismatic", curves)
 
 
