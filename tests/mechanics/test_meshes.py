@@ -159,7 +159,7 @@ def test_joint_load_table_and_csv_have_the_mesh_forces(paper):
     for joint in ("O5", "A1-6", "A2-7"):
         assert rows[(joint, "|F|")]["peaks"]["full"] > 1.0
     head = timeseries_csv(s).splitlines()[0].split(",")
-    for col in ("full.reaction.1'-5.Ft", "full.reaction.1'-5.Fr", "full.reaction.3'-6.Ft", "full.reaction.O5.Fx"):
+    for col in ("full.reaction.1'-5.Ft_N", "full.reaction.1'-5.Fr_N", "full.reaction.3'-6.Ft_N", "full.reaction.O5.Fx_N"):
         assert col in head
 
 

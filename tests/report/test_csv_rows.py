@@ -49,3 +49,28 @@ def test_the_file_written_by_pieces_is_the_whole_text(rng, tmp_path, monkeypatch
         path = tmp_path / f"ts{rows}.csv"
         write_new(path, f)
         assert path.read_bytes() == whole.encode("utf-8")
+
+
+#: the unit tags timeseries.csv's column names end with (SI)
+UNIT_TAGS = ("_s", "_N", "_Nm", "_m", "_rad", "_m_s", "_rad_s", "_W")
+
+
+def test_every_timeseries_column_names_its_unit(studies):
+    """Every column of timeseries.csv ends in its SI unit: the efforts (N m or N by their
+    driver), the joint reactions (forces N, moments and gear torques N m), the loads' series
+    (a friction's rate in rad/s at a revolute), the frame load and the motion's columns; on a
+    spec with gears, one with loads and friction, and a slider-driven one (an effort in N)."""
+    from balpipe.report.results import timeseries_columns
+
+    seen = set()
+    for name in ("paper004_five_bar.yaml", "custom_four_bar_loaded.yaml", "custom_slider_driven_slider_crank_gravity.yaml"):
+        cols = [c for c, _ in timeseries_columns(studies(name))]
+        missing = [c for c in cols if not c.endswith(UNIT_TAGS)]
+        assert not missing, (name, missing[:10])
+        seen |= {c.rsplit(".", 1)[0].split(".", 1)[-1] + "." + c.rsplit("_", 1)[-1] for c in cols if ".effort." in c}
+        if name == "paper004_five_bar.yaml":
+            assert any(".reaction." in c and c.endswith(".Ft_N") for c in cols)
+            assert any(".reaction." in c and c.endswith(".T_Nm") or c.endswith(".M_Nm") for c in cols)
+        if name == "custom_four_bar_loaded.yaml":
+            assert any(".load." in c for c in cols)
+    assert any(s.endswith(".Nm") for s in seen) and any(s.endswith(".N") for s in seen), seen

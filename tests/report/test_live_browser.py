@@ -164,7 +164,8 @@ def test_the_simulations_figures_are_interactive_with_readable_axes(simulated_si
     host = p.locator("#live-residuals")
     host.scroll_into_view_if_needed()
     assert "live-grid" in (host.get_attribute("class") or "")
-    boxes = [b.bounding_box() for b in host.locator(".live-plot").all()]
+    # both boxes read at once: the page may still scroll between two reads (a figure above drawn late)
+    boxes = host.evaluate("h => [...h.querySelectorAll('.live-plot')].map(e => { const r = e.getBoundingClientRect(); return {x: r.x, y: r.y}; })")
     assert len(boxes) == 2 and boxes[0]["y"] == boxes[1]["y"] and boxes[0]["x"] < boxes[1]["x"]
     for ticks in host.evaluate(_TICKS):
         assert len(ticks) >= 2 and all(re.fullmatch(r"1e-\d+|0\.0*1|1", t) for t in ticks), ticks

@@ -83,13 +83,32 @@ def load_summary(stages: list) -> dict | None:
             "external": any(ld.source == "external" for ld in model0.loads)}
 
 
+#: the unit of a load's series (:mod:`balpipe.engine.loads`) as a column name ends with it
+SERIES_UNITS = {"tension": "N", "length": "m", "power": "W", "loss": "W", "torque": "Nm", "angle": "rad",
+                "Fx": "N", "Fy": "N", "force": "N", "reaction": "N", "normal": "N"}
+
+
+def series_unit(key: str, keys) -> str:
+    """The unit tag of the series ``key`` of a load whose series are ``keys``: a friction's
+    ``rate`` and Coulomb magnitude ``coulomb`` follow its joint (rad/s and N m where it has a
+    ``torque``, a revolute's; m/s and N for a prismatic pair's ``force``)."""
+    turning = "torque" in keys
+    if key == "rate":
+        return "rad_s" if turning else "m_s"
+    if key == "coulomb":
+        return "Nm" if turning else "N"
+    return SERIES_UNITS[key]
+
+
 def load_columns(stage: str, an) -> list[tuple[str, np.ndarray]]:
     """The time series of the loads of one stage: the frame load (Fx, Fy, M about the moment
-    point), then every series of every load (``stage.load.name.series``); none without loads."""
+    point), then every series of every load (``stage.load.name.series_unit``,
+    :func:`series_unit`); none without loads."""
     if an.frame_force is None:
         return []
     cols = [(f"{stage}.frame.Fx_N", an.frame_force[:, 0]), (f"{stage}.frame.Fy_N", an.frame_force[:, 1]),
             (f"{stage}.frame.M_Nm", an.frame_moment)]
     for name in an.loads:
-        cols += [(f"{stage}.load.{name}.{key}", v) for key, v in sorted(an.loads[name].items())]
+        series = an.loads[name]
+        cols += [(f"{stage}.load.{name}.{key}_{series_unit(key, series)}", v) for key, v in sorted(series.items())]
     return cols

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
+from ..mechanics.drivers import driver_unit
 from ..mechanics.motion_outputs import motion_columns
 from ..balancing.regressor import model_size
 from ..study import Study
@@ -241,9 +242,21 @@ def timeseries_file(study: Study) -> CsvFile:
     return CsvFile(",".join(c for c, _ in cols), [v for _, v in cols])
 
 
+#: a joint reaction's unit by component (:func:`balpipe.engine.dynamics.joint_reactions`), as
+#: timeseries.csv's column names write it: forces in N, the moments and gear torques in N m
+REACTION_UNITS = {"Fx": "N", "Fy": "N", "N": "N", "Ft": "N", "Fr": "N", "M": "Nm", "T": "Nm"}
+
+
+def _unit_tag(unit: str) -> str:
+    """A unit as the CSV column names end with it: 'N m' -> 'Nm', 'm/s' -> 'm_s'."""
+    return unit.replace(" ", "").replace("/", "_")
+
+
 def timeseries_columns(study: Study) -> list[tuple[str, np.ndarray]]:
-    """The columns of ``timeseries.csv`` as (name, values), in its order: t, then per stage Fx,
-    Fy, |F|, M (about the moment point), every actuator effort, every joint reaction (see
+    """The columns of ``timeseries.csv`` as (name, values), in its order, every name ending in
+    its SI unit (``_N``, ``_Nm``, ``_m``, ``_rad_s``, ...): t, then per stage Fx,
+    Fy, |F|, M (about the moment point), every actuator effort (``effort.<driver>_Nm`` or
+    ``_N``), every joint reaction (``reaction.<joint>.<component>_N`` or ``_Nm``, see
     :func:`balpipe.engine.dynamics.joint_reactions`), with loads the frame load and every load's
     series (:func:`.load_table.load_columns`), the total centre of mass, every body's pose and
     every named point's path with their velocities
@@ -257,11 +270,12 @@ def timeseries_columns(study: Study) -> list[tuple[str, np.ndarray]]:
             (f"{n}.F_N", np.hypot(an.force[:, 0], an.force[:, 1])),
             (f"{n}.M_Nm", an.moment),
         ]
+        model = s.stage.model
         for d in sorted(an.efforts):
-            cols.append((f"{n}.effort.{d}", an.efforts[d]))
+            cols.append((f"{n}.effort.{d}_{_unit_tag(driver_unit(model, d))}", an.efforts[d]))
         for j in sorted(an.reactions):
             for comp, values in an.reactions[j].items():
-                cols.append((f"{n}.reaction.{j}.{comp}", values))
+                cols.append((f"{n}.reaction.{j}.{comp}_{REACTION_UNITS[comp]}", values))
         cols += load_columns(n, an)
         cols += [(f"{n}.{name}", values) for name, values in motion_columns(s.stage.model, an)]
     return cols
