@@ -153,3 +153,45 @@ def test_the_diff_says_first_whether_each_side_is_still_balanced(verdict_site, b
     assert any("old design" in s for s in legend) and any("new design" in s for s in legend)
     assert visible_in_width(page, "#verdict"), width
     assert not problems, problems
+
+
+@pytest.fixture(scope="module")
+def history_site(tmp_path_factory) -> Path:
+    """A spec committed twice (its slider made heavier, a note committed beside it), its history
+    recorded and built without simulation; returns the site."""
+    from _gitrepo import Repo, edit
+
+    repo = Repo(tmp_path_factory.mktemp("hist") / "repo")
+    repo.copy_spec("offset_slider_crank.yaml", "specs/osc.yaml")
+    text = repo.read("specs/osc.yaml") + "analysis:\n  samples: 81\n"
+    repo.commit("first design", {"specs/osc.yaml": text})
+    repo.commit("heavier slider", {"specs/osc.yaml": edit(text, "slider:  {mass: 600 g}", "slider:  {mass: 800 g}"),
+                                   "notes.txt": "why the slider is heavier\n"})
+    for args in (("history", "specs", "-o", "out", "--no-sim", "--cache", "cache"), ("build", "specs", "-o", "out", "--no-sim")):
+        r = subprocess.run([sys.executable, "-m", "balpipe", *args], cwd=repo.path, capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+    return repo.path / "out"
+
+
+@pytest.mark.parametrize("width", WIDTHS)
+def test_the_history_says_which_inputs_each_commit_changed_and_its_plots_are_live(history_site, browser, width):
+    page, problems = open_page(browser, history_site / "osc" / "history.html", width)
+    rows = page.eval_on_selector_all(".history-table tr", """trs => trs.slice(1).filter(t => t.querySelector('.inputs-changed'))
+        .map(t => [t.cells[0].textContent, t.querySelector('.inputs-changed').innerText, t.cells[5].innerText])""")
+    assert [r[0] for r in rows] == ["2", "1"]  # newest first
+    (_, changed2, verdict2), (_, changed1, verdict1) = rows
+    assert changed2.splitlines() == ["mechanism.slider.mass: 0.6 → 0.8", "files: notes.txt"]
+    assert changed1 == "first commit of the spec"
+    assert verdict1.startswith("force balanced as designed") and "cost: moment ×" in verdict2
+    # the plots over the commits are the pages' interactive ones: drawn, and hovering reads a commit
+    page.wait_for_selector("#live-hist-loads .u-over")
+    assert page.locator(".live").count() == 3  # loads, added mass and inertia, changing parameters
+    over = page.locator("#live-hist-loads .u-over").first
+    over.scroll_into_view_if_needed()
+    box = over.bounding_box()
+    page.mouse.move(box["x"] + 0.95 * box["width"], box["y"] + 0.5 * box["height"])
+    legend = page.eval_on_selector("#live-hist-loads .uplot", "el => [...el.querySelectorAll('.u-legend .u-series')]"
+                                   ".map(s => s.textContent)")
+    assert legend[0].startswith("commit #") and any(s.startswith("counterweights") for s in legend)
+    assert visible_in_width(page, ".history-table .inputs-changed code"), width
+    assert not problems, problems
