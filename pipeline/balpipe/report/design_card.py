@@ -11,7 +11,7 @@ from markupsafe import Markup
 from ..display import numbers
 from ..model import Model
 from ..study import Study
-from .costs import factor_text
+from .costs import drivers_text, factor_text
 from .notation_table import PageNames, names_for
 
 
@@ -80,9 +80,9 @@ def design_card(study: Study, results: dict) -> dict | None:
     names = names_for(study.spec)
     factors = [
         ("moving mass", factor_text(c["moving_mass"]), f"+{_fmt(c['added_mass'] or 0.0)} kg"),
-        ("peak actuator effort", factor_text(c["effort"]), names.driver(c["effort_driver"])),
-        ("RMS actuator effort", factor_text(c["rms"]), names.driver(c["rms_driver"])),
-        ("peak actuator power", factor_text(c["power"]), names.driver(c["power_driver"])),
+        ("peak actuator effort", factor_text(c["effort"]), drivers_text(c, "effort", names.driver)),
+        ("RMS actuator effort", factor_text(c["rms"]), drivers_text(c, "rms", names.driver)),
+        ("peak actuator power", factor_text(c["power"]), drivers_text(c, "power", names.driver)),
         ("largest joint load", factor_text(c["joint_load"]), names.joint(c["joint"])),
     ]
     parts = added_parts(ref.stage.model, final.stage.model, names)

@@ -9,7 +9,7 @@ from typing import Any, Sequence
 from ..runtime.fsutil import write_file_atomic  # replaced in one step, never through a planted symlink
 from . import citations, site_filter, verdict
 from .verdict import LEVELS
-from .costs import factor_text
+from .costs import drivers_text, factor_text
 from ..display.numbers import num_at
 from .mechanism_key import describe
 from .render import environment, num, printable, ratio
@@ -59,10 +59,10 @@ def _entry(out: Path, o) -> dict:
         e["verdict"] = v
         e["not_realisable"] = [f"{s['label']}: {s['not_realisable']}" for s in st if s.get("realisable") is False]
         tol = results.get("checks", {}).get("balance_tolerance")
-        e["headline"] = headline(v, tol)
+        e["headline"] = headline(v, tol, {a["driver"]: a.get("symbol") or a["driver"] for a in results.get("actuators") or []})
         # the main design's headline stage of its first motion (never a compared design's)
         last = next((s for s in st if v["motions"] and s["name"] == v["motions"][0]["final"]), st[-1])
-        e["added_mass"] = f"{num(last['added_mass'])} kg"
+        e["added_mass"] = f"{num_at(last['added_mass'], results.get('moving_mass'))} kg"
         e.update(_costs(results, first, last))
         e["refs"] = v["references"].get("badge") or "—"  # reproduced / explained / not reproduced, apart
         val = results.get("validation")
@@ -76,10 +76,12 @@ def _entry(out: Path, o) -> dict:
     return e
 
 
-def headline(v: dict, tol: float | None) -> dict:
+def headline(v: dict, tol: float | None, symbols: dict[str, str] | None = None) -> dict:
     """The index's headline numbers from the verdict's motions (the spec's main design only):
     inertial |F| and |M| peaks, reference -> final stage, and with gravity the weight apart; a
-    spec with several motions shows the range over them."""
+    spec with several motions shows the range over them. ``symbols`` names the drivers (the
+    paper's symbol of each) in the costs, which say which driver is the worst and every other
+    driver's factor."""
     ms = v.get("motions") or []
     if not ms:
         return {"force": "—", "moment": "—", "weight": "", "motions": 0, "rows": [], "costs": [], "realisable": True}
@@ -112,8 +114,12 @@ def headline(v: dict, tol: float | None) -> dict:
     w = ms[0].get("weight")
     weight = f"{num(w[0])} → {num(w[1])}" if w and w[0] is not None else ""
     c = ms[0]["costs"]
-    costs = [("moving mass", factor_text(c["moving_mass"])), ("peak effort", factor_text(c["effort"])),
-             ("RMS effort", factor_text(c["rms"])), ("peak power", factor_text(c["power"])),
+    def per_driver(name: str) -> str:  # the factor, which driver (the worst) and every other driver's
+        who = drivers_text(c, name, lambda d: (symbols or {}).get(d, d))
+        return factor_text(c[name]) + (f" ({who})" if who else "")
+
+    costs = [("moving mass", factor_text(c["moving_mass"])), ("peak effort", per_driver("effort")),
+             ("RMS effort", per_driver("rms")), ("peak power", per_driver("power")),
              ("largest joint load", factor_text(c["joint_load"]))]
     return {"force": force, "moment": moment, "weight": weight, "motions": len(ms), "rows": rows,
             "costs": costs, "realisable": c["realisable"]}
