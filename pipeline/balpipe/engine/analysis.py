@@ -219,13 +219,17 @@ def analyse(
     t = np.asarray(t, dtype=float)
     g = np.asarray(gravity, dtype=float)
     Mdiag = np.stack([c.mass, c.mass, c.inertia], axis=1).reshape(1, -1)
-    kin = None
+    kin: fastpath.Kinematics | fastpath.Motion | None = None
     actuation = rates = None
+    # the block path, chunk by chunk, where the multipliers are one backward solve (no loads,
+    # meshes or actuators apart from the drivers); otherwise its kinematics on the whole grid
+    by_chunks = not model.loads and not c.meshes and c.dynamics is None
     if method == "auto":
         if c.fast is None:
             c.fast = fastpath.prepare(c)
         try:
-            kin = fastpath.kinematics(c, c.fast, t)
+            kin = (fastpath.dynamics_by_chunks(c, c.fast, t, Mdiag, g) if by_chunks
+                   else fastpath.kinematics(c, c.fast, t))
         except fastpath.Fallback:
             kin = None
     placed = None
@@ -239,14 +243,22 @@ def analyse(
     lt = load_terms(model, c, t, q, v) if model.loads else None
     mesh_geo: list = []
     radial_on_frame = None
-    if kin is not None and not c.meshes and c.dynamics is None:
+    if isinstance(kin, fastpath.Motion):
+        done = kin
+
+        def solver(rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            return done.lamT.T, done.frame
+
+        rhs = q  # not read: the chunks solved with Q - M q''
+    elif isinstance(kin, fastpath.Kinematics) and not c.meshes and c.dynamics is None:
         rhsT = -Mdiag.T * kin.A[3:-1]
         rhsT[0::3] += (c.mass * g[0])[:, None]
         rhsT[1::3] += (c.mass * g[1])[:, None]
+        fast_kin = kin
 
         def solver(rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            lamT = fastpath.multipliers(c.fast, kin, rhs.T)
-            return lamT.T, fastpath.frame_load(c.fast, kin.vals, lamT)
+            lamT = fastpath.multipliers(c.fast, fast_kin, rhs.T)
+            return lamT.T, fastpath.frame_load(c.fast, fast_kin.vals, lamT)
 
         rhs = rhsT.T
     else:

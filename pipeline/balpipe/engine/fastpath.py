@@ -16,6 +16,9 @@ substitution on the decomposed Jacobian (:mod:`.structure`), the constraints eva
   (:mod:`.warmstart`).
 * Velocities Phi_q q' = nu, accelerations Phi_q q'' = gamma: forward substitution.
 * Multipliers Phi_q^T lambda = Q - M q'': backward substitution on the same values.
+* Long grids: after the positions, everything runs :data:`CHUNK` samples at a time
+  (:func:`dynamics_by_chunks`; the same values), so that the Jacobian's values and the
+  trigonometry of one chunk are alive at a time and stay in the caches.
 * Regularity: cond(Phi_q) >= max|entry| / sigma_min(block) for every diagonal block; samples
   where this bound passes 1e-4 of the limit get the exact (SVD) condition number, and a sample
   beyond the limit is reported by :func:`.positions._check_regular`, with the same message as
@@ -41,7 +44,7 @@ from .positions import _COND_LIMIT, _TOL, _check_regular, _condition, follow_mot
 from .constraints import with_frame, jacobian
 from .newton_blocks import BlockOps, polish
 from .structure import Decomposition, block_sigma_min, decompose, invert_blocks, solve
-from .vectorised import State, Vectorised, acceleration_rhs, jacobian_values, law_table, residual, velocity_rhs, vectorise
+from .vectorised import State, Vectorised, acceleration_rhs, jacobian_values, law_table, residual, residual_rows, velocity_rhs, vectorise
 
 _SCREEN = 1e-4  # exact condition numbers where the lower bound exceeds this fraction of the limit
 _RESIDUAL = 1e-9  # the general path's convergence test (:func:`.positions.newton_raphson`)
@@ -111,6 +114,73 @@ def kinematics(c: Compiled, p: Prepared, t: np.ndarray) -> Kinematics:
     return Kinematics(X, V, A, vals, state, inverses)
 
 
+CHUNK = 2048  # samples per chunk of :func:`dynamics_by_chunks`: its arrays stay in the caches
+
+
+@dataclass
+class Motion:
+    """What :func:`dynamics_by_chunks` returns: positions, velocities and accelerations,
+    coordinate-major as in :class:`Kinematics` (without the transients of the solves), the
+    multipliers (m, N) and the load on the frame (N, 3)."""
+
+    X: np.ndarray
+    V: np.ndarray
+    A: np.ndarray
+    lamT: np.ndarray
+    frame: np.ndarray
+
+
+def dynamics_by_chunks(c: Compiled, p: Prepared, t: np.ndarray, Mdiag: np.ndarray, g: np.ndarray,
+                       chunk: int | None = None) -> Motion:
+    """:func:`kinematics`, then the multipliers of Phi_q^T lambda = Q - M q'' (gravity ``g``,
+    ``Mdiag`` the diagonal of M, (1, 3 nb)) and the frame load, ``chunk`` samples at a time
+    (default :data:`CHUNK`):
+    the same operations sample by sample as the whole grid at once (the same values), with the
+    Jacobian's values, its blocks' inverses and the trigonometry of one chunk alive at a time
+    (a fifth of the memory of 20,000 samples of a 21-body ladder; the chunks' arrays stay in the
+    caches, so that throughput does not fall past 10^4 samples). The checks are those of
+    :func:`kinematics` chunk by chunk: an explicit solution off its equations falls back, a
+    singular configuration is reported at its first sample (the earlier chunks are regular)."""
+    dec, vz = p.dec, p.vz
+    if dec is None:
+        raise Fallback
+    N = len(t)
+    chunk = CHUNK if chunk is None else max(1, chunk)
+    f, fd, fdd = law_table(vz, t)  # the whole grid: a law may depend on it
+    X = np.zeros((vz.ncol + 1, N))
+    if not dec.explicit:
+        X[3:-1] = _closed_loop_positions(c, vz, dec, t, f).T
+    V, A = np.zeros_like(X), np.zeros_like(X)
+    lamT = np.empty((vz.m, N))
+    frame = np.empty((N, 3))
+    gx, gy = (c.mass * g[0])[:, None], (c.mass * g[1])[:, None]
+    for a in range(0, N, chunk):
+        b = min(N, a + chunk)
+        n, fa = b - a, f[:, a:b]
+        if dec.explicit:
+            Xc, state = _explicit_positions(vz, dec, fa, n)
+            phi = residual(vz, state, fa)
+            if not np.all(np.abs(phi) < _RESIDUAL):
+                raise Fallback
+            X[:, a:b] = Xc
+        else:
+            Xc = X[:, a:b]
+            state = State(vz, Xc[:-1])
+        vals = jacobian_values(vz, state)
+        inverses = invert_blocks(dec, vals)
+        _screen(c, p, vals, inverses, Xc, t[a:b])
+        Vc = solve(dec.forward, vals, velocity_rhs(vz, fd[:, a:b], n), inverses, offset=3)
+        Ac = solve(dec.forward, vals, acceleration_rhs(vz, state, Vc, fdd[:, a:b]), inverses, offset=3)
+        V[:, a:b], A[:, a:b] = Vc, Ac
+        rhsT = -Mdiag.T * Ac[3:-1]
+        rhsT[0::3] += gx
+        rhsT[1::3] += gy
+        lc = solve(dec.backward, vals, rhsT, inverses)[:-1]
+        lamT[:, a:b] = lc
+        frame[a:b] = frame_load(p, vals, lc)
+    return Motion(X, V, A, lamT, frame)
+
+
 def _explicit_positions(vz: Vectorised, dec: Decomposition, f: np.ndarray, N: int) -> tuple[np.ndarray, State]:
     """Every block 1 x 1 and linear: unknown = -phi(unknown = 0) / pivot, level by level. The
     angles come first (angle rows involve angles only), then the trigonometry once, then the
@@ -126,9 +196,9 @@ def _explicit_positions(vz: Vectorised, dec: Decomposition, f: np.ndarray, N: in
         X[unk + 3] = -(vz.akoef[eq] @ th + fa[eq]) / vz.const[piv][:, None]
     s = State(vz, X[:-1])
     for eq, unk, piv in dec.position_steps:
-        phi = residual(vz, s, f)
+        phi = residual_rows(vz, s, f, eq)
         p = vz.const[piv][:, None] if dec.pivots_constant else jacobian_values(vz, s)[piv]
-        X[unk + 3] = -phi[eq] / p
+        X[unk + 3] = -phi / p
     if not np.all(np.isfinite(X)):
         raise Fallback
     return X, s

@@ -170,6 +170,15 @@ class _Aux:
         self.const = np.append(vz.const, 0.0)[:, None]
         self.bodies = np.concatenate([vz.ci, vz.cj, vz.pi, vz.pi, vz.pj]).astype(np.intp)
         self.local = np.concatenate([vz.csi, vz.csj, vz.pa, vz.psi, vz.psj]).reshape(-1, 2)
+        # per constraint row: its kind (0, 1: a revolute's x, y; 2: an angle row; 3: a projection),
+        # its primitive's index within the kind, and its law's index (-1: no law)
+        self.kind = np.full(vz.m, -1, dtype=np.intp)
+        self.index = np.zeros(vz.m, dtype=np.intp)
+        self.law = np.full(vz.m, -1, dtype=np.intp)
+        for kind, rows in ((0, vz.crow), (1, vz.crow + 1), (2, vz.arow), (3, vz.prow)):
+            self.kind[rows] = kind
+            self.index[rows] = np.arange(len(rows))
+        self.law[vz.law_rows] = np.arange(len(vz.law_rows))
 
 
 class State:
@@ -215,6 +224,36 @@ def residual(vz: Vectorised, s: State, f: np.ndarray) -> np.ndarray:
         out[vz.prow] = s.ex * dx + s.ey * dy - ax.pconst
     if len(vz.law_rows):
         out[vz.law_rows] -= f
+    return out
+
+
+def residual_rows(vz: Vectorised, s: State, f: np.ndarray, eq: np.ndarray) -> np.ndarray:
+    """The rows ``eq`` of :func:`residual` (len(eq), N), each by the same operations as there (the
+    same values), the others not evaluated: what an explicit solve level by level needs (the
+    whole residual at every level is O(levels x rows): quadratic in a serial chain's length)."""
+    X, ax = s.X, s.aux
+    out = np.empty((len(eq), X.shape[1]))
+    kind, index = ax.kind[eq], ax.index[eq]
+    for kd in (0, 1, 2, 3):
+        at = np.flatnonzero(kind == kd)
+        if not len(at):
+            continue
+        k = index[at]
+        if kd == 0:
+            out[at] = X[ax.cix[k]] + s.AIx[k] - X[ax.cjx[k]] - s.AJx[k]
+        elif kd == 1:
+            out[at] = X[ax.ciy[k]] + s.AIy[k] - X[ax.cjy[k]] - s.AJy[k]
+        elif kd == 2:
+            out[at] = vz.akoef[k] @ X[2::3] - ax.aconst[k]
+        else:
+            xi, yi, xj, yj = ax.pix[k], ax.piy[k], ax.pjx[k], ax.pjy[k]
+            dx = X[xj] + s.PJx[k] - X[xi] - s.PIx[k]
+            dy = X[yj] + s.PJy[k] - X[yi] - s.PIy[k]
+            out[at] = s.ex[k] * dx + s.ey[k] * dy - ax.pconst[k]
+    law = ax.law[eq]
+    driven = np.flatnonzero(law >= 0)
+    if len(driven):
+        out[driven] -= f[law[driven]]
     return out
 
 

@@ -1,0 +1,97 @@
+"""The block path chunk by chunk (:func:`balpipe.engine.fastpath.dynamics_by_chunks`): the same
+values as the whole grid at once, bit for bit, on open chains (explicit positions, solved level
+by level with :func:`balpipe.engine.vectorised.residual_rows`) and closed loops; a singular
+configuration is reported by the chunk that holds it, the earlier ones being regular."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from balpipe import registry
+from balpipe.engine import analyse, compiled, fastpath
+from balpipe.engine.vectorised import State, law_table, residual, residual_rows
+from balpipe.loader import load
+from balpipe.model import FRAME, Body, Driver, Model, Revolute
+from balpipe.motion import PointToPoint, quintic
+from balpipe.study import gravity_vector
+
+
+def chain(n: int, seed: int = 0, sweep: float = 1.0) -> Model:
+    """A planar nR serial chain with random links, every joint on the 3-4-5 law over 1 s."""
+    rng = np.random.default_rng(seed)
+    L = rng.uniform(0.1, 0.5, n)
+    r, m = L * rng.uniform(0.3, 0.7, n), rng.uniform(0.5, 5.0, n)
+    q0 = rng.uniform(-0.5, 0.5, n) + 0.3
+    qf = q0 + sweep * rng.uniform(-1.0, 1.0, n)
+    bodies = tuple(Body(f"l{k}", m[k], (r[k], 0.0), m[k] * L[k] ** 2 / 12, points={"p": (0.0, 0.0), "d": (L[k], 0.0)},
+                        outline=("p", "d")) for k in range(n))
+    joints = tuple(Revolute(f"J{k}", FRAME if k == 0 else f"l{k - 1}", f"l{k}", (0.0, 0.0) if k == 0 else (L[k - 1], 0.0),
+                            (0.0, 0.0)) for k in range(n))
+    drivers = tuple(Driver(f"q{k}", ("joint", f"J{k}"), PointToPoint(q0[k], qf[k], 1.0, quintic)) for k in range(n))
+    initial, x, y, th = {}, 0.0, 0.0, 0.0
+    for k in range(n):
+        th += q0[k]
+        initial[f"l{k}"] = (x, y, th)
+        x, y = x + L[k] * math.cos(th), y + L[k] * math.sin(th)
+    return Model(f"{n}R chain", bodies, joints, drivers, initial, frame_points={"O": (0.0, 0.0)})
+
+
+def _both(model: Model, t: np.ndarray, g: np.ndarray, chunk: int):
+    c = compiled(model)
+    if c.fast is None:
+        c.fast = fastpath.prepare(c)
+    Mdiag = np.stack([c.mass, c.mass, c.inertia], axis=1).reshape(1, -1)
+    whole = fastpath.dynamics_by_chunks(c, c.fast, t, Mdiag, g, chunk=len(t))
+    parts = fastpath.dynamics_by_chunks(c, c.fast, t, Mdiag, g, chunk=chunk)
+    return whole, parts
+
+
+def test_analyse_takes_the_chunks_on_long_grids():
+    """analyse() on more samples than a chunk: the same Analysis as on one chunk."""
+    model, t = chain(5, seed=2), np.linspace(0.0, 1.0, 3 * fastpath.CHUNK + 5)
+    a = analyse(model, t, (0.0, -9.81))
+    saved = fastpath.CHUNK
+    try:
+        fastpath.CHUNK = len(t)
+        b = analyse(model, t, (0.0, -9.81))
+    finally:
+        fastpath.CHUNK = saved
+    for name in ("q", "v", "a", "force", "moment", "frame_pose"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    assert all(np.array_equal(a.efforts[k], b.efforts[k]) for k in a.efforts)
+
+
+@pytest.mark.parametrize("n", [1, 3, 12])
+def test_chain_chunks_bit_for_bit(n):
+    t = np.linspace(0.0, 1.0, 101)
+    whole, parts = _both(chain(n, seed=n), t, np.array([0.0, -9.81]), chunk=17)
+    for name in ("X", "V", "A", "lamT", "frame"):
+        assert np.array_equal(getattr(whole, name), getattr(parts, name)), name
+
+
+def test_closed_loop_chunks_bit_for_bit():
+    spec = load("specs/custom_four_bar_balancing.yaml").spec
+    for stage in registry.balance(spec).stages:
+        t = np.linspace(0.0, spec.motion.duration, 53)
+        whole, parts = _both(stage.model, t, np.asarray(gravity_vector(spec)), chunk=8)
+        for name in ("X", "V", "A", "lamT", "frame"):
+            assert np.array_equal(getattr(whole, name), getattr(parts, name)), (stage.name, name)
+
+
+def test_residual_rows_are_the_residuals_rows():
+    c = compiled(chain(7, seed=3))
+    if c.fast is None:
+        c.fast = fastpath.prepare(c)
+    vz = c.fast.vz
+    t = np.linspace(0.0, 1.0, 11)
+    f, _, _ = law_table(vz, t)
+    rng = np.random.default_rng(1)
+    X = rng.normal(size=(vz.ncol, len(t)))
+    X[:3] = 0.0
+    s = State(vz, X)
+    full = residual(vz, s, f)
+    for eq in (np.arange(vz.m), np.array([0, 5, 2]), np.array([vz.m - 1])):
+        assert np.array_equal(residual_rows(vz, s, f, eq), full[eq])
