@@ -55,7 +55,7 @@
     out.F = norm(out.Fx, out.Fy);
     return out;
   }
-  const api = { t: t, design: design, series: design, values: values, parts: parts, updates: 0 };
+  const api = { t: t, design: design, series: design, values: values, parts: parts, updates: 0, drawn: 0 };
   window.balpipeWhatif = api;
 
   // the controls: per part a group of four rows (range, number box, the computed value marked)
@@ -178,6 +178,7 @@
       u.setData(data);
       if (zoomed) u.setScale("x", { min: range[0], max: range[1] });
     });
+    api.drawn = api.updates;  // the plots show the design of this update
   }
   let frame = 0;
   function update() {

@@ -81,8 +81,7 @@ def test_random_sliders_give_the_engines_loads_and_the_reset_the_design(whatif_s
         assert set(state["series"]) == set(ref.keys) | {"F"}
         for k, y in state["series"].items():
             assert np.max(np.abs(np.array(y) - exact[k])) <= 1e-9 * _scale(k, exact), (slug, k)
-        p.wait_for_timeout(50)  # the plots are redrawn on the next frame
-        p.wait_for_function("() => document.getElementById('live-whatif').uplots.length > 0")
+        p.wait_for_function("() => window.balpipeWhatif.drawn === window.balpipeWhatif.updates")  # redrawn on the next frame
         plots = p.evaluate(_PLOTS)
         for plot in plots:  # the plot draws the design tried; the computed design stays
             assert plot["series"][2] == state["series"][plot["key"]], plot["key"]
@@ -93,7 +92,7 @@ def test_random_sliders_give_the_engines_loads_and_the_reset_the_design(whatif_s
     assert state["values"] == [list(q.design) for q in ref.parts]
     for k, y in state["series"].items():
         assert y == start["design"][k], k
-    p.wait_for_timeout(50)
+    p.wait_for_function("() => window.balpipeWhatif.drawn === window.balpipeWhatif.updates")
     for plot in p.evaluate(_PLOTS):
         assert plot["series"][2] == plot["series"][1], plot["key"]
     assert not w.problems, "\n".join(w.problems)
@@ -154,4 +153,26 @@ def test_round_off_of_the_computed_parts_reads_zero(whatif_site, browser):
       document.getElementById('whatif-peaks').innerText].join(' ')""")
     assert not re.search(r"\de-\d", text), re.findall(r"\S*\de-\d\S*", text)
     assert p.evaluate("window.balpipeWhatif.values") == design
+    assert not w.problems, "\n".join(w.problems)
+
+
+def test_a_design_tried_before_the_plots_are_built_is_drawn_when_they_are(whatif_site, browser):
+    """Charts are built when their section opens: sliders moved while the section is folded (no
+    plot yet) are drawn once it opens, the tried design's curves and not the computed one's."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto((whatif_site / "offset_slider_crank" / "index.html").as_uri(), wait_until="load")
+    p.wait_for_function("() => window.balpipeWhatif")
+    assert not p.evaluate("() => !!(document.getElementById('live-whatif').uplots || []).length")
+    p.evaluate("""() => { const r = document.querySelector('#whatif-panel input[type=range]');
+      r.value = String(+r.max); r.dispatchEvent(new Event('input', { bubbles: true })); }""")
+    p.evaluate("document.getElementById('whatif-panel').closest('details').open = true")
+    p.wait_for_function("() => (document.getElementById('live-whatif').uplots || []).length > 0")
+    p.wait_for_function("() => window.balpipeWhatif.drawn === window.balpipeWhatif.updates")
+    state = p.evaluate(_STATE)
+    plots = p.evaluate(_PLOTS)
+    assert state["series"]["M"] != state["design"]["M"]
+    for plot in plots:
+        assert plot["series"][2] == state["series"][plot["key"]], plot["key"]
     assert not w.problems, "\n".join(w.problems)
