@@ -200,6 +200,64 @@
     });
     host.insertBefore(box, host.firstChild);
   }
+  // the figure as drawn, as a PNG: every panel shown (its title, plot and a legend of the curves
+  // shown, each by its swatch), two a row in a figure of small multiples, on white
+  function figurePng(f) {
+    const shown = f.plots.filter(u => !u.root.parentNode.hidden);
+    if (!shown.length) return null;
+    const r = ratio(shown[0]), line = 16 * r, head = 26 * r, gap = 12 * r;
+    const cols = f.host.classList.contains("live-grid") && shown.length > 1 ? 2 : 1;
+    const cells = shown.map(u => {
+      const entries = u.series.map((s, n) => [s, n]).filter(([s, n]) => n > 0 && s.show);
+      return { u: u, entries: entries, w: u.ctx.canvas.width, h: head + u.ctx.canvas.height + entries.length * line + gap };
+    });
+    const w = Math.max(...cells.map(c => c.w)), heights = [];
+    cells.forEach((c, i) => { const row = Math.floor(i / cols); heights[row] = Math.max(heights[row] || 0, c.h); });
+    const out = document.createElement("canvas");
+    out.width = w * cols; out.height = heights.reduce((a, b) => a + b, 0);
+    const g = out.getContext("2d");
+    g.fillStyle = "#fff"; g.fillRect(0, 0, out.width, out.height);
+    cells.forEach((c, i) => {
+      const x = (i % cols) * w, y = heights.slice(0, Math.floor(i / cols)).reduce((a, b) => a + b, 0);
+      g.fillStyle = "#1d232b"; g.font = "bold " + (13 * r) + "px sans-serif"; g.textAlign = "center";
+      g.fillText(c.u.root.querySelector(".u-title") ? c.u.root.querySelector(".u-title").textContent : "", x + c.w / 2, y + 18 * r);
+      g.drawImage(c.u.ctx.canvas, x, y + head);
+      g.textAlign = "left"; g.font = (11 * r) + "px sans-serif";
+      c.entries.forEach(([s, n], j) => {
+        const d = f.series[f.order[n - 1]], ly = y + head + c.u.ctx.canvas.height + (j + 0.6) * line, lx = x + 60 * r;
+        g.save();
+        g.strokeStyle = d.stroke; g.lineWidth = d.width * r; g.setLineDash((d.dash || []).map(v => v * r));
+        g.beginPath(); g.moveTo(lx, ly); g.lineTo(lx + 28 * r, ly); g.stroke();
+        const marker = d.marker ? d.marker[0] : (d.points ? "o" : "");
+        if (marker) {
+          const pts = SHAPES[marker] || [], size = 3 * r, mx = lx + 14 * r;
+          g.setLineDash([]); g.lineWidth = r; g.fillStyle = "#fff"; g.beginPath();
+          if (!pts.length) g.arc(mx, ly, size, 0, 2 * Math.PI);
+          else pts.forEach(([px, py], k) => (k ? g.lineTo : g.moveTo).call(g, mx + px * size, ly + py * size));
+          g.closePath(); g.fill(); g.stroke();
+        }
+        g.restore();
+        g.fillStyle = "#1d232b"; g.fillText(d.label, lx + 34 * r, ly + 4 * r);
+      });
+    });
+    return out.toDataURL("image/png");
+  }
+  // the PNG button beside the figure's CSV link (report: draw/live.py's downloads line)
+  function pngButton(f) {
+    const bar = document.querySelector('p.downloads[data-for="' + f.host.id + '"]');
+    if (!bar || bar.querySelector("button.png")) return;
+    const b = document.createElement("button");
+    b.type = "button"; b.className = "png"; b.textContent = "figure (PNG)";
+    b.addEventListener("click", () => {
+      const url = figurePng(f);
+      if (!url) return;
+      const a = document.createElement("a");
+      a.href = url; a.download = f.host.id.replace(/^live-/, "figure-") + ".png";
+      document.body.appendChild(a); a.click(); a.remove();
+    });
+    bar.appendChild(document.createTextNode(" · "));
+    bar.appendChild(b);
+  }
   const figures = [], all = [];  // {host, plots, hovering, ...}: the figures over time, every figure
   let playerTime = null;
   function follow(f) {
@@ -281,6 +339,7 @@
     }
     if (d.choose != null) chooser(host, d, f);
     if (sims) simToggle(host, f, drawn);
+    pngButton(f);
     host.classList.add("live-ready");
     host.uplots = f.plots;  // the drawn plots, for the console and the browser tests
     all.push(f);

@@ -55,9 +55,12 @@ def test_write_writes_the_command_lines_page_files(api_studies, cli_site, tmp_pa
     st = api_studies("offset_slider_crank.yaml")
     page = st.write(tmp_path / "osc")
     assert page == tmp_path / "osc" / "index.html"
-    assert sorted(p.name for p in (tmp_path / "osc").iterdir()) == ["index.html", "results.json", "timeseries.csv"]
+    names = sorted(p.name for p in (tmp_path / "osc").iterdir())
+    figures = [n for n in names if n.startswith("figure-") and n.endswith(".csv")]  # each live figure's data
+    assert [n for n in names if n not in figures] == ["index.html", "results.json", "timeseries.csv"]
+    assert {"figure-loads.csv", "figure-efforts.csv"} <= set(figures)
     built = cli_site / _slug("offset_slider_crank.yaml")
-    for name in ("index.html", "timeseries.csv"):
+    for name in ("index.html", "timeseries.csv", *figures):
         assert (tmp_path / "osc" / name).read_bytes() == (built / name).read_bytes(), name
     assert json.loads((tmp_path / "osc" / "results.json").read_text(encoding="utf-8")) == st.results()
 

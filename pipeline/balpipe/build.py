@@ -268,8 +268,11 @@ def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outc
     from .report import history_page
 
     store = cache.Store(opts.out, slug, code_hash(), reuse=not opts.force) if figure_cache else None
-    with cache.using(store):
+    from .draw import live
+
+    with cache.using(store), live.collecting() as figure_files:  # the history figures' data files too
         history, files = history_page.section(target), history_page.build_files(target)
+    files = {**files, **figure_files}
     return Job(path, loaded.text, h, opts.simulate, history, files, opts.sim_workers, source=opts.name(path),
                figure_cache=opts.out if figure_cache else None, redraw=opts.force,
                figure_keys=frozenset(store.used) if store is not None else frozenset())
@@ -374,7 +377,8 @@ def page_files(loaded, st, results: dict, history: dict | None = None,
                history_files: dict[str, str] | None = None) -> dict[str, Any]:
     """The files of a study's page folder, by name: ``index.html`` (the page, with the spec's
     text and its ``history``), ``results.json`` (``results``), ``timeseries.csv`` (written by
-    pieces: :class:`balpipe.report.results.CsvFile`), with parts the bill of materials
+    pieces: :class:`balpipe.report.results.CsvFile`), each interactive figure's data
+    (``figure-<name>.csv``, :func:`balpipe.draw.live.collecting`), with parts the bill of materials
     (``parts.csv``) and each part's drawings (``part-*.dxf``, ``part-*.svg``), with the
     simulation the wall times of its runs (``timing.json``, ``timing.js``), and the history's
     files. ``balpipe build`` and :meth:`balpipe.Study.write` both write these."""
@@ -390,8 +394,13 @@ def page_files(loaded, st, results: dict, history: dict | None = None,
         from .report.parts_table import bom_csv
 
         extra.update({"parts.csv": bom_csv(results["parts"]), **drawing_files(st)})
+    from .draw import live
+
+    with live.collecting() as figure_files:  # each interactive figure's data, linked under it
+        page = render_page(st, results, loaded.text, history=history)
     return {
-        "index.html": render_page(st, results, loaded.text, history=history),
+        "index.html": page,
+        **figure_files,
         "results.json": dumps(results),
         "timeseries.csv": timeseries_file(st),
         **extra,

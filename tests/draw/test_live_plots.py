@@ -440,3 +440,36 @@ def test_a_log_panel_keeps_sixteen_decades_below_its_largest_value():
     shown = LV.data(c)["series"][0]["y"]["r"]
     assert LV.LOG_RANGE == 1e-16
     assert shown == [None, None, 2e-20, 1e-4, None]
+
+
+def test_a_figures_csv_holds_its_plotted_samples_exactly_in_si_with_units(rng):
+    """live.csv_text: the samples the plot keeps, 12 significant digits (not the plot's 6), a
+    column per curve and panel named with its unit in parentheses, the drift's mm as m and its
+    deg as rad; live.html links the file while collecting it, and not otherwise."""
+    import csv as csv_mod
+    import io
+
+    from balpipe.report import live_plots as LP
+
+    n = int(rng.integers(500, 900))
+    t = np.linspace(0.0, 1.0, n)
+    d = rng.normal(size=(n, 2)) * 1e-3
+    rot = rng.normal(size=n)
+    c = LP.drift([("first stage (a remark)", t, d, rot), ("second", t, 2 * d, -rot)])
+    rows = list(csv_mod.reader(io.StringIO(LV.csv_text(c))))
+    head, body = rows[0], np.array([[float(v) for v in r] for r in rows[1:]])
+    assert head == ["t (s)", "first stage: drift (m)", "second: drift (m)", "first stage: rotation (rad)",
+                    "second: rotation (rad)"]
+    k = LV._thin(n, 4)
+    assert len(body) == len(k) < n
+    assert np.allclose(body[:, 0], t[k], rtol=1e-11, atol=0)
+    assert np.allclose(body[:, 1], np.hypot(d[k, 0], d[k, 1]), rtol=1e-11, atol=0)  # in m: SI
+    assert np.allclose(body[:, 4], -rot[k], rtol=1e-11, atol=1e-300)  # rad
+    six = LV.data(c)["series"][0]["y"]["drift"]  # the plot's own values: 6 digits, in mm
+    assert np.allclose(np.array(six) / 1000, body[:, 1], rtol=1e-5)
+    assert "figure-drift.csv" not in LV.html("drift", c)
+    with LV.collecting() as files:
+        markup = LV.html("drift", c)
+    assert list(files) == ["figure-drift.csv"] and files["figure-drift.csv"] == LV.csv_text(c)
+    assert 'href="figure-drift.csv"' in markup
+    assert LV.column_unit("|ΔF| / F_ref") == ("|ΔF| / F_ref", "1", 1.0)

@@ -10,6 +10,8 @@ of the links runs everywhere.
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 import os
 import re
@@ -1064,4 +1066,36 @@ def test_a_folded_sections_figures_are_built_when_it_opens(paper_site, browser, 
     still = p.evaluate("""() => [...document.querySelectorAll('script[data-live]')].map(s => document.getElementById(s.dataset.live))
         .filter(h => h.closest('details:not([open])')).map(h => h.querySelectorAll('.live-plot').length)""")
     assert all(n == 0 for n in still), still
+    assert not w.problems, "\n".join(w.problems)
+
+
+_UNIT_IN_NAME = re.compile(r"\([^()]+\)$")
+
+
+@pytest.mark.parametrize("width", [400, 1400])
+def test_every_figure_offers_its_data_as_csv_with_units_and_itself_as_png(server, site, browser, width):
+    """Under every interactive figure: a link to its data (a CSV beside the page whose every
+    column name ends in its unit) and, once drawn, a button that downloads the figure as a PNG."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": width, "height": 900})
+    p.goto(server + "scott_russell/index.html", wait_until="load")
+    open_sections(p)
+    figures = p.evaluate("() => [...document.querySelectorAll('script[data-live]')].map(s => s.dataset.live)")
+    links = dict(p.evaluate("""() => [...document.querySelectorAll('p.downloads')].map(b =>
+        [b.dataset.for, b.querySelector('a[download]').getAttribute('href')])"""))
+    assert figures and sorted(links) == sorted(figures), (figures, links)
+    for fig, href in links.items():
+        text = (site / SUBFOLDER / "scott_russell" / href).read_text(encoding="utf-8")
+        head = next(iter(csv.reader(io.StringIO(text))))
+        assert len(head) >= 2 and all(_UNIT_IN_NAME.search(h) for h in head), (href, head)
+        assert text.count("\n") >= 2, href  # a header and a row at least (a history of one commit)
+    button = p.locator('p.downloads[data-for="live-loads"] button.png')
+    button.scroll_into_view_if_needed()
+    with p.expect_download() as got:
+        button.click()
+    d = got.value
+    assert d.suggested_filename == "figure-loads.png"
+    data = Path(d.path()).read_bytes()
+    assert data.startswith(b"\x89PNG") and len(data) > 5000
     assert not w.problems, "\n".join(w.problems)

@@ -19,8 +19,14 @@ generic figures build their curves in :mod:`balpipe.report.live_plots`.
 
 from __future__ import annotations
 
+import csv
+import io
 import json
-from typing import NamedTuple
+import math
+import re
+from contextlib import contextmanager
+from contextvars import ContextVar
+from typing import Iterator, NamedTuple
 
 import numpy as np
 
@@ -196,13 +202,86 @@ NUMBERS = ('its samples are in <a href="timeseries.csv">timeseries.csv</a>, its 
            'and in <a href="results.json">results.json</a>')
 
 
+#: the figure CSVs of the page being rendered (:func:`collecting`), by file name; None: not kept
+_FILES: ContextVar[dict[str, str] | None] = ContextVar("balpipe_live_files", default=None)
+
+
+@contextmanager
+def collecting() -> Iterator[dict[str, str]]:
+    """While active, every figure :func:`html` writes adds its data file (:func:`csv_name`:
+    :func:`csv_text`) to the dict yielded, and its markup links it: the page's folder gets one
+    CSV per interactive figure (``balpipe build``'s page files)."""
+    files: dict[str, str] = {}
+    token = _FILES.set(files)
+    try:
+        yield files
+    finally:
+        _FILES.reset(token)
+
+
+def csv_name(name: str) -> str:
+    """The data file of figure ``name`` beside the page."""
+    return f"figure-{name}.csv"
+
+
+#: a figure's unit as its CSV column names it, in SI: (SI unit, factor from the shown unit)
+TO_SI = {"mm": ("m", 1e-3), "deg": ("rad", math.pi / 180.0)}
+_UNIT = re.compile(r"\(([^()]*)\)\s*$")
+
+
+def column_unit(axis: str) -> tuple[str, str, float]:
+    """An axis label split into (quantity, SI unit, factor from the plotted values to SI): 'Fx
+    (N)' -> ('Fx', 'N', 1); 'drift (mm)' -> ('drift', 'm', 0.001); a label without a unit is a
+    ratio: ('|ΔF| / F_ref', '1', 1)."""
+    m = _UNIT.search(axis)
+    if not m:
+        return axis.strip(), "1", 1.0
+    unit = m.group(1).strip()
+    si, factor = TO_SI.get(unit, (unit, 1.0))
+    return axis[:m.start()].strip(), si, factor
+
+
+def csv_text(c: Curves) -> str:
+    """The figure's data as CSV: the samples it plots (:func:`data`'s, every sample of a figure
+    over another quantity) at their exact values (12 significant digits, as timeseries.csv, not
+    the plot's 6), in SI units; a column per curve and panel, each name ending in its unit in
+    parentheses ('t (s)', 'unbalanced: Fx (N)'); an empty cell where a curve has no value.
+    Deterministic."""
+    t = np.asarray(c.t, dtype=float)
+    k = (np.arange(len(t)) if c.x_axis else
+         _thin(len(t), sum(p["key"] in curves for _, curves in c.stages for p in c.panels)))
+    x_name, x_unit, x_factor = column_unit(c.x_axis) if c.x_axis else ("t", "s", 1.0)
+    header = [f"{x_name} ({x_unit})"]
+    columns = [t[k] * x_factor]
+    names = list(c.names) if c.names else short_names([label for label, _ in c.stages])
+    for p in c.panels:
+        quantity, unit, factor = column_unit(p["axis"])
+        for (label, curves), name in zip(c.stages, names):
+            if p["key"] in curves:
+                header.append(f"{name}: {quantity} ({unit})")
+                columns.append(np.asarray(curves[p["key"]], dtype=float)[k] * factor)
+    out = io.StringIO()
+    csv.writer(out, lineterminator="\n").writerow(header)
+    rows = [["" if not np.isfinite(v) else "%.12g" % (v + 0.0) for v in col.tolist()] for col in columns]
+    out.writelines(",".join(r) + "\n" for r in zip(*rows))
+    return out.getvalue()
+
+
 def html(name: str, c: Curves, numbers: str = NUMBERS) -> str:
     """The page's markup of one figure: the element ``#live-<name>`` that ``live_plots.js`` fills
     (on screen and in print), holding a ``<noscript>`` line that says the plot needs JavaScript
-    and where its ``numbers`` are (HTML), and the curves' JSON (:func:`data`)."""
+    and where its ``numbers`` are (HTML), and the curves' JSON (:func:`data`); while
+    :func:`collecting`, its data file too, linked under the plot (where ``live_plots.js`` adds
+    the PNG of the figure as drawn)."""
+    files = _FILES.get()
+    link = ""
+    if files is not None:
+        files[csv_name(name)] = csv_text(c)
+        link = (f'\n<p class="downloads" data-for="live-{name}">Download: <a href="{csv_name(name)}" download>'
+                f'data (CSV, SI)</a></p>')
     return (f'<div class="live" id="live-{name}"><noscript><p class="muted">This plot is drawn by JavaScript, '
             f'which is off: {numbers}.</p></noscript></div>\n'
-            f'<script type="application/json" data-live="live-{name}">{as_script(data(c))}</script>')
+            f'<script type="application/json" data-live="live-{name}">{as_script(data(c))}</script>' + link)
 
 
 def as_script(data: dict) -> str:
