@@ -255,3 +255,13 @@ def test_the_page_shows_the_part_that_does_not_fit_and_rebuilds_byte_identical(t
     assert ",no,thickness" in row and "max_thickness 50 mm" in row
     doc = ezdxf.readfile(folders[0] / "part-main-cw_crank.dxf")
     assert len(doc.modelspace().query('LWPOLYLINE[layer=="OUTLINE"]')) == 1
+
+
+def test_partial_balance_refuses_a_part_located_and_a_zero_mass_part_says_why():
+    text = (SPECS / "custom_v_twin_6000rpm.yaml").read_text(encoding="utf-8").replace(
+        "max_mass: 1.5 kg}", "max_mass: 1.5 kg, part: {material: steel, shape: disc, thickness: 10 mm}}", 1)
+    with pytest.raises(balpipe.SpecError) as info:
+        balpipe.loads(text)
+    assert "balancing.counterweights[0]" in str(info.value) and "partial_balance" in str(info.value)
+    none = make("cw", "crank", "disc", "steel", 7850.0, {"thickness": 0.01}, 0.0, (-0.06, 0.0))
+    assert not none.fits and "no part to make" in none.problems[0]

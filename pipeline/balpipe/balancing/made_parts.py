@@ -5,6 +5,9 @@ the model (the body's pivots, the axis point) and sized by
 Every method that places a counterweight with a ``part:`` gives the analysed model the part's
 own centroidal inertia (not a point mass's, nor the spread inertia of a least-mass programme):
 the stage's shaking moment, efforts and joint loads are those of the part that would be made.
+A part's second moment about its body's origin is its centroidal inertia (>= 0) plus m |c|^2, so
+it is always a realisable second moment in partial balancing's sense (J >= m |c|^2); a moment
+balance's counter-rotating discs are solved with it on the body (:mod:`.moment_balance`).
 """
 
 from __future__ import annotations

@@ -320,6 +320,9 @@ def make(name: str, body: str, shape: str, material: str, density: float, given:
         return MadePart(name, body, shape, material, density, dict(dims or given), float(mass), c, 0.0, (), axis,
                         where, (reason,), pivots)
 
+    if mass == 0:
+        return unmade("mass 0 kg: the design puts no counterweight here, so there is no part to make "
+                      "(remove the part, or the counterweight)")
     if not mass > 0:
         return unmade(f"mass {num(mass)} kg: a part needs a positive mass")
     try:

@@ -12,6 +12,7 @@ from pydantic import Field, model_validator
 from ...laws.motion_spec import Motion
 from ...spec_parts import Strict
 from ...units import Inertia, Mass, count, number
+from ..part_spec import PartShapeSpec
 from ..specs import CounterRotationSpec, CounterweightRegionSpec, LoadTerm, Point
 
 LOADS = ("shaking_force", "shaking_moment", "effort", "joint")
@@ -25,6 +26,9 @@ class PartialCounterweightSpec(CounterweightRegionSpec):
 
     polygon: list[Point] | None = Field(None, min_length=3, description="anywhere in this convex polygon (vertices in order)")
     max_mass: Mass | None = Field(None, description="upper bound on this counterweight's mass")
+    part: PartShapeSpec | None = Field(None, description="refused here: partial_balance chooses each counterweight's "
+                                       "spread inertia; make parts in a force_balance, moment_balance or stages "
+                                       "design (docs/parts.md)")
 
     @model_validator(mode="after")
     def _one_region(self):
