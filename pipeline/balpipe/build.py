@@ -99,6 +99,10 @@ class Options:
     sim_workers: int = 1  # processes for one spec's simulations (cores left over by fewer specs than cores)
     #: the published name of each spec path (:func:`published_names`); others as if their folder had been given
     names: tuple[tuple[Path, str], ...] = ()
+    #: when the build started (``time.time()``, set by :func:`build`): with ``force``, a cache entry
+    #: written since then was computed by this build and is used (the same simulation in two specs
+    #: runs once; :attr:`balpipe.cache.content.Store.fresh_since`)
+    started: float | None = None
 
     def name(self, path: Path) -> str:
         """How published files and messages name the spec ``path``: never a path of the machine.
@@ -185,6 +189,8 @@ class Job:
     #: access to it): all computed
     figure_cache: Path | None = None
     redraw: bool = False  # --force: every figure drawn, simulation run and search computed, its cache entry rewritten
+    #: with ``redraw``: entries written since this time (this build's) are used all the same
+    fresh_since: float | None = None
     figure_keys: frozenset[str] = frozenset()  # the cache entries the planning used (history figures): kept
     source: str = ""  # the spec's published name (Options.name), "" for str(path)
 
@@ -275,6 +281,7 @@ def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outc
     files = {**files, **figure_files}
     return Job(path, loaded.text, h, opts.simulate, history, files, opts.sim_workers, source=opts.name(path),
                figure_cache=opts.out if figure_cache else None, redraw=opts.force,
+               fresh_since=opts.started if opts.force else None,
                figure_keys=frozenset(store.used) if store is not None else frozenset())
 
 
@@ -289,11 +296,12 @@ def compute(job: Job) -> Computed:
 
     slug = slug_for(job.path)
     store = None if job.figure_cache is None else \
-        cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw, used=set(job.figure_keys))
+        cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw, used=set(job.figure_keys),
+                    fresh_since=job.fresh_since)
     sims = None if job.figure_cache is None or not job.simulate else \
-        sim_cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw)
+        sim_cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw, fresh_since=job.fresh_since)
     searches = None if job.figure_cache is None else \
-        balance_cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw)
+        balance_cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw, fresh_since=job.fresh_since)
     with cache.using(store), sim_cache.using(sims):
         done = _compute(job, balance_cache.Memo(searches))
     if done.status in ("ok", "failed"):
@@ -528,7 +536,8 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
     site stays whole."""
     problems: list[str] = []
     specs = find_specs(paths, problems)
-    opts = replace(opts, names=tuple(published_names(paths, specs).items()))
+    opts = replace(opts, names=tuple(published_names(paths, specs).items()),
+                   started=opts.started if opts.started is not None else time.time())
     outcomes: list[Outcome] = [Outcome(msg.split(":", 1)[0], "", "error", msg, spec_error=True) for msg in problems]
     clash = clashes(specs, opts.name)
     todo: list[Path] = []

@@ -126,6 +126,24 @@ def test_force_simulates_everything_and_no_sim_keeps_the_cache(tmp_path, simulat
     assert [o.status for o in outcomes] == ["ok"] and set(sims(out)) == set(kept)  # --no-sim: uses none, prunes none
 
 
+def test_force_simulates_a_stage_shared_by_two_specs_once(tmp_path, simulated):
+    """``--force`` trusts no entry of an earlier build, but what this build computed for one spec
+    serves the other: every run once, the same pages as two separate builds."""
+    specs = write_spec(tmp_path / "specs")
+    write_spec(specs, replaced(QUICK, DESCRIPTION, "A copy of it"), name="copy")
+    out = tmp_path / "out"
+    run(specs, out)
+    n = len(simulated)
+    kept = sims(out, "copy")
+    assert n >= 9 and kept == sims(out, "scott_russell")  # one spec's runs serve the other
+    before = {s: page(out, s) for s in ("copy", "scott_russell")}
+    simulated.clear()
+    run(specs, out, force=True)
+    assert sorted(simulated) == sorted(k.removesuffix(".pickle") for k in kept)  # every run again, once for both
+    assert sims(out, "copy") == sims(out, "scott_russell") != kept  # rewritten (their run times), then shared
+    assert {s: page(out, s) for s in ("copy", "scott_russell")} == before
+
+
 def test_the_keys_of_forked_simulation_workers_are_kept(tmp_path, simulated):
     specs = write_spec(tmp_path / "specs")
     out = tmp_path / "out"

@@ -109,3 +109,27 @@ def test_a_try_that_holds_together_without_ten_times_margin_goes_to_the_full_eff
     r = torque_driven(model, a, ValidationSettings(), economic=True, dt=1e-3, iterations=3200)
     assert seen == [(ITERATIONS, True), (2 * ITERATIONS, True), (3200, False)]
     assert r.iterations == 3200
+
+
+def test_steps_straight_into_chipmunk_give_pymunks_run_bit_for_bit(monkeypatch):
+    """``_Stepper`` calls ``cpSpaceStep`` itself after pymunk's first step: the same run as
+    ``space.step`` every step (position-driven with gears, and torque-driven)."""
+    model = five_bar()
+    a = analyse(model, GRID)
+    direct = simulate(model, a, 1e-3, 100, mass_floor=0.1, feedforward=True)
+    torque = _torque_run(arm_2r())
+    seen = []
+    real = run_mod._Stepper.__call__
+
+    def through_pymunk(self, dt):
+        seen.append(self.direct is not None)
+        self.space.step(dt)
+
+    monkeypatch.setattr(run_mod._Stepper, "__call__", through_pymunk)
+    slow = simulate(model, a, 1e-3, 100, mass_floor=0.1, feedforward=True)
+    slow_torque = _torque_run(arm_2r())
+    monkeypatch.setattr(run_mod._Stepper, "__call__", real)
+    assert seen and all(seen)  # the direct path was available on every step
+    for fast, ref in ((direct, slow), (torque, slow_torque)):
+        for name in ("force", "moment", "poses", "momentum"):
+            assert np.array_equal(getattr(fast, name), getattr(ref, name)), name

@@ -37,6 +37,7 @@ import hashlib
 import os
 import pickle
 import re
+import stat
 import struct
 import types
 from contextlib import contextmanager
@@ -292,6 +293,10 @@ class Store:
     used: set[str] = dataclasses.field(default_factory=set)
     hits: int = 0
     computed: int = 0
+    #: with ``reuse`` False: entries written at or after this time (``time.time()``, the start of a
+    #: ``--force`` build) are served all the same: computed by this build (for another spec of the
+    #: same output folder, or by another of its processes), not trusted from an earlier one
+    fresh_since: float | None = None
 
     @property
     def folder(self) -> Path:
@@ -310,7 +315,7 @@ class Store:
         """The value of key ``k``: the stored one when there is one (and ``reuse``), else
         ``compute()``, stored. ``k`` is kept by :meth:`prune` either way."""
         self.used.add(k)
-        if self.reuse:
+        if self.reuse or (self.fresh_since is not None and self._fresh(k)):
             hit = self.get(k)
             if hit is not None:
                 self.hits += 1
@@ -331,6 +336,31 @@ class Store:
             if data is not None:
                 self.put_bytes(k, data)
         return data
+
+    def _fresh(self, k: str) -> bool:
+        """Key ``k`` has an entry (a regular file, never a symlink) written at or after
+        :attr:`fresh_since`, in this spec's folder or another's; an older entry of this spec's is
+        then removed, so that :meth:`get` reads the fresh one."""
+        root = safe_folder(self.out, (CACHE_DIR, self.KIND), create=False)
+        if root is None or self.fresh_since is None:
+            return False
+        try:
+            slugs = [self.slug] + sorted(p.name for p in root.iterdir() if p.name != self.slug and not p.name.startswith("."))
+        except OSError:
+            return False
+        for slug in slugs:
+            try:
+                st = os.lstat(root / slug / f"{k}{self.SUFFIX}")
+            except OSError:
+                continue
+            if stat.S_ISREG(st.st_mode) and st.st_mtime >= self.fresh_since:
+                if slug != self.slug:
+                    try:
+                        os.unlink(root / self.slug / f"{k}{self.SUFFIX}")
+                    except OSError:
+                        pass
+                return True
+        return False
 
     def _read(self, slug: str, k: str) -> bytes | None:
         folder = safe_folder(self.out, (CACHE_DIR, self.KIND, slug), create=False)

@@ -73,8 +73,9 @@ class Store(content_cache.Store):
     SUFFIX: ClassVar[str] = ".svg"
     HEADER: ClassVar[bytes] = _HEADER.encode()
 
-    def __init__(self, out: Path, slug: str, salt: str, reuse: bool = True, used: set[str] | None = None) -> None:
-        super().__init__(out, slug, salt, reuse, set(used or ()))
+    def __init__(self, out: Path, slug: str, salt: str, reuse: bool = True, used: set[str] | None = None,
+                 fresh_since: float | None = None) -> None:
+        super().__init__(out, slug, salt, reuse, set(used or ()), fresh_since=fresh_since)
 
     @property
     def drawn(self) -> int:

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import pymunk
 import pymunk.batch
+from pymunk._chipmunk_cffi import lib as _cp
 
 from ..engine import Analysis
 from ..mechanics.planar import rotate
@@ -203,6 +204,7 @@ def simulate(
     torques, acts = _actuator_inputs(sim.actuators, efforts, settle, n) if efforts is not None else ([], [])
     set_torque = pymunk.Body.torque.fset
     push = _InertialForces(space, read, model, analysis, every, bodies[:nb], g) if feedforward and efforts is None else None
+    advance = _Stepper(space)
     current = None
     for step in range(settle + n + 1):
         if iters[step] != current:
@@ -222,7 +224,7 @@ def simulate(
             act.apply(float(e[max(k, 0)]), dt)
         if applied is not None:
             applied.apply(float(every[step]), dt)
-        space.step(dt)
+        advance(dt)
         if k >= -1:
             read()
         if k in check:
@@ -301,6 +303,26 @@ class _InertialForces:
     def __call__(self, k: int) -> None:
         self.array.num = k * self.stride
         self.each(self.space, self.setter, self.data)
+
+
+class _Stepper:
+    """``space.step(dt)``: the first call through pymunk (which checks every body's mass and
+    moment), the next ones straight into Chipmunk's ``cpSpaceStep``, the same step without
+    pymunk's bookkeeping of bodies and shapes added or removed during a step (a simulation adds
+    none, has no callbacks, and does not run threaded): about 3 us a step, a fifth of a step at
+    100 solver iterations."""
+
+    def __init__(self, space: pymunk.Space) -> None:
+        self.space = space
+        self.direct = None if space.threaded else _cp.cpSpaceStep
+
+    def __call__(self, dt: float) -> None:
+        space = self.space
+        if (self.direct is None or space._bodies_to_check or space._add_later or space._remove_later
+                or space._post_step_callbacks):
+            space.step(dt)
+        else:
+            self.direct(space._space, dt)
 
 
 class _BatchReader:
