@@ -10,9 +10,10 @@ from __future__ import annotations
 
 from typing import Annotated, Literal, Union
 
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from . import registry
+from .display.units import display_units
 from .laws.frame_spec import FrameSpec
 from .laws.load_spec import LoadSpec
 from .laws.motion_spec import Motion
@@ -91,6 +92,21 @@ class Reference(Strict):
     )
 
 
+class ReportSettings(Strict):
+    """How the study's pages show it (results.json and the CSV files stay SI)."""
+
+    units: str | dict[str, str] | None = Field(
+        None, description="the units every number on the pages uses: 'SI' (default) or 'engineering' (mm, kg, kN, "
+        "kN m, rpm, deg, kW), or a mapping {quantity: unit} over SI (or over 'preset'): length m/mm/cm, mass kg/g, "
+        "force N/kN, moment N m/kN m/N mm, speed rad/s/rpm, angle rad/deg, power W/kW")
+
+    @field_validator("units")
+    @classmethod
+    def _known_units(cls, v: str | dict[str, str] | None) -> str | dict[str, str] | None:
+        display_units(v)  # a ValueError names the quantity or unit
+        return v
+
+
 class Spec(Strict):
     """A balancing study: mechanism, motion, method, analysis and references."""
 
@@ -111,6 +127,7 @@ class Spec(Strict):
     compare: list[Design] = Field(
         [], description="other balancing designs of the same mechanism, analysed and tabulated beside the main one"
     )
+    report: ReportSettings = Field(ReportSettings(), description="how the pages show the study: their units")
     sweep: SweepSpec | None = Field(
         None, description="a design sweep run by 'balpipe sweep SPEC' (flags override it); 'balpipe build' ignores it"
     )

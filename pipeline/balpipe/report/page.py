@@ -7,6 +7,7 @@ import numpy as np
 
 from ..balancing.base import in_style_order, styled
 from ..display import numbers
+from ..display.units import display_units
 from ..laws.drives import law_names
 from ..study import Study
 from ..draw import extremes, figures, labels, live, player, sleeves
@@ -245,6 +246,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                 nav: dict | None = None) -> str:
     spec = study.spec
     names = names_for(spec)
+    units = display_units(spec.report.units)  # the spec's display units (results.json stays SI)
     validation_rows = []
     for s in study.stages:
         v = s.validation
@@ -304,7 +306,8 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         nav=nav or {},
         inputs=notation_groups(spec),
         verdict=results.get("verdict"),
-        card=design_card(study, results),
+        card=design_card(study, results, units),
+        u=units,
         whatif=whatif.section(study, results, {s.stage.name: k for k, s in enumerate(shown_stages(study))}),
         citation=citations.cite(spec.paper),
         names=names,

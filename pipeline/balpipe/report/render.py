@@ -12,7 +12,11 @@ import markupsafe
 from .. import __version__
 from ..balancing.conditions import clarity_text
 from ..display import numbers
+from ..display.units import DisplayUnits
 from ..display.numbers import num, tol  # noqa: F401  (the pages' filters, re-exported)
+
+#: the display units of a template rendered without a study's own (the index, the diff)
+SI = DisplayUnits()
 
 
 def ratio(x, tol: float | None = None) -> str:
@@ -20,6 +24,34 @@ def ratio(x, tol: float | None = None) -> str:
     percent below ten times, "×" from ten on). A ratio at or below ``tol`` (the stage's balance
     tolerance; the default floor 1e-9 without one) is round-off and shows as "0 (< 1e-9)"."""
     return numbers.ratio(x, numbers.FLOOR if tol is None else tol)
+
+
+def _units(ctx) -> DisplayUnits:
+    u = ctx.get("u")
+    return u if isinstance(u, DisplayUnits) else SI
+
+
+@jinja2.pass_context
+def qty(ctx, x, quantity: str, scale=None, digits: int = 4) -> str:
+    """``x`` (SI, of ``quantity``: 'force', 'N m', ...) as the page's display units show it (the
+    template's ``u``, SI without one), without the unit; round-off of ``scale`` reads 0."""
+    return _units(ctx).num(x, quantity, scale, digits)
+
+
+@jinja2.pass_context
+def qload(ctx, x, quantity: str, ref, tolerance, with_unit: bool = False) -> str:
+    """A peak load in the page's display units (``with_unit``: and its unit), or "0 (< 1e-9 of
+    reference)" at most ``tolerance`` times ``ref`` (:func:`load`)."""
+    if x is not None and ref and tolerance is not None and abs(float(x)) <= float(tolerance) * abs(float(ref)):
+        return load(x, ref, tolerance)
+    u = _units(ctx)
+    return u.text(x, quantity) if with_unit else u.num(x, quantity)
+
+
+@jinja2.pass_context
+def unit_of(ctx, quantity: str) -> str:
+    """The page's display unit of ``quantity`` ('force', or an SI unit such as 'N m')."""
+    return _units(ctx).unit(quantity) or unit(quantity)
 
 
 def clarity(gap) -> str:
@@ -81,6 +113,9 @@ def environment() -> jinja2.Environment:
     env.filters["ratio"] = ratio
     env.filters["tol"] = tol
     env.filters["num_at"] = numbers.num_at
+    env.filters["qty"] = qty
+    env.filters["qload"] = qload
+    env.filters["unit_of"] = unit_of
     env.filters["clarity"] = clarity
     env.filters["load"] = load
     env.filters["unit"] = unit

@@ -101,6 +101,7 @@ def results_dict(study: Study, source: str, input_hash: str, simulated: bool) ->
     # the linkage without its drivers, motion, loads and method: specs sharing it are compared on the index
     out["mechanism_key"] = mechanism_key(study.unbalanced.stage.model)
     out["moving_bodies"] = [b.name for b in study.unbalanced.stage.model.bodies]
+    out["units"] = "SI"  # every number of this file, whatever units the spec's pages show (report.units)
     out["length_scale"] = model_size(study.unbalanced.stage.model)
     out["inertia_scale"] = inertia_scale(study.unbalanced.stage.model, out["moving_mass"])
     if study.balance.details:
