@@ -265,3 +265,16 @@ def test_partial_balance_refuses_a_part_located_and_a_zero_mass_part_says_why():
     assert "balancing.counterweights[0]" in str(info.value) and "partial_balance" in str(info.value)
     none = make("cw", "crank", "disc", "steel", 7850.0, {"thickness": 0.01}, 0.0, (-0.06, 0.0))
     assert not none.fits and "no part to make" in none.problems[0]
+
+
+def test_the_parts_table_reads_in_the_pages_display_units():
+    from balpipe.display.units import display_units
+    from balpipe.report.parts_table import page_rows
+
+    part = make("cw", "crank", "annular_sector", "steel", 7850.0, {"inner_radius": 0.02, "thickness": 0.018}, 0.8,
+                (-0.06, 0.0))
+    row = {"design": "main", "stages": ["s"], **part.to_json(), "drawings": None}
+    si, eng = page_rows([row])[0], page_rows([row], display_units("engineering"))[0]
+    assert si["dimensions"].startswith("t 0.018 m, r_i 0.02 m") and si["centroid"] == "(-0.06, 0) m"
+    assert eng["dimensions"].startswith("t 18 mm, r_i 20 mm") and eng["centroid"] == "(-60, 0) mm"
+    assert eng["inertia"].endswith("kg mm²") and eng["mass"] == "0.8 kg"

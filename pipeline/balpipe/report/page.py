@@ -291,7 +291,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                       "player": rl.player(), "player_note": rl.player_note()} if rl is not None else None,
         drawn=drawing_times(study),
         joint_loads=joint_load_table(study),
-        parts=page_rows(results.get("parts") or []),
+        parts=page_rows(results.get("parts") or [], units),
         orders_figure=orders_svg([(s.stage.name, results["orders"][s.stage.name]) for s in shown_stages(study)
                                   if (results.get("orders") or {}).get(s.stage.name)]),
         mounts_figure=mounts_svg(results.get("mounts"), [(s.stage.name, s.stage.label) for s in shown_stages(study)]),

@@ -14,7 +14,7 @@ import json
 import re
 from typing import Any
 
-from ..display.numbers import num, point
+from ..display.numbers import num
 
 #: the dimensions' columns of the bill of materials, in its order, with their SI unit
 DIMENSIONS = (("thickness", "m"), ("radius", "m"), ("inner_radius", "m"), ("outer_radius", "m"), ("angle", "rad"),
@@ -73,28 +73,32 @@ def bom_csv(parts: list[dict]) -> str:
     return buf.getvalue()
 
 
-def _mm(x: float) -> str:
-    return f"{num(x * 1e3)} mm"
+#: the dimensions the page shows, by the name it gives them, with their quantity
+_SHOWN = {"thickness": ("t", "length"), "radius": ("r", "length"), "inner_radius": ("r_i", "length"),
+          "outer_radius": ("r_o", "length"), "angle": ("angle", "angle"), "length": ("length", "length"),
+          "width": ("width", "length"), "plates": ("plates", ""), "plate_thickness": ("each", "length")}
 
 
-#: how the page names each dimension, and how it prints it
-_SHOWN = {"thickness": ("t", _mm), "radius": ("r", _mm), "inner_radius": ("r_i", _mm), "outer_radius": ("r_o", _mm),
-          "angle": ("angle", lambda a: f"{num(a * 180 / 3.141592653589793)}°"), "length": ("length", _mm),
-          "width": ("width", _mm), "plates": ("plates", lambda n: f"{int(n)}"),
-          "plate_thickness": ("each", _mm)}
-
-
-def page_rows(parts: list[dict]) -> list[dict]:
+def page_rows(parts: list[dict], units: Any = None) -> list[dict]:
     """The page's table of parts (templates/parts.html): ``results.json``'s ``parts`` with their
-    numbers as text (lengths in mm, angles in degrees, masses in kg, inertias in kg m^2)."""
+    numbers as text in the page's display ``units`` (:class:`balpipe.display.units.DisplayUnits`,
+    SI when None)."""
+    from ..display.units import display_units
+
+    u = units if units is not None else display_units()
+
+    def shown(value: float, quantity: str) -> str:
+        return u.text(value, quantity) if quantity else num(value)
+
     rows = []
     for p in parts:
-        dims = ", ".join(f"{label} {fmt(p['dimensions'][k])}" for k, (label, fmt) in _SHOWN.items() if k in p["dimensions"])
+        dims = ", ".join(f"{label} {shown(p['dimensions'][k], q)}" for k, (label, q) in _SHOWN.items()
+                         if k in p["dimensions"])
         rows.append({
             "name": p["name"], "body": p["body"], "design": p["design"], "shape": p["shape"].replace("_", " "),
             "material": p["material"], "density": f"{num(p['density'], 6)} kg/m³", "dimensions": dims,
-            "mass": f"{num(p['mass'], 6)} kg", "centroid": f"{point([x * 1e3 for x in p['centroid']])} mm",
-            "inertia": f"{num(p['inertia'])} kg m²", "fits": p["fits"], "problems": "; ".join(p["problems"]),
+            "mass": u.text(p["mass"], "mass", digits=6), "centroid": u.point(p["centroid"]),
+            "inertia": u.text(p["inertia"], "inertia"), "fits": p["fits"], "problems": "; ".join(p["problems"]),
             "where": p["where"], "svg": (p["drawings"] or {}).get("svg"), "dxf": (p["drawings"] or {}).get("dxf"),
         })
     return rows
