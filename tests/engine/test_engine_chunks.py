@@ -95,3 +95,25 @@ def test_residual_rows_are_the_residuals_rows():
     full = residual(vz, s, f)
     for eq in (np.arange(vz.m), np.array([0, 5, 2]), np.array([vz.m - 1])):
         assert np.array_equal(residual_rows(vz, s, f, eq), full[eq])
+
+
+@pytest.mark.parametrize("n", [2, 9])
+def test_static_bound_holds_at_every_sample(n):
+    """An open chain's screen bound, known before any sample: above every sample's own bound
+    (max |entry| / min |pivot|); a closed loop has none."""
+    from balpipe.engine.structure import block_sigma_min, invert_blocks
+    from balpipe.engine.vectorised import jacobian_values
+
+    c = compiled(chain(n, seed=5, sweep=6.0))
+    p = fastpath.prepare(c)
+    assert p.static_bound is not None
+    t = np.linspace(0.0, 1.0, 400)
+    f, _, _ = law_table(p.vz, t)
+    assert p.dec is not None
+    X, state = fastpath._explicit_positions(p.vz, p.dec, f, len(t))
+    vals = jacobian_values(p.vz, state)
+    bound = np.abs(vals[p.free_slots]).max(axis=0) / block_sigma_min(p.dec, vals, invert_blocks(p.dec, vals))
+    assert bound.max() <= p.static_bound
+    assert bound.max() > 0.5 * p.static_bound  # and close to it: the links turn through every angle
+    spec = load("specs/custom_four_bar_balancing.yaml").spec
+    assert fastpath.prepare(compiled(registry.unbalanced_model(spec))).static_bound is None

@@ -328,7 +328,10 @@ def analyse(
     efforts = {name: -lam[:, row] for name, row in cd.driver_rows.items()}
     reactions = joint_reactions(model, cd, lam, mesh_geo)
     # frame poses for drawing: frame origin = com - A(theta) com_local
-    frame_pose = fastpath._place(q, -c.com_local).reshape(qb.shape)
+    if kin is not None:  # coordinate-major, as the block path's q (a view of its rows, no copy)
+        frame_pose = fastpath.place_rows(kin.X[3:-1], -c.com_local).T.reshape(qb.shape)
+    else:
+        frame_pose = fastpath._place(q, -c.com_local).reshape(qb.shape)
     return Analysis(
         t=t, names=c.names, q=qb, v=vb, a=ab,
         force=force, moment=about_P(moment_O, force),

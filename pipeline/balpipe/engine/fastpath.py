@@ -62,14 +62,31 @@ class Prepared:
     dec: Decomposition | None
     free_slots: np.ndarray  # Jacobian entries on free coordinates
     frame_slots: list[tuple[np.ndarray, np.ndarray]]  # per frame coordinate: (slots, rows)
+    static_bound: float | None = None  # a bound of :func:`_screen`'s bound valid at every sample
 
 
 def prepare(c: Compiled) -> Prepared:
     vz = vectorise(c)
     dec = decompose(vz) if redundancy(c) == 0 else None
     frame = [(np.flatnonzero(vz.cols == k), vz.rows[vz.cols == k]) for k in range(3)]
-    return Prepared(vz, dec, np.flatnonzero(vz.cols >= 3), frame)
+    free = np.flatnonzero(vz.cols >= 3)
+    return Prepared(vz, dec, free, frame, _static_bound(vz, dec, free))
 
+
+def _static_bound(vz: Vectorised, dec: Decomposition | None, free: np.ndarray) -> float | None:
+    """max|entry| / min|pivot| over every configuration, where it holds for all: every block 1 x 1
+    with a constant pivot and no projection (the varying entries are then the components of
+    rotated local vectors A s, at most |s| in size). None elsewhere."""
+    if dec is None or not dec.explicit or not dec.pivots_constant or len(vz.pi):
+        return None
+    const = vz.const[free]
+    fixed = np.abs(const[~np.isnan(const)])
+    local = np.hypot(np.concatenate([vz.csi, vz.csj])[:, 0], np.concatenate([vz.csi, vz.csj])[:, 1])
+    largest = float(max(fixed.max(initial=0.0), local.max(initial=0.0)))
+    pivots = [np.abs(vz.const[st.diag]).min() for st in dec.forward.steps if not st.square]
+    if not pivots or min(pivots) <= 0.0:
+        return None
+    return largest / float(min(pivots)) * (1.0 + 1e-9)  # the rotations' round-off
 
 @dataclass
 class Kinematics:
@@ -193,7 +210,9 @@ def _explicit_positions(vz: Vectorised, dec: Decomposition, f: np.ndarray, N: in
     is_angle = (at < len(vz.arow)) & (vz.arow[np.minimum(at, len(vz.arow) - 1)] == vz.law_rows)
     fa[at[is_angle]] -= f[is_angle]
     for eq, unk, piv in dec.angle_steps:
-        X[unk + 3] = -(vz.akoef[eq] @ th + fa[eq]) / vz.const[piv][:, None]
+        koef = vz.akoef[eq]
+        used = np.flatnonzero(np.any(koef != 0.0, axis=0))  # the angles these rows read: a few, not all
+        X[unk + 3] = -(koef[:, used] @ th[used] + fa[eq]) / vz.const[piv][:, None]
     s = State(vz, X[:-1])
     for eq, unk, piv in dec.position_steps:
         phi = residual_rows(vz, s, f, eq)
@@ -288,6 +307,18 @@ def _place(frame: np.ndarray, com: np.ndarray) -> np.ndarray:
     return q
 
 
+def place_rows(X: np.ndarray, com: np.ndarray) -> np.ndarray:
+    """:func:`_place` on coordinate-major coordinates ``X`` (3 nb, N) (the block path's layout),
+    returned in the same layout: the same values, without transposing the grid in memory."""
+    th = X[2::3]
+    cos, sin = np.cos(th), np.sin(th)
+    cx, cy = com[:, :1], com[:, 1:]
+    out = X.copy()
+    out[0::3] += cos * cx - sin * cy
+    out[1::3] += sin * cx + cos * cy
+    return out
+
+
 def _arms(frame: np.ndarray, com: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """R(phi) c (N, nb), x and y: the points at ``com`` (nb, 2) from their frames' origins."""
     th = frame[:, 2::3]
@@ -296,7 +327,10 @@ def _arms(frame: np.ndarray, com: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _screen(c: Compiled, p: Prepared, vals: np.ndarray, inverses: dict, X: np.ndarray, t: np.ndarray) -> None:
-    """Singular configurations: the block bound, then the exact check where it is close."""
+    """Singular configurations: the block bound, then the exact check where it is close (none
+    where the bound of every configuration is far from the limit: :func:`_static_bound`)."""
+    if p.static_bound is not None and p.static_bound <= _COND_LIMIT * _SCREEN:
+        return
     with np.errstate(divide="ignore", invalid="ignore"):
         bound = np.abs(vals[p.free_slots]).max(axis=0) / block_sigma_min(_decomposed(p), vals, inverses)
     close = ~(bound <= _COND_LIMIT * _SCREEN)
