@@ -15,6 +15,7 @@ this no-sim, REV no-sim, repeated), so that both see the same load. Run from the
     python benchmarks/bench_validation.py --against main --repeat 2
     python benchmarks/bench_validation.py -j 2                   # this tree only, 2 processes
     python benchmarks/bench_validation.py --specs specs/scott_russell.yaml --sim-only
+    python benchmarks/bench_validation.py --against main --keep /tmp/b   # then compare_verdicts.py /tmp/b/main-sim-0 /tmp/b/this-sim-0
 
 Nothing is asserted: it prints a table (and ``--json FILE`` writes the raw rows).
 """
@@ -38,9 +39,10 @@ from bench_build import DRIVER  # noqa: E402  (balpipe's command line from a sou
 
 
 
-def build_once(python: str, pipeline: Path, specs: str, jobs: int, sim: bool) -> dict:
-    """One build in a new process: wall, CPU (process and children) and peak RSS (MB)."""
-    out = tempfile.mkdtemp(prefix="bench_validation_")
+def build_once(python: str, pipeline: Path, specs: str, jobs: int, sim: bool, keep: Path | None = None) -> dict:
+    """One build in a new process: wall, CPU (process and children) and peak RSS (MB). ``keep``:
+    the output folder, kept (else a temporary one, removed)."""
+    out = str(keep) if keep is not None else tempfile.mkdtemp(prefix="bench_validation_")
     env = dict(os.environ, PYTHONPATH=str(pipeline), PYTHONHASHSEED="0")
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     # bench_build's driver with no phase wrapped: ``build SPECS -o OUT -j 1`` and these options (the last -j wins)
@@ -54,10 +56,14 @@ def build_once(python: str, pipeline: Path, specs: str, jobs: int, sim: bool) ->
     # RUSAGE_CHILDREN of this script would sum every build, so the figure is wait4's
     cpu = usage.ru_utime + usage.ru_stime
     rss = usage.ru_maxrss / 1024.0
-    shutil.rmtree(out, ignore_errors=True)
+    if keep is None:
+        shutil.rmtree(out, ignore_errors=True)
     rc = os.waitstatus_to_exitcode(status)
-    summary = [ln for ln in output.decode(errors="replace").splitlines() if ln.startswith("balpipe:")]
-    return {"wall": wall, "cpu": cpu, "rss_mb": rss, "rc": rc, "summary": summary[-1] if summary else output[-400:].decode(errors="replace")}
+    lines = output.decode(errors="replace").splitlines()
+    summary = [ln for ln in lines if ln.startswith("balpipe:")]
+    not_ok = [ln.split("] ", 1)[-1][:160] for ln in lines if ln.startswith("[") and ": ok" not in ln]
+    return {"wall": wall, "cpu": cpu, "rss_mb": rss, "rc": rc, "not_ok": not_ok,
+            "summary": summary[-1] if summary else "\n".join(lines[-5:])}
 
 
 def worktree(rev: str, where: Path) -> Path:
@@ -74,6 +80,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=1, help="builds of each kind per version (default 1)")
     ap.add_argument("--sim-only", action="store_true", help="only the simulated build")
     ap.add_argument("--json", help="write the rows to this file")
+    ap.add_argument("--keep", type=Path, help="keep each build's output in KEEP/<version>-<sim|no-sim>-<repeat> "
+                    "(for benchmarks/compare_verdicts.py)")
     a = ap.parse_args(argv)
     versions = {"this": ROOT / "pipeline"}
     tmp = None
@@ -86,12 +94,15 @@ def main(argv: list[str] | None = None) -> int:
         for r in range(a.repeat):
             for sim in kinds:
                 for name, pipeline in versions.items():
-                    res = build_once(sys.executable, pipeline, a.specs, a.jobs, sim)
+                    keep = a.keep / f"{name.replace('/', '_')}-{'sim' if sim else 'no-sim'}-{r}" if a.keep else None
+                    res = build_once(sys.executable, pipeline, a.specs, a.jobs, sim, keep)
                     res.update(version=name, sim=sim, repeat=r)
                     rows.append(res)
                     print(f"{name:>12s} {'sim' if sim else 'no-sim':>7s}  wall {res['wall']:7.2f} s  CPU "
                           f"{res['cpu']:7.2f} s  peak RSS {res['rss_mb']:6.0f} MB  rc {res['rc']}  {res['summary']}",
                           flush=True)
+                    for ln in res["not_ok"]:
+                        print(f"{'':>21s}{ln}", flush=True)
     finally:
         if tmp is not None:
             subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tmp / "tree")],

@@ -23,7 +23,7 @@ from balpipe.validate import run as run_mod
 from balpipe.validate import torque as torque_mod
 from balpipe.validate.settings import ITERATIONS
 from balpipe.validate.torque import floored_model, torque_driven
-from test_validate import GRID, arm_2r, five_bar, reactionless_arm
+from test_validate import GRID, arm_2r, five_bar, planetary, reactionless_arm
 
 
 def _torque_run(model, **kw):
@@ -133,3 +133,49 @@ def test_steps_straight_into_chipmunk_give_pymunks_run_bit_for_bit(monkeypatch):
     for fast, ref in ((direct, slow), (torque, slow_torque)):
         for name in ("force", "moment", "poses", "momentum"):
             assert np.array_equal(getattr(fast, name), getattr(ref, name)), name
+
+
+def test_the_meshes_placed_through_chipmunk_give_pymunks_run_bit_for_bit(monkeypatch):
+    """``_Mesh.update`` reads the bodies and sets the groove through Chipmunk's accessors: the same
+    run as through pymunk's properties (a planetary gear on a moving carrier)."""
+    from balpipe.validate import space as space_mod
+
+    model = planetary()
+    a = analyse(model, GRID)
+    fast = simulate(model, a, 1e-3, 100, mass_floor=0.1, feedforward=True)
+    assert fast.sim.meshes  # the gear pair is a mesh
+
+    def through_pymunk(self, dt):
+        def pred(body):
+            th = body.angle + dt * body.angular_velocity
+            cog = body.center_of_gravity
+            g = body.local_to_world(cog)
+            v = body.velocity
+            o = space_mod._rot(th, cog)
+            return g.x + dt * v.x - o[0], g.y + dt * v.y - o[1], th
+
+        xc, yc, thc = pred(self.c)
+        xa, ya, tha = pred(self.a)
+        xb, yb, thb = pred(self.b)
+        tha_r = self.ta.angle + dt * self.ta.angular_velocity
+        thb_r = self.tb.angle + dt * self.tb.angular_velocity
+        wa, wb = space_mod._rot(thc, self.oa), space_mod._rot(thc, self.ob)
+        wa, wb = (xc + wa[0], yc + wa[1]), (xc + wb[0], yc + wb[1])
+        dx, dy = wb[0] - wa[0], wb[1] - wa[1]
+        d = math.hypot(dx, dy)
+        u = (dx / d, dy / d)
+        t = (-u[1], u[0])
+        R = self.ratio
+        p, q = R * d / (R - 1.0), d / (R - 1.0)
+        err = (thb_r - thc) - R * (tha_r - thc) - self.phase
+        P = (wa[0] + p * u[0], wa[1] + p * u[1])
+        anchor = (P[0] + q * err * t[0], P[1] + q * err * t[1])
+        L = self.half_length
+        self.groove.groove_a = space_mod._unrot(tha, (P[0] - L * u[0] - xa, P[1] - L * u[1] - ya))
+        self.groove.groove_b = space_mod._unrot(tha, (P[0] + L * u[0] - xa, P[1] + L * u[1] - ya))
+        self.groove.anchor_b = space_mod._unrot(thb, (anchor[0] - xb, anchor[1] - yb))
+
+    monkeypatch.setattr(space_mod._Mesh, "update", through_pymunk)
+    slow = simulate(model, a, 1e-3, 100, mass_floor=0.1, feedforward=True)
+    for name in ("force", "moment", "poses", "momentum"):
+        assert np.array_equal(getattr(fast, name), getattr(slow, name)), name

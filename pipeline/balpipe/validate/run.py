@@ -344,9 +344,18 @@ class _BatchReader:
         self.count = len(ids)
         self.order = np.array([ids.index(b.id) for b in bodies], dtype=int)
         self.recorded = 0
+        # what pymunk.batch.get_space_bodies does, its call data made once (not at every step)
+        ffi, lib = pymunk.batch.ffi, pymunk.batch.lib
+        self.data = ffi.new("pmBatchedData *")
+        self.data.fields = self.FIELDS.value
+        self.data.floatArray = self.buf._float_arr
+        self.data.intArray = self.buf._int_arr
+        self.each = lib.cpSpaceEachBody
+        self.getter = ffi.addressof(lib, "pmSpaceBodyGetIteratorFuncBatched")
+        self.cspace = space._space
 
     def __call__(self) -> None:
-        pymunk.batch.get_space_bodies(self.space, self.FIELDS, self.buf)
+        self.each(self.cspace, self.getter, self.data)
         self.recorded += 1
 
     def rows(self, ks: list[int] | None = None) -> np.ndarray:
