@@ -355,3 +355,20 @@ def test_external_loads_reach_the_mounts_through_the_frame_load():
         peaks = [float(np.max(np.linalg.norm(f, axis=1))) for f in r.mount_forces(frame)]
         assert (peaks == [m["peak"] for m in got["mounts"]]) == same
     assert np.max(np.abs(an.frame_load[0] - an.force)) > 0.1 * np.max(np.abs(an.force))
+
+
+def test_the_moment_point_does_not_move_the_frame():
+    """The frame load's moment is moved to the frame's centre of mass: another
+    analysis.moment_point gives the same floor forces and velocities (to 1e-9), by orders and in
+    the time domain."""
+    for periodic in (True, False):
+        text = four_bar(periodic)
+        a = mounts_json(run(load_text(text, "s.yaml")[0], page=False))
+        moved = text.replace("\nanalysis:\n", "\nanalysis:\n  moment_point: [0.7, -0.4]\n", 1)
+        assert moved != text
+        b = mounts_json(run(load_text(moved, "s.yaml")[0], page=False))
+        for name, s in a["stages"].items():
+            for x, y in zip(s["mounts"], b["stages"][name]["mounts"]):
+                assert y["peak"] == pytest.approx(x["peak"], rel=1e-9, abs=1e-9 * a["stages"]["unbalanced"]["mounts"][0]["peak"])
+            for x, y in zip(s["velocity"], b["stages"][name]["velocity"]):
+                assert y["rms"] == pytest.approx(x["rms"], rel=1e-9, abs=1e-9 * a["stages"]["unbalanced"]["velocity"][0]["rms"])
