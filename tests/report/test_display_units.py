@@ -75,3 +75,27 @@ def test_display_units_convert_every_quantity():
     assert u.point((-0.05, 3e-18)) == "(-50, 0) mm" and u.text(628.3185307, "speed") == "6000 rpm"
     assert u.text(0.0123, "kg m^2") == "12300 kg mm²" and u.text(3.0, "angle") == "171.9 deg"
     assert display_units().text(0.05, "length") == "0.05 m" and display_units({"preset": "engineering", "force": "N"}).unit("force") == "N"
+
+
+def test_the_interactive_plots_use_the_units_and_their_csv_stays_si(si_and_engineering):
+    import json
+
+    from balpipe.display.units import display_units
+    from balpipe.draw import live
+
+    (_, si), (_, eng), _ = si_and_engineering
+
+    def loads(html):
+        raw = re.search(r'<script type="application/json" data-live="live-loads">(.*?)</script>', html, re.S).group(1)
+        return json.loads(raw)
+
+    a, b = loads(si), loads(eng)
+    assert [p["axis"] for p in b["panels"]] == [p["axis"].replace("(N)", "(kN)").replace("(N m)", "(kN m)") for p in a["panels"]]
+    assert any("(kN)" in p["title"] for p in b["panels"]) and any("(kN m)" in p["title"] for p in b["panels"])
+    for sa, sb in zip(a["series"], b["series"]):
+        for key, ya in sa["y"].items():
+            assert [y / 1000 if y is not None else None for y in ya] == pytest.approx(sb["y"][key], rel=1e-5, abs=1e-12)
+    c = live.Curves([0.0, 1.0], [("a", {"F": [1500.0, -20.0]})], [{"key": "F", "title": "force (N)", "axis": "F (N)"}], [])
+    shown = live.shown_in(c, display_units("engineering"))
+    assert shown.panels[0]["axis"] == "F (kN)" and list(shown.stages[0][1]["F"]) == [1.5, -0.02]
+    assert live.csv_text(shown) == live.csv_text(c)  # the figure's CSV in SI, whatever the page shows

@@ -30,6 +30,7 @@ from typing import Iterator, NamedTuple
 
 import numpy as np
 
+from ..display.units import CHOICES, OF_SI_UNIT, DisplayUnits
 from ..mechanics.sampling import spread_indices
 from . import figures
 from .stage_names import short_names
@@ -224,8 +225,10 @@ def csv_name(name: str) -> str:
     return f"figure-{name}.csv"
 
 
-#: a figure's unit as its CSV column names it, in SI: (SI unit, factor from the shown unit)
-TO_SI = {"mm": ("m", 1e-3), "deg": ("rad", math.pi / 180.0)}
+#: a figure's unit as its CSV column names it, in SI: (SI unit, factor from the shown unit); the
+#: display units a spec may choose (:mod:`balpipe.display.units`) included
+TO_SI = {"mm": ("m", 1e-3), "deg": ("rad", math.pi / 180.0),
+         **{u: (next(iter(us)), f) for us in CHOICES.values() for u, f in us.items() if f != 1.0}}
 _UNIT = re.compile(r"\(([^()]*)\)\s*$")
 
 
@@ -239,6 +242,29 @@ def column_unit(axis: str) -> tuple[str, str, float]:
     unit = m.group(1).strip()
     si, factor = TO_SI.get(unit, (unit, 1.0))
     return axis[:m.start()].strip(), si, factor
+
+
+def shown_in(c: Curves, units: DisplayUnits) -> Curves:
+    """The figure in the page's display ``units``: each panel whose axis ends in an SI unit that
+    the units show otherwise ('Fx (N)' with forces in kN) has its curves divided by the unit's
+    factor and its title and axis in the shown unit ('Fx (kN)'); its CSV (:func:`csv_text`) is
+    converted back to SI by the unit's name."""
+    scale: dict[str, float] = {}
+    panels = []
+    for p in c.panels:
+        m = _UNIT.search(p["axis"])
+        si = m.group(1).strip() if m else ""
+        shown = units.unit(si) if si in OF_SI_UNIT else ""
+        if not shown or shown == si:
+            panels.append(p)
+            continue
+        scale[p["key"]] = units.factor(si)
+        panels.append({**p, "axis": _UNIT.sub(f"({shown})", p["axis"]), "title": _UNIT.sub(f"({shown})", p["title"])})
+    if not scale:
+        return c
+    stages = [(label, {k: (np.asarray(v, dtype=float) / scale[k] if k in scale else v) for k, v in curves.items()})
+              for label, curves in c.stages]
+    return c._replace(stages=stages, panels=panels)
 
 
 def csv_text(c: Curves) -> str:

@@ -89,7 +89,8 @@ def stage_styles(study: Study) -> dict[str, tuple[int, str]]:
 def time_curves(study: Study, names: PageNames | None = None) -> dict[str, live.Curves]:
     """The curves of the page's time-series figures, by name: ``loads`` (the shaking force and
     moment of the shown stages, with their pymunk runs when simulated), ``efforts`` (the
-    actuators') and ``joints`` (the joint loads; no panel when the mechanism has no joint load)."""
+    actuators') and ``joints`` (the joint loads; no panel when the mechanism has no joint load), in
+    the spec's display units (``report.units``; their CSV files stay SI)."""
     names = names if names is not None else names_for(study.spec)
     sims = []
     for s in shown_stages(study):
@@ -103,9 +104,10 @@ def time_curves(study: Study, names: PageNames | None = None) -> dict[str, live.
     joint_names = {j: names.text("joint", j) for _, an in shown for j in an.reactions}  # the paper's symbols
     styles = stage_styles(study)
     short = [styles[s.stage.name][1] for s in shown_stages(study)]
-    return {"loads": live_plots.loads(shown, sims, short),
-            "efforts": live_plots.efforts(shown, units, marks, shown_names, short),
-            "joints": live_plots.joints(shown, joint_names, short)}
+    u = display_units(study.spec.report.units)  # the spec's display units
+    return {"loads": live.shown_in(live_plots.loads(shown, sims, short), u),
+            "efforts": live.shown_in(live_plots.efforts(shown, units, marks, shown_names, short), u),
+            "joints": live.shown_in(live_plots.joints(shown, joint_names, short), u)}
 
 
 def drawing_settings(study: Study, names: PageNames) -> dict:
@@ -272,7 +274,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
                 "dt": q.dt, "steps": q.steps, "iterations": q.iterations, "tolerance": q.tracking_tolerance,
                 "passed": q.passed, "status": q.status, "remedy": q.remedy, "reasons": "; ".join(q.reasons),
                 "notes": "; ".join(q.notes),
-                "per_driver": markupsafe.Markup(", ").join(names.driver(k) + f" {numbers.num(v, 2)}"
+                "per_driver": markupsafe.Markup(", ").join(names.driver(k) + f" {numbers.num_at(v, 1.0, 2)}"
                                                            for k, v in sorted(q.tracking_error.items())),
             })
     rl = study.reactionless

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..display import numbers
 from ..engine import Analysis
 from ..mechanics.planar import cross, rotate
 from ..model import Attachment, Model
@@ -241,9 +242,9 @@ def free_floating(
                 if fraction is not None:
                     notes.append(
                         "massless parts simulated with a mass of their own, as pymunk needs one (" + ", ".join(
-                            f"{k} {1000 * m:.3g} g" + (f" and {i:.3g} kg m^2" if i > 0 else "")
+                            f"{k} {numbers.num(1000 * m, 3)} g" + (f" and {numbers.num(i, 3)} kg m^2" if i > 0 else "")
                             for k, (m, i) in small.items()
-                        ) + f": each {100 * fraction:g} % of the mechanism's mass)"
+                        ) + f": each {numbers.num(100 * fraction)} % of the mechanism's mass)"
                         + (f"; with {', '.join(failed)} of the mechanism's mass pymunk did not hold together" if failed else "")
                     )
                     phi_ref, origin_ref = _conservation_solution(sim_model, analysis, float(base_mass), bi, centre)
