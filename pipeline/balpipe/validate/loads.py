@@ -449,7 +449,17 @@ def _validate_once(model: Model, analysis: Analysis, unbalanced_peaks: tuple[flo
     W, Ms = analysis.static_load()
     exact = loads_at(model, analysis)
 
+    measured_runs: dict[int, tuple[SimulationRun, tuple]] = {}
+
     def measure(run: SimulationRun):
+        """:func:`measure_once`, once per run (the acceptance, the convergence test and the
+        verdict all ask for the same run's numbers)."""
+        hit = measured_runs.get(id(run))
+        if hit is None or hit[0] is not run:
+            hit = measured_runs[id(run)] = (run, measure_once(run))
+        return hit[1]
+
+    def measure_once(run: SimulationRun):
         """Loads on the grid, measured mask and counts, errors, residuals and inertial peaks."""
         F, M, measured, extrapolated = _on_grid(run, analysis, idx, kinds, settings.skip_initial_steps,
                                                 _jumps(model, run.t), lambda steps: exact(run.t[steps]))
