@@ -264,7 +264,7 @@ def sort_keys(e: dict) -> dict:
         "force": max((g["force"][1] for g in ms), default=""),
         "moment": max((g["moment"][1] for g in ms), default=""),
         "cost": added / mm if mm and added is not None else "",
-        "built": e["status"],
+        "built": site_filter.STATUS.get(e["status"], e["status"]),  # the status filter's short value
     }
 
 
