@@ -278,3 +278,17 @@ def test_the_parts_table_reads_in_the_pages_display_units():
     assert si["dimensions"].startswith("t 0.018 m, r_i 0.02 m") and si["centroid"] == "(-0.06, 0) m"
     assert eng["dimensions"].startswith("t 18 mm, r_i 20 mm") and eng["centroid"] == "(-60, 0) mm"
     assert eng["inertia"].endswith("kg mm²") and eng["mass"] == "0.8 kg"
+
+
+def test_the_svg_drawing_frames_the_whole_part_arcs_included():
+    import re
+
+    for c in ((-0.06, 0.0), (0.0, 0.07), (0.05, -0.05)):
+        part = make("cw", "crank", "annular_sector", "steel", 7850.0, {"inner_radius": 0.02, "thickness": 0.018}, 0.8,
+                    c, pivots=(("O", (0.0, 0.0)),))
+        x0, y0, w, h = map(float, re.search(r'viewBox="([^"]+)"', svg_text(part)).group(1).split())
+        ro, a = part.dimensions["outer_radius"], part.dimensions["angle"] / 2
+        mid = math.atan2(c[1], c[0])
+        for phi in np.linspace(mid - a, mid + a, 101):  # the outer arc, in mm, y down
+            x, y = ro * math.cos(phi) * 1e3, -ro * math.sin(phi) * 1e3
+            assert x0 < x < x0 + w and y0 < y < y0 + h

@@ -65,9 +65,28 @@ def _f(x: float) -> str:
     return "0.0000" if text == "-0.0000" else text
 
 
+def _points(part: Any) -> list[tuple[float, float]]:
+    """Points that bound the part's outline (its vertices and 16 points along each arc), its
+    axis and its body's pivots (m)."""
+    out = [(part.axis[0], part.axis[1])] + [p for _, p in part.pivots]
+    n = len(part.outline)
+    for k, (x0, y0, b) in enumerate(part.outline):
+        x1, y1, _ = part.outline[(k + 1) % n]
+        out.append((x0, y0))
+        if b:  # the arc through its chord's ends, bulging by b = tan(sweep / 4)
+            s = 4 * math.atan(b)
+            chord = math.hypot(x1 - x0, y1 - y0)
+            r = chord / (2 * math.sin(abs(s) / 2))
+            h = r * math.cos(s / 2) * (1 if s > 0 else -1)  # centre left of the chord for a ccw arc
+            cx, cy = (x0 + x1) / 2 - (y1 - y0) / chord * h, (y0 + y1) / 2 + (x1 - x0) / chord * h
+            a0 = math.atan2(y0 - cy, x0 - cx)
+            out += [(cx + r * math.cos(a0 + s * i / 16), cy + r * math.sin(a0 + s * i / 16)) for i in range(1, 16)]
+    return out
+
+
 def _extent(part: Any) -> float:
-    xs = [v[0] for v in part.outline] + [part.axis[0]]
-    ys = [v[1] for v in part.outline] + [part.axis[1]]
+    pts = _points(part)
+    xs, ys = [p[0] for p in pts], [p[1] for p in pts]
     return max(max(xs) - min(xs), max(ys) - min(ys), 1e-6)
 
 
@@ -90,8 +109,8 @@ def svg_path(outline: tuple) -> str:
 
 def svg_text(part: Any) -> str:
     """The part's drawing as a standalone SVG, in mm (the page shows it)."""
-    xs = [v[0] for v in part.outline] + [part.axis[0]] + [p[0] for _, p in part.pivots]
-    ys = [v[1] for v in part.outline] + [part.axis[1]] + [p[1] for _, p in part.pivots]
+    pts = _points(part)
+    xs, ys = [p[0] for p in pts], [p[1] for p in pts]
     pad = 0.08 * _extent(part)
     x0, x1 = (min(xs) - pad) * MM, (max(xs) + pad) * MM
     y0, y1 = (-max(ys) - pad) * MM, (-min(ys) + pad) * MM
