@@ -55,6 +55,8 @@ def test_the_page_shows_the_chosen_units(si_and_engineering):
     # inertias in kg mm²; with cm and g: cm, g and g cm²
     assert re.search(r"at \(-100, 0\) mm", eng) and re.search(r"at \(-0\.1, 0\) m", si) and re.search(r"at \(-10, 0\) cm", mixed)
     assert "Inertia (kg mm²)" in eng and "Mass (g)" in mixed and "Inertia (g cm²)" in mixed
+    # what the ratios are relative to, in the same units
+    assert re.search(r"stage&#39;s peak force \([\d.]+ kN\)", eng) and re.search(r"stage&#39;s peak force \([\d.]+ N\)", si)
     # the actuators' table: the crank's torque in kN m, its power in kW
     assert "Peak |effort| (kN m)" in eng and "Peak |power| (kW)" in eng and "Peak |power| (kW)" in mixed
 

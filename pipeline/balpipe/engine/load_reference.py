@@ -31,6 +31,7 @@ import numpy as np
 
 from . import Analysis
 from ..display import numbers
+from ..display.units import DisplayUnits
 from ..model import Model
 
 #: fraction of the gross inertial load that is the smallest denominator of a relative figure
@@ -77,16 +78,17 @@ class LoadReference:
     def floored(self) -> bool:
         return self.force_basis != "unbalanced peak" or self.moment_basis != "unbalanced peak"
 
-    def describe(self, which: str) -> str:
-        """One phrase for the page: what the force (moment) figures are relative to."""
-        value, basis, unit = (
-            (self.force, self.force_basis, "N") if which == "force" else (self.moment, self.moment_basis, "N m")
-        )
+    def describe(self, which: str, units: DisplayUnits | None = None) -> str:
+        """One phrase for the page: what the force (moment) figures are relative to, its loads in
+        the page's display ``units`` (SI without)."""
+        u = units or DisplayUnits()
+        value, basis = (self.force, self.force_basis) if which == "force" else (self.moment, self.moment_basis)
+        q = "force" if which == "force" else "moment"
         if basis == "unbalanced peak":
-            return f"the unbalanced stage's peak {which} ({numbers.num(value)} {unit})"
+            return f"the unbalanced stage's peak {which} ({u.text(value, q)})"
         return (
-            f"{numbers.num(self.floor_fraction)} of the gross inertial {which} ({numbers.num(value)} {unit}), "
-            f"larger than the unbalanced stage's peak ({numbers.num(self.force_peak if which == 'force' else self.moment_peak, 3)} {unit})"
+            f"{numbers.num(self.floor_fraction)} of the gross inertial {which} ({u.text(value, q)}), "
+            f"larger than the unbalanced stage's peak ({u.text(self.force_peak if which == 'force' else self.moment_peak, q, digits=3)})"
         )
 
     def to_json(self) -> dict:

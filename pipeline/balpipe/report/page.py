@@ -294,12 +294,12 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         drawn=drawing_times(study),
         joint_loads=joint_load_table(study),
         parts=page_rows(results.get("parts") or [], units),
-        orders_figure=orders_svg([(s.stage.name, results["orders"][s.stage.name]) for s in shown_stages(study)
+        orders_figure=orders_svg(units, [(s.stage.name, results["orders"][s.stage.name]) for s in shown_stages(study)
                                   if (results.get("orders") or {}).get(s.stage.name)]),
         mounts_figure=mounts_svg(results.get("mounts"), [(s.stage.name, s.stage.label) for s in shown_stages(study)]),
         stage_names=[(s.stage.name, s.stage.label) for s in shown_stages(study)],
         group=study.stages[0].stage.group if len(shown_stages(study)) < len(study.stages) else "",
-        reference={"force": study.reference.describe("force"), "moment": study.reference.describe("moment"),
+        reference={"force": study.reference.describe("force", units), "moment": study.reference.describe("moment", units),
                    "floored": study.reference.floored},
         spec_text=markupsafe.escape(spec_text),  # verbatim: markup, so render.typeset leaves its units as written
         history=history,
