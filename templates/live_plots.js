@@ -302,7 +302,9 @@
          s.points ? { paths: () => null } : {})));
       const opts = Object.assign({
         title: p.title, width: w, height: plotHeight(p.axis),
-        scales: p.log ? { x: { time: false }, y: { distr: 3 } } : { x: { time: false } },  // p.log: a log10 axis
+        // p.log: a log10 axis; p.range, p.xrange: the axes' limits (a front's plot, its outliers named in the caption)
+        scales: Object.assign(p.log ? { x: { time: false }, y: { distr: 3 } } : { x: { time: false } },
+          p.range ? { y: { range: p.range } } : {}, p.xrange ? { x: { time: false, range: p.xrange } } : {}),
         axes: [{ label: d.x || "time (s)" }, { label: p.axis, labelFont: LABEL_FONT, size: 64, values: ticks(!!p.log) }],
         series: series,
         cursor: { sync: { key: src.dataset.live } },

@@ -473,3 +473,38 @@ def test_a_figures_csv_holds_its_plotted_samples_exactly_in_si_with_units(rng):
     assert list(files) == ["figure-drift.csv"] and files["figure-drift.csv"] == LV.csv_text(c)
     assert 'href="figure-drift.csv"' in markup
     assert LV.column_unit("|ΔF| / F_ref") == ("|ΔF| / F_ref", "1", 1.0)
+
+
+def test_a_pareto_front_fills_its_axes_and_outliers_are_named():
+    """A front's plot takes its axes from the front (and the marks near it): a mark far off
+    (the unbalanced mechanism's peak, a complete balance's mass) is left outside and named with
+    its values in the caption, so the front spans at least half of each axis."""
+    from balpipe.report import partial_figures as PFG
+
+    pts = [{"m": 1.0 + 0.1 * i, "f": 10.0 - i} for i in range(6)]
+    marks = [("near", 1.2, 7.5), ("far", 9.0, 300.0)]
+    (x0, x1), (y0, y1), off = PFG.limits(pts, "m", "f", marks)
+    assert off == [("far", 9.0, 300.0)]
+    assert x0 < 1.0 and x1 > 1.5 and y0 < 5.0 and y1 > 10.0 and y1 < 20.0
+
+
+def test_the_specs_fronts_fill_their_axes(studies):
+    """On every spec with a partial balancing, each front spans at least half of both axes of its plot."""
+    from balpipe.report import partial_figures as PFG
+
+    for name in ("partial_offset_slider_crank.yaml", "partial_paper000_rpr3.yaml", "partial_paper004_five_bar.yaml"):
+        st = studies(name)
+        det = st.balance.details["partial_balance"]
+        figs = {t: (svg, cap) for t, svg, cap in PFG.figures(st)}
+        for key, x, y, title, _ in PFG.FRONTS:
+            pts = det["fronts"].get(key) or []
+            if len(pts) < 2:
+                continue
+            d = _live(figs[title][0], f"partial_{key}")
+            p = d["panels"][0]
+            fx, fy = [q[x] for q in pts], [q[y] for q in pts]
+            for lo_hi, v in ((p["xrange"], fx), (p["range"], fy)):
+                span = max(v) - min(v)
+                assert span == 0 or span >= 0.5 * (lo_hi[1] - lo_hi[0]), (name, key, lo_hi, span)
+            for label, vx, vy in PFG.limits(pts, x, y, PFG._marks(st, det, x, y))[2]:
+                assert label in figs[title][1], (name, key, label)

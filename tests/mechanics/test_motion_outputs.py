@@ -22,10 +22,31 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def table(study) -> dict[str, np.ndarray]:
+    """The CSV's columns, and every stage's pose and point columns that the CSV writes once,
+    under an earlier stage's name (the same motion), read from there."""
     text = timeseries_csv(study)
     head = text.splitlines()[0].split(",")
     data = np.loadtxt(io.StringIO(text), delimiter=",", skiprows=1)
-    return {h: data[:, k] for k, h in enumerate(head)}
+    cols = {h: data[:, k] for k, h in enumerate(head)}
+    names = [s.stage.name for s in study.stages]
+    for h in list(cols):
+        stage, rest = h.split(".", 1) if "." in h else ("", "")
+        if rest.startswith(("pose.", "point.")):
+            for later in names[names.index(stage) + 1:]:
+                cols.setdefault(f"{later}.{rest}", cols[h])
+    return cols
+
+
+def test_a_shared_motion_is_written_once():
+    """Stages whose bodies move alike (the counterweights change the masses, not the motion)
+    share their pose and point columns: written under the first stage's name only, the centre
+    of mass (which the counterweights move) per stage."""
+    study = run(load(ROOT / "specs" / "custom_stephenson_six_bar_120rpm.yaml").spec)
+    head = timeseries_csv(study).splitlines()[0].split(",")
+    first, second = study.stages[0].stage.name, study.stages[1].stage.name
+    assert f"{first}.pose.crank.x_m" in head and f"{second}.pose.crank.x_m" not in head
+    assert f"{first}.com.x_m" in head and f"{second}.com.x_m" in head
+    assert len(head) == len(set(head))
 
 
 def check_stage(cols: dict, t: np.ndarray, sr, gravity_free: bool) -> None:

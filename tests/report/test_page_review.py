@@ -231,7 +231,8 @@ def test_tracking_error_caption_gives_each_travel():
 
 def test_no_two_stages_look_alike_and_the_caption_names_each_style(monkeypatch, studies, pages):
     """A spec with compared designs has seven stages: the loads figure draws each in its own
-    line, colour and marker, and its caption says which is which (it named only four)."""
+    line, colour and marker, and the page's key says which is which (it named only four): each
+    stage's words, its short name, its long label as the tooltip."""
     looks = [(str(figures.style(k)["color"]), figures.style(k)["linestyle"], figures.marked(k, 100)["marker"])
              for k in range(10)]
     assert len(set(looks)) == len(looks)
@@ -240,11 +241,13 @@ def test_no_two_stages_look_alike_and_the_caption_names_each_style(monkeypatch, 
     shown = page.shown_stages(st)
     assert len(shown) == 7
     html = pages("paper000_rpr3_scott_russell_corrected.yaml")
-    cap = html[html.index('<figure class="wide">'):]
-    cap = cap[cap.index("<figcaption>"):cap.index("</figcaption>")]
-    cap = html_mod.unescape(cap).lower()
+    key = html[html.index('id="style-legend"'):]
+    key = html_mod.unescape(key[:key.index("</p>")])
+    styles = page.stage_styles(st)
     for k, s in enumerate(shown):
-        assert f"{figures.style_text(k)}: {s.stage.label}".lower() in cap, (k, cap)
+        entry = key[key.index(f'data-stage="{styles[s.stage.name][1]}"'):]
+        entry = entry[:entry.index("</span></span>")]
+        assert f'title="{s.stage.label}"' in entry and f"({figures.style_text(k)})" in entry, (k, entry)
 
 
 def test_dimensionless_parameters_say_so_and_round_off_before_counter_rotations_is_zero():

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..display.numbers import num_at
 from ..draw import live
 
 AXES = {
@@ -42,8 +43,41 @@ def front_curves(points: list[dict], x: str, y: str, marks: list[tuple[str, floa
     for i, (_, series, value) in enumerate(rows):
         ys[series, i] = value
     stages = [(FRONT, {"y": ys[0]})] + [(label, {"y": ys[k + 1]}) for k, (label, _, _) in enumerate(marks)]
-    return live.Curves(np.array([r[0] for r in rows]), stages, [{"key": "y", "title": "", "axis": AXES[y]}], [],
+    xlim, ylim, _ = limits(points, x, y, marks)
+    panel = {"key": "y", "title": "", "axis": AXES[y], "range": ylim, "xrange": xlim}
+    return live.Curves(np.array([r[0] for r in rows]), stages, [panel], [],
                        styles=list(range(len(stages))), x_axis=AXES[x], points=tuple(range(1, len(stages))))
+
+
+#: a mark farther from the front than this many times the front's own span (along x or y) is
+#: left off the plot's axes (and named in the caption): the front keeps most of its plot
+OUTLIER_SPANS = 0.5
+PAD = 0.05  # of an axis's span, each side
+
+
+def limits(points: list[dict], x: str, y: str, marks: list[tuple[str, float, float]]
+           ) -> tuple[list[float], list[float], list[tuple[str, float, float]]]:
+    """The axes of a front's plot: x and y limits that hold the front's designs and every mark
+    within :data:`OUTLIER_SPANS` of the front's span of it, padded by :data:`PAD`; and the marks
+    left outside (the outliers, for the caption). A front's span of 0 counts as its largest
+    |value| (or 1)."""
+    fx = np.array([float(p[x]) for p in points])
+    fy = np.array([float(p[y]) for p in points])
+
+    def window(v: np.ndarray) -> tuple[float, float]:
+        span = float(np.ptp(v)) or float(np.max(np.abs(v))) or 1.0
+        return float(np.min(v)) - OUTLIER_SPANS * span, float(np.max(v)) + OUTLIER_SPANS * span
+
+    (x0, x1), (y0, y1) = window(fx), window(fy)
+    kept = [m for m in marks if x0 <= m[1] <= x1 and y0 <= m[2] <= y1]
+    out = [m for m in marks if m not in kept]
+
+    def axis(v: np.ndarray, extra: list[float]) -> list[float]:
+        lo, hi = float(min([*v, *extra])), float(max([*v, *extra]))
+        pad = PAD * ((hi - lo) or abs(hi) or 1.0)
+        return [lo - pad, hi + pad]
+
+    return axis(fx, [m[1] for m in kept]), axis(fy, [m[2] for m in kept]), out
 
 
 def _marks(study, det: dict, x: str, y: str) -> list[tuple[str, float, float]]:
@@ -102,11 +136,17 @@ def figures(study) -> list[tuple[str, str, str]]:
         spare = sum(1 for p in pts if "budget" in p and p["added_mass"] < p["budget"] * (1 - 1e-6) - 1e-9)
         lightest = (f" At {spare} of the budgets more mass would not lower it: there the point is the lightest of "
                     "the optimal designs, its added mass below the budget." if spare else "")
-        caption = (f"{len(pts)} points, each {what}, solved to global optimality {where} "
-                   f"(second-order cone programme, Clarabel).{lightest} Markers: the least-mass complete balances in the same "
-                   f"regions along {'this motion' if n == 1 else 'these motions'}, where they exist, and {marked}. "
-                   + headline(study, det) + " Interactive where JavaScript runs: hover a design for its "
-                   f"{AXES[x].split(' (')[0]} and {AXES[y].split(' (')[0]}, drag across to zoom (double-click "
-                   "resets), click a legend entry to hide it.")
+        off = limits(pts, x, y, marks)[2]
+        # a value at round-off of its axis's largest (a balanced design's 1e-14 N) reads 0
+        sx = max(abs(float(v)) for v in [*(p[x] for p in pts), *(m[1] for m in marks)])
+        sy = max(abs(float(v)) for v in [*(p[y] for p in pts), *(m[2] for m in marks)])
+        outside = ("" if not off else " Off the axes, which the front fills: " + "; ".join(
+            f"{label} at {AXES[x].split(' (')[0]} {num_at(vx, sx)} {AXES[x].split('(')[-1].rstrip(')')}, "
+            f"{AXES[y].split(' (')[0]} {num_at(vy, sy)} {AXES[y].split('(')[-1].rstrip(')')}" for label, vx, vy in off) + ".")
+        caption = (f"{len(pts)} points, each {what}, in absolute values (not relative to the unbalanced mechanism), "
+                   f"solved to global optimality {where}.{lightest} Markers: the least-mass complete balances in the same "
+                   f"regions along {'this motion' if n == 1 else 'these motions'}, where they exist, and {marked}."
+                   f"{outside} " + headline(study, det) + f" Hover a design for its {AXES[x].split(' (')[0]} and "
+                   f"{AXES[y].split(' (')[0]}.")
         out.append((title, svg, caption))
     return out

@@ -261,8 +261,11 @@ def timeseries_columns(study: Study) -> list[tuple[str, np.ndarray]]:
     :func:`balpipe.engine.dynamics.joint_reactions`), with loads the frame load and every load's
     series (:func:`.load_table.load_columns`), the total centre of mass, every body's pose and
     every named point's path with their velocities
-    (:func:`balpipe.mechanics.motion_outputs.motion_columns`); SI units, full precision."""
+    (:func:`balpipe.mechanics.motion_outputs.motion_columns`), a body's pose or point path
+    that equals the same column of an earlier stage (bit for bit: the stages share the motion)
+    left out, read under that earlier stage's name; SI units, full precision."""
     cols: list[tuple[str, np.ndarray]] = [("t_s", study.unbalanced.analysis.t)]
+    motion: dict[str, list[np.ndarray]] = {}
     for s in study.stages:
         an, n = s.analysis, s.stage.name
         cols += [
@@ -278,7 +281,13 @@ def timeseries_columns(study: Study) -> list[tuple[str, np.ndarray]]:
             for comp, values in an.reactions[j].items():
                 cols.append((f"{n}.reaction.{j}.{comp}_{REACTION_UNITS[comp]}", values))
         cols += load_columns(n, an)
-        cols += [(f"{n}.{name}", values) for name, values in motion_columns(s.stage.model, an)]
+        for name, values in motion_columns(s.stage.model, an):
+            # a body's pose or point path the same as an earlier stage's (the stages share their
+            # motion): written once, under the earliest stage's name
+            if name.startswith(("pose.", "point.")) and any(np.array_equal(values, v) for v in motion.get(name, ())):
+                continue
+            motion.setdefault(name, []).append(values)
+            cols.append((f"{n}.{name}", values))
     return cols
 
 
