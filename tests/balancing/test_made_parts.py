@@ -292,3 +292,22 @@ def test_the_svg_drawing_frames_the_whole_part_arcs_included():
         for phi in np.linspace(mid - a, mid + a, 101):  # the outer arc, in mm, y down
             x, y = ro * math.cos(phi) * 1e3, -ro * math.sin(phi) * 1e3
             assert x0 < x < x0 + w and y0 < y < y0 + h
+
+
+def test_the_dxf_is_the_same_bytes_whatever_the_processs_hash_seed():
+    """ezdxf lists the entity classes in use in a set's order: balpipe sorts them, so that a
+    rebuild in another process (another string hash seed) writes the same file."""
+    import hashlib
+    import os
+    import subprocess
+    import sys
+
+    code = ("import hashlib; from balpipe.mechanics.part_shapes import make; "
+            "from balpipe.report.part_drawings import dxf_text; "
+            "p = make('cw', 'crank', 'annular_sector', 'steel', 7850.0, {'inner_radius': 0.02, 'thickness': 0.018}, "
+            "0.8, (-0.06, 0.0), pivots=(('O', (0.0, 0.0)),)); print(hashlib.sha256(dxf_text(p).encode()).hexdigest())")
+    digests = {subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONHASHSEED": str(seed)},
+                              capture_output=True, text=True, check=True).stdout for seed in range(4)}
+    part = make("cw", "crank", "annular_sector", "steel", 7850.0, {"inner_radius": 0.02, "thickness": 0.018}, 0.8,
+                (-0.06, 0.0), pivots=(("O", (0.0, 0.0)),))
+    assert digests == {hashlib.sha256(dxf_text(part).encode()).hexdigest() + "\n"}

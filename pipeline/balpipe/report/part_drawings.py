@@ -9,7 +9,9 @@ material, thickness, mass). The DXF has ``$INSUNITS`` = 4 (mm).
 
 Byte-identical on rebuild: ezdxf's creation and update dates, GUIDs and its version stamp are
 written fixed (``ezdxf.options.write_fixed_meta_data_for_testing``, set only while the document is
-made and written), and the entities are added in one order, so their handles repeat.
+made and written), the entities are added in one order, so their handles repeat, and the CLASSES
+section is sorted by name (ezdxf lists the classes in use in a set's order, which depends on the
+process's hash seed).
 """
 
 from __future__ import annotations
@@ -54,6 +56,11 @@ def _dxf(ezdxf: Any, part: Any) -> str:
     for _, (x, y) in part.pivots:
         msp.add_circle((x * MM, y * MM), size / 2, dxfattribs={"layer": "PIVOTS"})
     msp.add_text(_title(part), height=size, dxfattribs={"layer": "TEXT", "insert": (ax, ay - 4 * size)})
+    # ezdxf registers the CLASS entries of the entity types in use in a set's order, which varies
+    # with the process's string hash seed: write once (every object and class is made), put the
+    # classes in their names' order, and write again
+    doc.write(io.StringIO())
+    doc.classes.classes = dict(sorted(doc.classes.classes.items()))
     buf = io.StringIO()
     doc.write(buf)
     return buf.getvalue()
