@@ -146,7 +146,7 @@
   const table = document.createElement("table");
   table.className = "whatif-peaks";
   const head = table.insertRow();
-  ["Peak", (fig.series[0] || {}).label || "reference", d.stage, "design tried"].forEach(text => {
+  ["Peak", (fig.series[0] || {}).label || "reference", (fig.series[1] || {}).label || d.stage, "design tried"].forEach(text => {
     const th = document.createElement("th"); th.textContent = text; head.appendChild(th);
   });
   const peak = y => { let m = 0; for (let i = 0; i < y.length; i++) if (y[i] != null) m = Math.max(m, Math.abs(y[i])); return m; };

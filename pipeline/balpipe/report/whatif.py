@@ -102,6 +102,7 @@ class WhatIf:
     parts: list[Part]
     notes: list[str] = field(default_factory=list)
     styles: tuple[int, int] = (1, 0)  # line styles of the design and of its reference stage
+    names: tuple[str, str] = ("", "")  # their short names in legends (the labels when empty)
 
     @property
     def t(self) -> np.ndarray:
@@ -244,10 +245,11 @@ def check(w: WhatIf) -> list[str]:
             if np.max(np.abs(got[k] - exact[k]), initial=0.0) > TOL * max(_scale(k, exact, w.reference), 1e-300)]
 
 
-def build(study, results: dict, styles: dict[str, int] | None = None) -> WhatIf | str | None:
+def build(study, results: dict, styles: dict[str, tuple[int, str]] | None = None) -> WhatIf | str | None:
     """The what-if of the study's main design (:func:`balpipe.report.design_card.main_stages`):
     None when it adds no part; a sentence saying why when its loads are not affine in the parts;
-    else its checked maps. ``styles``: the page's line style of each stage by name."""
+    else its checked maps. ``styles``: each stage's line style and short name on the page, by
+    stage name (:func:`balpipe.report.page.stage_styles`)."""
     pair = main_stages(study, results)
     if pair is None:
         return None
@@ -290,10 +292,12 @@ def build(study, results: dict, styles: dict[str, int] | None = None) -> WhatIf 
     columns = {k: {b: [full[k][index, 4 * at[b] + j].copy() if nonzero[k][b][j] else None for j in range(4)]
                    for b in bodies} for k in keys}
     styles = styles or {}
+    design_style, design_name = styles.get(final.stage.name, (1, final.stage.label))
+    reference_style, reference_name = styles.get(ref.stage.name, (0, ref.stage.label))
     w = WhatIf(final.stage.name, final.stage.label, ref.stage.label, model, np.asarray(an.t, dtype=float),
                an.gravity, an.moment_point, index, keys, panels, _quantities(an, keys, index),
                _quantities(ref.analysis, [k for k in keys if k.split(":", 1)[-1] in ref.analysis.efforts], index), bodies, columns, parts, notes,
-               (styles.get(final.stage.name, 1), styles.get(ref.stage.name, 0)))
+               (design_style, reference_style), (design_name, reference_name))
     for k in keys:
         w.reference.setdefault(k, np.zeros(len(index)))
     missed = check(w)
@@ -319,7 +323,8 @@ def curves(w: WhatIf) -> live.Curves:
     design's until a slider moves)."""
     return live.Curves(w.t, [(w.reference_label, {k: w.reference[k] for k in ["F", *w.keys] if k in w.reference}),
                              (w.label, dict(w.design)), ("design tried", {})],
-                       w.panels, [], styles=[w.styles[1], w.styles[0], STYLE], grid=True)
+                       w.panels, [], styles=[w.styles[1], w.styles[0], STYLE], grid=True,
+                       names=(w.names[1] or w.reference_label, w.names[0] or w.label, "design tried"))
 
 
 def data(w: WhatIf) -> dict:
@@ -336,7 +341,7 @@ def data(w: WhatIf) -> dict:
             "stage": w.label}
 
 
-def section(study, results: dict, styles: dict[str, int] | None = None) -> dict | None:
+def section(study, results: dict, styles: dict[str, tuple[int, str]] | None = None) -> dict | None:
     """The template's ``whatif``: None (no section), ``{"reason": ...}`` (no sliders, and why) or the
     live figure's markup, the maps' JSON and the notes."""
     w = build(study, results, styles)
