@@ -176,3 +176,16 @@ def test_a_design_tried_before_the_plots_are_built_is_drawn_when_they_are(whatif
     for plot in plots:
         assert plot["series"][2] == state["series"][plot["key"]], plot["key"]
     assert not w.problems, "\n".join(w.problems)
+
+
+def test_the_design_card_links_to_the_sliders(whatif_site, browser):
+    """The design card's link opens the folded section of the sliders and brings them into view."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": 1400, "height": 900})
+    p.goto((whatif_site / "offset_slider_crank" / "index.html").as_uri(), wait_until="load")
+    assert not p.locator("#whatif-panel input[type=range]").first.is_visible()
+    p.click("#design-summary a[href='#designs-tried-live']")
+    p.wait_for_function("() => document.getElementById('whatif-panel').closest('details').open")
+    assert p.locator("#whatif-panel input[type=range]").first.is_visible()
+    assert not w.problems, "\n".join(w.problems)
