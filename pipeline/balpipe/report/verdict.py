@@ -236,7 +236,8 @@ def stage_words(stage: Any, paper: bool = False, reference: dict | None = None) 
     if costs:
         text += f"; cost{'s' if len(costs) > 1 else ''}: " + ", ".join(costs)
     if not realisable:
-        text += f"; {row.get('not_realisable') or 'not realisable'} (balanced on paper only)"
+        text += f"; {row.get('not_realisable') or 'not realisable'}" + ("" if words.endswith("on paper only")
+                                                                         else " (balanced on paper only)")
     return {**out, "verdict": kind, "words": words, "level": level, "text": text,
             "holds": (not fails) if claims else None}
 
