@@ -356,10 +356,12 @@ def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
 
 def headline(sections: list) -> list[list[str]]:
     """The headline changes: the peak |F| and |M| rows of the stages, last stage first (the
-    balanced design's before the unbalanced one's)."""
+    balanced design's before the unbalanced one's); only those of stages both designs have, where any."""
     rows = next((r for title, r, _ in sections if title == "Stages"), [])
     keys = (STAGE_NAMES["max_shaking_force"], STAGE_NAMES["max_shaking_moment"])
-    return [r for r in reversed(rows) if r[1] in keys][:4]
+    peaks = [r for r in reversed(rows) if r[1] in keys]
+    both = [r for r in peaks if "—" not in (r[2], r[3])]  # a stage of both designs before one that one lacks
+    return (both or peaks)[:4]
 
 
 def to_text(data: dict) -> str:

@@ -131,6 +131,9 @@ def test_the_diff_says_whether_each_side_is_still_balanced_in_the_pages_words(tm
     html = out.read_text()
     assert html.index('id="verdict"') < html.index('id="headline"') < html.index("<h2>Inputs</h2>") < html.index("<h2>Stages</h2>")
     assert 'href="paper000_rpr3_scott_russell/index.html" class="page-link"' in html
+    # what changed: the stages both designs have (the corrected spec's compared idler loop is not one)
+    head = html[html.index('id="headline"'):html.index("<h2>Inputs</h2>")]
+    assert "counter-rotations: peak |M|" in head and "idler" not in head
     assert html.count('class="page-link"') == 1  # the corrected design has no page on this site: no dead link
     text = balpipe("diff", old, new, "--no-sim").stdout
     stages = text[text.index("Stages:"):text.index("References")]

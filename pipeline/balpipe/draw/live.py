@@ -172,7 +172,7 @@ def data(c: Curves) -> dict:
     if c.styles is not None:
         for one, style in zip(series, c.styles):
             one.update(line_style(style))
-    if c.markers and not c.x_axis:
+    if c.markers:  # over another quantity too (the history's commits): the stage's marker, as the page's key
         for n, one in enumerate(series):
             style = n if c.styles is None else c.styles[n]
             if not isinstance(style, dict):

@@ -4,8 +4,8 @@ commit, drag zooms, a legend entry hides its curve).
 
 The x axis is the commits' number, oldest first, as the history table numbers them (its rows
 give each commit's hash, date, subject and the inputs it changed). A commit whose spec is invalid
-or crashed has no value there (its marker is missing). Each stage keeps the line style it has on
-the study page's figures (its place in the stage table).
+or crashed has no value there (its marker is missing). Each stage keeps the line style and marker
+it has on the study page's figures and key (its place in the stage table).
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ def _panels(commits: list[dict], stages: list[tuple[str, str]], panels: tuple[tu
     """A panel per (results key, title, axis) of ``panels``: every stage's value per commit."""
     curves = [(label, {key: _series(commits, name, key) for key, _, _ in panels}) for name, label in stages]
     return Curves(_commits_x(commits), curves, [{"key": k, "title": t, "axis": ax} for k, t, ax in panels], [],
-                  styles=[k + first_style for k in range(len(stages))], x_axis=X_AXIS, grid=True)
+                  styles=[k + first_style for k in range(len(stages))], markers=True, x_axis=X_AXIS, grid=True)
 
 
 def loads_history_figure(commits: list[dict]) -> Curves:
