@@ -5,7 +5,8 @@ configuration is reported by the chunk that holds it, the earlier ones being reg
 
 from __future__ import annotations
 
-import math
+import runpy
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,29 +15,15 @@ from balpipe import registry
 from balpipe.engine import analyse, compiled, fastpath
 from balpipe.engine.vectorised import State, law_table, residual, residual_rows
 from balpipe.loader import load
-from balpipe.model import FRAME, Body, Driver, Model, Revolute
-from balpipe.motion import PointToPoint, quintic
+from balpipe.model import Model
 from balpipe.study import gravity_vector
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def chain(n: int, seed: int = 0, sweep: float = 1.0) -> Model:
-    """A planar nR serial chain with random links, every joint on the 3-4-5 law over 1 s."""
-    rng = np.random.default_rng(seed)
-    L = rng.uniform(0.1, 0.5, n)
-    r, m = L * rng.uniform(0.3, 0.7, n), rng.uniform(0.5, 5.0, n)
-    q0 = rng.uniform(-0.5, 0.5, n) + 0.3
-    qf = q0 + sweep * rng.uniform(-1.0, 1.0, n)
-    bodies = tuple(Body(f"l{k}", m[k], (r[k], 0.0), m[k] * L[k] ** 2 / 12, points={"p": (0.0, 0.0), "d": (L[k], 0.0)},
-                        outline=("p", "d")) for k in range(n))
-    joints = tuple(Revolute(f"J{k}", FRAME if k == 0 else f"l{k - 1}", f"l{k}", (0.0, 0.0) if k == 0 else (L[k - 1], 0.0),
-                            (0.0, 0.0)) for k in range(n))
-    drivers = tuple(Driver(f"q{k}", ("joint", f"J{k}"), PointToPoint(q0[k], qf[k], 1.0, quintic)) for k in range(n))
-    initial, x, y, th = {}, 0.0, 0.0, 0.0
-    for k in range(n):
-        th += q0[k]
-        initial[f"l{k}"] = (x, y, th)
-        x, y = x + L[k] * math.cos(th), y + L[k] * math.sin(th)
-    return Model(f"{n}R chain", bodies, joints, drivers, initial, frame_points={"O": (0.0, 0.0)})
+    """benchmarks/chains.py's planar nR chain: random links, every joint on the 3-4-5 law."""
+    return runpy.run_path(str(ROOT / "benchmarks" / "chains.py"))["serial_chain"](n, seed, sweep)[0]
 
 
 def _both(model: Model, t: np.ndarray, g: np.ndarray, chunk: int):
@@ -51,7 +38,11 @@ def _both(model: Model, t: np.ndarray, g: np.ndarray, chunk: int):
 
 def test_analyse_takes_the_chunks_on_long_grids():
     """analyse() on more samples than a chunk: the same Analysis as on one chunk."""
-    model, t = chain(5, seed=2), np.linspace(0.0, 1.0, 3 * fastpath.CHUNK + 5)
+    model = chain(5, seed=2)
+    c = compiled(model)
+    size = fastpath.chunk_size(fastpath.prepare(c).vz)
+    assert 1024 <= size <= 16384
+    t = np.linspace(0.0, 1.0, 3 * size + 5)
     a = analyse(model, t, (0.0, -9.81))
     saved = fastpath.CHUNK
     try:

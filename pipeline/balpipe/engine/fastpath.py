@@ -16,7 +16,7 @@ substitution on the decomposed Jacobian (:mod:`.structure`), the constraints eva
   (:mod:`.warmstart`).
 * Velocities Phi_q q' = nu, accelerations Phi_q q'' = gamma: forward substitution.
 * Multipliers Phi_q^T lambda = Q - M q'': backward substitution on the same values.
-* Long grids: after the positions, everything runs :data:`CHUNK` samples at a time
+* Long grids: after the positions, everything runs :func:`chunk_size` samples at a time
   (:func:`dynamics_by_chunks`; the same values), so that the Jacobian's values and the
   trigonometry of one chunk are alive at a time and stay in the caches.
 * Regularity: cond(Phi_q) >= max|entry| / sigma_min(block) for every diagonal block; samples
@@ -131,7 +131,16 @@ def kinematics(c: Compiled, p: Prepared, t: np.ndarray) -> Kinematics:
     return Kinematics(X, V, A, vals, state, inverses)
 
 
-CHUNK = 2048  # samples per chunk of :func:`dynamics_by_chunks`: its arrays stay in the caches
+CHUNK: int | None = None  # samples per chunk of :func:`dynamics_by_chunks` (None: :func:`chunk_size`)
+_CHUNK_VALUES = 1 << 20  # the float rows x samples of one chunk: a few MB, in the caches
+
+
+def chunk_size(vz: Vectorised) -> int:
+    """Samples per chunk: about :data:`_CHUNK_VALUES` values over the Jacobian's entries and the
+    coordinates' rows (X, V, A and the trigonometry), 1024 to 16384 samples (a small model's
+    chunk is long: each chunk costs a fixed few hundred numpy calls)."""
+    rows = vz.nnz + 4 * vz.ncol
+    return int(min(16384, max(1024, _CHUNK_VALUES // max(1, rows))))
 
 
 @dataclass
@@ -151,7 +160,7 @@ def dynamics_by_chunks(c: Compiled, p: Prepared, t: np.ndarray, Mdiag: np.ndarra
                        chunk: int | None = None) -> Motion:
     """:func:`kinematics`, then the multipliers of Phi_q^T lambda = Q - M q'' (gravity ``g``,
     ``Mdiag`` the diagonal of M, (1, 3 nb)) and the frame load, ``chunk`` samples at a time
-    (default :data:`CHUNK`):
+    (default :data:`CHUNK`, else :func:`chunk_size`):
     the same operations sample by sample as the whole grid at once (the same values), with the
     Jacobian's values, its blocks' inverses and the trigonometry of one chunk alive at a time
     (a fifth of the memory of 20,000 samples of a 21-body ladder; the chunks' arrays stay in the
@@ -162,15 +171,22 @@ def dynamics_by_chunks(c: Compiled, p: Prepared, t: np.ndarray, Mdiag: np.ndarra
     if dec is None:
         raise Fallback
     N = len(t)
-    chunk = CHUNK if chunk is None else max(1, chunk)
+    chunk = max(1, chunk if chunk is not None else CHUNK if CHUNK is not None else chunk_size(vz))
+    gx, gy = (c.mass * g[0])[:, None], (c.mass * g[1])[:, None]
+    if N <= chunk:  # one chunk: the arrays of the solves are the results
+        kin = kinematics(c, p, t)
+        rhsT = -Mdiag.T * kin.A[3:-1]
+        rhsT[0::3] += gx
+        rhsT[1::3] += gy
+        lamT1 = multipliers(p, kin, rhsT)
+        return Motion(kin.X, kin.V, kin.A, lamT1, frame_load(p, kin.vals, lamT1))
     f, fd, fdd = law_table(vz, t)  # the whole grid: a law may depend on it
     X = np.zeros((vz.ncol + 1, N))
     if not dec.explicit:
         X[3:-1] = _closed_loop_positions(c, vz, dec, t, f).T
-    V, A = np.zeros_like(X), np.zeros_like(X)
-    lamT = np.empty((vz.m, N))
+    V, A = np.zeros(X.shape), np.zeros(X.shape)
+    lamT = np.zeros((vz.m + 1, N))  # a padding row last, as solve() lays it out
     frame = np.empty((N, 3))
-    gx, gy = (c.mass * g[0])[:, None], (c.mass * g[1])[:, None]
     for a in range(0, N, chunk):
         b = min(N, a + chunk)
         n, fa = b - a, f[:, a:b]
@@ -186,16 +202,15 @@ def dynamics_by_chunks(c: Compiled, p: Prepared, t: np.ndarray, Mdiag: np.ndarra
         vals = jacobian_values(vz, state)
         inverses = invert_blocks(dec, vals)
         _screen(c, p, vals, inverses, Xc, t[a:b])
-        Vc = solve(dec.forward, vals, velocity_rhs(vz, fd[:, a:b], n), inverses, offset=3)
-        Ac = solve(dec.forward, vals, acceleration_rhs(vz, state, Vc, fdd[:, a:b]), inverses, offset=3)
-        V[:, a:b], A[:, a:b] = Vc, Ac
+        Vc = solve(dec.forward, vals, velocity_rhs(vz, fd[:, a:b], n), inverses, offset=3, out=V[:, a:b])
+        Ac = solve(dec.forward, vals, acceleration_rhs(vz, state, Vc, fdd[:, a:b]), inverses, offset=3,
+                   out=A[:, a:b])
         rhsT = -Mdiag.T * Ac[3:-1]
         rhsT[0::3] += gx
         rhsT[1::3] += gy
-        lc = solve(dec.backward, vals, rhsT, inverses)[:-1]
-        lamT[:, a:b] = lc
+        lc = solve(dec.backward, vals, rhsT, inverses, out=lamT[:, a:b])[:-1]
         frame[a:b] = frame_load(p, vals, lc)
-    return Motion(X, V, A, lamT, frame)
+    return Motion(X, V, A, lamT[:-1], frame)
 
 
 def _explicit_positions(vz: Vectorised, dec: Decomposition, f: np.ndarray, N: int) -> tuple[np.ndarray, State]:

@@ -329,13 +329,15 @@ def strong_components(succ: list[list[int]]) -> list[list[int]]:
     return comps
 
 
-def solve(plan: Plan, vals: np.ndarray, rhs: np.ndarray, inverses: dict[int, np.ndarray], offset: int = 0) -> np.ndarray:
+def solve(plan: Plan, vals: np.ndarray, rhs: np.ndarray, inverses: dict[int, np.ndarray], offset: int = 0,
+          out: np.ndarray | None = None) -> np.ndarray:
     """Solve the triangular system of ``plan`` with Jacobian values ``vals`` (nnz + 1, N) (last
     row zero), the inverses of its k x k diagonal blocks (:func:`invert_blocks`) and right-hand
     side ``rhs`` (equations, N). Returns (offset + n + 1, N): ``offset`` zero rows, the n
-    unknowns, a zero row (padding)."""
+    unknowns, a zero row (padding); written into ``out`` when given (zero, that shape: a
+    chunk's columns of a larger array)."""
     N = rhs.shape[1]
-    U = np.zeros((offset + plan.n_unknowns + 1, N))
+    U = np.zeros((offset + plan.n_unknowns + 1, N)) if out is None else out
     for st in plan.steps:
         b = rhs[st.eq]
         if st.off_slots.shape[1]:
