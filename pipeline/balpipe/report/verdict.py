@@ -10,14 +10,24 @@ published numbers the build reproduces. A load that was already at round-off in 
 (a Scotch yoke's shaking moment about its axis) and stays there reads *0 before and after*
 (outcome ``zero``): nothing was cancelled, and nothing is lost.
 
-Levels, worst first: ``bad`` (a claim fails, or the build failed), ``warn`` (a stage makes a
-load worse than its reference, a part cannot be built, or a published number does not
-reproduce), ``neutral`` (nothing changed), ``good``. A spec's level is the worst of its main
-design's headline stages (below), of its stages' claims and of its references: a spec whose |M|
-gets worse after a stage that claims moment balance is never ``good``. "Balancing fails" is said
-only where a claim of the analysis fails: a build that failed a check while every claim holds (the
-pymunk simulation contradicts the analysis) says so instead, and a check that could not resolve
-its own error (``unconfirmed`` in results.json: nothing shown false) is named after the loads.
+One vocabulary, from one function (:func:`stage_words`), for the index, the page, ``balpipe
+diff`` and results.json: what was claimed and holds ("force balanced as designed", "balanced as
+claimed" for a paper's claim of complete balance), the loads a stage does not claim that grow as
+costs ("moment × 12.6", never a lower level), a claim that fails ("the paper's claim fails: moment
+× 6.74"), an optimised stage by its objective (:func:`aim_verdict`); machine-readable as
+``verdict`` (:data:`KINDS`), ``words`` and ``costs``.
+
+Levels, worst first: ``bad`` (a claim fails, a published number that should reproduce does not,
+or the build failed), ``warn`` (a stage that claims nothing makes a load worse than its
+reference, a part cannot be built, or a published number is known not to reproduce), ``neutral``
+(nothing changed), ``good``. A published number the page explains (a misprint, or reproduced
+within the stated tolerance under stated assumptions) is counted apart and never lowers the level
+(:func:`references_verdict`). A spec's level is the worst of its main design's headline stages
+(below), of its stages' claims and of its references: a spec whose |M| gets worse after a stage
+that claims moment balance is never ``good``. A failing claim is said only where a claim of the
+analysis fails: a build that failed a check while every claim holds (the pymunk simulation
+contradicts the analysis) says so instead, and a check that could not resolve its own error
+(``unconfirmed`` in results.json: nothing shown false) is named after the loads.
 
 The headline numbers come from the spec's main design (not a design of ``compare``), one
 row per motion (the stages sharing a reference stage); a compared design never stands in. Per
