@@ -83,7 +83,7 @@ def test_build_writes_the_site(built, work):
     page = (out / "scott_russell" / "index.html").read_text()
     # the drawings are inline SVG, the plots over time are drawn in the browser from their data
     live = re.findall(r'<script type="application/json" data-live="([a-z-]+)">', page)
-    assert set(live) == {"live-loads", "live-efforts", "live-joints"}
+    assert set(live) == {"live-loads", "live-efforts", "live-joints", "live-whatif"}  # and the designs tried live
     assert all(f'<div class="live" id="{name}">' in page for name in live)
     assert page.count("<figure>") + page.count('<figure class="wide">') >= 5
     assert page.count("<svg") >= 3 and "skipped" in page
