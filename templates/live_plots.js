@@ -91,14 +91,15 @@
       drawn.forEach((s, n) => {
         if (!s.marker || !u.series[n + 1].show) return;
         const [shape, start, every] = s.marker, ys = u.data[n + 1], pts = SHAPES[shape] || [];
-        c.strokeStyle = s.stroke; c.lineWidth = r; c.setLineDash([]);
+        const rad = s.points ? 1.7 * size : size;  // a single design (a front's mark) stands out, filled white
+        c.strokeStyle = s.stroke; c.lineWidth = s.points ? 1.5 * r : r; c.setLineDash([]); c.fillStyle = "#fff";
         for (let i = start; i < ys.length; i += every) {
           if (ys[i] == null) continue;
           const x = u.valToPos(u.data[0][i], "x", true), y = u.valToPos(ys[i], "y", true);
           c.beginPath();
-          if (!pts.length) c.arc(x, y, size, 0, 2 * Math.PI);
-          else pts.forEach(([px, py], j) => (j ? c.lineTo : c.moveTo).call(c, x + px * size, y + py * size));
-          c.closePath(); c.stroke();
+          if (!pts.length) c.arc(x, y, rad, 0, 2 * Math.PI);
+          else pts.forEach(([px, py], j) => (j ? c.lineTo : c.moveTo).call(c, x + px * rad, y + py * rad));
+          c.closePath(); if (s.points) c.fill(); c.stroke();
         }
       });
       c.restore();
@@ -298,7 +299,7 @@
       const series = [{ label: d.x || "t (s)", value: (u, v) => fmt(v) }].concat(drawn.map(s => Object.assign({
         label: s.label, stroke: s.stroke, dash: s.dash, width: s.width, value: (u, v) => fmt(v, p.floor),
         show: !s.sim || f.simShown,
-      }, d.x ? { spanGaps: true, points: { show: true, size: s.points ? 10 : 5, width: 1.5, fill: "#fff" } } : {},
+      }, d.x ? { spanGaps: true, points: { show: !s.marker, size: s.points ? 10 : 5, width: 1.5, fill: "#fff" } } : {},
          s.points ? { paths: () => null } : {})));
       const opts = Object.assign({
         title: p.title, width: w, height: plotHeight(p.axis),

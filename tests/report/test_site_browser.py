@@ -1082,7 +1082,7 @@ def test_every_figure_offers_its_data_as_csv_with_units_and_itself_as_png(server
     p.goto(server + "scott_russell/index.html", wait_until="load")
     open_sections(p)
     figures = p.evaluate("() => [...document.querySelectorAll('script[data-live]')].map(s => s.dataset.live)")
-    links = dict(p.evaluate("""() => [...document.querySelectorAll('p.downloads')].map(b =>
+    links = dict(p.evaluate("""() => [...document.querySelectorAll('p.downloads[data-for]')].map(b =>
         [b.dataset.for, b.querySelector('a[download]').getAttribute('href')])"""))
     assert figures and sorted(links) == sorted(figures), (figures, links)
     for fig, href in links.items():
@@ -1098,4 +1098,28 @@ def test_every_figure_offers_its_data_as_csv_with_units_and_itself_as_png(server
     assert d.suggested_filename == "figure-loads.png"
     data = Path(d.path()).read_bytes()
     assert data.startswith(b"\x89PNG") and len(data) > 5000
+    assert not w.problems, "\n".join(w.problems)
+
+
+@pytest.mark.parametrize("width", [400, 1400])
+def test_every_static_figure_downloads_as_svg_and_png(server, browser, width):
+    """Under every figure drawn as an inline SVG (the mechanism drawings), a button saves that
+    SVG as a file (a standalone SVG document) and one saves it as a PNG."""
+    w = Watched(browser)
+    p = w.page
+    p.set_viewport_size({"width": width, "height": 900})
+    p.goto(server + "osc/index.html", wait_until="load")
+    open_sections(p)
+    bars = p.locator("p.downloads.static")
+    assert bars.count() >= 2  # a drawing per stage
+    assert p.evaluate("() => [...document.querySelectorAll('p.downloads.static')].every(b => b.closest('figure').querySelector(':scope > svg, svg'))")
+    bar = bars.first
+    bar.scroll_into_view_if_needed()
+    with p.expect_download() as got:
+        bar.locator("button.svg").click()
+    text = Path(got.value.path()).read_text(encoding="utf-8")
+    assert got.value.suggested_filename.endswith(".svg") and 'xmlns="http://www.w3.org/2000/svg"' in text and text.rstrip().endswith("</svg>")
+    with p.expect_download() as got:
+        bar.locator("button.png").click()
+    assert got.value.suggested_filename.endswith(".png") and Path(got.value.path()).read_bytes().startswith(b"\x89PNG")
     assert not w.problems, "\n".join(w.problems)

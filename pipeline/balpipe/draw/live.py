@@ -176,7 +176,8 @@ def data(c: Curves) -> dict:
         for n, one in enumerate(series):
             style = n if c.styles is None else c.styles[n]
             if not isinstance(style, dict):
-                one.update(markers(style, len(k)))
+                # over time at staggered samples; over another quantity (a front, commits) at every value
+                one.update(markers(style, len(k)) if not c.x_axis else {"marker": [figures.marker(style), 0, 1]})
     out = {"t": _round(t[k]), "series": series, "panels": [{**p, "floor": floors[p["key"]]} for p in c.panels],
            "draw": draw_order(series),
            "marks": [[_round([tm])[0], text] for tm, text in sorted(set(c.marks))]}
