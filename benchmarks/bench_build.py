@@ -78,9 +78,12 @@ clock = time.process_time if os.environ.get("BENCH_CLOCK") == "cpu" else time.pe
 t_start = clock()
 import balpipe
 # a source tree on PYTHONPATH: its templates/ folder (beside pipeline/, installed as
-# balpipe.templates) is found where no install of the same tree provides it
+# balpipe.templates) is used, not another tree's that an editable install provides (a revision's
+# pages rendered with today's templates crash)
 _tpl = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(balpipe.__file__))), "templates")
-if importlib.util.find_spec("balpipe.templates") is None and os.path.isdir(_tpl):
+_found = importlib.util.find_spec("balpipe.templates")
+_theirs = _found is None or os.path.dirname(os.path.realpath(_found.origin or "")) != os.path.realpath(_tpl)
+if _theirs and os.path.isdir(_tpl):
     _s = importlib.util.spec_from_file_location("balpipe.templates", os.path.join(_tpl, "__init__.py"),
                                                 submodule_search_locations=[_tpl])
     balpipe.templates = sys.modules["balpipe.templates"] = importlib.util.module_from_spec(_s)
