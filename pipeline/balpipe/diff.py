@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from . import runner
+from .display.numbers import num_at
 from .loader import LoadedSpec, SpecError, SpecErrors, load, load_text
 from .report.results import json_safe
 from .study import Study
@@ -252,6 +253,7 @@ def compare(a: Side, b: Side) -> dict:
     ]
     va, vb = side_verdict(a), side_verdict(b)
     return json_safe({
+        "mounts": mounts_changes(a, b),
         "old": a.ref, "new": b.ref,
         "verdict": {"old": va, "new": vb, "still": still(va, vb)},
         "old_spec": a.loaded.spec.name, "new_spec": b.loaded.spec.name,
@@ -305,6 +307,34 @@ def _rel(d: dict) -> str:
     return f"{100 * r:+.3g} %" if math.isfinite(r) and abs(r) >= 1e-4 else (f"{r:+.2e}" if math.isfinite(r) else "new")
 
 
+def _frame_summary(side: Side) -> dict[str, dict]:
+    """Per stage, what the frame on its mounts feels (none without a ``frame``): the largest peak
+    floor force of any mount (N), the largest RMS vibration velocity along x or y of any point
+    (m/s), and the verdicts against the spec's limits."""
+    from .report.frame_mounts import mounts_json
+
+    mounts = mounts_json(side.study)
+    if mounts is None:
+        return {}
+    return {name: {"floor_force_peak": max(m["peak"] for m in st["mounts"]),
+                   "velocity_rms": max(max(p["rms_x"], p["rms_y"]) for p in st["velocity"]),
+                   "limits": "; ".join(f"{c['quantity']} at {c['where']}: {c['verdict']}" for c in st["limits"])}
+            for name, st in mounts["stages"].items()}
+
+
+def mounts_changes(a: Side, b: Side) -> list[dict]:
+    """The frame on its mounts in both designs (:mod:`balpipe.report.frame_mounts`), per stage
+    either side has: the largest floor force and RMS vibration velocity, old and new, and the
+    limits' verdicts; empty when neither spec has a ``frame``."""
+    fa, fb = _frame_summary(a), _frame_summary(b)
+    rows = []
+    for name in list(fa) + [n for n in fb if n not in fa]:
+        x, y = fa.get(name, {}), fb.get(name, {})
+        rows.append({"name": name, **{k: _change(x.get(k), y.get(k)) for k in ("floor_force_peak", "velocity_rms")},
+                     "limits": {"old": x.get("limits"), "new": y.get("limits")}})
+    return rows
+
+
 def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
     """Sections as (title, rows, header) for the text and Markdown renderers: the verdict of each
     side first (is it still balanced?), the inputs that changed next, then what they did (stages,
@@ -347,6 +377,24 @@ def _rows(data: dict) -> list[tuple[str, list[list[str]], list[str]]]:
     if sim:
         sections.append(("Simulation residuals (numerical, not a design change)", sim,
                          ["stage", "residual", "old", "new", "change"]))
+    labels = {s["name"]: s.get("label") or s["name"] for s in data["stages"]}
+    frame: list[list[str]] = []
+    mounts = data.get("mounts", [])
+    # round-off of a side's largest value (its unbalanced stage's) reads 0; 0 on both sides is no change
+    scale = {(key, w): max((abs(m[key][w]) for m in mounts if m[key][w] is not None), default=0.0)
+             for key in ("floor_force_peak", "velocity_rms") for w in ("old", "new")}
+    for m in mounts:
+        label = labels.get(m["name"], m["name"])
+        for key, what, k in (("floor_force_peak", "largest peak floor force (N)", 1.0),
+                             ("velocity_rms", "largest RMS vibration velocity (mm/s)", 1000.0)):
+            d = m[key]
+            old, new = ("—" if d[w] is None else num_at(k * d[w], k * scale[key, w]) for w in ("old", "new"))
+            if old != new:
+                frame.append([label, what, old, new, _rel(d) if "0" not in (old, new) else ""])
+        if m["limits"]["old"] != m["limits"]["new"]:
+            frame.append([label, "against the limits", _fmt(m["limits"]["old"]), _fmt(m["limits"]["new"]), ""])
+    if frame:
+        sections.append(("The frame on its mounts", frame, ["stage", "result", "old", "new", "change"]))
     sections.append(("References", [[r["name"], _fmt(r["published"]), _fmt(r["old"]), _fmt(r["new"]), f"{_fmt(r['old_status'])} -> {_fmt(r['new_status'])}"] for r in data["references"]],
                      ["reference", "published", "old", "new", "status"]))
     sections.append(("Computed parameters", [[p["name"], _fmt(p["old"]), _fmt(p["new"]), _rel(p), p["unit"]] for p in data["parameters"]],

@@ -184,3 +184,29 @@ def test_a_load_cancelled_to_round_off_reads_zero_and_a_long_text_is_cut():
     (symbol, field, old, new, _), = sections["Inputs"]
     assert symbol == "—" and field == "description"  # no symbol: a text of the spec's
     assert old.startswith("a" * 20) and old.endswith("… (1097 characters)") and len(old) < 70 and new == "short"
+
+
+def test_the_diff_says_what_the_frame_on_its_mounts_feels_now(tmp_path):
+    """The V-twin's front mount made stiffer: the floor force and vibration velocity of each
+    stage, old and new, in a section of its own (JSON, text and HTML), with no round-off shown as
+    a change; a spec without ``frame`` has no such section."""
+    old, new = ROOT / "specs" / "custom_v_twin_6000rpm.yaml", tmp_path / "new.yaml"
+    new.write_text(replaced(old.read_text(), "{name: front, at: [0.18, -0.12], kx: 250 kN/m",
+                            "{name: front, at: [0.18, -0.12], kx: 500 kN/m"))
+    r = balpipe("diff", old, new, "--no-sim", "-f", "json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    rows = {m["name"]: m for m in d["mounts"]}
+    assert set(rows) == {s["name"] for s in d["stages"]}
+    un = rows["unbalanced"]
+    assert un["floor_force_peak"]["old"] > 0 and un["floor_force_peak"]["new"] != un["floor_force_peak"]["old"]
+    assert un["velocity_rms"]["relative"] is not None
+    text = balpipe("diff", old, new, "--no-sim").stdout
+    section = text[text.index("The frame on its mounts"):text.index("References")]
+    assert "largest peak floor force (N)" in section and "largest RMS vibration velocity (mm/s)" in section
+    assert "e-" not in section and "e+" not in section
+    out = tmp_path / "d.html"
+    assert balpipe("diff", old, new, "--no-sim", "-f", "html", "-o", out).returncode == 0
+    assert "The frame on its mounts" in out.read_text()
+    plain = balpipe("diff", ROOT / "specs" / "scott_russell.yaml", ROOT / "specs" / "scott_russell.yaml", "--no-sim", "-f", "json")
+    assert json.loads(plain.stdout)["mounts"] == []

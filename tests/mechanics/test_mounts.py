@@ -372,3 +372,24 @@ def test_the_moment_point_does_not_move_the_frame():
                 assert y["peak"] == pytest.approx(x["peak"], rel=1e-9, abs=1e-9 * a["stages"]["unbalanced"]["mounts"][0]["peak"])
             for x, y in zip(s["velocity"], b["stages"][name]["velocity"]):
                 assert y["rms"] == pytest.approx(x["rms"], rel=1e-9, abs=1e-9 * a["stages"]["unbalanced"]["velocity"][0]["rms"])
+
+
+def test_mounts_section_reads_in_the_pages_display_units():
+    """``report.units: engineering``: the frame's mass, position, floor forces and limits on the
+    page in the chosen units (kN, mm), the same numbers as the SI page scaled; results.json stays SI."""
+    from balpipe.report.page import render_page
+    from balpipe.report.results import results_dict
+    pages = {}
+    for units in ("SI", "engineering"):
+        text = four_bar(True).replace("force_peak: 300 N", "force_peak: 2 N") + f"report:\n  units: {units}\n"
+        spec, _ = load_text(text, "s.yaml")
+        study = run(spec)
+        results = results_dict(study, "s.yaml", "h", simulated=False)
+        html = render_page(study, results, text)
+        pages[units] = html.split("The frame on its mounts</h2>")[1].split("<h3>Natural modes</h3>")[0]
+        assert results["mounts"]["frame"]["com"] == [0.1, -0.05]
+    si, eng = pages["SI"], pages["engineering"]
+    assert "centre of mass at (0.1, -0.05) m)" in si and "centre of mass at (100, -50) mm)" in eng
+    assert "<th>peak (N)</th>" in si and "<th>peak (kN)</th>" in eng and "(N)</th>" not in eng
+    assert "(0.1, 0.3) m</td>" in si and "(100, 300) mm</td>" in eng
+    assert " N vs 2 N" in si and " kN vs 0.002 kN" in eng

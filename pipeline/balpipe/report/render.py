@@ -39,11 +39,11 @@ def qty(ctx, x, quantity: str, scale=None, digits: int = 4) -> str:
 
 
 @jinja2.pass_context
-def qload(ctx, x, quantity: str, ref, tolerance, with_unit: bool = False) -> str:
+def qload(ctx, x, quantity: str, ref, tolerance, with_unit: bool = False, of: str = "reference") -> str:
     """A peak load in the page's display units (``with_unit``: and its unit), or "0 (< 1e-9 of
-    reference)" at most ``tolerance`` times ``ref`` (:func:`load`)."""
+    reference)" at most ``tolerance`` times ``ref`` (:func:`load`; ``of`` names the reference)."""
     if x is not None and ref and tolerance is not None and abs(float(x)) <= float(tolerance) * abs(float(ref)):
-        return load(x, ref, tolerance)
+        return load(x, ref, tolerance, of=of)
     u = _units(ctx)
     return u.text(x, quantity) if with_unit else u.num(x, quantity)
 
