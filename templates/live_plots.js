@@ -14,12 +14,21 @@
   if (typeof uPlot === "undefined") return;
   const HEIGHT = 240;
   const PRINT_WIDTH = 700, PRINT_GAP = 16, PRINT_RATIO = 3;  // CSS px: an A4 or Letter page's column
-  // a value within the panel's round-off floor (draw/live.py) reads as the tables write it
+  // numbers as the pages write them (balpipe.display.numbers): fixed-point decimals to 4
+  // significant digits, never "1.2e-5"; a magnitude below a millionth or from a thousand million
+  // as a written-out power of ten (2.8×10⁻¹¹); a value within the panel's round-off floor
+  // (draw/live.py) reads as the tables write it
+  const SUPERSCRIPT = { "-": "⁻", "0": "⁰", "1": "¹", "2": "²", "3": "³", "4": "⁴", "5": "⁵", "6": "⁶", "7": "⁷", "8": "⁸", "9": "⁹" };
+  function powerOfTen(v, digits) {
+    const parts = v.toExponential(Math.max(0, digits - 1)).split("e");
+    const m = parts[0].indexOf(".") >= 0 ? parts[0].replace(/0+$/, "").replace(/\.$/, "") : parts[0];
+    return m + "×10" + String(parseInt(parts[1], 10)).replace(/[-0-9]/g, c => SUPERSCRIPT[c]);
+  }
   function fmt(v, floor) {
     if (v == null) return "—";
     const a = Math.abs(v);
     if (floor && a <= floor) return "0 (< tolerance)";
-    return a !== 0 && (a < 1e-3 || a >= 1e6) ? v.toExponential(3) : (+v.toPrecision(4)).toString();
+    return a !== 0 && (a < 1e-6 || a >= 1e9) ? powerOfTen(v, 4) : (+v.toPrecision(4)).toString();
   }
   // an axis's tick labels: uPlot's own (at most 3 decimals: a residual of 1e-5 read "0"), in
   // exponent form when the ticks are all below 1e-3 or from 1e6; on a log axis (p.log) the powers
@@ -37,10 +46,10 @@
       const every = Math.max(1, Math.ceil(decades * LOG_LABEL_PX / Math.max(u.height - TITLE_AND_AXIS_PX, 40)));
       return vals.map(v => {
         if (v == null) return "";
-        if (!log) return exp && v !== 0 ? v.toExponential(1) : num(v);
+        if (!log) return exp && v !== 0 ? powerOfTen(v, 2) : num(v);
         const e = Math.round(Math.log10(v));
         if (Math.abs(Math.log10(v) - e) > 1e-6 || e % every !== 0) return "";
-        return Math.abs(e) >= 3 ? "1e" + e : num(v);
+        return Math.abs(e) >= 3 ? powerOfTen(v, 1) : num(v);
       });
     };
   }

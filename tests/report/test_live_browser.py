@@ -253,3 +253,20 @@ def test_a_value_axis_label_fits_along_its_plot(live_site, browser):
             assert width <= height, (figure, label, width, height)
     assert "peak actuator effort (N m or N)" in checked
     assert not w.problems, "\n".join(w.problems)
+
+
+def test_the_plots_write_numbers_as_the_pages_do(live_site, browser):
+    """The hover legend's values (window.balpipeLive.fmt, shared with the what-if) follow
+    balpipe.display.numbers.num: fixed-point to 4 significant digits, never exponent notation; a
+    magnitude below a millionth or from a thousand million as a written-out power of ten; round-off
+    of the panel's floor as the tables write it. Every value checked against the Python function."""
+    from balpipe.display.numbers import num
+
+    w, p, _ = _open(browser, live_site, "paper000_rpr3_idler_loop", "live-loads")
+    values = [1.23456e-5, -0.000321, 54.6213, 136300.0, 2.7531e-11, 5e10, -4.2e-8, 0.0, 1.0, 999999.0]
+    got = p.evaluate("vs => vs.map(v => window.balpipeLive.fmt(v))", values)
+    assert got == [num(v) for v in values]
+    assert not any(re.search(r"\de[-+]?\d", g) for g in got)
+    assert p.evaluate("() => window.balpipeLive.fmt(3e-12, 1e-6)") == "0 (< tolerance)"
+    assert w.problems == []
+    p.close()
