@@ -792,14 +792,15 @@ _SHOWN = """id => { const el = document.getElementById(id); const d = el && el.c
     return !!d && d.open && r.top >= -1 && r.top < innerHeight; }"""
 
 
-def test_the_papers_figures_and_the_costs_are_open_and_links_open_their_section(server, browser):
+@pytest.mark.parametrize("width", [400, 1400])
+def test_the_papers_figures_and_the_costs_are_open_and_links_open_their_section(server, browser, width):
     """Open at load: the paper's figures, "Published vs computed" and the actuators' costs, beside
     the stage table and the shaking loads; the other sections folded. A deep link loaded directly,
     a Contents entry clicked and a change of the fragment open the section of their target and
     scroll to it; "open all" and "close all" act on every section."""
     w = Watched(browser)
     p = w.page
-    p.set_viewport_size({"width": 1400, "height": 900})
+    p.set_viewport_size({"width": width, "height": 900})
     url = server + "scott_russell/index.html"
     p.goto(url, wait_until="load")
     state = dict(p.evaluate(_SECTIONS))
@@ -850,12 +851,14 @@ def _order(page) -> list[str]:
     return page.eval_on_selector_all("#studies tbody.entry", "els => els.map(e => e.dataset.spec)")
 
 
-def test_index_sorts_filters_by_verdict_and_compares_designs_of_one_mechanism(compare_site, browser):
+@pytest.mark.parametrize("width", [400, 1400])
+def test_index_sorts_filters_by_verdict_and_compares_designs_of_one_mechanism(compare_site, browser, width):
     """Every column of the index sorts (again: the other way) and the order is kept in the
     address; the verdict filter; a row's paper links to its one citation; the designs of one
     mechanism are side by side, sortable, with the added mass relative to the moving mass."""
     w = Watched(browser)
     p = w.page
+    p.set_viewport_size({"width": width, "height": 900})
     p.goto((compare_site / "index.html").as_uri(), wait_until="load")
     built = _order(p)
     force = {s: float(json.loads((compare_site / s / "results.json").read_text())["verdict"]["motions"][0]["force"][1])
