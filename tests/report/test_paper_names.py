@@ -170,7 +170,7 @@ def test_a_custom_page_keeps_the_specs_names_and_keeps_the_numerics_collapsed():
     assert "actuator effort: crank" in page.lower()
     # the force-balance conditions in words; the singular values only inside a collapsed <details>
     seen = _visible(page)
-    assert "Force-balance conditions" in seen and "stand out from round-off" in seen
+    assert "Force-balance conditions" in seen and "clear of round-off by a factor over 10" in seen
     for jargon in ("singular value", "regressor", "row space", "rank tolerance", "sampled states"):
         assert jargon not in seen.lower(), jargon
     details = re.findall(r"<details\b.*?</details>", page, flags=re.S)
