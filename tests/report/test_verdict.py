@@ -57,6 +57,8 @@ def test_outcomes_in_words():
     assert V.outcome(1.004, False, False)["outcome"] == "unchanged"
     w = V.outcome(6.7404, False, False)
     assert w["outcome"] == "worse" and w["text"] == "worse: 674 % of the reference"
+    # the site's one ratio convention: a factor from ten times on, never "4173 %"
+    assert V.outcome(41.73, False, False)["text"] == "worse: × 41.7 the reference"
 
 
 def test_a_force_balance_holds_as_designed_its_moment_a_cost_and_references_count_apart():

@@ -5,8 +5,9 @@ stage balanced anything. This module reads a study's result rows (:class:`balpip
 peaks and ratios of the *inertial* loads to the stage's reference, the stage's claim) and says,
 per stage and per spec, for the force and for the moment each: *cancelled* (at most the balance
 tolerance of the reference), *reduced by x*, *unchanged* (within :data:`UNCHANGED`) or
-*worse* (x % of the reference: one format, percent, for every ratio), against what the stage claims; and how many of the paper's
-published numbers the build reproduces. A load that was already at round-off in the reference
+*worse* (x % of the reference below ten times, × x the reference from there on: the site's one
+ratio convention), against what the stage claims; and how many of the paper's published numbers
+the build reproduces. A load that was already at round-off in the reference
 (a Scotch yoke's shaking moment about its axis) and stays there reads *0 before and after*
 (outcome ``zero``): nothing was cancelled, and nothing is lost.
 
@@ -43,6 +44,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..display.numbers import ratio as ratio_text
 from ..study import REFERENCE_KINDS, reference_kind
 from .costs import cost_factors, factor_text
 
@@ -83,7 +85,8 @@ def outcome(ratio: float | None, cancelled: bool, claimed: bool, was_zero: bool 
     elif r < 1.0:
         kind, text = "reduced", f"reduced by {percent(1.0 - r)}"
     else:
-        kind, text = "worse", f"worse: {percent(r)} of the reference"
+        shown = ratio_text(r, None)  # the site's convention: percent below ten times, a factor from there on
+        kind, text = "worse", f"worse: {shown} {'the' if shown.startswith('×') else 'of the'} reference"
     return {"outcome": kind, "ratio": r, "claimed": claimed, "text": text}
 
 
