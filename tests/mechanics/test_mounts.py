@@ -393,3 +393,4 @@ def test_mounts_section_reads_in_the_pages_display_units():
     assert "<th>peak (N)</th>" in si and "<th>peak (kN)</th>" in eng and "(N)</th>" not in eng
     assert "(0.1, 0.3) m</td>" in si and "(100, 300) mm</td>" in eng
     assert " N vs 2 N" in si and " kN vs 0.002 kN" in eng
+    assert "RMS force on the floor (N)" in si and "RMS force on the floor (kN)" in eng  # the figure's axis too

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..display.units import DisplayUnits
 from ..draw import figures
 
 _HATCHES = ("", "///", "...", "xxx", "\\\\\\")  # the stages' colours repeat: their bars differ by hatching
@@ -27,15 +28,16 @@ def _bars(ax, groups: list[str], rows: list[tuple[str, list[float]]]) -> None:
         ax.set_yscale("log")
 
 
-def mounts_svg(mounts: dict | None, stages: list[tuple[str, str]]) -> str:
+def mounts_svg(mounts: dict | None, stages: list[tuple[str, str]], units: DisplayUnits = DisplayUnits()) -> str:
     """An SVG of two bar charts from ``results.json``'s ``mounts`` for the (name, label) stages
-    shown; "" when the spec has no frame."""
+    shown, the floor forces in the page's display ``units``; "" when the spec has no frame."""
     if not mounts or not stages:
         return ""
     fig, (left, right) = figures.plt.subplots(1, 2, figsize=(8.0, 3.0))
     names = [m["name"] for m in mounts["frame"]["mounts"]]
-    _bars(left, names, [(label, [m["rms"] for m in mounts["stages"][name]["mounts"]]) for name, label in stages])
-    left.set_ylabel("RMS force on the floor (N)")
+    per = units.factor("force")
+    _bars(left, names, [(label, [m["rms"] / per for m in mounts["stages"][name]["mounts"]]) for name, label in stages])
+    left.set_ylabel(f"RMS force on the floor ({units.unit('force')})")
     points = [p["name"] for p in mounts["stages"][stages[0][0]]["velocity"]]
     _bars(right, points, [(label, [1000 * max(p["rms_x"], p["rms_y"]) for p in mounts["stages"][name]["velocity"]])
                           for name, label in stages])

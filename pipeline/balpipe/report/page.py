@@ -296,7 +296,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         parts=page_rows(results.get("parts") or [], units),
         orders_figure=orders_svg(units, [(s.stage.name, results["orders"][s.stage.name]) for s in shown_stages(study)
                                   if (results.get("orders") or {}).get(s.stage.name)]),
-        mounts_figure=mounts_svg(results.get("mounts"), [(s.stage.name, s.stage.label) for s in shown_stages(study)]),
+        mounts_figure=mounts_svg(results.get("mounts"), [(s.stage.name, s.stage.label) for s in shown_stages(study)], units),
         stage_names=[(s.stage.name, s.stage.label) for s in shown_stages(study)],
         group=study.stages[0].stage.group if len(shown_stages(study)) < len(study.stages) else "",
         reference={"force": study.reference.describe("force", units), "moment": study.reference.describe("moment", units),
