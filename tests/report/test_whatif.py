@@ -13,6 +13,9 @@ import re
 import numpy as np
 import pytest
 
+from balpipe.balancing.mass_sweep import MassSweep
+from balpipe.draw import live
+from balpipe.mechanics.sampling import spread_indices
 from balpipe.report import whatif
 from balpipe.report.results import results_dict
 
@@ -142,6 +145,65 @@ def test_the_pages_data_are_the_maps_exactly_and_deterministic(studies):
     assert a == b and a is not None and a["reason"] is None
     figure = json.loads(re.search(r'data-live="live-whatif">(.*)</script>', a["figure"], re.S).group(1))
     assert len(figure["t"]) == d["n"] and [s["label"] for s in figure["series"]][-1] == "design tried"
+
+
+@pytest.mark.parametrize("name", ["paper000_rpr3_scott_russell.yaml", "offset_slider_crank.yaml",
+                                  "custom_four_bar_loaded.yaml"])
+def test_the_maps_are_built_at_the_kept_samples_only(studies, monkeypatch, name):
+    """Issue 43: the maps of a 20,000-sample grid held every sample's Jacobian and per-parameter
+    multipliers (3.5 GB) for a page that keeps a few hundred. Every map array is built at the
+    samples the page may keep, one row per such sample: first the charts' most
+    (:data:`balpipe.draw.live.POINTS` spread over the grid), then, where the maps' size keeps fewer
+    (the Scott-Russell's 100 of 501), those; never one row per grid sample (Coulomb friction's
+    shaking maps alike)."""
+    built, sweeps = [], []
+    real_maps, real_build = whatif._maps, MassSweep.build
+
+    def maps(model, an, samples):
+        out = real_maps(model, an, samples)
+        built.append((np.asarray(samples), out))
+        return out
+
+    def build(*args, **kwargs):
+        sweeps.append(real_build(*args, **kwargs))
+        return sweeps[-1]
+
+    monkeypatch.setattr(whatif, "_maps", maps)
+    monkeypatch.setattr(whatif.MassSweep, "build", build)
+    _, w = _whatif(studies, name)
+    assert isinstance(w, whatif.WhatIf), w
+    N = len(w.grid)
+    assert N > live.POINTS and len(w.index) < N
+    assert np.array_equal(built[0][0], spread_indices(N, live.POINTS))
+    assert np.array_equal(built[-1][0], w.index) and len(built) == (1 if len(w.index) == live.POINTS else 2)
+    for samples, (YF, YM, G, _, _) in built:
+        n = len(samples)
+        assert YF.shape[0] == YM.shape[0] == n and (G is None or G.shape[0] == n)
+    assert len(sweeps) == (0 if whatif.coulomb_friction(w.model) else len(built))
+    for sweep, (samples, _) in zip(sweeps, built):
+        assert sweep.Lam.shape[0] == sweep.G.shape[0] == len(sweep.t) == len(samples)
+
+
+@pytest.mark.parametrize("name", ["paper001_4rrr_fig6c.yaml", "custom_pumpjack_rod_load.yaml",
+                                  "paper002_decoupling.yaml"])
+def test_a_sweep_at_some_samples_is_the_whole_grids_at_those_samples(studies, name):
+    """MassSweep.build(samples=...) from the analysis of the whole grid: every matrix equals the
+    whole grid's sweep at those samples bit for bit (redundant actuators, loads, gears), in the
+    order given, so the page's maps are the same numbers whichever samples are mapped."""
+    st = studies(name)
+    final = st.stages[-1]
+    model, an = final.stage.model, final.analysis
+    full = MassSweep.build(model, an.t, an.gravity, an.moment_point, analysis=an)
+    samples = np.random.default_rng(5).choice(len(an.t), 37, replace=False)
+    sub = MassSweep.build(model, an.t, an.gravity, an.moment_point, analysis=an, samples=samples)
+    assert np.array_equal(sub.t, an.t[samples])
+    for key in ("YF", "YM", "Lam", "G"):
+        assert getattr(sub, key).shape[0] == len(samples)
+        assert np.array_equal(getattr(sub, key), getattr(full, key)[samples]), key
+    if model.loads:
+        assert np.array_equal(sub.G0, full.G0[samples]) and np.array_equal(sub.Lam0, full.Lam0[samples])
+    p = sub.parameters(model)
+    assert np.array_equal(sub.multipliers(p), full.multipliers(p)[samples])
 
 
 def test_parts_of_one_name_on_two_links_are_two_parts(studies):

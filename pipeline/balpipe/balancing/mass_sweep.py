@@ -92,30 +92,38 @@ class MassSweep:
 
     @classmethod
     def build(cls, model: Model, t: np.ndarray, gravity=(0.0, 0.0), moment_point=(0.0, 0.0),
-              analysis=None) -> "MassSweep":
+              analysis=None, samples: np.ndarray | None = None) -> "MassSweep":
         """One engine analysis of ``model`` (``analysis``, when given, is taken as that analysis:
         the engine's of ``model`` on ``t`` with this gravity and moment point, already at hand);
-        raises :class:`balpipe.engine.AnalysisError` like it."""
+        raises :class:`balpipe.engine.AnalysisError` like it.
+
+        ``samples``: the matrices at these indices of ``t`` only (the sweep's ``t`` is then
+        ``t[samples]``), from the analysis of the whole of ``t``: every sample's matrices are
+        computed alone, so they are the same numbers as in the sweep of every sample, and the
+        sweep holds (samples, rows, 4 x bodies) arrays instead of (N, ...) ones."""
         t = np.asarray(t, dtype=float)
         an = analysis if analysis is not None else analyse(model, t, gravity, moment_point)
-        states = states_from_analysis(model, an)
+        at = slice(None) if samples is None else np.asarray(samples, dtype=int)
+        t = t[at]
+        q, v = an.q[at], an.v[at]
+        states = states_from_analysis(model, an, samples=samples)
         YF, YM = shaking_regressor(states, gravity, moment_point)
         YD = dynamics_regressor(states, gravity)
         base = compile_model(model)
         c = base.dynamics or base  # with actuators: their rows, not the drivers' (engine.compile._actuated)
         N = len(t)
-        qx = with_frame(an.q.reshape(N, -1))
+        qx = with_frame(q.reshape(N, -1))
         J = jacobian(c, qx)
         geo = tooth_rows(c, qx, J)
         Lam0: np.ndarray | float = 0.0
         if model.loads:  # in centre-of-mass coordinates, before the change below
-            lt = load_terms(model, base, t, an.q.reshape(N, -1), an.v.reshape(N, -1))
+            lt = load_terms(model, base, t, q.reshape(N, -1), v.reshape(N, -1))
             if lt.coulomb:
                 raise ValueError("Coulomb friction is not linear in the masses: no mass sweep of this model")
             Lam0 = solve_multipliers(c, J[:, :, 3:].copy(), lt.Q)
         for k, b in enumerate(model.bodies):  # centre-of-mass -> frame-origin coordinates
             _, com, _ = b.mass_properties()
-            s = rotate(an.q[:, k, 2], np.asarray(com, dtype=float))
+            s = rotate(q[:, k, 2], np.asarray(com, dtype=float))
             col = 3 * (k + 1)
             J[:, :, col + 2] += -J[:, :, col] * s[:, 1, None] + J[:, :, col + 1] * s[:, 0, None]
         Jf = J[:, :, 3:]

@@ -267,16 +267,20 @@ def _block_round(block: BlockRound, joints_only: Compiled, guess: np.ndarray, ne
     return q, ok, m, good, null_of, done
 
 
-def states_from_analysis(model: Model, *analyses) -> States:
+def states_from_analysis(model: Model, *analyses, samples: np.ndarray | None = None) -> States:
     """The states along engine analyses of ``model`` (its own motions, concatenated): for checking
     Y_P p = P and Y_H p = H against the engine, or for conditions restricted to a family of
     motions (e.g. a translating platform: several analyses of such motions, passed to
-    ``conditions.find(model, t, states=...)``)."""
+    ``conditions.find(model, t, states=...)``). ``samples``: only these indices of the
+    concatenated samples, in that order (each sample's state is computed alone, so it is the
+    same bits as in the states of every sample)."""
     c = compile_model(model)
-    q = np.concatenate([a.q.reshape(len(a.t), -1) for a in analyses])
-    v = np.concatenate([a.v.reshape(len(a.t), -1) for a in analyses])
-    acc = np.concatenate([a.a.reshape(len(a.t), -1) for a in analyses])
-    return _body_frames(model, c, q, v, -1, 0, acc)
+
+    def rows(field: str) -> np.ndarray:
+        x = np.concatenate([getattr(a, field).reshape(len(a.t), -1) for a in analyses])
+        return x if samples is None else x[samples]
+
+    return _body_frames(model, c, rows("q"), rows("v"), -1, 0, rows("a"))
 
 
 def _is_length(model: Model, prim) -> bool:

@@ -17,8 +17,9 @@ to its body's p (the parallel-axis theorem), so, with Y_b the columns of p of bo
 
 exactly, a nonlinear map of the sliders made of affine maps in q. The page ships load(design) (the
 engine's own series) and the columns Y_b of the bodies that carry parts at the samples its charts
-draw, as base64 float64 arrays (little-endian), and ``templates/whatif.js`` turns the slider values
-into q and sums; |F| is the norm of (Fx, Fy). :func:`series` is the same sum in numpy,
+draw, as base64 float64 arrays (little-endian; the maps are computed at those samples only, never
+at every sample of a long grid), and ``templates/whatif.js`` turns the slider values into q and
+sums; |F| is the norm of (Fx, Fy). :func:`series` is the same sum in numpy,
 :func:`engine_series` the engine's analysis of the model with those parts (the browser test's
 reference, to 1e-9 of each series' scale).
 
@@ -206,15 +207,45 @@ def parts_of(base: Model, final: Model, names: PageNames | None = None) -> list[
     return out
 
 
-def _maps(model: Model, an) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, list[str], list[str]]:
-    """YF (N, 2, np), YM (N, np) and the efforts' G (N, nd, np) with their drivers (None and the
-    Coulomb frictions' names when the efforts are not affine in the masses)."""
+Maps = tuple[np.ndarray, np.ndarray, "np.ndarray | None", list[str], list[str]]
+
+
+def _maps(model: Model, an, samples: np.ndarray) -> Maps:
+    """YF (n, 2, np), YM (n, np) and the efforts' G (n, nd, np) with their drivers (None and the
+    Coulomb frictions' names when the efforts are not affine in the masses), at the ``samples``
+    (n indices of the analysis's grid) only: a long grid's maps would hold its every sample's
+    Jacobian and multipliers (:meth:`balpipe.balancing.mass_sweep.MassSweep.build`: each sample's
+    numbers are the same as in the maps of every sample)."""
     friction = coulomb_friction(model)
     if friction:
-        YF, YM = shaking_regressor(states_from_analysis(model, an), an.gravity, an.moment_point)
+        YF, YM = shaking_regressor(states_from_analysis(model, an, samples=samples), an.gravity, an.moment_point)
         return YF, YM, None, [], friction
-    sweep = MassSweep.build(model, an.t, an.gravity, an.moment_point, analysis=an)
+    sweep = MassSweep.build(model, an.t, an.gravity, an.moment_point, analysis=an, samples=samples)
     return sweep.YF, sweep.YM, sweep.G, [d for d in sweep.drivers if d in an.efforts], []
+
+
+MAP_ERRORS = (AnalysisError, ValueError, np.linalg.LinAlgError)  # why a stage's loads have no maps
+
+
+def _unmapped(label: str, exc: Exception) -> str:
+    """The page's sentence for a stage whose maps failed with ``exc``."""
+    return f"The loads of {label} could not be mapped onto its parts ({exc}), so the page offers no sliders."
+
+
+def _columns(maps: Maps, keys: list[str], at: dict[str, int], bodies: list[str]) -> dict[str, dict[str, list[np.ndarray]]]:
+    """``out[key][body]``: the 4 columns (m, mx, my, J) of that body's p in the map of ``key``, at
+    the maps' samples (the bodies' order in the model is ``at``)."""
+    YF, YM, G, drivers, _ = maps
+
+    def cols(key: str) -> np.ndarray:  # (n, np)
+        if key in ("Fx", "Fy"):
+            return YF[:, 0 if key == "Fx" else 1, :]
+        if key == "M":
+            return YM
+        assert G is not None
+        return G[:, drivers.index(key.split(":", 1)[1]), :]
+
+    return {k: {b: [cols(k)[:, 4 * at[b] + j].copy() for j in range(4)] for b in bodies} for k in keys}
 
 
 def _samples(N: int, panels: int, per_sample: int) -> np.ndarray:
@@ -259,11 +290,13 @@ def build(study, results: dict, styles: dict[str, tuple[int, str]] | None = None
     if not parts:
         return None
     model, an = final.stage.model, final.analysis
+    N = len(an.t)
+    first = spread_indices(N, live.POINTS)  # the most samples the page keeps (every one of a short grid)
     try:
-        YF, YM, G, drivers, friction = _maps(model, an)
-    except (AnalysisError, ValueError, np.linalg.LinAlgError) as exc:
-        return (f"The loads of {final.stage.label} could not be mapped onto its parts ({exc}), so the page offers "
-                "no sliders.")
+        maps = _maps(model, an, first)
+    except MAP_ERRORS as exc:
+        return _unmapped(final.stage.label, exc)
+    drivers, friction = maps[3], maps[4]
     notes = []
     if friction:
         notes.append(f"Coulomb friction ({', '.join(friction)}) makes the actuators' efforts follow the joint "
@@ -272,25 +305,22 @@ def build(study, results: dict, styles: dict[str, tuple[int, str]] | None = None
     keys = ["Fx", "Fy", "M"] + [f"effort:{d}" for d in drivers]
     bodies = [b.name for b in model.bodies if any(p.body == b.name for p in parts)]
     at = {b.name: k for k, b in enumerate(model.bodies)}
-
-    def cols(key: str) -> np.ndarray:  # (N, np)
-        if key in ("Fx", "Fy"):
-            return YF[:, 0 if key == "Fx" else 1, :]
-        if key == "M":
-            return YM
-        assert G is not None
-        return G[:, drivers.index(key.split(":", 1)[1]), :]
-
-    full = {k: cols(k) for k in keys}
-    nonzero = {k: {b: [bool(np.any(full[k][:, 4 * at[b] + j] != 0)) for j in range(4)] for b in bodies} for k in keys}
-    per_sample = len(keys) + sum(sum(v) for k in keys for v in nonzero[k].values())
     units = {d: present.driver_unit(model, d) for d in drivers}
     panels = [{"key": key, "title": title, "axis": axis} for key, title, axis, _ in LOADS]
     panels += [{"key": f"effort:{d}", "title": f"actuator effort: {names.text('driver', d)}"
                 + (f" ({units[d]})" if units[d] else ""), "axis": figures.effort_axis(units[d])} for d in drivers]
-    index = _samples(len(an.t), len(panels), per_sample)
-    columns = {k: {b: [full[k][index, 4 * at[b] + j].copy() if nonzero[k][b][j] else None for j in range(4)]
-                   for b in bodies} for k in keys}
+    # the maps' size per sample counts the columns not zero at the samples ``first``; when that keeps
+    # fewer samples, those are mapped again (a sample's maps are the same numbers whatever the others)
+    found = _columns(maps, keys, at, bodies)
+    per_sample = len(keys) + sum(bool(np.any(c != 0)) for k in keys for b in bodies for c in found[k][b])
+    index = _samples(N, len(panels), per_sample)
+    if not np.array_equal(index, first):
+        try:
+            found = _columns(_maps(model, an, index), keys, at, bodies)
+        except MAP_ERRORS as exc:
+            return _unmapped(final.stage.label, exc)
+    columns: dict[str, dict[str, list[np.ndarray | None]]] = {
+        k: {b: [c if np.any(c != 0) else None for c in found[k][b]] for b in bodies} for k in keys}
     styles = styles or {}
     design_style, design_name = styles.get(final.stage.name, (1, final.stage.label))
     reference_style, reference_name = styles.get(ref.stage.name, (0, ref.stage.label))
