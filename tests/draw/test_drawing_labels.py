@@ -319,3 +319,25 @@ def test_names_on_paper001_drawings_never_overlap(studies, name, monkeypatch):
                 for sg in segs:
                     assert not labels.segment_hits_box(sg, box), f"{where}: {t!r} over a link {sg}"
     assert panels >= 4
+
+
+def test_the_drawings_box_is_every_point_tracks_extremes(studies):
+    """The box the drawings share (:func:`balpipe.draw.figures.common_limits`, the player's panels)
+    is reduced point track by point track (a long grid's (frames x points) array is never held):
+    it equals the extremes of every body origin, named point and attachment over the frames and
+    of the frame's pivots, stacked."""
+    from balpipe.draw.player import _extent_box
+    from balpipe.mechanics.planar import world_point
+
+    for s in studies("custom_four_bar_balancing.yaml").stages:
+        model, poses = s.stage.model, s.analysis.frame_pose
+        tracks = [poses[:, :, :2].reshape(-1, 2), np.array(list(model.frame_points.values()), dtype=float)]
+        for i, b in enumerate(model.bodies):
+            local = list(b.points.values()) + [a.position for a in b.attachments]
+            r = b.radius or 0.0
+            local += [(r, 0.0), (-r, 0.0), (0.0, r), (0.0, -r)] if r else []
+            local += [(a.position[0] + dx * a.radius, a.position[1] + dy * a.radius) for a in b.attachments if a.radius
+                      for dx, dy in ((1, 0), (-1, 0), (0, 1), (0, -1))]
+            tracks += [world_point(poses[:, i], p) for p in local]
+        xy = np.vstack(tracks)
+        assert np.array_equal(_extent_box(model, poses), np.array([xy.min(axis=0), xy.max(axis=0)]))

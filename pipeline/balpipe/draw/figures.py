@@ -461,9 +461,9 @@ def place_items(fig, ax, items: list, segs: list, keep: list) -> list:
 
 def common_limits(items: list[tuple[Model, np.ndarray]], pad: float = 0.08) -> tuple[float, float, float, float]:
     """One box for every panel: every point, attachment and disc rim of every (model, poses)."""
-    from .player import _extent_points
+    from .player import _extent_box
 
-    xy = np.vstack([_extent_points(m, p) for m, p in items])
+    xy = np.vstack([_extent_box(m, p) for m, p in items])
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     d = pad * float(max(hi - lo)) or 0.05
     return (float(lo[0] - d), float(lo[1] - d), float(hi[0] + d), float(hi[1] + d))

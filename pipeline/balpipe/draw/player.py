@@ -51,10 +51,18 @@ def _outline(model: Model) -> list[dict]:
     return shapes
 
 
-def _extent_points(model: Model, poses: np.ndarray, base: np.ndarray | None = None) -> np.ndarray:
-    """Global positions of every named point, attachment and disc rim over the frames, and of
-    the frame's pivots and guides (carried by the frame's poses ``base`` where it moves)."""
-    out = [poses[:, :, :2].reshape(-1, 2)]
+def _extent_box(model: Model, poses: np.ndarray, base: np.ndarray | None = None) -> np.ndarray:
+    """The box [[x_min, y_min], [x_max, y_max]] of the global positions of every named point,
+    attachment and disc rim over the frames, and of the frame's pivots and guides (carried by the
+    frame's poses ``base`` where it moves): each point's track reduced as it is computed, so that
+    no (frames x points) array is held (a long grid's would be tens of MB)."""
+    lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
+
+    def add(xy: np.ndarray) -> None:
+        np.minimum(lo, xy.min(axis=0), out=lo)
+        np.maximum(hi, xy.max(axis=0), out=hi)
+
+    add(poses[:, :, :2].reshape(-1, 2))
     for i, b in enumerate(model.bodies):
         local = list(b.points.values()) + [a.position for a in b.attachments]
         r = b.radius or 0.0
@@ -66,16 +74,17 @@ def _extent_points(model: Model, poses: np.ndarray, base: np.ndarray | None = No
                 local += [(px + a.radius, py), (px - a.radius, py), (px, py + a.radius), (px, py - a.radius)]
         x, y, th = poses[:, i, 0], poses[:, i, 1], poses[:, i, 2]
         for px, py in local:
-            out.append(np.stack([x + np.cos(th) * px - np.sin(th) * py, y + np.sin(th) * px + np.cos(th) * py], axis=1))
+            add(np.stack([x + np.cos(th) * px - np.sin(th) * py, y + np.sin(th) * px + np.cos(th) * py], axis=1))
     fixed = list(model.frame_points.values()) + [p for g in model.guides for p in g]
     if not fixed:
         fixed = [(0.0, 0.0)]
     if base is None:
-        return np.vstack(out + [np.array(fixed, dtype=float)])
-    bx, by, bth = base[:, 0], base[:, 1], base[:, 2]
-    for px, py in fixed:
-        out.append(np.stack([bx + np.cos(bth) * px - np.sin(bth) * py, by + np.sin(bth) * px + np.cos(bth) * py], axis=1))
-    return np.vstack(out)
+        add(np.array(fixed, dtype=float))
+    else:
+        bx, by, bth = base[:, 0], base[:, 1], base[:, 2]
+        for px, py in fixed:
+            add(np.stack([bx + np.cos(bth) * px - np.sin(bth) * py, by + np.sin(bth) * px + np.cos(bth) * py], axis=1))
+    return np.array([lo, hi])
 
 
 PANEL_W = 300  # px per panel
@@ -103,7 +112,7 @@ def _length_text(x: float) -> str:
 
 def panel_views(extents: list[np.ndarray], width: int = PANEL_W) -> dict:
     """Per-panel view boxes: every panel the same pixel size (its height from the widest
-    aspect of the stages' extents), each mechanism centred in its panel at one scale for every
+    aspect of the stages' extents: points (n, 2), e.g. a box's two corners), each mechanism centred in its panel at one scale for every
     panel (the smallest of the panels' own, so that every stage fits) where their own scales
     differ by at most :data:`COMMON_SCALE`, else each scaled to fill its own panel: ``box``
     (x0, y0, x1, y1, m, with a 6 % margin), ``view`` (ox, oy, s: pixel = (ox + s x, oy - s y) on
@@ -226,7 +235,7 @@ def player_data(stages: list[dict]) -> dict:
     from .labels import gear_numbers
 
     numbers = gear_numbers([s["model"] for s in stages])
-    extents = [_extent_points(s["model"], s["poses"], s["base"]) for s in stages]
+    extents = [_extent_box(s["model"], s["poses"], s["base"]) for s in stages]
     views = panel_views(extents)
     size = math.hypot(views["width"], views["height"])
     data = []
