@@ -9,9 +9,9 @@ from dataclasses import dataclass, field, replace
 from .runtime import pool
 from .cache import simulation as sim_cache
 from .study import Study
-from .validate import FreeFloating, ValidationSettings, free_floating, validate
+from .validate import FreeFloating, ValidationSettings, free_floating
 from .validate.run import model_scale
-from .validate.torque import torque_driven
+from .validate.shared import stage_runs
 
 #: mass of the free-floating frame (kg)
 BASE_MASS = 10.0
@@ -95,13 +95,9 @@ def _stage_runs(k: int, study: Study):
     F0, M0 = ref.force_peak, ref.moment_peak
     expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
     model = simulated_model(s.stage.model)
-    v = sim_cache.run(validate, model, s.analysis, (F0, M0), settings, expect, reference=ref)
-    # the inverse dynamics: the engine's efforts drive the mechanism (same step and solver effort)
-    tq = sim_cache.run(
-        torque_driven, model, s.analysis, settings, economic=True, reference=(ref.force, ref.moment),
-        dt=v.dt, iterations=v.iterations,
-    )
-    return v, tq
+    # the loads imposed on the motion, and the inverse dynamics (the engine's efforts drive the
+    # mechanism): one torque-driven run where it proves both (:mod:`balpipe.validate.shared`)
+    return sim_cache.run(stage_runs, model, s.analysis, (F0, M0), settings, expect, reference=ref)
 
 
 def simulated_model(model):

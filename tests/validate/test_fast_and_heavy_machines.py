@@ -292,3 +292,37 @@ def test_a_machine_unstable_open_loop_is_unconfirmed_never_failed(tmp_path):
                                                         encoding="utf-8")
     p = _build(specs)
     assert p.returncode == 0 and "unconfirmed" not in p.stderr, p.stderr
+
+
+def _shared(st, s, model=None, analysis=None):
+    """The build's runs of a stage (:func:`balpipe.validate.shared.stage_runs`: one torque-driven
+    run where it proves both checks)."""
+    from balpipe.validate.shared import stage_runs
+
+    ref = ratio_reference(st.reference_stage(s))
+    expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
+    return stage_runs(simulated_model(model or s.stage.model), analysis or s.analysis, (ref.force_peak, ref.moment_peak),
+                      settings_for(st), expect, reference=ref)
+
+
+def test_the_heavily_counterbalanced_arm_passes_through_the_shared_runs(scara):
+    """Issue 43: the build's path (a torque-driven run that proves both checks where it can) on
+    the arm counterbalanced to eight times its mass: every stage passes both checks, no false fail."""
+    for s in scara.stages:
+        v, tq = _shared(scara, s)
+        assert v.status == "pass" and tq.status == "pass", (s.stage.name, v.reasons, tq.reasons, v.proved_by)
+
+
+@pytest.mark.parametrize("factor", [1.01, 0.99])
+def test_a_one_percent_counterweight_error_fails_through_the_shared_runs(scara, factor):
+    """Issue 43: the counter-rotations stage with every counterweight 1 % off, analysed as it is,
+    claiming the force and moment balance: the torque-driven run's loads show the claim false
+    (the moment: 2.2 % of the reference), so it proves nothing, and the position-driven run fails
+    the claim, as before."""
+    s = _stage(scara, "counter_rotations")
+    off_model = _counterweights_scaled(s.stage.model, factor)
+    off_analysis = analyse(off_model, s.analysis.t, s.analysis.gravity, s.analysis.moment_point)
+    v, tq = _shared(scara, s, off_model, off_analysis)
+    assert v.proved_by == "position-driven run"
+    assert v.status == "fail" and any("not balanced" in r for r in v.reasons), v.reasons
+    assert max(v.force_peak, v.moment_peak) > 0.01 and max(v.force_residual, v.moment_residual) < 0.01

@@ -269,7 +269,8 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         if q is not None:
             torque_rows.append({
                 "label": s.stage.label, "tracking": q.tracking_error_max, "calibration": q.calibration_error,
-                "resolution": q.resolution, "force_residual": q.force_residual, "moment_residual": q.moment_residual,
+                "resolution": q.resolution, "at_least": "≥ " if getattr(q, "calibration_stopped", False) else "",
+                "force_residual": q.force_residual, "moment_residual": q.moment_residual,
                 "force_peak": q.force_peak, "moment_peak": q.moment_peak,
                 "dt": q.dt, "steps": q.steps, "iterations": q.iterations, "tolerance": q.tracking_tolerance,
                 "passed": q.passed, "status": q.status, "remedy": q.remedy, "reasons": "; ".join(q.reasons),

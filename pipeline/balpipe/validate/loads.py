@@ -201,6 +201,9 @@ class StageValidation(Verdict):
     solver_change: float = math.nan
     unconfirmed: bool = False
     remedy: str = ""
+    #: the run the verdict reads: the position-driven run, or a torque-driven run that proves the
+    #: same (:mod:`balpipe.validate.shared`)
+    proved_by: str = "position-driven run"
 
     def to_json(self) -> dict:
         """Plain, deterministic summary (no curves, no wall-clock times)."""
@@ -230,6 +233,7 @@ class StageValidation(Verdict):
             "extrapolated_samples": int(self.extrapolated_samples),
             "floored_bodies": ",".join(self.floored_bodies),
             "notes": "; ".join(self.notes),
+            "proved_by": self.proved_by,
             "pymunk_version": str(self.pymunk_version),
             "chipmunk_version": str(self.chipmunk_version),
             "method": "momentum",

@@ -28,6 +28,9 @@ from .space import SimModel, build_space
 #: checked samples compared with the analysis at a time (a run that comes apart ends at most
 #: this many checks, ten steps apart, after it strays)
 CHECK_BLOCK = 5
+#: steps between two looks at a run's tracking error where it may stop once that error suffices
+#: (``simulate(stop_at=...)``)
+STOP_EVERY = 50
 
 @dataclass
 class SimulationRun:
@@ -44,6 +47,8 @@ class SimulationRun:
     iterations: int
     wall: float
     sim: SimModel
+    #: the run ended before the motion's end (``simulate(stop_at=...)``): its arrays stop there
+    stopped: bool = False
 
 
 
@@ -111,6 +116,7 @@ def simulate(
     settle: int = 0,
     feedforward: bool = False,
     applied=None,
+    stop_at: tuple[float, dict[str, float]] | None = None,
     **build_options,
 ) -> SimulationRun:
     """Simulate ``model`` along ``analysis``' motion and measure the loads on the frame.
@@ -143,6 +149,12 @@ def simulate(
     drivers impose the motion either way, the solver converges with fewer iterations.
     ``applied``: a :class:`balpipe.validate.applied.AppliedLoads`, whose loads act on the
     bodies before every step (a torque-driven run of a model with loads).
+    ``stop_at`` = (limit, travel): the run ends as soon as a driven coordinate's error, relative
+    to its ``travel`` (driver name -> rad or m), has reached ``limit`` (or is not finite),
+    looked at every :data:`STOP_EVERY` steps over every step since the last look: the returned
+    run then holds the steps up to that look (``SimulationRun.stopped``), and its largest
+    relative tracking error is at least ``limit``. For a run whose only use is to show an error
+    at least that large (the torque-driven run's calibration, :mod:`balpipe.validate.torque`).
     """
     t = np.asarray(analysis.t, dtype=float)
     t0 = float(t[0])
@@ -206,6 +218,8 @@ def simulate(
     push = _InertialForces(space, read, model, analysis, every, bodies[:nb], g) if feedforward and efforts is None else None
     advance = _Stepper(space)
     current = None
+    stopped = False
+    looked = 0  # recorded rows already looked at by stop_at
     for step in range(settle + n + 1):
         if iters[step] != current:
             current = space.iterations = iters[step]
@@ -233,6 +247,15 @@ def simulate(
                 _check_apart(read.rows(pending), nb, len(bodies) if sim.floating else None,
                              analysis.q[[check[j] for j in pending]], abort, times[pending])
                 pending.clear()
+        if stop_at is not None and k >= 0 and (k % STOP_EVERY == 0 or k == n):
+            upto = read.recorded - 1  # rows 1 .. upto hold the states after steps 0 .. upto - 1
+            if _tracking_reached(model, read.rows(list(range(looked, upto))), names, com, laws_now, looked,
+                                 stop_at, nb, len(bodies) if sim.floating else None):
+                stopped = k < n
+                n = k
+                times = times[: n + 1]
+                break
+            looked = upto
     if pending:
         _check_apart(read.rows(pending), nb, len(bodies) if sim.floating else None,
                      analysis.q[[check[j] for j in pending]], abort, times[pending])
@@ -261,11 +284,29 @@ def simulate(
     poses = states[:, :nb, :3].copy() if record_poses else np.zeros((0, nb, 3))
     st = {nm: (states[:, i, 0], states[:, i, 1], states[:, i, 2]) for i, nm in enumerate(names)}
     st[FRAME] = (base[:, 0], base[:, 1], base[:, 2])
-    derr = {d.name: np.asarray(_driver_coordinate(model, d, st, com), dtype=float) - laws_now[d.name]
+    derr = {d.name: np.asarray(_driver_coordinate(model, d, st, com), dtype=float) - laws_now[d.name][: n + 1]
             for d in model.drivers}
     wall = time.perf_counter() - start
     space.iterations = iterations
-    return SimulationRun(times, force, moment, poses, base, derr, total, dt, iterations, wall, sim)
+    return SimulationRun(times, force, moment, poses, base, derr, total, dt, iterations, wall, sim, stopped)
+
+
+def _tracking_reached(model: Model, rows: np.ndarray, names: list[str], com: dict, laws: dict[str, np.ndarray],
+                      first: int, stop_at: tuple[float, dict[str, float]], nb: int, base: int | None) -> bool:
+    """Some driven coordinate of the states ``rows`` (the steps ``first``, ``first + 1``, ...) is
+    ``stop_at[0]`` of its travel or more from its law ``laws`` (or not finite)."""
+    if not len(rows):
+        return False
+    limit, travel = stop_at
+    st = {nm: (rows[:, i, 0], rows[:, i, 1], rows[:, i, 2]) for i, nm in enumerate(names)}
+    frame = rows[:, base, :3] if base is not None else np.zeros((len(rows), 3))
+    st[FRAME] = (frame[:, 0], frame[:, 1], frame[:, 2])
+    for d in model.drivers:
+        err = np.asarray(_driver_coordinate(model, d, st, com), dtype=float) - laws[d.name][first : first + len(rows)]
+        worst = float(np.max(np.abs(err))) / (travel.get(d.name) or 1.0)
+        if not worst < limit:
+            return True
+    return False
 
 
 

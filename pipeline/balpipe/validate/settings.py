@@ -61,6 +61,9 @@ class ValidationSettings:
     ``max_refinement``: the validator's own budget for a run that cannot resolve its error at the
     first step: steps down to the first divided by this (:func:`refine_step`); a run still
     unresolved there is *unconfirmed*, with the step that would resolve it (1: no refinement).
+    ``shared_runs``: a stage starting from rest is first run torque-driven at the first solver
+    effort, and where that run proves what the position-driven run would (both pass by ten times
+    over), it is the only run (:mod:`balpipe.validate.shared`; with ``early_accept`` only).
     """
 
     dt: float | None = None
@@ -75,6 +78,7 @@ class ValidationSettings:
     early_accept: bool = True
     feedforward: bool = True
     max_refinement: float = MAX_REFINEMENT
+    shared_runs: bool = True
 
 
 #: how much a halving must shrink the error for it to be the step's (second order: 4x); a
