@@ -1126,3 +1126,26 @@ def test_every_static_figure_downloads_as_svg_and_png(server, browser, width):
         bar.locator("button.png").click()
     assert got.value.suggested_filename.endswith(".png") and Path(got.value.path()).read_bytes().startswith(b"\x89PNG")
     assert not w.problems, "\n".join(w.problems)
+
+
+def test_a_spec_named_in_a_description_links_to_its_page_when_the_site_has_it(compare_site, browser):
+    """partial_offset_slider_crank.yaml's description names offset_slider_crank.yaml, built on
+    this site: the name is a link to that page, titled with its study; a name the site does not
+    hold stays text (no dead link), and the page's own text is otherwise unchanged."""
+    w = Watched(browser)
+    p = w.page
+    page = compare_site / "partial_offset_slider_crank" / "index.html"
+    raw = page.read_text(encoding="utf-8")
+    assert "offset_slider_crank.yaml" in raw.split('<p class="description">')[1].split("</p>")[0]
+    p.goto(page.as_uri(), wait_until="load")
+    links = p.eval_on_selector_all("p.description a", "els => els.map(a => [a.getAttribute('href'), a.textContent, a.title])")
+    assert links and all(h == "../offset_slider_crank/index.html" and t == "offset_slider_crank.yaml" and title
+                         for h, t, title in links), links
+    before = p.text_content("p.description")
+    p.click("p.description a")
+    p.wait_for_url("**/offset_slider_crank/index.html", wait_until="load")
+    # the Scott-Russell 3-RPR names its corrected spec, which this site does not hold: text only
+    p.goto((compare_site / "paper000_rpr3_scott_russell" / "index.html").as_uri(), wait_until="load")
+    assert p.eval_on_selector_all("p.description a", "els => els.length") == 0
+    assert "paper000_rpr3_scott_russell_corrected.yaml" in p.text_content("p.description")
+    assert "offset_slider_crank.yaml" in before and not w.problems, "\n".join(w.problems)

@@ -280,8 +280,11 @@ def site_papers(entries: list[dict]) -> list[dict]:
 
 
 def site_nav_script(entries: list[dict]) -> str:
-    """``site_nav.js``: previous/next links between the study pages in the index's order,
-    written once per build so that a cached page needs no rebuild when another spec changes."""
+    """``site_nav.js``: previous/next links between the study pages in the index's order, and a
+    spec's file name in a page's description (``other_spec.yaml``, ``specs/other_spec.yaml``)
+    made a link to that spec's page when this site has it (titled with its study's title);
+    written once per build so that a cached page needs no rebuild when another spec changes,
+    and no link points at a page the site does not hold."""
     pages = [[e["link"].split("/")[0], e["title"]] for e in entries if e.get("link")]
     data = json.dumps(pages, separators=(",", ":"), sort_keys=True, ensure_ascii=False)
     return f"""// previous/next between the studies of this site (written by balpipe build)
@@ -296,6 +299,24 @@ document.querySelectorAll(".sitenav").forEach(el => {{
   if (k > 0) el.append(" · ", link(P[k - 1], "prev", "\u2190 previous: "));
   if (k < P.length - 1) el.append(" · ", link(P[k + 1], "next", "next: "));
   if (k < P.length - 1) el.lastChild.textContent += " \u2192";
+}});
+const bySlug = new Map(P.map(p => [p[0], p]));
+document.querySelectorAll("p.description").forEach(el => {{
+  const walker = document.createTreeWalker(el, NodeFilter.SHOW_TEXT), texts = [];
+  while (walker.nextNode()) texts.push(walker.currentNode);
+  texts.forEach(t => {{
+    const re = /(?:specs\\/)?([A-Za-z0-9_.-]+)\\.yaml\\b/g, frag = document.createDocumentFragment();
+    let m, last = 0;
+    while ((m = re.exec(t.data))) {{
+      const p = bySlug.get(m[1]);
+      if (!p || p[0] === here) continue;
+      const a = document.createElement("a");
+      a.href = "../" + p[0] + "/index.html"; a.title = p[1]; a.textContent = m[0];
+      frag.append(t.data.slice(last, m.index), a);
+      last = m.index + m[0].length;
+    }}
+    if (last) {{ frag.append(t.data.slice(last)); t.replaceWith(frag); }}
+  }});
 }});
 }})();
 """
