@@ -263,7 +263,7 @@ def balance(ctx: BalanceContext) -> BalanceResult:
         f"{len(motions)} motions ({', '.join(f'{n}: {len(m.t)} samples' for n, m in zip(PMo.names(method), motions))}; "
         "a term is the largest of its values on each motion)")
     notes = [
-        "Optimal partial balancing by a second-order cone programme (Clarabel) over "
+        "Optimal partial balancing by a second-order cone programme over "
         f"{over}: objective {' + '.join(f'{x.weight:g} x {x.label}' for x in objective)} "
         f"(each divided by its unbalanced value) = {details['objective']:.6g} with {details['added_mass']:.6g} kg added; "
         f"active: {', '.join(active) or 'none'}; d objective / d budget = {numbers.num_at(out.budget_dual, 1.0 / max(model.total_mass(), 1e-12))} per kg; "

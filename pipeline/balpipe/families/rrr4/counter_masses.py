@@ -398,7 +398,7 @@ def finder_stage(mech: RRR4Mechanism, spec: RRR4Balancing, model: Model, lbl: Mo
                  for i in legs for j in (1, 2)}
         lm, sol = generic.least_mass(model, radii, gen)
         k = [s.name for s in stages].index("leg_by_leg") + 1
-        stages.insert(k, Stage("least_mass", "least-mass counter-masses (generic conditions, linprog)", lm,
+        stages.insert(k, Stage("least_mass", "least-mass counter-masses (generic conditions)", lm,
                                "one counter-mass per link within the leg-by-leg distance of its proximal joint "
                                "(proximal %.4g m, distal %.4g m), least total mass meeting the finder's %d conditions"
                                % (spec.counterweights.proximal, spec.counterweights.distal, gen.count), "force"))

@@ -513,10 +513,10 @@ def _method_note(method: ComMotionPlanning, planner: Planner, plans: list[Plan],
     return (
         f"phi optimisation: degree-{o.degree} polynomial, ends fixed in phi, phi', phi'' ({o.degree - 5} free "
         f"coefficients); objective the peak |M| on the analysis grid ({len(planner.t)} samples), by the explicit "
-        f"serial dynamics; scipy.optimize.minimize Nelder-Mead from {o.starts} starts (the 3-4-5 law and "
+        f"serial dynamics; the Nelder-Mead simplex from {o.starts} starts (the 3-4-5 law and "
         f"{o.starts - 1} normal random points, sd {o.spread} rad, numpy default_rng({o.seed})), at most "
         f"{o.max_evaluations} evaluations per start, xatol {o.tolerance}; {sum(p.evaluations for p in plans)} objective evaluations in "
-        f"all for {len(plans)} trajectories (benchmarks/bench_paper003.py times them). Case 3: the shortest ramps (bisection on "
+        f"all for {len(plans)} trajectories. Case 3: the shortest ramps (bisection on "
         f"f) for which every joint's torque rate, by central differences on {method.rate_samples} samples and 64 "
         f"in each ramp, stays "
         f"within {numbers.num(method.torque_rate_limit)} N m/s."
