@@ -69,7 +69,7 @@ class ValidationSpec(Strict):
     dt: quantity("time", gt=0) | None = Field(None, description="time step in s (default chosen per mechanism); at least duration / 1e6 (a limit: one million steps)")
     iterations: count(ge=1, le=10_000) | None = Field(None, description="solver iterations per step")
     tolerance: number(gt=0, le=0.01) = Field(0.01, description="pass when residuals are below this fraction of the reference loads: the unbalanced peaks, floored by 1 % of the gross inertial load (at most 1 %)")
-    reactionless: bool | None = Field(None, description="free-floating frame demonstration (default: on for paper specs)")
+    reactionless: bool | None = Field(None, description="free-floating frame demonstration of every stage (default: in paper specs, the stages claiming to cancel force and moment and their reference stage)")
     max_refinement: number(ge=1, le=64) = Field(8, description="the validator's own budget: a run that cannot resolve its error at the first step is rerun at finer steps, down to the first divided by this; still unresolved, it is 'unconfirmed' with the setting that would resolve it (1: no refinement)")
 
 
