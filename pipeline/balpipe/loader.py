@@ -20,7 +20,7 @@ from pydantic import ValidationError
 from .laws.drives import read_tables
 from .runtime.inputs import InputFileError, read_regular
 from .limits import check_limits
-from .spec import Spec
+from .spec import Spec, validate
 from .spec_parts import SpecFieldError
 
 try:  # the C loader is 5-10x faster; fall back to the pure-Python one
@@ -384,7 +384,7 @@ def load_text(text: str, file: str, folder: str | Path | None = None) -> tuple[S
     if dup:
         raise SpecErrors(dup)
     try:
-        spec = Spec.model_validate(data)
+        spec = validate(data)
     except ValidationError as exc:
         errors = []
         for err in exc.errors():
@@ -438,8 +438,9 @@ def load(path: str | Path, name: str | None = None) -> LoadedSpec:
 
 
 def prepare() -> None:
-    """Build the spec's validator now (pydantic defers it to the first spec validated, ~50 ms):
-    before a process pool forks, so that its workers inherit it instead of each building it."""
+    """Build the whole spec's validator now (every family's sections, ~50 ms; pydantic defers it
+    to the first spec validated): before a process pool forks, so that its workers inherit it
+    instead of each building it or the narrower ones of :func:`balpipe.spec.validate`."""
     Spec.model_rebuild()
 
 

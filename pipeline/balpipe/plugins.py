@@ -14,9 +14,11 @@ Families come out sorted by :attr:`Family.order`, then name; templates and metho
 order within a family. That order is the order of the spec's unions (:mod:`balpipe.spec`), so it
 fixes the JSON Schema and the text of a "which template?" error.
 
-A family's spec sections are classes (the schema needs them), but its computing code, figures
-and notation tables may be :class:`Ref` objects, ``"package.module:name"`` imported on first use: the
-schema (``balpipe check``) then loads no method's code but the one it runs.
+A family's spec sections, computing code, figures and notation tables may all be :class:`Ref`
+objects, ``"package.module:name"`` imported on first use: ``balpipe check`` of a spec then loads
+the sections of its own template and methods only (:func:`balpipe.spec.validate`) and no
+method's code but the one it runs; the whole schema (``balpipe schema``, :class:`balpipe.spec.Spec`
+validated directly) resolves every section.
 """
 
 from __future__ import annotations
@@ -27,7 +29,9 @@ from functools import lru_cache
 from importlib import import_module
 from importlib.metadata import entry_points
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, cast
+
+from pydantic import BaseModel
 
 from . import FAMILY_GROUP
 from .balancing.base import BalanceResult
@@ -68,9 +72,18 @@ def resolved(obj: Any) -> Any:
     return obj.resolve() if isinstance(obj, Ref) else obj
 
 
+def section_class(spec: type[Strict] | Ref) -> type[Strict]:
+    """A template's or method's spec section: the class, or the class its :class:`Ref` names."""
+    cls = resolved(spec)
+    if not (isinstance(cls, type) and issubclass(cls, BaseModel)):
+        raise TypeError(f"a spec section is a pydantic model class (balpipe.spec_parts.Strict), not {cls!r}")
+    return cast("type[Strict]", cls)
+
+
 @dataclass(frozen=True)
 class Template:
     """A mechanism template: ``spec`` is its pydantic section (a ``template`` literal names it),
+    a class or a :class:`Ref` to one (:attr:`section` is the class),
     ``build(mechanism_spec, laws, t) -> Model``; ``laws`` maps drive names to laws. ``build``,
     ``figures`` and ``notation`` may be :class:`Ref` objects.
     ``figures(study)`` optionally yields extra report figures as (title, svg, caption).
@@ -79,13 +92,18 @@ class Template:
     (:mod:`balpipe.site_files.check_cost`), never a limit."""
 
     name: str
-    spec: type[Strict]
+    spec: type[Strict] | Ref
     build: Callable[..., Model]
     label: str
     figures: Callable[..., Any] | None = None
     notation: Any = None  # the papers' symbols of the inputs: a table or table(mechanism_spec) (balpipe.notation)
     check_cost: float = 0.0  # seconds that ``balpipe check`` of a spec of this template takes beyond a plain one's
     build_cost: float = 0.0  # seconds that ``balpipe build --no-sim`` of such a spec takes beyond its text's estimate
+
+    @property
+    def section(self) -> type[Strict]:
+        """The spec section's class (``spec``, its module imported now if it is a :class:`Ref`)."""
+        return section_class(self.spec)
 
 
 @dataclass(frozen=True)
@@ -102,8 +120,9 @@ class Method:
     ``balpipe check`` balances with them set to None. ``ctx.page`` is False in ``balpipe check``
     of a spec without references: a method may then leave out parameters, notes and details that
     no error depends on (designs only drawn).
-    ``balance``, ``figures`` and ``notation`` may be :class:`Ref` objects: the spec section is a class,
-    the computing code is imported when the method runs. ``check_cost``: the seconds (on one
+    ``spec``, ``balance``, ``figures`` and ``notation`` may be :class:`Ref` objects (:attr:`section`
+    is the spec's class): the section is imported when a spec names the method, the computing code
+    when the method runs. ``check_cost``: the seconds (on one
     core, measured) that checking a spec with this method takes beyond a plain spec's few
     hundredths; ``balpipe check`` starts its costliest specs first (:mod:`balpipe.site_files.check_cost`),
     so that a long one does not start last and leave the other cores idle at the end.
@@ -111,7 +130,7 @@ class Method:
     text (:func:`balpipe.build.spec_cost`)."""
 
     name: str
-    spec: type[Strict]
+    spec: type[Strict] | Ref
     balance: Callable[[BalanceContext], BalanceResult]
     templates: tuple[str, ...]  # the templates it applies to; () for every template (the generic methods)
     label: str
@@ -120,6 +139,11 @@ class Method:
     page_only: tuple[str, ...] = ()
     check_cost: float = 0.0  # seconds that ``balpipe check`` of a spec with this method takes beyond a plain one's
     build_cost: float = 0.0  # seconds that ``balpipe build --no-sim`` of such a spec takes beyond its text's estimate
+
+    @property
+    def section(self) -> type[Strict]:
+        """The spec section's class (``spec``, its module imported now if it is a :class:`Ref`)."""
+        return section_class(self.spec)
 
 
 @dataclass(frozen=True)

@@ -12,8 +12,6 @@ import numpy as np
 from . import units
 from .balancing.base import BalanceResult, Stage
 from .balancing.context import BalanceContext, Memo, compute
-from .balancing.partial.spec import PartialBalance
-from .balancing.specs import ForceBalance, MomentBalance, Stages
 from .model import Law, Model
 from .laws.drives import drive_laws
 from .laws.load_spec import model_loads
@@ -28,18 +26,18 @@ __all__ = [
 ]
 
 # methods for every template (they read only the model); "none" is the spec's own default. Their
-# code is imported when a spec uses them (the schema needs only their sections).
+# sections and code are imported when a spec uses them (the whole schema needs every section).
 _CODE = "balpipe.balancing"
 GENERIC: tuple[Method, ...] = (
-    Method("force_balance", ForceBalance, Ref(f"{_CODE}.force_balance:balance"), (),
+    Method("force_balance", Ref(f"{_CODE}.specs:ForceBalance"), Ref(f"{_CODE}.force_balance:balance"), (),
            "force-balance conditions from the momentum + least-mass counterweights",
            notation=Ref(f"{_CODE}.force_balance:notation")),
-    Method("moment_balance", MomentBalance, Ref(f"{_CODE}.moment_balance:balance"), (),
+    Method("moment_balance", Ref(f"{_CODE}.specs:MomentBalance"), Ref(f"{_CODE}.moment_balance:balance"), (),
            "least-mass counterweights + counter-rotations from the angular momentum",
            notation=Ref(f"{_CODE}.moment_balance:notation")),
-    Method("stages", Stages, Ref(f"{_CODE}.stages:balance"), (), "stages written by hand, each adding parts",
+    Method("stages", Ref(f"{_CODE}.specs:Stages"), Ref(f"{_CODE}.stages:balance"), (), "stages written by hand, each adding parts",
            notation=Ref(f"{_CODE}.stages:notation")),
-    Method("partial_balance", PartialBalance, Ref(f"{_CODE}.partial.method:balance"), (),
+    Method("partial_balance", Ref(f"{_CODE}.partial.spec:PartialBalance"), Ref(f"{_CODE}.partial.method:balance"), (),
            "optimal partial balancing (cone programme)",
            notation=Ref(f"{_CODE}.partial.method:notation"),
            page_only=("fronts",),  # the Pareto fronts: about 90 % of its time, drawn only on the page
@@ -76,13 +74,14 @@ TEMPLATES, METHODS, PAPERS = _tables()
 
 
 def template_specs() -> tuple[type, ...]:
-    """The templates' spec sections, in union order."""
-    return tuple(t.spec for t in TEMPLATES.values())
+    """The templates' spec sections, in union order (every family's section module imported)."""
+    return tuple(t.section for t in TEMPLATES.values())
 
 
 def method_specs() -> tuple[type, ...]:
-    """The methods' spec sections, in union order (after the spec's own "none")."""
-    return tuple(m.spec for m in METHODS.values())
+    """The methods' spec sections, in union order (after the spec's own "none"; every section
+    module imported)."""
+    return tuple(m.section for m in METHODS.values())
 
 
 def scalar_laws(motion: Any, dims: dict[str, str]) -> dict[str, Law]:

@@ -3,14 +3,19 @@ analysis. ``balpipe schema`` prints its JSON Schema.
 
 The mechanism and balancing sections are unions of the templates and methods the registry
 discovered (:mod:`balpipe.plugins`, :mod:`balpipe.registry`): each is a pydantic model with a
-``template`` (``method``) literal that discriminates the union.
+``template`` (``method``) literal that discriminates the union. The unions are resolved when a
+validator or the schema is built, not when this module is imported: :class:`Spec` validated
+directly (and its JSON Schema) imports every family's sections, :func:`validate` only those of the
+template and methods a spec names (``balpipe check`` of one spec: one family's).
 """
 
 from __future__ import annotations
 
-from typing import Annotated, Literal, Union
+import functools
+from typing import Annotated, Any, Callable, Literal, Union, cast
 
-from pydantic import Field, field_validator
+from pydantic import Field, GetCoreSchemaHandler, create_model, field_validator
+from pydantic_core import CoreSchema
 
 from . import registry
 from .display.units import display_units
@@ -28,14 +33,39 @@ class NoBalancing(Strict):
     method: Literal["none"] = Field(description="balancing method")
 
 
-Mechanism = Annotated[
-    Union[registry.template_specs()],
-    Field(discriminator="template", description="the mechanism: a template with its parameters"),
-]
-Balancing = Annotated[
-    Union[(NoBalancing, *registry.method_specs())],
-    Field(discriminator="method", description="the balancing method and its design choices"),
-]
+class Sections:
+    """A discriminated union of spec sections, built when pydantic builds a validator or a schema
+    that holds it (not when a model naming it is defined): ``key`` is the discriminating field
+    (``template``, ``method``), ``sections()`` the member classes in union order."""
+
+    def __init__(self, key: str, sections: Callable[[], tuple[type, ...]], description: str) -> None:
+        self.key = key
+        self.sections = sections
+        self.description = description
+
+    def union(self) -> Any:
+        """The union as a type: ``Annotated[Union[...], Field(discriminator=key, description=...)]``."""
+        return Annotated[Union[self.sections()], Field(discriminator=self.key, description=self.description)]
+
+    def __get_pydantic_core_schema__(self, source: Any, handler: GetCoreSchemaHandler) -> CoreSchema:
+        return handler.generate_schema(self.union())
+
+
+_MECHANISM = "the mechanism: a template with its parameters"
+_BALANCING = "the balancing method and its design choices"
+#: every template's section (the registry's union order)
+MECHANISMS = Sections("template", registry.template_specs, _MECHANISM)
+#: "none" and every method's section
+BALANCINGS = Sections("method", lambda: (NoBalancing, *registry.method_specs()), _BALANCING)
+
+
+def __getattr__(name: str) -> Any:
+    """``Mechanism`` and ``Balancing``: the whole unions as types (every family's sections imported)."""
+    if name == "Mechanism":
+        return MECHANISMS.union()
+    if name == "Balancing":
+        return BALANCINGS.union()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class Design(Strict):
@@ -43,7 +73,13 @@ class Design(Strict):
 
     name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_\-]+$", description="short name, prefixes its stages (name:stage)")
     label: str = Field("", description="label in figures and tables (default: the name)")
-    balancing: Balancing
+    balancing: Annotated[Any, BALANCINGS]
+
+    def __eq__(self, other: object) -> bool:
+        return _same(self, other, Design)
+
+    def __reduce__(self) -> tuple:
+        return restore, (Design, self.__getstate__())
 
 
 class AnalysisSettings(Strict):
@@ -113,9 +149,9 @@ class Spec(Strict):
     name: str = Field(min_length=1, description="title of the study")
     description: str = Field("", description="what the spec reproduces and which values are assumed")
     paper: str | None = Field(None, description="the paper the spec reproduces, if any")
-    mechanism: Mechanism
+    mechanism: Annotated[Any, MECHANISMS]
     motion: Motion
-    balancing: Balancing = Field(NoBalancing(method="none"))
+    balancing: Annotated[Any, BALANCINGS] = Field(NoBalancing(method="none"))
     analysis: AnalysisSettings = Field(AnalysisSettings())
     validation: ValidationSpec = Field(ValidationSpec())
     loads: list[LoadSpec] = Field(
@@ -131,3 +167,80 @@ class Spec(Strict):
     sweep: SweepSpec | None = Field(
         None, description="a design sweep run by 'balpipe sweep SPEC' (flags override it); 'balpipe build' ignores it"
     )
+
+    def __eq__(self, other: object) -> bool:
+        return _same(self, other, Spec)
+
+    def __reduce__(self) -> tuple:
+        return restore, (Spec, self.__getstate__())
+
+
+def restore(cls: type, state: dict) -> Any:
+    """A pickled :class:`Spec` or :class:`Design` (which class validated it aside), as pickle
+    restores a pydantic model: the instance made without validation, its state set."""
+    obj = cls.__new__(cls)
+    obj.__setstate__(state)
+    return obj
+
+
+def _same(a: Any, b: object, base: type) -> bool:
+    """pydantic's equality, with a :class:`Spec` (:class:`Design`) validated by :func:`validate`'s
+    narrower class equal to the same one validated by the whole schema."""
+    if isinstance(b, base) and type(b) is not type(a):
+        return a.__dict__ == b.__dict__ and (a.__pydantic_extra__ or {}) == (b.__pydantic_extra__ or {})
+    return bool(super(base, a).__eq__(b))
+
+
+def validate(data: Any) -> Spec:
+    """``data`` (a spec's YAML, parsed) validated as a :class:`Spec`, with the same result and the
+    same errors as ``Spec.model_validate(data)``. Until the whole schema is built (:class:`Spec`
+    validated directly, its JSON Schema, :func:`balpipe.loader.prepare`), a spec that names a
+    known template and known methods (its own and its compared designs') is validated by a Spec
+    whose unions hold only those sections: only their families' section modules are imported and
+    the validator is a fraction of the whole one. Any other spec (an unknown or missing name,
+    errors to report) goes through the whole schema, whose messages list every choice. The
+    narrower classes are named, pickled, hashed (:mod:`balpipe.cache.content`) and compared as
+    :class:`Spec` and :class:`Design`."""
+    names = None if Spec.__pydantic_complete__ else named_sections(data)
+    cls = Spec if names is None else _narrowed(*names)
+    return cls.model_validate(data)
+
+
+def named_sections(data: Any) -> tuple[str, tuple[str, ...]] | None:
+    """(template, methods in the registry's order) that ``data`` names in ``mechanism``,
+    ``balancing`` and each design of ``compare``, when every one is a name the registry knows
+    ("none" left out); None otherwise."""
+    if not isinstance(data, dict) or not isinstance(data.get("mechanism"), dict):
+        return None
+    template = data["mechanism"].get("template")
+    if not isinstance(template, str) or template not in registry.TEMPLATES:
+        return None
+    compare = data.get("compare", [])
+    if not isinstance(compare, list) or not all(isinstance(d, dict) and "balancing" in d for d in compare):
+        return None
+    methods = set()
+    for balancing in [data.get("balancing", {"method": "none"}), *(d["balancing"] for d in compare)]:
+        method = balancing.get("method") if isinstance(balancing, dict) else None
+        if not isinstance(method, str) or (method != "none" and method not in registry.METHODS):
+            return None
+        methods.add(method)
+    return template, tuple(m for m in registry.METHODS if m in methods)
+
+
+@functools.lru_cache(maxsize=None)
+def _narrowed(template: str, methods: tuple[str, ...]) -> type[Spec]:
+    """:class:`Spec` with its unions narrowed to ``template``'s section and "none" and ``methods``'
+    (:func:`validate`); one class per combination in a process."""
+    mechanism = Sections("template", lambda: (registry.TEMPLATES[template].section,), _MECHANISM)
+    balancing = Sections("method", lambda: (NoBalancing, *(registry.METHODS[m].section for m in methods)),
+                         _BALANCING)
+    design = create_model("Design", __base__=Design, __module__=__name__, balancing=(Annotated[Any, balancing], ...))
+    fields = Spec.model_fields
+    spec = create_model(
+        "Spec", __base__=Spec, __module__=__name__,
+        mechanism=(Annotated[Any, mechanism], ...),
+        balancing=(Annotated[Any, balancing], Field(fields["balancing"].default)),
+        compare=(list[design], Field(fields["compare"].default, description=fields["compare"].description)),  # type: ignore[valid-type]
+    )
+    return cast("type[Spec]", spec)
+

@@ -24,8 +24,8 @@ def test_page_only_fields_are_optional_fields_of_their_method():
     declared = [(m, f) for m in registry.METHODS.values() for f in m.page_only]
     assert declared, "no method declares page-only fields: check computes everything"
     for m, f in declared:
-        assert f in m.spec.model_fields, (m.name, f)
-        assert type(None) in typing.get_args(m.spec.model_fields[f].annotation), (m.name, f)
+        assert f in m.section.model_fields, (m.name, f)
+        assert type(None) in typing.get_args(m.section.model_fields[f].annotation), (m.name, f)
 
 
 def test_without_the_page_the_design_is_the_same_and_the_fronts_are_left_out():

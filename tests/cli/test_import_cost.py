@@ -89,13 +89,47 @@ def test_the_schema_loads_no_methods_code(module):
 
 
 @pytest.mark.parametrize("spec, code", [
-    ("specs/scott_russell.yaml", ["balpipe.families.slider_crank.counterweights"]),
-    ("specs/paper002_decoupling.yaml", ["balpipe.families.serial_arm.decoupling"]),
-    ("specs/paper004_five_bar.yaml", ["balpipe.families.five_bar.gear_balancing"]),
+    ("specs/scott_russell.yaml", ["balpipe.families.slider_crank.counterweights", "balpipe.families.slider_crank.template"]),
+    ("specs/paper002_decoupling.yaml", ["balpipe.families.serial_arm.decoupling", "balpipe.families.serial_arm.template"]),
+    ("specs/paper004_five_bar.yaml", ["balpipe.families.five_bar.gear_balancing", "balpipe.families.five_bar.template"]),
 ])
 def test_check_loads_the_code_of_its_specs_method_only(spec, code):
-    """``balpipe check`` of a spec imports its own method's code and no other's (registry entries
-    are :class:`balpipe.plugins.Ref` objects, resolved on first use), nor any figure module."""
+    """``balpipe check`` of a spec imports its own method's code and its own template's and no
+    other's (registry entries are :class:`balpipe.plugins.Ref` objects, resolved on first use),
+    nor any figure module."""
     found = code_loaded(f"from balpipe.cli import main\ntry:\n    main(['check', {spec!r}])\nexcept SystemExit:\n    pass")
     assert found["code"] == code
     assert [m for m in found["heavy"] if not m.startswith(("balpipe.engine", "balpipe.study"))] == []
+
+
+SECTIONS_PROBE = """
+import json, sys
+from balpipe.cli import main
+try:
+    main(json.loads(sys.argv[1]))
+except SystemExit:
+    pass
+print(json.dumps(sorted(m for m in sys.modules if m.startswith(("balpipe.families.", "balpipe.balancing.")))),
+      file=sys.stderr)
+"""
+
+
+@pytest.mark.parametrize("spec, family, generic", [
+    ("specs/offset_slider_crank.yaml", "slider_crank", []),
+    ("specs/paper002_decoupling.yaml", "serial_arm", []),
+    ("specs/custom_four_bar_balancing.yaml", "custom", ["balpipe.balancing.specs"]),
+    ("specs/partial_offset_slider_crank.yaml", "slider_crank",  # its method's code reads the generic sections
+     ["balpipe.balancing.partial.spec", "balpipe.balancing.specs"]),
+])
+def test_check_of_one_spec_loads_its_own_family_only(spec, family, generic):
+    """``balpipe check`` of one spec validates it with its own template's and methods' sections
+    (:func:`balpipe.spec.validate`): no module of another family is imported (every family's
+    package is: its ``FAMILY`` names the rest by :class:`balpipe.plugins.Ref`), and of the generic
+    methods' sections only those the spec names."""
+    r = subprocess.run([sys.executable, "-c", SECTIONS_PROBE, json.dumps(["check", spec])], cwd=ROOT,
+                       capture_output=True, text=True, timeout=120)
+    loaded = json.loads(r.stderr.strip().splitlines()[-1])
+    families = {m.split(".")[2] for m in loaded if m.startswith("balpipe.families.") and m.count(".") >= 3}
+    assert families == {family}, loaded
+    sections = [m for m in loaded if m in ("balpipe.balancing.specs", "balpipe.balancing.partial.spec")]
+    assert sections == generic, loaded

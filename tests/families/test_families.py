@@ -51,9 +51,9 @@ def test_entry_points_and_package_scan_agree():
 
 
 def test_union_order_is_the_discovery_order():
-    assert _union(spec.Mechanism) == tuple(t.spec for t in TEMPLATES)
-    generic = tuple(m.spec for m in registry.GENERIC)
-    assert _union(spec.Balancing) == (spec.NoBalancing,) + tuple(m.spec for m in METHODS) + generic
+    assert _union(spec.Mechanism) == tuple(t.section for t in TEMPLATES)
+    generic = tuple(m.section for m in registry.GENERIC)
+    assert _union(spec.Balancing) == (spec.NoBalancing,) + tuple(m.section for m in METHODS) + generic
     assert list(registry.TEMPLATES) == [t.name for t in TEMPLATES]
 
 

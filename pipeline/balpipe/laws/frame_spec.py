@@ -4,12 +4,16 @@ Coordinates are the frame's (the mechanism's global axes); every number may carr
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from pydantic import Field, model_validator
 
-from ..mechanics.mounts import Frame, Mount
 from ..spec_parts import Strict
 from ..units import (Damping, Length, OpenFraction, PositiveForce, PositiveInertia, PositiveMass, PositiveVelocity,
                      Stiffness)
+
+if TYPE_CHECKING:
+    from ..mechanics.mounts import Frame
 
 _NAME = r"^[A-Za-z0-9_\-]+$"
 
@@ -69,7 +73,10 @@ class FrameSpec(Strict):
         return self
 
     def model(self) -> Frame:
-        """The frame and its mounts (SI) for :mod:`balpipe.mechanics.mounts`."""
+        """The frame and its mounts (SI) for :mod:`balpipe.mechanics.mounts` (imported here: a spec
+        without a frame does not load it)."""
+        from ..mechanics.mounts import Frame, Mount
+
         return Frame(self.mass, self.inertia, (float(self.com[0]), float(self.com[1])), tuple(
             Mount(m.name or f"mount{i + 1}", (float(m.at[0]), float(m.at[1])), m.kx, m.ky, m.cx, m.cy)
             for i, m in enumerate(self.mounts)))

@@ -38,11 +38,11 @@ def effort_unit(plan) -> str:
     torque (revolute joint, angle), 'N' when every one is a force, else 'N m or N'. The varied
     fields are values, so every design has the base spec's drivers."""
     from .. import registry
-    from ..spec import Spec
+    from ..spec import validate
     from .present import driver_unit
 
     try:
-        model = registry.unbalanced_model(Spec.model_validate(plan.data))
+        model = registry.unbalanced_model(validate(plan.data))
     except Exception:  # noqa: BLE001  (the base spec was checked; a unit is not worth a failed page)
         return "N m or N"
     units = {driver_unit(model, d.name) for d in model.drivers}

@@ -12,9 +12,9 @@ from ..vary import get_attr_path, with_values
 
 
 def _validate(data: dict):
-    from ..spec import Spec
+    from ..spec import validate
 
-    return Spec.model_validate(data)
+    return validate(data)
 
 
 def _pick_stage(result, stage: str | None):

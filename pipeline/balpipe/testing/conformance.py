@@ -83,13 +83,13 @@ def _check_part(kind: str, name: str, label: str, notation: object, spec: type, 
 
 def check_template(template: plugins.Template) -> None:
     """A template has a label, a notation table, a ``template`` literal naming it, a build."""
-    _check_part("template", template.name, template.label, template.notation, template.spec, template.build)
+    _check_part("template", template.name, template.label, template.notation, template.section, template.build)
 
 
 def check_method(method: plugins.Method) -> None:
     """A method has a label, a notation table, a ``method`` literal naming it, a balance, and
     applies to templates balpipe knows."""
-    _check_part("method", method.name, method.label, method.notation, method.spec, method.balance)
+    _check_part("method", method.name, method.label, method.notation, method.section, method.balance)
     unknown = set(method.templates) - set(registry.TEMPLATES)
     _require(method.templates and not unknown,
              f"method {method.name!r}: applies to no template, or to unknown ones {sorted(unknown)}")

@@ -1,8 +1,7 @@
 """The custom family: a mechanism written body by body and joint by joint (the generic methods
 balance it)."""
 
-from ...plugins import Family, Template, packaged_examples
-from . import template
+from ...plugins import Family, Ref, Template, packaged_examples
 
 FAMILY = Family(
     name="custom",
@@ -10,6 +9,7 @@ FAMILY = Family(
     package=__name__,
     examples=packaged_examples(__file__),
     templates=(
-        Template("custom", template.CustomMechanism, template.build, "custom mechanism", notation=template.notation),
+        Template("custom", Ref(f"{__name__}.template:CustomMechanism"), Ref(f"{__name__}.template:build"),
+                 "custom mechanism", notation=Ref(f"{__name__}.template:notation")),
     ),
 )

@@ -2,7 +2,6 @@
 planning (paper 003)."""
 
 from ...plugins import Citation, Family, Method, Paper, Ref, Template, packaged_examples
-from . import specs, template
 
 FAMILY = Family(
     name="serial_arm",
@@ -20,13 +19,14 @@ FAMILY = Family(
         Paper("003", figures=("2", "3", "4")),  # stored from its abstract on: the spec's title is cited
     ),
     templates=(
-        Template("serial_arm", template.SerialArmMechanism, template.build, "serial nR arm", notation=template.notation),
+        Template("serial_arm", Ref(f"{__name__}.template:SerialArmMechanism"), Ref(f"{__name__}.template:build"),
+                 "serial nR arm", notation=Ref(f"{__name__}.template:notation")),
     ),
     methods=(
-        Method("gear_decoupling", specs.GearDecoupling, Ref(f"{__name__}.decoupling:balance"), ("serial_arm",),
+        Method("gear_decoupling", Ref(f"{__name__}.specs:GearDecoupling"), Ref(f"{__name__}.decoupling:balance"), ("serial_arm",),
                "decoupling by gears 1'-2' and mass redistribution, counter-rotating gear 3 (paper 002)",
                notation=Ref(f"{__name__}.decoupling:NOTATION"), figures=Ref(f"{__name__}.figures:decoupling_figures")),
-        Method("com_motion_planning", specs.ComMotionPlanning, Ref(f"{__name__}.com_planning:balance"),
+        Method("com_motion_planning", Ref(f"{__name__}.specs:ComMotionPlanning"), Ref(f"{__name__}.com_planning:balance"),
                ("serial_arm",), "centre-of-mass motion planning, phi optimised (paper 003)",
                notation=Ref(f"{__name__}.com_planning:NOTATION"), figures=Ref(f"{__name__}.figures:com_planning_figures"),
                check_cost=2.0,  # paper 003's eight trajectories: phi optimised, ramps bisected

@@ -2,7 +2,6 @@
 a Scott-Russell mechanism)."""
 
 from ...plugins import Family, Method, Ref, Template, packaged_examples
-from . import specs, template
 
 FAMILY = Family(
     name="slider_crank",
@@ -10,11 +9,11 @@ FAMILY = Family(
     package=__name__,
     examples=packaged_examples(__file__),
     templates=(
-        Template("slider_crank", template.SliderCrankMechanism, template.build, "slider-crank",
-                 notation=template.NOTATION),
+        Template("slider_crank", Ref(f"{__name__}.template:SliderCrankMechanism"), Ref(f"{__name__}.template:build"),
+                 "slider-crank", notation=Ref(f"{__name__}.template:NOTATION")),
     ),
     methods=(
-        Method("slider_crank_counterweights", specs.SliderCrankCounterweights, Ref(f"{__name__}.counterweights:balance"),
+        Method("slider_crank_counterweights", Ref(f"{__name__}.specs:SliderCrankCounterweights"), Ref(f"{__name__}.counterweights:balance"),
                ("slider_crank",), "counterweights (+ eq. 20 inertia for Scott-Russell)",
                notation=Ref(f"{__name__}.counterweights:NOTATION")),
     ),
