@@ -7,8 +7,12 @@
 // and motion). The curves are drawn by live_plots.js (the figure #live-whatif: the reference
 // stage, the computed design and the design tried); this script replaces the tried design's
 // series with uPlot's setData, now or when the plots are built. The computed design is marked on
-// every slider; "Reset" restores it. window.balpipeWhatif holds the series and the values (for
-// the console and the browser tests).
+// every slider; "Reset" restores it. Everything is shown in the page's display units (report.units:
+// d.params per slider value, d.factors per panel, from report/whatif.py), while the maps, the
+// values and the series stay SI: a value shown is the SI value over its unit's factor, a value
+// slid or typed is multiplied by it, and the reset restores the exact SI design.
+// window.balpipeWhatif holds the series and the values in SI, and the units' factors (for the
+// console and the browser tests).
 (function () {
   "use strict";
   const src = document.getElementById("whatif-data"), box = document.getElementById("whatif-panel");
@@ -55,15 +59,27 @@
     out.F = norm(out.Fx, out.Fy);
     return out;
   }
-  const api = { t: t, design: design, series: design, values: values, parts: parts, updates: 0, drawn: 0 };
+  // the display units: each slider value's name, unit and factor to SI; each panel's factor
+  const PARAMS = d.params;
+  const factor = key => (d.factors && d.factors[key]) || 1;
+  const shownSeries = (y, key) => { const f = factor(key); return Array.from(y, v => v / f); };
+  const api = { t: t, design: design, series: design, values: values, parts: parts, updates: 0, drawn: 0,
+    params: PARAMS, factors: d.factors };
   window.balpipeWhatif = api;
 
   // the controls: per part a group of four rows (range, number box, the computed value marked)
-  // what a number box and a label show: 6 digits, and 0 for a value within 1e-9 of its slider's
-  // range of 0 (a computation's round-off, 2e-17 m); the value itself is kept whole
-  const clean = (p, j, v) => (Math.abs(v) <= 1e-9 * (p.hi[j] - p.lo[j]) ? 0 : v);
-  const shown = (p, j, v) => String(+clean(p, j, v).toPrecision(6));
-  const PARAMS = [["mass", "kg"], ["x", "m"], ["y", "m"], ["inertia", "kg m²"]];
+  // what a number box and a label show, in the display unit: 0 for a value within 1e-9 of its
+  // slider's range of 0 (a computation's round-off, 2e-17 m); the value itself is kept whole
+  const clean = (p, j, v) => (Math.abs(v) <= 1e-9 * (p.hi[j] - p.lo[j]) ? 0 : v) / PARAMS[j].factor;
+  // a number box's value: fixed-point decimals to 6 significant digits, as the pages write numbers
+  // (balpipe.display.numbers), never exponent notation ("0.0000275272", not "2.75272e-11")
+  function plain(v) {
+    if (v === 0 || !isFinite(v)) return String(v);
+    const r = +v.toPrecision(6), e = Math.floor(Math.log10(Math.abs(r)));
+    const s = r.toFixed(Math.min(100, Math.max(0, 5 - e)));
+    return s.indexOf(".") >= 0 ? s.replace(/0+$/, "").replace(/\.$/, "") : s;
+  }
+  const shown = (p, j, v) => plain(clean(p, j, v));
   const inputs = [];
   const added = document.createElement("p");
   added.className = "whatif-added";
@@ -88,7 +104,7 @@
     kind.textContent = "(" + p.kind + (p.kind.indexOf(p.body) < 0 && p.label.indexOf(p.body) < 0 ? ", on " + p.body : "") + ")";
     legend.appendChild(kind);
     set.appendChild(legend);
-    inputs.push(PARAMS.map(([name, unit], j) => {
+    inputs.push(PARAMS.map(({ name: name, unit: unit, factor: f }, j) => {
       const row = document.createElement("div");
       row.className = "whatif-row";
       const label = document.createElement("label");
@@ -98,8 +114,8 @@
       const track = document.createElement("span");
       track.className = "whatif-track";
       const range = document.createElement("input");
-      Object.assign(range, { type: "range", id: id, min: p.lo[j], max: p.hi[j], step: "any" });
-      range.value = String(p.design[j]);
+      Object.assign(range, { type: "range", id: id, min: p.lo[j] / f, max: p.hi[j] / f, step: "any" });
+      range.value = String(p.design[j] / f);
       range.dataset.part = String(i);
       range.dataset.param = String(j);
       range.setAttribute("aria-label", name + " of " + p.label + " (" + unit + ")");
@@ -110,7 +126,7 @@
       mark.style.setProperty("--at", String(frac));
       track.append(range, mark);
       const num = document.createElement("input");
-      Object.assign(num, { type: "number", min: p.lo[j], max: p.hi[j], step: "any" });
+      Object.assign(num, { type: "number", min: p.lo[j] / f, max: p.hi[j] / f, step: "any" });
       num.value = shown(p, j, p.design[j]);
       num.setAttribute("aria-label", name + " of " + p.label + " (" + unit + "), typed");
       const was = document.createElement("span");
@@ -118,11 +134,11 @@
       was.textContent = "computed " + fmt(clean(p, j, p.design[j]));
       row.append(label, track, num, was);
       set.appendChild(row);
-      const take = (v, from) => {
-        if (!isFinite(v)) return;
-        v = Math.min(p.hi[j], Math.max(p.lo[j], v));
+      const take = (x, from) => {  // x in the display unit
+        if (!isFinite(x)) return;
+        const v = Math.min(p.hi[j], Math.max(p.lo[j], x * f));
         values[i][j] = v;
-        if (from !== range) range.value = String(v);
+        if (from !== range) range.value = String(v / f);
         if (from !== num) num.value = shown(p, j, v);
         row.classList.toggle("moved", v !== p.design[j]);
         update();
@@ -137,7 +153,7 @@
     parts.forEach((p, i) => p.design.forEach((v, j) => {
       values[i][j] = v;
       const c = inputs[i][j];
-      c.range.value = String(v); c.num.value = shown(p, j, v); c.row.classList.remove("moved");
+      c.range.value = String(v / PARAMS[j].factor); c.num.value = shown(p, j, v); c.row.classList.remove("moved");
     }));
     update();
   });
@@ -157,7 +173,7 @@
     const c = [row.insertCell(), row.insertCell(), row.insertCell()];
     c.forEach(x => { x.className = "num"; });
     c[0].textContent = ref ? fmt(peak(ref), p.floor) : "—";
-    c[1].textContent = fmt(peak(design[p.key]), p.floor);
+    c[1].textContent = fmt(peak(design[p.key]) / factor(p.key), p.floor);
     return [c[2], p.floor, k];
   });
   (document.getElementById("whatif-peaks") || box).appendChild(table);
@@ -170,8 +186,8 @@
       const key = fig.panels[k] && fig.panels[k].key;
       if (!key || !api.series[key]) return;
       const data = u.data.slice();
-      data[1 + order.indexOf(d.computed)] = Array.from(design[key]);  // whole, not the figure's 6 digits
-      data[1 + order.indexOf(d.tried)] = Array.from(api.series[key]);
+      data[1 + order.indexOf(d.computed)] = shownSeries(design[key], key);  // whole, not the figure's 6 digits
+      data[1 + order.indexOf(d.tried)] = shownSeries(api.series[key], key);
       const x = u.scales.x, first = data[0][0], last = data[0][data[0].length - 1];
       const zoomed = x.min != null && (x.min > first || x.max < last);
       const range = [x.min, x.max];
@@ -185,8 +201,12 @@
     api.series = compute();
     api.updates++;
     const mass = values.reduce((s, v) => s + v[0], 0), was = parts.reduce((s, p) => s + p.design[0], 0);
-    added.textContent = "Mass of the parts tried: " + fmt(mass) + " kg (computed design: " + fmt(was) + " kg).";
-    cells.forEach(([cell, floor, k]) => { cell.textContent = fmt(peak(api.series[fig.panels[k].key]), floor); });
+    const mf = PARAMS[0].factor, unit = " " + PARAMS[0].unit;
+    added.textContent = "Mass of the parts tried: " + fmt(mass / mf) + unit + " (computed design: " + fmt(was / mf) + unit + ").";
+    cells.forEach(([cell, floor, k]) => {
+      const key = fig.panels[k].key;
+      cell.textContent = fmt(peak(api.series[key]) / factor(key), floor);
+    });
     cancelAnimationFrame(frame);
     frame = requestAnimationFrame(redraw);
   }

@@ -218,3 +218,38 @@ def test_parts_of_one_name_on_two_links_are_two_parts(studies):
     assert [(p.name, p.body, p.design[0]) for p in parts] == [("cw", "crank", 1.5), ("cw", "coupler", 0.7)]
     moved = whatif.with_parts(final, parts, np.array([[2.0, -0.1, 0.0, 0.0], [0.3, 0.05, 0.02, 1e-3]]))
     assert [a.mass for b in moved.bodies for a in b.attachments] == [2.0, 0.3]
+
+
+def test_the_pages_display_units_show_the_figure_and_sliders_while_the_maps_stay_si(studies):
+    """report.units: the data's maps are the SI ones whatever the units; ``params`` gives each
+    slider value's unit and factor to SI (kg, mm, mm, kg mm² on the V-twin's page) and ``factors``
+    each panel's (1000 for its forces in kN, 1 for its moment, still N m; 1000 for both in the
+    engineering preset); the figure's curves are the SI series over those factors, its titles and
+    axes in the shown units, and its CSV in SI again."""
+    from balpipe.display.units import display_units
+    from balpipe.draw import live
+
+    st, w = _whatif(studies, "custom_v_twin_6000rpm.yaml")
+    u = display_units(st.spec.report.units)
+    d, si = whatif.data(w, u), whatif.data(w)
+    assert {k: v for k, v in d.items() if k not in ("params", "factors")} == \
+        {k: v for k, v in si.items() if k not in ("params", "factors")}
+    assert [(q["name"], q["unit"], q["factor"]) for q in si["params"]] == [
+        ("mass", "kg", 1.0), ("x", "m", 1.0), ("y", "m", 1.0), ("inertia", "kg m²", 1.0)]
+    assert [(q["name"], q["unit"]) for q in d["params"]] == [("mass", "kg"), ("x", "mm"), ("y", "mm"), ("inertia", "kg mm²")]
+    assert [q["factor"] for q in d["params"]] == [1.0, 1e-3, 1e-3, u.factor("inertia")] and u.factor("inertia") == pytest.approx(1e-6)
+    assert set(si["factors"].values()) == {1.0}
+    efforts = [k for k in d["factors"] if k.startswith("effort:")]
+    assert efforts and d["factors"] == {"Fx": 1e3, "Fy": 1e3, "F": 1e3, "M": 1.0, **{k: 1.0 for k in efforts}}
+    eng = whatif.data(w, display_units("engineering"))["factors"]
+    assert eng == {"Fx": 1e3, "Fy": 1e3, "F": 1e3, "M": 1e3, **{k: 1e3 for k in efforts}}  # torques in kN m
+    c, c_si = whatif.curves(w, u), whatif.curves(w)
+    assert [p["axis"] for p in c.panels][:4] == ["Fx (kN)", "Fy (kN)", "|F| (kN)", "M (N m)"]
+    assert all(p["title"].endswith("(kN)") for p in c.panels if p["key"] in ("Fx", "Fy", "F"))
+    for (_, shown), (_, exact) in zip(c.stages, c_si.stages):
+        for k, y in shown.items():
+            assert np.array_equal(y, np.asarray(exact[k]) / d["factors"][k]), k
+    a, b = live.csv_text(c).splitlines(), live.csv_text(c_si).splitlines()
+    assert a[0] == b[0] and "(N)" in a[0] and "kN" not in a[0]
+    np.testing.assert_allclose(np.array([r.split(",") for r in a[1:]], dtype=float),
+                               np.array([r.split(",") for r in b[1:]], dtype=float), rtol=1e-11, atol=0)

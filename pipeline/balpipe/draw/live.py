@@ -245,24 +245,32 @@ def column_unit(axis: str) -> tuple[str, str, float]:
     return axis[:m.start()].strip(), si, factor
 
 
-def shown_in(c: Curves, units: DisplayUnits) -> Curves:
-    """The figure in the page's display ``units``: each panel whose axis ends in an SI unit that
-    the units show otherwise ('Fx (N)' with forces in kN) has its curves divided by the unit's
-    factor and its title and axis in the shown unit ('Fx (kN)'); its CSV (:func:`csv_text`) is
-    converted back to SI by the unit's name."""
-    scale: dict[str, float] = {}
-    panels = []
-    for p in c.panels:
+def panel_units(panels: list, units: DisplayUnits) -> dict[str, tuple[str, float]]:
+    """Per panel key whose axis ends in an SI unit that ``units`` show otherwise ('Fx (N)' with
+    forces in kN): its shown unit and that unit's factor to SI ('kN', 1000); panels shown in
+    their SI unit (or without one) are absent. The one conversion of :func:`shown_in` and of the
+    what-if's script (:mod:`balpipe.report.whatif`)."""
+    out = {}
+    for p in panels:
         m = _UNIT.search(p["axis"])
         si = m.group(1).strip() if m else ""
         shown = units.unit(si) if si in OF_SI_UNIT else ""
-        if not shown or shown == si:
-            panels.append(p)
-            continue
-        scale[p["key"]] = units.factor(si)
-        panels.append({**p, "axis": _UNIT.sub(f"({shown})", p["axis"]), "title": _UNIT.sub(f"({shown})", p["title"])})
-    if not scale:
+        if shown and shown != si:
+            out[p["key"]] = (shown, units.factor(si))
+    return out
+
+
+def shown_in(c: Curves, units: DisplayUnits) -> Curves:
+    """The figure in the page's display ``units``: each panel of :func:`panel_units` has its
+    curves divided by the unit's factor and its title and axis in the shown unit ('Fx (kN)');
+    its CSV (:func:`csv_text`) is converted back to SI by the unit's name."""
+    shown = panel_units(c.panels, units)
+    if not shown:
         return c
+    panels = [p if p["key"] not in shown else
+              {**p, "axis": _UNIT.sub(f"({shown[p['key']][0]})", p["axis"]),
+               "title": _UNIT.sub(f"({shown[p['key']][0]})", p["title"])} for p in c.panels]
+    scale = {k: f for k, (_, f) in shown.items()}
     stages = [(label, {k: (np.asarray(v, dtype=float) / scale[k] if k in scale else v) for k, v in curves.items()})
               for label, curves in c.stages]
     return c._replace(stages=stages, panels=panels)

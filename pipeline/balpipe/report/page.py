@@ -311,7 +311,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         verdict=results.get("verdict"),
         card=design_card(study, results, units),
         u=units,
-        whatif=whatif.section(study, results, stage_styles(study)),
+        whatif=whatif.section(study, results, stage_styles(study), units),
         citation=citations.cite(spec.paper),
         names=names,
         param_scale=numbers.scales_by_unit(((p["value"], p["unit"]) for p in results.get("parameters") or []),

@@ -21,7 +21,9 @@ draw, as base64 float64 arrays (little-endian; the maps are computed at those sa
 at every sample of a long grid), and ``templates/whatif.js`` turns the slider values into q and
 sums; |F| is the norm of (Fx, Fy). :func:`series` is the same sum in numpy,
 :func:`engine_series` the engine's analysis of the model with those parts (the browser test's
-reference, to 1e-9 of each series' scale).
+reference, to 1e-9 of each series' scale). The page shows the sliders, the peaks and the curves in
+the spec's display units (:func:`data`'s ``params`` and ``factors``); the maps, the values and the
+series stay SI.
 
 Affinity is checked, not assumed: before shipping, the maps' prediction at a design away from the
 computed one (every slider at a value drawn from its range with a fixed seed) must equal the
@@ -41,6 +43,7 @@ import numpy as np
 from ..balancing.mass_sweep import MassSweep
 from ..balancing.partial.maps import coulomb_friction
 from ..balancing.regressor import model_size, shaking_regressor, states_from_analysis
+from ..display.units import DisplayUnits
 from ..draw import figures, live
 from ..engine import AnalysisError, analyse
 from ..mechanics.sampling import spread_indices
@@ -61,6 +64,8 @@ STYLE = {"color": "tab:purple", "linestyle": "-", "linewidth": 2.0}
 FIGURE = "whatif"  # the live figure's name: its element is #live-whatif
 #: parts whose kind is a body of their own (its bare link's mass, centre and inertia move)
 BODY_KINDS = ("counter-rotation", "link changed")
+#: a part's four slider values (m, x, y, I): their names and quantities (balpipe.display.units)
+PARAMS = (("mass", "mass"), ("x", "length"), ("y", "length"), ("inertia", "inertia"))
 
 
 @dataclass(frozen=True)
@@ -347,20 +352,28 @@ def _b64(a: np.ndarray) -> str:
     return base64.b64encode(np.ascontiguousarray(a, dtype="<f8").tobytes()).decode("ascii")
 
 
-def curves(w: WhatIf) -> live.Curves:
-    """The live figure: per panel the reference stage, the computed design and the design tried,
-    in that order; the design tried has no samples here (``whatif.js`` draws it, the computed
-    design's until a slider moves)."""
-    return live.Curves(w.t, [(w.reference_label, {k: w.reference[k] for k in ["F", *w.keys] if k in w.reference}),
-                             (w.label, dict(w.design)), ("design tried", {})],
-                       w.panels, [], styles=[w.styles[1], w.styles[0], STYLE], grid=True,
-                       names=(w.names[1] or w.reference_label, w.names[0] or w.label, "design tried"))
+def curves(w: WhatIf, units: DisplayUnits | None = None) -> live.Curves:
+    """The live figure in the page's display ``units`` (SI when None; :func:`balpipe.draw.live.shown_in`):
+    per panel the reference stage, the computed design and the design tried, in that order; the
+    design tried has no samples here (``whatif.js`` draws it, the computed design's until a
+    slider moves)."""
+    c = live.Curves(w.t, [(w.reference_label, {k: w.reference[k] for k in ["F", *w.keys] if k in w.reference}),
+                          (w.label, dict(w.design)), ("design tried", {})],
+                    w.panels, [], styles=[w.styles[1], w.styles[0], STYLE], grid=True,
+                    names=(w.names[1] or w.reference_label, w.names[0] or w.label, "design tried"))
+    return c if units is None else live.shown_in(c, units)
 
 
-def data(w: WhatIf) -> dict:
+def data(w: WhatIf, units: DisplayUnits | None = None) -> dict:
     """What ``whatif.js`` reads: the samples' times, the design's series and the columns (base64
     float64, None for a zero column), the parts with their design values and ranges, and which
-    series of the live figure is the design tried."""
+    series of the live figure is the design tried; all in SI. How the script shows them, in the
+    page's display ``units`` (SI when None): ``params``, per slider value of a part its name, unit
+    and the unit's factor to SI (a value shown is the SI value over it, a value typed or slid is
+    multiplied by it), and ``factors``, per panel key of the figure the factor its curves and
+    peaks are divided by (1 where the panel is in SI: :func:`balpipe.draw.live.panel_units`)."""
+    u = units or DisplayUnits()
+    shown = live.panel_units(w.panels, u)
     return {"figure": f"live-{FIGURE}", "tried": 2, "computed": 1, "t": _b64(w.t), "n": int(len(w.index)),
             "keys": w.keys, "design": {k: _b64(w.design[k]) for k in w.keys},
             "bodies": w.bodies,
@@ -368,20 +381,23 @@ def data(w: WhatIf) -> dict:
                         for k in w.keys},
             "parts": [{"name": p.name, "label": p.label, "kind": p.kind, "body": p.body, "design": list(p.design),
                        "lo": list(p.lo), "hi": list(p.hi)} for p in w.parts],
+            "params": [{"name": name, "unit": u.unit(q), "factor": u.factor(q)} for name, q in PARAMS],
+            "factors": {p["key"]: shown[p["key"]][1] if p["key"] in shown else 1.0 for p in w.panels},
             "stage": w.label}
 
 
-def section(study, results: dict, styles: dict[str, tuple[int, str]] | None = None) -> dict | None:
+def section(study, results: dict, styles: dict[str, tuple[int, str]] | None = None,
+            units: DisplayUnits | None = None) -> dict | None:
     """The template's ``whatif``: None (no section), ``{"reason": ...}`` (no sliders, and why) or the
-    live figure's markup, the maps' JSON and the notes."""
+    live figure's markup, the maps' JSON and the notes; the figure, the sliders and the peaks in
+    the page's display ``units`` (SI when None), the maps and the figure's CSV in SI."""
     w = build(study, results, styles)
     if w is None:
         return None
     if isinstance(w, str):
         return {"reason": w}
-    c = curves(w)
+    c = curves(w, units)
     figure = live.html(FIGURE, c, "the computed design's samples are in <a href=\"timeseries.csv\">timeseries.csv</a>")
-    return {"reason": None, "figure": figure, "data": live.as_script(data(w)), "notes": w.notes, "stage": w.label,
+    return {"reason": None, "figure": figure, "data": live.as_script(data(w, units)), "notes": w.notes, "stage": w.label,
             "reference": w.reference_label, "parts": len(w.parts), "samples": int(len(w.index)),
             "efforts": any(k.startswith("effort:") for k in w.keys)}
-
