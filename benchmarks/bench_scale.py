@@ -14,6 +14,7 @@ exponent (log(cpu_40 / cpu_20) / log 2). Nothing is asserted about speed.
 
     python benchmarks/bench_scale.py --against ab64d4b
     python benchmarks/bench_scale.py --loops 2 5 10 20 40 --no-build --repeat 3
+    python benchmarks/bench_scale.py --against ab64d4b --loops --builds 20k --repeat 3
 
 Ladders above ``--against-loops`` loops (default 40) are not run with REV, check or build (before
 the block sampler, its dense SVDs of a 100-loop ladder's states would hold some 19 GB: the table
@@ -74,9 +75,12 @@ def run(python: str, pipeline: Path, args: list[str]) -> tuple[float, float, flo
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--against", metavar="REV", help="git revision to compare with, alternated in the same run")
-    ap.add_argument("--loops", type=int, nargs="+", default=[2, 5, 10, 20, 40, 100], help="ladders to check")
+    ap.add_argument("--loops", type=int, nargs="*", default=[2, 5, 10, 20, 40, 100],
+                    help="ladders to check (none: no check)")
     ap.add_argument("--against-loops", type=int, default=40, help="the largest ladder REV checks")
     ap.add_argument("--no-build", action="store_true", help="check only (no builds)")
+    ap.add_argument("--builds", nargs="+", choices=["100", "20k"], default=["100", "20k"],
+                    help="which builds: the 100-loop ladder, the 10-loop one at 20,000 samples")
     ap.add_argument("--repeat", type=int, default=2, help="alternated runs of each command")
     ap.add_argument("--python", default=sys.executable)
     args = ap.parse_args(argv)
@@ -94,11 +98,12 @@ def main(argv: list[str] | None = None) -> int:
                 f = work / f"ladder{n}.yaml"
                 f.write_text(ladder_spec(n))
                 cases.append((f"check, {n} loops ({2 * n + 1} bodies)", ["check", "-j", "1", str(f)], n))
-            if not args.no_build:
+            if not args.no_build and "100" in args.builds:
                 f = work / "ladder100.yaml"
                 f.write_text(ladder_spec(100))
                 cases.append(("build --no-sim, 100 loops (201 bodies)", ["build", str(f), "--no-sim", "--force", "-j", "1",
                                                                           "-o", str(work / "out100")], 100))
+            if not args.no_build and "20k" in args.builds:
                 f = work / "ladder10_20k.yaml"
                 f.write_text(ladder_spec(10, samples=20_000))
                 cases.append(("build --no-sim, 10 loops, 20,000 samples", ["build", str(f), "--no-sim", "--force", "-j", "1",
