@@ -212,6 +212,7 @@ def parts_of(base: Model, final: Model, names: PageNames | None = None) -> list[
     return out
 
 
+#: what :func:`_maps` gives: YF, YM, G (None with Coulomb friction), the efforts' drivers, the frictions
 Maps = tuple[np.ndarray, np.ndarray, "np.ndarray | None", list[str], list[str]]
 
 
