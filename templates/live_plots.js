@@ -315,7 +315,10 @@
         // p.log: a log10 axis; p.range, p.xrange: the axes' limits (a front's plot, its outliers named in the caption)
         scales: Object.assign(p.log ? { x: { time: false }, y: { distr: 3 } } : { x: { time: false } },
           p.range ? { y: { range: p.range } } : {}, p.xrange ? { x: { time: false, range: p.xrange } } : {}),
-        axes: [{ label: d.x || "time (s)" }, { label: p.axis, labelFont: LABEL_FONT, size: 64, values: ticks(!!p.log) }],
+        // a log axis: every decade's split reaches ticks(), which labels every k-th (uPlot's own
+        // filter kept every k-th counted from the top, which could miss each of ours: no label)
+        axes: [{ label: d.x || "time (s)" }, Object.assign({ label: p.axis, labelFont: LABEL_FONT, size: 64, values: ticks(!!p.log) },
+                                                         p.log ? { filter: (u, splits) => splits } : {})],
         series: series,
         cursor: { sync: { key: src.dataset.live } },
         plugins: (d.marks.length ? [marksPlugin(d.marks)] : []).concat(drawn.some(s => s.marker) ? [markersPlugin(drawn)] : []),

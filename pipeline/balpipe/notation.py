@@ -245,6 +245,32 @@ COMMON: dict[str, Sym] = {
     "balancing.samples": setting("N_{states}", "states the mechanism can reach at which its momentum is evaluated to find the conditions (0: automatic)"),
     "balancing.seed": setting("seed", "picks those states at random, the same ones at every build"),
     "balancing.polygon_sides": setting("n_{sides}", "sides of the polygon inscribed in each disc region"),
+    # the frame on its mounts (docs/mounts.md): our names, no paper gives them
+    "frame.mass": ours("m_f", "frame: mass"),
+    "frame.inertia": ours("J_f", "frame: moment of inertia about its centre of mass"),
+    "frame.com": ours("G_f", "frame: centre of mass"),
+    "frame.mounts[<k>].at": ours("p_<k>", "mount <k> (from 0): where it holds the frame"),
+    "frame.mounts[<k>].kx": ours("k_{x,<k>}", "mount <k>: stiffness along x"),
+    "frame.mounts[<k>].ky": ours("k_{y,<k>}", "mount <k>: stiffness along y"),
+    "frame.mounts[<k>].cx": ours("c_{x,<k>}", "mount <k>: viscous damping along x"),
+    "frame.mounts[<k>].cy": ours("c_{y,<k>}", "mount <k>: viscous damping along y"),
+    "frame.points[<k>].at": ours("r_<k>", "point <k> of the frame whose vibration velocity is reported"),
+    "frame.limits.velocity_rms": ours("v_{lim}", "limit of the RMS vibration velocity (along x or y)"),
+    "frame.limits.force_peak": ours("F_{lim}", "limit of the peak force of a mount on the floor"),
+    "frame.resonance_band": setting("β_{res}", "an excitation order within this fraction of a natural frequency is near resonance"),
+    # external loads (docs/loads.md): the usual quantities by name, any other field by its own
+    "loads[<k>].type": setting("load <k>", "kind of external load <k> (from 0)"),
+    "loads[<k>].stiffness": ours("k_<k>", "load <k>: spring stiffness"),
+    "loads[<k>].preload": ours("F_{0,<k>}", "load <k>: spring preload"),
+    "loads[<k>].damping": ours("c_<k>", "load <k>: viscous damping"),
+    "loads[<k>].coefficient": ours("μ_<k>", "load <k>: Coulomb friction coefficient"),
+    "loads[<k>].viscous": ours("c_{v,<k>}", "load <k>: viscous friction coefficient"),
+    "loads[<k>].pin_radius": ours("r_{p,<k>}", "load <k>: pin radius of the bearing's friction"),
+    "loads[<k>].area": ours("A_<k>", "load <k>: piston area"),
+    "loads[<k>].<f>": ours("`<f>`_<k>", "load <k>: <f>"),
+    "loads[<k>].<f>.<g>": ours("`<f>.<g>`_<k>", "load <k>: <f>, <g>"),
+    "loads[<k>].<f>.<g>.<h>": ours("`<f>.<g>.<h>`_<k>", "load <k>: <f>, <g>, <h>"),
+    "loads[<k>].<f>.<g>.<h>.<i>": ours("`<f>.<g>.<h>.<i>`_<k>", "load <k>: <f>, <g>, <h>, <i>"),
 }
 
 
@@ -255,10 +281,15 @@ _MASS_LEAVES = {"mass", "inertia", "com", "com_offset", "payload", "platform_spl
 
 def group_of(path: str, unit: str) -> str:
     """The group of an input in the table: geometry and mass parameters of the mechanism, its
-    motion, the balancing method (with compared designs), analysis and validation settings."""
+    motion, the balancing method (with compared designs), analysis and validation settings, the
+    external loads and the frame on its mounts."""
     head = path.split(".", 1)[0].split("[", 1)[0]
     if head == "motion":
         return "Motion"
+    if head == "loads":
+        return "External loads"
+    if head == "frame":
+        return "The frame on its mounts"
     if head in ("balancing", "compare"):
         return "Balancing method"
     if head in ("analysis", "validation"):

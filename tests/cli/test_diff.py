@@ -196,6 +196,7 @@ def test_the_diff_says_what_the_frame_on_its_mounts_feels_now(tmp_path):
     r = balpipe("diff", old, new, "--no-sim", "-f", "json")
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
+    assert d["inputs"] == [{"field": "frame.mounts[0].kx", "symbol": "k_x,0", "old": 250000.0, "new": 500000.0, "unit": "N/m"}]
     rows = {m["name"]: m for m in d["mounts"]}
     assert set(rows) == {s["name"] for s in d["stages"]}
     un = rows["unbalanced"]

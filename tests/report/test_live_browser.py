@@ -157,7 +157,7 @@ _LABEL_GAPS = """el => el.uplots.map(u => {
 def test_the_simulations_figures_are_interactive_with_readable_axes(simulated_site, browser):
     """Residuals, tracking errors and the free frame's drift are live plots (issue 23: no
     matplotlib): the residuals on log axes labelled in powers of ten, the two panels side by side
-    at 1400 px; the tracking error's ticks of 1e-5 written as such (not rounded to "0"); each
+    at 1400 px; the tracking error's ticks of 1e-5 written as such (1×10⁻⁵, not rounded to "0"); each
     prints itself."""
     w, p, d = _open(browser, simulated_site, "scott_russell", "live-residuals")
     assert [x["log"] for x in d["panels"]] == [True, True]
@@ -168,12 +168,13 @@ def test_the_simulations_figures_are_interactive_with_readable_axes(simulated_si
     boxes = host.evaluate("h => [...h.querySelectorAll('.live-plot')].map(e => { const r = e.getBoundingClientRect(); return {x: r.x, y: r.y}; })")
     assert len(boxes) == 2 and boxes[0]["y"] == boxes[1]["y"] and boxes[0]["x"] < boxes[1]["x"]
     for ticks in host.evaluate(_TICKS):
-        assert len(ticks) >= 2 and all(re.fullmatch(r"1e-\d+|0\.0*1|1", t) for t in ticks), ticks
+        assert len(ticks) >= 2 and all(re.fullmatch(r"1×10⁻[⁰¹²³⁴⁵⁶⁷⁸⁹]+|0\.0*1|1", t) for t in ticks), ticks
     tracking = _json(p, "live-tracking")
     peak = max(abs(v) for s in tracking["series"] for v in s["y"]["q"] if v is not None)
     assert peak < 1e-3  # a tracking error of a few 1e-5 of the travel
     (ticks,) = p.locator("#live-tracking").evaluate(_TICKS)
-    assert len(set(ticks)) == len(ticks) >= 3 and "0" in ticks and any("e-" in t for t in ticks), ticks
+    assert len(set(ticks)) == len(ticks) >= 3 and "0" in ticks and any("×10⁻" in t for t in ticks), ticks
+    assert not any("e-" in t for t in ticks), ticks  # the pages' powers of ten, never exponent notation
     drift = _json(p, "live-drift")
     assert [x["key"] for x in drift["panels"]] == ["drift", "rotation"]
     for figure in ("live-residuals", "live-tracking", "live-drift"):

@@ -212,3 +212,18 @@ def test_page_shows_the_inputs_in_the_papers_notation():
     assert "(not in the paper)" in table  # e.g. the duration, which the paper does not give
     assert "kg m²" in table
     assert html.index('<table class="inputs notation">') < html.index("<pre>" + loaded.text[:40])
+
+
+def test_the_external_loads_and_the_frame_on_its_mounts_are_inputs_in_groups_of_their_own():
+    """The compressor's gas pressure and friction and the V-twin's frame and mounts are in the
+    inputs table with their units, each in its own group after the analysis settings."""
+    groups = {g["name"]: g["rows"] for g in notation_groups(load(SPECS / "custom_v_twin_6000rpm.yaml").spec)}
+    frame = {r["path"]: r for r in groups["The frame on its mounts"]}
+    assert frame["frame.mounts[0].kx"]["value"] == "250000" and frame["frame.mounts[0].kx"]["unit"] == "N/m"
+    assert frame["frame.limits.velocity_rms"]["unit"] == "m/s" and frame["frame.mass"]["unit"] == "kg"
+    names = list(groups)
+    assert names.index("Analysis and validation") < names.index("The frame on its mounts")
+    loads = {r["path"]: r for r in dict((g["name"], g["rows"]) for g in
+             notation_groups(load(SPECS / "custom_compressor_gas_pressure.yaml").spec))["External loads"]}
+    assert loads["loads[0].area"]["unit"] == "m^2" and loads["loads[0].type"]["value"] == "pressure"
+    assert not any(r["missing"] for r in list(frame.values()) + list(loads.values()))

@@ -70,9 +70,11 @@ def _walk(value, path: str, unit: str | None, out: list[dict]) -> None:
 
 def input_rows(spec: BaseModel) -> list[dict]:
     """Rows (path, value, unit) of every scalar the spec sets, mechanism, motion and balancing
-    first; descriptions and notes are left to the YAML below the table."""
+    first, then the analysis, the external loads and the frame on its mounts (the compared
+    designs' inputs are :func:`balpipe.report.notation_table.notation_rows`'); descriptions and
+    notes are left to the YAML below the table."""
     out: list[dict] = []
-    for part in ("mechanism", "motion", "balancing", "analysis"):
+    for part in ("mechanism", "motion", "balancing", "analysis", "loads", "frame"):
         if hasattr(spec, part):
             _walk(getattr(spec, part), part, None, out)
     return out
