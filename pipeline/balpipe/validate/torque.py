@@ -217,12 +217,21 @@ def _travel(model: Model, t: np.ndarray) -> dict[str, float]:
 
 
 def _floor_share(efforts: dict[str, np.ndarray], analysis: Analysis, analytic_model: Model,
-                 times: np.ndarray) -> float:
+                 times: np.ndarray, idx: np.ndarray | None = None) -> float:
     """Largest effort of the floor parts / the peak effort: ``efforts`` (with the floor parts, on
-    the step times ``times``) less the analytic model's own on the same times. (Not the
-    analysis' samples where they are step times: a sample on a law's acceleration jump may hold
-    the other side's effort, one ulp of time away, and a slider's floor moment, which adds
-    nothing, was reported as 64 % of the peak effort.)"""
+    the step times ``times``) less the analytic model's own. Where the analysis' samples are
+    steps (``idx``), at those samples, less the analysis' own efforts, leaving out the samples
+    where a law's acceleration jumps (their analysed effort may be the other side's, one ulp of
+    time away: a slider's floor moment, which adds nothing, was reported as 64 % of the peak
+    effort); else over every step time, the analytic model analysed there (a call of the engine
+    per stage for a figure of the page, a twentieth of the simulated build before)."""
+    if idx is not None and len(idx) == len(analysis.t):
+        smooth = np.array([k in ("smooth", "kink") for k in _law_kinds(analytic_model, np.asarray(analysis.t, dtype=float))])
+        if smooth.any():
+            at = np.asarray(idx, dtype=int)[smooth]
+            bare = {k: np.asarray(v, dtype=float)[smooth] for k, v in analysis.efforts.items()}
+            peak = max((float(np.max(np.abs(v))) for v in bare.values()), default=0.0) or 1.0
+            return max(float(np.max(np.abs(efforts[k][at] - bare[k]))) for k in bare) / peak
     bare = analyse(analytic_model, times, analysis.gravity, analysis.moment_point).efforts
     peak = max((float(np.max(np.abs(v))) for v in bare.values()), default=0.0) or 1.0
     return max(float(np.max(np.abs(efforts[k] - np.asarray(bare[k], dtype=float)))) for k in bare) / peak
@@ -278,7 +287,7 @@ def _plan(model: Model, analysis: Analysis, settings: ValidationSettings, analyt
     notes: list[str] = []
     share = 0.0
     if floored or auxiliary:  # before the jumps' averaging, which the bare efforts do not have
-        share = _floor_share(efforts, analysis, analytic_model, times)
+        share = _floor_share(efforts, analysis, analytic_model, times, idx)
         loads = (f"the efforts include their inertial loads, {100 * share:.3g} % of the peak effort" if share > 1e-9
                  else "along this motion they add no load to the efforts")
         size = f"{100 * settings.mass_floor:g} % of the largest mass and moment"
