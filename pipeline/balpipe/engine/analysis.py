@@ -12,6 +12,7 @@ import numpy as np
 from ..cache.content import MEMO
 from ..mechanics.planar import cross
 from ..model import Model
+from ..runtime.allocator import keep_freed_memory
 from . import fastpath, shared, structure
 from .compile import Compiled, compile_model
 from .constraints import with_frame, jacobian
@@ -211,10 +212,13 @@ def analyse(
     ``method``: ``"auto"`` takes the block-triangular path (:mod:`.fastpath`) where it applies
     and the general dense path otherwise; ``"dense"`` forces the general path (continuation,
     batched Newton-Raphson and dense batched solves on every sample's full Jacobian). Both give
-    the same results to round-off.
+    the same results to round-off. The first call sets the C allocator's thresholds for the
+    arrays of the chunks (:func:`balpipe.runtime.allocator.keep_freed_memory`: no page faulted in
+    again for every chunk; the same results).
     """
     if method not in ("auto", "dense"):
         raise ValueError(f"method must be 'auto' or 'dense', not {method!r}")
+    keep_freed_memory()
     c = compiled(model)
     t = np.asarray(t, dtype=float)
     g = np.asarray(gravity, dtype=float)
