@@ -5,8 +5,8 @@ One module per job:
 * :mod:`.space`: building the simulation (a :class:`~balpipe.model.Model` translated into a
   pymunk space: bodies, joints, gears, drivers);
 * :mod:`.settings`: numerical settings, the time step and the corners of the motion laws;
-* :mod:`.extend`: the motion before t0 and after T (laws continued; a settling cycle for a
-  periodic motion that is moving at t0, a run-in for another moving start);
+* :mod:`.extend`: the motion before t0 and after T (laws continued; a run-in for a
+  motion that is moving at t0, from the cycle's own state for a periodic one);
 * :mod:`.run`: running it along the analysed motion and recording the loads on the frame;
 * :mod:`.loads`: measuring a stage's loads against the analysis, the verdict (``validate``);
 * :mod:`.floating`: the reactionless demonstration on a free-floating frame;

@@ -13,8 +13,8 @@ and t1 (a 120 rpm six-bar showed a force residual of 150 times the unbalanced pe
 * **periodic moving motion** (every body at t1 in its pose at t0, angles up to whole turns,
   with the same velocities, and some velocity not zero): the law repeats itself, shifted by
   its travel per cycle: q(t + k P) = q(t) + k (q(t1) - q(t0)), P = t1 - t0. The simulation
-  then starts one whole cycle early (a settling cycle, :func:`settling_steps`) and measures the
-  next cycle, in steady state;
+  then starts a run-in early, from the cycle's own analysed state there (:func:`settling_steps`),
+  and measures the cycle in steady state;
 * **otherwise**: the law continues at its end velocity, q(t) = q(t1) + q'(t1) (t - t1) after t1
   and q(t0) + q'(t0) (t - t0) before t0, with zero acceleration. For a law at rest at its ends
   (every point-to-point law) this is exactly the law's own hold, so rest-to-rest motions are
@@ -121,8 +121,13 @@ def continued(model: Model, analysis: Analysis) -> Model:
 
 
 def settling_steps(model: Model, analysis: Analysis, nsteps: int) -> int:
-    """Steps to run before t0: a whole cycle (``nsteps``) for a periodic moving motion,
-    RUN_IN_STEPS for another motion that is moving at t0, none for a start from rest.
+    """Steps to run before t0: a run-in of at least RUN_IN_STEPS for a motion that is moving at
+    t0, none for a start from rest. A periodic moving motion starts on its own cycle's state at
+    an analysis sample (the run-in rounded up to whole sample intervals of a uniform grid, so
+    that :func:`start_state` reads the analysed state there, on the constraints); on a grid that
+    is not uniform, a whole cycle (``nsteps``). Before, a periodic motion always settled over a
+    whole cycle: half of its run, for nothing more than the run-in gives (the same steady state
+    from the 20th step on: the first step's missing correction settles within a step or two).
 
     Why a moving start needs them: pymunk integrates positions along straight lines and its
     joints (``error_bias`` 0) pull them back onto the constraints in the next step, so in a
@@ -132,19 +137,40 @@ def settling_steps(model: Model, analysis: Analysis, nsteps: int) -> int:
     (on a slider-crank at 120 rpm: 0.5 and 1.5 times the load at t0 and t0 + dt). After the
     run-in the recorded steps are those of a running simulation."""
     if any(isinstance(d.law, ContinuedLaw) and d.law.periodic for d in model.drivers):
-        return nsteps
+        sub = _sample_steps(analysis, nsteps)
+        if sub is None:
+            return nsteps
+        return min(sub * math.ceil(RUN_IN_STEPS / sub), nsteps)
     return RUN_IN_STEPS if is_moving_start(analysis) else 0
+
+
+def _sample_steps(analysis: Analysis, nsteps: int) -> int | None:
+    """Simulation steps per interval of a uniform analysis grid (None: not uniform, or not a
+    whole number of steps per interval)."""
+    t = np.asarray(analysis.t, dtype=float)
+    if len(t) < 2 or nsteps % (len(t) - 1):
+        return None
+    h = np.diff(t)
+    return nsteps // (len(t) - 1) if np.allclose(h, h[0], rtol=1e-9, atol=0.0) else None
 
 
 def start_state(model: Model, analysis: Analysis, settle: int, dt: float):
     """Centre-of-mass poses, velocities and accelerations (nb, 3) of the model ``settle`` steps
-    before t0: the analysed state at t0 itself when ``settle`` is 0; one cycle's travel earlier
-    for a periodic motion (angles less their whole turns); otherwise moved back at the
-    velocities of t0 (the continued laws' constant speed; the first step's correction settles
-    during the run-in)."""
+    before t0: the analysed state at t0 itself when ``settle`` is 0; for a periodic motion, the
+    analysed state that many steps before the cycle's end, less one cycle's travel (angles less
+    their whole turns; :func:`settling_steps` puts it on a sample), or the state at t0 less the
+    travel for a whole cycle; otherwise moved back at the velocities of t0 (the continued laws'
+    constant speed; the first step's correction settles during the run-in)."""
     q0, v0, a0 = (np.asarray(x[0], dtype=float) for x in (analysis.q, analysis.v, analysis.a))
     if not settle:
         return q0, v0, a0
     if any(isinstance(d.law, ContinuedLaw) and d.law.periodic for d in model.drivers):
-        return q0 - (np.asarray(analysis.q[-1], dtype=float) - q0), v0, a0
+        travel = np.asarray(analysis.q[-1], dtype=float) - q0  # one cycle's (angles: whole turns)
+        t = np.asarray(analysis.t, dtype=float)
+        back = int(round(settle * dt / (t[1] - t[0]))) if len(t) > 1 else 0  # sample intervals before t0
+        k = len(t) - 1 - back
+        if 0 <= k < len(t) and abs(t[-1] - back * (t[1] - t[0]) - t[k]) <= 1e-9 * max(t[-1] - t[0], 1e-300):
+            return (np.asarray(analysis.q[k], dtype=float) - travel, np.asarray(analysis.v[k], dtype=float),
+                    np.asarray(analysis.a[k], dtype=float))
+        return q0 - travel, v0, a0
     return q0 - settle * dt * v0, v0, np.zeros_like(a0)

@@ -41,7 +41,7 @@ def inertial_forces(analysis: Analysis, times: np.ndarray, mass: np.ndarray, mom
                     gravity: np.ndarray) -> np.ndarray:
     """(len(times), nb, 3): m (a - g) and I alpha of the analysis' bodies at ``times``, with the
     masses ``mass`` and moments ``moment`` (nb,) that the bodies are simulated with. Times
-    outside the analysed interval take the nearest end's accelerations (a settling cycle of a
+    outside the analysed interval take the nearest end's accelerations (a run-in of a
     periodic motion is mapped into the cycle)."""
     t = np.asarray(analysis.t, dtype=float)
     t0, t1 = float(t[0]), float(t[-1])
@@ -64,6 +64,6 @@ def inertial_forces(analysis: Analysis, times: np.ndarray, mass: np.ndarray, mom
 
 
 def periodic_times(times: np.ndarray, t0: float, t1: float) -> np.ndarray:
-    """``times`` before t0 (a settling cycle) moved into [t0, t1] by whole periods t1 - t0."""
+    """``times`` before t0 (a periodic motion's run-in) moved into [t0, t1] by whole periods t1 - t0."""
     times = np.asarray(times, dtype=float)
     return np.where(times < t0, t0 + np.mod(times - t0, t1 - t0), times)

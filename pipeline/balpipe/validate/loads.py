@@ -86,8 +86,9 @@ Defaults and why (measured with pymunk 7.3.1 on a 2-core machine)
 
 Moving starts
     The drivers' laws are continued outside [t0, T] (:mod:`balpipe.validate.extend`): a periodic
-    motion moving at t0 is simulated from one cycle earlier (a settling cycle) and checked over
-    the next, in steady state; another motion moving at t0 gets a 20-step run-in. Stephenson
+    motion moving at t0 starts a run-in of whole sample intervals (at least 20 steps) early, from
+    its own cycle's analysed state there, and is checked over the cycle, in steady state (a whole
+    settling cycle before); another motion moving at t0 gets a 20-step run-in. Stephenson
     six-bar at 120 rpm (tests/fixtures/six_bar_polynomial_speed.yaml): force / moment residuals 4.2e-5 /
     9.7e-5 unbalanced, 7.2e-8 / 6.1e-5 with counterweights (150 / 15 before: spikes at 0 and T).
 

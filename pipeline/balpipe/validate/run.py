@@ -142,7 +142,7 @@ def simulate(
     coordinates, is more than ``limit`` (rad, or ``limit * scale`` m) from the analysed motion
     at an analysis sample (checked every tenth step): a run that came apart ends early.
     ``settle``: steps run before t0 and not recorded (:func:`balpipe.validate.extend.settling_steps`:
-    a settling cycle of a periodic motion, a run-in of a motion moving at t0), from
+    a run-in of a motion moving at t0), from
     :func:`balpipe.validate.extend.start_state`, so that the recorded steps are in steady state.
     ``feedforward`` (a position-driven run only): before each step every moving body gets the
     inertial force and torque of the analysed motion (:mod:`balpipe.validate.feedforward`); the

@@ -6,7 +6,7 @@ efforts, lets pymunk integrate the motion and measures the same loads the same w
 samples. Where the torque-driven run
 
 * starts from rest (a moving start leaves its first sample out of the load residuals, which the
-  position-driven run measures after its settling cycle or run-in),
+  position-driven run measures after its run-in),
 * follows its plan to a tenth of the tracking tolerance with ten times the resolution a verdict
   asks for (what :func:`.torque.torque_driven` keeps from its cheapest try),
 * and has load residuals at most a tenth of the tolerance, with the simulated peak of every load
