@@ -45,11 +45,13 @@ def body_point(pose: tuple[Triple, Triple, Triple], c) -> Triple:
     return pos, vel, acc
 
 
-def body_point_xy(pose: tuple[Triple, Triple, Triple], c) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+def body_point_xy(pose: tuple[Triple, Triple, Triple], c,
+                  cos_sin: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
     """:func:`body_point` as ((x, y), (x', y'), (x'', y'')), each an (N,) array (the same
-    values, half the time where the caller wants the components)."""
+    values, half the time where the caller wants the components); ``cos_sin``: cos phi and
+    sin phi when the caller has them."""
     (x, xd, xdd), (y, yd, ydd), (f, fd, fdd) = pose
-    cf, sf = np.cos(f), np.sin(f)
+    cf, sf = (np.cos(f), np.sin(f)) if cos_sin is None else cos_sin
     rx, ry = cf * c[0] - sf * c[1], sf * c[0] + cf * c[1]  # R c
     jx, jy = -ry, rx  # J R c
     w2 = fd**2

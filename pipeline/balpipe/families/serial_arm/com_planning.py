@@ -207,7 +207,7 @@ class Planner:
         """The joint solution and the links' state along a centre-of-mass motion (:meth:`loads`
         without the shaking loads: what the ramp's torque rates need)."""
         sol = JointSolution(self.com, motion, mode, self.t if t is None else t, check=check)
-        return sol, absolute_state(self.arm, sol.th, sol.thd, sol.thdd)
+        return sol, absolute_state(self.arm, sol.th, sol.thd, sol.thdd, sol.trig)
 
     def objective(self, plan: Plan, path: tuple):
         """The optimiser's objective c -> max |M| over the analysis grid with the CoM on the
@@ -226,11 +226,11 @@ class Planner:
             self.calls += 1
             c = np.asarray(c, dtype=float)
             x[:, 2], xd[:, 2], xdd[:, 2] = x0[:, 2] + B[0] @ c, xd0[:, 2] + B[1] @ c, xdd0[:, 2] + B[2] @ c
-            th, thd, thdd, margin, sg = absolute_motion(self.com, x, xd, xdd, plan.com_mode)
+            th, thd, thdd, margin, sg, trig = absolute_motion(self.com, x, xd, xdd, plan.com_mode)
             bad = max(0.0, float(-margin.min())) + max(0.0, 1e-6 - float(np.abs(sg).min()))
             if bad > 0:
                 return 1e6 * (1.0 + bad)
-            M = shaking_moment(self.arm, absolute_state(self.arm, th, thd, thdd), self.gravity, self.point)
+            M = shaking_moment(self.arm, absolute_state(self.arm, th, thd, thdd, trig), self.gravity, self.point)
             peak = float(np.max(np.abs(M)))
             return peak if math.isfinite(peak) else 1e6
 

@@ -259,7 +259,10 @@ class TaskMotion:
 
 def absolute_motion(chain: Chain, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray, mode: int):
     """Absolute link angles theta, theta', theta'' (N, n) of a task-space motion (x, y[, phi])
-    with their exact derivatives, and (margin, sin gamma) for the reach and singularity checks.
+    with their exact derivatives, (margin, sin gamma) for the reach and singularity checks, and
+    the angles' cosines and sines, (n, N) each, when this computed them already (every
+    equivalent vector along its link, delta_k = 0: theta_k is alpha_k bit for bit, theta_3 is
+    phi), else None: what :func:`absolute_state` would compute again.
 
     With phi = theta_3 given (n = 3) the first two links reach W = P - R(phi) v3, whose
     derivatives follow by the chain rule; then, with alpha_k = theta_k + delta_k the angles of the
@@ -273,8 +276,10 @@ def absolute_motion(chain: Chain, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray
     Wdx, Wdy, Wddx, Wddy = xd[:, 0], xd[:, 1], xdd[:, 0], xdd[:, 1]
     if n == 3:
         phi, phid, phidd = x[:, 2], xd[:, 2], xdd[:, 2]
+        cf, sf = np.cos(phi), np.sin(phi)
         # W: the point -v3 of the last link's frame placed at the target, phi its angle
-        (Wx, Wy), (Wdx, Wdy), (Wddx, Wddy) = body_point_xy(((Wx, Wdx, Wddx), (Wy, Wdy, Wddy), (phi, phid, phidd)), -v[2])
+        (Wx, Wy), (Wdx, Wdy), (Wddx, Wddy) = body_point_xy(((Wx, Wdx, Wddx), (Wy, Wdy, Wddy), (phi, phid, phidd)), -v[2],
+                                                           (cf, sf))
     elif n != 2:
         raise ValueError("task-space motions need a 2R or 3R chain")
     a, b = math.hypot(*v[0]), math.hypot(*v[1])
@@ -293,23 +298,30 @@ def absolute_motion(chain: Chain, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray
     th = [al1 - d1, al2 - d2]
     thd = [a1d, a2d]
     thdd = [a1dd, a2dd]
+    trig = None
+    if d1 == 0.0 and d2 == 0.0:  # theta_k = alpha_k - 0.0 = alpha_k
+        trig = ([c1, c2], [s1, s2])
     if n == 3:
         th.append(phi)
         thd.append(phid)
         thdd.append(phidd)
-    return np.stack(th, 1), np.stack(thd, 1), np.stack(thdd, 1), margin, sg
+        if trig is not None:
+            trig[0].append(cf), trig[1].append(sf)
+    cos_sin = None if trig is None else (np.stack(trig[0]), np.stack(trig[1]))
+    return np.stack(th, 1), np.stack(thd, 1), np.stack(thdd, 1), margin, sg, cos_sin
 
 
 class JointSolution:
     """Joint angles, rates and accelerations (N, n) along a task-space motion, exact to
     round-off: q by inverse kinematics (eqs. 8-10), q' = J^-1 x', q'' = J^-1 (x'' - J' q')
-    (:func:`absolute_motion`). ``th``, ``thd``, ``thdd``: the absolute angles and derivatives."""
+    (:func:`absolute_motion`). ``th``, ``thd``, ``thdd``: the absolute angles and derivatives;
+    ``trig``: their cosines and sines when :func:`absolute_motion` computed them, else None."""
 
     def __init__(self, chain: Chain, motion: TaskMotion, mode: int, t: np.ndarray, check: bool = True):
         t = np.asarray(t, dtype=float).reshape(-1)
         x, xd, xdd = motion.values(t)
         n = chain.n
-        th, thd, thdd, margin, sg = absolute_motion(chain, x, xd, xdd, mode)
+        th, thd, thdd, margin, sg, self.trig = absolute_motion(chain, x, xd, xdd, mode)
         self.t, self.margin, self.det = t, margin, sg
         self.th, self.thd, self.thdd = th, thd, thdd
         if check:
@@ -467,13 +479,19 @@ def arm_state(arm: ArmGeometry, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) 
     return absolute_state(arm, np.cumsum(q, axis=1), np.cumsum(qd, axis=1), np.cumsum(qdd, axis=1))
 
 
-def absolute_state(arm: ArmGeometry, th: np.ndarray, thd: np.ndarray, thdd: np.ndarray) -> ArmState:
+def absolute_state(arm: ArmGeometry, th: np.ndarray, thd: np.ndarray, thdd: np.ndarray,
+                   trig: tuple[np.ndarray, np.ndarray] | None = None) -> ArmState:
     """Positions and accelerations of the centres of mass from the absolute link angles (N, n):
     (R u)'' = theta'' perp(R u) - theta'^2 R u for every vector u fixed in a link. Computed link
     by link on (n, N) rows, so that every operation runs along the samples (paper 003's
-    optimiser calls it thousands of times on three links); the fields are (N, n)."""
-    t, w, acc = (np.ascontiguousarray(a.T) for a in (th, thd, thdd))
-    c, s = np.cos(t), np.sin(t)
+    optimiser calls it thousands of times on three links); the fields are (N, n). ``trig``: the
+    angles' cosines and sines (n, N) when known (:func:`absolute_motion`'s), not computed again."""
+    w, acc = (np.ascontiguousarray(a.T) for a in (thd, thdd))
+    if trig is None:
+        t = np.ascontiguousarray(th.T)
+        c, s = np.cos(t), np.sin(t)
+    else:
+        c, s = trig
     L = np.asarray(arm.lengths, dtype=float)[:, None]
     cm = np.asarray(arm.coms, dtype=float)
     cx, cy = cm[:, :1], cm[:, 1:]
