@@ -56,7 +56,8 @@ def test_a_correct_design_is_proved_by_its_torque_driven_run(make, expect):
 def test_a_one_percent_counter_rotation_error_is_not_proved_by_the_torque_run(disc):
     """A counter-rotation's inertia 1 % off: the torque-driven run tracks its plan (its efforts
     are the off design's own) but its moment is off the claimed analysis by the error's effect,
-    far above a tenth of the tolerance: the position-driven run measures it as before."""
+    above a tenth of the tolerance: never proved at the first effort, and the verdict is the
+    position-driven run's (a fail where the effect exceeds the tolerance)."""
     good = reactionless_arm()
     claimed = analyse(good, GRID)
     b = good.body(disc)
@@ -64,10 +65,14 @@ def test_a_one_percent_counter_rotation_error_is_not_proved_by_the_torque_run(di
     peaks = _peaks()
     settings = ValidationSettings()
     v, tq = stage_runs(off, claimed, peaks, settings, ("force", "moment"))
-    assert not proves_loads(tq, settings, ("force", "moment")) or tq.moment_residual > 1e-3
-    assert v.proved_by == "position-driven run"
+    assert not proves_loads(tq, settings, ("force", "moment"))  # never ten times within the tolerance
     before = validate(off, claimed, peaks, ValidationSettings(shared_runs=False), ("force", "moment"))
-    assert v.status == before.status and v.moment_residual == before.moment_residual
+    assert v.status == before.status
+    assert v.moment_residual == pytest.approx(before.moment_residual, rel=1e-4)  # the error's effect, measured
+    if disc == "disc1":  # the frame's disc: 2.8 % of the reference moment, the claim fails
+        assert v.status == "fail" and v.proved_by == "position-driven run"
+    else:  # 0.59 %, within the tolerance: a pass either way, here proved with twice the solver effort
+        assert v.status == "pass" and 0.005 < v.moment_residual < 0.01
 
 
 def test_the_torque_verdict_is_the_one_of_its_own_path():
@@ -101,3 +106,46 @@ def test_a_moving_start_is_never_proved_by_the_torque_run():
     a = analyse(model, GRID)
     v, tq = stage_runs(model, a, (a.max_force, a.max_moment), ValidationSettings())
     assert v.proved_by == "position-driven run" and v.passed
+
+
+@pytest.fixture(scope="module")
+def idler():
+    from balpipe import study
+    from balpipe.loader import load
+
+    return study.run(load(Path(__file__).resolve().parents[2] / "specs" / "paper000_rpr3_idler_loop.yaml").spec)
+
+
+def _idler_runs(st, model=None, analysis=None):
+    from balpipe.study import ratio_reference
+    from balpipe.validation_stage import settings_for, simulated_model
+
+    s = next(x for x in st.stages if x.stage.name == "counter_rotations")
+    ref = ratio_reference(st.reference_stage(s))
+    return s, stage_runs(simulated_model(model or s.stage.model), analysis or s.analysis,
+                         (ref.force_peak, ref.moment_peak), settings_for(st), ("force", "moment"), reference=ref)
+
+
+def test_twice_the_solver_effort_proves_a_run_within_the_tolerance(idler):
+    """Paper 000's idler-loop counter-rotations stage: the torque-driven run first holds together
+    at 800 iterations, its moment residual 2.4e-3 within the tolerance but not ten times; at 1600
+    it is 4.9e-4, ten times within: that run proves the stage (the position-driven run needed 1600
+    and 3200 iterations to show its own convergence). The torque-driven verdict is the 800 run's."""
+    s, (v, tq) = _idler_runs(idler)
+    assert v.proved_by == "torque-driven run" and v.status == "pass" and v.iterations == 1600
+    assert max(v.force_residual, v.moment_residual) <= 1e-3 and v.moment_peak <= 0.01
+    assert tq.status == "pass" and tq.iterations == 800 and tq.resolution >= 100
+
+
+def test_a_one_percent_counter_rotation_error_on_the_idler_loop_still_fails(idler):
+    """The same stage with its heaviest gear's inertia 1 % off, analysed as it is and claiming the
+    moment balance: the torque-driven run's loads show the claim false, so they prove nothing, and
+    the position-driven run fails it."""
+    s = next(x for x in idler.stages if x.stage.name == "counter_rotations")
+    gears = [b for b in s.stage.model.bodies if b.kind == "gear" and b.inertia > 0]
+    heaviest = max(gears, key=lambda b: b.inertia)
+    off = s.stage.model.replace_body(dataclasses.replace(heaviest, inertia=1.01 * heaviest.inertia))
+    a_off = analyse(off, s.analysis.t, s.analysis.gravity, s.analysis.moment_point)
+    _, (v, tq) = _idler_runs(idler, off, a_off)
+    assert v.proved_by == "position-driven run"
+    assert v.status == "fail" and any("moment not balanced" in r for r in v.reasons), v.reasons

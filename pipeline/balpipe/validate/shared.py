@@ -21,9 +21,15 @@ from its analysis (a counterweight or counter-rotation off by 1 %: its residual 
 effect, far above a tenth of the tolerance), runs the position-driven validation as before, and
 the torque-driven check at its step and solver effort, reusing this try where it is that run.
 
-Measured on specs/: 101 of 134 stages' torque-driven runs prove both checks; the
-idler-loop counterweights stage of paper 000, whose position-driven run converges at 1600-3200
-solver iterations, is proved at 100 (tracking 6.2e-6 of the travel, moment residual 3.7e-4).
+Where the first run that holds together is within the tolerance but not ten times within, it is
+made once more with twice the solver iterations: that run proves the stage where it is ten
+times within, or within and the same as the first to a tenth of the tolerance (the
+position-driven run's convergence test, :func:`converged`).
+
+Measured on specs/: 95 of 134 stages proved by their torque-driven run; paper 000's idler-loop
+counterweights stage, whose position-driven run converges at 1600-3200 solver iterations, at 100
+(tracking 6.2e-6 of the travel, moment residual 3.7e-4), its counter-rotations stage at 1600
+(800 holds together at 2.4e-3, 1600 gives 4.9e-4).
 """
 
 from __future__ import annotations
@@ -34,7 +40,7 @@ from ..engine import Analysis
 from ..model import Model
 from .extend import is_moving_start
 from .loads import StageValidation, validate
-from .settings import ITERATIONS, ValidationSettings
+from .settings import ITERATIONS, MAX_ITERATIONS, ValidationSettings
 from .torque import MIN_RESOLUTION, TorqueDriven, _torque_driven_once, _plan, torque_driven
 
 #: the margins of a proof: the torque-driven run's tracking error and load residuals at most this
@@ -43,34 +49,53 @@ from .torque import MIN_RESOLUTION, TorqueDriven, _torque_driven_once, _plan, to
 MARGIN = 10.0
 
 
-def proves_loads(tq: TorqueDriven, settings: ValidationSettings, expect: tuple[str, ...]) -> bool:
+def proves_loads(tq: TorqueDriven, settings: ValidationSettings, expect: tuple[str, ...],
+                 residual_margin: float = MARGIN, calibrated: bool = True) -> bool:
     """``tq`` proves what a position-driven run would (see the module's docstring): it passes by
-    :data:`MARGIN` over, its loads match the analysis to a tenth of the tolerance on every sample
-    a position-driven run measures, and the loads ``expect`` claims to cancel stay within the
-    balance tolerance."""
+    :data:`MARGIN` over (its resolution too, where ``calibrated``), its loads match the analysis
+    to the tolerance over ``residual_margin`` on every sample a position-driven run measures,
+    and the loads ``expect`` claims to cancel stay within the balance tolerance."""
     if not tq.passed or tq.measured is None:
         return False
     claims = all(pk <= settings.balance_tolerance for what, pk in (("force", tq.force_peak), ("moment", tq.moment_peak))
                  if what in expect)
     return bool(tq.tracking_error_max <= settings.tracking_tolerance / MARGIN
-                and tq.resolution >= MARGIN * MIN_RESOLUTION
-                and tq.force_residual <= settings.tolerance / MARGIN
-                and tq.moment_residual <= settings.tolerance / MARGIN and claims)
+                and (not calibrated or tq.resolution >= MARGIN * MIN_RESOLUTION)
+                and tq.force_residual <= settings.tolerance / residual_margin
+                and tq.moment_residual <= settings.tolerance / residual_margin and claims)
+
+
+def converged(a: TorqueDriven, b: TorqueDriven, limit: float) -> bool:
+    """The loads of two runs (``b`` with twice ``a``'s solver iterations) differ by at most
+    ``limit`` of the reference loads on every sample both measure (the same samples): the
+    position-driven run's convergence test (:func:`.run._run_adaptive`)."""
+    if a.measured is None or b.measured is None or not np.array_equal(a.measured, b.measured) or not a.measured.any():
+        return False
+    m = a.measured
+    df = float(np.max(np.linalg.norm(b.force[m] - a.force[m], axis=1))) / (a.force_reference or 1.0)
+    dm = float(np.max(np.abs(b.moment[m] - a.moment[m]))) / (a.moment_reference or 1.0)
+    return bool(np.isfinite(df) and np.isfinite(dm) and df <= limit and dm <= limit)
 
 
 def validation_from_torque(tq: TorqueDriven, analysis: Analysis, peaks: tuple[float, float],
-                           settings: ValidationSettings, expect: tuple[str, ...]) -> StageValidation:
+                           settings: ValidationSettings, expect: tuple[str, ...],
+                           halved: TorqueDriven | None = None) -> StageValidation:
     """The position-driven verdict read from a torque-driven run that proves it
     (:func:`proves_loads`): its loads, residuals and simulated peaks (the same definitions, the
     same reference loads), its step and solver iterations; ``tracking_error`` is the driven
-    coordinates' (rad or m) under the efforts, not under a drive."""
+    coordinates' (rad or m) under the efforts, not under a drive. ``halved``: the run with half
+    its solver iterations, whose loads it matches to a tenth of the tolerance (its residuals are
+    then within the tolerance, not a tenth of it)."""
     measured = np.asarray(tq.measured, dtype=bool)
     ferr = np.linalg.norm(tq.force - analysis.force, axis=1)
     merr = np.abs(tq.moment - analysis.moment)
     track = {k: float(np.max(np.abs(v))) for k, v in tq.tracking.items()}
+    how = ("a tenth of the tolerance or less" if halved is None else
+           f"within the tolerance, and the run with {halved.iterations} solver iterations gave the same loads to a "
+           f"tenth of the tolerance (the solver converged)")
     note = (f"proved by the torque-driven run: under the engine's efforts pymunk followed the plan to "
             f"{tq.tracking_error_max:.2g} of the travel, and its loads on the frame match the analysis to "
-            f"{max(tq.force_residual, tq.moment_residual):.2g} of the reference, a tenth of the tolerance or less: "
+            f"{max(tq.force_residual, tq.moment_residual):.2g} of the reference, {how}: "
             f"no position-driven run needed")
     return StageValidation(
         t=np.asarray(analysis.t, dtype=float), force=tq.force, moment=tq.moment, force_error=ferr, moment_error=merr,
@@ -103,6 +128,24 @@ def stage_runs(model: Model, analysis: Analysis, peaks: tuple[float, float], set
                                     trial=True, plan=plan)
         if proves_loads(tried, settings, expect):
             return validation_from_torque(tried, analysis, peaks, settings, expect), tried
+        it = ITERATIONS
+        while not np.isfinite(tried.tracking_error_max) and it < MAX_ITERATIONS // 4:  # came apart: more effort
+            it *= 2
+            tried = _torque_driven_once(model, analysis, settings, reference=loads_ref, iterations=it, trial=True,
+                                        plan=plan)
+        # within the tolerance but not ten times over: twice the solver effort, which proves it where
+        # its loads match the analysis ten times over (more iterations cannot change that, as for the
+        # position-driven run's first run), or within the tolerance and the same as the first run's to a
+        # tenth of it (the position-driven run's own convergence test); the torque-driven verdict is
+        # the first run's, which passes by ten times over (calibrated)
+        if proves_loads(tried, settings, expect, residual_margin=1.0):
+            twice = _torque_driven_once(model, analysis, settings, reference=loads_ref, iterations=2 * it,
+                                        calibrate=False, plan=plan)
+            if proves_loads(twice, settings, expect, calibrated=False):
+                return validation_from_torque(twice, analysis, peaks, settings, expect), tried
+            if (proves_loads(twice, settings, expect, residual_margin=1.0, calibrated=False)
+                    and converged(tried, twice, settings.tolerance / MARGIN)):
+                return validation_from_torque(twice, analysis, peaks, settings, expect, halved=tried), tried
     v = validate(model, analysis, peaks, settings, expect, reference=reference)
     same_step = plan is not None and plan.dt == v.dt
     tq = torque_driven(model, analysis, settings, economic=True, reference=loads_ref, dt=v.dt, iterations=v.iterations,
