@@ -63,8 +63,8 @@ def run(args) -> int:
         print(msg, file=sys.stderr)
     clash = clashes(files)
     jobs = args.jobs if args.jobs is not None else default_jobs(len(files))
-    if jobs > 1 and len(files) > 1:  # the whole schema, frozen below and built once, not in every worker;
-        loader.prepare()  # in one process, each spec is validated by its own sections (balpipe.spec.validate)
+    if len(files) > 1:  # the whole schema, frozen below and built once (not in every worker, nor narrowed
+        loader.prepare()  # per spec); one spec is validated by its own sections alone (balpipe.spec.validate)
     # the schema's and the libraries' objects live as long as the process: the collector stops
     # scanning them at each full collection (10-20 % of the checks' CPU) and forked workers stop
     # copying their pages (the objects made from here on are collected as usual)
