@@ -60,3 +60,26 @@ def test_every_stage_is_still_validated_when_the_demonstration_shows_two(studies
     validation_stage.simulate_study(st)
     assert ran == [0, 1, 2] and floated == [0, 2]
     assert st.reactionless.names == ["unbalanced", "full"]
+
+
+def test_the_demonstration_runs_at_the_motions_own_step():
+    """A spec's validation.dt is its checks' step (chosen for their residual limits); the
+    demonstration, which has no verdict, runs at the motion's default step, and still tells the
+    reactionless arm (at rest) from the unbalanced one (pushed around)."""
+    import sys
+    from pathlib import Path
+
+    from balpipe.engine import analyse
+    from balpipe.validate import ValidationSettings, default_settings, free_floating
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_validate import GRID, arm_2r, reactionless_arm
+
+    runs = {}
+    for name, make in (("unbalanced", arm_2r), ("reactionless", reactionless_arm)):
+        model = make()
+        a = analyse(model, GRID)
+        ff = free_floating(model, a, settings=ValidationSettings(dt=1e-4))
+        assert ff.dt == pytest.approx(default_settings(model, a)[0], rel=1e-9) and ff.dt > 1e-4
+        runs[name] = ff
+    assert runs["unbalanced"].max_drift > 1e6 * runs["reactionless"].max_drift
