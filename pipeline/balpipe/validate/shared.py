@@ -79,11 +79,13 @@ def converged(a: TorqueDriven, b: TorqueDriven, limit: float) -> bool:
 
 def validation_from_torque(tq: TorqueDriven, analysis: Analysis, peaks: tuple[float, float],
                            settings: ValidationSettings, expect: tuple[str, ...],
-                           halved: TorqueDriven | None = None) -> StageValidation:
+                           halved: TorqueDriven | None = None, reference=None) -> StageValidation:
     """The position-driven verdict read from a torque-driven run that proves it
     (:func:`proves_loads`): its loads, residuals and simulated peaks (the same definitions, the
     same reference loads), its step and solver iterations; ``tracking_error`` is the driven
-    coordinates' (rad or m) under the efforts, not under a drive. ``halved``: the run with half
+    coordinates' (rad or m) under the efforts, not under a drive; ``reference`` (a
+    :class:`balpipe.load_reference.LoadReference`) says what the reference loads are, as in
+    :func:`.loads.validate`. ``halved``: the run with half
     its solver iterations, whose loads it matches to a tenth of the tolerance (its residuals are
     then within the tolerance, not a tenth of it)."""
     measured = np.asarray(tq.measured, dtype=bool)
@@ -108,6 +110,8 @@ def validation_from_torque(tq: TorqueDriven, analysis: Analysis, peaks: tuple[fl
         extrapolated_samples=tq.extrapolated_samples, floored_bodies=list(tq.floored_bodies), notes=[note],
         timing={"simulation_s": 0.0, "total_s": 0.0}, force_reference=tq.force_reference,
         moment_reference=tq.moment_reference, proved_by="torque-driven run",
+        **({"reference_basis": f"force: {reference.force_basis}; moment: {reference.moment_basis}"}
+           if reference is not None else {}),
     )
 
 
@@ -127,7 +131,7 @@ def stage_runs(model: Model, analysis: Analysis, peaks: tuple[float, float], set
         tried = _torque_driven_once(model, analysis, settings, reference=loads_ref, iterations=ITERATIONS,
                                     trial=True, plan=plan)
         if proves_loads(tried, settings, expect):
-            return validation_from_torque(tried, analysis, peaks, settings, expect), tried
+            return validation_from_torque(tried, analysis, peaks, settings, expect, reference=reference), tried
         it = ITERATIONS
         while not np.isfinite(tried.tracking_error_max) and it < MAX_ITERATIONS // 4:  # came apart: more effort
             it *= 2
@@ -142,10 +146,10 @@ def stage_runs(model: Model, analysis: Analysis, peaks: tuple[float, float], set
             twice = _torque_driven_once(model, analysis, settings, reference=loads_ref, iterations=2 * it,
                                         calibrate=False, plan=plan)
             if proves_loads(twice, settings, expect, calibrated=False):
-                return validation_from_torque(twice, analysis, peaks, settings, expect), tried
+                return validation_from_torque(twice, analysis, peaks, settings, expect, reference=reference), tried
             if (proves_loads(twice, settings, expect, residual_margin=1.0, calibrated=False)
                     and converged(tried, twice, settings.tolerance / MARGIN)):
-                return validation_from_torque(twice, analysis, peaks, settings, expect, halved=tried), tried
+                return validation_from_torque(twice, analysis, peaks, settings, expect, halved=tried, reference=reference), tried
     v = validate(model, analysis, peaks, settings, expect, reference=reference)
     same_step = plan is not None and plan.dt == v.dt
     tq = torque_driven(model, analysis, settings, economic=True, reference=loads_ref, dt=v.dt, iterations=v.iterations,
