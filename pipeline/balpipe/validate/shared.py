@@ -89,6 +89,8 @@ def validation_from_torque(tq: TorqueDriven, analysis: Analysis, peaks: tuple[fl
     its solver iterations, whose loads it matches to a tenth of the tolerance (its residuals are
     then within the tolerance, not a tenth of it)."""
     measured = np.asarray(tq.measured, dtype=bool)
+    basis = ("force: unbalanced peak; moment: unbalanced peak" if reference is None
+             else f"force: {reference.force_basis}; moment: {reference.moment_basis}")
     ferr = np.linalg.norm(tq.force - analysis.force, axis=1)
     merr = np.abs(tq.moment - analysis.moment)
     track = {k: float(np.max(np.abs(v))) for k, v in tq.tracking.items()}
@@ -109,9 +111,7 @@ def validation_from_torque(tq: TorqueDriven, analysis: Analysis, peaks: tuple[fl
         expect=tuple(expect), passed=True, reasons=[], excluded_samples=int(np.count_nonzero(~measured)),
         extrapolated_samples=tq.extrapolated_samples, floored_bodies=list(tq.floored_bodies), notes=[note],
         timing={"simulation_s": 0.0, "total_s": 0.0}, force_reference=tq.force_reference,
-        moment_reference=tq.moment_reference, proved_by="torque-driven run",
-        **({"reference_basis": f"force: {reference.force_basis}; moment: {reference.moment_basis}"}
-           if reference is not None else {}),
+        moment_reference=tq.moment_reference, proved_by="torque-driven run", reference_basis=basis,
     )
 
 
