@@ -52,6 +52,14 @@ def variants(data: dict):
     d = copy.deepcopy(data)
     d["motion"] = {}
     yield "empty motion", d
+    for key, value in (("frame", {}), ("loads", [{"type": "nope"}]), ("sweep", {"vary": 5})):
+        d = copy.deepcopy(data)
+        d[key] = value  # an optional section present, and wrong
+        yield f"{key} wrong", d
+        if key in data:
+            d = copy.deepcopy(data)
+            del d[key]
+            yield f"{key} left out", d
 
 
 def outcome(cls: type, data: dict):
@@ -82,11 +90,14 @@ def test_a_narrower_class_validates_as_the_whole_schema(path):
             assert type(back) is Spec and back == full and pickle.dumps(got) == pickle.dumps(full)
 
 
+NONE = ("loads", "frame", "sweep")  # the optional sections a spec leaves out
+
+
 @pytest.mark.parametrize("data, names", [
-    ({"mechanism": {"template": "slider_crank"}}, ("slider_crank", ())),
-    ({"mechanism": {"template": "custom"}, "balancing": {"method": "none"}}, ("custom", ())),
-    ({"mechanism": {"template": "custom"}, "balancing": {"method": "stages"},
-      "compare": [{"balancing": {"method": "force_balance"}}]}, ("custom", ("force_balance", "stages"))),
+    ({"mechanism": {"template": "slider_crank"}}, ("slider_crank", (), NONE)),
+    ({"mechanism": {"template": "custom"}, "balancing": {"method": "none"}, "frame": None}, ("custom", (), ("loads", "sweep"))),
+    ({"mechanism": {"template": "custom"}, "balancing": {"method": "stages"}, "loads": [], "sweep": {},
+      "compare": [{"balancing": {"method": "force_balance"}}]}, ("custom", ("force_balance", "stages"), ("frame",))),
     ({"mechanism": {"template": "nope"}}, None),
     ({"mechanism": {"template": ["slider_crank"]}}, None),
     ({"mechanism": "slider_crank"}, None),
@@ -98,7 +109,7 @@ def test_a_narrower_class_validates_as_the_whole_schema(path):
 ])
 def test_only_known_names_narrow(data, names):
     """A spec names its sections by known names, or the whole schema validates it (and its
-    messages list every choice)."""
+    messages list every choice); the optional sections it leaves out are left out of its class."""
     assert named_sections(data) == names
 
 

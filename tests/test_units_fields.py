@@ -12,7 +12,7 @@ from pydantic import BaseModel, BeforeValidator
 
 from balpipe import registry, units
 from balpipe.loader import SpecErrors, load_text
-from balpipe.spec import Sections, Spec
+from balpipe.spec import Deferred, Spec
 from balpipe.spec_parts import SpecFieldError
 from _edits import replaced
 
@@ -138,9 +138,9 @@ def test_no_numeric_field_escapes_the_units_parsers():
             args = typing.get_args(tp)
             walk(args[0], where, tuple(meta) + tuple(tp.__metadata__))
             return
-        sections = [m for m in meta if isinstance(m, Sections)]  # a union resolved when the schema is built
-        if sections:
-            walk(sections[0].union(), where)
+        deferred = [m for m in meta if isinstance(m, Deferred)]  # a type resolved when the schema is built
+        if deferred:
+            walk(deferred[0].type(), where)
             return
         if tp in (float, int) or tp is typing.Any and meta:
             if not guarded(meta):

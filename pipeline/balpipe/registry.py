@@ -14,7 +14,6 @@ from .balancing.base import BalanceResult, Stage
 from .balancing.context import BalanceContext, Memo, compute
 from .model import Law, Model
 from .laws.drives import drive_laws
-from .laws.load_spec import model_loads
 from .motion import law_for
 from .plugins import Method, Paper, Ref, Template, discover
 from .mechanics.sampling import gravity_vector, time_grid
@@ -119,6 +118,8 @@ def unbalanced_model(spec: Any) -> Model:
     t = time_grid(spec)
     model = template.build(mech, laws, t)
     if getattr(spec, "loads", None):
+        from .laws.load_spec import model_loads  # the loads' section module only for a spec with loads
+
         model = replace(model, loads=model_loads(spec.loads, model, float(t[0])))
     return model
 

@@ -12,18 +12,15 @@ template and methods a spec names (``balpipe check`` of one spec: one family's).
 from __future__ import annotations
 
 import functools
-from typing import Annotated, Any, Callable, Literal, Union, cast
+from typing import Annotated, Any, Callable, Literal, Optional, Union, cast
 
 from pydantic import Field, GetCoreSchemaHandler, create_model, field_validator
 from pydantic_core import CoreSchema
 
 from . import registry
 from .display.units import display_units
-from .laws.frame_spec import FrameSpec
-from .laws.load_spec import LoadSpec
 from .laws.motion_spec import Motion
 from .spec_parts import Strict
-from .sweep_spec import SweepSpec
 from .units import Length, count, number, quantity
 
 
@@ -33,12 +30,28 @@ class NoBalancing(Strict):
     method: Literal["none"] = Field(description="balancing method")
 
 
-class Sections:
-    """A discriminated union of spec sections, built when pydantic builds a validator or a schema
-    that holds it (not when a model naming it is defined): ``key`` is the discriminating field
-    (``template``, ``method``), ``sections()`` the member classes in union order."""
+class Deferred:
+    """A field's type (in ``Annotated[Any, Deferred(...)]``) made by ``resolve()`` when pydantic
+    builds a validator or a schema that holds it, not when a model naming it is defined: its
+    modules are imported then."""
+
+    def __init__(self, resolve: Callable[[], Any]) -> None:
+        self.resolve = resolve
+
+    def type(self) -> Any:
+        """The field's type (its modules imported now)."""
+        return self.resolve()
+
+    def __get_pydantic_core_schema__(self, source: Any, handler: GetCoreSchemaHandler) -> CoreSchema:
+        return handler.generate_schema(self.type())
+
+
+class Sections(Deferred):
+    """A discriminated union of spec sections (:class:`Deferred`): ``key`` is the discriminating
+    field (``template``, ``method``), ``sections()`` the member classes in union order."""
 
     def __init__(self, key: str, sections: Callable[[], tuple[type, ...]], description: str) -> None:
+        super().__init__(self.union)
         self.key = key
         self.sections = sections
         self.description = description
@@ -47,8 +60,28 @@ class Sections:
         """The union as a type: ``Annotated[Union[...], Field(discriminator=key, description=...)]``."""
         return Annotated[Union[self.sections()], Field(discriminator=self.key, description=self.description)]
 
-    def __get_pydantic_core_schema__(self, source: Any, handler: GetCoreSchemaHandler) -> CoreSchema:
-        return handler.generate_schema(self.union())
+
+def _loads() -> Any:
+    from .laws.load_spec import LoadSpec
+
+    return list[LoadSpec]  # type: ignore[valid-type]
+
+
+def _frame() -> Any:
+    from .laws.frame_spec import FrameSpec
+
+    return Optional[FrameSpec]
+
+
+def _sweep() -> Any:
+    from .sweep_spec import SweepSpec
+
+    return Optional[SweepSpec]
+
+
+#: the spec's optional sections whose modules are imported when a spec has them (or the whole
+#: schema is built): a spec without them is validated by :func:`validate` without them
+OPTIONAL = {"loads": Deferred(_loads), "frame": Deferred(_frame), "sweep": Deferred(_sweep)}
 
 
 _MECHANISM = "the mechanism: a template with its parameters"
@@ -154,17 +187,17 @@ class Spec(Strict):
     balancing: Annotated[Any, BALANCINGS] = Field(NoBalancing(method="none"))
     analysis: AnalysisSettings = Field(AnalysisSettings())
     validation: ValidationSpec = Field(ValidationSpec())
-    loads: list[LoadSpec] = Field(
+    loads: Annotated[Any, OPTIONAL["loads"]] = Field(
         [], description="springs, dampers, force laws, gas pressures, torsional springs, applied forces and torques, "
         "joint friction: counted in the efforts, reactions and frame loads, never in the shaking loads")
-    frame: FrameSpec | None = Field(
+    frame: Annotated[Any, OPTIONAL["frame"]] = Field(
         None, description="the frame as a rigid body on elastic mounts: its vibration and the forces on the floor per stage")
     references: list[Reference] = Field([], description="published values to compare with")
     compare: list[Design] = Field(
         [], description="other balancing designs of the same mechanism, analysed and tabulated beside the main one"
     )
     report: ReportSettings = Field(ReportSettings(), description="how the pages show the study: their units")
-    sweep: SweepSpec | None = Field(
+    sweep: Annotated[Any, OPTIONAL["sweep"]] = Field(
         None, description="a design sweep run by 'balpipe sweep SPEC' (flags override it); 'balpipe build' ignores it"
     )
 
@@ -196,8 +229,9 @@ def validate(data: Any) -> Spec:
     same errors as ``Spec.model_validate(data)``. Until the whole schema is built (:class:`Spec`
     validated directly, its JSON Schema, :func:`balpipe.loader.prepare`), a spec that names a
     known template and known methods (its own and its compared designs') is validated by a Spec
-    whose unions hold only those sections: only their families' section modules are imported and
-    the validator is a fraction of the whole one. Any other spec (an unknown or missing name,
+    whose unions hold only those sections and that leaves out the :data:`OPTIONAL` sections it
+    does not have (their defaults): only their families' section modules are imported and the
+    validator is a fraction of the whole one. Any other spec (an unknown or missing name,
     errors to report) goes through the whole schema, whose messages list every choice. The
     narrower classes are named, pickled, hashed (:mod:`balpipe.cache.content`) and compared as
     :class:`Spec` and :class:`Design`."""
@@ -206,10 +240,10 @@ def validate(data: Any) -> Spec:
     return cls.model_validate(data)
 
 
-def named_sections(data: Any) -> tuple[str, tuple[str, ...]] | None:
-    """(template, methods in the registry's order) that ``data`` names in ``mechanism``,
-    ``balancing`` and each design of ``compare``, when every one is a name the registry knows
-    ("none" left out); None otherwise."""
+def named_sections(data: Any) -> tuple[str, tuple[str, ...], tuple[str, ...]] | None:
+    """(template, methods in the registry's order, the :data:`OPTIONAL` sections it does not
+    have) of ``data``: the names in ``mechanism``, ``balancing`` and each design of ``compare``,
+    when every one is a name the registry knows ("none" left out); None otherwise."""
     if not isinstance(data, dict) or not isinstance(data.get("mechanism"), dict):
         return None
     template = data["mechanism"].get("template")
@@ -224,13 +258,15 @@ def named_sections(data: Any) -> tuple[str, tuple[str, ...]] | None:
         if not isinstance(method, str) or (method != "none" and method not in registry.METHODS):
             return None
         methods.add(method)
-    return template, tuple(m for m in registry.METHODS if m in methods)
+    absent = tuple(k for k in OPTIONAL if k not in data)
+    return template, tuple(m for m in registry.METHODS if m in methods), absent
 
 
 @functools.lru_cache(maxsize=None)
-def _narrowed(template: str, methods: tuple[str, ...]) -> type[Spec]:
-    """:class:`Spec` with its unions narrowed to ``template``'s section and "none" and ``methods``'
-    (:func:`validate`); one class per combination in a process."""
+def _narrowed(template: str, methods: tuple[str, ...], absent: tuple[str, ...] = ()) -> type[Spec]:
+    """:class:`Spec` with its unions narrowed to ``template``'s section and "none" and ``methods``',
+    and the ``absent`` optional sections left at their defaults without a type (a spec without
+    them never validates them) (:func:`validate`); one class per combination in a process."""
     mechanism = Sections("template", lambda: (registry.TEMPLATES[template].section,), _MECHANISM)
     balancing = Sections("method", lambda: (NoBalancing, *(registry.METHODS[m].section for m in methods)),
                          _BALANCING)
@@ -241,6 +277,7 @@ def _narrowed(template: str, methods: tuple[str, ...]) -> type[Spec]:
         mechanism=(Annotated[Any, mechanism], ...),
         balancing=(Annotated[Any, balancing], Field(fields["balancing"].default)),
         compare=(list[design], Field(fields["compare"].default, description=fields["compare"].description)),  # type: ignore[valid-type]
+        **{k: (Any, Field(fields[k].default, description=fields[k].description)) for k in absent},  # type: ignore[dict-item]
     )
     return cast("type[Spec]", spec)
 

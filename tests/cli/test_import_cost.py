@@ -133,3 +133,18 @@ def test_check_of_one_spec_loads_its_own_family_only(spec, family, generic):
     assert families == {family}, loaded
     sections = [m for m in loaded if m in ("balpipe.balancing.specs", "balpipe.balancing.partial.spec")]
     assert sections == generic, loaded
+
+
+@pytest.mark.parametrize("spec, optional", [
+    ("specs/offset_slider_crank.yaml", []),
+    ("specs/custom_four_bar_loaded.yaml", ["balpipe.laws.load_spec"]),
+    ("specs/custom_v_twin_6000rpm.yaml", ["balpipe.laws.frame_spec"]),
+])
+def test_check_of_one_spec_loads_the_optional_sections_it_has(spec, optional):
+    """The loads', frame's and sweep's section modules are imported for a spec that has them."""
+    probe = SECTIONS_PROBE.replace('("balpipe.families.", "balpipe.balancing.")', '("balpipe.laws.", "balpipe.sweep")')
+    r = subprocess.run([sys.executable, "-c", probe, json.dumps(["check", spec])], cwd=ROOT,
+                       capture_output=True, text=True, timeout=120)
+    loaded = json.loads(r.stderr.strip().splitlines()[-1])
+    assert [m for m in loaded if m in ("balpipe.laws.load_spec", "balpipe.laws.frame_spec", "balpipe.sweep_spec")] \
+        == optional, loaded

@@ -25,7 +25,6 @@ from ..units import Angle, Duration, Length, PositiveLength, Rate, RateRate, num
 from . import cycle as cycle_laws
 from . import paths as geometry
 from .periodic import Cam, ConstantSpeed, Fourier, cam_jumps
-from .load_spec import table_files as table_files_of_loads
 from .table import Tabulated, TableError, parse_table
 
 #: relative size of a state jump at a join that counts as a jump (of the segment's own scale)
@@ -537,7 +536,12 @@ def spec_tables(spec: Any) -> list[tuple[tuple, Any]]:
     table drives, then its loads' tables (:func:`.load_spec.table_files`)."""
     out = [(sub, d) for root, motion in motion_sections(spec) for name, drive in motion.drive.items()
            for sub, d in _tables(drive, root + ("drive", name))]
-    return out + table_files_of_loads(getattr(spec, "loads", None) or [])
+    loads = getattr(spec, "loads", None)
+    if not loads:  # the loads' section module only for a spec with loads
+        return out
+    from .load_spec import table_files as table_files_of_loads
+
+    return out + table_files_of_loads(loads)
 
 
 def read_tables(spec: Any, folder: FilePath) -> None:
