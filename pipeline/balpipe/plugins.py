@@ -127,7 +127,11 @@ class Method:
     hundredths; ``balpipe check`` starts its costliest specs first (:mod:`balpipe.site_files.check_cost`),
     so that a long one does not start last and leave the other cores idle at the end.
     ``build_cost``: the same for ``balpipe build --no-sim``, beyond the estimate from the spec's
-    text (:func:`balpipe.build.spec_cost`)."""
+    text (:func:`balpipe.build.spec_cost`). ``imports``: the libraries the method's code imports
+    when it runs (inside its functions, so that importing it stays light: ``"scipy.optimize"``,
+    0.3 s); ``balpipe check`` of several specs imports them, and the method's code, before its
+    workers fork when a spec names the method, so that each worker does not import them again.
+    Only the time depends on it."""
 
     name: str
     spec: type[Strict] | Ref
@@ -139,11 +143,18 @@ class Method:
     page_only: tuple[str, ...] = ()
     check_cost: float = 0.0  # seconds that ``balpipe check`` of a spec with this method takes beyond a plain one's
     build_cost: float = 0.0  # seconds that ``balpipe build --no-sim`` of such a spec takes beyond its text's estimate
+    imports: tuple[str, ...] = ()  # libraries its code imports when it runs (loaded before check's workers fork)
 
     @property
     def section(self) -> type[Strict]:
         """The spec section's class (``spec``, its module imported now if it is a :class:`Ref`)."""
         return section_class(self.spec)
+
+    def load_code(self) -> None:
+        """Import the method's code (its ``balance``'s module) and its :attr:`imports` now."""
+        resolved(self.balance)
+        for name in self.imports:
+            import_module(name)
 
 
 @dataclass(frozen=True)

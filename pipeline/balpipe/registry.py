@@ -27,13 +27,14 @@ __all__ = [
 # methods for every template (they read only the model); "none" is the spec's own default. Their
 # sections and code are imported when a spec uses them (the whole schema needs every section).
 _CODE = "balpipe.balancing"
+_LINPROG = ("scipy.optimize",)  # the least-mass programmes (balpipe.balancing.least_mass)
 GENERIC: tuple[Method, ...] = (
     Method("force_balance", Ref(f"{_CODE}.specs:ForceBalance"), Ref(f"{_CODE}.force_balance:balance"), (),
            "force-balance conditions from the momentum + least-mass counterweights",
-           notation=Ref(f"{_CODE}.force_balance:notation")),
+           notation=Ref(f"{_CODE}.force_balance:notation"), imports=_LINPROG),
     Method("moment_balance", Ref(f"{_CODE}.specs:MomentBalance"), Ref(f"{_CODE}.moment_balance:balance"), (),
            "least-mass counterweights + counter-rotations from the angular momentum",
-           notation=Ref(f"{_CODE}.moment_balance:notation")),
+           notation=Ref(f"{_CODE}.moment_balance:notation"), imports=_LINPROG),
     Method("stages", Ref(f"{_CODE}.specs:Stages"), Ref(f"{_CODE}.stages:balance"), (), "stages written by hand, each adding parts",
            notation=Ref(f"{_CODE}.stages:notation")),
     Method("partial_balance", Ref(f"{_CODE}.partial.spec:PartialBalance"), Ref(f"{_CODE}.partial.method:balance"), (),
@@ -41,7 +42,8 @@ GENERIC: tuple[Method, ...] = (
            notation=Ref(f"{_CODE}.partial.method:notation"),
            page_only=("fronts",),  # the Pareto fronts: about 90 % of its time, drawn only on the page
            check_cost=0.5,  # the optimum's cone programme (Clarabel): 0.1-1 s beyond a plain spec
-           build_cost=0.3),  # and the fronts: 0.3-1.2 s a spec
+           build_cost=0.3,  # and the fronts: 0.3-1.2 s a spec
+           imports=("clarabel", "scipy.sparse")),
 )
 
 

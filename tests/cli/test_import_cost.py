@@ -148,3 +148,15 @@ def test_check_of_one_spec_loads_the_optional_sections_it_has(spec, optional):
     loaded = json.loads(r.stderr.strip().splitlines()[-1])
     assert [m for m in loaded if m in ("balpipe.laws.load_spec", "balpipe.laws.frame_spec", "balpipe.sweep_spec")] \
         == optional, loaded
+
+
+def test_check_with_workers_loads_the_methods_libraries_before_they_fork():
+    """``balpipe check`` of several specs in worker processes imports, in the parent before they
+    fork, the code of the methods the specs name and the libraries it declares
+    (:attr:`balpipe.plugins.Method.imports`), so that no worker imports them again; a method that
+    declares none loads none (the other tests above)."""
+    probe = PROBE.format(heavy=("scipy.optimize", "balpipe.balancing.force_balance", "balpipe.families.rpr3.idler_loop"))
+    args = ["check", "-j", "2", "specs/custom_four_bar_loaded.yaml", "specs/offset_slider_crank.yaml"]
+    r = subprocess.run([sys.executable, "-c", probe, json.dumps(args)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=120)
+    assert json.loads(r.stderr.strip().splitlines()[-1]) == ["balpipe.balancing.force_balance", "scipy.optimize"]

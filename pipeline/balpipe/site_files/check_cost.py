@@ -38,18 +38,30 @@ def declared_cost(path: Path, hint: str) -> float:
     """The sum of the ``hint`` attribute (``check_cost`` or ``build_cost``) of the template and
     the method that the spec at ``path`` names; 0 where it cannot be read or names neither."""
     from .. import registry
+
+    names = _read_names(path)
+    template = registry.TEMPLATES.get(names.get(_NAMES[0], ""))
+    method = registry.METHODS.get(names.get(_NAMES[1], ""))
+    return sum(getattr(item, hint) for item in (template, method) if item is not None)
+
+
+def declared_method(path: Path) -> str | None:
+    """The ``balancing: {method: ...}`` that the spec at ``path`` names, read as for its cost;
+    None where it cannot be read or names none."""
+    return _read_names(path).get(_NAMES[1])
+
+
+def _read_names(path: Path) -> dict[tuple[str, str], str]:
+    """:func:`declared_names` of the file at ``path``; empty where it cannot be read."""
     from ..loader import MAX_FILE_BYTES
 
     try:
         st = path.stat()
         if not stat.S_ISREG(st.st_mode) or st.st_size > MAX_FILE_BYTES:  # a pipe would block here
-            return 0.0
-        names = declared_names(path.read_text(encoding="utf-8"))
+            return {}
+        return declared_names(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError):
-        return 0.0
-    template = registry.TEMPLATES.get(names.get(_NAMES[0], ""))
-    method = registry.METHODS.get(names.get(_NAMES[1], ""))
-    return sum(getattr(item, hint) for item in (template, method) if item is not None)
+        return {}
 
 
 def declared_names(text: str) -> dict[tuple[str, str], str]:

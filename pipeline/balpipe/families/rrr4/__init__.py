@@ -24,6 +24,7 @@ FAMILY = Family(
         Method("rrr4_counter_masses", Ref(f"{__name__}.specs:RRR4Balancing"), Ref(f"{__name__}.counter_masses:balance"), ("rrr4",),
                "counter-masses: leg by leg (eqs. 8-11), from eq. 17 (Fig. 4a) and eqs. 19/21 (Fig. 6)",
                notation=Ref(f"{__name__}.counter_masses:NOTATION"), figures=Ref(f"{__name__}.figures:figures"),
-               build_cost=2.0),  # 1.9-2.9 s: the topologies' designs analysed, the condition finder
+               build_cost=2.0,  # 1.9-2.9 s: the topologies' designs analysed, the condition finder
+               imports=("scipy.optimize",)),  # the least-mass programmes
     ),
 )
