@@ -184,6 +184,13 @@ def test_simulated_build_passes_and_reports_validation(simulated):
     out = work / "a" / "scott_russell"
     page = (out / "index.html").read_text()
     assert "timing.js" in page and (out / "timing.json").exists()
+    # the run-time column: every run of a stage, also where its torque-driven run alone proves it
+    times = json.loads((out / "timing.json").read_text())
+    for t in times.values():
+        parts = t.get("total_s", 0.0) + t.get("torque_driven_s", 0.0) + t.get("reactionless_s", 0.0)
+        assert t["all_runs_s"] == parts > 0
+    shown = json.loads((out / "timing.js").read_text().split("var T=")[1].split(";")[0])
+    assert shown == {k: round(t["all_runs_s"], 4) for k, t in times.items()}
     assert "<canvas" in page and "Reactionless demonstration" in page and "Residuals of the simulation" in page
     # the torque-driven run (issue 7, item 7): every stage follows its plan under the engine's efforts
     td = res["torque_driven"]
