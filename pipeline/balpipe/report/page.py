@@ -21,6 +21,7 @@ from .orders_figure import orders_svg
 from .mounts_figure import mounts_svg
 from .parts_table import page_rows
 from .results import joint_load_table
+from ..display.numbers import num as _num
 
 
 def shown_stages(study: Study) -> list:
@@ -69,7 +70,7 @@ def drawing_times(study: Study) -> dict:
     the mechanism barely moves) and their ``count``, and ``sleeves``: whether a drawing has a
     prismatic pair between two links (:mod:`balpipe.draw.sleeves`)."""
     solid, ghosts = drawn_times(study)
-    texts = [f"{t:.4g} s" for t in ghosts]
+    texts = [f"{_num(t, 4)} s" for t in ghosts]
     sleeved = any(sleeves.guided_sliders(s.stage.model) for s in shown_stages(study))
     return {"solid": f"{solid:.4g}", "ghosts": " and ".join(texts), "count": len(texts), "sleeves": sleeved}
 
@@ -197,7 +198,7 @@ def travel_text(s, names: PageNames | None = None) -> str:
     """'crank 2.793 rad' per driver of a stage's torque-driven run: the tracking error's reference
     (with ``names``, each driver in the paper's symbol: 'θ₁ [theta1] 0.61 rad')."""
     model = s.stage.model
-    return ", ".join(f"{names.text('driver', d) if names else d} {v:.4g} {'m' if present.driver_unit(model, d) == 'N' else 'rad'}"
+    return ", ".join(f"{names.text('driver', d) if names else d} {_num(v, 4)} {'m' if present.driver_unit(model, d) == 'N' else 'rad'}"
                      for d, v in sorted(s.torque.travel.items()))
 
 
@@ -230,9 +231,9 @@ def _reference_phrase(ref, label: str, which: str) -> str:
     value, basis, peak, unit, sym = ((ref.force, ref.force_basis, ref.force_peak, "N", "F_ref") if which == "force"
                                      else (ref.moment, ref.moment_basis, ref.moment_peak, "N m", "M_ref"))
     if basis == "unbalanced peak":
-        return f"{sym} = {value:.4g} {unit}, the peak inertial {which} of the unbalanced stage '{label}'"
-    return (f"{sym} = {value:.4g} {unit}, {ref.floor_fraction:g} of the gross inertial {which} of the unbalanced "
-            f"stage '{label}' (larger than its peak, {peak:.3g} {unit})")
+        return f"{sym} = {_num(value, 4)} {unit}, the peak inertial {which} of the unbalanced stage '{label}'"
+    return (f"{sym} = {_num(value, 4)} {unit}, {ref.floor_fraction:g} of the gross inertial {which} of the unbalanced "
+            f"stage '{label}' (larger than its peak, {_num(peak, 3)} {unit})")
 
 
 def base_scales(results: dict) -> dict[str, float]:
