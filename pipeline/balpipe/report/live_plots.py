@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..display import numbers
 from ..draw import figures
 from ..draw.live import Curves
 from ..draw.stage_names import short_names
 from .results import joint_load_series
-from ..display.numbers import num as _num
 
 
 #: the shaking loads' panels: key, title, axis, the values of a force (N, 2) and moment (N,)
@@ -141,17 +141,17 @@ def residuals(rows: list, styles: list[int] | None = None, names: list[str] | No
     shorts = list(names) if names else short_names([r[0] for r in rows])
     curves, legend = [], []
     for k, (label, t, fe, me, F0, M0) in enumerate(rows):
-        refs = "" if one else f" (F_ref {_num(F0, 4)} N, M_ref {_num(M0, 4)} N m)"
+        refs = "" if one else f" (F_ref {numbers.num(F0, 4)} N, M_ref {numbers.num(M0, 4)} N m)"
         curves.append((label + refs, {"force": fe / F0 if F0 > 0 else fe, "moment": me / M0 if M0 > 0 else me}))
         legend.append(shorts[k] + refs)
     F0, M0 = rows[0][4], rows[0][5]
     panels = [
         {"key": "force", "log": True,
-         "title": "Force residual |F_sim − F_analytic|" + (f" / F_ref, F_ref = {_num(F0, 4)} N" if F0 > 0 and one else
+         "title": "Force residual |F_sim − F_analytic|" + (f" / F_ref, F_ref = {numbers.num(F0, 4)} N" if F0 > 0 and one else
                                                             " / F_ref, F_ref per stage (legend)" if not one else " (N)"),
          "axis": "|ΔF| / F_ref" if F0 > 0 or not one else "|ΔF| (N)"},
         {"key": "moment", "log": True,
-         "title": "Moment residual |M_sim − M_analytic|" + (f" / M_ref, M_ref = {_num(M0, 4)} N m" if M0 > 0 and one else
+         "title": "Moment residual |M_sim − M_analytic|" + (f" / M_ref, M_ref = {numbers.num(M0, 4)} N m" if M0 > 0 and one else
                                                               " / M_ref, M_ref per stage (legend)" if not one else " (N m)"),
          "axis": "|ΔM| / M_ref" if M0 > 0 or not one else "|ΔM| (N m)"},
     ]

@@ -21,7 +21,6 @@ from .orders_figure import orders_svg
 from .mounts_figure import mounts_svg
 from .parts_table import page_rows
 from .results import joint_load_table
-from ..display.numbers import num as _num
 
 
 def shown_stages(study: Study) -> list:
@@ -70,9 +69,9 @@ def drawing_times(study: Study) -> dict:
     the mechanism barely moves) and their ``count``, and ``sleeves``: whether a drawing has a
     prismatic pair between two links (:mod:`balpipe.draw.sleeves`)."""
     solid, ghosts = drawn_times(study)
-    texts = [f"{_num(t, 4)} s" for t in ghosts]
+    texts = [f"{numbers.num(t, 4)} s" for t in ghosts]
     sleeved = any(sleeves.guided_sliders(s.stage.model) for s in shown_stages(study))
-    return {"solid": f"{solid:.4g}", "ghosts": " and ".join(texts), "count": len(texts), "sleeves": sleeved}
+    return {"solid": numbers.num(solid, 4), "ghosts": " and ".join(texts), "count": len(texts), "sleeves": sleeved}
 
 
 def stage_styles(study: Study) -> dict[str, tuple[int, str]]:
@@ -198,7 +197,7 @@ def travel_text(s, names: PageNames | None = None) -> str:
     """'crank 2.793 rad' per driver of a stage's torque-driven run: the tracking error's reference
     (with ``names``, each driver in the paper's symbol: 'θ₁ [theta1] 0.61 rad')."""
     model = s.stage.model
-    return ", ".join(f"{names.text('driver', d) if names else d} {_num(v, 4)} {'m' if present.driver_unit(model, d) == 'N' else 'rad'}"
+    return ", ".join(f"{names.text('driver', d) if names else d} {numbers.num(v, 4)} {'m' if present.driver_unit(model, d) == 'N' else 'rad'}"
                      for d, v in sorted(s.torque.travel.items()))
 
 
@@ -231,9 +230,9 @@ def _reference_phrase(ref, label: str, which: str) -> str:
     value, basis, peak, unit, sym = ((ref.force, ref.force_basis, ref.force_peak, "N", "F_ref") if which == "force"
                                      else (ref.moment, ref.moment_basis, ref.moment_peak, "N m", "M_ref"))
     if basis == "unbalanced peak":
-        return f"{sym} = {_num(value, 4)} {unit}, the peak inertial {which} of the unbalanced stage '{label}'"
-    return (f"{sym} = {_num(value, 4)} {unit}, {ref.floor_fraction:g} of the gross inertial {which} of the unbalanced "
-            f"stage '{label}' (larger than its peak, {_num(peak, 3)} {unit})")
+        return f"{sym} = {numbers.num(value, 4)} {unit}, the peak inertial {which} of the unbalanced stage '{label}'"
+    return (f"{sym} = {numbers.num(value, 4)} {unit}, {ref.floor_fraction:g} of the gross inertial {which} of the unbalanced "
+            f"stage '{label}' (larger than its peak, {numbers.num(peak, 3)} {unit})")
 
 
 def base_scales(results: dict) -> dict[str, float]:

@@ -44,10 +44,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..display.numbers import ratio as ratio_text
+from ..display import numbers
 from ..study import REFERENCE_KINDS, reference_kind
 from .costs import cost_factors, factor_text
-from ..display.numbers import num as _num
 
 #: a ratio within this of 1 reads "unchanged"
 UNCHANGED = 0.01
@@ -67,7 +66,7 @@ def percent(x: float) -> str:
     v = 100 * x
     if abs(v) >= 100:
         return f"{v:.0f} %"  # 4743 %, never 4.74e+03
-    return f"{_num(v, 3)} %" if abs(v) >= 1 else f"{_num(v, 2)} %"
+    return f"{numbers.num(v, 3)} %" if abs(v) >= 1 else f"{numbers.num(v, 2)} %"
 
 
 def outcome(ratio: float | None, cancelled: bool, claimed: bool, was_zero: bool = False) -> dict:
@@ -86,7 +85,7 @@ def outcome(ratio: float | None, cancelled: bool, claimed: bool, was_zero: bool 
     elif r < 1.0:
         kind, text = "reduced", f"reduced by {percent(1.0 - r)}"
     else:
-        shown = ratio_text(r, None)  # the site's convention: percent below ten times, a factor from there on
+        shown = numbers.ratio(r, None)  # the site's convention: percent below ten times, a factor from there on
         kind, text = "worse", f"worse: {shown} {'the' if shown.startswith('×') else 'of the'} reference"
     return {"outcome": kind, "ratio": r, "claimed": claimed, "text": text}
 
@@ -123,7 +122,7 @@ def aim_verdict(aim: dict, loads: dict, realisable: bool) -> tuple[str, str, dic
     else:
         level = "good"
     parts = [f"{o['label']} {o['text']} (objective)" for o in objective]
-    parts += [f"{c['label']} {_num(c['ratio'], 3)} x the unbalanced, cap {c['at_most']:g} x "
+    parts += [f"{c['label']} {numbers.num(c['ratio'], 3)} x the unbalanced, cap {c['at_most']:g} x "
               f"{'kept' if c['kept'] else 'broken'}" for c in caps]
     if side:
         parts.append(", ".join(f"{p} {loads[p]['text']}" for p in side) + (" (side effects)" if len(side) > 1 else " (side effect)"))

@@ -28,7 +28,6 @@ from ..mechanics.planar import cross, rotate
 from ..model import Attachment, Model
 from .run import model_scale, _run_adaptive
 from .settings import ValidationSettings, _step_grid, default_settings
-from ..display.numbers import num as _num
 
 #: the small masses tried in turn, times ``small_mass``: the smallest that pymunk holds together
 SMALL_MASS_STEPS = (1.0, 10.0, 100.0)
@@ -242,7 +241,7 @@ def free_floating(
                 p_scale = float(np.max(speed @ mk)) or 1.0
                 h_scale = float(np.max((arm * speed) @ mk + np.abs(analysis.v[:, :, 2]) @ ik)) or 1.0
                 if dh > 1e-3 * h_scale or dp > 1e-3 * p_scale:
-                    run_notes.append(f"the simulation lost {_num(dh, 3)} N m s of angular momentum")
+                    run_notes.append(f"the simulation lost {numbers.num(dh, 3)} N m s of angular momentum")
                     run = None
             if run is not None:
                 if fraction is not None:

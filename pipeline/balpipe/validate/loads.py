@@ -136,6 +136,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pymunk
 
+from ..display import numbers
 from ..engine import Analysis, analyse
 from ..model import Model
 from .extend import continued, settling_steps
@@ -143,7 +144,6 @@ from .run import SimulationRun, model_scale, _relative_poses, _run_adaptive
 from .settings import (MAX_ITERATIONS, Refinement, ValidationSettings, _jumps, _law_kinds, _step_grid,
                        default_settings, refine_step, step_setting)
 from .verdict import Verdict
-from ..display.numbers import num as _num
 
 @dataclass
 class StageValidation(Verdict):
@@ -406,15 +406,15 @@ def _judge(v: StageValidation, refinement: Refinement, settings: ValidationSetti
                                           default=-math.inf))
     if not math.isfinite(worst):
         v.unconfirmed = True
-        v.remedy = f"a finer validation.dt than {_num(v.dt, 3)} s, or validation: {{iterations: {2 * MAX_ITERATIONS}}}"
+        v.remedy = f"a finer validation.dt than {numbers.num(v.dt, 3)} s, or validation: {{iterations: {2 * MAX_ITERATIONS}}}"
     elif refinement.shrinks is not False and refinement.remedy_dt is not None:
         v.unconfirmed = True
         v.remedy = (f"{step_setting(refinement.remedy_dt)} (second order: the residual falls with the square of the step; the "
-                    f"validator stopped at {_num(1e3 * v.dt, 4)} ms, {settings.max_refinement:g} times finer at most)")
+                    f"validator stopped at {numbers.num(1e3 * v.dt, 4)} ms, {settings.max_refinement:g} times finer at most)")
     elif not excess > (v.solver_change if math.isfinite(v.solver_change) else math.inf):
         v.unconfirmed = True
         v.remedy = (f"validation: {{iterations: {2 * v.iterations}}} (the solver had not converged: its loads still "
-                    f"changed by {_num(v.solver_change, 2)} of the reference between the last doublings)")
+                    f"changed by {numbers.num(v.solver_change, 2)} of the reference between the last doublings)")
     return v
 
 
@@ -518,12 +518,12 @@ def _validate_once(model: Model, analysis: Analysis, unbalanced_peaks: tuple[flo
     reasons = []
     tol = settings.tolerance
     if not fres <= tol:
-        reasons.append(f"force residual {_num(fres, 3)} > {tol:g}")
+        reasons.append(f"force residual {numbers.num(fres, 3)} > {tol:g}")
     if not mres <= tol:
-        reasons.append(f"moment residual {_num(mres, 3)} > {tol:g}")
+        reasons.append(f"moment residual {numbers.num(mres, 3)} > {tol:g}")
     for what, pk in (("force", fpk), ("moment", mpk)):
         if what in expect and not pk <= settings.balance_tolerance:
-            reasons.append(f"{what} not balanced: simulated peak {_num(pk, 3)} of the reference > {settings.balance_tolerance:g}")
+            reasons.append(f"{what} not balanced: simulated peak {numbers.num(pk, 3)} of the reference > {settings.balance_tolerance:g}")
     notes = notes + list(run.sim.notes)
     if run.sim.floored:
         notes.append(

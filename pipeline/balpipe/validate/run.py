@@ -17,6 +17,7 @@ import pymunk
 import pymunk.batch
 from pymunk._chipmunk_cffi import lib as _cp
 
+from ..display import numbers
 from ..engine import Analysis
 from ..mechanics.planar import rotate
 from ..model import FRAME, Gear, Model, Prismatic, Revolute
@@ -24,7 +25,6 @@ from .extend import is_periodic_moving, start_state
 from .feedforward import inertial_forces, periodic_times
 from .settings import HEALTH_LIMIT, MAX_ITERATIONS, _jumps
 from .space import SimModel, build_space
-from ..display.numbers import num as _num
 
 #: checked samples compared with the analysis at a time (a run that comes apart ends at most
 #: this many checks, ten steps apart, after it strays)
@@ -441,7 +441,7 @@ def _check_apart(states: np.ndarray, nb: int, base: int | None, q_ref: np.ndarra
     dev_a = np.max(np.abs(q[:, :, 2] - frame[:, None, 2] - q_ref[:, :, 2]), axis=1)
     bad = ~((dev_p <= abort[0]) & (dev_a <= abort[0]))
     if bad.any():
-        raise FloatingPointError(f"the simulation came apart at t = {_num(float(t[np.argmax(bad)]), 4)} s")
+        raise FloatingPointError(f"the simulation came apart at t = {numbers.num(float(t[np.argmax(bad)]), 4)} s")
 
 
 def _relative_poses(run: SimulationRun, idx: np.ndarray | None, t: np.ndarray) -> np.ndarray:

@@ -13,9 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..display import numbers
 from ..engine import Analysis
 from ..model import Model
-from ..display.numbers import num as _num
 
 #: default number of steps over the motion (the step is also kept below 0.01 / w_max)
 STEPS_PER_MOTION = 1000
@@ -140,12 +140,12 @@ def refine_step(first, rerun, error, good, what: str, budget: float = MAX_REFINE
         if not shrinks:
             break
         best = finer
-    steps = ", ".join(f"{_num(e, 2)} at {_num(1e3 * dt, 4)} ms" for dt, e in trail)
+    steps = ", ".join(f"{numbers.num(e, 2)} at {numbers.num(1e3 * dt, 4)} ms" for dt, e in trail)
     if len(trail) > 1:
         if best is first:
             first.notes.append(f"{what} {steps}: a finer step does not shrink it as an integration error shrinks")
         else:
-            best.notes.append(f"{what} {steps} (the step's error, second order): kept the run at {_num(1e3 * best.dt, 4)} ms")
+            best.notes.append(f"{what} {steps} (the step's error, second order): kept the run at {numbers.num(1e3 * best.dt, 4)} ms")
     best.timing["total_s"] = spent
     resolved = good(best)
     remedy = None

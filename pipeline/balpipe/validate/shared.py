@@ -36,13 +36,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..display import numbers
 from ..engine import Analysis
 from ..model import Model
 from .extend import is_moving_start
 from .loads import StageValidation, validate
 from .settings import ITERATIONS, MAX_ITERATIONS, ValidationSettings
 from .torque import MIN_RESOLUTION, TorqueDriven, _torque_driven_once, _plan, torque_driven
-from ..display.numbers import num as _num
 
 #: the margins of a proof: the torque-driven run's tracking error and load residuals at most this
 #: fraction of their tolerances (the early acceptance of both runs), its resolution this many
@@ -99,8 +99,8 @@ def validation_from_torque(tq: TorqueDriven, analysis: Analysis, peaks: tuple[fl
            f"within the tolerance, and the run with {halved.iterations} solver iterations gave the same loads to a "
            f"tenth of the tolerance (the solver converged)")
     note = (f"proved by the torque-driven run: under the engine's efforts pymunk followed the plan to "
-            f"{_num(tq.tracking_error_max, 2)} of the travel, and its loads on the frame match the analysis to "
-            f"{_num(max(tq.force_residual, tq.moment_residual), 2)} of the reference, {how}: "
+            f"{numbers.num(tq.tracking_error_max, 2)} of the travel, and its loads on the frame match the analysis to "
+            f"{numbers.num(max(tq.force_residual, tq.moment_residual), 2)} of the reference, {how}: "
             f"no position-driven run needed")
     return StageValidation(
         t=np.asarray(analysis.t, dtype=float), force=tq.force, moment=tq.moment, force_error=ferr, moment_error=merr,

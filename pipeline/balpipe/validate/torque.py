@@ -50,6 +50,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..display import numbers
 from ..engine import Analysis, analyse
 from ..model import Attachment, Model
 from .loads import _on_grid, loads_at  # the same sampling of the loads as the position-driven check
@@ -60,7 +61,6 @@ from .settings import (HEALTH_LIMIT, ITERATIONS, ValidationSettings, _jumps, _la
 from .applied import COULOMB_NOTE, AppliedLoads
 from .space import build_space
 from .verdict import Verdict
-from ..display.numbers import num as _num
 
 __all__ = ["TorqueDriven", "torque_driven", "floored_model", "TRACKING_TOLERANCE", "CALIBRATION_FACTOR"]
 
@@ -289,7 +289,7 @@ def _plan(model: Model, analysis: Analysis, settings: ValidationSettings, analyt
     share = 0.0
     if floored or auxiliary:  # before the jumps' averaging, which the bare efforts do not have
         share = _floor_share(efforts, analysis, analytic_model, times, idx)
-        loads = (f"the efforts include their inertial loads, {_num(100 * share, 3)} % of the peak effort" if share > 1e-9
+        loads = (f"the efforts include their inertial loads, {numbers.num(100 * share, 3)} % of the peak effort" if share > 1e-9
                  else "along this motion they add no load to the efforts")
         size = f"{100 * settings.mass_floor:g} % of the largest mass and moment"
         what = (["floor parts (" + ", ".join(floored) + f": {size})"] if floored else []) + (
@@ -397,7 +397,7 @@ def _torque_driven_once(
         low = run(CALIBRATION_FACTOR, stop_at=enough)
         calib, partial = relative_error(low), low is not None and low.stopped
         if partial:
-            notes.append(f"the calibration run stopped at t = {_num(low.t[-1], 4)} s, once its tracking error was "
+            notes.append(f"the calibration run stopped at t = {numbers.num(low.t[-1], 4)} s, once its tracking error was "
                          f"{calibration_stop:g} times the run's (what the verdict needs): its error and the "
                          f"resolution are lower bounds")
     F0, M0 = reference if reference is not None else (analysis.max_inertial_force, analysis.max_inertial_moment)
@@ -442,7 +442,7 @@ def _torque_driven_once(
     tol = settings.tracking_tolerance
     amplification = math.nan
     if not worst <= tol:
-        reasons.append(f"tracking error {_num(worst, 3)} of the travel > {tol:g}")
+        reasons.append(f"tracking error {numbers.num(worst, 3)} of the travel > {tol:g}")
         nudged = run(1.0 + SENSITIVITY)
         amplification = (math.inf if nudged is None else max(
             (float(np.max(np.abs(np.asarray(nudged.driver_error[k]) - np.asarray(e)))) / (travel[k] or 1.0)
@@ -450,7 +450,7 @@ def _torque_driven_once(
     if calibrate and not resolution >= MIN_RESOLUTION:
         reasons.append(
             f"the run does not resolve a model error: efforts times {CALIBRATION_FACTOR:g} give only "
-            f"{_num(resolution, 3)} times its tracking error (< {MIN_RESOLUTION:g})"
+            f"{numbers.num(resolution, 3)} times its tracking error (< {MIN_RESOLUTION:g})"
         )
     return TorqueDriven(
         t=t, force=F, moment=M, tracking=tracking, tracking_error=rel, travel=travel, tracking_error_max=worst,
@@ -568,13 +568,13 @@ def _judge(r: TorqueDriven, refinement: Refinement, settings: ValidationSettings
         return r  # the efforts do not drive the mechanism along its plan: fails
     r.unconfirmed = True
     if unstable:
-        moved = "came apart" if math.isinf(r.amplification) else f"moved by {_num(r.amplification, 3)} times its tracking error"
+        moved = "came apart" if math.isinf(r.amplification) else f"moved by {numbers.num(r.amplification, 3)} times its tracking error"
         r.remedy = (f"none at this step: the run is unstable open loop (efforts times 1 + {SENSITIVITY:g} {moved}), so its "
                     f"tracking error cannot show the efforts wrong; the position-driven check stands. A driven shaft "
                     f"with its real inertia (a flywheel, a motor's rotor seen through its reduction) steadies it")
     elif refinement.remedy_dt is not None:
         r.remedy = (f"{step_setting(refinement.remedy_dt)} (second order: the tracking error falls with the square of the step; "
-                    f"the validator stopped at {_num(1e3 * r.dt, 4)} ms, {settings.max_refinement:g} times finer at most)")
+                    f"the validator stopped at {numbers.num(1e3 * r.dt, 4)} ms, {settings.max_refinement:g} times finer at most)")
     elif settings.dt:
         goal = 0.5 * min(tol, r.calibration_error / MIN_RESOLUTION if math.isfinite(r.calibration_error) else tol)
         r.remedy = f"a finer validation.dt than the spec's {settings.dt:g} s"
