@@ -231,7 +231,7 @@ def timing_script(times: dict) -> str:
     from one identical build to the next, so the page itself stays byte-identical."""
     import json
 
-    totals = {k: round(v.get("all_runs_s", v.get("total_s", 0.0)), 4) for k, v in times.items()}
+    totals = {k: round(v["all_runs_s"], 4) for k, v in times.items()}
     return (
         "(function(){var T=" + json.dumps(totals, sort_keys=True) + ";"
         "document.querySelectorAll('[data-timing]').forEach(function(e){"
