@@ -205,6 +205,8 @@ def test_a_part_that_does_not_fit_is_a_located_problem_and_not_green():
     judged = r["verdict"]["stages"]["counterweights"]
     assert judged["level"] not in ("good", "ok") and not judged["realisable"] and "part cannot be made" in judged["text"]
     assert not st.ok
+    # the headline names the claim shown false (the part fits its region), not a cross-check
+    assert r["verdict"]["verdict"] == "fails" and r["verdict"]["words"] == "part cw_crank cannot be made as specified"
 
 
 def test_parts_bad_input_is_a_located_error():

@@ -414,7 +414,7 @@ def verdict(results: dict, weights: dict[str, float] | None = None, main: set[st
         # while every claim holds (the simulation contradicts the analysis) says so instead, never
         # "balancing fails" beside loads the analysis finds cancelled
         if not claims_fail and balance_level != "bad":
-            kind, words = "fails", check_failure(results.get("problems") or [])
+            kind, words = "fails", check_failure(results.get("problems") or [], results.get("parts") or [])
         elif kind != "fails":
             kind, words = "fails", "balancing fails"
     unconfirmed = list(results.get("unconfirmed") or [])
@@ -441,10 +441,14 @@ def verdict(results: dict, weights: dict[str, float] | None = None, main: set[st
             "validation": "unconfirmed" if unconfirmed else None}
 
 
-def check_failure(problems: list[str]) -> str:
-    """The headline of a build that failed a check while every claim of the analysis holds: the
-    simulation contradicts the analysis (a claim shown false by pymunk), or the analysis' own
-    cross-check fails."""
+def check_failure(problems: list[str], parts: list[dict] | None = None) -> str:
+    """The headline of a build that failed a check while every claim of the analysis holds, naming
+    the claim shown false: the simulation contradicts the analysis (pymunk), a counterweight made
+    as a part does not fit the region its spec allows (``parts``: results.json's, ``fits``), or
+    the analysis' own cross-check fails."""
     if any(p.startswith(("pymunk validation", "torque-driven run")) for p in problems):
         return "the simulation contradicts the analysis"
+    unfit = sorted({p["name"] for p in parts or [] if p.get("fits") is False})
+    if unfit:
+        return f"part{'s' if len(unfit) > 1 else ''} {', '.join(unfit)} cannot be made as specified"
     return "a cross-check fails"
