@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from . import runner
-from .display.numbers import num_at
+from .display.numbers import num, num_at
 from .loader import LoadedSpec, SpecError, SpecErrors, load, load_text
 from .report.results import json_safe
 from .study import Study
@@ -271,7 +271,7 @@ def _fmt(x: Any) -> str:
     if isinstance(x, bool):
         return str(x).lower()
     if isinstance(x, float):
-        return f"{x:.6g}"
+        return num(x, 6)  # the pages' numbers: 1500000, never 1.5e+06
     return str(x)
 
 
@@ -304,7 +304,9 @@ def _rel(d: dict) -> str:
         return ""
     if r == 0:
         return "="
-    return f"{100 * r:+.3g} %" if math.isfinite(r) and abs(r) >= 1e-4 else (f"{r:+.2e}" if math.isfinite(r) else "new")
+    if not math.isfinite(r):
+        return "new"
+    return f"{'+' if r > 0 else ''}{num(100 * r, 3)} %"
 
 
 def _frame_summary(side: Side) -> dict[str, dict]:

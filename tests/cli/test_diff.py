@@ -211,3 +211,13 @@ def test_the_diff_says_what_the_frame_on_its_mounts_feels_now(tmp_path):
     assert "The frame on its mounts" in out.read_text()
     plain = balpipe("diff", ROOT / "specs" / "scott_russell.yaml", ROOT / "specs" / "scott_russell.yaml", "--no-sim", "-f", "json")
     assert json.loads(plain.stdout)["mounts"] == []
+
+
+def test_the_diffs_numbers_are_the_pages_numbers():
+    """An input of 1.5 MN/m reads 1500000 (not 1.5e+06), a relative change of a millionth
+    +0.0001 % (not +1.00e-06): balpipe.display.numbers, as on the pages."""
+    from balpipe.diff import _fmt, _rel
+
+    assert _fmt(1.5e6) == "1500000" and _fmt(0.000123456789) == "0.000123457"
+    assert _rel({"relative": 1e-6}) == "+0.0001 %" and _rel({"relative": -0.25}) == "-25 %"
+    assert _rel({"relative": 0.0}) == "=" and _rel({"relative": float("inf")}) == "new"
