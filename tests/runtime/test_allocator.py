@@ -47,5 +47,9 @@ def test_the_thresholds_keep_the_chunks_memory_and_change_no_result():
     ours, default, users = run(), run(BALPIPE_MALLOC="default"), run(MALLOC_TRIM_THRESHOLD_="131072")
     assert ours["set"] is True and default["set"] is False and users["set"] is False
     assert ours["digest"] == default["digest"] == users["digest"]
-    # a second analysis in the memory the first one freed: a fraction of the pages faulted in again
-    assert 4 * ours["faults"] < default["faults"], (ours, default)
+    # a second analysis in the memory the first one freed: under half the pages faulted in again.
+    # The default re-faults the chunks' arrays (5,450 pages on both machines seen); what is left
+    # with the thresholds set depends on the kernel (715 pages on the development machine, 1,430
+    # on CI's), so the bound is the half, which thresholds that did nothing (about the same count
+    # as the default) still fail.
+    assert 2 * ours["faults"] < default["faults"], (ours, default)
