@@ -196,25 +196,33 @@ def _step_grid(t: np.ndarray, dt_target: float) -> tuple[float, int, np.ndarray 
 
 
 JUMP = 1e-3  # an acceleration step above this fraction of a law's largest acceleration is a jump
+#: :func:`_find_jumps` cuts each candidate interval in this many sections a round (one call of each
+#: law for all of them: the calls, not the points, are what a law costs), SECTION_ROUNDS rounds
+SECTIONS = 32
+SECTION_ROUNDS = 12
 
 
-#: the last results of :func:`_located_jumps`, by (id(model), times): every run of a stage, and every
-#: measurement of its loads, asks again for the same model and step times (the bisection evaluates
-#: each law 120 times: 7 % of the simulated build's CPU before it was remembered)
-_JUMPS_MEMO: dict[tuple, tuple[Model, np.ndarray, tuple[np.ndarray, np.ndarray]]] = {}
+#: the last results of :func:`_located_jumps`, by (the driver laws, times): every run of a stage, and
+#: every measurement of its loads, asks again for the same laws and step times, on the stage's model
+#: and on the model with pymunk's floor parts, which shares its laws (the bisection evaluates each
+#: law 120 times: 7 % of the simulated build's CPU before it was remembered; by model, a third of
+#: paper 003's finds were the other model's)
+_JUMPS_MEMO: dict[tuple, tuple[tuple, np.ndarray, tuple[np.ndarray, np.ndarray]]] = {}
 _JUMPS_MEMO_SIZE = 32
 
 
 def _located_jumps(model: Model, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_find_jumps`, remembered for the last few (model, times) pairs (the model by identity:
-    its laws are functions; the times by value). The arrays returned are copies."""
+    """:func:`_find_jumps`, remembered for the last few (laws, times) pairs (the model's driver laws
+    by identity, all that :func:`_find_jumps` reads of it: they are functions; the times by value).
+    The arrays returned are copies."""
     times = np.asarray(times, dtype=float)
-    k = (id(model), times.shape, hash(times.tobytes()))
+    laws = tuple(d.law for d in model.drivers)
+    k = (tuple(id(law) for law in laws), times.shape, hash(times.tobytes()))
     hit = _JUMPS_MEMO.get(k)
-    if hit is None or hit[0] is not model or not np.array_equal(hit[1], times):
+    if hit is None or any(a is not b for a, b in zip(hit[0], laws)) or not np.array_equal(hit[1], times):
         if len(_JUMPS_MEMO) >= _JUMPS_MEMO_SIZE:
             _JUMPS_MEMO.pop(next(iter(_JUMPS_MEMO)))
-        hit = (model, times.copy(), _find_jumps(model, times))
+        hit = (laws, times.copy(), _find_jumps(model, times))
         _JUMPS_MEMO[k] = hit
     ks, tj = hit[2]
     return ks.copy(), tj.copy()
@@ -223,7 +231,9 @@ def _located_jumps(model: Model, times: np.ndarray) -> tuple[np.ndarray, np.ndar
 def _find_jumps(model: Model, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(k, t_j) of every acceleration jump of a driver law between times[k-1] and times[k]. The
     intervals where some law's acceleration changes by more than 50 times the median change are
-    candidates; each is bisected (all at once) down to round-off and kept where the acceleration
+    candidates; each is cut in :data:`SECTIONS` (all at once), the section with the largest change
+    kept, down to round-off (:data:`SECTION_ROUNDS` rounds: the 2^-60 of the interval that 60
+    bisections reach, in a fifth of the laws' calls), and kept where the acceleration
     still steps by more than :data:`JUMP` of the law's largest across the last interval: a fast
     but smooth change (a path's arc, where the acceleration turns with the tangent) shrinks to
     nothing and is no jump."""
@@ -246,12 +256,14 @@ def _find_jumps(model: Model, times: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
     a, b = times[ks - 1].astype(float), times[ks].astype(float)
     fa, fb = acc(a), acc(b)
-    for _ in range(60):
-        m = 0.5 * (a + b)
-        fm = acc(m)
-        left = np.max(np.abs(fm - fa), axis=0) >= np.max(np.abs(fb - fm), axis=0)  # the step is in [a, m]
-        b, fb = np.where(left, m, b), np.where(left, fm, fb)
-        a, fa = np.where(left, a, m), np.where(left, fa, fm)
+    inner = np.arange(1, SECTIONS)[:, None] / SECTIONS
+    for _ in range(SECTION_ROUNDS):  # SECTIONS ** SECTION_ROUNDS = 2^60: the bisection's 60 halvings
+        nodes = np.concatenate([a[None], a + (b - a) * inner, b[None]])  # (SECTIONS + 1, intervals)
+        f = np.concatenate([fa[:, None], acc(nodes[1:-1].reshape(-1)).reshape(len(laws), SECTIONS - 1, -1),
+                            fb[:, None]], axis=1)  # (laws, SECTIONS + 1, intervals)
+        j = np.argmax(np.max(np.abs(np.diff(f, axis=1)), axis=0), axis=0)  # the section with the step (the first)
+        cols = np.arange(len(a))
+        a, b, fa, fb = nodes[j, cols], nodes[j + 1, cols], f[:, j, cols], f[:, j + 1, cols]
     real = np.max(np.abs(fb - fa), axis=0) > JUMP
     return ks[real], (0.5 * (a + b))[real]
 
