@@ -246,6 +246,31 @@ def test_jump_times_are_the_laws_acceleration_corners(fraction):
 
 
 @pytest.mark.parametrize("fraction", [0.3, 0.2371])
+def test_jump_times_are_found_to_the_float_and_shared_by_models_with_the_same_laws(fraction):
+    """The 32-section ends on the two neighbouring floats around the corner (what 60 bisections
+    reached), and a model that shares the laws (the stage's model with pymunk's floor parts) is
+    answered from the same search, with the same values."""
+    from balpipe.model import Attachment
+    from balpipe.validate import settings as S
+
+    model = _jumpy_arm(None, fraction)
+    times = np.linspace(0.0, 0.5, 1001)
+    ks, tj = S._find_jumps(model, times)
+    for t_j, exact in zip(tj, (fraction * 0.5, (1 - fraction) * 0.5)):
+        assert abs(t_j - exact) <= 2 * np.spacing(exact)
+    heavier = model.replace_body(model.bodies[0].with_attachments(Attachment("pymunk floor", 0.1, (0.0, 0.0), 0.0, kind="part")))
+    calls = []
+    find = S._find_jumps
+    try:
+        S._find_jumps = lambda m, t: calls.append(m) or find(m, t)
+        S._JUMPS_MEMO.clear()
+        first, second = S.jump_times(model, times), S.jump_times(heavier, times)
+    finally:
+        S._find_jumps = find
+    assert first == second == tj.tolist() and calls == [model]
+
+
+@pytest.mark.parametrize("fraction", [0.3, 0.2371])
 def test_a_jump_of_the_effort_inside_a_step_gets_its_impulse(fraction):
     """The effort of the step whose velocity window holds an acceleration jump is the window's
     mean (the efforts just before and after, each over its part): the open-loop run follows the
