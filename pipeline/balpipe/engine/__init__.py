@@ -20,7 +20,8 @@ Inverse dynamics solves Phi_q^T lambda = Q - M q'' (M q'' + Phi_q^T lambda = Q).
 
 Redundant actuation (more drivers than degrees of freedom, e.g. a 4-RRR with four base motors):
 the consistent over-determined position, velocity and acceleration equations are solved in least
-squares (Gauss-Newton, least squares by QR, exact for consistent drivers), and the
+squares (Gauss-Newton, exact for consistent drivers; by the normal equations, refined, where they are
+well conditioned, :mod:`.normal`, else by QR), and the
 multipliers are those whose actuator efforts have the least norm (:func:`.dynamics.solve_multipliers`). The
 joints alone must not be over-constrained. The shaking
 loads are computed twice, independently:
@@ -34,7 +35,8 @@ loads are computed twice, independently:
 Modules, one job each: :mod:`.compile` (primitives, :func:`compile_model`), :mod:`.constraints`
 (Phi, Phi_q, nu, gamma), :mod:`.positions` (continuation; its solves on the block path in
 :mod:`.newton_blocks`), :mod:`.kinematics` (velocities, accelerations),
-:mod:`.dynamics` (multipliers, tooth loads, reactions), :mod:`.analysis` (:class:`Analysis`,
+:mod:`.dynamics` (multipliers, tooth loads, reactions), :mod:`.normal` (the redundant systems' solves by
+the normal equations), :mod:`.analysis` (:class:`Analysis`,
 :func:`analyse`), :mod:`.structure` and :mod:`.fastpath` (the block-triangular path),
 :mod:`.warmstart` (a new geometry of a closed loop solved from fixed anchors:
 :func:`record_anchors`, :func:`warm_start`), :mod:`.shared` (the general path's models of one

@@ -3,6 +3,8 @@ tooth forces and joint reactions."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from ..model import Model, Prismatic, Revolute
@@ -10,6 +12,7 @@ from ..mechanics.planar import cross, rotate
 from .compile import Compiled, _perp
 from .constraints import _split
 from .errors import AnalysisError
+from .normal import Normal, factor
 
 
 def tooth_rows(c: Compiled, qx: np.ndarray, J: np.ndarray) -> list[dict[str, np.ndarray]]:
@@ -145,7 +148,21 @@ def multiplier_map(c: Compiled, Jf: np.ndarray) -> np.ndarray:
     return solve_multipliers(c, Jf, np.broadcast_to(np.eye(n), (len(Jf), n, n)))
 
 
-def solve_multipliers(c: Compiled, Jf: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+def multiplier_solver(c: Compiled, Jf: np.ndarray, normal: Normal | None = None) -> Callable[[np.ndarray], np.ndarray]:
+    """rhs (N, n) -> the multipliers (N, m) of :func:`solve_multipliers`, for many right-hand
+    sides with one ``Jf`` (the models of one geometry, :func:`.shared.multipliers`): with
+    redundant actuation the normal equations' factorisation (``normal``: :mod:`.normal`, of this
+    ``Jf``; made here if None) and its null space, kept, where they hold; else the map
+    :func:`multiplier_map`, made once."""
+    if Jf.shape[1] > Jf.shape[2]:
+        ne = normal if normal is not None else factor(Jf)
+        if ne is not None and ne.null_space(sorted(c.driver_rows.values()), Jf.shape[1] - Jf.shape[2]) is not None:
+            return lambda rhs: solve_multipliers(c, Jf, rhs, ne)
+    K = multiplier_map(c, Jf)
+    return lambda rhs: np.einsum("nmk,nk->nm", K, rhs)
+
+
+def solve_multipliers(c: Compiled, Jf: np.ndarray, rhs: np.ndarray, normal: Normal | None = None) -> np.ndarray:
     """Lagrange multipliers from Phi_q^T lambda = Q - M q'' (N samples): ``rhs`` (N, n) gives
     (N, m); (N, n, k), k right-hand sides at once (a regressor's columns), gives (N, m, k).
 
@@ -158,18 +175,29 @@ def solve_multipliers(c: Compiled, Jf: np.ndarray, rhs: np.ndarray) -> np.ndarra
     still equals minus the momentum rate, whatever the split (the null space loads every body
     with zero net force). This is the pseudo-inverse solution tau = (G^T)^+ f of the reduced
     dynamics G^T tau = f, G the Jacobian of the actuated coordinates.
+
+    lambda_p and N come from the normal equations (:mod:`.normal`: ``normal``, the
+    factorisation of this ``Jf``, or made here) where they hold, refined to QR's accuracy;
+    else from the complete QR factorisation of Jf (the same solution to round-off).
     """
     A = np.transpose(Jf, (0, 2, 1))  # (N, n, m)
     n, m = A.shape[1], A.shape[2]
     B = rhs[..., None] if rhs.ndim == 2 else rhs  # (N, n, k)
+    lam = None
     if m == n:
         lam = np.linalg.solve(A, B)
     else:
-        Q, R = np.linalg.qr(Jf, mode="complete")  # Jf = [Q1 Q2] [R1; 0]: Q2 spans the null space of A
-        y = np.linalg.solve(np.transpose(R[:, :n, :], (0, 2, 1)), B)  # R1^T y = rhs
-        lam_p = Q[:, :, :n] @ y  # the least-norm solution, Q1 R1^-T rhs
-        null = Q[:, :, n:]  # (N, m, r)
         drv = sorted(c.driver_rows.values())
-        z = -np.linalg.pinv(null[:, drv, :]) @ lam_p[:, drv]  # (N, r, k)
-        lam = lam_p + null @ z
+        ne = normal if normal is not None else factor(Jf)
+        M = None if ne is None else ne.null_space(drv, m - n)
+        lam_p = None if M is None or ne is None else ne.least_norm(B)
+        if M is not None and lam_p is not None:
+            lam = lam_p - M @ lam_p[:, drv]  # the null space's component that minimises the efforts
+        else:
+            Q, R = np.linalg.qr(Jf, mode="complete")  # Jf = [Q1 Q2] [R1; 0]: Q2 spans the null space of A
+            y = np.linalg.solve(np.transpose(R[:, :n, :], (0, 2, 1)), B)  # R1^T y = rhs
+            lam_p = Q[:, :, :n] @ y  # the least-norm solution, Q1 R1^-T rhs
+            null = Q[:, :, n:]  # (N, m, r)
+            z = -np.linalg.pinv(null[:, drv, :]) @ lam_p[:, drv]  # (N, r, k)
+            lam = lam_p + null @ z
     return lam[..., 0] if rhs.ndim == 2 else lam

@@ -6,6 +6,7 @@ import numpy as np
 
 from .compile import Compiled
 from .constraints import with_frame, acceleration_rhs, jacobian, velocity_rhs
+from .normal import Normal, factor
 
 
 def _solve_rect(J: np.ndarray, b: np.ndarray, qr: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
@@ -24,13 +25,42 @@ def _factors(J: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     return None if J.shape[-2] == J.shape[-1] else np.linalg.qr(J)
 
 
-def _vel_acc(c: Compiled, q: np.ndarray, t: np.ndarray, laws: list | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Velocities and accelerations (N, n) at positions q: one Jacobian and, with redundant
-    drivers, one QR factorisation for both solves (the same numbers as factorising it twice).
-    ``laws``: :func:`.constraints.law_triples` at ``t`` (evaluated when not given)."""
+class Consistent:
+    """Solves of J x = b for one stack J (N, m, n) of full column rank and consistent right-hand
+    sides: LU where square; with redundant drivers (m > n) the normal equations, refined
+    (:mod:`.normal`: one Cholesky factorisation for every right-hand side), and where they do
+    not hold (:func:`.normal.factor` or a refinement gives None), the reduced QR factors of
+    :func:`_solve_rect`, made once. ``normal``: the factorisation, for other solves with this J
+    (the multipliers of :func:`.dynamics.solve_multipliers`), or None."""
+
+    def __init__(self, J: np.ndarray):
+        self.J = J
+        self.normal: Normal | None = factor(J) if J.shape[-2] > J.shape[-1] else None
+        self._qr: tuple[np.ndarray, np.ndarray] | None = None
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """x (N, n)."""
+        if self.normal is not None:
+            x = self.normal.solve(b)
+            if x is not None:
+                return x
+        if self._qr is None:
+            self._qr = _factors(self.J)
+        return _solve_rect(self.J, b, self._qr)
+
+
+def rates(c: Compiled, q: np.ndarray, t: np.ndarray, laws: list | None = None) -> tuple[np.ndarray, np.ndarray, Consistent]:
+    """Velocities and accelerations (N, n) at positions q, and the solves of their Jacobian
+    Phi_q (:class:`Consistent`: one factorisation for both). ``laws``:
+    :func:`.constraints.law_triples` at ``t`` (evaluated when not given)."""
     qx = with_frame(q)
-    J = jacobian(c, qx)[:, :, 3:]
-    qr = _factors(J)
-    v = _solve_rect(J, velocity_rhs(c, t, laws), qr)
-    a = _solve_rect(J, acceleration_rhs(c, qx, with_frame(v), t, laws), qr)
+    solver = Consistent(jacobian(c, qx)[:, :, 3:])
+    v = solver.solve(velocity_rhs(c, t, laws))
+    a = solver.solve(acceleration_rhs(c, qx, with_frame(v), t, laws))
+    return v, a, solver
+
+
+def _vel_acc(c: Compiled, q: np.ndarray, t: np.ndarray, laws: list | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Velocities and accelerations (N, n) at positions q (:func:`rates`)."""
+    v, a, _ = rates(c, q, t, laws)
     return v, a

@@ -13,6 +13,7 @@ from .compile import Compiled
 from .constraints import GridLaws, with_frame, jacobian, law_positions, law_triples, residual
 from .errors import AnalysisError
 from .kinematics import _solve_rect, _vel_acc
+from .normal import factor
 
 
 class Ops(Protocol):
@@ -73,13 +74,20 @@ def _check_redundancy(c: Compiled, q: np.ndarray, t: float) -> None:
 
 
 def newton_raphson(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER,
-                   laws: list | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   laws: list | None = None, normal: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Batched Newton-Raphson. Returns (q, converged mask, residual norms). ``laws``: the
-    drivers' f(t), :func:`.constraints.law_positions` (evaluated here when not given)."""
+    drivers' f(t), :func:`.constraints.law_positions` (evaluated here when not given).
+
+    With redundant drivers a step is the least-squares one (Gauss-Newton), through the normal
+    equations (:mod:`.normal`) where their factorisation holds, else by QR; with ``normal``, the
+    samples that do not converge so are iterated again from ``q`` by QR alone (what they did
+    before the normal equations: an ill-conditioned step never fails where QR's converges)."""
+    q0 = q
     q = q.copy()
     norms = np.full(len(t), np.inf)
     if laws is None:
         laws = law_positions(c, t)  # the drivers' f(t): the same at every iteration
+    used = False
     for _ in range(max_iter):
         qx = with_frame(q)
         phi = residual(c, qx, t, laws)
@@ -88,14 +96,24 @@ def newton_raphson(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _M
         if not todo.any():
             break
         J = jacobian(c, qx[todo])[:, :, 3:]
-        try:
-            dq = _solve_rect(J, -phi[todo])
-        except np.linalg.LinAlgError:
-            dq = np.stack([np.linalg.lstsq(Jk, -pk, rcond=None)[0] for Jk, pk in zip(J, phi[todo])])
+        ne = factor(J) if normal else None
+        if ne is not None:
+            used = True
+            dq = ne.step(-phi[todo])
+        else:
+            try:
+                dq = _solve_rect(J, -phi[todo])
+            except np.linalg.LinAlgError:
+                dq = np.stack([np.linalg.lstsq(Jk, -pk, rcond=None)[0] for Jk, pk in zip(J, phi[todo])])
         q[todo] += dq
     qx = with_frame(q)
     norms = np.abs(residual(c, qx, t, laws)).max(axis=1)
-    return q, norms < 1e-9, norms
+    ok = norms < 1e-9
+    if used and not ok.all():
+        again = np.flatnonzero(~ok)
+        sub = [None if f is None else np.broadcast_to(f, t.shape)[again] for f in laws]
+        q[again], ok[again], norms[again] = newton_raphson(c, q0[again], t[again], max_iter, sub, normal=False)
+    return q, ok, norms
 
 
 def _worst_rows(c: Compiled, values: np.ndarray) -> str:

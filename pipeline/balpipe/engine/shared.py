@@ -15,11 +15,12 @@ frame model cannot be followed, the continuation runs on the model itself, which
 model's own located error. The regularity check (a singular configuration is an error) runs on
 the model's own Jacobian either way, so the same specs fail, with the same messages. The
 velocities and accelerations of an accepted model are placed too (:func:`kinematics`): the
-frames' are solved once per geometry (one QR factorisation per sample of the frame model's
-Jacobian instead of one per model), and a centre of mass at c in its body's frame moves with
+frames' are solved once per geometry (one factorisation per sample of the frame model's
+Jacobian instead of one per model; with redundant drivers its normal equations, :mod:`.normal`,
+which the multipliers' solve reuses), and a centre of mass at c in its body's frame moves with
 r' = r_f' + w perp(R c), r'' = r_f'' + alpha perp(R c) - w^2 R c, exact kinematics; and so are
 their Lagrange multipliers where the model has no gear meshes or named actuators
-(:func:`multipliers`: the frame model's map, the generalised forces moved to the frames' origins).
+(:func:`multipliers`: the frame model's solve, the generalised forces moved to the frames' origins).
 
 A model whose centres of mass are at its frames' origins is its own frame model: its positions
 are the continuation's, and its rates its own solves, bit for bit. The others' agree with their
@@ -30,6 +31,7 @@ depend only on the geometry and on their own mass properties. Counts of what hap
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,8 +40,9 @@ from .compile import Compiled, compile_model
 from .errors import AnalysisError
 from .fastpath import _arms, _place as place, frame_model
 from .constraints import jacobian, with_frame
-from .dynamics import multiplier_map
-from .kinematics import _vel_acc
+from .dynamics import multiplier_solver
+from .kinematics import _vel_acc, rates
+from .normal import Normal
 from .positions import _JUMP, DenseOps, _check_regular, follow_motion, newton_raphson, solve_positions
 from .warmstart import motion_key
 
@@ -51,14 +54,16 @@ _KEPT = 16
 class _Shared:
     """What the models of one geometry and grid share: the frame model ``fc``, its motion
     (None where it cannot be followed), and, made when first needed, its rates and its
-    multiplier map with the frame's Jacobian columns. ``laws``: the drivers' laws, kept alive
-    (their ids are part of the key)."""
+    multipliers' solve with the frame's Jacobian columns. ``laws``: the drivers' laws, kept alive
+    (their ids are part of the key); ``normal``: the normal equations of the rates' Jacobian
+    (redundant drivers, :mod:`.normal`), for the multipliers' solve."""
 
     laws: list
     fc: Compiled
     frame: np.ndarray | None
     rates: tuple[np.ndarray, np.ndarray] | None = None
-    dynamics: tuple[np.ndarray, np.ndarray] | None = None
+    normal: Normal | None = None
+    dynamics: tuple[Callable[[np.ndarray], np.ndarray], np.ndarray] | None = None
 
 
 _MOTIONS: dict[tuple, _Shared] = {}  # motion key -> what its models share
@@ -76,7 +81,8 @@ def kinematics(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.n
         return (q, *_vel_acc(c, q, t), None)
     frame = _motion(entry)
     if entry.rates is None:
-        entry.rates = _vel_acc(entry.fc, frame, t)  # once per geometry and grid
+        v, a, solver = rates(entry.fc, frame, t)  # once per geometry and grid
+        entry.rates, entry.normal = (v, a), solver.normal
     return (q, *_place_rates(frame, *entry.rates, c.com_local), entry)
 
 
@@ -91,7 +97,7 @@ def _motion(entry: _Shared) -> np.ndarray:
 def multipliers(c: Compiled, entry: _Shared | None, rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """The multipliers (N, m) of Phi_q^T lambda = ``rhs`` for a model placed in the frame motion
     of ``entry`` (:func:`kinematics`), and the frame's columns J0 (N, m, 3) of Phi_q, from the
-    frame model's map (:func:`.dynamics.multiplier_map`, made once per geometry and grid): the
+    frame model's solve (:func:`.dynamics.multiplier_solver`, made once per geometry and grid): the
     model's Jacobian is the frame model's times T^-1 (a centre of mass at R c from its frame's
     origin: dr = dr_f + dphi perp(R c)), so Phi_q^T lambda = rhs is J_f^T lambda = T^T rhs, the
     generalised forces moved to the frames' origins (the moment gains r x F). None where the
@@ -103,12 +109,13 @@ def multipliers(c: Compiled, entry: _Shared | None, rhs: np.ndarray) -> tuple[np
         return None
     if entry.dynamics is None:
         J = jacobian(fc, with_frame(_motion(entry)))
-        entry.dynamics = (multiplier_map(fc, J[:, :, 3:]), J[:, :, :3])  # once per geometry and grid
-    K, J0 = entry.dynamics
+        entry.dynamics = (multiplier_solver(fc, J[:, :, 3:], entry.normal), J[:, :, :3])  # once per geometry and grid
+        entry.normal = None
+    solve, J0 = entry.dynamics
     rx, ry = _arms(_motion(entry), c.com_local)
     moved = rhs.copy()
     moved[:, 2::3] += rx * rhs[:, 1::3] - ry * rhs[:, 0::3]
-    return np.einsum("nmk,nk->nm", K, moved), J0
+    return solve(moved), J0
 
 
 def _positions(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, _Shared | None]:
