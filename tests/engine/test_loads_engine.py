@@ -283,13 +283,8 @@ def test_masses_times_k_without_loads_still_scale():
     assert not math.isclose(_peak(one), _peak(bare))
 
 
-def test_prismatic_coulomb_friction_and_pressure_equal_newton_euler():
-    """A slider-crank (gravity on, offset guide) against a constant gas pressure, Coulomb friction
-    on the slideway (mu |N|) and in the crank pin (mu r |R|): Newton-Euler per body with the pin
-    forces, the slideway's normal force and lock moment and the motor torque as unknowns, the
-    friction by plain fixed-point iteration."""
-    from balpipe.loader import load_text
-    spec = load_text("""
+#: a slider-crank against a constant gas pressure with Coulomb friction on the slideway and in the crank pin
+SLIDER_CRANK = """
 name: x
 mechanism:
   template: slider_crank
@@ -307,7 +302,16 @@ loads:
   - {type: pressure, name: gas, piston: {body: slider, point: C}, head: {body: frame, point: [0.3, 0.02]}, area: 20 cm^2, pressure: 3 bar}
   - {type: friction, name: rings, joint: guide, coefficient: 0.12}
   - {type: friction, name: pin, joint: B, coefficient: 0.2, pin_radius: 8 mm}
-""", "x.yaml")[0]
+"""
+
+
+def test_prismatic_coulomb_friction_and_pressure_equal_newton_euler():
+    """A slider-crank (gravity on, offset guide) against a constant gas pressure, Coulomb friction
+    on the slideway (mu |N|) and in the crank pin (mu r |R|): Newton-Euler per body with the pin
+    forces, the slideway's normal force and lock moment and the motor torque as unknowns, the
+    friction by plain fixed-point iteration."""
+    from balpipe.loader import load_text
+    spec = load_text(SLIDER_CRANK, "x.yaml")[0]
     from balpipe import registry
     from balpipe.mechanics.sampling import gravity_vector
     model, t = registry.unbalanced_model(spec), registry.time_grid(spec)

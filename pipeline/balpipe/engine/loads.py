@@ -21,17 +21,19 @@ inertial ones whatever the loads (DESIGN.md, "Loads, and what the frame feels").
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, TypeVar, cast
 
 import numpy as np
 
 from ..mechanics.loads import Anchor, AppliedLoad, ForceElement, JointFriction, LoadTable, TorsionElement
 from ..mechanics.planar import cross, rotate
-from ..model import Model, Prismatic, Revolute
+from ..model import Driver, Model, Prismatic, Revolute
 from .compile import Compiled, _perp
 from .errors import AnalysisError
 
 Solver = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+#: a load's value: a float (one state, :mod:`.step_loads`) or an array (along a motion)
+Num = TypeVar("Num", float, np.ndarray)
 
 #: Newton iterations of the Coulomb friction before it is declared self-locking
 MAX_ITERATIONS = 60
@@ -150,19 +152,28 @@ class _Motion:
         if kind == "time":
             return self.t, np.ones_like(self.t)
         if kind == "driver":
-            for d in self.model.drivers:
-                if d.name == law.argument[1]:
-                    x, xd, _ = d.law(self.t)
-                    return np.broadcast_to(np.asarray(x, dtype=float), self.t.shape), np.broadcast_to(np.asarray(xd, dtype=float), self.t.shape)
-            raise ValueError(f"a load table refers to unknown driver {law.argument[1]!r}")
+            x, xd, _ = driver(self.model, law.argument[1]).law(self.t)
+            return np.broadcast_to(np.asarray(x, dtype=float), self.t.shape), np.broadcast_to(np.asarray(xd, dtype=float), self.t.shape)
         if kind == "stroke":
             _, body, p, direction, origin = law.argument
             _, P, V = self.point(Anchor(body, p))
-            axis = np.asarray(direction, dtype=float)
-            return P @ axis - origin, V @ axis
+            return stroke(P[:, 0], P[:, 1], V[:, 0], V[:, 1], direction, origin)
         if kind == "deflection" and own is not None:
             return own
-        raise ValueError(f"unknown load table argument {law.argument!r}")
+        raise unknown_argument(law)
+
+
+def driver(model: Model, name: str) -> Driver:
+    """The driver a table's argument names."""
+    for d in model.drivers:
+        if d.name == name:
+            return d
+    raise ValueError(f"a load table refers to unknown driver {name!r}")
+
+
+def unknown_argument(law: LoadTable) -> ValueError:
+    """The error of a table whose argument is none this module knows (a deflection off a force element)."""
+    return ValueError(f"unknown load table argument {law.argument!r}")
 
 
 def terms(model: Model, c: Compiled, t: np.ndarray, q: np.ndarray, v: np.ndarray) -> LoadTerms:
@@ -186,6 +197,43 @@ def terms(model: Model, c: Compiled, t: np.ndarray, q: np.ndarray, v: np.ndarray
     return out
 
 
+def tension(e: ForceElement, T0: Num, L: Num, Ld: Num, law: Num | None) -> Num:
+    """A force element's tension T0 + k (L - L_ref) + c dL/dt + scale * law (``T0``: its preload;
+    ``law``: its table's value, None without one), only the terms it has, in that order: the same
+    operations on floats as on arrays (the engine's and the simulation's values are equal)."""
+    T = T0
+    if e.stiffness:
+        T = T + e.stiffness * (L - cast(float, e.free_length))
+    if e.damping:
+        T = T + e.damping * Ld
+    if law is not None:
+        T = T + e.scale * law
+    return T
+
+
+def deflection(e: ForceElement, L: Num, Ld: Num) -> tuple[Num, Num]:
+    """A force element's deflection argument (L - L_free, dL/dt) for its table."""
+    return L - (e.free_length or 0.0), Ld
+
+
+def torsion(e: TorsionElement, T0: Num, phi: Num, w: Num) -> Num:
+    """A torsion element's torque T0 + k (phi - phi_ref) + c dphi/dt (``T0``: its preload), only
+    the terms it has, in that order: the same operations on floats as on arrays."""
+    T = T0
+    if e.stiffness:
+        T = T + e.stiffness * (phi - cast(float, e.free_angle))
+    if e.damping:
+        T = T + e.damping * w
+    return T
+
+
+def stroke(px: Num, py: Num, vx: Num, vy: Num, direction: tuple[float, float], origin: float) -> tuple[Num, Num]:
+    """A stroke table's argument: the point's displacement along ``direction`` from ``origin``
+    and its rate (written out, not a matrix product, so that floats and arrays agree)."""
+    dx, dy = float(direction[0]), float(direction[1])
+    return px * dx + py * dy - origin, vx * dx + vy * dy
+
+
 def _element(mo: _Motion, acc: _Acc, e: ForceElement) -> dict[str, np.ndarray]:
     ka, Pa, Va = mo.point(e.a)
     kb, Pb, Vb = mo.point(e.b)
@@ -195,13 +243,8 @@ def _element(mo: _Motion, acc: _Acc, e: ForceElement) -> dict[str, np.ndarray]:
         raise ValueError(f"force element {e.name!r}: its two points coincide, its direction is undefined")
     u = d / L[:, None]
     Ld = np.einsum("nk,nk->n", Vb - Va, u)
-    T = np.full(len(L), float(e.preload))
-    if e.stiffness:
-        T = T + e.stiffness * (L - e.free_length)
-    if e.damping:
-        T = T + e.damping * Ld
-    if e.law is not None:
-        T = T + e.scale * e.law(*mo.argument(e.law, (L - (e.free_length or 0.0), Ld)))
+    law = None if e.law is None else e.law(*mo.argument(e.law, deflection(e, L, Ld)))
+    T = tension(e, np.full(len(L), float(e.preload)), L, Ld, law)
     Fa, Fb = T[:, None] * u, -T[:, None] * u
     for k, P, F in ((ka, Pa, Fa), (kb, Pb, Fb)):
         if k is None and e.source == "external":
@@ -219,11 +262,7 @@ def _torsion(mo: _Motion, acc: _Acc, e: TorsionElement) -> dict[str, np.ndarray]
     ka, kb = mo.body(jt.a), mo.body(jt.b)
     (tha, wa), (thb, wb) = mo.angle(ka), mo.angle(kb)
     phi, w = thb - tha, wb - wa
-    T = np.full(len(phi), float(e.preload))
-    if e.stiffness:
-        T = T + e.stiffness * (phi - e.free_angle)
-    if e.damping:
-        T = T + e.damping * w
+    T = torsion(e, np.full(len(phi), float(e.preload)), phi, w)
     for k, s in ((kb, -1.0), (ka, 1.0)):
         if k is None and e.source == "external":
             continue

@@ -15,7 +15,9 @@ equals the shaking load plus the external loads (DESIGN.md, "Loads, and what the
 
 from __future__ import annotations
 
+import bisect
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Literal
 
 import numpy as np
@@ -63,6 +65,49 @@ class LoadTable:
             return up
         down = np.interp(x, *self.falling, period=self.period)
         return np.where(rate < 0.0, down, up)
+
+    def at(self, x: float, rate: float) -> float:
+        """The value at one argument ``x`` moving at ``rate``, in plain floats: equal to the
+        array call's to the last bit (numpy's interpolation, its periodic rows and its rules at
+        the rows, outside them and on NaN, taken step by step; ``tests/validate/test_step_loads.py``)."""
+        rows = self._rows[1] if rate < 0.0 and self._rows[1] is not None else self._rows[0]
+        return _interp(x % abs(self.period) if self.period is not None else x, *rows)
+
+    @cached_property
+    def _rows(self) -> tuple[tuple[list[float], list[float]], tuple[list[float], list[float]] | None]:
+        """The rising and falling rows as lists, a periodic table's as numpy's ``interp`` makes
+        them (wrapped into one period, sorted, one row repeated a period off at each end)."""
+        return _periodic(self.rising, self.period), None if self.falling is None else _periodic(self.falling, self.period)
+
+
+def _periodic(rows: tuple[np.ndarray, np.ndarray], period: float | None) -> tuple[list[float], list[float]]:
+    xp, fp = (np.asarray(r, dtype=np.float64) for r in rows)
+    if period is not None:
+        period = abs(period)
+        xp = xp % period
+        order = np.argsort(xp)
+        xp, fp = xp[order], fp[order]
+        xp = np.concatenate((xp[-1:] - period, xp, xp[0:1] + period))
+        fp = np.concatenate((fp[-1:], fp, fp[0:1]))
+    return xp.tolist(), fp.tolist()
+
+
+def _interp(x: float, xp: list[float], fp: list[float]) -> float:
+    """numpy's linear interpolation of one float (``np.interp`` with the end values outside)."""
+    if x != x:
+        return x
+    j = bisect.bisect_right(xp, x) - 1
+    if j < 0:
+        return fp[0]
+    if j >= len(xp) - 1 or xp[j] == x:
+        return fp[j]
+    slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
+    y = slope * (x - xp[j]) + fp[j]
+    if y != y:  # numpy's retry from the other end of the interval
+        y = slope * (x - xp[j + 1]) + fp[j + 1]
+        if y != y and fp[j] == fp[j + 1]:
+            y = fp[j]
+    return y
 
 
 @dataclass(frozen=True)

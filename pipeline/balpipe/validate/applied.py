@@ -2,7 +2,8 @@
 
 Before every step, each load of the model (:mod:`balpipe.mechanics.loads`) is evaluated from the
 simulated bodies' own state (positions, angles, velocities: pymunk's body position is the centre
-of mass) by the engine's load terms (:func:`balpipe.engine.loads.terms`), and its generalized
+of mass) as the engine evaluates it (:class:`balpipe.engine.step_loads.StepLoads`, compiled once
+per run: the engine's load terms at one state in plain floats, equal to theirs), and its generalized
 force on each body, a force through the centre of mass and a torque, is added to the body: so
 springs, dampers, force laws, pressures, applied forces and torques, and viscous friction act on
 the simulated mechanism as they would on the real one, and an error in the engine's treatment of
@@ -17,10 +18,11 @@ simulated; a floating-base run applies no loads (it demonstrates the inertial sh
 from __future__ import annotations
 
 import numpy as np
+import pymunk
 
 from ..engine import Analysis
 from ..engine.analysis import compiled
-from ..engine.loads import terms
+from ..engine.step_loads import StepLoads
 from ..model import Model
 
 #: what the page says of the friction in the simulation
@@ -29,18 +31,23 @@ COULOMB_NOTE = ("Coulomb friction is applied with the engine's magnitude along t
                 "compute the friction from its own reactions); springs, dampers, applied loads and viscous "
                 "friction act from the simulated state")
 
+# the properties' setters, without pymunk's __setattr__ layer
+_set_force, _set_torque = vars(pymunk.Body)["force"].fset, vars(pymunk.Body)["torque"].fset
+
 
 class AppliedLoads:
     """Applies ``model``'s loads to ``bodies`` (pymunk bodies in ``model.bodies`` order) before
     each step; ``plan``: the analysis on the simulation's step times ``times`` (the Coulomb
-    friction's magnitudes)."""
+    friction's magnitudes). The loads are evaluated by :class:`balpipe.engine.step_loads.StepLoads`,
+    compiled once: the engine's generalized forces at the simulated state, to the last bit."""
 
     def __init__(self, model: Model, plan: Analysis, times: np.ndarray):
         self.model = model
-        self.c = compiled(model)
+        self.loads = StepLoads(model, compiled(model))
         self.times = np.asarray(times, dtype=float)
         self.coulomb = {name: np.asarray(s["coulomb"], dtype=float)
                         for name, s in plan.loads.items() if "coulomb" in s}
+        self._magnitudes = [self.coulomb[name].tolist() for name in self.loads.coulomb]
         self.bodies: list = []
 
     @property
@@ -51,25 +58,33 @@ class AppliedLoads:
         self.bodies = list(bodies[: len(self.model.bodies)])
         return self
 
+    def _step(self, t: float) -> int:
+        """The index of the step time nearest ``t`` (the Coulomb magnitudes' sample)."""
+        if len(self.times) <= 1:
+            return 0
+        k = int(round((t - self.times[0]) / (self.times[1] - self.times[0])))
+        return min(max(k, 0), len(self.times) - 1)
+
     def apply(self, t: float, dt: float) -> None:
         """Add every load for the step of ``dt`` that lands on time ``t``: pymunk moves the
         positions first (with the current velocities) and then integrates the velocities with
         the forces, so the loads are those at the positions the step lands on."""
-        nb = len(self.bodies)
-        q = np.empty((1, 3 * nb))
-        v = np.empty((1, 3 * nb))
-        for k, b in enumerate(self.bodies):
-            p, vel = b.position, b.velocity
-            q[0, 3 * k: 3 * k + 3] = (p.x + dt * vel.x, p.y + dt * vel.y, b.angle + dt * b.angular_velocity)
-            v[0, 3 * k: 3 * k + 3] = (vel.x, vel.y, b.angular_velocity)
-        lt = terms(self.model, self.c, np.array([t]), q, v)
-        Q = lt.Q[0].copy()
-        if lt.coulomb:
-            k = min(max(int(round((t - self.times[0]) / (self.times[1] - self.times[0]))), 0), len(self.times) - 1) \
-                if len(self.times) > 1 else 0
-            for cf in lt.coulomb:
-                Q += self.coulomb[cf.name][k] * cf.Q[0]
-        for k, b in enumerate(self.bodies):
+        n = 3 * len(self.bodies)
+        q, v = [0.0] * n, [0.0] * n  # the bodies no load reads stay at zero
+        for k in self.loads.bodies:
+            b = self.bodies[k]
+            p, vel, w = b.position, b.velocity, b.angular_velocity
+            q[3 * k: 3 * k + 3] = (p.x + dt * vel.x, p.y + dt * vel.y, b.angle + dt * w)
+            v[3 * k: 3 * k + 3] = (vel.x, vel.y, w)
+        Q, units = self.loads(t, q, v)
+        if units:
+            k = self._step(t)
+            for magnitudes, unit in zip(self._magnitudes, units):
+                m = magnitudes[k]
+                for i, u in unit:
+                    Q[i] += m * u
+        for k in self.loads.bodies:
+            b = self.bodies[k]
             f = b.force
-            b.force = (f.x + float(Q[3 * k]), f.y + float(Q[3 * k + 1]))
-            b.torque = b.torque + float(Q[3 * k + 2])
+            _set_force(b, (f.x + Q[3 * k], f.y + Q[3 * k + 1]))
+            _set_torque(b, b.torque + Q[3 * k + 2])
