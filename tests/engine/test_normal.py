@@ -60,12 +60,14 @@ def test_square_jacobians_keep_lu():
 
 
 @pytest.mark.parametrize("k", [None, 3])
-def test_least_effort_multipliers_equal_qr(k):
-    """The multipliers with the least driver efforts (two redundant drivers among four driver
-    rows): the normal equations' solution equals the complete QR's to round-off, for one
-    right-hand side and for several."""
-    J, _, _ = _consistent(11, N=30, m=12, n=10, spread=50.0)
-    c = _Drivers({"a": 8, "b": 9, "c": 10, "d": 11})
+@pytest.mark.parametrize("m", [11, 12])
+def test_least_effort_multipliers_equal_qr(k, m):
+    """The multipliers with the least driver efforts (one or two redundant drivers among the
+    driver rows 8 to m - 1: the one-vector null space's own formula, and the eigenvectors'):
+    the normal equations' solution equals the complete QR's to round-off, for one right-hand
+    side and for several."""
+    J, _, _ = _consistent(11, N=30, m=m, n=10, spread=50.0)
+    c = _Drivers({f"d{i}": i for i in range(8, m)})
     rng = np.random.default_rng(5)
     rhs = rng.standard_normal((30, 10) if k is None else (30, 10, k))
     F = normal.factor(J)
@@ -79,7 +81,7 @@ def test_least_effort_multipliers_equal_qr(k):
     r0 = rhs if k is None else rhs[..., 0]
     assert np.abs(np.einsum("nmi,nm->ni", J, lam) - r0).max() <= 1e-12 * np.abs(r0).max()
     null = np.linalg.svd(J, full_matrices=True)[0][:, :, 10:]
-    shifted = lam + (null @ rng.standard_normal((30, 2, 1)))[..., 0]
+    shifted = lam + (null @ rng.standard_normal((30, m - 10, 1)))[..., 0]
     assert np.all(np.linalg.norm(lam[:, 8:], axis=1) <= np.linalg.norm(shifted[:, 8:], axis=1) * (1 + 1e-12))
 
 

@@ -49,12 +49,14 @@ class Consistent:
         return _solve_rect(self.J, b, self._qr)
 
 
-def rates(c: Compiled, q: np.ndarray, t: np.ndarray, laws: list | None = None) -> tuple[np.ndarray, np.ndarray, Consistent]:
+def rates(c: Compiled, q: np.ndarray, t: np.ndarray, laws: list | None = None,
+          J: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, Consistent]:
     """Velocities and accelerations (N, n) at positions q, and the solves of their Jacobian
     Phi_q (:class:`Consistent`: one factorisation for both). ``laws``:
-    :func:`.constraints.law_triples` at ``t`` (evaluated when not given)."""
+    :func:`.constraints.law_triples` at ``t`` (evaluated when not given); ``J``: the whole
+    Jacobian at q, frame columns included (formed when not given)."""
     qx = with_frame(q)
-    solver = Consistent(jacobian(c, qx)[:, :, 3:])
+    solver = Consistent((jacobian(c, qx) if J is None else J)[:, :, 3:])
     v = solver.solve(velocity_rhs(c, t, laws))
     a = solver.solve(acceleration_rhs(c, qx, with_frame(v), t, laws))
     return v, a, solver

@@ -78,7 +78,8 @@ class Normal:
         have the least norm (:func:`.dynamics.solve_multipliers`). N is made of the projections
         W = P S^T of the rows' unit vectors, P = I - J G^-1 J^T applied twice (the second
         application corrects the first's rounding, and is its check), and the r leading
-        eigenvectors of W^T W. They span the null space when the rows' multipliers determine its
+        eigenvectors of W^T W (one redundant driver, r = 1: W = n (S n)^T for the unit null vector
+        n, so M = W / trace(S W) without them). They span the null space when the rows' multipliers determine its
         component (S N of rank r: the joints' own rows independent,
         :func:`.positions._check_redundancy`). Made once per ``rows``."""
         key = tuple(rows)
@@ -90,7 +91,11 @@ class Normal:
             W -= J @ self.gram_solve(JT @ W)
             d = J @ self.gram_solve(JT @ W)
             M = None
-            if _small(d, W):
+            if _small(d, W) and r == 1:
+                # P = n n^T, W = n (S n)^T: M = n (S n)^T / |S n|^2 = W / trace(S W)
+                W -= d
+                M = W / np.einsum("nii->n", W[:, rows, :])[:, None, None]
+            elif _small(d, W):
                 W -= d
                 w, V = np.linalg.eigh(W.transpose(0, 2, 1) @ W)  # ascending
                 basis = (W @ V[:, :, -r:]) / np.sqrt(w[:, -r:])[:, None, :]

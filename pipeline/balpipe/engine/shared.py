@@ -56,13 +56,15 @@ class _Shared:
     (None where it cannot be followed), and, made when first needed, its rates and its
     multipliers' solve with the frame's Jacobian columns. ``laws``: the drivers' laws, kept alive
     (their ids are part of the key); ``normal``: the normal equations of the rates' Jacobian
-    (redundant drivers, :mod:`.normal`), for the multipliers' solve."""
+    (redundant drivers, :mod:`.normal`), and ``jacobian``, the rates' whole Jacobian, for the
+    multipliers' solve."""
 
     laws: list
     fc: Compiled
     frame: np.ndarray | None
     rates: tuple[np.ndarray, np.ndarray] | None = None
     normal: Normal | None = None
+    jacobian: np.ndarray | None = None
     dynamics: tuple[Callable[[np.ndarray], np.ndarray], np.ndarray] | None = None
 
 
@@ -81,8 +83,9 @@ def kinematics(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.n
         return (q, *_vel_acc(c, q, t), None)
     frame = _motion(entry)
     if entry.rates is None:
-        v, a, solver = rates(entry.fc, frame, t)  # once per geometry and grid
-        entry.rates, entry.normal = (v, a), solver.normal
+        J = jacobian(entry.fc, with_frame(frame))
+        v, a, solver = rates(entry.fc, frame, t, J=J)  # once per geometry and grid
+        entry.rates, entry.normal, entry.jacobian = (v, a), solver.normal, J
     return (q, *_place_rates(frame, *entry.rates, c.com_local), entry)
 
 
@@ -108,9 +111,9 @@ def multipliers(c: Compiled, entry: _Shared | None, rhs: np.ndarray) -> tuple[np
     if fc.meshes or fc.dynamics is not None or fc.row_owner != c.row_owner or fc.driver_rows != c.driver_rows:
         return None
     if entry.dynamics is None:
-        J = jacobian(fc, with_frame(_motion(entry)))
+        J = entry.jacobian if entry.jacobian is not None else jacobian(fc, with_frame(_motion(entry)))
         entry.dynamics = (multiplier_solver(fc, J[:, :, 3:], entry.normal), J[:, :, :3])  # once per geometry and grid
-        entry.normal = None
+        entry.normal = entry.jacobian = None
     solve, J0 = entry.dynamics
     rx, ry = _arms(_motion(entry), c.com_local)
     moved = rhs.copy()
