@@ -456,3 +456,48 @@ def test_the_papers_own_page_keeps_the_papers_wording(paper):
     assert {"Fig. 2 of paper 003: the tested trajectories", "Fig. 3 of paper 003: variations of the shaking forces, "
             "trajectory P15P7", "Fig. 4 of paper 003: variations of the shaking moment, trajectory P15P7"} <= set(titles)
     assert sum("(not in the paper)" in s.stage.label for s in st.stages) == len(spec.balancing.trajectories)
+
+
+
+def _scipy_path(f, simplex, maxfev):
+    """scipy's Nelder-Mead from ``simplex``: its optimum, its value and the points it evaluated."""
+    from scipy.optimize import minimize
+
+    seen = []
+
+    def g(x):
+        seen.append(np.array(x))
+        return f(x)
+
+    res = minimize(g, simplex[0], method="Nelder-Mead",
+                   options={"maxfev": maxfev, "xatol": 1e-6, "fatol": 1e-9, "initial_simplex": simplex})
+    return res.x, float(res.fun), seen
+
+
+@pytest.mark.parametrize("maxfev", [7, 60, 400])
+def test_simplex_searches_side_by_side_are_scipys_nelder_mead(maxfev):
+    """Each search of .simplex visits scipy's points and returns its optimum bit for bit, alone or
+    side by side with others: on Rosenbrock's valley and on a kinked peak (shrinks, contractions,
+    the budget spent mid-iteration, convergence)."""
+    from balpipe.families.serial_arm.simplex import minimise_together, nelder_mead
+
+    def rosen(x):
+        return float(np.sum(100.0 * (x[1:] - x[:-1] ** 2) ** 2 + (1 - x[:-1]) ** 2))
+
+    def kinked(x):
+        return float(np.max(np.abs(np.array([x[0] - 0.3 * x[1], x[1] + x[2] ** 2, 0.1 - x[2]]))))
+
+    rng = np.random.default_rng(3)
+    for f in (rosen, kinked):
+        simplices = [cp._simplex(rng.normal(0.0, 0.5, 3), 0.2) for _ in range(4)]
+        scipys = [_scipy_path(f, s, maxfev) for s in simplices]
+        for s, (sx, sfun, path) in zip(simplices, scipys):  # alone: the same points in the same order
+            seen: list = []
+            [(x, fun)] = minimise_together(lambda P: [seen.append(p) or f(p) for p in P], [nelder_mead(s, maxfev, 1e-6, 1e-9)])
+            assert np.array_equal(x, sx) and fun == sfun
+            assert len(seen) == len(path) and all(np.array_equal(a, b) for a, b in zip(seen, path))
+        calls: list[int] = []
+        together = minimise_together(lambda P: calls.append(len(P)) or [f(p) for p in P],
+                                     [nelder_mead(s, maxfev, 1e-6, 1e-9) for s in simplices])
+        assert all(np.array_equal(x, sx) and fun == sfun for (x, fun), (sx, sfun, _) in zip(together, scipys))
+        assert calls[0] == len(simplices) and sum(calls) == sum(len(path) for *_, path in scipys)

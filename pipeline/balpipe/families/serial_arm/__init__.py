@@ -30,7 +30,6 @@ FAMILY = Family(
                ("serial_arm",), "centre-of-mass motion planning, phi optimised (paper 003)",
                notation=Ref(f"{__name__}.com_planning:NOTATION"), figures=Ref(f"{__name__}.figures:com_planning_figures"),
                check_cost=2.0,  # paper 003's eight trajectories: phi optimised, ramps bisected
-               build_cost=2.0,  # and their figures: 2.5 s
-               imports=("scipy.optimize",)),  # Nelder-Mead
+               build_cost=2.0),  # and their figures: 2.5 s (Nelder-Mead is .simplex's: no scipy)
     ),
 )

@@ -58,6 +58,7 @@ from ...motion import PointToPoint, bang_bang, law_for, quintic
 from ...spec_parts import SpecFieldError, paper_id
 from ...balancing.base import BalanceResult, Parameter, Stage
 from ...mechanics.sampling import gravity_vector, time_grid
+from .simplex import minimise_together, nelder_mead
 from .specs import ComMotionPlanning
 
 ROOT = ("balancing",)
@@ -212,29 +213,56 @@ class Planner:
     def objective(self, plan: Plan, path: tuple):
         """The optimiser's objective c -> max |M| over the analysis grid with the CoM on the
         bang-bang law and phi(c) (a penalty outside the workspace or at a singular
-        configuration). The CoM law and phi's basis are evaluated once; each call is a few
-        vectorised array operations (explicit serial kinematics and dynamics)."""
+        configuration): :meth:`peaks` of one point."""
+        peaks = self.peaks(plan, path)
+        return lambda c: peaks(np.asarray(c, dtype=float)[None, :])[0]
+
+    def peaks(self, plan: Plan, path: tuple):
+        """The objective of several points at once: (k, free coefficients) -> their k values. The
+        CoM law and phi's basis are evaluated once; each call is a few vectorised array operations
+        (explicit serial kinematics and dynamics) on the k points' grids one after the other, every
+        sample computed as for one point alone (the same values, bit for bit, whatever k: the
+        kinematics and the state are sample by sample, :func:`shaking_moment` keeps the grids
+        apart), so that a call of k points costs little more than a call of one."""
         t, T = self.t, self.T
         nfree = self.method.phi.degree - 5
         com = _com_motion(plan, bang_bang, T, PhiPolynomial(plan.start[2], plan.end[2], T), path)
         x0, xd0, xdd0 = com.values(t)
         basis = [PhiPolynomial(0.0, 0.0, T, tuple(1.0 if j == k else 0.0 for j in range(k + 1)))(t) for k in range(nfree)]
         B = [np.stack([b[d] for b in basis], axis=1) if nfree else np.zeros((len(t), 0)) for d in range(3)]
-        x, xd, xdd = x0.copy(), xd0.copy(), xdd0.copy()
+        n = len(t)
 
-        def f(c) -> float:
-            self.calls += 1
-            c = np.asarray(c, dtype=float)
-            x[:, 2], xd[:, 2], xdd[:, 2] = x0[:, 2] + B[0] @ c, xd0[:, 2] + B[1] @ c, xdd0[:, 2] + B[2] @ c
+        def values(C: np.ndarray) -> list[float]:
+            k = len(C)
+            self.calls += k
+            x, xd, xdd = (np.tile(a, (k, 1)) for a in (x0, xd0, xdd0))
+            for i, c in enumerate(C):
+                rows = slice(i * n, (i + 1) * n)
+                x[rows, 2], xd[rows, 2], xdd[rows, 2] = x0[:, 2] + B[0] @ c, xd0[:, 2] + B[1] @ c, xdd0[:, 2] + B[2] @ c
             th, thd, thdd, margin, sg, trig = absolute_motion(self.com, x, xd, xdd, plan.com_mode)
-            bad = max(0.0, float(-margin.min())) + max(0.0, 1e-6 - float(np.abs(sg).min()))
-            if bad > 0:
-                return 1e6 * (1.0 + bad)
-            M = shaking_moment(self.arm, absolute_state(self.arm, th, thd, thdd, trig), self.gravity, self.point)
-            peak = float(np.max(np.abs(M)))
-            return peak if math.isfinite(peak) else 1e6
+            out = [0.0] * k
+            good = []
+            for i in range(k):
+                rows = slice(i * n, (i + 1) * n)
+                bad = max(0.0, float(-margin[rows].min())) + max(0.0, 1e-6 - float(np.abs(sg[rows]).min()))
+                if bad > 0:
+                    out[i] = 1e6 * (1.0 + bad)
+                else:
+                    good.append(i)
+            if len(good) < k:  # the state of the points in the workspace only
+                if not good:
+                    return out
+                keep = np.concatenate([np.arange(i * n, (i + 1) * n) for i in good])
+                th, thd, thdd = th[keep], thd[keep], thdd[keep]
+                trig = None if trig is None else (trig[0][:, keep], trig[1][:, keep])
+            M = shaking_moment(self.arm, absolute_state(self.arm, th, thd, thdd, trig), self.gravity, self.point,
+                               grids=len(good))
+            for j, i in enumerate(good):
+                peak = float(np.max(np.abs(M[j * n:(j + 1) * n])))
+                out[i] = peak if math.isfinite(peak) else 1e6
+            return out
 
-        return f
+        return values
 
     def peak_moment(self, plan: Plan, coeffs, path: tuple) -> float:
         """max |M| of one phi (see :meth:`objective`)."""
@@ -259,12 +287,12 @@ class Planner:
         return Plan(name, tuple(start), tuple(end), qa, qb, self.com.point(qa[None])[0], self.com.point(qb[None])[0], cmode)
 
     def optimise_phi(self, plan: Plan, path: tuple) -> None:
-        from scipy.optimize import minimize
-
+        """Nelder-Mead from ``starts`` points (the 3-4-5 law and random ones), side by side
+        (:func:`.simplex.minimise_together`: one call of :meth:`peaks` evaluates a point of each)."""
         opt = self.method.phi
         nfree = opt.degree - 5
-        f = self.objective(plan, path)
-        start_peak = f(np.zeros(nfree))
+        peaks = self.peaks(plan, path)
+        start_peak = peaks(np.zeros((1, nfree)))[0]
         plan.phi_peak_start = start_peak
         if nfree == 0:
             plan.phi_peak_best = start_peak
@@ -273,12 +301,11 @@ class Planner:
         starts = [np.zeros(nfree)] + [rng.normal(0.0, opt.spread, nfree) for _ in range(opt.starts - 1)]
         best_x, best_f = np.zeros(nfree), start_peak
         calls0 = self.calls
-        for x0 in starts:
-            res = minimize(f, x0, method="Nelder-Mead",
-                           options={"maxfev": opt.max_evaluations, "xatol": opt.tolerance,
-                                    "fatol": opt.tolerance * start_peak, "initial_simplex": _simplex(x0, 0.2)})
-            if res.fun < best_f:
-                best_x, best_f = np.asarray(res.x, dtype=float), float(res.fun)
+        searches = [nelder_mead(_simplex(x0, 0.2), opt.max_evaluations, opt.tolerance, opt.tolerance * start_peak)
+                    for x0 in starts]
+        for x, fun in minimise_together(peaks, searches):
+            if fun < best_f:
+                best_x, best_f = np.asarray(x, dtype=float), float(fun)
         plan.phi_coefficients = tuple(float(c) for c in best_x)
         plan.phi_peak_best = best_f
         plan.evaluations = self.calls - calls0 + 1

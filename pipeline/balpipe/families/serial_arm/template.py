@@ -529,11 +529,17 @@ def shaking_loads(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0), point=(0.0
     return np.stack([fx.sum(axis=1), fy.sum(axis=1)], axis=1), M
 
 
-def shaking_moment(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0), point=(0.0, 0.0)) -> np.ndarray:
-    """The moment of :func:`shaking_loads` alone (the optimiser's objective)."""
+def shaking_moment(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0), point=(0.0, 0.0), grids: int = 1) -> np.ndarray:
+    """The moment of :func:`shaking_loads` alone (the optimiser's objective). ``grids``: the
+    samples are that many grids of equal length one after the other (several motions in one
+    state: the optimiser's points), each grid's moment the same bits as alone (a matrix-vector
+    product rounds a row as its place in the product makes it: the inertia term is computed per
+    grid; the sum over the links rounds every row alike)."""
     m = np.asarray(arm.masses)
     fx, fy = m * (gravity[0] - st.ax), m * (gravity[1] - st.ay)
-    return ((st.rx - point[0]) * fy - (st.ry - point[1]) * fx) @ np.ones(arm.n) - st.thdd @ np.asarray(arm.inertias)
+    inertias = np.asarray(arm.inertias)
+    inertia = st.thdd @ inertias if grids == 1 else np.concatenate([part @ inertias for part in np.split(st.thdd, grids)])
+    return ((st.rx - point[0]) * fy - (st.ry - point[1]) * fx) @ np.ones(arm.n) - inertia
 
 
 def joint_torques(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0)) -> np.ndarray:
