@@ -16,6 +16,7 @@ from . import registry
 from .balancing.base import BalanceResult, Stage
 from .balancing.context import Memo, compute
 from .mechanics.claim_precision import claim_tolerances
+from .runtime.allocator import keep_freed_memory
 from .engine import Analysis, AnalysisError, analyse, condition_peak
 from .engine.load_reference import LoadReference, load_reference
 from .mechanics.sampling import gravity_vector  # noqa: F401  (balpipe.study.gravity_vector, as before)
@@ -328,7 +329,11 @@ def run(spec: Spec, page: bool = True, memo: Memo = compute) -> Study:
     condition numbers, near-singular notes and dead-centre warnings (``checks`` then has
     ``max_condition_number`` None), nor the parameters of the method's ``derived`` hook unless
     the spec has references (which may name them): none of them makes a spec invalid. ``memo``:
-    what the balancing's searches go through (:class:`balpipe.cache.balance.Memo` in a build)."""
+    what the balancing's searches go through (:class:`balpipe.cache.balance.Memo` in a build).
+    The C allocator keeps freed memory from here on (:func:`balpipe.runtime.allocator.keep_freed_memory`,
+    which the engine's first analysis would set): a balancing's searches allocate arrays of the same
+    sizes thousands of times (paper 003's ramps: 70,000 pages faulted in again, 0.15 s, without it)."""
+    keep_freed_memory()
     model = registry.unbalanced_model(spec)
     if model.sources:  # a spec that gives its own poses (custom): the assembly must confirm them
         assembly.check(model, float(registry.time_grid(spec)[0]))

@@ -46,8 +46,9 @@ from .template import (
     com_chain,
     joint_laws,
     joint_torques,
+    moment_rows,
     shaking_loads,
-    shaking_moment,
+    state_rows,
     tip_chain,
     with_joint_laws,
 )
@@ -220,10 +221,10 @@ class Planner:
     def peaks(self, plan: Plan, path: tuple):
         """The objective of several points at once: (k, free coefficients) -> their k values. The
         CoM law and phi's basis are evaluated once; each call is a few vectorised array operations
-        (explicit serial kinematics and dynamics) on the k points' grids one after the other, every
-        sample computed as for one point alone (the same values, bit for bit, whatever k: the
-        kinematics and the state are sample by sample, :func:`shaking_moment` keeps the grids
-        apart), so that a call of k points costs little more than a call of one."""
+        (explicit serial kinematics and dynamics, on (links, samples) rows) on the k points' grids
+        one after the other, every sample computed as for one point alone (the same values, bit for
+        bit, whatever k: the kinematics and the state are sample by sample, :func:`moment_rows`
+        keeps the grids apart), so that a call of three points costs 1.7 times a call of one."""
         t, T = self.t, self.T
         nfree = self.method.phi.degree - 5
         com = _com_motion(plan, bang_bang, T, PhiPolynomial(plan.start[2], plan.end[2], T), path)
@@ -235,16 +236,17 @@ class Planner:
         def values(C: np.ndarray) -> list[float]:
             k = len(C)
             self.calls += k
-            x, xd, xdd = (np.tile(a, (k, 1)) for a in (x0, xd0, xdd0))
+            # the task-space motion as rows (x, y, phi; k grids one after the other), read as (k n, 3)
+            X, Xd, Xdd = (np.tile(a.T, (1, k)) for a in (x0, xd0, xdd0))
             for i, c in enumerate(C):
-                rows = slice(i * n, (i + 1) * n)
-                x[rows, 2], xd[rows, 2], xdd[rows, 2] = x0[:, 2] + B[0] @ c, xd0[:, 2] + B[1] @ c, xdd0[:, 2] + B[2] @ c
-            th, thd, thdd, margin, sg, trig = absolute_motion(self.com, x, xd, xdd, plan.com_mode)
+                grid = slice(i * n, (i + 1) * n)
+                X[2, grid], Xd[2, grid], Xdd[2, grid] = x0[:, 2] + B[0] @ c, xd0[:, 2] + B[1] @ c, xdd0[:, 2] + B[2] @ c
+            th, thd, thdd, margin, sg, trig = absolute_motion(self.com, X.T, Xd.T, Xdd.T, plan.com_mode, rows=True)
             out = [0.0] * k
             good = []
             for i in range(k):
-                rows = slice(i * n, (i + 1) * n)
-                bad = max(0.0, float(-margin[rows].min())) + max(0.0, 1e-6 - float(np.abs(sg[rows]).min()))
+                grid = slice(i * n, (i + 1) * n)
+                bad = max(0.0, float(-margin[grid].min())) + max(0.0, 1e-6 - float(np.abs(sg[grid]).min()))
                 if bad > 0:
                     out[i] = 1e6 * (1.0 + bad)
                 else:
@@ -253,10 +255,11 @@ class Planner:
                 if not good:
                     return out
                 keep = np.concatenate([np.arange(i * n, (i + 1) * n) for i in good])
-                th, thd, thdd = th[keep], thd[keep], thdd[keep]
+                th, thd, thdd = th[:, keep], thd[:, keep], thdd[:, keep]
                 trig = None if trig is None else (trig[0][:, keep], trig[1][:, keep])
-            M = shaking_moment(self.arm, absolute_state(self.arm, th, thd, thdd, trig), self.gravity, self.point,
-                               grids=len(good))
+            rx, ry, ax, ay, _, _ = state_rows(self.arm, th if trig is None else None, thd, thdd, trig)
+            M = moment_rows(self.arm, rx, ry, ax, ay, np.ascontiguousarray(thdd.T), self.gravity, self.point,
+                            grids=len(good))
             for j, i in enumerate(good):
                 peak = float(np.max(np.abs(M[j * n:(j + 1) * n])))
                 out[i] = peak if math.isfinite(peak) else 1e6

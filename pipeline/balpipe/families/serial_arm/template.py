@@ -257,7 +257,7 @@ class TaskMotion:
         return tuple(np.stack([v[k] for v in vals], axis=-1) for k in range(3))
 
 
-def absolute_motion(chain: Chain, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray, mode: int):
+def absolute_motion(chain: Chain, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray, mode: int, rows: bool = False):
     """Absolute link angles theta, theta', theta'' (N, n) of a task-space motion (x, y[, phi])
     with their exact derivatives, (margin, sin gamma) for the reach and singularity checks, and
     the angles' cosines and sines, (n, N) each, when this computed them already (every
@@ -269,6 +269,8 @@ def absolute_motion(chain: Chain, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray
     equivalent vectors (lengths a, b): W = a e(alpha1) + b e(alpha2), so
     [a perp(e1), b perp(e2)] alpha' = W' and the same matrix maps alpha'' to
     W'' + a alpha1'^2 e1 + b alpha2'^2 e2 (solved by Cramer's rule, det = a b sin(alpha2 - alpha1)).
+    ``rows``: theta, theta', theta'' as (n, N) rows instead (the same values: what
+    :func:`state_rows` takes).
     """
     v = np.asarray(chain.vectors, dtype=float)
     n = chain.n
@@ -308,7 +310,8 @@ def absolute_motion(chain: Chain, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray
         if trig is not None:
             trig[0].append(cf), trig[1].append(sf)
     cos_sin = None if trig is None else (np.stack(trig[0]), np.stack(trig[1]))
-    return np.stack(th, 1), np.stack(thd, 1), np.stack(thdd, 1), margin, sg, cos_sin
+    axis = 0 if rows else 1
+    return np.stack(th, axis), np.stack(thd, axis), np.stack(thdd, axis), margin, sg, cos_sin
 
 
 class JointSolution:
@@ -482,14 +485,24 @@ def arm_state(arm: ArmGeometry, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) 
 def absolute_state(arm: ArmGeometry, th: np.ndarray, thd: np.ndarray, thdd: np.ndarray,
                    trig: tuple[np.ndarray, np.ndarray] | None = None) -> ArmState:
     """Positions and accelerations of the centres of mass from the absolute link angles (N, n):
-    (R u)'' = theta'' perp(R u) - theta'^2 R u for every vector u fixed in a link. Computed link
-    by link on (n, N) rows, so that every operation runs along the samples (paper 003's
-    optimiser calls it thousands of times on three links); the fields are (N, n). ``trig``: the
+    :func:`state_rows` on the angles' rows, its results back in (N, n) fields. ``trig``: the
     angles' cosines and sines (n, N) when known (:func:`absolute_motion`'s), not computed again."""
     w, acc = (np.ascontiguousarray(a.T) for a in (thd, thdd))
+    rows = state_rows(arm, np.ascontiguousarray(th.T) if trig is None else None, w, acc, trig)
+    rx, ry, ax, ay, ox, oy = (np.ascontiguousarray(a.T) for a in rows)
+    return ArmState(rx, ry, ax, ay, ox, oy, thdd)
+
+
+def state_rows(arm: ArmGeometry, th: np.ndarray | None, w: np.ndarray, acc: np.ndarray,
+               trig: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, ...]:
+    """The links' centres of mass, their accelerations and the proximal joints, (rx, ry, ax, ay,
+    ox, oy) as (n, N) rows, from the absolute angles' rows ``th`` (or their cosines and sines
+    ``trig``, then ``th`` may be None), rates ``w`` and accelerations ``acc`` (n, N):
+    (R u)'' = theta'' perp(R u) - theta'^2 R u for every vector u fixed in a link, computed link
+    by link on rows, so that every operation runs along the samples (paper 003's optimiser calls
+    it thousands of times on three links)."""
     if trig is None:
-        t = np.ascontiguousarray(th.T)
-        c, s = np.cos(t), np.sin(t)
+        c, s = np.cos(th), np.sin(th)
     else:
         c, s = trig
     L = np.asarray(arm.lengths, dtype=float)[:, None]
@@ -502,11 +515,7 @@ def absolute_state(arm: ArmGeometry, th: np.ndarray, thd: np.ndarray, thdd: np.n
     rax, ray = -acc * rcy - w2 * rcx, acc * rcx - w2 * rcy
     ox, oy = _proximal(segx, arm.base[0]), _proximal(segy, arm.base[1])
     oax, oay = _proximal(sax), _proximal(say)
-
-    def back(a: np.ndarray) -> np.ndarray:
-        return np.ascontiguousarray(a.T)
-
-    return ArmState(back(ox + rcx), back(oy + rcy), back(oax + rax), back(oay + ray), back(ox), back(oy), thdd)
+    return ox + rcx, oy + rcy, oax + rax, oay + ray, ox, oy
 
 
 def _proximal(seg: np.ndarray, start: float | None = None) -> np.ndarray:
@@ -529,17 +538,24 @@ def shaking_loads(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0), point=(0.0
     return np.stack([fx.sum(axis=1), fy.sum(axis=1)], axis=1), M
 
 
-def shaking_moment(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0), point=(0.0, 0.0), grids: int = 1) -> np.ndarray:
-    """The moment of :func:`shaking_loads` alone (the optimiser's objective). ``grids``: the
-    samples are that many grids of equal length one after the other (several motions in one
-    state: the optimiser's points), each grid's moment the same bits as alone (a matrix-vector
-    product rounds a row as its place in the product makes it: the inertia term is computed per
-    grid; the sum over the links rounds every row alike)."""
-    m = np.asarray(arm.masses)
-    fx, fy = m * (gravity[0] - st.ax), m * (gravity[1] - st.ay)
+def shaking_moment(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0), point=(0.0, 0.0)) -> np.ndarray:
+    """The moment of :func:`shaking_loads` alone (the optimiser's objective)."""
+    return moment_rows(arm, st.rx.T, st.ry.T, st.ax.T, st.ay.T, st.thdd, gravity, point)
+
+
+def moment_rows(arm: ArmGeometry, rx: np.ndarray, ry: np.ndarray, ax: np.ndarray, ay: np.ndarray,
+                thdd: np.ndarray, gravity=(0.0, 0.0), point=(0.0, 0.0), grids: int = 1) -> np.ndarray:
+    """:func:`shaking_moment` from the centres of mass and their accelerations as (n, N) rows
+    (:func:`state_rows`'s) and the angular accelerations ``thdd`` (N, n). ``grids``: the samples
+    are that many grids of equal length one after the other (several motions at once: the
+    optimiser's points), each grid's moment the same bits as alone (a matrix-vector product
+    rounds a row as its place in the product makes it: the inertia term is computed per grid; the
+    sum over the links rounds every row alike)."""
+    m = np.asarray(arm.masses)[:, None]
+    fx, fy = m * (gravity[0] - ax), m * (gravity[1] - ay)
     inertias = np.asarray(arm.inertias)
-    inertia = st.thdd @ inertias if grids == 1 else np.concatenate([part @ inertias for part in np.split(st.thdd, grids)])
-    return ((st.rx - point[0]) * fy - (st.ry - point[1]) * fx) @ np.ones(arm.n) - inertia
+    inertia = thdd @ inertias if grids == 1 else np.concatenate([part @ inertias for part in np.split(thdd, grids)])
+    return np.ascontiguousarray(((rx - point[0]) * fy - (ry - point[1]) * fx).T) @ np.ones(arm.n) - inertia
 
 
 def joint_torques(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0)) -> np.ndarray:
