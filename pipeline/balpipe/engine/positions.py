@@ -106,8 +106,9 @@ def newton_raphson(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _M
             except np.linalg.LinAlgError:
                 dq = np.stack([np.linalg.lstsq(Jk, -pk, rcond=None)[0] for Jk, pk in zip(J, phi[todo])])
         q[todo] += dq
-    qx = with_frame(q)
-    norms = np.abs(residual(c, qx, t, laws)).max(axis=1)
+    else:  # the last step's residual (after a break, norms are those of q as it is)
+        qx = with_frame(q)
+        norms = np.abs(residual(c, qx, t, laws)).max(axis=1)
     ok = norms < 1e-9
     if used and not ok.all():
         again = np.flatnonzero(~ok)
