@@ -493,11 +493,31 @@ def test_simplex_searches_side_by_side_are_scipys_nelder_mead(maxfev):
         scipys = [_scipy_path(f, s, maxfev) for s in simplices]
         for s, (sx, sfun, path) in zip(simplices, scipys):  # alone: the same points in the same order
             seen: list = []
-            [(x, fun)] = minimise_together(lambda P: [seen.append(p) or f(p) for p in P], [nelder_mead(s, maxfev, 1e-6, 1e-9)])
+            [(x, fun)] = minimise_together(lambda _, P: [seen.append(p) or f(p) for p in P], [nelder_mead(s, maxfev, 1e-6, 1e-9)])
             assert np.array_equal(x, sx) and fun == sfun
             assert len(seen) == len(path) and all(np.array_equal(a, b) for a, b in zip(seen, path))
         calls: list[int] = []
-        together = minimise_together(lambda P: calls.append(len(P)) or [f(p) for p in P],
+        together = minimise_together(lambda _, P: calls.append(len(P)) or [f(p) for p in P],
                                      [nelder_mead(s, maxfev, 1e-6, 1e-9) for s in simplices])
         assert all(np.array_equal(x, sx) and fun == sfun for (x, fun), (sx, sfun, _) in zip(together, scipys))
         assert calls[0] == len(simplices) and sum(calls) == sum(len(path) for *_, path in scipys)
+
+
+def test_the_objective_of_several_trajectories_at_once_is_each_ones_alone(paper):
+    """Planner.peaks evaluates points of several trajectories (working modes mixed, points outside
+    the workspace among them) in one call: each value is the one its trajectory's objective gives
+    alone, bit for bit."""
+    spec, st, p = paper
+    model = registry.unbalanced_model(spec)
+    pl = cp.Planner(model, spec.mechanism, spec.balancing, spec.motion.duration, registry.time_grid(spec),
+                    (0.0, 0.0), (0.0, 0.0))
+    plans = [(pl.plan(name, start, end, path), path) for name, start, end, path in cp.trajectories_of(spec.balancing, model)[:3]]
+    plans.append((cp.replace(plans[0][0], com_mode=-plans[0][0].com_mode), plans[0][1]))  # the other working mode
+    plans.append((cp.replace(plans[1][0], com_start=plans[1][0].com_start + 0.5), plans[1][1]))  # out of reach
+    rng = np.random.default_rng(7)
+    points = rng.normal(0.0, 0.8, (15, spec.balancing.phi.degree - 5))
+    owners = [i % len(plans) for i in range(len(points))]
+    together = pl.peaks(plans)(points, owners)
+    alone = [pl.objective(*plans[o])(c) for c, o in zip(points, owners)]
+    assert together == alone
+    assert any(v >= 1e6 for v in alone) and any(v < 1e6 for v in alone)  # penalised points among them

@@ -30,6 +30,7 @@ engine analyses only the final stages (tests check that both agree to 1e-9).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -52,7 +53,7 @@ from .template import (
     tip_chain,
     with_joint_laws,
 )
-from ...balancing.context import BalanceContext
+from ...balancing.context import BalanceContext, Memo, compute
 from ...display import numbers
 from ...model import Law, Model
 from ...motion import PointToPoint, bang_bang, law_for, quintic
@@ -215,33 +216,38 @@ class Planner:
         """The optimiser's objective c -> max |M| over the analysis grid with the CoM on the
         bang-bang law and phi(c) (a penalty outside the workspace or at a singular
         configuration): :meth:`peaks` of one point."""
-        peaks = self.peaks(plan, path)
-        return lambda c: peaks(np.asarray(c, dtype=float)[None, :])[0]
+        peaks = self.peaks([(plan, path)])
+        return lambda c: peaks(np.asarray(c, dtype=float)[None, :], [0])[0]
 
-    def peaks(self, plan: Plan, path: tuple):
-        """The objective of several points at once: (k, free coefficients) -> their k values. The
-        CoM law and phi's basis are evaluated once; each call is a few vectorised array operations
-        (explicit serial kinematics and dynamics, on (links, samples) rows) on the k points' grids
-        one after the other, every sample computed as for one point alone (the same values, bit for
-        bit, whatever k: the kinematics and the state are sample by sample, :func:`moment_rows`
-        keeps the grids apart), so that a call of three points costs 1.7 times a call of one."""
+    def peaks(self, plans: Sequence[tuple[Plan, tuple]]):
+        """The objectives of ``plans`` ((plan, spec path) pairs), of several points at once:
+        ``values(points, owners)``, points (k, free coefficients) and the index of each one's
+        plan, -> their k values. The CoM laws and phi's basis are evaluated once; each call is a
+        few vectorised array operations (explicit serial kinematics and dynamics, on (links,
+        samples) rows) on the k points' grids one after the other, every sample computed as for
+        one point alone (the same values, bit for bit, whatever the points evaluated with it: the
+        kinematics and the state are sample by sample, :func:`moment_rows` keeps the grids
+        apart), so that a call of 24 points costs 11 times a call of one."""
         t, T = self.t, self.T
         nfree = self.method.phi.degree - 5
-        com = _com_motion(plan, bang_bang, T, PhiPolynomial(plan.start[2], plan.end[2], T), path)
-        x0, xd0, xdd0 = com.values(t)
+        laws = [_com_motion(plan, bang_bang, T, PhiPolynomial(plan.start[2], plan.end[2], T), path).values(t)
+                for plan, path in plans]
+        rows = [tuple(np.ascontiguousarray(a.T) for a in law) for law in laws]  # x, y, phi rows and derivatives
+        modes = [plan.com_mode for plan, _ in plans]
         basis = [PhiPolynomial(0.0, 0.0, T, tuple(1.0 if j == k else 0.0 for j in range(k + 1)))(t) for k in range(nfree)]
         B = [np.stack([b[d] for b in basis], axis=1) if nfree else np.zeros((len(t), 0)) for d in range(3)]
         n = len(t)
 
-        def values(C: np.ndarray) -> list[float]:
+        def values(C: np.ndarray, owners: Sequence[int]) -> list[float]:
             k = len(C)
-            self.calls += k
-            # the task-space motion as rows (x, y, phi; k grids one after the other), read as (k n, 3)
-            X, Xd, Xdd = (np.tile(a.T, (1, k)) for a in (x0, xd0, xdd0))
-            for i, c in enumerate(C):
+            # the task-space motions as rows (x, y, phi; the k grids one after the other), read as (k n, 3)
+            X, Xd, Xdd = (np.concatenate([rows[o][d] for o in owners], axis=1) for d in range(3))
+            for i, (c, o) in enumerate(zip(C, owners)):
                 grid = slice(i * n, (i + 1) * n)
+                x0, xd0, xdd0 = laws[o]
                 X[2, grid], Xd[2, grid], Xdd[2, grid] = x0[:, 2] + B[0] @ c, xd0[:, 2] + B[1] @ c, xdd0[:, 2] + B[2] @ c
-            th, thd, thdd, margin, sg, trig = absolute_motion(self.com, X.T, Xd.T, Xdd.T, plan.com_mode, rows=True)
+            mode = modes[owners[0]] if len({modes[o] for o in owners}) == 1 else np.repeat([modes[o] for o in owners], n)
+            th, thd, thdd, margin, sg, trig = absolute_motion(self.com, X.T, Xd.T, Xdd.T, mode, rows=True)
             out = [0.0] * k
             good = []
             for i in range(k):
@@ -289,29 +295,39 @@ class Planner:
                                  "modes of the centre-of-mass chain; no motion of the centre of mass joins them")
         return Plan(name, tuple(start), tuple(end), qa, qb, self.com.point(qa[None])[0], self.com.point(qb[None])[0], cmode)
 
-    def optimise_phi(self, plan: Plan, path: tuple) -> None:
-        """Nelder-Mead from ``starts`` points (the 3-4-5 law and random ones), side by side
-        (:func:`.simplex.minimise_together`: one call of :meth:`peaks` evaluates a point of each)."""
+    def optimise_phi(self, plans: Sequence[tuple[Plan, tuple]]) -> None:
+        """phi's coefficients of each of ``plans`` ((plan, spec path) pairs, updated): Nelder-Mead
+        from ``starts`` points (the 3-4-5 law and random ones), every plan's searches side by side
+        (:func:`.simplex.minimise_together`: one call of :meth:`peaks` evaluates a point of each
+        unfinished search). Each plan gets what it gets optimised alone, bit for bit."""
+        if not plans:
+            return
         opt = self.method.phi
         nfree = opt.degree - 5
-        peaks = self.peaks(plan, path)
-        start_peak = peaks(np.zeros((1, nfree)))[0]
-        plan.phi_peak_start = start_peak
-        if nfree == 0:
-            plan.phi_peak_best = start_peak
-            return
-        rng = np.random.default_rng(opt.seed)
-        starts = [np.zeros(nfree)] + [rng.normal(0.0, opt.spread, nfree) for _ in range(opt.starts - 1)]
-        best_x, best_f = np.zeros(nfree), start_peak
-        calls0 = self.calls
-        searches = [nelder_mead(_simplex(x0, 0.2), opt.max_evaluations, opt.tolerance, opt.tolerance * start_peak)
-                    for x0 in starts]
-        for x, fun in minimise_together(peaks, searches):
-            if fun < best_f:
-                best_x, best_f = np.asarray(x, dtype=float), float(fun)
-        plan.phi_coefficients = tuple(float(c) for c in best_x)
-        plan.phi_peak_best = best_f
-        plan.evaluations = self.calls - calls0 + 1
+        peaks = self.peaks(plans)
+        start = peaks(np.zeros((len(plans), nfree)), range(len(plans)))
+        searches, owner = [], []
+        for i, (plan, _) in enumerate(plans):
+            plan.phi_peak_start = plan.phi_peak_best = start[i]
+            if nfree == 0:
+                continue
+            plan.phi_coefficients, plan.evaluations = (0.0,) * nfree, 1  # the start's evaluation
+            rng = np.random.default_rng(opt.seed)
+            starts = [np.zeros(nfree)] + [rng.normal(0.0, opt.spread, nfree) for _ in range(opt.starts - 1)]
+            for x0 in starts:
+                searches.append(nelder_mead(_simplex(x0, 0.2), opt.max_evaluations, opt.tolerance, opt.tolerance * start[i]))
+                owner.append(i)
+
+        def values(asking: list[int], points: np.ndarray) -> list[float]:
+            owners = [owner[j] for j in asking]
+            for o in owners:
+                plans[o][0].evaluations += 1
+            return peaks(points, owners)
+
+        for o, (x, fun) in zip(owner, minimise_together(values, searches)):  # each plan's starts in order
+            plan = plans[o][0]
+            if fun < plan.phi_peak_best:
+                plan.phi_coefficients, plan.phi_peak_best = tuple(float(c) for c in np.asarray(x, dtype=float)), float(fun)
 
     def ramp(self, plan: Plan, phi: Law, path: tuple) -> None:
         """Case 3: the shortest ramp fraction f whose torque rates stay within the limit
@@ -442,15 +458,23 @@ def balance(ctx: BalanceContext) -> BalanceResult:
     m_total = planner.arm.total_mass
     trajectories = trajectories_of(method, model)
     main = main_trajectory(method, trajectories)
+    prepared: list[tuple[str, tuple, tuple, tuple, Plan]] = []
+    failure: SpecFieldError | None = None
     for name, start, end, path in trajectories:
-        plan = planner.plan(name, start, end, path)
-        # located errors on every path before optimising (case 1 and the bang-bang line)
-        tip_laws = tuple(law_for(_Motion(law_name, T), a, b) for a, b in zip(plan.start, plan.end))
-        JointSolution(planner.tip, TaskMotion(tip_laws, "tip", path, name), mech.working_mode, t)
-        JointSolution(planner.com, _com_motion(plan, bang_bang, T, PhiPolynomial(start[2], end[2], T), path),
-                      plan.com_mode, t)
-        plan.phi_coefficients, plan.phi_peak_start, plan.phi_peak_best, plan.evaluations = ctx.memo(
-            phi_search, model, mech, method, T, t, planner.gravity, planner.point, replace(plan), path)
+        try:
+            plan = planner.plan(name, start, end, path)
+            # located errors on every path before optimising (case 1 and the bang-bang line)
+            tip_laws = tuple(law_for(_Motion(law_name, T), a, b) for a, b in zip(plan.start, plan.end))
+            JointSolution(planner.tip, TaskMotion(tip_laws, "tip", path, name), mech.working_mode, t)
+            JointSolution(planner.com, _com_motion(plan, bang_bang, T, PhiPolynomial(start[2], end[2], T), path),
+                          plan.com_mode, t)
+        except SpecFieldError as exc:  # raised once the trajectories before it are done: the error one by one gives
+            failure = exc
+            break
+        prepared.append((name, start, end, path, plan))
+    searched = phi_searches(ctx.memo, model, mech, method, T, t, planner, [(plan, path) for *_, path, plan in prepared])
+    for (name, start, end, path, plan), found in zip(prepared, searched):
+        plan.phi_coefficients, plan.phi_peak_start, plan.phi_peak_best, plan.evaluations = found
         planner.ramp(plan, PhiPolynomial(start[2], end[2], T, plan.phi_coefficients), path)
         plan.models = planner.stages(plan, law_name, path)
         plans.append(plan)
@@ -476,6 +500,8 @@ def balance(ctx: BalanceContext) -> BalanceResult:
         P(f"phi_evaluations{sfx}", plan.evaluations, "", "phi optimisation", "objective evaluations, all starts")
         P(f"ramp_fraction{sfx}", plan.ramp_fraction, "", "case 3", "ramp duration of the trapezoidal acceleration / T")
         P(f"ramp_torque_rate{sfx}", plan.ramp_rate, "N m/s", "case 3", "largest actuator torque rate with that ramp")
+    if failure is not None:
+        raise failure
     notes = [_method_note(method, planner, plans, law_name)]
     for p in plans:
         if not p.ramp_feasible:
@@ -486,13 +512,28 @@ def balance(ctx: BalanceContext) -> BalanceResult:
     return BalanceResult(params, stages, notes, derived=lambda results: derived(results, plans, T, m_total))
 
 
+def phi_searches(memo: Memo, model: Model, mech: SerialArmMechanism, method: ComMotionPlanning, T: float,
+                 t: np.ndarray, planner: Planner, plans: list[tuple[Plan, tuple]]) -> list[tuple]:
+    """phi's search of each of ``plans`` ((plan, spec path) pairs, as :meth:`Planner.plan` made
+    them; not changed), as :func:`phi_search` returns it: one search per trajectory through
+    ``memo``, which the build's balancing cache keeps one by one; side by side in one
+    :meth:`Planner.optimise_phi` when ``memo`` keeps nothing (``balpipe check``: one objective call
+    evaluates a point of up to 24 searches, the same results)."""
+    if memo is not compute:
+        return [memo(phi_search, model, mech, method, T, t, planner.gravity, planner.point, replace(plan), path)
+                for plan, path in plans]
+    copies = [(replace(plan), path) for plan, path in plans]
+    planner.optimise_phi(copies)
+    return [(p.phi_coefficients, p.phi_peak_start, p.phi_peak_best, p.evaluations) for p, _ in copies]
+
+
 def phi_search(model: Model, mech: SerialArmMechanism, method: ComMotionPlanning, T: float, t: np.ndarray,
                gravity: tuple, point: tuple, plan: Plan, path: tuple) -> tuple[tuple[float, ...], float, float, int]:
     """:meth:`Planner.optimise_phi` of one trajectory (``plan`` as :meth:`Planner.plan` made it,
     updated here) as a function of plain data: what the build's balancing cache keys and keeps
     (:mod:`balpipe.cache.balance`; about 2 s of paper 003's balancing). Returns phi's
     coefficients, the peak moments at the start and at the optimum, and the evaluations."""
-    Planner(model, mech, method, T, t, gravity, point).optimise_phi(plan, path)
+    Planner(model, mech, method, T, t, gravity, point).optimise_phi([(plan, path)])
     return plan.phi_coefficients, plan.phi_peak_start, plan.phi_peak_best, plan.evaluations
 
 

@@ -105,18 +105,19 @@ def nelder_mead(simplex: np.ndarray, maxfev: int, xatol: float, fatol: float) ->
     return sim[0], float(np.min(fsim))
 
 
-def minimise_together(values: Callable[[np.ndarray], Sequence[float]], searches: Sequence[Search]
+def minimise_together(values: Callable[[list[int], np.ndarray], Sequence[float]], searches: Sequence[Search]
                       ) -> list[tuple[np.ndarray, float]]:
     """Run ``searches`` side by side: at each step the point every unfinished search needs,
-    evaluated by ``values`` ((k, n) points -> their k values) in one call. Returns each search's
-    (x, f(x)), in the order given. The searches are independent: each gives what it gives alone."""
+    evaluated by ``values(asking, points)`` (the indices of the searches asking, their (k, n)
+    points -> the k values) in one call. Returns each search's (x, f(x)), in the order given.
+    The searches are independent: each gives what it gives alone."""
     results: list[tuple[np.ndarray, float] | None] = [None] * len(searches)
     pending: dict[int, np.ndarray] = {}
-    for i, search in enumerate(searches):
+    for i in range(len(searches)):
         _advance(searches, i, None, pending, results)
     while pending:
-        order = list(pending)
-        for i, v in zip(order, values(np.stack([pending[i] for i in order]))):
+        asking = list(pending)
+        for i, v in zip(asking, values(asking, np.stack([pending[i] for i in asking]))):
             _advance(searches, i, v, pending, results)
     return [r for r in results if r is not None]
 
