@@ -26,17 +26,13 @@ from .compile import Compiled
 from .constraints import GridLaws, with_frame, jacobian
 from .kinematics import _solve_rect, _vel_acc
 from .structure import Decomposition, invert_blocks, solve
-from .vectorised import State, Vectorised, acceleration_rhs, jacobian_values, law_table, residual, velocity_rhs
+from .vectorised import (State, Vectorised, acceleration_rhs, jacobian_values, law_table, residual, table_row,
+                         velocity_rhs)
 
 _TOL = 1e-12  # as :data:`.positions._TOL`
 _CONVERGED = 1e-9  # as :func:`.positions.newton_raphson`'s convergence test
 _DENSE_ENTRIES = 20_000  # samples x n^2 up to which the dense scattered Jacobian is used
 _POLISH = 1e-14  # closed loops: one more Newton step where the residual exceeds this (:func:`polish`)
-
-
-def _table_row(table: tuple[np.ndarray, np.ndarray, np.ndarray], k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Sample k of :func:`.vectorised.law_table`'s table, as the table of that time alone."""
-    return table[0][:, k : k + 1], table[1][:, k : k + 1], table[2][:, k : k + 1]
 
 
 class BlockOps:
@@ -45,7 +41,7 @@ class BlockOps:
     def __init__(self, c: Compiled, vz: Vectorised, dec: Decomposition, t: np.ndarray | None = None):
         """``t``: the time grid of the motion, whose law values are then evaluated once."""
         self.c, self.vz, self.dec = c, vz, dec
-        self._grid = None if t is None else GridLaws(t, lambda grid: law_table(vz, grid), _table_row)
+        self._grid = None if t is None else GridLaws(t, lambda grid: law_table(vz, grid), table_row)
         free = np.flatnonzero(vz.cols >= 3)
         self._free, self._frow, self._fcol = free, vz.rows[free], vz.cols[free] - 3
         self.n = vz.ncol - 3

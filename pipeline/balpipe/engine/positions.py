@@ -4,7 +4,7 @@ Phi(q, t) = 0, with the regularity (singularity) check."""
 from __future__ import annotations
 
 import functools
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -12,8 +12,9 @@ from ..mechanics.sampling import spread_indices
 from .compile import Compiled
 from .constraints import GridLaws, with_frame, jacobian, law_positions, law_triples, residual
 from .errors import AnalysisError
-from .kinematics import _solve_rect, _vel_acc
+from .kinematics import _solve_rect, _vel_acc, rates_by_type
 from .normal import factor
+from .vectorised import State, Vectorised, jacobian_values, law_table, residual as vresidual, table_row, vectorise
 
 
 class Ops(Protocol):
@@ -73,29 +74,89 @@ def _check_redundancy(c: Compiled, q: np.ndarray, t: float) -> None:
         )
 
 
+class _ByPrimitive:
+    """Phi (N, m) and the free columns of Phi_q (k, m, n) of ``c`` at times ``t`` by
+    :mod:`.constraints` (a loop over the primitives); ``laws``: :func:`.constraints.law_positions`
+    at ``t``."""
+
+    def __init__(self, c: Compiled, t: np.ndarray, laws: list):
+        self.c, self.t, self.laws = c, t, laws
+        self._qx = np.zeros((0, 0))
+
+    def residual(self, q: np.ndarray) -> np.ndarray:
+        self._qx = with_frame(q)
+        return residual(self.c, self._qx, self.t, self.laws)
+
+    def jacobian(self, todo: np.ndarray) -> np.ndarray:
+        """At the positions of the last :meth:`residual`, for the samples ``todo`` (a mask)."""
+        return jacobian(self.c, self._qx[todo])[:, :, 3:]
+
+    def subset(self, idx: np.ndarray) -> _ByPrimitive:
+        return _ByPrimitive(self.c, self.t[idx], [None if f is None else np.broadcast_to(f, self.t.shape)[idx] for f in self.laws])
+
+
+class _ByType:
+    """The same as :class:`_ByPrimitive` by :mod:`.vectorised` (a few numpy operations per
+    primitive type: on paper 001's 4-RRR the same floats, bit for bit, in a third of the time);
+    ``f``: the driven rows' law values at the samples, :func:`.vectorised.law_table`'s first."""
+
+    def __init__(self, vz: Vectorised, f: np.ndarray):
+        self.vz, self.f = vz, f
+        free = np.flatnonzero(vz.cols >= 3)
+        self._free, self._frow, self._fcol = free, vz.rows[free], vz.cols[free] - 3
+        self._state: State | None = None
+
+    def residual(self, q: np.ndarray) -> np.ndarray:
+        X = np.zeros((self.vz.ncol, q.shape[0]))
+        X[3:] = q.T
+        self._state = State(self.vz, X)
+        return vresidual(self.vz, self._state, self.f).T
+
+    def jacobian(self, todo: np.ndarray) -> np.ndarray:
+        """At the positions of the last :meth:`residual`, for the samples ``todo`` (a mask)."""
+        assert self._state is not None
+        vals = jacobian_values(self.vz, self._state)[self._free][:, todo]
+        J = np.zeros((vals.shape[1], self.vz.m, self.vz.ncol - 3))
+        J[:, self._frow, self._fcol] = vals.T
+        return J
+
+    def subset(self, idx: np.ndarray) -> _ByType:
+        return _ByType(self.vz, self.f[:, idx])
+
+
 def newton_raphson(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER,
-                   laws: list | None = None, normal: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   laws: list | None = None, normal: bool = True,
+                   by_type: tuple[Vectorised, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Batched Newton-Raphson. Returns (q, converged mask, residual norms). ``laws``: the
-    drivers' f(t), :func:`.constraints.law_positions` (evaluated here when not given).
+    drivers' f(t), :func:`.constraints.law_positions` (evaluated here when not given);
+    ``by_type``: (the model's :func:`.vectorised.vectorise`, its :func:`.vectorised.law_table`'s
+    values at ``t``), to evaluate Phi and Phi_q by primitive type (:class:`_ByType`) instead
+    (``laws`` not read).
 
     With redundant drivers a step is the least-squares one (Gauss-Newton), through the normal
     equations (:mod:`.normal`) where their factorisation holds, else by QR; with ``normal``, the
     samples that do not converge so are iterated again from ``q`` by QR alone (what they did
     before the normal equations: an ill-conditioned step never fails where QR's converges)."""
+    if by_type is not None:
+        ev: _ByPrimitive | _ByType = _ByType(*by_type)
+    else:
+        ev = _ByPrimitive(c, t, law_positions(c, t) if laws is None else laws)  # f(t): the same at every iteration
+    return _newton(q, ev, max_iter, normal)
+
+
+def _newton(q: np.ndarray, ev: _ByPrimitive | _ByType, max_iter: int, normal: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`newton_raphson` with the evaluation ``ev``."""
     q0 = q
     q = q.copy()
-    norms = np.full(len(t), np.inf)
-    if laws is None:
-        laws = law_positions(c, t)  # the drivers' f(t): the same at every iteration
+    norms = np.full(len(q), np.inf)
     used = False
     for _ in range(max_iter):
-        qx = with_frame(q)
-        phi = residual(c, qx, t, laws)
+        phi = ev.residual(q)
         norms = np.abs(phi).max(axis=1)
         todo = ~(norms < _TOL)
         if not todo.any():
             break
-        J = jacobian(c, qx[todo])[:, :, 3:]
+        J = ev.jacobian(todo)
         ne = factor(J) if normal else None
         if ne is not None:
             used = True
@@ -107,13 +168,11 @@ def newton_raphson(c: Compiled, q: np.ndarray, t: np.ndarray, max_iter: int = _M
                 dq = np.stack([np.linalg.lstsq(Jk, -pk, rcond=None)[0] for Jk, pk in zip(J, phi[todo])])
         q[todo] += dq
     else:  # the last step's residual (after a break, norms are those of q as it is)
-        qx = with_frame(q)
-        norms = np.abs(residual(c, qx, t, laws)).max(axis=1)
+        norms = np.abs(ev.residual(q)).max(axis=1)
     ok = norms < 1e-9
     if used and not ok.all():
         again = np.flatnonzero(~ok)
-        sub = [None if f is None else np.broadcast_to(f, t.shape)[again] for f in laws]
-        q[again], ok[again], norms[again] = newton_raphson(c, q0[again], t[again], max_iter, sub, normal=False)
+        q[again], ok[again], norms[again] = _newton(q0[again], ev.subset(again), max_iter, normal=False)
     return q, ok, norms
 
 
@@ -217,23 +276,42 @@ class DenseOps:
     ``t``: the motion's time grid, whose drivers' values are then evaluated once and taken for
     the grid itself and for single times on it (the continuation's steps: a 4-RRR's driver laws
     solve the legs' inverse kinematics, 60 % of a step when evaluated one time at a time), as
-    :class:`.newton_blocks.BlockOps` does."""
+    :class:`.newton_blocks.BlockOps` does. ``by_type``: Phi, Phi_q, nu and gamma evaluated by
+    primitive type instead (:mod:`.vectorised`: :func:`newton_raphson`'s ``by_type``,
+    :func:`.kinematics.rates_by_type`), in a third of the time: the continuation's single-sample
+    steps are mostly these evaluations. The same values to round-off (gear rows' sums in another
+    order), on paper 001's 4-RRR bit for bit: taken for the frame motions of the general path's
+    models (:mod:`.shared`), not where it is the block path's reference or the balancing's
+    states (:func:`solve_positions`)."""
 
-    def __init__(self, c: Compiled, t: np.ndarray | None = None):
+    def __init__(self, c: Compiled, t: np.ndarray | None = None, by_type: bool = False):
         self.c = c
-        self._grid = None if t is None else GridLaws(t, functools.partial(law_triples, c), _triples_row)
+        self._vz = (c.fast.vz if c.fast is not None else vectorise(c)) if by_type else None
+        vz = self._vz
+        if t is None:
+            self._grid = None
+        elif vz is None:
+            self._grid = GridLaws(t, functools.partial(law_triples, c), _triples_row)
+        else:
+            self._grid = GridLaws(t, lambda grid: law_table(vz, grid), table_row)
 
-    def _laws(self, t: np.ndarray) -> list | None:
-        """:func:`.constraints.law_triples` at ``t`` from the grid's table (the grid itself, or a
-        single time on it), else None (the callee evaluates them)."""
+    def _laws(self, t: np.ndarray) -> Any:
+        """The drivers' values at ``t`` (:func:`.constraints.law_triples`, or by type
+        :func:`.vectorised.law_table`) from the grid's table (the grid itself, or a single time
+        on it), else None (evaluated by the callee)."""
         return None if self._grid is None else self._grid.at(t)
 
     def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         laws = self._laws(t)
+        if self._vz is not None:
+            return newton_raphson(self.c, q, t, max_iter, by_type=(self._vz, (law_table(self._vz, t) if laws is None else laws)[0]))
         return newton_raphson(self.c, q, t, max_iter, None if laws is None else [None if f is None else f[0] for f in laws])
 
     def vel_acc(self, q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return _vel_acc(self.c, q, t, self._laws(t))
+        laws = self._laws(t)
+        if self._vz is not None:
+            return rates_by_type(self._vz, q, law_table(self._vz, t) if laws is None else laws)
+        return _vel_acc(self.c, q, t, laws)
 
 
 def _triples_row(table: list, k: int) -> list:

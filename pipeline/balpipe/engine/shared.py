@@ -4,7 +4,8 @@ The block path (:mod:`.fastpath`) solves a closed loop's motion once per geometr
 model, and places every model's centres of mass in it. The general path (redundant actuation,
 patterns with no block form) does the same here: the balancing stages and mass designs of a
 mechanism differ only in their mass properties, so the motion of the bodies' own frames is
-solved once by the continuation of :mod:`.positions` on the **frame model**
+solved once by the continuation of :mod:`.positions` (its constraints evaluated by primitive
+type, :class:`.positions.DenseOps`' ``by_type``) on the **frame model**
 (:func:`.fastpath.frame_model`: every centre of mass at its frame's origin, so that the motion
 depends on the geometry alone, not on which model of it came first) and kept by
 :func:`.warmstart.motion_key` (joints, drivers by identity, points, initial poses, time grid).
@@ -146,7 +147,7 @@ def _frame_entry(c: Compiled, t: np.ndarray) -> _Shared:
         c.frame = compile_model(frame_model(c.model))
     fc = c.frame
     try:
-        frame = follow_motion(fc, t, DenseOps(fc, t))
+        frame = follow_motion(fc, t, DenseOps(fc, t, by_type=True))
         STATS["solved"] += 1
     except (AnalysisError, np.linalg.LinAlgError):
         frame = None

@@ -151,6 +151,11 @@ def law_table(vz: Vectorised, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np
     return F[0], F[1], F[2]
 
 
+def table_row(table: tuple[np.ndarray, np.ndarray, np.ndarray], k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sample k of :func:`law_table`'s table, as the table of that time alone."""
+    return table[0][:, k : k + 1], table[1][:, k : k + 1], table[2][:, k : k + 1]
+
+
 def _rot(C: np.ndarray, S: np.ndarray, b: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A(theta_b) s for arrays of bodies b and local vectors s (k, 2): x and y, (k, N) each."""
     cb, sb = C[b], S[b]
