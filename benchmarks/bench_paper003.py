@@ -9,7 +9,9 @@ Prints (asserts nothing):
    the ramp search of case 3), the engine's analyses of the 32 stages (number of ``analyse``
    calls and time per call), the page (figures, tables), and the optimiser's objective: number
    of evaluations and time per evaluation (the explicit vectorised serial dynamics on the
-   analysis grid), against one engine call on the same stage.
+   analysis grid), against one engine call on the same stage, and per point when 3 or 24 points
+   are evaluated in one call (as the searches side by side ask them: a trajectory's starts in a
+   build, every trajectory's in ``balpipe check``).
 """
 
 from __future__ import annotations
@@ -57,9 +59,6 @@ def breakdown() -> None:
     loaded = load(SPEC)
     spec = loaded.spec
     t_load = time.perf_counter() - t0
-    import scipy.optimize  # noqa: F401  (its import is counted apart)
-
-    t_import = time.perf_counter() - t0 - t_load
     calls = {"n": 0, "s": 0.0}
     real = engine.analyse
 
@@ -100,6 +99,15 @@ def breakdown() -> None:
     for _ in range(n):
         f(c0)
     per_eval = (time.process_time() - s) / n
+    # several points in one call, as the searches side by side ask them (3 per trajectory, 24 in check)
+    values = pl.peaks([(plan, path)])
+    per_point = {}
+    for k in (3, 24):
+        points = np.zeros((k, len(c0)))
+        s = time.process_time()
+        for _ in range(max(n // k, 10)):
+            values(points, [0] * k)
+        per_point[k] = (time.process_time() - s) / (max(n // k, 10) * k)
     stage = next(x for x in result.stages if x.name.endswith("com_bang_bang_phi_opt"))
     s = time.process_time()
     for _ in range(5):
@@ -107,7 +115,6 @@ def breakdown() -> None:
     per_engine = (time.process_time() - s) / 5
     rows = [
         ("load the spec", t_load, None),
-        ("import scipy.optimize (first use)", t_import, None),
         (f"method: plan 8 trajectories ({evals} objective evaluations, ramp search)", t_method, c_method),
         (f"engine: {calls['n']} analyse calls of {len(t)} samples ({calls['s'] / max(calls['n'], 1) * 1e3:.1f} ms wall per call)", t_engine, c_engine),
         ("study.run again (method + engine + checks)", t_run, c_run),
@@ -118,7 +125,8 @@ def breakdown() -> None:
     for label, sec, cpu in rows:
         print(f"{label.ljust(w)}  {sec:8.3f}  {'-' if cpu is None else f'{cpu:.3f}':>8}")
     print(f"CPU time per objective evaluation (fast path, {len(t)} samples): {per_eval * 1e3:.3f} ms; per engine "
-          f"analyse of the same stage: {per_engine * 1e3:.1f} ms ({per_engine / per_eval:.0f}x)")
+          f"analyse of the same stage: {per_engine * 1e3:.1f} ms ({per_engine / per_eval:.0f}x); per point evaluated "
+          + ", ".join(f"{k} at once {v * 1e3:.3f} ms" for k, v in per_point.items()))
     print(f"stages: {len(stages)}; load average {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
 
 
