@@ -170,3 +170,45 @@ def test_placed_models_multipliers_by_their_geometrys_map(rrr4):
         assert np.abs(residual).max() <= 1e-9 * np.abs(rhs).max(), s.name
         assert np.array_equal(J0, J[:, :, :3])  # the frame's columns do not see the masses
     assert used >= 3
+
+
+def test_placed_models_regular_by_the_frame_motions_proof(rrr4, monkeypatch):
+    """A placed stage is shown regular by its geometry's frame motion, screened once
+    (shared._shown_regular): its own screen does not run, its condition numbers are computed
+    when read and are its own Jacobian's; with centres of mass too far from their frames for the
+    bound (cond(T)^2 above shared._TRANSFER) its own screen runs, as before."""
+    from balpipe.engine import positions
+
+    _, stages, t = rrr4
+    placed = [s.model for s in stages if _offsets(s.model)]
+    engine.clear_cache()
+    screens = []
+    real = shared._check_regular
+    monkeypatch.setattr(shared, "_check_regular", lambda *a, **k: screens.append(1) or real(*a, **k))
+    mine = [analyse(m, t) for m in placed]
+    assert screens == []
+    for m, a in zip(placed, mine):
+        own = positions.condition_numbers(compiled(m), a.q.reshape(len(t), -1))
+        assert np.array_equal(a.condition, own)
+    monkeypatch.setattr(shared, "_TRANSFER", 1.0)  # no arm passes: every stage screens its own
+    engine.clear_cache()
+    again = [analyse(m, t) for m in placed]
+    assert len(screens) == len(placed)
+    for a, b in zip(mine, again):
+        assert a.force.tobytes() == b.force.tobytes() and np.array_equal(a.condition, b.condition)
+
+
+def test_a_singular_placed_model_fails_with_its_own_error(rrr4, monkeypatch):
+    """Where the frame motion is not shown regular (here: its screen refuses), the placed model's
+    own check runs and raises its own located error (here: the screens refuse and the condition
+    limit is lowered below every condition number)."""
+    from balpipe.engine import positions
+
+    _, stages, t = rrr4
+    model = [s.model for s in stages if _offsets(s.model)][0]
+    engine.clear_cache()
+    monkeypatch.setattr(shared, "_proven_regular", lambda J, G=None: False)
+    monkeypatch.setattr(positions, "_proven_regular", lambda J, G=None: False)  # its own screen too
+    monkeypatch.setattr(positions, "_COND_LIMIT", 1.0)
+    with pytest.raises(engine.AnalysisError, match="singular configuration"):
+        analyse(model, t)

@@ -32,12 +32,13 @@ class Consistent:
     sides: LU where square; with redundant drivers (m > n) the normal equations, refined
     (:mod:`.normal`: one Cholesky factorisation for every right-hand side), and where they do
     not hold (:func:`.normal.factor` or a refinement gives None), the reduced QR factors of
-    :func:`_solve_rect`, made once. ``normal``: the factorisation, for other solves with this J
-    (the multipliers of :func:`.dynamics.solve_multipliers`), or None."""
+    :func:`_solve_rect`, made once. ``G``: J^T J when the caller has it. ``normal``: the
+    factorisation, for other solves with this J (the multipliers of
+    :func:`.dynamics.solve_multipliers`), or None."""
 
-    def __init__(self, J: np.ndarray):
+    def __init__(self, J: np.ndarray, G: np.ndarray | None = None):
         self.J = J
-        self.normal: Normal | None = factor(J) if J.shape[-2] > J.shape[-1] else None
+        self.normal: Normal | None = factor(J, G) if J.shape[-2] > J.shape[-1] else None
         self._qr: tuple[np.ndarray, np.ndarray] | None = None
 
     def solve(self, b: np.ndarray) -> np.ndarray:
@@ -52,13 +53,14 @@ class Consistent:
 
 
 def rates(c: Compiled, q: np.ndarray, t: np.ndarray, laws: list | None = None,
-          J: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, Consistent]:
+          J: np.ndarray | None = None, G: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, Consistent]:
     """Velocities and accelerations (N, n) at positions q, and the solves of their Jacobian
     Phi_q (:class:`Consistent`: one factorisation for both). ``laws``:
     :func:`.constraints.law_triples` at ``t`` (evaluated when not given); ``J``: the whole
-    Jacobian at q, frame columns included (formed when not given)."""
+    Jacobian at q, frame columns included (formed when not given); ``G``: the Gram matrix of its
+    free columns, when the caller has it."""
     qx = with_frame(q)
-    solver = Consistent((jacobian(c, qx) if J is None else J)[:, :, 3:])
+    solver = Consistent((jacobian(c, qx) if J is None else J)[:, :, 3:], G)
     v = solver.solve(velocity_rhs(c, t, laws))
     a = solver.solve(acceleration_rhs(c, qx, with_frame(v), t, laws))
     return v, a, solver

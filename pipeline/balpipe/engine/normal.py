@@ -113,10 +113,15 @@ def _small(d: np.ndarray, x: np.ndarray) -> bool:
     return bool(np.all(dm <= REFINED * xm))
 
 
-def factor(J: np.ndarray) -> Normal | None:
+def gram(J: np.ndarray) -> np.ndarray:
+    """G = J^T J per sample, (N, n, n)."""
+    return np.matmul(J.transpose(0, 2, 1), J)
+
+
+def factor(J: np.ndarray, G: np.ndarray | None = None) -> Normal | None:
     """The normal equations of a stack J (N, m, n), m > n, or None (square, empty or not finite:
-    the caller takes QR)."""
+    the caller takes QR). ``G``: :func:`gram` of J when the caller has it."""
     N, m, n = J.shape
     if m <= n or N == 0 or not np.all(np.isfinite(J)):
         return None
-    return Normal(J, np.matmul(J.transpose(0, 2, 1), J))
+    return Normal(J, gram(J) if G is None else G)

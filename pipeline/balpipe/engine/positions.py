@@ -13,7 +13,7 @@ from .compile import Compiled
 from .constraints import GridLaws, with_frame, jacobian, law_positions, law_triples, residual
 from .errors import AnalysisError
 from .kinematics import _solve_rect, _vel_acc, rates_by_type
-from .normal import factor
+from .normal import factor, gram
 from .vectorised import State, Vectorised, jacobian_values, law_table, residual as vresidual, table_row, vectorise
 
 
@@ -218,9 +218,10 @@ def condition_of(s: np.ndarray) -> np.ndarray:
     return s[:, 0] / np.maximum(s[:, -1], 1e-300)
 
 
-def _proven_regular(J: np.ndarray) -> bool:
+def _proven_regular(J: np.ndarray, G: np.ndarray | None = None) -> bool:
     """Whether every sample's Phi_q (N, m, n), m >= n, is shown far from singular without an SVD
-    (a Cholesky factorisation, a quarter of the SVD's time on the 4-RRR's 28 x 27).
+    (a Cholesky factorisation, a quarter of the SVD's time on the 4-RRR's 28 x 27). ``G``: J^T J
+    when the caller has it (:func:`.normal.gram`; not modified), else formed here.
 
     With G = J^T J and delta = d ||J||_F^2, a factorisation of G - delta I that succeeds in
     floating point shows that J^T J - delta I + E is positive semi-definite, E the rounding of G
@@ -236,7 +237,7 @@ def _proven_regular(J: np.ndarray) -> bool:
         return False
     eps = np.finfo(float).eps
     d = max(1e-10, 100.0 * (m + n * (n + 1)) * eps)
-    G = np.matmul(J.transpose(0, 2, 1), J)
+    G = gram(J) if G is None else G.copy()
     scale = np.einsum("nij,nij->n", J, J)  # ||J||_F^2 per sample
     G[:, np.arange(n), np.arange(n)] -= (d * scale)[:, None]
     try:

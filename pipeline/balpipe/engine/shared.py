@@ -14,7 +14,8 @@ continuation (no iteration where the residual is already below its 1e-12): accep
 sample converges and no angle moves by the continuation's branch guard; otherwise, or when the
 frame model cannot be followed, the continuation runs on the model itself, which raises the
 model's own located error. The regularity check (a singular configuration is an error) runs on
-the model's own Jacobian either way, so the same specs fail, with the same messages. The
+the model's own Jacobian either way, unless the frame motion's, screened once, shows it regular
+(:func:`_shown_regular`: then it could not fail), so the same specs fail, with the same messages. The
 velocities and accelerations of an accepted model are placed too (:func:`kinematics`): the
 frames' are solved once per geometry (one factorisation per sample of the frame model's
 Jacobian instead of one per model; with redundant drivers its normal equations, :mod:`.normal`,
@@ -43,8 +44,8 @@ from .fastpath import _arms, _place as place, frame_model
 from .constraints import jacobian, with_frame
 from .dynamics import multiplier_solver
 from .kinematics import _vel_acc, rates
-from .normal import Normal
-from .positions import _JUMP, DenseOps, _check_regular, follow_motion, newton_raphson, solve_positions
+from .normal import Normal, gram
+from .positions import _JUMP, DenseOps, _check_regular, _proven_regular, follow_motion, newton_raphson, solve_positions
 from .warmstart import motion_key
 
 STATS = {"shared": 0, "solved": 0, "rejected": 0}
@@ -58,7 +59,8 @@ class _Shared:
     multipliers' solve with the frame's Jacobian columns. ``laws``: the drivers' laws, kept alive
     (their ids are part of the key); ``normal``: the normal equations of the rates' Jacobian
     (redundant drivers, :mod:`.normal`), and ``jacobian``, the rates' whole Jacobian, for the
-    multipliers' solve."""
+    multipliers' solve; ``regular``: whether the frame motion's Phi_q is shown regular
+    (:func:`_shown_regular`), with ``gram`` (its free columns' J^T J, for the rates) made there."""
 
     laws: list
     fc: Compiled
@@ -66,6 +68,8 @@ class _Shared:
     rates: tuple[np.ndarray, np.ndarray] | None = None
     normal: Normal | None = None
     jacobian: np.ndarray | None = None
+    gram: np.ndarray | None = None
+    regular: bool | None = None
     dynamics: tuple[Callable[[np.ndarray], np.ndarray], np.ndarray] | None = None
 
 
@@ -84,9 +88,9 @@ def kinematics(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.n
         return (q, *_vel_acc(c, q, t), None)
     frame = _motion(entry)
     if entry.rates is None:
-        J = jacobian(entry.fc, with_frame(frame))
-        v, a, solver = rates(entry.fc, frame, t, J=J)  # once per geometry and grid
-        entry.rates, entry.normal, entry.jacobian = (v, a), solver.normal, J
+        J = entry.jacobian if entry.jacobian is not None else jacobian(entry.fc, with_frame(frame))
+        v, a, solver = rates(entry.fc, frame, t, J=J, G=entry.gram)  # once per geometry and grid
+        entry.rates, entry.normal, entry.jacobian, entry.gram = (v, a), solver.normal, J, None
     return (q, *_place_rates(frame, *entry.rates, c.com_local), entry)
 
 
@@ -132,10 +136,40 @@ def _positions(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, _Shared | None]:
         q = _from_shared(c, t, entry.frame)
         if q is not None:
             STATS["shared"] += 1
-            c.condition = _check_regular(c, q, t, screen=True)
+            c.condition = None if _shown_regular(c, entry) else _check_regular(c, q, t, screen=True)
             return q, entry
         STATS["rejected"] += 1
     return solve_positions(c, t), None
+
+
+#: the largest cond(T)^2 (:func:`_shown_regular`) for which the frame motion's proof is taken
+_TRANSFER = 10.0
+
+
+def _shown_regular(c: Compiled, entry: _Shared) -> bool:
+    """Whether ``c``'s Phi_q along its positions placed in ``entry``'s frame motion is shown
+    regular by the frame motion's (made once per geometry and grid), instead of screening
+    ``c``'s own (:func:`.positions._check_regular`, what it does otherwise).
+
+    The model's Jacobian is the frame model's times T^-1 (:func:`multipliers`), T block
+    diagonal with, per body, [[1, 0, -r_y], [0, 1, r_x], [0, 0, 1]], r = R c its centre of mass
+    from its frame's origin: singular values 1, s and 1/s, s = (|c| + sqrt(|c|^2 + 4)) / 2. So
+    cond(Phi_q) <= cond(Phi_q of the frame) s_max^2, and where the frame motion's is shown below
+    1.1e5 (:func:`.positions._proven_regular`) and s_max^2 <= :data:`_TRANSFER`, the model's is
+    below 1.1e6 (the refinement of the placed positions moves Phi_q by round-off, 1e-12 of it),
+    far below the singular limit 1e11: no configuration of the motion is singular, as the
+    model's own screen would show, and its condition numbers are computed when read
+    (``c.condition`` None), the same values."""
+    rho = float(np.hypot(c.com_local[:, 0], c.com_local[:, 1]).max(initial=0.0))
+    if ((rho + np.sqrt(rho * rho + 4.0)) / 2.0) ** 2 > _TRANSFER:
+        return False
+    if entry.regular is None:
+        J = jacobian(entry.fc, with_frame(_motion(entry)))
+        G = gram(J[:, :, 3:])
+        if entry.rates is None:
+            entry.jacobian, entry.gram = J, G  # for the rates and the multipliers
+        entry.regular = _proven_regular(J[:, :, 3:], G)
+    return entry.regular
 
 
 def _frame_entry(c: Compiled, t: np.ndarray) -> _Shared:
