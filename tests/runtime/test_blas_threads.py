@@ -56,3 +56,18 @@ def test_numpy_imported_first_the_engine_still_runs_on_one_blas_thread():
 def test_a_thread_count_the_user_set_is_kept():
     """OPENBLAS_NUM_THREADS set by the user (before balpipe) is the engine's too."""
     assert _probe({"OPENBLAS_NUM_THREADS": "3"})["inside"] == [3]
+
+
+def test_the_command_line_loads_every_blas_with_balpipes_setting_and_scans_nothing():
+    """``balpipe check`` imports balpipe before any BLAS library: each loads with the variables'
+    one thread, so the runner's limit has nothing to do and threadpoolctl (its scan of the loaded
+    libraries, 2 ms a spec) is not even imported; a process that loaded numpy first still scans."""
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")}
+    spec = str(ROOT / "specs" / "offset_slider_crank.yaml")
+    probe = ("import sys{first}; from balpipe.cli import entry; sys.argv = ['balpipe', 'check', sys.argv[1]]; "
+             "import atexit; atexit.register(lambda: print('threadpoolctl' in sys.modules, file=sys.stderr)); entry()")
+    for first, scanned in (("", "False"), ("; import numpy", "True")):
+        r = subprocess.run([sys.executable, "-c", probe.format(first=first), spec], env=env, capture_output=True,
+                           text=True, timeout=300, cwd=ROOT)
+        assert r.returncode == 0, r.stderr
+        assert r.stderr.strip().splitlines()[-1] == scanned

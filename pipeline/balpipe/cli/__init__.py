@@ -77,6 +77,9 @@ def entry() -> None:
     that arrives before :func:`main` handles it (parsing the arguments) or after it returned is
     caught here; once the command's code is known, both are blocked until the exit (the work is
     done: the pools' clean-up at exit cannot print "Exception ignored" for one)."""
+    from ..runtime.threads import environment_only
+
+    environment_only()  # BLAS libraries load after import balpipe set their thread count: no limit to set
     try:
         signal.signal(signal.SIGTERM, on_sigterm)  # main() sets it too; here it covers parsing the arguments
         try:

@@ -17,6 +17,10 @@ from typing import Iterator
 #: the variables that name a BLAS thread count, in the order they are read
 VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
+#: the thread count every BLAS library of this process was loaded with, when the command line
+#: knows it (:func:`environment_only`); None: unknown, :func:`blas_threads` limits the libraries
+_loaded_with: dict[str, int] = {}
+
 
 def wanted() -> int:
     """The BLAS threads balpipe runs on: the first of :data:`VARIABLES` set to a positive whole
@@ -28,11 +32,29 @@ def wanted() -> int:
     return 1
 
 
+def environment_only() -> None:
+    """Called by the command line (:func:`balpipe.cli.entry`) before anything loads a BLAS
+    library: every one this process (and the workers it forks) loads reads the variables that
+    ``import balpipe`` set, and nothing but balpipe's code runs here to change them, so
+    :func:`blas_threads` has nothing to limit while :func:`wanted` is what they were loaded with
+    (the scan of the loaded libraries costs 2 ms a spec in ``balpipe check``). Not done when numpy
+    is loaded already."""
+    import sys
+
+    if "numpy" not in sys.modules and "scipy" not in sys.modules:
+        _loaded_with["threads"] = wanted()
+
+
 @contextmanager
 def blas_threads(limit: int | None = None) -> Iterator[None]:
     """Within the block, every loaded BLAS library uses at most ``limit`` threads (default
-    :func:`wanted`); nested blocks cost one library scan each (about a millisecond)."""
+    :func:`wanted`); nested blocks cost one library scan each (about a millisecond). Nothing to
+    do when every library was loaded with that many (:func:`environment_only`)."""
+    threads = wanted() if limit is None else limit
+    if _loaded_with.get("threads") == threads:
+        yield
+        return
     from threadpoolctl import threadpool_limits
 
-    with threadpool_limits(limits=wanted() if limit is None else limit, user_api="blas"):
+    with threadpool_limits(limits=threads, user_api="blas"):
         yield
