@@ -66,23 +66,34 @@ def rates(c: Compiled, q: np.ndarray, t: np.ndarray, laws: list | None = None,
     return v, a, solver
 
 
-def rates_by_type(vz: Vectorised, q: np.ndarray, table: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`rates`' velocities and accelerations with Phi_q, nu and gamma evaluated by primitive
-    type (:mod:`.vectorised`, ``vz``: the model's; ``table``: its :func:`.vectorised.law_table`
-    at the samples): the same values (on paper 001's 4-RRR bit for bit) with fewer numpy calls."""
+def jacobian_by_type(vz: Vectorised, q: np.ndarray) -> tuple[State, np.ndarray]:
+    """The state (:class:`.vectorised.State`) and the whole Phi_q (N, m, 3 nb + 3), frame columns
+    included, at positions q (N, 3 nb), evaluated by primitive type (``vz``: the model's
+    :func:`.vectorised.vectorise`): :func:`.constraints.jacobian`'s values with fewer numpy calls."""
     N = q.shape[0]
     X = np.zeros((vz.ncol, N))
     X[3:] = q.T
     s = State(vz, X)
-    free = np.flatnonzero(vz.cols >= 3)
-    J = np.zeros((N, vz.m, vz.ncol - 3))
-    J[:, vz.rows[free], vz.cols[free] - 3] = jacobian_values(vz, s)[free].T
-    solver = Consistent(J)
+    J = np.zeros((N, vz.m, vz.ncol))
+    J[:, vz.rows, vz.cols] = jacobian_values(vz, s)[:-1].T
+    return s, J
+
+
+def rates_by_type(vz: Vectorised, q: np.ndarray, table: tuple[np.ndarray, np.ndarray, np.ndarray],
+                  at: tuple[State, np.ndarray] | None = None, G: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, Consistent]:
+    """:func:`rates` with Phi_q, nu and gamma evaluated by primitive type (:mod:`.vectorised`,
+    ``vz``: the model's; ``table``: its :func:`.vectorised.law_table` at the samples): the same
+    values (on paper 001's 4-RRR bit for bit) with fewer numpy calls. ``at``:
+    :func:`jacobian_by_type` at q, and ``G`` the Gram matrix of its free columns, when the caller
+    has them."""
+    N = q.shape[0]
+    s, J = jacobian_by_type(vz, q) if at is None else at
+    solver = Consistent(J[:, :, 3:], G)
     v = solver.solve(by_type_velocity_rhs(vz, table[1], N).T)
     V = np.zeros((vz.ncol, N))
     V[3:] = v.T
     a = solver.solve(by_type_acceleration_rhs(vz, s, V, table[2]).T)
-    return v, a
+    return v, a, solver
 
 
 def _vel_acc(c: Compiled, q: np.ndarray, t: np.ndarray, laws: list | None = None) -> tuple[np.ndarray, np.ndarray]:

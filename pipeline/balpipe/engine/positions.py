@@ -296,6 +296,18 @@ class DenseOps:
         else:
             self._grid = GridLaws(t, lambda grid: law_table(vz, grid), table_row)
 
+    @property
+    def vectorised(self) -> Vectorised | None:
+        """The model's :func:`.vectorised.vectorise` with ``by_type``, else None."""
+        return self._vz
+
+    def table(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """With ``by_type``: :func:`.vectorised.law_table` at ``t``, from the grid's table where
+        it has them."""
+        assert self._vz is not None
+        laws = self._laws(t)
+        return law_table(self._vz, t) if laws is None else laws
+
     def _laws(self, t: np.ndarray) -> Any:
         """The drivers' values at ``t`` (:func:`.constraints.law_triples`, or by type
         :func:`.vectorised.law_table`) from the grid's table (the grid itself, or a single time
@@ -303,16 +315,15 @@ class DenseOps:
         return None if self._grid is None else self._grid.at(t)
 
     def newton(self, q: np.ndarray, t: np.ndarray, max_iter: int = _MAX_ITER) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        laws = self._laws(t)
         if self._vz is not None:
-            return newton_raphson(self.c, q, t, max_iter, by_type=(self._vz, (law_table(self._vz, t) if laws is None else laws)[0]))
+            return newton_raphson(self.c, q, t, max_iter, by_type=(self._vz, self.table(t)[0]))
+        laws = self._laws(t)
         return newton_raphson(self.c, q, t, max_iter, None if laws is None else [None if f is None else f[0] for f in laws])
 
     def vel_acc(self, q: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        laws = self._laws(t)
         if self._vz is not None:
-            return rates_by_type(self._vz, q, law_table(self._vz, t) if laws is None else laws)
-        return _vel_acc(self.c, q, t, laws)
+            return rates_by_type(self._vz, q, self.table(t))[:2]
+        return _vel_acc(self.c, q, t, self._laws(t))
 
 
 def _triples_row(table: list, k: int) -> list:

@@ -43,7 +43,8 @@ from .errors import AnalysisError
 from .fastpath import _arms, _place as place, frame_model
 from .constraints import jacobian, with_frame
 from .dynamics import multiplier_solver
-from .kinematics import _vel_acc, rates
+from .kinematics import _vel_acc, jacobian_by_type, rates_by_type
+from .vectorised import State
 from .normal import Normal, gram
 from .positions import _JUMP, DenseOps, _check_regular, _proven_regular, follow_motion, newton_raphson, solve_positions
 from .warmstart import motion_key
@@ -60,14 +61,19 @@ class _Shared:
     (their ids are part of the key); ``normal``: the normal equations of the rates' Jacobian
     (redundant drivers, :mod:`.normal`), and ``jacobian``, the rates' whole Jacobian, for the
     multipliers' solve; ``regular``: whether the frame motion's Phi_q is shown regular
-    (:func:`_shown_regular`), with ``gram`` (its free columns' J^T J, for the rates) made there."""
+    (:func:`_shown_regular`), with ``gram`` (its free columns' J^T J, for the rates) made there.
+    ``ops``: the solves that followed the motion (the constraints by primitive type and the
+    drivers' table on the grid, :class:`.positions.DenseOps`), for its rates; ``state``: its
+    :class:`.vectorised.State` at the frame motion, with ``jacobian``."""
 
     laws: list
     fc: Compiled
     frame: np.ndarray | None
+    ops: DenseOps | None = None
     rates: tuple[np.ndarray, np.ndarray] | None = None
     normal: Normal | None = None
     jacobian: np.ndarray | None = None
+    state: State | None = None
     gram: np.ndarray | None = None
     regular: bool | None = None
     dynamics: tuple[Callable[[np.ndarray], np.ndarray], np.ndarray] | None = None
@@ -87,10 +93,12 @@ def kinematics(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.n
     if entry is None:
         return (q, *_vel_acc(c, q, t), None)
     frame = _motion(entry)
-    if entry.rates is None:
-        J = entry.jacobian if entry.jacobian is not None else jacobian(entry.fc, with_frame(frame))
-        v, a, solver = rates(entry.fc, frame, t, J=J, G=entry.gram)  # once per geometry and grid
-        entry.rates, entry.normal, entry.jacobian, entry.gram = (v, a), solver.normal, J, None
+    if entry.rates is None:  # once per geometry and grid
+        at = _frame_jacobian(entry) if entry.state is None or entry.jacobian is None else (entry.state, entry.jacobian)
+        ops = entry.ops
+        assert ops is not None and ops.vectorised is not None  # the entry's motion was followed by type
+        v, a, solver = rates_by_type(ops.vectorised, frame, ops.table(t), at, entry.gram)
+        entry.rates, entry.normal, entry.jacobian, entry.gram, entry.state = (v, a), solver.normal, at[1], None, None
     return (q, *_place_rates(frame, *entry.rates, c.com_local), entry)
 
 
@@ -164,12 +172,19 @@ def _shown_regular(c: Compiled, entry: _Shared) -> bool:
     if ((rho + np.sqrt(rho * rho + 4.0)) / 2.0) ** 2 > _TRANSFER:
         return False
     if entry.regular is None:
-        J = jacobian(entry.fc, with_frame(_motion(entry)))
+        s, J = _frame_jacobian(entry)
         G = gram(J[:, :, 3:])
         if entry.rates is None:
-            entry.jacobian, entry.gram = J, G  # for the rates and the multipliers
+            entry.state, entry.jacobian, entry.gram = s, J, G  # for the rates and the multipliers
         entry.regular = _proven_regular(J[:, :, 3:], G)
     return entry.regular
+
+
+def _frame_jacobian(entry: _Shared) -> tuple[State, np.ndarray]:
+    """The state and whole Phi_q of the frame model at the frame motion, by primitive type."""
+    ops = entry.ops
+    assert ops is not None and ops.vectorised is not None
+    return jacobian_by_type(ops.vectorised, _motion(entry))
 
 
 def _frame_entry(c: Compiled, t: np.ndarray) -> _Shared:
@@ -180,14 +195,15 @@ def _frame_entry(c: Compiled, t: np.ndarray) -> _Shared:
     if c.frame is None:
         c.frame = compile_model(frame_model(c.model))
     fc = c.frame
+    ops = DenseOps(fc, t, by_type=True)
     try:
-        frame = follow_motion(fc, t, DenseOps(fc, t, by_type=True))
+        frame = follow_motion(fc, t, ops)
         STATS["solved"] += 1
     except (AnalysisError, np.linalg.LinAlgError):
         frame = None
     if len(_MOTIONS) >= _KEPT:
         _MOTIONS.clear()
-    entry = _MOTIONS[key] = _Shared([d.law for d in c.model.drivers], fc, frame)
+    entry = _MOTIONS[key] = _Shared([d.law for d in c.model.drivers], fc, frame, ops)
     return entry
 
 
