@@ -521,3 +521,28 @@ def test_the_objective_of_several_trajectories_at_once_is_each_ones_alone(paper)
     alone = [pl.objective(*plans[o])(c) for c, o in zip(points, owners)]
     assert together == alone
     assert any(v >= 1e6 for v in alone) and any(v < 1e6 for v in alone)  # penalised points among them
+
+
+def test_the_ramps_torques_on_rows_are_the_states_bit_for_bit(paper):
+    """Planner.torques (absolute_motion, state_rows and torques_rows on (links, samples) rows) gives
+    joint_torques of the (samples, links) state, bit for bit, on a trapezoidal motion."""
+    from balpipe.families.serial_arm.template import joint_torques
+
+    spec, st, p = paper
+    model = registry.unbalanced_model(spec)
+    T = spec.motion.duration
+    pl = cp.Planner(model, spec.mechanism, spec.balancing, T, registry.time_grid(spec), (0.0, -9.81), (0.0, 0.0))
+    name, start, end, path = cp.trajectories_of(spec.balancing, model)[2]
+    plan = pl.plan(name, start, end, path)
+    phi = cp.PhiPolynomial(start[2], end[2], T, tuple(p[f"phi_c{k}_{name}"] for k in range(3)))
+    motion = cp._com_motion(plan, cp.trapezoidal_acceleration(0.03), T, phi, path)
+    tt = np.unique(np.concatenate([np.linspace(0.0, T, 1001), T * np.linspace(0.45, 0.55, 64)]))
+    _, state = pl.state(motion, plan.com_mode, tt)
+    tau = joint_torques(pl.arm, state, pl.gravity)
+    assert np.array_equal(pl.torques(motion, plan.com_mode, tt), tau)
+    # and the virtual work summed over (samples, links) columns, as numpy sums them
+    m, inertia = np.asarray(pl.arm.masses), np.asarray(pl.arm.inertias)
+    fx, fy = m * (state.ax - pl.gravity[0]), m * (state.ay - pl.gravity[1])
+    for j in range(3):
+        dx, dy = state.rx[:, j:] - state.ox[:, j:j + 1], state.ry[:, j:] - state.oy[:, j:j + 1]
+        assert np.array_equal(tau[:, j], np.sum(dx * fy[:, j:] - dy * fx[:, j:], axis=1) + state.thdd[:, j:] @ inertia[j:])

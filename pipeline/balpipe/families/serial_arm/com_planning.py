@@ -46,7 +46,7 @@ from .template import (
     absolute_state,
     com_chain,
     joint_laws,
-    joint_torques,
+    torques_rows,
     moment_rows,
     shaking_loads,
     state_rows,
@@ -212,6 +212,15 @@ class Planner:
         sol = JointSolution(self.com, motion, mode, self.t if t is None else t, check=check)
         return sol, absolute_state(self.arm, sol.th, sol.thd, sol.thdd, sol.trig)
 
+    def torques(self, motion: TaskMotion, mode: int, t: np.ndarray) -> np.ndarray:
+        """The joint torques (N, n) along a centre-of-mass motion on the grid ``t`` (what the
+        ramp's torque rates differentiate): :meth:`state` and :func:`joint_torques`, the same
+        values, on (links, samples) rows."""
+        x, xd, xdd = motion.values(np.asarray(t, dtype=float).reshape(-1))
+        th, thd, thdd, _, _, trig = absolute_motion(self.com, x, xd, xdd, mode, rows=True)
+        rows = state_rows(self.arm, th if trig is None else None, thd, thdd, trig)
+        return torques_rows(self.arm, rows, np.ascontiguousarray(thdd.T), self.gravity)
+
     def objective(self, plan: Plan, path: tuple):
         """The optimiser's objective c -> max |M| over the analysis grid with the CoM on the
         bang-bang law and phi(c) (a penalty outside the workspace or at a singular
@@ -340,8 +349,7 @@ class Planner:
             ramps = [np.linspace(a, b, 64) for a, b in ((0.0, f), (0.5 - f, 0.5 + f), (1.0 - f, 1.0))]
             tt = np.unique(np.concatenate([uniform, self.T * np.concatenate(ramps)]))
             motion = _com_motion(plan, trapezoidal_acceleration(f), self.T, phi, path)
-            _, st = self.state(motion, plan.com_mode, tt)
-            tau = joint_torques(self.arm, st, self.gravity)
+            tau = self.torques(motion, plan.com_mode, tt)
             return float(np.max(np.abs(np.gradient(tau, tt, axis=0))))
 
         lo, hi = 1e-4, 0.25

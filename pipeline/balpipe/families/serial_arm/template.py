@@ -559,14 +559,26 @@ def moment_rows(arm: ArmGeometry, rx: np.ndarray, ry: np.ndarray, ax: np.ndarray
 
 
 def joint_torques(arm: ArmGeometry, st: ArmState, gravity=(0.0, 0.0)) -> np.ndarray:
-    """tau_j = sum_{k >= j} [(r_k - O_j) x m_k (r_k'' - g) + I_k theta_k''] (virtual work), (N, n)."""
-    m, I = np.asarray(arm.masses), np.asarray(arm.inertias)
-    fx, fy = m * (st.ax - gravity[0]), m * (st.ay - gravity[1])
-    out = np.empty(st.thdd.shape)
+    """tau_j = sum_{k >= j} [(r_k - O_j) x m_k (r_k'' - g) + I_k theta_k''] (virtual work), (N, n):
+    :func:`torques_rows` on the state's rows."""
+    return torques_rows(arm, (st.rx.T, st.ry.T, st.ax.T, st.ay.T, st.ox.T, st.oy.T), st.thdd, gravity)
+
+
+def torques_rows(arm: ArmGeometry, rows: tuple[np.ndarray, ...], thdd: np.ndarray, gravity=(0.0, 0.0)) -> np.ndarray:
+    """:func:`joint_torques` from :func:`state_rows`'s (rx, ry, ax, ay, ox, oy) rows (n, N) and the
+    angular accelerations ``thdd`` (N, n): the links' terms added in order, as numpy sums a row of
+    fewer than eight (the 3R arm's, tested), and the inertia term the same matrix-vector product
+    on ``thdd``'s columns."""
+    rx, ry, ax, ay, ox, oy = rows
+    m, I = np.asarray(arm.masses)[:, None], np.asarray(arm.inertias)
+    fx, fy = m * (ax - gravity[0]), m * (ay - gravity[1])
+    out = np.empty(thdd.shape)
     for j in range(arm.n):
-        dx = st.rx[:, j:] - st.ox[:, j:j + 1]
-        dy = st.ry[:, j:] - st.oy[:, j:j + 1]
-        out[:, j] = np.sum(dx * fy[:, j:] - dy * fx[:, j:], axis=1) + st.thdd[:, j:] @ I[j:]
+        terms = (rx[j:] - ox[j]) * fy[j:] - (ry[j:] - oy[j]) * fx[j:]
+        total = terms[0]
+        for term in terms[1:]:
+            total = total + term
+        out[:, j] = total + thdd[:, j:] @ I[j:]
     return out
 
 
