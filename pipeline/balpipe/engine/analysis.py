@@ -15,12 +15,14 @@ from ..model import Model
 from ..runtime.allocator import keep_freed_memory
 from . import fastpath, shared, structure
 from .compile import Compiled, compile_model
-from .constraints import with_frame, jacobian
+from .constraints import with_frame
 from .dynamics import joint_reactions, solve_multipliers, radial_tooth_loads, tooth_rows, actuation_condition
 from .conditioning import motion_peak
 from .errors import AnalysisError
+from .kinematics import jacobian_by_type
 from .loads import solve as solve_loads, terms as load_terms
 from .positions import condition_numbers, redundancy
+from .vectorised import vectorised_of
 
 
 @dataclass
@@ -281,7 +283,7 @@ def analyse(
                 return lam, -np.einsum("nmk,nm->nk", J0, lam)  # load on the frame: Fx, Fy, M_O
         else:
             qx = with_frame(q)
-            J = jacobian(cd, qx)
+            J = jacobian_by_type(vectorised_of(cd), q)[1]  # constraints.jacobian's values (fewer numpy calls)
             mesh_geo = tooth_rows(cd, qx, J)  # gear meshes with pitch radii act by tooth forces
             Jf, J0 = J[:, :, 3:], J[:, :, :3]
             if c.dynamics is not None:

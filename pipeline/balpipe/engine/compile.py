@@ -78,6 +78,7 @@ class Compiled:
     keys: tuple | None = None  # (shape, numbers, law ids) of the model (:func:`.warmstart.model_keys`), made once
     dynamics: "Compiled | None" = None  # with actuators: the joints' rows and the actuators' (:func:`_actuated`)
     revolutes: Any = None  # the revolute joints' rows at once (:func:`.constraints.revolute_rows`), made once
+    vectorised: Any = None  # its constraints by primitive type (:func:`.vectorised.vectorised_of`), made once
 
     @property
     def nb(self) -> int:

@@ -14,7 +14,7 @@ from .constraints import GridLaws, with_frame, jacobian, law_positions, law_trip
 from .errors import AnalysisError
 from .kinematics import _solve_rect, _vel_acc, rates_by_type
 from .normal import factor, gram
-from .vectorised import State, Vectorised, jacobian_values, law_table, residual as vresidual, table_row, vectorise
+from .vectorised import State, Vectorised, jacobian_values, law_table, residual as vresidual, table_row, vectorised_of
 
 
 class Ops(Protocol):
@@ -287,7 +287,7 @@ class DenseOps:
 
     def __init__(self, c: Compiled, t: np.ndarray | None = None, by_type: bool = False):
         self.c = c
-        self._vz = (c.fast.vz if c.fast is not None else vectorise(c)) if by_type else None
+        self._vz = vectorised_of(c) if by_type else None
         vz = self._vz
         if t is None:
             self._grid = None

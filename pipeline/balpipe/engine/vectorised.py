@@ -141,6 +141,16 @@ def vectorise(c: Compiled) -> Vectorised:
     )
 
 
+def vectorised_of(c: Compiled) -> Vectorised:
+    """``c``'s :func:`vectorise`, made once: the block path's (:func:`.fastpath.prepare`) where
+    it has been prepared, else kept on ``c``."""
+    if c.fast is not None:
+        return c.fast.vz
+    if c.vectorised is None:
+        c.vectorised = vectorise(c)
+    return c.vectorised
+
+
 def law_table(vz: Vectorised, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """f, f', f'' of every driven row, (len(law_rows), N) each: each law called once."""
     N = len(t)
