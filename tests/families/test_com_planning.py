@@ -546,3 +546,14 @@ def test_the_ramps_torques_on_rows_are_the_states_bit_for_bit(paper):
     for j in range(3):
         dx, dy = state.rx[:, j:] - state.ox[:, j:j + 1], state.ry[:, j:] - state.oy[:, j:j + 1]
         assert np.array_equal(tau[:, j], np.sum(dx * fy[:, j:] - dy * fx[:, j:], axis=1) + state.thdd[:, j:] @ inertia[j:])
+
+
+def test_the_ramps_grid_is_np_uniques():
+    """The ramp's grid (sorted runs merged by a stable sort, each value once) is np.unique's."""
+    rng = np.random.default_rng(5)
+    for f in (1e-4, 0.0123, 0.25, *rng.uniform(0, 0.25, 20)):
+        runs = [np.linspace(0.0, 0.5, 4001)] + [0.5 * np.linspace(a, b, 64) for a, b in ((0.0, f), (0.5 - f, 0.5 + f), (1.0 - f, 1.0))]
+        x = np.concatenate(runs)
+        assert np.array_equal(cp._sorted_unique(x), np.unique(x))
+    x = np.round(rng.normal(size=1000), 1)  # many repeated values, unsorted
+    assert np.array_equal(cp._sorted_unique(x), np.unique(x))
