@@ -212,3 +212,19 @@ def test_a_singular_placed_model_fails_with_its_own_error(rrr4, monkeypatch):
     monkeypatch.setattr(positions, "_COND_LIMIT", 1.0)
     with pytest.raises(engine.AnalysisError, match="singular configuration"):
         analyse(model, t)
+
+
+def test_positions_moved_from_the_placed_ones_screen_their_own(rrr4, monkeypatch):
+    """The frame motion's proof holds at the placed positions: a model whose refined positions
+    moved from them by more than shared._PLACED (here: the refinement made to move them) screens
+    its own Jacobian."""
+    _, stages, t = rrr4
+    model = [s.model for s in stages if _offsets(s.model)][0]
+    engine.clear_cache()
+    real = shared._from_shared
+    monkeypatch.setattr(shared, "_from_shared", lambda c, t, frame: None if (q := real(c, t, frame)) is None else q + 1e-6)
+    screens = []
+    own = shared._check_regular
+    monkeypatch.setattr(shared, "_check_regular", lambda *a, **k: screens.append(1) or own(*a, **k))
+    analyse(model, t)
+    assert screens == [1]

@@ -144,7 +144,7 @@ def _positions(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, _Shared | None]:
         q = _from_shared(c, t, entry.frame)
         if q is not None:
             STATS["shared"] += 1
-            c.condition = None if _shown_regular(c, entry) else _check_regular(c, q, t, screen=True)
+            c.condition = None if _shown_regular(c, entry, q) else _check_regular(c, q, t, screen=True)
             return q, entry
         STATS["rejected"] += 1
     return solve_positions(c, t), None
@@ -152,24 +152,30 @@ def _positions(c: Compiled, t: np.ndarray) -> tuple[np.ndarray, _Shared | None]:
 
 #: the largest cond(T)^2 (:func:`_shown_regular`) for which the frame motion's proof is taken
 _TRANSFER = 10.0
+#: the largest move of the refined positions from the placed ones (relative) for which it is taken
+_PLACED = 1e-9
 
 
-def _shown_regular(c: Compiled, entry: _Shared) -> bool:
-    """Whether ``c``'s Phi_q along its positions placed in ``entry``'s frame motion is shown
-    regular by the frame motion's (made once per geometry and grid), instead of screening
+def _shown_regular(c: Compiled, entry: _Shared, q: np.ndarray) -> bool:
+    """Whether ``c``'s Phi_q along its positions ``q``, placed in ``entry``'s frame motion, is
+    shown regular by the frame motion's (made once per geometry and grid), instead of screening
     ``c``'s own (:func:`.positions._check_regular`, what it does otherwise).
 
     The model's Jacobian is the frame model's times T^-1 (:func:`multipliers`), T block
     diagonal with, per body, [[1, 0, -r_y], [0, 1, r_x], [0, 0, 1]], r = R c its centre of mass
     from its frame's origin: singular values 1, s and 1/s, s = (|c| + sqrt(|c|^2 + 4)) / 2. So
-    cond(Phi_q) <= cond(Phi_q of the frame) s_max^2, and where the frame motion's is shown below
-    1.1e5 (:func:`.positions._proven_regular`) and s_max^2 <= :data:`_TRANSFER`, the model's is
-    below 1.1e6 (the refinement of the placed positions moves Phi_q by round-off, 1e-12 of it),
-    far below the singular limit 1e11: no configuration of the motion is singular, as the
-    model's own screen would show, and its condition numbers are computed when read
-    (``c.condition`` None), the same values."""
+    cond(Phi_q) <= cond(Phi_q of the frame) s_max^2 at the placed positions, and where the frame
+    motion's is shown below 1.1e5 (:func:`.positions._proven_regular`) and s_max^2 <=
+    :data:`_TRANSFER`, the model's is below 1.1e6, far below the singular limit 1e11; ``q`` (the
+    placed positions refined by Newton-Raphson, :func:`_from_shared`) must be within
+    :data:`_PLACED` of them (Phi_q moves by as little: Weyl's inequality). No configuration of
+    the motion is then singular, as the model's own screen would show, and its condition numbers
+    are computed when read (``c.condition`` None), the same values."""
     rho = float(np.hypot(c.com_local[:, 0], c.com_local[:, 1]).max(initial=0.0))
     if ((rho + np.sqrt(rho * rho + 4.0)) / 2.0) ** 2 > _TRANSFER:
+        return False
+    placed = place(_motion(entry), c.com_local)
+    if not np.abs(q - placed).max(initial=0.0) <= _PLACED * max(1.0, float(np.abs(placed).max(initial=0.0))):
         return False
     if entry.regular is None:
         s, J = _frame_jacobian(entry)
