@@ -89,7 +89,7 @@ class _Refusing(normal.Normal):
     """Normal equations that never hold: :func:`solve_multipliers` takes its QR path."""
 
     def __init__(self, J: np.ndarray, F: normal.Normal):
-        super().__init__(J, F._G)
+        super().__init__(J, normal.gram(J))
 
     def null_space(self, rows, r):
         return None

@@ -39,18 +39,21 @@ class Normal:
     def __init__(self, J: np.ndarray, G: np.ndarray):
         self.J = J
         self._JT = J.transpose(0, 2, 1)
-        self._G = G
+        self._G: np.ndarray | None = G  # dropped once its inverse is made (a shared entry keeps the inverse)
         self._Ginv: np.ndarray | None = None
         self._null: dict[tuple[int, ...], np.ndarray | None] = {}
 
     def gram_solve(self, B: np.ndarray) -> np.ndarray:
         """G^-1 B for B (N, n, k)."""
         if self._Ginv is None:
-            self._Ginv = np.linalg.inv(self._G)
+            assert self._G is not None
+            self._Ginv, self._G = np.linalg.inv(self._G), None
         return self._Ginv @ B
 
     def step(self, b: np.ndarray) -> np.ndarray:
         """x (N, n) with G x = J^T b (N, m): the least-squares solution, unrefined (a Newton step)."""
+        if self._G is None:
+            return self.gram_solve(self._JT @ b[..., None])[..., 0]
         return np.linalg.solve(self._G, self._JT @ b[..., None])[..., 0]
 
     def solve(self, b: np.ndarray) -> np.ndarray | None:
