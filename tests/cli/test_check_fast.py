@@ -139,8 +139,10 @@ def test_check_leaves_the_collector_as_it_found_it(capsys):
 
 
 def test_velocities_and_accelerations_factorise_a_redundant_jacobian_once_to_the_bit(monkeypatch):
-    """With redundant drivers the engine's general path solves for q' and q'' by one QR
-    factorisation of the Jacobian (it used to factorise the same matrix twice): the same bits."""
+    """With redundant drivers the engine's general path solves for q' and q'' with one
+    factorisation of the Jacobian: its normal equations (engine/normal.py: one inverse of J^T J,
+    no QR), the same values as QR's to round-off; where they do not hold, one QR factorisation
+    (it used to factorise the same matrix twice): the same bits as two."""
     from balpipe.engine import kinematics
 
     spec, stages = _stages(RRR4)
@@ -149,12 +151,17 @@ def test_velocities_and_accelerations_factorise_a_redundant_jacobian_once_to_the
     c = compiled(stages[0].model)
     q = analyse(stages[0].model, t).q.reshape(len(t), -1)
     J = constraints.jacobian(c, with_frame(q))[:, :, 3:]
-    assert J.shape[1] > J.shape[2]  # redundant: the QR branch
+    assert J.shape[1] > J.shape[2]  # redundant
     calls = []
     real_qr = np.linalg.qr
     monkeypatch.setattr(np.linalg, "qr", lambda *a, **k: calls.append(1) or real_qr(*a, **k))
+    v0, a0 = kinematics._vel_acc(c, q, t)
+    assert calls == []  # the normal equations
+    monkeypatch.setattr(kinematics, "factor", lambda J, G=None: None)  # the QR branch
     v, a = kinematics._vel_acc(c, q, t)
     assert len(calls) == 1
+    for mine, ref in ((v0, v), (a0, a)):
+        assert np.abs(mine - ref).max() <= 1e-13 * np.abs(ref).max()
     monkeypatch.setattr(kinematics, "_factors", lambda J: None)  # each solve factorises again
     v2, a2 = kinematics._vel_acc(c, q, t)
     assert len(calls) == 3
