@@ -30,7 +30,7 @@ def _factors(J: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
 class Consistent:
     """Solves of J x = b for one stack J (N, m, n) of full column rank and consistent right-hand
     sides: LU where square; with redundant drivers (m > n) the normal equations, refined
-    (:mod:`.normal`: one Cholesky factorisation for every right-hand side), and where they do
+    (:mod:`.normal`: one inverse of J^T J for every right-hand side), and where they do
     not hold (:func:`.normal.factor` or a refinement gives None), the reduced QR factors of
     :func:`_solve_rect`, made once. ``G``: J^T J when the caller has it. ``normal``: the
     factorisation, for other solves with this J (the multipliers of

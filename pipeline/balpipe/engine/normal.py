@@ -1,9 +1,10 @@
 """Consistent over-determined systems J x = b (stacks (N, m, n), m > n: redundant drivers) and the
-least-norm-efforts multipliers of J^T lambda = rhs, by the normal equations: one Cholesky
-factorisation L L^T = G = J^T J per sample, batched, instead of a QR factorisation.
+least-norm-efforts multipliers of J^T lambda = rhs, by the normal equations: G = J^T J per
+sample, batched, and one factorisation of G (a Newton step by an LU solve of G; the refined
+solves by G's inverse, made once) instead of a QR factorisation.
 
 numpy's QR of a stack (LAPACK's geqrf and orgqr, and triangular copies) costs about three times
-G and its Cholesky factor (a 4-RRR's 28 x 27 Jacobians at 1,000 samples: 15 ms against 5 ms),
+G and its factorisation (a 4-RRR's 28 x 27 Jacobians at 1,000 samples: 15 ms against 5 ms),
 and one factorisation serves every right-hand side (velocities and accelerations, the multipliers
 of every model of one geometry) without a QR's Q.
 
