@@ -72,22 +72,28 @@ WRAPS = [
 PHASES = ["import", "load", "balance", "analyse", "validate", "torque", "reactionless", "figures", "page",
           "write", "other", "total"]
 
+#: imports balpipe from a source tree on PYTHONPATH and uses that tree's templates/ folder
+#: (beside pipeline/, installed as balpipe.templates), not another tree's that an install provides
+#: (a revision's pages rendered with today's templates crash; a non-editable install has none of a
+#: source tree's): the start of every benchmark's child process that runs a version's balpipe
+SOURCE_TREE = r'''
+import importlib.util as _util, os as _os, sys as _sys
+import balpipe
+_tpl = _os.path.join(_os.path.dirname(_os.path.dirname(_os.path.dirname(balpipe.__file__))), "templates")
+_found = _util.find_spec("balpipe.templates")
+_theirs = _found is None or _os.path.dirname(_os.path.realpath(_found.origin or "")) != _os.path.realpath(_tpl)
+if _theirs and _os.path.isdir(_tpl):
+    _s = _util.spec_from_file_location("balpipe.templates", _os.path.join(_tpl, "__init__.py"),
+                                       submodule_search_locations=[_tpl])
+    balpipe.templates = _sys.modules["balpipe.templates"] = _util.module_from_spec(_s)
+    _s.loader.exec_module(balpipe.templates)
+'''
+
 DRIVER = r'''
 import functools, importlib, importlib.util, json, os, sys, time
 clock = time.process_time if os.environ.get("BENCH_CLOCK") == "cpu" else time.perf_counter
 t_start = clock()
-import balpipe
-# a source tree on PYTHONPATH: its templates/ folder (beside pipeline/, installed as
-# balpipe.templates) is used, not another tree's that an editable install provides (a revision's
-# pages rendered with today's templates crash)
-_tpl = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(balpipe.__file__))), "templates")
-_found = importlib.util.find_spec("balpipe.templates")
-_theirs = _found is None or os.path.dirname(os.path.realpath(_found.origin or "")) != os.path.realpath(_tpl)
-if _theirs and os.path.isdir(_tpl):
-    _s = importlib.util.spec_from_file_location("balpipe.templates", os.path.join(_tpl, "__init__.py"),
-                                                submodule_search_locations=[_tpl])
-    balpipe.templates = sys.modules["balpipe.templates"] = importlib.util.module_from_spec(_s)
-    _s.loader.exec_module(balpipe.templates)
+''' + SOURCE_TREE + r'''
 import balpipe.cli as cli
 stack = []
 

@@ -24,8 +24,10 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from bench_build import SOURCE_TREE  # noqa: E402  (a version's balpipe with its own templates)
 
-CHILD = r"""
+CHILD = SOURCE_TREE + r"""
 import json, statistics, sys, time
 import numpy as np
 import balpipe

@@ -34,18 +34,12 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
+from bench_build import SOURCE_TREE  # noqa: E402  (a version's balpipe with its own templates)
 from ladder import ladder_spec  # noqa: E402
 
 DRIVER = r'''
-import importlib.util, os, sys
-import balpipe
-# the version's own templates/ folder (beside pipeline/, installed as balpipe.templates)
-_tpl = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(balpipe.__file__))), "templates")
-if os.path.isdir(_tpl):
-    _s = importlib.util.spec_from_file_location("balpipe.templates", os.path.join(_tpl, "__init__.py"),
-                                                submodule_search_locations=[_tpl])
-    balpipe.templates = sys.modules["balpipe.templates"] = importlib.util.module_from_spec(_s)
-    _s.loader.exec_module(balpipe.templates)
+import sys
+''' + SOURCE_TREE + r'''
 import balpipe.cli as cli
 try:
     rc = cli.main(sys.argv[1:])
