@@ -42,6 +42,7 @@ closure, and before this a warm build here ran every simulation again.)
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import shutil
@@ -50,6 +51,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Iterator
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -88,6 +90,26 @@ if _theirs and _os.path.isdir(_tpl):
     balpipe.templates = _sys.modules["balpipe.templates"] = _util.module_from_spec(_s)
     _s.loader.exec_module(balpipe.templates)
 '''
+
+@contextlib.contextmanager
+def versions(against: str | None, prefix: str) -> Iterator[tuple[dict[str, Path], Path]]:
+    """``({"this": <this tree's pipeline/>, REV: <REV's>}, a temporary folder)``: REV (``against``,
+    when given) checked out with ``git worktree add --detach`` into that folder, removed with it on
+    the way out, whatever happened; the benchmarks that compare a revision alternate their runs
+    over these ``pipeline/`` folders (each run's child on PYTHONPATH, :data:`SOURCE_TREE`)."""
+    found = {"this": ROOT / "pipeline"}
+    with tempfile.TemporaryDirectory(prefix=prefix) as tmp:
+        tree = Path(tmp) / "against"
+        if against:
+            subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), against],
+                           check=True, capture_output=True)
+            found[against] = tree / "pipeline"
+        try:
+            yield found, Path(tmp)
+        finally:
+            if against:
+                subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)], capture_output=True)
+
 
 DRIVER = r'''
 import functools, importlib, importlib.util, json, os, sys, time

@@ -30,6 +30,8 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from bench_build import versions as versions_of  # noqa: E402  (this tree and a revision, checked out)
 
 CHILD = r'''
 import json, sys, time
@@ -118,28 +120,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=2, help="alternated runs of each case")
     ap.add_argument("--python", default=sys.executable)
     args = ap.parse_args(argv)
-    versions = {"this": ROOT / "pipeline"}
-    with tempfile.TemporaryDirectory(prefix="bench_chains_") as tmp:
-        tree = Path(tmp) / "against"
-        if args.against:
-            subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), args.against],
-                           check=True, capture_output=True)
-            versions[args.against] = tree / "pipeline"
-        try:
-            best: dict[tuple[int, int, str], dict] = {}
-            for _ in range(args.repeat):
-                for n in args.joints:
-                    for N in args.samples:
-                        for v, pipeline in versions.items():
-                            r = run(args.python, pipeline, n, N)
-                            b = best.setdefault((n, N, v), {})
-                            for k, x in r.items():
-                                b[k] = max(b.get(k, 0.0), x) if k in ("peak", "error") else min(b.get(k, x), x)
-                        print(".", end="", file=sys.stderr, flush=True)
-            print(file=sys.stderr)
-        finally:
-            if args.against:
-                subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)], capture_output=True)
+    best: dict[tuple[int, int, str], dict] = {}
+    with versions_of(args.against, "bench_chains_") as (versions, _):
+        for _ in range(args.repeat):
+            for n in args.joints:
+                for N in args.samples:
+                    for v, pipeline in versions.items():
+                        r = run(args.python, pipeline, n, N)
+                        b = best.setdefault((n, N, v), {})
+                        for k, x in r.items():
+                            b[k] = max(b.get(k, 0.0), x) if k in ("peak", "error") else min(b.get(k, x), x)
+                    print(".", end="", file=sys.stderr, flush=True)
+        print(file=sys.stderr)
     heads = ["chain", "samples"]
     for v in versions:
         heads += [f"{v}: CPU s / samples/s / peak MB", "engine / pin"]

@@ -20,12 +20,11 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from bench_build import SOURCE_TREE  # noqa: E402  (a version's balpipe with its own templates)
+from bench_build import SOURCE_TREE, versions as versions_of  # noqa: E402  (a version's balpipe with its own templates)
 
 CHILD = SOURCE_TREE + r"""
 import json, statistics, sys, time
@@ -62,27 +61,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=3, help="alternated runs of each case")
     ap.add_argument("--python", default=sys.executable)
     args = ap.parse_args(argv)
-    versions = {"this": ROOT / "pipeline"}
     best: dict[tuple[str, int, str], dict] = {}
-    with tempfile.TemporaryDirectory(prefix="bench_dense_") as tmp:
-        tree = Path(tmp) / "against"
-        if args.against:
-            subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), args.against],
-                           check=True, capture_output=True)
-            versions[args.against] = tree / "pipeline"
-        try:
-            for _ in range(args.repeat):
-                for spec in args.specs:
-                    for N in args.samples:
-                        for v, pipeline in versions.items():
-                            b = best.setdefault((spec, N, v), {})
-                            for k, x in run(args.python, pipeline, spec, N).items():
-                                b[k] = min(b.get(k, x), x)
-                    print(".", end="", file=sys.stderr, flush=True)
-            print(file=sys.stderr)
-        finally:
-            if args.against:
-                subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)], capture_output=True)
+    with versions_of(args.against, "bench_dense_") as (versions, _):
+        for _ in range(args.repeat):
+            for spec in args.specs:
+                for N in args.samples:
+                    for v, pipeline in versions.items():
+                        b = best.setdefault((spec, N, v), {})
+                        for k, x in run(args.python, pipeline, spec, N).items():
+                            b[k] = min(b.get(k, x), x)
+                print(".", end="", file=sys.stderr, flush=True)
+        print(file=sys.stderr)
     heads = ["spec", "samples"] + [f"{v}: first seen / placed (ms)" for v in versions]
     print("| " + " | ".join(heads) + " |")
     print("|" + " --- |" * len(heads))
