@@ -251,7 +251,7 @@ def simulate(
         if stop_at is not None and k >= 0 and (k % STOP_EVERY == 0 or k == n):
             upto = read.recorded - 1  # rows 1 .. upto hold the states after steps 0 .. upto - 1
             if _tracking_reached(model, read.rows(list(range(looked, upto))), names, com, laws_now, looked,
-                                 stop_at, nb, len(bodies) if sim.floating else None):
+                                 stop_at, len(bodies) if sim.floating else None):
                 stopped = k < n
                 n = k
                 times = times[: n + 1]
@@ -283,31 +283,33 @@ def simulate(
         total = np.stack([states[:, :, 3] @ mm, states[:, :, 4] @ mm,
                           (gx * states[:, :, 4] - gy * states[:, :, 3]) @ mm + states[:, :, 5] @ ii], axis=1)
     poses = states[:, :nb, :3].copy() if record_poses else np.zeros((0, nb, 3))
-    st = {nm: (states[:, i, 0], states[:, i, 1], states[:, i, 2]) for i, nm in enumerate(names)}
-    st[FRAME] = (base[:, 0], base[:, 1], base[:, 2])
-    derr = {d.name: np.asarray(_driver_coordinate(model, d, st, com), dtype=float) - laws_now[d.name][: n + 1]
-            for d in model.drivers}
+    derr = _driver_errors(model, states, names, com, laws_now, 0, len(bodies) if sim.floating else None)
     wall = time.perf_counter() - start
     space.iterations = iterations
     return SimulationRun(times, force, moment, poses, base, derr, total, dt, iterations, wall, sim, stopped)
 
 
+def _driver_errors(model: Model, rows: np.ndarray, names: list[str], com: dict, laws: dict[str, np.ndarray],
+                   first: int, base: int | None) -> dict[str, np.ndarray]:
+    """Each driven coordinate of the recorded states ``rows`` (the steps ``first``, ``first + 1``,
+    ...; the floating base's state at index ``base``, else the frame at rest) less its law
+    ``laws`` at those steps (rad or m)."""
+    st = {nm: (rows[:, i, 0], rows[:, i, 1], rows[:, i, 2]) for i, nm in enumerate(names)}
+    frame = rows[:, base, :3] if base is not None else np.zeros((len(rows), 3))
+    st[FRAME] = (frame[:, 0], frame[:, 1], frame[:, 2])
+    return {d.name: np.asarray(_driver_coordinate(model, d, st, com), dtype=float) - laws[d.name][first : first + len(rows)]
+            for d in model.drivers}
+
+
 def _tracking_reached(model: Model, rows: np.ndarray, names: list[str], com: dict, laws: dict[str, np.ndarray],
-                      first: int, stop_at: tuple[float, dict[str, float]], nb: int, base: int | None) -> bool:
+                      first: int, stop_at: tuple[float, dict[str, float]], base: int | None) -> bool:
     """Some driven coordinate of the states ``rows`` (the steps ``first``, ``first + 1``, ...) is
     ``stop_at[0]`` of its travel or more from its law ``laws`` (or not finite)."""
     if not len(rows):
         return False
     limit, travel = stop_at
-    st = {nm: (rows[:, i, 0], rows[:, i, 1], rows[:, i, 2]) for i, nm in enumerate(names)}
-    frame = rows[:, base, :3] if base is not None else np.zeros((len(rows), 3))
-    st[FRAME] = (frame[:, 0], frame[:, 1], frame[:, 2])
-    for d in model.drivers:
-        err = np.asarray(_driver_coordinate(model, d, st, com), dtype=float) - laws[d.name][first : first + len(rows)]
-        worst = float(np.max(np.abs(err))) / (travel.get(d.name) or 1.0)
-        if not worst < limit:
-            return True
-    return False
+    return any(not float(np.max(np.abs(err))) / (travel.get(name) or 1.0) < limit
+               for name, err in _driver_errors(model, rows, names, com, laws, first, base).items())
 
 
 
