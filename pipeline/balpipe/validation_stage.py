@@ -10,6 +10,7 @@ from .runtime import pool
 from .cache import simulation as sim_cache
 from .study import Study
 from .validate import FreeFloating, ValidationSettings, free_floating
+from .validate.floating import motion_only
 from .validate.run import model_scale
 from .validate.shared import stage_runs
 
@@ -133,8 +134,10 @@ def simulated_model(model):
 def _floating_run(k: int, base_inertia: float, settings: ValidationSettings | None,
                   study: Study) -> FreeFloating:
     s = study.stages[k]
-    return sim_cache.run(free_floating, simulated_model(s.stage.model), s.analysis, BASE_MASS, base_inertia,
-                         settings=settings)
+    # the motion alone (:func:`balpipe.validate.floating.motion_only`): one run for every spec of the
+    # same mechanism and motion, whatever their gravity and loads
+    return sim_cache.run(free_floating, simulated_model(s.stage.model), motion_only(s.analysis), BASE_MASS,
+                         base_inertia, settings=settings)
 
 
 def _parallel(study: Study, workers: int, tasks: list[tuple]) -> list:

@@ -84,3 +84,27 @@ def test_five_bar_stages_are_simulated_on_one_frame(five_bar_runs):
     for r in rl.runs:  # the small masses change the unbalanced motion by little
         assert r.massless_difference[0] < 0.01 * max(unb.max_drift, 1e-3)
         assert r.reference_difference[0] < 1e-6 and r.reference_difference[1] < 1e-5
+
+
+def test_the_demonstration_reads_the_motion_alone_and_is_shared_across_gravity(tmp_path):
+    """What the free-floating run reads of an analysis is its motion (:func:`motion_only`): the
+    same run bit for bit, and one simulation for two analyses of the same motion under other
+    gravity (paper 002's vertical and horizontal specs ran their three demonstrations twice)."""
+    import numpy as np
+
+    from balpipe.cache import simulation as sim_cache
+    from balpipe.validate.floating import motion_only
+
+    model = gear_train()
+    down, sideways = analyse(model, GRID, (0.0, -9.81)), analyse(model, GRID, (-9.81, 0.0))
+    assert not np.array_equal(down.efforts["q"], sideways.efforts["q"])  # the analyses differ
+    full = free_floating(model, down, base_mass=10.0, base_inertia=1.0)
+    view = free_floating(model, motion_only(down), base_mass=10.0, base_inertia=1.0)
+    for name in ("base", "poses", "drift", "rotation"):
+        assert np.array_equal(getattr(full, name), getattr(view, name))
+    assert full.to_json() == view.to_json()
+    store = sim_cache.Store(tmp_path, "spec", "salt")
+    with sim_cache.using(store):
+        a = sim_cache.run(free_floating, model, motion_only(down), 10.0, 1.0)
+        b = sim_cache.run(free_floating, model, motion_only(sideways), 10.0, 1.0)
+    assert store.computed == 1 and a.to_json() == b.to_json()

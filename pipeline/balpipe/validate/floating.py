@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -143,6 +143,25 @@ def _conservation_solution(model: Model, analysis: Analysis, mb: float, ib: floa
     rG = s[0][None, :] + np.outer(t - t[0], p0 / M)
     origin = rG - rotate(phi, s)
     return phi, origin
+
+
+def motion_only(analysis: Analysis) -> Analysis:
+    """``analysis`` with only what :func:`free_floating` reads: the time grid, the centres of
+    mass' poses, velocities and accelerations, the momenta that follow from them and the moment
+    point. The loads, efforts and reactions, which depend on gravity and the external loads
+    (a free-floating run has neither), are left out (NaN, empty), and gravity is zero. Two
+    analyses of the same model and motion under other gravity or loads give the same view, so
+    the simulation cache (:mod:`balpipe.cache.simulation`, keyed by the arguments) runs their
+    demonstration once: paper 002's vertical and horizontal specs share all three of theirs.
+    ``free_floating(model, motion_only(a))`` is ``free_floating(model, a)``, bit for bit
+    (tests/validate/test_floating.py)."""
+    nan = np.full_like(np.asarray(analysis.force, dtype=float), np.nan)
+    return replace(
+        analysis, force=nan, moment=np.full_like(np.asarray(analysis.moment, dtype=float), np.nan),
+        force_momentum=nan, moment_momentum=np.full_like(np.asarray(analysis.moment, dtype=float), np.nan),
+        efforts={}, reactions={}, gravity=(0.0, 0.0), actuation_condition=None, actuator_rates=None,
+        frame_force=None, frame_moment=None, loads={},
+    )
 
 
 def with_small_masses(model: Model, fraction: float, reach: float) -> tuple[Model, dict[str, tuple[float, float]]]:
