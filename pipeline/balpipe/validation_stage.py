@@ -90,19 +90,12 @@ class Reactionless:
         """Every stage ran on the same frame (mass and inertia)."""
         return len({(r.base_mass, r.base_inertia) for r in self.runs}) == 1
 
-    def player(self) -> str:
-        from .draw.player import player_html
+    def player(self) -> tuple[str, str]:
+        """The free-floating runs' player (:func:`balpipe.draw.player.player`): its markup and its
+        caption's sentence on the panels' scales and the gears' numbers."""
+        from .draw.player import player
 
-        return player_html([
-            {"label": lab, "model": m, "t": r.t, "base": r.base, "poses": r.poses}
-            for lab, m, r in zip(self.labels, self.models, self.runs)
-        ])
-
-    def player_note(self) -> str:
-        """The player caption's sentence on the panels' scales and the gears' numbers."""
-        from .draw.player import scale_note
-
-        return scale_note([
+        return player([
             {"label": lab, "model": m, "t": r.t, "base": r.base, "poses": r.poses}
             for lab, m, r in zip(self.labels, self.models, self.runs)
         ])

@@ -250,6 +250,10 @@ def test_player_grid_and_names_in_the_html(studies):
     names = d["stages"][2]["names"]
     assert sorted(g[-1] for g in names["gears"]) == ["1'", "2'", "3'", "4'", "5", "6", "7"]
     assert html == player.player_html(_stages(st, False))  # same bytes
+    # the page's player and its note from one player_data: the same text as each alone
+    assert player.player(_stages(st, False)) == (html, player.scale_note(_stages(st, False)))
+    assert player.player(_stages(st, False), "p2", floating=False, autoplay=False)[0] == \
+        player.player_html(_stages(st, False), "p2", floating=False, autoplay=False)
 
 
 # -- paper 001's 4-RRR drawings (Figs. 2a, 3a-f, 4a, 4b, 6) -------------------------------------

@@ -268,7 +268,20 @@ def player_data(stages: list[dict]) -> dict:
 
 def scale_note(stages: list[dict]) -> str:
     """The caption's sentence on the panels' scales, and the gears' numbers."""
+    return _note(player_data(stages))
+
+
+def player(stages: list[dict], element_id: str = "player", floating: bool = True,
+           autoplay: bool = True) -> tuple[str, str]:
+    """:func:`player_html` and :func:`scale_note` of the same ``stages``, the same text as each
+    alone, from one :func:`player_data` (a page shows both: its poses, loads and names, about
+    half of a page's player time, are made once)."""
     d = player_data(stages)
+    return _html(d, element_id, floating, autoplay), _note(d)
+
+
+def _note(d: dict) -> str:
+    """:func:`scale_note` of the player's data ``d`` (:func:`player_data`)."""
     from .labels import gear_key
 
     note = ("Every panel is at the same scale (scale bar in each)." if d["same_scale"] else
@@ -288,7 +301,11 @@ def player_html(stages: list[dict], element_id: str = "player", floating: bool =
     each with its scale bar; as many columns as the page's width holds (one on a phone).
     ``floating``: the frame moves (the free-floating runs), its pose is printed per panel;
     ``autoplay``: it plays at load (unless the reader asked for reduced motion)."""
-    d = player_data(stages)
+    return _html(player_data(stages), element_id, floating, autoplay)
+
+
+def _html(d: dict, element_id: str, floating: bool, autoplay: bool) -> str:
+    """:func:`player_html` of the player's data ``d`` (:func:`player_data`)."""
     lay = d["layout"]
     payload = json.dumps({"stages": d["stages"], "layout": lay, "loads": d["loads"]}, separators=(",", ":"), sort_keys=True)
     # names are data: no '</script>' or '<!--' can end the script early

@@ -138,7 +138,8 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
                                                  **drawing))
         for k, s in enumerate(table_order(study))
     ]
-    moving = mechanism_player_stages(study)
+    moving, moving_note = player.player(mechanism_player_stages(study), "mechanism-player", floating=False,
+                                        autoplay=False)
     extra = [(title, svg, caption) for title, svg, caption in study.extra_figures()]
     extra += partial_figures.figures(study)  # the fronts of an optimal partial balancing, if any
     extra += paper_figures.own_figures(study)  # the paper's panels as it numbers them
@@ -188,8 +189,7 @@ def study_figures(study: Study, names: PageNames | None = None) -> dict:
                             "These are the line styles of the paper whose method balances this spec, so the figures "
                             "drawn as that paper's draw each stage as every other figure does"),
             "efforts": efforts, "mechanism": mech,
-            "player": player.player_html(moving, "mechanism-player", floating=False, autoplay=False),
-            "player_note": player.scale_note(moving), "gear_key": labels.gear_key(drawing["numbers"]), "extra": extra,
+            "player": moving, "player_note": moving_note, "gear_key": labels.gear_key(drawing["numbers"]), "extra": extra,
             "residuals": residuals, "drift": drift, "torque": torque}
 
 
@@ -280,6 +280,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
             })
     rl = study.reactionless
     drawn = study_figures(study, names)
+    floating = rl.player() if rl is not None else ("", "")  # the free-floating runs' player and its note
     return toc.add_toc(sections.collapse(environment().get_template("spec.html").render(
         r=results,
         paper=spec.paper,
@@ -291,7 +292,7 @@ def render_page(study: Study, results: dict, spec_text: str, history: dict | Non
         torque=torque_rows,
         reactionless={"base_mass": rl.base_mass, "base_inertia": rl.base_inertia, "rows": rl.rows(),
                       "same_base": rl.same_base,
-                      "player": rl.player(), "player_note": rl.player_note()} if rl is not None else None,
+                      "player": floating[0], "player_note": floating[1]} if rl is not None else None,
         drawn=drawing_times(study),
         joint_loads=joint_load_table(study),
         parts=page_rows(results.get("parts") or [], units),
