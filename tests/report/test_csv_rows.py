@@ -1,5 +1,5 @@
-"""The time-series CSV's number text (:func:`balpipe.report.results.csv_rows`): each distinct
-column formatted once, the same text as one %.12g format per row."""
+"""The time-series CSV's number text (:func:`balpipe.report.results.csv_rows`,
+:func:`balpipe.display.csv_numbers.rows`): the same text as one %.12g format per row."""
 
 from __future__ import annotations
 
@@ -24,6 +24,22 @@ def test_same_text_as_a_format_per_row_with_repeated_and_awkward_columns(rng):
     assert text == _per_row(columns)
     assert "-0," not in text and ",-0\n" not in text  # no negative zero
     assert text.count("\n") == n and all(line.count(",") == len(columns) - 1 for line in text.splitlines())
+
+
+def test_a_figures_cells_leave_what_is_not_finite_empty(rng):
+    """csv_numbers.rows with ``missing``: NaN, inf and -inf as that text (a figure's CSV leaves
+    them empty), every other value as one %.12g format per value writes it."""
+    from balpipe.display.csv_numbers import rows
+
+    n = 23
+    a = rng.normal(size=n) * 10.0 ** rng.integers(-12, 12, size=n)
+    b = np.array([np.nan, -0.0, np.inf, -np.inf, 1e-300, 5e-324, 1 / 3, -2.5] * 3)[:n]
+    expected = "".join(",".join("" if not np.isfinite(v) else "%.12g" % (v + 0.0) for v in r) + "\n"
+                       for r in zip(a.tolist(), b.tolist(), a.tolist()))
+    assert rows([a, b, a], missing="") == expected
+    assert rows([a, b], missing="") != rows([a, b])  # without it, as %.12g writes them
+    assert rows([a, b]) == _per_row([a, b])
+    assert rows([a], missing="") == _per_row([a])  # all finite: the same text
 
 
 def test_one_row_one_column_and_no_rows():

@@ -30,6 +30,7 @@ from typing import Iterator, NamedTuple
 
 import numpy as np
 
+from ..display import csv_numbers
 from ..display.units import CHOICES, OF_SI_UNIT, DisplayUnits
 from ..mechanics.sampling import spread_indices
 from . import figures
@@ -297,9 +298,7 @@ def csv_text(c: Curves) -> str:
                 columns.append(np.asarray(curves[p["key"]], dtype=float)[k] * factor)
     out = io.StringIO()
     csv.writer(out, lineterminator="\n").writerow(header)
-    rows = [["" if not np.isfinite(v) else "%.12g" % (v + 0.0) for v in col.tolist()] for col in columns]
-    out.writelines(",".join(r) + "\n" for r in zip(*rows))
-    return out.getvalue()
+    return out.getvalue() + csv_numbers.rows(columns, missing="")
 
 
 def html(name: str, c: Curves, numbers: str = NUMBERS) -> str:

@@ -12,6 +12,7 @@ from .. import __version__
 from ..mechanics.drivers import driver_unit
 from ..mechanics.motion_outputs import motion_columns
 from ..balancing.regressor import model_size
+from ..display import csv_numbers
 from ..study import Study
 from . import present
 from .frame_mounts import mounts_json
@@ -292,21 +293,6 @@ def timeseries_columns(study: Study) -> list[tuple[str, np.ndarray]]:
 
 
 def csv_rows(columns: list[np.ndarray]) -> str:
-    """The rows of equal-length ``columns`` as CSV text, %.12g, no "-0". A column that repeats
-    another (the stages share their motion: about 60 % of the columns over specs/) is formatted
-    once; each column by one %-format of all its values, split into cells (the same text as one
-    format per row, 30 % faster on the 4-RRR's tables)."""
-    n = len(columns[0]) if columns else 0
-    if n == 0:
-        return ""
-    fmt = "\n".join(["%.12g"] * n)
-    done: dict[bytes, list[str]] = {}
-    cells = []
-    for v in columns:
-        v = np.asarray(v, dtype=float).reshape(n) + 0.0  # + 0.0: no "-0"
-        key = v.tobytes()
-        text = done.get(key)
-        if text is None:
-            text = done[key] = (fmt % tuple(v.tolist())).split("\n")
-        cells.append(text)
-    return "".join([",".join(row) + "\n" for row in zip(*cells)])
+    """The rows of equal-length ``columns`` as CSV text, %.12g, no "-0"
+    (:func:`balpipe.display.csv_numbers.rows`: the same text as one format per row)."""
+    return csv_numbers.rows(columns)
