@@ -402,3 +402,28 @@ def test_a_run_failing_on_the_steps_error_alone_is_run_at_finer_steps():
     wrong = torque_driven(s.stage.model, analyse(heavy, s.analysis.t), analytic_model=heavy, calibrate=False)
     assert not wrong.passed and wrong.tracking_error_max > 1e-2
     assert any("does not shrink it" in n for n in wrong.notes), wrong.notes
+
+
+def test_the_law_kinds_are_remembered_by_laws_and_times():
+    """The smoothness of the motion at each sample (:func:`balpipe.validate.settings._law_kinds`,
+    read by every run of a stage) is computed once for a stage's laws and grid: the model with
+    pymunk's floor parts shares it, a changed list does not change the next answer, and the answer
+    is the computation's."""
+    from balpipe.model import Attachment
+    from balpipe.validate import settings as S
+
+    model = _jumpy_arm(None, 0.3)
+    times = np.linspace(0.0, 0.5, 1001)
+    heavier = model.replace_body(model.bodies[0].with_attachments(Attachment("pymunk floor", 0.1, (0.0, 0.0), 0.0, kind="part")))
+    calls = []
+    find = S._find_law_kinds
+    try:
+        S._find_law_kinds = lambda m, t: calls.append(m) or find(m, t)
+        S._KINDS_MEMO.clear()
+        first = S._law_kinds(model, times)
+        first[0] = "changed by the caller"
+        second = S._law_kinds(heavier, times)
+    finally:
+        S._find_law_kinds = find
+    assert calls == [model] and second == find(model, times)
+    assert {"left", "right"} & set(second) and second[0] != "changed by the caller"

@@ -202,29 +202,47 @@ SECTIONS = 32
 SECTION_ROUNDS = 12
 
 
-#: the last results of :func:`_located_jumps`, by (the driver laws, times): every run of a stage, and
-#: every measurement of its loads, asks again for the same laws and step times, on the stage's model
-#: and on the model with pymunk's floor parts, which shares its laws (the bisection evaluates each
-#: law 120 times: 7 % of the simulated build's CPU before it was remembered; by model, a third of
-#: paper 003's finds were the other model's)
-_JUMPS_MEMO: dict[tuple, tuple[tuple, np.ndarray, tuple[np.ndarray, np.ndarray]]] = {}
-_JUMPS_MEMO_SIZE = 32
+class _ByLaws:
+    """The last few results of a function of a model's driver laws and a time grid, remembered:
+    every run of a stage, and every measurement of its loads, asks again for the same laws and
+    step times, on the stage's model and on the model with pymunk's floor parts, which shares its
+    laws. Keyed by the laws' identity (all that such a function reads of the model: they are
+    functions, kept alive by the entry) and the times by value; ``size`` entries, the oldest
+    forgotten first."""
+
+    def __init__(self, size: int) -> None:
+        self.size = size
+        self.entries: dict[tuple, tuple[tuple, np.ndarray, object]] = {}
+
+    def get(self, model: Model, times: np.ndarray, compute):
+        """``compute(model, times)``, or the result remembered for the same laws and times."""
+        times = np.asarray(times, dtype=float)
+        laws = tuple(d.law for d in model.drivers)
+        k = (tuple(id(law) for law in laws), times.shape, hash(times.tobytes()))
+        hit = self.entries.get(k)
+        if hit is None or any(a is not b for a, b in zip(hit[0], laws)) or not np.array_equal(hit[1], times):
+            if len(self.entries) >= self.size:
+                self.entries.pop(next(iter(self.entries)))
+            hit = (laws, times.copy(), compute(model, times))
+            self.entries[k] = hit
+        return hit[2]
+
+    def clear(self) -> None:
+        self.entries.clear()
+
+
+#: :func:`_find_jumps` by laws and times (the bisection evaluates each law 120 times: 7 % of the
+#: simulated build's CPU before it was remembered; by model, a third of paper 003's finds were the
+#: other model's)
+_JUMPS_MEMO = _ByLaws(32)
+#: :func:`_find_law_kinds` by laws and times (three evaluations of every law on the analysis grid
+#: and a loop over the samples, for every run of a stage: 1,900 calls in the simulated build of specs/)
+_KINDS_MEMO = _ByLaws(32)
 
 
 def _located_jumps(model: Model, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_find_jumps`, remembered for the last few (laws, times) pairs (the model's driver laws
-    by identity, all that :func:`_find_jumps` reads of it: they are functions; the times by value).
-    The arrays returned are copies."""
-    times = np.asarray(times, dtype=float)
-    laws = tuple(d.law for d in model.drivers)
-    k = (tuple(id(law) for law in laws), times.shape, hash(times.tobytes()))
-    hit = _JUMPS_MEMO.get(k)
-    if hit is None or any(a is not b for a, b in zip(hit[0], laws)) or not np.array_equal(hit[1], times):
-        if len(_JUMPS_MEMO) >= _JUMPS_MEMO_SIZE:
-            _JUMPS_MEMO.pop(next(iter(_JUMPS_MEMO)))
-        hit = (laws, times.copy(), _find_jumps(model, times))
-        _JUMPS_MEMO[k] = hit
-    ks, tj = hit[2]
+    """:func:`_find_jumps`, remembered (:data:`_JUMPS_MEMO`). The arrays returned are copies."""
+    ks, tj = _JUMPS_MEMO.get(model, times, _find_jumps)
     return ks.copy(), tj.copy()
 
 
@@ -279,6 +297,11 @@ def jump_times(model: Model, times: np.ndarray) -> list[float]:
 
 
 def _law_kinds(model: Model, times: np.ndarray) -> list[str]:
+    """:func:`_find_law_kinds`, remembered (:data:`_KINDS_MEMO`); the list returned is a copy."""
+    return list(_KINDS_MEMO.get(model, times, _find_law_kinds))
+
+
+def _find_law_kinds(model: Model, times: np.ndarray) -> list[str]:
     """Smoothness of the motion at each analysis sample: "smooth", "kink" (a jump of some
     law's jerk: the central difference straddling it is only first order), "left"/"right"
     (a jump of some law's acceleration, the law's value at the sample being the left/right
