@@ -27,6 +27,7 @@ Inside [t0, t1] the laws are untouched.
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -110,13 +111,33 @@ def is_periodic_moving(model: Model, analysis: Analysis) -> bool:
     return True
 
 
+#: the continued laws alive, by (id of the law, t0, t1, periodic): :func:`continued` gives one object
+#: for one law continued the same way (a value lives as long as some model holds it, and holds its law)
+_CONTINUED: weakref.WeakValueDictionary[tuple[int, float, float, bool], ContinuedLaw] = weakref.WeakValueDictionary()
+
+
+def continued_law(law: object, t0: float, t1: float, periodic: bool) -> ContinuedLaw:
+    """``ContinuedLaw(law, t0, t1, periodic)``, the same object for the same law continued the same
+    way while one is alive. The engine keys a geometry's motion by its laws' identities
+    (:func:`balpipe.engine.warmstart.motion_key`): every model of a mechanism continued over one
+    interval (a stage's torque-driven plans, the other stages') then shares its frame motion on a
+    grid, solved once, instead of once per continued model (the same values: a continued law is a
+    pure function of these four)."""
+    key = (id(law), t0, t1, periodic)
+    hit = _CONTINUED.get(key)
+    if hit is None or hit.law is not law:
+        hit = _CONTINUED[key] = ContinuedLaw(law, t0, t1, periodic)
+    return hit
+
+
 def continued(model: Model, analysis: Analysis) -> Model:
-    """``model`` with every driver's law continued outside the analysed interval."""
+    """``model`` with every driver's law continued outside the analysed interval (by
+    :func:`continued_law`: one object per law and interval)."""
     if any(isinstance(d.law, ContinuedLaw) for d in model.drivers):
         return model
     t0, t1 = float(analysis.t[0]), float(analysis.t[-1])
     periodic = is_periodic_moving(model, analysis)
-    drivers = tuple(replace(d, law=ContinuedLaw(d.law, t0, t1, periodic)) for d in model.drivers)
+    drivers = tuple(replace(d, law=continued_law(d.law, t0, t1, periodic)) for d in model.drivers)
     return replace(model, drivers=drivers)
 
 
