@@ -154,16 +154,19 @@ def context(spec: Any, balancing: Any = None, page: bool = True, memo: Memo = co
         models=functools.partial(motion_model, spec), memo=memo)
 
 
-def balance(spec: Any, balancing: Any = None, page: bool = True, memo: Memo = compute) -> BalanceResult:
+def balance(spec: Any, balancing: Any = None, page: bool = True, memo: Memo = compute,
+            model: Model | None = None) -> BalanceResult:
     """The unbalanced model and the method's stages, with every semantic check of the spec:
     ``METHODS[name].balance(ctx)`` with ctx its :func:`context`. ``balancing`` replaces
     ``spec.balancing`` (the designs of ``spec.compare``). Without ``page``, the method's
     :attr:`Method.page_only` fields are left out (``balpipe check``) and the context says so
     unless the spec has references. ``memo``: what the method's searches go through (the
-    build's cache, :class:`balpipe.cache.balance.Memo`; default: computed)."""
+    build's cache, :class:`balpipe.cache.balance.Memo`; default: computed). ``model``: the
+    spec's :func:`unbalanced_model` when the caller has it (built here otherwise): the same
+    frozen object then serves as the unbalanced stage's model."""
     balancing = balancing if balancing is not None else spec.balancing
     name = balancing.method
-    model = unbalanced_model(spec)
+    model = model if model is not None else unbalanced_model(spec)
     if name == "none":
         return BalanceResult([], [Stage("unbalanced", "unbalanced", model, "the mechanism as given")])
     method = METHODS[name]
@@ -177,13 +180,16 @@ def balance(spec: Any, balancing: Any = None, page: bool = True, memo: Memo = co
     return method.balance(context(spec, balancing, page, memo, model))
 
 
-def balance_designs(spec: Any, page: bool = True, memo: Memo = compute) -> BalanceResult:
+def balance_designs(spec: Any, page: bool = True, memo: Memo = compute,
+                    model: Model | None = None) -> BalanceResult:
     """:func:`balance`, then the stages of every design in ``spec.compare`` after the main
     design's, each with its :attr:`Stage.design` and named ``design:stage`` on the page and in
     results.json (their unbalanced stage, the same model, is dropped);
     parameters are prefixed the same way and details go to ``details["compare"][design]``;
-    ``page`` and ``memo`` as in :func:`balance`."""
-    main = balance(spec, page=page, memo=memo)
+    ``page``, ``memo`` and ``model`` as in :func:`balance`: the unbalanced model is built once
+    for every design (each design's mechanism is the spec's)."""
+    model = model if model is not None else unbalanced_model(spec)
+    main = balance(spec, page=page, memo=memo, model=model)
     designs = getattr(spec, "compare", None) or []
     if not designs:
         return main
@@ -192,7 +198,7 @@ def balance_designs(spec: Any, page: bool = True, memo: Memo = compute) -> Balan
     details["compare"] = {}
     for k, d in enumerate(designs):
         try:
-            res = balance(spec, d.balancing, page, memo)
+            res = balance(spec, d.balancing, page, memo, model)
         except SpecFieldError as exc:
             path = exc.path
             if path[:1] == ("balancing",):

@@ -338,7 +338,7 @@ def run(spec: Spec, page: bool = True, memo: Memo = compute) -> Study:
     if model.sources:  # a spec that gives its own poses (custom): the assembly must confirm them
         assembly.check(model, float(registry.time_grid(spec)[0]))
     try:
-        balance = registry.balance_designs(spec, page, memo)
+        balance = registry.balance_designs(spec, page, memo, model)  # the model built once
     except AnalysisError as exc:  # a balancing method analysed a motion that cannot be followed
         raise loop_closure.located(model, registry.time_grid(spec), exc) from None
     stages = run_stage_analyses(spec, balance)

@@ -395,3 +395,21 @@ def test_generic_methods_apply_to_templates_offset_slider_crank_fully_balanced()
     f, m = _ratios(st)["counter_rotations"]
     assert f <= 1e-9 and m <= 1e-9
     assert _ratios(st)["counterweights"][1] > 0.1  # force balance alone leaves the moment
+
+
+def test_the_unbalanced_model_is_built_once_for_every_design(monkeypatch):
+    """study.run builds the spec's unbalanced model once and every design's balance starts from
+    it (the designs share the spec's mechanism): the unbalanced stage is that model, and the
+    stages are those of a balance that builds its own."""
+    spec = load(SPECS / "custom_four_bar_balancing.yaml").spec
+    assert spec.compare
+    own = registry.balance_designs(spec, page=False)
+    built = []
+    real = registry.unbalanced_model
+    monkeypatch.setattr(registry, "unbalanced_model", lambda s: built.append(s) or real(s))
+    st = study.run(spec, page=False)
+    assert len(built) == 1
+    assert [s.stage.name for s in st.stages] == [s.name for s in own.stages]
+    assert all(s.stage.model == o.model for s, o in zip(st.stages, own.stages))
+    given = real(spec)
+    assert registry.balance_designs(spec, page=False, model=given).stages[0].model is given
