@@ -11,7 +11,7 @@ import pytest
 
 from balpipe.runtime import pool
 from balpipe import registry
-from balpipe.site_files.check_cost import PLAIN, check_cost, declared_names
+from balpipe.site_files.check_cost import PLAIN, check_cost, check_hints, declared_names
 from balpipe.cli import main
 
 SPECS = Path(__file__).resolve().parents[2] / "specs"
@@ -43,6 +43,19 @@ def test_declared_costs_order_the_repository_specs():
     # a partial balancing solves its optimum's cone programme in check too
     assert check_cost(SPECS / "partial_offset_slider_crank.yaml") > check_cost(PLAIN_SPEC)
     assert check_cost(PAPER003) > check_cost(SPECS / "partial_paper000_rpr3.yaml")
+
+
+def test_the_hints_are_the_cost_and_the_method_from_one_read(tmp_path):
+    """check_hints: what check_cost gives and the method the spec names (the parent loads that
+    method's code before its workers fork), None where no name can be read."""
+    for p in SPECS.glob("*.yaml"):
+        method = declared_names(p.read_text(encoding="utf-8"))[("balancing", "method")]
+        assert check_hints(p) == (check_cost(p), method)
+    assert check_hints(PAPER003)[1] == "com_motion_planning"
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("balancing: [unclosed\n", encoding="utf-8")
+    assert check_hints(bad) == (PLAIN, None)
+    assert check_hints(tmp_path / "gone.yaml") == (PLAIN, None)
 
 
 @pytest.mark.parametrize("text", ["mechanism: [unclosed\n", "mechanism: {template: nothing_known}\n",

@@ -50,7 +50,7 @@ def run(args) -> int:
     import gc
 
     from .. import loader, runner  # noqa: F401  (loaded once here, before the workers fork)
-    from ..site_files.check_cost import check_cost
+    from ..site_files.check_cost import check_hints
     from ..runtime.pool import default_jobs, finished, in_order
     from ..site_files.spec_files import clashes, find_specs
 
@@ -63,6 +63,8 @@ def run(args) -> int:
         print(msg, file=sys.stderr)
     clash = clashes(files)
     jobs = args.jobs if args.jobs is not None else default_jobs(len(files))
+    # with workers: each spec's expected cost and method, its names read once for both
+    hints = {f: check_hints(f) for f in files} if jobs > 1 and len(files) > 1 else {}
     if len(files) > 1:
         # the whole schema, frozen below and built once (not in every worker, nor narrowed per spec;
         # one spec is validated by its own sections alone, balpipe.spec.validate), and the methods'
@@ -71,8 +73,8 @@ def run(args) -> int:
         gc.disable()
         try:
             loader.prepare()
-            if jobs > 1:
-                _load_methods_code(files)
+            if hints:
+                _load_methods_code([method for _, method in hints.values()])
         finally:
             gc.enable()
     # the schema's and the libraries' objects live as long as the process: the collector stops
@@ -81,7 +83,7 @@ def run(args) -> int:
     gc.freeze()
     try:
         with finished(in_order(_check_item, [(f, clash.get(f)) for f in files], jobs,
-                               cost=lambda item: check_cost(item[0]))) as results:
+                               cost=(lambda item: hints[item[0]][0]) if hints else None)) as results:
             bad, crashed = _report(results)
     finally:
         gc.unfreeze()  # as it was for a caller in the same process (tests)
@@ -95,16 +97,15 @@ def run(args) -> int:
     return EXIT_USAGE if bad else EXIT_OK
 
 
-def _load_methods_code(files: list) -> None:
-    """Before the pool forks: the code of the methods the specs name and the libraries it imports
-    when it runs (:attr:`balpipe.plugins.Method.imports`, scipy's optimiser: 0.3 s), loaded once
-    here rather than again in every worker. The names are read as for the costs
-    (:func:`balpipe.site_files.check_cost.declared_method`); a spec whose name cannot be read is
-    left to its worker."""
+def _load_methods_code(methods: list[str | None]) -> None:
+    """Before the pool forks: the code of the ``methods`` the specs name and the libraries it
+    imports when it runs (:attr:`balpipe.plugins.Method.imports`, scipy's optimiser: 0.3 s),
+    loaded once here rather than again in every worker. The names are read with the costs
+    (:func:`balpipe.site_files.check_cost.check_hints`); a spec whose name cannot be read (None)
+    is left to its worker."""
     from .. import registry
-    from ..site_files.check_cost import declared_method
 
-    for name in dict.fromkeys(declared_method(f) for f in files):
+    for name in dict.fromkeys(methods):
         method = registry.METHODS.get(name or "")
         if method is not None:
             method.load_code()

@@ -34,21 +34,28 @@ def check_cost(path: Path) -> float:
     return PLAIN + declared_cost(path, "check_cost")
 
 
+def check_hints(path: Path) -> tuple[float, str | None]:
+    """(:func:`check_cost`, the ``balancing: {method: ...}`` it names or None) of the spec at
+    ``path``, from one read of its names: ``balpipe check`` of several specs needs both before its
+    workers fork (the methods' code is loaded there)."""
+    names = _read_names(path)
+    return PLAIN + _cost_of(names, "check_cost"), names.get(_NAMES[1])
+
+
 def declared_cost(path: Path, hint: str) -> float:
     """The sum of the ``hint`` attribute (``check_cost`` or ``build_cost``) of the template and
     the method that the spec at ``path`` names; 0 where it cannot be read or names neither."""
+    return _cost_of(_read_names(path), hint)
+
+
+def _cost_of(names: dict[tuple[str, str], str], hint: str) -> float:
+    """The sum of the ``hint`` attribute of the template and the method of ``names``
+    (:func:`declared_names`' dictionary); 0 for names not known."""
     from .. import registry
 
-    names = _read_names(path)
     template = registry.TEMPLATES.get(names.get(_NAMES[0], ""))
     method = registry.METHODS.get(names.get(_NAMES[1], ""))
     return sum(getattr(item, hint) for item in (template, method) if item is not None)
-
-
-def declared_method(path: Path) -> str | None:
-    """The ``balancing: {method: ...}`` that the spec at ``path`` names, read as for its cost;
-    None where it cannot be read or names none."""
-    return _read_names(path).get(_NAMES[1])
 
 
 def _read_names(path: Path) -> dict[tuple[str, str], str]:
