@@ -327,7 +327,7 @@ def test_names_on_paper001_drawings_never_overlap(studies, name, monkeypatch):
 
 def test_the_drawings_box_is_every_point_tracks_extremes(studies):
     """The box the drawings share (:func:`balpipe.draw.figures.common_limits`, the player's panels)
-    is reduced point track by point track (a long grid's (frames x points) array is never held):
+    is reduced body by body (a long grid's (frames x every point) array is never held):
     it equals the extremes of every body origin, named point and attachment over the frames and
     of the frame's pivots, stacked."""
     from balpipe.draw.player import _extent_box

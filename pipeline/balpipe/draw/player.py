@@ -54,13 +54,20 @@ def _outline(model: Model) -> list[dict]:
 def _extent_box(model: Model, poses: np.ndarray, base: np.ndarray | None = None) -> np.ndarray:
     """The box [[x_min, y_min], [x_max, y_max]] of the global positions of every named point,
     attachment and disc rim over the frames, and of the frame's pivots and guides (carried by the
-    frame's poses ``base`` where it moves): each point's track reduced as it is computed, so that
-    no (frames x points) array is held (a long grid's would be tens of MB)."""
+    frame's poses ``base`` where it moves): each body's points' tracks reduced as they are
+    computed, so that no (frames x every point) array is held (a long grid's would be tens of MB)."""
     lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
 
     def add(xy: np.ndarray) -> None:
         np.minimum(lo, xy.min(axis=0), out=lo)
         np.maximum(hi, xy.max(axis=0), out=hi)
+
+    def add_tracks(pose: np.ndarray, local: list) -> None:
+        """The body points ``local`` carried by the poses ``pose`` (n, 3): (x + cos th px - sin th py,
+        y + sin th px + cos th py) at every pose, all of the body's points in one (n, points) array."""
+        c, s = np.cos(pose[:, 2:3]), np.sin(pose[:, 2:3])
+        px, py = (np.array([p[k] for p in local], dtype=float) for k in (0, 1))
+        add(np.stack([(pose[:, 0:1] + c * px - s * py).ravel(), (pose[:, 1:2] + s * px + c * py).ravel()], axis=1))
 
     add(poses[:, :, :2].reshape(-1, 2))
     for i, b in enumerate(model.bodies):
@@ -72,18 +79,15 @@ def _extent_box(model: Model, poses: np.ndarray, base: np.ndarray | None = None)
             if a.radius:
                 px, py = a.position
                 local += [(px + a.radius, py), (px - a.radius, py), (px, py + a.radius), (px, py - a.radius)]
-        x, y, th = poses[:, i, 0], poses[:, i, 1], poses[:, i, 2]
-        for px, py in local:
-            add(np.stack([x + np.cos(th) * px - np.sin(th) * py, y + np.sin(th) * px + np.cos(th) * py], axis=1))
+        if local:
+            add_tracks(poses[:, i], local)
     fixed = list(model.frame_points.values()) + [p for g in model.guides for p in g]
     if not fixed:
         fixed = [(0.0, 0.0)]
     if base is None:
         add(np.array(fixed, dtype=float))
     else:
-        bx, by, bth = base[:, 0], base[:, 1], base[:, 2]
-        for px, py in fixed:
-            add(np.stack([bx + np.cos(bth) * px - np.sin(bth) * py, by + np.sin(bth) * px + np.cos(bth) * py], axis=1))
+        add_tracks(base, fixed)
     return np.array([lo, hi])
 
 
