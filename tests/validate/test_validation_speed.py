@@ -112,24 +112,33 @@ def test_a_try_that_holds_together_without_ten_times_margin_goes_to_the_full_eff
 
 
 def test_steps_straight_into_chipmunk_give_pymunks_run_bit_for_bit(monkeypatch):
-    """``_Stepper`` calls ``cpSpaceStep`` itself after pymunk's first step: the same run as
-    ``space.step`` every step (position-driven with gears, and torque-driven)."""
+    """``_Stepper.first`` hands the steps after pymunk's first to ``cpSpaceStep``: the same run
+    as ``space.step`` every step (position-driven with gears, and torque-driven)."""
     model = five_bar()
     a = analyse(model, GRID)
+    real = run_mod._Stepper.first
+    handed = []
+
+    def recorded(self, dt):
+        handed.append(real(self, dt))
+        return handed[-1]
+
+    monkeypatch.setattr(run_mod._Stepper, "first", recorded)
     direct = simulate(model, a, 1e-3, 100, mass_floor=0.1, feedforward=True)
     torque = _torque_run(arm_2r())
-    seen = []
-    real = run_mod._Stepper.__call__
+    assert len(handed) == 2 and all(fn is run_mod._cp.cpSpaceStep for fn, _ in handed)  # the direct path
+    steps = []
 
     def through_pymunk(self, dt):
-        seen.append(self.direct is not None)
         self.space.step(dt)
+        steps.append(1)
+        return lambda space, dt: (steps.append(1), space.step(dt)), self.space
 
-    monkeypatch.setattr(run_mod._Stepper, "__call__", through_pymunk)
+    monkeypatch.setattr(run_mod._Stepper, "first", through_pymunk)
     slow = simulate(model, a, 1e-3, 100, mass_floor=0.1, feedforward=True)
     slow_torque = _torque_run(arm_2r())
-    monkeypatch.setattr(run_mod._Stepper, "__call__", real)
-    assert seen and all(seen)  # the direct path was available on every step
+    monkeypatch.undo()
+    assert len(steps) == len(slow.t) + len(slow_torque.t)  # every step through pymunk
     for fast, ref in ((direct, slow), (torque, slow_torque)):
         for name in ("force", "moment", "poses", "momentum"):
             assert np.array_equal(getattr(fast, name), getattr(ref, name)), name
@@ -179,3 +188,4 @@ def test_the_meshes_placed_through_chipmunk_give_pymunks_run_bit_for_bit(monkeyp
     slow = simulate(model, a, 1e-3, 100, mass_floor=0.1, feedforward=True)
     for name in ("force", "moment", "poses", "momentum"):
         assert np.array_equal(getattr(fast, name), getattr(slow, name)), name
+

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import Any, Callable
 
 import numpy as np
 import pymunk
@@ -204,20 +205,30 @@ def simulate(
         read()
     start = time.perf_counter()
     iters = np.where(boost, startup_iterations, iterations).tolist()
-    # per-step inputs as Python floats, computed before the loop with the same arithmetic
+    # The loop makes the Chipmunk calls of pymunk's properties and step with the same values in
+    # the same order, its choices made before it starts: the per-step inputs as Python floats,
+    # computed with the same arithmetic, a phase and a summed torque set with the Chipmunk
+    # function that the property's setter calls, the states read with _BatchReader's own call,
+    # the checked steps and stop_at's looks as the next k to stop at.
     phases, grooves = [], []
     for dr in sim.drives:
         v = targets[dr.driver.name]
         if dr.kind == "phase":  # the joint's phase, offset + scale * law (see _Drive.set)
-            phases.append((dr.constraint, (dr.offset + dr.scale * v).tolist()))
+            phases.append((dr.constraint._constraint, (dr.offset + dr.scale * v).tolist()))
         else:
             grooves.append((dr, v))
-    set_phase = pymunk.GearJoint.phase.fset  # the property's setter, without pymunk's __setattr__ layer
+    set_phase, set_torque = _cp.cpGearJointSetPhase, _cp.cpBodySetTorque
     updates = sim.meshes + sim.carried
     torques, acts = _actuator_inputs(sim.actuators, efforts, settle, n) if efforts is not None else ([], [])
-    set_torque = pymunk.Body.torque.fset
+    torques = [(body._body, tq) for body, tq in torques]
     push = _InertialForces(space, read, model, analysis, every, bodies[:nb], g) if feedforward and efforts is None else None
-    advance = _Stepper(space)
+    each, cspace, getter, data = read.each, read.cspace, read.getter, read.data  # read() is each(cspace, getter, data)
+    checks = iter(sorted(check))
+    next_check = next(checks, n + 1)  # n + 1: no more checks
+    next_look = 0 if stop_at is not None else n + 1
+    stepper = _Stepper(space)
+    advance: Callable[[Any, float], object]  # the steps after the first: advance(advance_on, dt)
+    advance_on: Any
     current = None
     stopped = False
     looked = 0  # recorded rows already looked at by stop_at
@@ -231,24 +242,30 @@ def simulate(
         for u in updates:
             u.update(dt)
         k = step - settle
-        for body, tq in torques:
-            set_torque(body, tq[step])
+        for b, tq in torques:
+            set_torque(b, tq[step])
         if push is not None:
             push(step)
         for act, e in acts:
             act.apply(float(e[max(k, 0)]), dt)
         if applied is not None:
             applied.apply(float(every[step]), dt)
-        advance(dt)
+        if step:
+            advance(advance_on, dt)
+        else:  # the first step through pymunk, which hands the next ones over
+            advance, advance_on = stepper.first(dt)
         if k >= -1:
-            read()
-        if k in check:
+            each(cspace, getter, data)
+            read.recorded += 1
+        if k == next_check:
             pending.append(k)
+            next_check = next(checks, n + 1)
             if len(pending) == CHECK_BLOCK or k == n:
                 _check_apart(read.rows(pending), nb, len(bodies) if sim.floating else None,
                              analysis.q[[check[j] for j in pending]], abort, times[pending])
                 pending.clear()
-        if stop_at is not None and k >= 0 and (k % STOP_EVERY == 0 or k == n):
+        if k == next_look:  # k = 0, STOP_EVERY, 2 STOP_EVERY, ... and n
+            next_look = min(k + STOP_EVERY, n)
             upto = read.recorded - 1  # rows 1 .. upto hold the states after steps 0 .. upto - 1
             if _tracking_reached(model, read.rows(list(range(looked, upto))), names, com, laws_now, looked,
                                  stop_at, len(bodies) if sim.floating else None):
@@ -350,28 +367,31 @@ class _InertialForces:
 
 
 class _Stepper:
-    """``space.step(dt)``: the first call through pymunk (which checks every body's mass and
-    moment), the next ones straight into Chipmunk's ``cpSpaceStep``, the same step without
-    pymunk's bookkeeping of bodies and shapes added or removed during a step (a simulation adds
-    none, has no callbacks, and does not run threaded): about 3 us a step, a fifth of a step at
-    100 solver iterations."""
+    """A run's steps, ``space.step(dt)`` each: ``first(dt)`` steps through pymunk (which checks
+    every body's mass and moment) and returns the call of the next steps, ``(fn, arg)`` for
+    ``fn(arg, dt)``: straight into Chipmunk's ``cpSpaceStep`` where pymunk's step would only add
+    its bookkeeping of bodies and shapes added or removed during a step and of post-step
+    callbacks (none pending after its step; a simulation adds and removes nothing and registers
+    no callback while it runs), else ``pymunk.Space.step`` (a threaded space). The same
+    Chipmunk step; about 3 us a step less, a fifth of a step at 100 solver iterations."""
 
     def __init__(self, space: pymunk.Space) -> None:
         self.space = space
         self.direct = None if space.threaded else _cp.cpSpaceStep
 
-    def __call__(self, dt: float) -> None:
+    def first(self, dt: float) -> tuple[Callable[[Any, float], object], Any]:
         space = self.space
+        space.step(dt)
         if (self.direct is None or space._bodies_to_check or space._add_later or space._remove_later
                 or space._post_step_callbacks):
-            space.step(dt)
-        else:
-            self.direct(space._space, dt)
+            return pymunk.Space.step, space
+        return self.direct, space._space
 
 
 class _BatchReader:
     """Records x, y, angle, vx, vy, w of ``bodies`` after each step with one call into Chipmunk
-    (``pymunk.batch``), appended to one buffer (no per-step conversion): ``read()`` records a row;
+    (``pymunk.batch``), appended to one buffer (no per-step conversion): ``read()`` records a row
+    (``each(cspace, getter, data)``, which :func:`simulate`'s loop calls itself, counting the row);
     ``rows(ks)`` returns the rows of steps ``ks`` (row k + 1 holds the state after step k, row 0
     the state before the first recorded step), every row by default, (len, len(bodies), 6) in the
     order of ``bodies``."""
