@@ -189,3 +189,26 @@ def test_the_meshes_placed_through_chipmunk_give_pymunks_run_bit_for_bit(monkeyp
     for name in ("force", "moment", "poses", "momentum"):
         assert np.array_equal(getattr(fast, name), getattr(slow, name)), name
 
+
+def test_the_fixed_frames_check_in_floats_gives_numpys_answer():
+    """``_strayed_fixed`` (the fixed frame's check in Python floats) answers as ``_strayed``
+    (numpy's) row by row: random states near and far from the plan, deviations exactly at the
+    limit, signed zeros, infinities and NaNs in every coordinate."""
+    rng = np.random.default_rng(7)
+    limit, scale = 0.25, 2.0
+    specials = [np.nan, np.inf, -np.inf, -0.0, 0.0, limit * scale, -limit * scale, limit, -limit,
+                np.nextafter(limit * scale, np.inf), np.nextafter(limit, np.inf), 1e308, -1e308]
+    for trial in range(300):
+        m, nb = int(rng.integers(1, 6)), int(rng.integers(1, 4))
+        q_ref = rng.normal(size=(m, nb, 3)) * rng.choice([0.0, 1.0])
+        states = np.zeros((m, nb + int(rng.integers(0, 2)), 6))
+        states[:, :nb, :3] = q_ref + rng.normal(size=(m, nb, 3)) * rng.choice([0.0, 0.1, 1.0])
+        for _ in range(int(rng.integers(0, 4))):  # special values, or a deviation of exactly them
+            i, j, c = int(rng.integers(m)), int(rng.integers(nb)), int(rng.integers(3))
+            v = float(rng.choice(specials))
+            states[i, j, c] = v if rng.random() < 0.5 else q_ref[i, j, c] + v
+        if rng.random() < 0.3:
+            q_ref[int(rng.integers(m)), int(rng.integers(nb)), int(rng.integers(3))] = float(rng.choice(specials))
+        with np.errstate(all="ignore"):
+            expected = run_mod._strayed(states, nb, None, q_ref, (limit, scale))
+        assert run_mod._strayed_fixed(states, nb, q_ref, (limit, scale)) == expected, trial
