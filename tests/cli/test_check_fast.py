@@ -138,6 +138,27 @@ def test_check_leaves_the_collector_as_it_found_it(capsys):
     assert "specs/scott_russell.yaml: ok" in capsys.readouterr().out
 
 
+def test_check_loads_its_modules_with_the_collector_off_and_freezes_them(capsys):
+    """In a fresh interpreter, check imports the loader and the runner with the collector off
+    and freezes what they made before it reads a spec (no collection scans them: a one-spec
+    check's collections 0.015 -> 0.002 s of CPU); a usage error leaves the collector as it was."""
+    import gc
+    import subprocess
+    import sys
+
+    from balpipe.cli import main
+
+    probe = ("import gc, sys\nfrom balpipe.cli import check\nseen = []\nreal = check._check\n"
+             "check._check = lambda *a: seen.append((gc.get_freeze_count(), gc.isenabled(), 'balpipe.runner' in sys.modules))"
+             " or real(*a)\nfrom balpipe.cli import main\ncode = main(['check', 'specs/scott_russell.yaml'])\n"
+             "print(code, seen[0][0] > 10000, seen[0][1], seen[0][2], gc.get_freeze_count())")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120).stdout
+    assert out.splitlines()[-1].split() == ["0", "True", "True", "True", "0"]
+    assert main(["check", "--jobs", "0", "specs/scott_russell.yaml"]) == 2
+    assert gc.get_freeze_count() == 0 and gc.isenabled()
+    capsys.readouterr()
+
+
 def test_velocities_and_accelerations_factorise_a_redundant_jacobian_once_to_the_bit(monkeypatch):
     """With redundant drivers the engine's general path solves for q' and q'' with one
     factorisation of the Jacobian: its normal equations (engine/normal.py: one inverse of J^T J,
