@@ -81,6 +81,46 @@ def test_alias_bomb_is_refused_fast_and_located(tmp_path, monkeypatch):
     assert "bomb.yaml:" in r.stderr and "alias" in r.stderr and "limit" in r.stderr
 
 
+@pytest.mark.parametrize("text, values, refused", [
+    ("a: 1\n", None, False), ("a: [1, 2, {b: c}]\nd: [[], {}]\n", None, False),  # small trees
+    ("a: " + "[" * 63 + "1" + "]" * 63 + "\n", None, True),  # 64 collections, a scalar in the deepest: 65 levels
+    ("a: " + "[" * 62 + "1" + "]" * 62 + "\n", None, False),  # 63 and a scalar: 64 levels, the limit
+    ("a: " + "[" * 63 + "]" * 63 + "\n", None, False),  # 64 empty collections: 64 levels
+    ("[" + ", ".join(["1"] * 10) + "]\n", 11, False),  # 11 values, the (lowered) limit
+    ("[" + ", ".join(["1"] * 11) + "]\n", 11, True),  # 12 values
+    ("a: &x [1, 2]\nb: *x\n", None, False), ("a: &x {b: 1}\nc: {<<: *x, d: 2}\n", None, False),
+    (BOMB, None, True), ("name: &a [*a]\n", None, True),
+])
+def test_the_alias_walk_is_left_out_only_where_it_finds_nothing(text, values, refused, monkeypatch):
+    """The walk of the node graph (aliases, sizes, depths) runs unless the event stream shows it
+    cannot refuse the document (no alias, within the values' and the levels' limits): every
+    document it refuses is walked (``values``: the values' limit lowered)."""
+    import yaml
+
+    import balpipe.loader as loader_mod
+
+    if values is not None:
+        monkeypatch.setattr(loader_mod, "MAX_VALUES", values)
+    stream = loader_mod._check_nesting(text, "s.yaml")
+    node = yaml.compose(text, Loader=loader_mod._Loader)
+    try:
+        loader_mod._check_aliases(node, "s.yaml")
+        walk_refuses = False
+    except SpecErrors:
+        walk_refuses = True
+    assert walk_refuses == refused
+    walked = loader_mod._needs_alias_check(*stream)
+    assert walked == ("*" in text or stream[0] > loader_mod.MAX_VALUES or stream[1] >= loader_mod.MAX_DEPTH)
+    assert walked or not refused
+
+
+def test_no_worked_example_needs_the_alias_walk():
+    import balpipe.loader as loader_mod
+
+    for spec in Path(__file__).resolve().parents[1].joinpath("specs").glob("*.yaml"):
+        assert not loader_mod._needs_alias_check(*loader_mod._check_nesting(spec.read_text(encoding="utf-8"), "x"))
+
+
 def test_recursive_alias_is_a_located_error_and_the_build_goes_on(tmp_path):
     d = tmp_path / "specs"
     d.mkdir()
