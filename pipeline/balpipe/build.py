@@ -256,6 +256,12 @@ def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outc
     or unchanged since the last build), else the :class:`Job` that computes it. The history
     figures of the page (drawn here, where the page folder is read) and, with ``figure_cache``,
     the job's figures go through the output folder's figure cache (:mod:`balpipe.cache.figures`)."""
+    return _plan(path, opts, figure_cache)[0]
+
+
+def _plan(path: Path, opts: Options, figure_cache: bool = True) -> tuple[Job | Outcome, Any]:
+    """:func:`plan_one`, and the spec it loaded (a :class:`balpipe.loader.LoadedSpec` of the
+    job's text; None with an outcome): what :func:`compute` would load again in this process."""
     from .loader import SpecErrors
 
     start = time.perf_counter()
@@ -263,13 +269,14 @@ def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outc
     try:
         loaded = load(path, opts.name(path))
     except SpecErrors as exc:
-        return Outcome(opts.name(path), slug, "error", str(exc), spec_error=True, seconds=time.perf_counter() - start)
+        return Outcome(opts.name(path), slug, "error", str(exc), spec_error=True,
+                       seconds=time.perf_counter() - start), None
     target = opts.out / slug
     h = page_hash(loaded, target, opts.simulate)
     if not opts.force:
         previous = _read_results(target)
         if previous is not None and previous.get("input_hash") == h:
-            return _unchanged(opts.name(path), slug, target, previous, time.perf_counter() - start)
+            return _unchanged(opts.name(path), slug, target, previous, time.perf_counter() - start), None
     from .cache import figures as cache
     from .report import history_page
 
@@ -282,15 +289,18 @@ def plan_one(path: Path, opts: Options, figure_cache: bool = True) -> Job | Outc
     return Job(path, loaded.text, h, opts.simulate, history, files, opts.sim_workers, source=opts.name(path),
                figure_cache=opts.out if figure_cache else None, redraw=opts.force,
                fresh_since=opts.started if opts.force else None,
-               figure_keys=frozenset(store.used) if store is not None else frozenset())
+               figure_keys=frozenset(store.used) if store is not None else frozenset()), loaded
 
 
-def compute(job: Job) -> Computed:
+def compute(job: Job, loaded: Any = None) -> Computed:
     """Balance, analyse, validate and render one spec; never raises (errors become the result).
     With ``job.figure_cache``, the figures, the simulations and the balancing's searches come
     from that folder's caches where their inputs are unchanged (:mod:`balpipe.cache.figures`,
     :mod:`balpipe.cache.simulation`, :mod:`balpipe.cache.balance`), and the spec's entries this build
-    did not use are removed when its page is made."""
+    did not use are removed when its page is made. ``loaded``: the spec as :func:`plan_one` loaded
+    it in this process (:func:`_plan`, a :class:`balpipe.loader.LoadedSpec`), used when it holds
+    the job's text under the job's name instead of loading that text again (the same spec);
+    None: loaded from ``job.text``."""
     from .cache import balance as balance_cache, simulation as sim_cache
     from .cache import figures as cache
 
@@ -303,7 +313,7 @@ def compute(job: Job) -> Computed:
     searches = None if job.figure_cache is None else \
         balance_cache.Store(job.figure_cache, slug, code_hash(), reuse=not job.redraw, fresh_since=job.fresh_since)
     with cache.using(store), sim_cache.using(sims):
-        done = _compute(job, balance_cache.Memo(searches))
+        done = _compute(job, balance_cache.Memo(searches), loaded)
     if done.status in ("ok", "failed"):
         for used in (store, sims, searches):
             if used is not None:
@@ -311,9 +321,10 @@ def compute(job: Job) -> Computed:
     return done
 
 
-def _compute(job: Job, memo: Any = None) -> Computed:
+def _compute(job: Job, memo: Any = None, planned: Any = None) -> Computed:
     """:func:`compute` without the caches' set-up; the balancing's searches through ``memo``
-    (a :class:`balpipe.cache.balance.Memo`; default: computed, no cache)."""
+    (a :class:`balpipe.cache.balance.Memo`; default: computed, no cache); the spec ``planned``
+    (:func:`compute`'s ``loaded``) where it holds the job's text and name."""
     from .loader import LoadedSpec, SpecErrors, load_text
     from .spec_parts import SpecFieldError
 
@@ -321,8 +332,11 @@ def _compute(job: Job, memo: Any = None) -> Computed:
     source = job.source or str(job.path)
     loaded = None
     try:
-        spec, node = load_text(job.text, source, job.path.parent)
-        loaded = LoadedSpec(job.path, job.text, spec, node, source)
+        if planned is not None and planned.text == job.text and planned.path == job.path and planned.name == source:
+            loaded = planned
+        else:
+            spec, node = load_text(job.text, source, job.path.parent)
+            loaded = LoadedSpec(job.path, job.text, spec, node, source)
         st = study_of(loaded, job.simulate, job.sim_workers, memo)
         results = page_results(loaded, st, job.input_hash)
         files = page_files(loaded, st, results, job.history, job.history_files)
@@ -445,10 +459,10 @@ def build_one(path: Path, opts: Options) -> Outcome:
     """Build one spec in this process (:func:`plan_one`, :func:`compute`, :func:`finish`);
     never raises (errors become the outcome)."""
     start = time.perf_counter()
-    job = plan_one(path, opts)
+    job, loaded = _plan(path, opts)
     if isinstance(job, Outcome):
         return job
-    out = finish(job, compute(job), opts)
+    out = finish(job, compute(job, loaded), opts)
     out.seconds = time.perf_counter() - start
     return out
 

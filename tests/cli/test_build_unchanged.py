@@ -105,3 +105,28 @@ def test_forcing_rebuilds_whatever_the_pages_say(site):
     specs, out = site
     outcomes = build([str(specs)], Options(out=out, simulate=False, force=True), jobs=1)
     assert not any(o.skipped for o in outcomes)
+
+
+def test_a_built_spec_is_read_once_and_computed_from_the_planned_spec(site, monkeypatch):
+    """build_one hands the spec plan_one loaded to compute (the same text under the same name):
+    each changed spec's YAML is validated once, not once to plan and again to compute; the page
+    is the same as computed from the job's text (a spec loaded for another text is not used)."""
+    import balpipe.build as build_mod
+    import balpipe.loader as loader
+
+    specs, out = site
+    calls = []
+    real = loader.load_text
+    monkeypatch.setattr(loader, "load_text", lambda text, *a, **k: calls.append(text) or real(text, *a, **k))
+    outcomes = build([str(specs)], Options(out=out, simulate=False, force=True), jobs=1)
+    assert [o.status for o in outcomes] == ["ok", "ok"] and len(calls) == 2, [o.message for o in outcomes]
+    opts = Options(out=out, simulate=False, force=True)
+    job, planned = build_mod._plan(specs / "table.yaml", opts)
+    assert planned.text == job.text and planned.name == job.source
+    calls.clear()
+    reused, again = build_mod.compute(job, planned), build_mod.compute(job)
+    assert len(calls) == 1  # the second, without the planned spec
+    assert reused.files["index.html"] == again.files["index.html"] and reused.results == again.results
+    _, other = build_mod._plan(specs / "sr.yaml", opts)
+    calls.clear()
+    assert build_mod.compute(job, other).files["index.html"] == again.files["index.html"] and len(calls) == 1
