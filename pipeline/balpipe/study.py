@@ -192,15 +192,17 @@ class StageMetrics:
         return float(value) if isinstance(value, (int, float)) else None
 
 
-def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float, overrides: dict | None = None) -> StageMetrics:
+def stage_metrics(sr: StageResult, unbalanced: StageResult, tol: float, overrides: dict | None = None,
+                  ref: LoadReference | None = None) -> StageMetrics:
     """Peaks, ratios and balance of one stage. Ratios and the balance criterion use the inertial
     part of the loads (the shaking loads less the moving links' weight and its moment, which a
     force-balanced mechanism keeps constant); without gravity that is the loads themselves.
     They divide by :func:`ratio_reference` (the unbalanced peaks, or their floor). The claims
     are judged at the stage's own tolerances (:func:`balpipe.mechanics.claim_precision.claim_tolerances`:
     ``tol`` for computed designs, the precision of the entered numbers for designs typed by
-    hand, or ``overrides[stage]``)."""
-    ref = ratio_reference(unbalanced)
+    hand, or ``overrides[stage]``). ``ref``: :func:`ratio_reference` of ``unbalanced`` when the
+    caller has it (computed here otherwise)."""
+    ref = ref if ref is not None else ratio_reference(unbalanced)
     claim = claim_tolerances(sr.stage, sr.stage.model, sr.analysis, ref, tol, overrides)
     F0, M0 = ref.force, ref.moment
     F, M = sr.analysis.max_inertial_force, sr.analysis.max_inertial_moment
@@ -348,8 +350,16 @@ def run(spec: Spec, page: bool = True, memo: Memo = compute) -> Study:
         if name not in {s.stage.name for s in stages}:
             raise SpecFieldError(("analysis", "claim_tolerance", name),
                                  f"no stage {name!r} (stages: {', '.join(s.stage.name for s in stages)})")
+    loads_of: dict[int, LoadReference] = {}  # each reference stage's loads, computed once for all its stages
+
+    def reference_loads(r: StageResult) -> LoadReference:
+        if id(r) not in loads_of:
+            loads_of[id(r)] = ratio_reference(r)
+        return loads_of[id(r)]
+
     for s in stages:
-        s._metrics = stage_metrics(s, reference_of(stages, s), tol, overrides)
+        r = reference_of(stages, s)
+        s._metrics = stage_metrics(s, r, tol, overrides, reference_loads(r))
     metrics = [s.metrics for s in stages]
     if balance.derived is not None and (page or spec.references):  # the page's, and what a reference may name
         balance.parameters.extend(balance.derived(stages))
@@ -386,5 +396,5 @@ def run(spec: Spec, page: bool = True, memo: Memo = compute) -> Study:
         balance.notes.append(virtual)
     refs = compare_references(spec, balance, metrics)
     checks = {"reactions_vs_momentum": rvm, "balance_tolerance": tol, "max_condition_number": max_condition,
-              "reference": ratio_reference(stages[0]).to_json()}
+              "reference": reference_loads(stages[0]).to_json()}
     return Study(spec, balance, stages, refs, checks, problems, warnings=warnings)

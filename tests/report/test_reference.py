@@ -164,3 +164,20 @@ def test_a_moment_already_zero_reads_zero_before_and_after_not_cancelled():
     row = headline(v, 1e-9)
     assert row["moment"].startswith("0 (<") and row["moment"].count("0 (<") == 2
     assert not row["force"].startswith("0 (<")
+
+
+def test_each_reference_stage_loads_are_computed_once(monkeypatch):
+    """study.run computes a reference stage's loads once for every stage that refers to it (and
+    for the checks), the same metrics as each stage computing its own."""
+    spec = loader.load(ROOT / "specs" / "custom_four_bar_balancing.yaml").spec
+    calls = []
+    real = study.ratio_reference
+    monkeypatch.setattr(study, "ratio_reference", lambda sr: calls.append(sr.stage.name) or real(sr))
+    st = study.run(spec, page=False)
+    assert len(st.stages) > 2 and calls == [st.stages[0].stage.name]
+    monkeypatch.undo()
+    tol = spec.analysis.balance_tolerance
+    for s in st.stages:
+        own = study.stage_metrics(s, st.stages[0], tol, spec.analysis.claim_tolerance)
+        assert s.metrics.to_json() == own.to_json() and s.metrics.reference_loads == own.reference_loads
+    assert st.checks["reference"] == real(st.stages[0]).to_json()
