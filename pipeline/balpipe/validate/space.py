@@ -158,48 +158,51 @@ class _Mesh:
     def update(self, dt: float) -> None:
         """Place groove and anchor for the positions the next step will integrate to. (The bodies'
         state read and the joint's geometry set through Chipmunk's own accessors, as pymunk's
-        properties do, without their Vec2d objects: the same numbers, a third of the time.)"""
+        properties do, without their Vec2d objects: the same numbers, a third of the time; each
+        predicted angle's cosine and sine taken once, where ``_rot`` and ``_unrot`` took them at
+        every use: the same numbers again, the same Chipmunk calls in the same order, 7.1 -> 4 us.)"""
         angle, spin = _cp.cpBodyGetAngle, _cp.cpBodyGetAngularVelocity
-
-        def pred(body):
-            # pymunk integrates the centre of gravity: p += v dt, angle += w dt
-            b = body._body
-            th = angle(b) + dt * spin(b)
-            cog = _cp.cpBodyGetCenterOfGravity(b)
-            g = _cp.cpBodyLocalToWorld(b, cog)
-            v = _cp.cpBodyGetVelocity(b)
-            o = _rot(th, (cog.x, cog.y))
-            return g.x + dt * v.x - o[0], g.y + dt * v.y - o[1], th
-
-        xc, yc, thc = pred(self.c)
-        xa, ya, tha = pred(self.a)
-        xb, yb, thb = pred(self.b)
+        xc, yc, thc, cc, sc = _predicted(self.c._body, dt)
+        xa, ya, tha, ca, sa = _predicted(self.a._body, dt)
+        xb, yb, thb, cb, sb = _predicted(self.b._body, dt)
         ta, tb = self.ta._body, self.tb._body
         tha_r = angle(ta) + dt * spin(ta)
         thb_r = angle(tb) + dt * spin(tb)
-        wa = _rot(thc, self.oa)
-        wb = _rot(thc, self.ob)
-        wa = (xc + wa[0], yc + wa[1])
-        wb = (xc + wb[0], yc + wb[1])
-        dx, dy = wb[0] - wa[0], wb[1] - wa[1]
+        (oax, oay), (obx, oby) = self.oa, self.ob
+        wax, way = xc + (cc * oax - sc * oay), yc + (sc * oax + cc * oay)  # _rot(thc, oa) from the carrier's centre
+        wbx, wby = xc + (cc * obx - sc * oby), yc + (sc * obx + cc * oby)
+        dx, dy = wbx - wax, wby - way
         d = math.hypot(dx, dy)
         if not d > 0.0:  # the mechanism came apart
             raise FloatingPointError(f"gear pair {self.name!r}: its centres coincide")
-        u = (dx / d, dy / d)
-        t = (-u[1], u[0])
+        ux, uy = dx / d, dy / d
+        tx, ty = -uy, ux
         R = self.ratio
         p = R * d / (R - 1.0)
         q = d / (R - 1.0)
         err = (thb_r - thc) - R * (tha_r - thc) - self.phase
-        P = (wa[0] + p * u[0], wa[1] + p * u[1])
-        anchor = (P[0] + q * err * t[0], P[1] + q * err * t[1])
+        Px, Py = wax + p * ux, way + p * uy
+        ax, ay = Px + q * err * tx, Py + q * err * ty  # the anchor
         L = self.half_length
-        g1 = _unrot(tha, (P[0] - L * u[0] - xa, P[1] - L * u[1] - ya))
-        g2 = _unrot(tha, (P[0] + L * u[0] - xa, P[1] + L * u[1] - ya))
+        g1x, g1y = Px - L * ux - xa, Py - L * uy - ya  # _unrot(tha, .) of these, below
+        g2x, g2y = Px + L * ux - xa, Py + L * uy - ya
+        bx, by = ax - xb, ay - yb  # _unrot(thb, .)
         c = self.groove._constraint
-        _cp.cpGrooveJointSetGrooveA(c, g1)
-        _cp.cpGrooveJointSetGrooveB(c, g2)
-        _cp.cpGrooveJointSetAnchorB(c, _unrot(thb, (anchor[0] - xb, anchor[1] - yb)))
+        _cp.cpGrooveJointSetGrooveA(c, (ca * g1x + sa * g1y, -sa * g1x + ca * g1y))
+        _cp.cpGrooveJointSetGrooveB(c, (ca * g2x + sa * g2y, -sa * g2x + ca * g2y))
+        _cp.cpGrooveJointSetAnchorB(c, (cb * bx + sb * by, -sb * bx + cb * by))
+
+
+def _predicted(b, dt: float) -> tuple[float, float, float, float, float]:
+    """The pose a Chipmunk body ``b`` (``Body._body``) integrates to in a step of ``dt`` (pymunk
+    integrates the centre of gravity: p += v dt, angle += w dt), its origin's x, y and angle th,
+    and cos th, sin th."""
+    th = _cp.cpBodyGetAngle(b) + dt * _cp.cpBodyGetAngularVelocity(b)
+    cog = _cp.cpBodyGetCenterOfGravity(b)
+    g = _cp.cpBodyLocalToWorld(b, cog)
+    v = _cp.cpBodyGetVelocity(b)
+    c, s = math.cos(th), math.sin(th)
+    return g.x + dt * v.x - (c * cog.x - s * cog.y), g.y + dt * v.y - (s * cog.x + c * cog.y), th, c, s
 
 
 @dataclass
