@@ -18,7 +18,7 @@ simulated; a floating-base run applies no loads (it demonstrates the inertial sh
 from __future__ import annotations
 
 import numpy as np
-import pymunk
+from pymunk._chipmunk_cffi import lib as _cp
 
 from ..engine import Analysis
 from ..engine.analysis import compiled
@@ -31,8 +31,9 @@ COULOMB_NOTE = ("Coulomb friction is applied with the engine's magnitude along t
                 "compute the friction from its own reactions); springs, dampers, applied loads and viscous "
                 "friction act from the simulated state")
 
-# the properties' setters, without pymunk's __setattr__ layer
-_set_force, _set_torque = vars(pymunk.Body)["force"].fset, vars(pymunk.Body)["torque"].fset
+# the Chipmunk functions that pymunk's properties call (the same calls, without their Python layer and Vec2d objects)
+_position, _velocity, _angle, _spin = _cp.cpBodyGetPosition, _cp.cpBodyGetVelocity, _cp.cpBodyGetAngle, _cp.cpBodyGetAngularVelocity
+_force, _set_force, _torque, _set_torque = _cp.cpBodyGetForce, _cp.cpBodySetForce, _cp.cpBodyGetTorque, _cp.cpBodySetTorque
 
 
 class AppliedLoads:
@@ -68,13 +69,15 @@ class AppliedLoads:
     def apply(self, t: float, dt: float) -> None:
         """Add every load for the step of ``dt`` that lands on time ``t``: pymunk moves the
         positions first (with the current velocities) and then integrates the velocities with
-        the forces, so the loads are those at the positions the step lands on."""
+        the forces, so the loads are those at the positions the step lands on. (The bodies are
+        read and their force and torque set through the Chipmunk functions that pymunk's
+        properties call, in the same order.)"""
         n = 3 * len(self.bodies)
         q, v = [0.0] * n, [0.0] * n  # the bodies no load reads stay at zero
         for k in self.loads.bodies:
-            b = self.bodies[k]
-            p, vel, w = b.position, b.velocity, b.angular_velocity
-            q[3 * k: 3 * k + 3] = (p.x + dt * vel.x, p.y + dt * vel.y, b.angle + dt * w)
+            b = self.bodies[k]._body
+            p, vel, w = _position(b), _velocity(b), _spin(b)
+            q[3 * k: 3 * k + 3] = (p.x + dt * vel.x, p.y + dt * vel.y, _angle(b) + dt * w)
             v[3 * k: 3 * k + 3] = (vel.x, vel.y, w)
         Q, units = self.loads(t, q, v)
         if units:
@@ -84,7 +87,7 @@ class AppliedLoads:
                 for i, u in unit:
                     Q[i] += m * u
         for k in self.loads.bodies:
-            b = self.bodies[k]
-            f = b.force
+            b = self.bodies[k]._body
+            f = _force(b)
             _set_force(b, (f.x + Q[3 * k], f.y + Q[3 * k + 1]))
-            _set_torque(b, b.torque + Q[3 * k + 2])
+            _set_torque(b, _torque(b) + Q[3 * k + 2])
