@@ -186,7 +186,8 @@ def simulate(
 
     every = t0 + dt * np.arange(-settle, n + 1)  # settling steps, then the recorded ones
     target_t = every + dt  # the step landing on every[k] starts at every[k] - dt: target t + 2 dt
-    targets = {d.name: np.asarray(d.law(target_t)[0], dtype=float) for d in model.drivers}
+    # the drives' targets (a torque-driven run has none: its laws are only compared with)
+    targets = {d.name: np.asarray(d.law(target_t)[0], dtype=float) for d in model.drivers} if sim.drives else {}
     laws_now = {d.name: np.asarray(d.law(times)[0], dtype=float) for d in model.drivers}
     boost = np.zeros(settle + n + 1, dtype=bool)
     boost[:startup_steps] = True
@@ -199,7 +200,8 @@ def simulate(
     if abort is not None:
         steps = np.rint((t - t0) / dt).astype(int)
         on = np.abs(t0 + steps * dt - t) <= 1e-9 * max(float(t[-1] - t0), 1e-12)
-        check = {int(k): i for i, k in enumerate(steps) if on[i] and k % 10 == 0}
+        at = np.flatnonzero(on & (steps % 10 == 0))
+        check = dict(zip(steps[at].tolist(), at.tolist()))  # step k -> analysis sample i
     pending: list[int] = []  # checked steps whose states are not yet compared (a block at a time)
     if settle == 0:
         read()
