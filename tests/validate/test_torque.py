@@ -4,6 +4,7 @@ the analytic model only (the simulated mechanism keeps the true one) makes the c
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import math
@@ -245,12 +246,32 @@ def test_jump_times_are_the_laws_acceleration_corners(fraction):
     assert jump_times(arm_2r(), times) == []  # a quintic law: smooth, however fast it changes
 
 
+def _floored(model):
+    """``model`` with a pymunk floor part on its first body: the same driver laws."""
+    from balpipe.model import Attachment
+
+    return model.replace_body(model.bodies[0].with_attachments(Attachment("pymunk floor", 0.1, (0.0, 0.0), 0.0, kind="part")))
+
+
+@contextlib.contextmanager
+def _computations(module, name: str, memo):
+    """The models that ``module.<name>`` (a computation remembered in ``memo``, emptied first)
+    is called with inside the block."""
+    calls: list = []
+    find = getattr(module, name)
+    setattr(module, name, lambda m, t: calls.append(m) or find(m, t))
+    memo.clear()
+    try:
+        yield calls
+    finally:
+        setattr(module, name, find)
+
+
 @pytest.mark.parametrize("fraction", [0.3, 0.2371])
 def test_jump_times_are_found_to_the_float_and_shared_by_models_with_the_same_laws(fraction):
     """The 32-section ends on the two neighbouring floats around the corner (what 60 bisections
     reached), and a model that shares the laws (the stage's model with pymunk's floor parts) is
     answered from the same search, with the same values."""
-    from balpipe.model import Attachment
     from balpipe.validate import settings as S
 
     model = _jumpy_arm(None, fraction)
@@ -258,15 +279,8 @@ def test_jump_times_are_found_to_the_float_and_shared_by_models_with_the_same_la
     ks, tj = S._find_jumps(model, times)
     for t_j, exact in zip(tj, (fraction * 0.5, (1 - fraction) * 0.5)):
         assert abs(t_j - exact) <= 2 * np.spacing(exact)
-    heavier = model.replace_body(model.bodies[0].with_attachments(Attachment("pymunk floor", 0.1, (0.0, 0.0), 0.0, kind="part")))
-    calls = []
-    find = S._find_jumps
-    try:
-        S._find_jumps = lambda m, t: calls.append(m) or find(m, t)
-        S._JUMPS_MEMO.clear()
-        first, second = S.jump_times(model, times), S.jump_times(heavier, times)
-    finally:
-        S._find_jumps = find
+    with _computations(S, "_find_jumps", S._JUMPS_MEMO) as calls:
+        first, second = S.jump_times(model, times), S.jump_times(_floored(model), times)
     assert first == second == tj.tolist() and calls == [model]
 
 
@@ -409,21 +423,13 @@ def test_the_law_kinds_are_remembered_by_laws_and_times():
     read by every run of a stage) is computed once for a stage's laws and grid: the model with
     pymunk's floor parts shares it, a changed list does not change the next answer, and the answer
     is the computation's."""
-    from balpipe.model import Attachment
     from balpipe.validate import settings as S
 
     model = _jumpy_arm(None, 0.3)
     times = np.linspace(0.0, 0.5, 1001)
-    heavier = model.replace_body(model.bodies[0].with_attachments(Attachment("pymunk floor", 0.1, (0.0, 0.0), 0.0, kind="part")))
-    calls = []
-    find = S._find_law_kinds
-    try:
-        S._find_law_kinds = lambda m, t: calls.append(m) or find(m, t)
-        S._KINDS_MEMO.clear()
+    with _computations(S, "_find_law_kinds", S._KINDS_MEMO) as calls:
         first = S._law_kinds(model, times)
         first[0] = "changed by the caller"
-        second = S._law_kinds(heavier, times)
-    finally:
-        S._find_law_kinds = find
-    assert calls == [model] and second == find(model, times)
+        second = S._law_kinds(_floored(model), times)
+    assert calls == [model] and second == S._find_law_kinds(model, times)
     assert {"left", "right"} & set(second) and second[0] != "changed by the caller"
