@@ -168,4 +168,5 @@ def test_the_torque_driven_run_doubles_its_effort_until_its_loads_converge(studi
     assert v.passed and tq.passed and v.proved_by == "torque-driven run"
     assert v.iterations == 400 and "the run with 200 solver iterations gave the same loads" in v.notes[0]
     assert tq.iterations == 100  # the torque-driven verdict: the first run, calibrated
+    assert v.timing["total_s"] > 0.0  # the runs at 200 and 400 iterations count in the page's run time
     assert settings_for(st).tolerance / 10 < v.moment_residual <= settings_for(st).tolerance

@@ -81,7 +81,7 @@ def converged(a: TorqueDriven, b: TorqueDriven, limit: float) -> bool:
 
 def validation_from_torque(tq: TorqueDriven, analysis: Analysis, peaks: tuple[float, float],
                            settings: ValidationSettings, expect: tuple[str, ...],
-                           halved: TorqueDriven | None = None, reference=None) -> StageValidation:
+                           halved: TorqueDriven | None = None, reference=None, seconds: float = 0.0) -> StageValidation:
     """The position-driven verdict read from a torque-driven run that proves it
     (:func:`proves_loads`): its loads, residuals and simulated peaks (the same definitions, the
     same reference loads), its step and solver iterations; ``tracking_error`` is the driven
@@ -89,7 +89,9 @@ def validation_from_torque(tq: TorqueDriven, analysis: Analysis, peaks: tuple[fl
     :class:`balpipe.load_reference.LoadReference`) says what the reference loads are, as in
     :func:`.loads.validate`. ``halved``: the run with half
     its solver iterations, whose loads it matches to a tenth of the tolerance (its residuals are
-    then within the tolerance, not a tenth of it)."""
+    then within the tolerance, not a tenth of it). ``seconds``: the wall time of the runs with more
+    solver iterations than ``tq``'s first try made for this proof (its ``timing``: the page's run
+    time of the stage adds it to the torque-driven run's)."""
     measured = np.asarray(tq.measured, dtype=bool)
     basis = ("force: unbalanced peak; moment: unbalanced peak" if reference is None
              else f"force: {reference.force_basis}; moment: {reference.moment_basis}")
@@ -112,7 +114,7 @@ def validation_from_torque(tq: TorqueDriven, analysis: Analysis, peaks: tuple[fl
         iterations=tq.iterations, tolerance=settings.tolerance, balance_tolerance=settings.balance_tolerance,
         expect=tuple(expect), passed=True, reasons=[], excluded_samples=int(np.count_nonzero(~measured)),
         extrapolated_samples=tq.extrapolated_samples, floored_bodies=list(tq.floored_bodies), notes=[note],
-        timing={"simulation_s": 0.0, "total_s": 0.0}, force_reference=tq.force_reference,
+        timing={"simulation_s": 0.0, "total_s": float(seconds)}, force_reference=tq.force_reference,
         moment_reference=tq.moment_reference, proved_by="torque-driven run", reference_basis=basis,
     )
 
@@ -147,16 +149,19 @@ def stage_runs(model: Model, analysis: Analysis, peaks: tuple[float, float], set
         # position-driven run does (paper 000's Scott-Russell stage: 200 -> 400 converged, where the
         # position-driven run it fell back on took 200 to 1600); the torque-driven verdict is the first
         # run's, which passes by ten times over (calibrated)
-        half = tried
+        half, spent = tried, 0.0
         while proves_loads(half, settings, expect, residual_margin=1.0, calibrated=half is tried) and it < MAX_ITERATIONS:
             it *= 2
             twice = _torque_driven_once(model, analysis, settings, reference=loads_ref, iterations=it,
                                         calibrate=False, plan=plan)
+            spent += twice.timing.get("total_s", 0.0)
             if proves_loads(twice, settings, expect, calibrated=False):
-                return validation_from_torque(twice, analysis, peaks, settings, expect, reference=reference), tried
+                return validation_from_torque(twice, analysis, peaks, settings, expect, reference=reference,
+                                              seconds=spent), tried
             if (proves_loads(twice, settings, expect, residual_margin=1.0, calibrated=False)
                     and converged(half, twice, settings.tolerance / MARGIN)):
-                return validation_from_torque(twice, analysis, peaks, settings, expect, halved=half, reference=reference), tried
+                return validation_from_torque(twice, analysis, peaks, settings, expect, halved=half, reference=reference,
+                                              seconds=spent), tried
             half = twice  # within the tolerance, still changing with the solver effort: twice again
     v = validate(model, analysis, peaks, settings, expect, reference=reference)
     same_step = plan is not None and plan.dt == v.dt
