@@ -207,6 +207,45 @@ def test_a_search_inside_a_locked_one_takes_no_second_lock(tmp_path):
     assert p.exitcode == 0
 
 
+def _hold(out: str, held, done) -> None:
+    store = balance_cache.Store(Path(out), "spec", "salt")
+    with store.lock("ab" + "0" * 62):
+        held.set()
+        done.wait(30)
+
+
+def _take(out: str) -> None:
+    store = balance_cache.Store(Path(out), "other", "salt")
+    with store.lock("ab" + "1" * 62):
+        pass
+
+
+def test_a_process_never_waits_for_another_key_and_no_lock_file_stays(tmp_path):
+    """Issue 43: a lock per key, not per first two hex digits of the key: while one process holds
+    a key's lock (computing it), another takes the lock of a key that begins the same at once
+    (before, a build of specs/ on two processes waited 0.69 s for a simulation of another spec);
+    the lock files go when their locks are released."""
+    out = tmp_path / "out"
+    out.mkdir()
+    ctx = multiprocessing.get_context("fork")
+    held, done = ctx.Event(), ctx.Event()
+    holder = ctx.Process(target=_hold, args=(str(out), held, done))
+    holder.start()
+    try:
+        assert held.wait(20)
+        taker = ctx.Process(target=_take, args=(str(out),))
+        taker.start()
+        taker.join(20)  # with one lock file for both keys it would wait for the holder, which waits for it
+        if taker.is_alive():
+            taker.kill()
+        assert taker.exitcode == 0
+    finally:
+        done.set()
+        holder.join(20)
+    assert holder.exitcode == 0
+    assert list((out / content_cache.CACHE_DIR / balance_cache.Store.KIND / content_cache.LOCKS).iterdir()) == []
+
+
 def test_paper003s_phi_optimisation_is_read_on_a_rebuild(tmp_path, stored, monkeypatch):
     """paper 003's phi optimisation (Nelder-Mead per trajectory, ~2 s) is a search of the cache:
     a rebuild after a comment optimises nothing and writes the same page; the note still counts
