@@ -52,6 +52,11 @@ def schema() -> dict:
     return f()
 
 
+def schema_text() -> str:
+    """The site's ``balpipe.schema.json``: :func:`schema` as indented JSON, keys sorted."""
+    return json.dumps(schema(), indent=2, sort_keys=True) + "\n"
+
+
 def render_page(*args, **kwargs) -> str:
     """:func:`balpipe.report.page.render_page`."""
     from .report.page import render_page as f
@@ -575,10 +580,11 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
     with locked(opts.out):
         remove_temporaries(opts.out)
         try:
+            text = None  # the schema, when a worker made it (:data:`SCHEMA_TASK`)
             if scheduler:
                 _run_on_cluster(scheduler, todo, opts, progress, outcomes)
             else:
-                _run(todo, opts, jobs, progress, outcomes)
+                text = _run(todo, opts, jobs, progress, outcomes)
         except BaseException:
             remove_temporaries(opts.out)
             raise
@@ -598,7 +604,7 @@ def build(paths: list[str], opts: Options, jobs: int | None = None, progress=Non
 
             try:
                 write_site(opts.out, built, earlier, site_key=key)
-                write_file_atomic(opts.out / "balpipe.schema.json", json.dumps(schema(), indent=2, sort_keys=True) + "\n")
+                write_file_atomic(opts.out / "balpipe.schema.json", text if text is not None else schema_text())
             except OSError as exc:
                 remove_temporaries(opts.out)
                 raise OutputError(f"the site's index was not written ({describe(exc, opts.out)}); the pages built are "
@@ -645,17 +651,33 @@ def _site_is_current(out: Path, key: str) -> bool:
     return m is not None and m.group(1) == key
 
 
-def _run(todo: list[Path], opts: Options, jobs: int, progress, outcomes: list[Outcome]) -> None:
+#: the process pool's last task, after every spec: the schema's text (:func:`schema_text`), made by
+#: the first worker left without a spec while another builds its last, not by this process once
+#: they are all done (0.3 s of CPU, which a build of specs/ on two processes waited for at its end)
+SCHEMA_TASK = "balpipe.schema.json"
+
+
+def build_or_schema(item: Path | str, opts: Options) -> Outcome | str:
+    """A pool task of :func:`_run`: :func:`build_one` of a spec, or the schema's text for :data:`SCHEMA_TASK`."""
+    return schema_text() if item == SCHEMA_TASK else build_one(Path(item), opts)
+
+
+def _run(todo: list[Path], opts: Options, jobs: int, progress, outcomes: list[Outcome]) -> str | None:
     """Build ``todo`` in its order: the specs whose pages are up to date are told here at once
     (:func:`up_to_date`), the others go to the process pool, and the outcomes come back in
-    the specs' order whatever ``jobs``."""
+    the specs' order whatever ``jobs``. With a pool (``jobs`` > 1, more than one spec to
+    build), its last task makes the site's schema: returned (else None)."""
     total = len(todo)
     known: dict[Path, tuple[dict | None, float]] = {}
     for p in todo:
         start = time.perf_counter()
         known[p] = (up_to_date(p, opts), time.perf_counter() - start)
-    rest = [p for p in todo if known[p][0] is None]
-    with pool.finished(pool.in_order(build_one, rest, jobs, opts, cost=lambda p: spec_cost(p, opts.simulate))) as built:
+    rest: list[Path | str] = [p for p in todo if known[p][0] is None]
+    pooled = jobs > 1 and len(rest) > 1
+    tasks = rest + [SCHEMA_TASK] if pooled else rest
+    cost = {p: spec_cost(p, opts.simulate) for p in rest}
+    text = None
+    with pool.finished(pool.in_order(build_or_schema, tasks, jobs, opts, cost=lambda p: cost.get(p, -1.0))) as built:
         for k, p in enumerate(todo):
             previous, seconds = known[p]
             o = next(built) if previous is None else _unchanged(opts.name(p), slug_for(p), opts.out / slug_for(p),
@@ -663,6 +685,9 @@ def _run(todo: list[Path], opts: Options, jobs: int, progress, outcomes: list[Ou
             outcomes.append(o)
             if progress:
                 progress(k + 1, total, o)
+        if pooled:
+            text = next(built)
+    return text
 
 
 def spec_cost(path: Path, simulate: bool = True) -> float:

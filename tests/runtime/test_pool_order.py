@@ -133,3 +133,34 @@ def test_the_pools_fork_on_linux_whatever_pythons_default():
     if sys.platform != "linux":
         pytest.skip("fork is the start method on Linux only")
     assert pool._context().get_start_method() == "fork"
+
+
+def test_the_pools_last_task_makes_the_sites_schema(tmp_path, monkeypatch):
+    """Issue 43: with a pool, the site's schema is the pool's last task (the first worker left
+    without a spec makes it while another builds its last: this process no longer makes it after
+    them), and the file is the one this process would write; one process makes it at the end."""
+    import shutil
+
+    from balpipe import build
+    from balpipe.cli import main
+
+    folder = tmp_path / "specs"
+    folder.mkdir()
+    root = Path(__file__).resolve().parents[2] / "specs"
+    for name in ("offset_slider_crank.yaml", "scott_russell.yaml"):
+        shutil.copy(root / name, folder / name)
+    tasks: list[list] = []
+    real = pool.in_order
+
+    def recording(fn, items, jobs, *args, cost=None):
+        tasks.append([items[i] for i in sorted(range(len(items)), key=lambda i: -cost(items[i]))])
+        return real(fn, items, jobs, *args, cost=cost)
+
+    monkeypatch.setattr(pool, "in_order", recording)
+    assert main(["build", str(folder), "-o", str(tmp_path / "two"), "--no-sim", "-j", "2"]) == 0
+    assert tasks[-1][-1] == build.SCHEMA_TASK and len(tasks[-1]) == 3
+    text = (tmp_path / "two" / "balpipe.schema.json").read_text()
+    assert text == build.schema_text() and '"title": "balpipe spec"' in text
+    assert main(["build", str(folder), "-o", str(tmp_path / "one"), "--no-sim", "-j", "1"]) == 0
+    assert build.SCHEMA_TASK not in tasks[-1]
+    assert (tmp_path / "one" / "balpipe.schema.json").read_text() == text
