@@ -8,7 +8,7 @@ version (and numpy's): :func:`run` keys it by all of them (:func:`balpipe.cache.
 result (the run's dataclass, pickled) in ``<out>/.cache/sims/<slug>/<sha256>.pickle``. A key is
 looked up in the spec's own folder, then in the other specs' folders (copied into its own when
 found there: :class:`balpipe.cache.content.Store`). While one process computes a
-key, another that needs the same key waits for it (a lock file per key prefix, ``.locks/``),
+key, another that needs the same key waits for it (a lock file per key, ``.locks/``, removed after),
 so that a cold build of several specs runs a shared simulation once. What :func:`run` cannot
 key (a lambda in a model) is simulated, never cached.
 
