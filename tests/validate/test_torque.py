@@ -447,7 +447,7 @@ def test_the_calibration_runs_without_the_start_up_and_measures_the_same_error(n
     original = torque.simulate
 
     def recording(model, analysis, dt, iterations, **kw):
-        calls.append((kw["efforts"] is not None and kw.get("stop_at") is not None, iterations, kw["startup_iterations"]))
+        calls.append((kw.get("stop_at") is not None, iterations, kw["startup_iterations"]))
         return original(model, analysis, dt, iterations, **kw)
 
     monkeypatch.setattr(torque, "simulate", recording)

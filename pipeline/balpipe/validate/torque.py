@@ -76,12 +76,13 @@ MIN_RESOLUTION = 10.0
 #: times :data:`MIN_RESOLUTION`), so a longer run could not change one
 CALIBRATION_STOP = 10.0 * MIN_RESOLUTION
 
-#: the calibration run's first steps (and those after a law's jump) at the run's own solver iterations,
-#: not the start-up's: its error is that of efforts 10 % off (where it stops, a hundred times the
-#: run's own), which the solver's accuracy in the first steps does not move. Measured on specs/: every calibration
-#: error and resolution the same to 5.3e-8 (relative), no verdict changed, and the 126 calibration
-#: runs (most stopped a few percent of the motion in, where the start-up's 10 steps at 5000
-#: iterations cost more than the rest) 1.71 -> 1.17 s of CPU in the simulated build
+#: the calibration run's first steps (and those after a law's jump) at the run's own solver
+#: iterations, not the start-up's: its error is that of efforts 10 % off (where it stops, a hundred
+#: times the run's own), which the solver's accuracy in the first steps does not move. Measured on
+#: specs/: every calibration error and resolution the same to 5.3e-8 (relative), no verdict
+#: changed, and the 126 calibration runs (most stopped a few percent of the motion in, where the
+#: start-up's 10 steps at 5000 iterations cost more than the rest) 1.71 -> 1.17 s of CPU in the
+#: simulated build
 CALIBRATION_STARTUP = False
 
 #: the efforts' relative change of the sensitivity run (:func:`_torque_driven_once`): a run off its
