@@ -158,22 +158,28 @@ def test_four_times_the_effort_after_a_try_that_came_apart_proves_the_idler_loop
     assert tq.status == "pass" and tq.iterations == 1600 and tq.resolution >= 100
 
 
+def _spec_stage_runs(st, name: str):
+    """:func:`stage_runs` of the stage ``name`` of the study ``st``, as the build runs it
+    (relative to the stage's reference loads), and the spec's validation settings."""
+    from balpipe.validation_stage import settings_for, simulated_model
+
+    s = next(x for x in st.stages if x.stage.name == name)
+    ref = s.metrics.reference_loads
+    expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
+    v, tq = stage_runs(simulated_model(s.stage.model), s.analysis, (ref.force_peak, ref.moment_peak), settings_for(st),
+                       expect, reference=ref)
+    return v, tq, settings_for(st)
+
+
 def test_the_first_try_that_holds_together_proves_the_stage_where_it_passes_ten_times(studies, efforts):
     """Paper 002's decoupled stage: the try at 100 iterations comes apart, the one at 400 holds
     together and passes by ten times over: it proves the stage, without a run at twice its effort.
     (Before, the first try that held together after one that came apart was never taken as the
     proof: it was doubled, and the stage proved at 200 was run at 400 as well.)"""
-    from balpipe.validation_stage import settings_for, simulated_model
-
-    st = studies("paper002_decoupling.yaml")
-    s = next(x for x in st.stages if x.stage.name == "decoupled")
-    ref = s.metrics.reference_loads
-    expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
-    v, tq = stage_runs(simulated_model(s.stage.model), s.analysis, (ref.force_peak, ref.moment_peak), settings_for(st),
-                       expect, reference=ref)
+    v, tq, settings = _spec_stage_runs(studies("paper002_decoupling.yaml"), "decoupled")
     assert efforts == ["100x", "400"]
     assert v.proved_by == "torque-driven run" and v.passed and v.iterations == tq.iterations == 400
-    assert max(v.force_residual, v.moment_residual) <= settings_for(st).tolerance / 10
+    assert max(v.force_residual, v.moment_residual) <= settings.tolerance / 10
 
 
 def test_a_one_percent_counter_rotation_error_on_the_idler_loop_still_fails(idler):
@@ -196,16 +202,9 @@ def test_the_torque_driven_run_doubles_its_effort_until_its_loads_converge(studi
     a tenth of the tolerance, which proves the stage (the position-driven run's own convergence
     test). Before, one doubling was all, and the position-driven run it fell back on took 200 to
     1600 iterations for the same verdict."""
-    from balpipe.validation_stage import settings_for, simulated_model
-
-    st = studies("paper000_rpr3_scott_russell.yaml")
-    s = next(x for x in st.stages if x.stage.name == "scott_russell")
-    ref = s.metrics.reference_loads
-    expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
-    v, tq = stage_runs(simulated_model(s.stage.model), s.analysis, (ref.force_peak, ref.moment_peak), settings_for(st),
-                       expect, reference=ref)
+    v, tq, settings = _spec_stage_runs(studies("paper000_rpr3_scott_russell.yaml"), "scott_russell")
     assert v.passed and tq.passed and v.proved_by == "torque-driven run"
     assert v.iterations == 400 and "the run with 200 solver iterations gave the same loads" in v.notes[0]
     assert tq.iterations == 100  # the torque-driven verdict: the first run, calibrated
     assert v.timing["total_s"] > 0.0  # the runs at 200 and 400 iterations count in the page's run time
-    assert settings_for(st).tolerance / 10 < v.moment_residual <= settings_for(st).tolerance
+    assert settings.tolerance / 10 < v.moment_residual <= settings.tolerance
