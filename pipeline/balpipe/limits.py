@@ -20,18 +20,21 @@ MAX_SIM_STEPS = 1_000_000
 
 def check_limits(spec: Any) -> None:
     """Raise :class:`SpecFieldError` for a spec whose fields together exceed a limit."""
-    dt = spec.validation.dt
     T = spec.motion.duration
-    if dt is not None:
+    steps_of = [(("validation", "dt"), spec.validation.dt)] + [
+        (("validation", "stage_dt", name), dt) for name, dt in spec.validation.stage_dt.items()]
+    for where, dt in steps_of:
+        if dt is None:
+            continue
         steps = T / dt
         if not math.isfinite(steps) or steps > MAX_SIM_STEPS:
             raise SpecFieldError(
-                ("validation", "dt"),
+                where,
                 f"a time step of {dt:.3g} s takes {steps:.3g} steps over the {T:.4g} s motion "
                 f"(limit {MAX_SIM_STEPS:,} steps: dt >= {T / MAX_SIM_STEPS:.3g} s)",
             )
         if dt > T:
-            raise SpecFieldError(("validation", "dt"), f"the time step {dt:.4g} s is longer than the motion ({T:.4g} s)")
+            raise SpecFieldError(where, f"the time step {dt:.4g} s is longer than the motion ({T:.4g} s)")
 
 
 def check_finite(study: Any) -> None:
@@ -48,6 +51,13 @@ def check_finite(study: Any) -> None:
                 )
 
 
+def stage_dt(spec: Any, stage: str) -> float | None:
+    """The time step the spec gives the stage named ``stage``: its ``validation.stage_dt``, else
+    ``validation.dt``; None: the default (:func:`balpipe.validate.default_settings`)."""
+    v = spec.validation
+    return v.stage_dt.get(stage, v.dt)
+
+
 def check_simulation(study: Any) -> None:
     """Before the pymunk validation starts: the number of steps of each stage's simulation,
     duration / dt with the spec's dt or the default one (which shrinks with the fastest body's
@@ -59,11 +69,12 @@ def check_simulation(study: Any) -> None:
 
     T = spec.motion.duration
     for s in study.stages:
-        dt = spec.validation.dt or default_settings(s.stage.model, s.analysis)[0]
+        given = stage_dt(spec, s.stage.name)
+        dt = given or default_settings(s.stage.model, s.analysis)[0]
         steps = T / dt if dt > 0 else math.inf
         if not math.isfinite(steps) or steps > MAX_SIM_STEPS:
             raise SpecFieldError(
-                ("validation", "dt") if spec.validation.dt else ("motion", "duration"),
+                ("validation", "dt") if given else ("motion", "duration"),
                 f"stage {s.stage.name!r}: the simulation would take {steps:.3g} steps of {dt:.3g} s "
                 f"(limit {MAX_SIM_STEPS:,}); the motion is too fast for its duration: lengthen it, or set "
                 "validation.enabled: false",

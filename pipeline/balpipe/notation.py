@@ -236,6 +236,7 @@ COMMON: dict[str, Sym] = {
     "analysis.balance_tolerance": setting("ε", "a stage counts as balanced when its peak is at most this fraction of its reference"),
     "validation.enabled": setting("simulate", "simulate every stage in pymunk"),
     "validation.dt": setting("Δt", "pymunk time step"),
+    "validation.stage_dt.<s>": setting("Δt(`<s>`)", "pymunk time step of stage <s>"),
     "validation.iterations": setting("iterations", "pymunk solver iterations per step"),
     "validation.tolerance": setting("ε_{sim}", "pymunk residuals pass below this fraction of the reference loads"),
     "validation.reactionless": setting("free frame", "free-floating frame demonstration"),

@@ -136,6 +136,9 @@ class ValidationSpec(Strict):
 
     enabled: bool = Field(True, description="simulate every stage in pymunk")
     dt: quantity("time", gt=0) | None = Field(None, description="time step in s (default chosen per mechanism); at least duration / 1e6 (a limit: one million steps)")
+    stage_dt: dict[str, quantity("time", gt=0)] = Field(
+        {}, description="the time step of the stages named here (s), where one needs another step than the others "
+        "(a motion with features of a few milliseconds); the other stages keep dt or the default")
     iterations: count(ge=1, le=10_000) | None = Field(None, description="solver iterations per step")
     tolerance: number(gt=0, le=0.01) = Field(0.01, description="pass when residuals are below this fraction of the reference loads: the unbalanced peaks, floored by 1 % of the gross inertial load (at most 1 %)")
     reactionless: bool | None = Field(None, description="free-floating frame demonstration of every stage (default: in paper specs, the stages claiming to cancel force and moment and their reference stage)")

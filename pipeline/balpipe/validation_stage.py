@@ -8,6 +8,7 @@ from dataclasses import dataclass, field, replace
 
 from .runtime import pool
 from .cache import simulation as sim_cache
+from .limits import stage_dt
 from .study import Study
 from .validate import FreeFloating, ValidationSettings, free_floating
 from .validate.floating import motion_only
@@ -18,9 +19,12 @@ from .validate.shared import stage_runs
 BASE_MASS = 10.0
 
 
-def settings_for(study: Study) -> ValidationSettings:
+def settings_for(study: Study, stage: str | None = None) -> ValidationSettings:
+    """The validation settings of the spec, with the time step of the stage named ``stage``
+    (:func:`balpipe.limits.stage_dt`; None: the spec's ``validation.dt``)."""
     v = study.spec.validation
-    return ValidationSettings(dt=v.dt, iterations=v.iterations, tolerance=v.tolerance, max_refinement=v.max_refinement)
+    dt = v.dt if stage is None else stage_dt(study.spec, stage)
+    return ValidationSettings(dt=dt, iterations=v.iterations, tolerance=v.tolerance, max_refinement=v.max_refinement)
 
 
 def reactionless_stages(study: Study) -> list[int]:
@@ -107,8 +111,8 @@ def _stage_runs(k: int, study: Study):
     several trajectories, that trajectory's unbalanced stage; else the first stage), floored by
     that model's gross inertial loads (balpipe.load_reference): the same denominators as the
     stage's ratios)."""
-    settings = settings_for(study)
     s = study.stages[k]
+    settings = settings_for(study, s.stage.name)
     ref = s.metrics.reference_loads
     F0, M0 = ref.force_peak, ref.moment_peak
     expect = tuple(x for x in ("force", "moment") if x in s.stage.balances)
