@@ -17,7 +17,7 @@ from balpipe.engine import analyse
 from balpipe.families.serial_arm.template import ArmGeometry, TaskMotion, com_chain, joint_laws, with_joint_laws
 from balpipe.motion import PointToPoint, bang_bang, quintic
 from test_serial_arm import arm_spec
-from _edits import replaced
+from _edits import replaced, stage_steps_kept
 
 SPEC = Path(__file__).resolve().parents[2] / "specs" / "paper003_com_planning.yaml"
 
@@ -179,6 +179,7 @@ def spec_text(trajectories: str, square: str = "{centre: [0 m, 0.487 m], side: 0
     text = replaced(text, "test_square: {centre: [0 m, 0.487 m], side: 0.3 m, divisions: 4, first_corner: bottom-left}",
                         f"test_square: {square}")
     text = replaced(text, "trajectories: [P1P13, P2P12, P3P11, P4P10, P5P9, P15P7, P14P8, P13P9]", f"trajectories: {trajectories}")
+    text = stage_steps_kept(text, trajectories)
     text = "\n".join(line for line in text.splitlines() if "main_trajectory:" not in line) + "\n"
     return replaced(text, "starts: 3", "starts: 1").split("references:")[0]
 
