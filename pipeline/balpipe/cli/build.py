@@ -28,6 +28,7 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     from ..build import Options, OutputError, SchedulerError, build
+    from ..runtime.collector import fewer_collections
 
     problem = paths_jobs_problem(args.paths, args.jobs)
     if problem:
@@ -58,7 +59,8 @@ def run(args) -> int:
             print("    " + u, file=sys.stderr)
 
     try:
-        outcomes = build(args.paths, opts, jobs=args.jobs, progress=progress, scheduler=args.scheduler)
+        with fewer_collections():  # 0.8 -> 0.2 s of the build's CPU (balpipe.runtime.collector)
+            outcomes = build(args.paths, opts, jobs=args.jobs, progress=progress, scheduler=args.scheduler)
     except (OutputError, SchedulerError) as exc:
         return usage_error(str(exc))
     if not outcomes:
