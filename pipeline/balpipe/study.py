@@ -346,10 +346,12 @@ def run(spec: Spec, page: bool = True, memo: Memo = compute) -> Study:
     stages = run_stage_analyses(spec, balance)
     tol = spec.analysis.balance_tolerance
     overrides = spec.analysis.claim_tolerance
-    for where, by_stage in ((("analysis", "claim_tolerance"), overrides), (("validation", "stage_dt"), spec.validation.stage_dt)):
+    names = [s.stage.name for s in stages]
+    for where, by_stage in ((("analysis", "claim_tolerance"), overrides),
+                            (("validation", "stage_dt"), spec.validation.stage_dt)):
         for name in by_stage:
-            if name not in {s.stage.name for s in stages}:
-                raise SpecFieldError((*where, name), f"no stage {name!r} (stages: {', '.join(s.stage.name for s in stages)})")
+            if name not in names:
+                raise SpecFieldError((*where, name), f"no stage {name!r} (stages: {', '.join(names)})")
     loads_of: dict[int, LoadReference] = {}  # each reference stage's loads, computed once for all its stages
 
     def reference_loads(r: StageResult) -> LoadReference:

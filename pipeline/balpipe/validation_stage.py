@@ -221,7 +221,7 @@ def timing(study: Study) -> dict:
         for name, r in zip(study.reactionless.names, study.reactionless.runs):
             out.setdefault(name, {})["reactionless_s"] = float(r.timing.get("total_s", 0.0))
     for t in out.values():  # every run of the stage (a stage its torque-driven run proves: that run's, and
-        # the validation's are those of its runs with more solver iterations, if any)
+        # the validation's are its tries that came apart and its runs with more solver iterations, if any)
         t["all_runs_s"] = t.get("total_s", 0.0) + t.get("torque_driven_s", 0.0) + t.get("reactionless_s", 0.0)
     return out
 

@@ -447,16 +447,16 @@ def test_the_calibration_runs_without_the_start_up_and_measures_the_same_error(n
     original = torque.simulate
 
     def recording(model, analysis, dt, iterations, **kw):
-        calls.append((kw.get("stop_at") is not None, iterations, kw["startup_iterations"]))
+        calls.append((iterations, kw["startup_iterations"]))
         return original(model, analysis, dt, iterations, **kw)
 
     monkeypatch.setattr(torque, "simulate", recording)
     r, _ = run(MODELS[name](), calibration_stop=None)
     main, calibration = calls  # the run, then its calibration (run to the end: no stop_at)
-    assert main[2] == ValidationSettings().startup_iterations and calibration[2] == calibration[1] == 200
+    assert main[1] == ValidationSettings().startup_iterations and calibration[1] == calibration[0] == 200
     monkeypatch.setattr(torque, "CALIBRATION_STARTUP", True)
     boosted, _ = run(MODELS[name](), calibration_stop=None)
-    assert calls[-1][2] == ValidationSettings().startup_iterations
+    assert calls[-1][1] == ValidationSettings().startup_iterations
     assert r.tracking_error_max == boosted.tracking_error_max  # the run that judges is the same
     assert r.calibration_error == pytest.approx(boosted.calibration_error, rel=1e-9)
     assert r.status == boosted.status == "pass"
