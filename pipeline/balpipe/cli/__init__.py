@@ -39,6 +39,9 @@ def _parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
+    from ..runtime.plotting import lean_docstrings
+
+    lean_docstrings()  # matplotlib without help()'s docstrings in this process and its workers
     import signal
     import threading
 

@@ -14,7 +14,10 @@ from dataclasses import replace
 
 import matplotlib
 
+from ..runtime import plotting
+
 matplotlib.use("Agg")
+plotting.prepare()  # in the CLI's processes, no docstrings for help() (balpipe.runtime.plotting)
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.layout_engine import PlaceHolderLayoutEngine  # noqa: E402

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import matplotlib
 
+from ..draw.figures import to_svg  # noqa: E402  (before pyplot: balpipe.runtime.plotting)
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-
-from ..draw.figures import to_svg  # noqa: E402
 from .render import environment  # noqa: E402
 
 
