@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 from functools import lru_cache
 from importlib import resources
+from pathlib import Path
 
 import jinja2
 import markupsafe
@@ -14,6 +15,7 @@ from ..balancing.conditions import clarity_text
 from ..display import numbers
 from ..display.units import DisplayUnits
 from ..display.numbers import num, tol  # noqa: F401  (the pages' filters, re-exported)
+from . import template_build
 
 #: the display units of a template rendered without a study's own (the index, the diff)
 SI = DisplayUnits()
@@ -101,14 +103,12 @@ def typeset(value):
 
 @lru_cache(maxsize=1)
 def environment() -> jinja2.Environment:
+    """The pages' environment: the templates of ``balpipe/templates``, compiled when balpipe was
+    built where they are (:func:`.template_build.loader`), the options and filters that
+    :mod:`.template_build` names."""
     folder = resources.files("balpipe.templates")
-    env = jinja2.Environment(
-        loader=jinja2.FileSystemLoader(str(folder)),
-        autoescape=jinja2.select_autoescape(["html"]),
-        undefined=jinja2.StrictUndefined,
-        keep_trailing_newline=True,
-        finalize=typeset,
-    )
+    env = jinja2.Environment(loader=template_build.loader(Path(str(folder))), finalize=typeset,
+                             **template_build.options())
     env.filters["num"] = num
     env.filters["ratio"] = ratio
     env.filters["tol"] = tol
