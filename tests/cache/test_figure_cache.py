@@ -192,6 +192,20 @@ def test_a_symlinked_entry_or_folder_is_never_followed(tmp_path):
         s2.prune()
     assert s2.hits == 0 and s2.drawn == 1
     assert [p.name for p in (elsewhere / "figures" / "spec").iterdir()] == [f"{k}.svg"]
+    # another spec's folder that is a link (to a folder with a valid entry): not read from
+    out3 = tmp_path / "out3"
+    (out3 / ".cache" / "figures").mkdir(parents=True)
+    (out3 / ".cache" / "figures" / "other").symlink_to(elsewhere / "figures" / "spec", target_is_directory=True)
+    with cache.using(cache.Store(out3, "spec3", "salt")) as s3:
+        assert series_figure(*_series()) == fresh
+    assert s3.hits == 0 and s3.drawn == 1
+    # and the same entry in another spec's own folder is read (copied into this spec's folder)
+    out4 = tmp_path / "out4"
+    (out4 / ".cache" / "figures" / "other").mkdir(parents=True)
+    (out4 / ".cache" / "figures" / "other" / f"{k}.svg").write_text(cache._pack(fresh))
+    with cache.using(cache.Store(out4, "spec4", "salt")) as s4:
+        assert series_figure(*_series()) == fresh
+    assert s4.hits == 1 and s4.drawn == 0 and (out4 / ".cache" / "figures" / "spec4" / f"{k}.svg").is_file()
 
 
 # --- builds -----------------------------------------------------------------------------------
