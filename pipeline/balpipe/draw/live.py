@@ -58,8 +58,9 @@ def _round(values, floor: float = 0.0) -> list[float | None]:
     finite = np.isfinite(a)
     out = np.zeros(a.shape)
     kept = finite & (np.abs(a) > floor)
-    if kept.any():  # one format string for all, one parse (both correctly rounded): as float(f"{v:.6g}") each
-        out[kept] = np.array((("%.6g " * int(kept.sum())) % tuple(a[kept].tolist())).split(), dtype=float)
+    if kept.any():  # one format string for all, each value parsed (both correctly rounded): as float(f"{v:.6g}") each
+        # (float() on the words: a third of numpy's parse of the same strings, the same floats)
+        out[kept] = list(map(float, (("%.6g " * int(kept.sum())) % tuple(a[kept].tolist())).split()))
     shown = out.tolist()
     return shown if finite.all() else [v if ok else None for v, ok in zip(shown, finite.tolist())]
 

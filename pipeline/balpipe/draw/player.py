@@ -209,9 +209,21 @@ def digits(scale: float, size: float) -> tuple[int, int]:
     return position, angle
 
 
-def _pose(row, position: int, angle: int) -> list[float]:
-    """(x, y, angle) rounded to its decimals (:func:`digits`)."""
-    return [round(float(row[0]), position) + 0.0, round(float(row[1]), position) + 0.0, round(float(row[2]), angle) + 0.0]
+def _poses(a: np.ndarray, position: int, angle: int) -> list:
+    """Every row (x, y, angle) of ``a`` (..., 3) rounded to its decimals (:func:`digits`), -0 as
+    0, nested as ``a`` is: ``round(v, position) + 0.0`` of x and y, ``round(v, angle) + 0.0`` of the angle."""
+    return _formatted(a, (f"%.{position}f", f"%.{position}f", f"%.{angle}f"))
+
+
+def _formatted(a: np.ndarray, formats: tuple[str, ...]) -> list:
+    """Every value of ``a`` (..., len(formats)) written by its column's %-format and read back,
+    -0 as 0, nested as ``a`` is: ``float(fmt % v) + 0.0`` each, which for ``"%.nf"`` is
+    ``round(v, n) + 0.0`` (both the correctly rounded decimal, read back correctly rounded), from
+    one format of all the values (a page's player rounded 200,000 values one call each)."""
+    a = np.asarray(a, dtype=float)
+    rows = a.reshape(-1, len(formats))
+    text = ((" ".join(formats) + " ") * len(rows)) % tuple(rows.ravel().tolist())
+    return (np.array(list(map(float, text.split())), dtype=float).reshape(a.shape) + 0.0).tolist()
 
 
 def _loads(stages: list[dict], ks_of: list[np.ndarray]) -> tuple[list[dict], dict]:
@@ -225,7 +237,8 @@ def _loads(stages: list[dict], ks_of: list[np.ndarray]) -> tuple[list[dict], dic
     fmax = max(float(np.max(np.hypot(s["force"][:, 0], s["force"][:, 1]), initial=0.0)) for s in stages)
     mmax = max(float(np.max(np.abs(s["moment"]), initial=0.0)) for s in stages)
     sig = lambda v: float(f"{float(v):.4g}") + 0.0  # noqa: E731
-    out = [{"force": [[sig(f[0]), sig(f[1])] for f in s["force"][ks]], "moment": [sig(m) for m in s["moment"][ks]],
+    out = [{"force": _formatted(np.asarray(s["force"])[ks], ("%.4g", "%.4g")),
+            "moment": _formatted(np.asarray(s["moment"])[ks], ("%.4g",)),
             "point": [round(float(s["point"][0]), 6), round(float(s["point"][1]), 6)]}
            for s, ks in zip(stages, ks_of)]
     return out, {"fmax": sig(fmax), "mmax": sig(mmax), "floor": 1e-9}
@@ -253,8 +266,8 @@ def player_data(stages: list[dict]) -> dict:
         data.append({
             "label": s["label"],
             "t": [round(float(v), 5) for v in s["t"][ks]],
-            "base": [_pose(row, position, angle) for row in base],
-            "poses": [[_pose(body, position, angle) for body in frame] for frame in poses],
+            "base": _poses(base, position, angle),
+            "poses": _poses(poses, position, angle),
             "shapes": _outline(s["model"]),
             "pivots": fp,
             "pivot_names": list(s["model"].frame_points),
