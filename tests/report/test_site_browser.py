@@ -751,10 +751,15 @@ def test_built_site_page_fits_the_window_with_nothing_clipped(built_page, browse
 
 
 # for a live plot: [has its quantity] per curve, from the data it was drawn from (a stage without
-# the joint of a joint-load panel has no curve there, its legend entry shows a dash)
+# the joint of a joint-load panel has no curve there, its legend entry shows a dash); the what-if's
+# tried design is drawn by whatif.js from the what-if's maps, with the computed design's quantities
+# (its entry in the figure's data is empty)
 _CURVES_PRESENT = """el => {
-  const d = JSON.parse(document.querySelector(`script[data-live='${el.parentElement.id}']`).textContent);
-  return d.series.map(s => el.dataset.quantity in s.y);
+  const id = el.parentElement.id;
+  const d = JSON.parse(document.querySelector(`script[data-live='${id}']`).textContent);
+  const src = document.getElementById("whatif-data"), w = src ? JSON.parse(src.textContent) : null;
+  const drawnFrom = i => (w !== null && w.figure === id && i === w.tried) ? w.computed : i;
+  return d.series.map((s, i) => el.dataset.quantity in d.series[drawnFrom(i)].y);
 }"""
 
 
