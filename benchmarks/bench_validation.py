@@ -16,6 +16,12 @@ this no-sim, REV no-sim, repeated), so that both see the same load. Run from the
     python benchmarks/bench_validation.py -j 2                   # this tree only, 2 processes
     python benchmarks/bench_validation.py --specs specs/scott_russell.yaml --sim-only
     python benchmarks/bench_validation.py --against main --keep /tmp/b   # then compare_verdicts.py /tmp/b/main-sim-0 /tmp/b/this-sim-0
+    python benchmarks/bench_validation.py --python /venvs/new/bin/python --against-python /venvs/old/bin/python \
+        --against old --repeat 6        # two installed versions (`pip install .` in each venv)
+
+A source tree runs its templates from their text; an installed balpipe runs them compiled
+(``balpipe.report.template_build``): ``--python`` and ``--against-python`` measure what the
+README's quick start runs.
 
 Nothing is asserted: it prints a table (and ``--json FILE`` writes the raw rows).
 """
@@ -39,16 +45,24 @@ from bench_build import DRIVER  # noqa: E402  (balpipe's command line from a sou
 
 
 
-def build_once(python: str, pipeline: Path, specs: str, jobs: int, sim: bool, keep: Path | None = None) -> dict:
+def build_once(python: str, pipeline: Path | None, specs: str, jobs: int, sim: bool, keep: Path | None = None) -> dict:
     """One build in a new process: wall, CPU (process and children) and peak RSS (MB). ``keep``:
-    the output folder, kept (else a temporary one, removed)."""
+    the output folder, kept (else a temporary one, removed). ``pipeline`` None: the balpipe
+    installed for ``python`` (``python -m balpipe build``, as the README's quick start runs it)."""
     out = str(keep) if keep is not None else tempfile.mkdtemp(prefix="bench_validation_")
-    env = dict(os.environ, PYTHONPATH=str(pipeline), PYTHONHASHSEED="0")
+    env = dict(os.environ, PYTHONHASHSEED="0")
     env.pop("PYTHONDONTWRITEBYTECODE", None)
-    # bench_build's driver with no phase wrapped: ``build SPECS -o OUT -j 1`` and these options (the last -j wins)
-    args = [python, "-c", DRIVER, "[]", specs, out, "--force", "-j", str(jobs)] + ([] if sim else ["--no-sim"])
+    options = ["--force", "-j", str(jobs)] + ([] if sim else ["--no-sim"])
+    if pipeline is None:
+        env.pop("PYTHONPATH", None)
+        args = [python, "-m", "balpipe", "build", specs, "-o", out] + options
+    else:
+        env["PYTHONPATH"] = str(pipeline)
+        # bench_build's driver with no phase wrapped: ``build SPECS -o OUT -j 1`` and these options (the last -j wins)
+        args = [python, "-c", DRIVER, "[]", specs, out] + options
     t0 = time.perf_counter()
-    proc = subprocess.Popen(args, env=env, cwd=str(pipeline.parent), stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    proc = subprocess.Popen(args, env=env, cwd=str(pipeline.parent if pipeline is not None else ROOT),
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
     output = proc.stdout.read() if proc.stdout else b""
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - t0
@@ -82,20 +96,28 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", help="write the rows to this file")
     ap.add_argument("--keep", type=Path, help="keep each build's output in KEEP/<version>-<sim|no-sim>-<repeat> "
                     "(for benchmarks/compare_verdicts.py)")
+    ap.add_argument("--python", metavar="PYTHON",
+                    help="build this version as installed for PYTHON (a venv's python after `pip install .`: "
+                    "python -m balpipe, no source tree, so that what an install adds counts, the compiled templates)")
+    ap.add_argument("--against-python", metavar="PYTHON",
+                    help="the version compared with, installed for PYTHON (named by --against, default 'against')")
     a = ap.parse_args(argv)
-    versions = {"this": ROOT / "pipeline"}
+    versions: dict[str, tuple[str, Path | None]] = {"this": (a.python or sys.executable, None if a.python else ROOT / "pipeline")}
     tmp = None
-    if a.against:
+    if a.against_python:
+        a.against = a.against or "against"
+        versions[a.against] = (a.against_python, None)
+    elif a.against:
         tmp = Path(tempfile.mkdtemp(prefix="bench_validation_rev_"))
-        versions[a.against] = worktree(a.against, tmp / "tree") / "pipeline"
+        versions[a.against] = (sys.executable, worktree(a.against, tmp / "tree") / "pipeline")
     kinds = [True] if a.sim_only else [True, False]
     rows = []
     try:
         for r in range(a.repeat):
             for sim in kinds:
-                for name, pipeline in versions.items():
+                for name, (python, pipeline) in versions.items():
                     keep = a.keep / f"{name.replace('/', '_')}-{'sim' if sim else 'no-sim'}-{r}" if a.keep else None
-                    res = build_once(sys.executable, pipeline, a.specs, a.jobs, sim, keep)
+                    res = build_once(python, pipeline, a.specs, a.jobs, sim, keep)
                     res.update(version=name, sim=sim, repeat=r)
                     rows.append(res)
                     print(f"{name:>12s} {'sim' if sim else 'no-sim':>7s}  wall {res['wall']:7.2f} s  CPU "
