@@ -73,8 +73,10 @@ def check_simulation(study: Any) -> None:
         dt = given or default_settings(s.stage.model, s.analysis)[0]
         steps = T / dt if dt > 0 else math.inf
         if not math.isfinite(steps) or steps > MAX_SIM_STEPS:
+            where = (("validation", "stage_dt", s.stage.name) if s.stage.name in spec.validation.stage_dt
+                     else ("validation", "dt") if given else ("motion", "duration"))
             raise SpecFieldError(
-                ("validation", "dt") if given else ("motion", "duration"),
+                where,
                 f"stage {s.stage.name!r}: the simulation would take {steps:.3g} steps of {dt:.3g} s "
                 f"(limit {MAX_SIM_STEPS:,}); the motion is too fast for its duration: lengthen it, or set "
                 "validation.enabled: false",
